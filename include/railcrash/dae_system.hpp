@@ -1,0 +1,133 @@
+// The DAE the integrators see (they never see an element).
+//
+// Stabilized index-2 (Gear-Gupta-Leimkuhler) form, unknowns y = [q, v, lambda, mu]:
+//   r_q   = q' - v + G^T mu          (3n, differential)
+//   r_v   = M v' - f(t, q, v) + G^T lambda   (3n, differential)
+//   r_phi = Phi(q)                    (m, algebraic)
+//   r_vel = G v                       (m, algebraic)
+// Jacobian J = dr/dy + cj dr/dy' in compressed sparse columns. Its pattern is learned once
+// by a dry run of the same assembly code against a recorder; every later evaluation
+// replays the same sequence of additions into precomputed value slots. Rows of a failed
+// constraint (later: lambda = 0, mu = 0) already have their diagonal slots, so the pattern
+// never changes.
+//
+// The same element code also gives the plain generalized forces for explicit integration,
+// with constraints replaced by penalty spring-dampers.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "railcrash/model.hpp"
+
+namespace railcrash {
+
+/// Compressed sparse column structure of the Jacobian.
+struct SparsePattern {
+  int size = 0;
+  std::vector<int> column_start;  // size + 1
+  std::vector<int> row_index;     // nonzeros
+  int nonzeros() const { return static_cast<int>(row_index.size()); }
+};
+
+/// Penalty stiffness and damping per constraint row (explicit Euler).
+struct PenaltyRows {
+  std::vector<double> stiffness;  // [force/length] or [moment/rad]
+  std::vector<double> damping;    // [force*time/length] or [moment*time/rad]
+};
+
+/// Energy figures of one state [force*length]; work terms are the quadratures so far.
+struct EnergyState {
+  double kinetic = 0.0;
+  double elastic = 0.0;       // stored in elements (and penalty springs)
+  double gravity = 0.0;       // potential of gravity, -sum m g . r
+  double element_work = 0.0;  // work done on elements (and penalties) by the bodies
+  double load_work = 0.0;     // work done by applied loads
+};
+
+/// Energy balance between a start state and now [force*length].
+struct EnergyBalance {
+  double kinetic = 0.0;
+  double elastic = 0.0;       // stored in elements (and penalty springs)
+  double gravity = 0.0;       // potential of gravity, zero at the initial configuration
+  double dissipated = 0.0;    // by elements (and penalty dampers)
+  double external_work = 0.0; // done by applied loads
+  double initial_total = 0.0;
+  double error() const { return kinetic + elastic + gravity + dissipated - initial_total - external_work; }
+  static EnergyBalance between(const EnergyState& start, const EnergyState& now);
+};
+
+class DaeSystem {
+ public:
+  explicit DaeSystem(const Model& model);
+
+  const Model& model() const { return model_; }
+  int size() const { return model_.size(); }
+  int body_unknowns() const { return 3 * model_.body_count(); }
+  int constraint_rows() const { return model_.constraint_rows(); }
+
+  /// y at t = 0 from the model's bodies (lambda = mu = 0).
+  std::vector<double> initial_state() const;
+  /// 1 for differential unknowns (q, v), 0 for algebraic ones (lambda, mu).
+  std::vector<double> differential_ids() const;
+
+  void residual(double t, const double* y, const double* yp, double* r) const;
+  const SparsePattern& pattern() const { return pattern_; }
+  /// Writes the Jacobian values in pattern order (values has pattern().nonzeros() entries).
+  void jacobian(double t, double cj, const double* y, const double* yp, double* values) const;
+
+  /// Generalized forces f(t, q, v) from gravity, loads and force elements; when penalty is
+  /// given, constraints add -G^T (k Phi + c G v) and penalty_lambda receives k Phi + c G v.
+  void generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty = nullptr,
+                          double* penalty_lambda = nullptr) const;
+  /// Triplets of df/dq and df/dv (same force definition as generalized_forces).
+  struct Triplet { int row, col; double value; };
+  void force_jacobian(double t, const double* q, const double* v, const PenaltyRows* penalty,
+                      std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv) const;
+
+  /// Phi(q) and G = dPhi/dq (triplets, row = constraint row, col = q index).
+  void constraints(const double* q, double* phi, std::vector<Triplet>* gradient) const;
+  /// gamma_r = v^T (d^2 Phi_r / dq^2) v, so that the acceleration constraint is G v' + gamma = 0.
+  void constraint_acceleration_bias(const double* q, const double* v, double* gamma) const;
+  /// Largest |Phi| over rows (lengths and angles*length_scale mixed: a quality figure).
+  double constraint_residual(const double* q) const;
+  /// Element owning constraint row `row`.
+  const Element& constraint_owner(int row) const;
+  /// True when constraint row `row` is an angle equation.
+  bool constraint_row_is_rotational(int row) const { return row_is_rotational_[static_cast<std::size_t>(row)]; }
+
+  // ---- quadratures integrated alongside: [ integral of kinetic energy dt,
+  //      work of applied loads, work done on each element (by the bodies), work on penalties ]
+  int quadrature_count() const { return 3 + static_cast<int>(model_.elements().size()); }
+  void quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda = nullptr) const;
+  static constexpr int kKineticIntegral = 0;
+  static constexpr int kLoadWork = 1;
+  static constexpr int kPenaltyWork = 2;
+  static constexpr int kFirstElementWork = 3;
+
+  double kinetic_energy(const double* v) const;
+  EnergyState energy(const double* y, const double* quadratures, const PenaltyRows* penalty = nullptr) const;
+
+  /// Element output columns "<element>.<quantity>" and their values at y.
+  const std::vector<std::string>& output_names() const { return output_names_; }
+  void outputs(const double* y, const double* lambda, double* out) const;
+
+  /// Mass-matrix diagonal entry of body unknown k (mass or inertia).
+  double mass_diagonal(int k) const { return mass_[static_cast<std::size_t>(k)]; }
+
+ private:
+  template <class Sink>
+  void assemble_jacobian(double t, double cj, const double* y, const double* yp, Sink& sink) const;
+  double gravity_potential(const double* q) const;
+  void load_forces(double t, const double* q, double* f) const;
+
+  const Model& model_;
+  std::vector<double> mass_;  // 3n diagonal of M
+  SparsePattern pattern_;
+  std::vector<int> slots_;    // value slot of every addition, in assembly order
+  std::vector<std::string> output_names_;
+  std::vector<int> constraint_row_owner_;  // element index of each constraint row
+  std::vector<bool> row_is_rotational_;
+};
+
+}  // namespace railcrash

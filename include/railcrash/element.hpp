@@ -1,0 +1,211 @@
+// The element interface: what every connecting element (report Table 2) provides.
+//
+// An element couples at most two bodies ("slots" 0 and 1; a slot may be ground). It never
+// touches global storage: it evaluates its law on its local state and the DAE system adds
+// the result in (r += F, J += dF/dy + cj dF/dy').
+//
+// * Force elements (springs, dashpots, ...) give the generalized forces f on their slots,
+//   f(t, q, v); their derivatives come from forward-mode AD over the 12 local unknowns.
+// * Constraint elements (joints) give m equations Phi(q) = 0 (m <= 3). G = dPhi/dq and the
+//   second derivatives needed for d(G^T lambda)/dq come from nested AD of the same Phi code.
+//
+// Concrete elements derive from ForceElement<Derived> or ConstraintElement<Derived> and
+// write their law once, as a template over the scalar type.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "railcrash/autodiff.hpp"
+#include "railcrash/error.hpp"
+#include "railcrash/planar.hpp"
+
+namespace railcrash {
+
+constexpr int kGround = -1;  // body index of the fixed ground
+
+/// A connection point: a body and an offset from its centre of mass in its own frame.
+struct PointRef {
+  int body = kGround;
+  double sx = 0.0;  // [length] body-fixed offset, body x axis
+  double sy = 0.0;  // [length] body-fixed offset, body y axis
+};
+
+/// Local state of an element: pose and rate of its two slots (ground slots stay zero).
+template <class T>
+struct ElementState {
+  std::array<Pose<T>, 2> q{};
+  std::array<Pose<T>, 2> v{};
+};
+
+using ForceBlock = std::array<std::array<double, 6>, 6>;  // d f(slot, comp) / d (slot, comp)
+constexpr int kMaxConstraintRows = 3;
+
+class Element {
+ public:
+  Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where);
+  virtual ~Element() = default;
+  Element(const Element&) = delete;
+  Element& operator=(const Element&) = delete;
+
+  const std::string& name() const { return name_; }
+  const std::string& type() const { return type_; }
+  const SourceLocation& where() const { return where_; }
+  const std::vector<PointRef>& points() const { return points_; }
+
+  /// Global body index of slot 0 / 1 (kGround for ground or an unused slot).
+  int slot_body(int slot) const { return slot_body_[static_cast<std::size_t>(slot)]; }
+  /// Slot holding the body of point p.
+  int point_slot(int p) const { return point_slot_[static_cast<std::size_t>(p)]; }
+  /// Offset of point p on its body.
+  const PointRef& point(int p) const { return points_[static_cast<std::size_t>(p)]; }
+
+  // ---- constraint elements ----
+  virtual int constraint_count() const { return 0; }
+  /// True when a constraint row is an angle (its penalty stiffness is then a torsional one).
+  virtual bool constraint_row_is_rotational(int /*row*/) const { return false; }
+  /// Phi(q); phi has constraint_count() entries.
+  virtual void constraint(const std::array<Pose<double>, 2>& /*q*/, double* /*phi*/) const {}
+  /// Phi and G = dPhi/dq (G[row][3*slot + component]).
+  virtual void constraint_gradient(const std::array<Pose<double>, 2>& q, double* phi,
+                                   double gradient[kMaxConstraintRows][6]) const;
+  /// Phi, G and the second derivatives H[row][i][j] = d^2 Phi_row / dq_i dq_j.
+  virtual void constraint_hessian(const std::array<Pose<double>, 2>& q, double* phi,
+                                  double gradient[kMaxConstraintRows][6],
+                                  double hessian[kMaxConstraintRows][6][6]) const;
+
+  // ---- force elements ----
+  /// Generalized forces on slot 0 and 1 (force x, force y, moment), added to f.
+  virtual void add_force(double /*t*/, const ElementState<double>& /*s*/, std::array<Pose<double>, 2>& /*f*/) const {}
+  /// The same forces and their derivatives with respect to (q, v) of both slots.
+  virtual void add_force_jacobian(double t, const ElementState<double>& s, std::array<Pose<double>, 2>& f,
+                                  ForceBlock& df_dq, ForceBlock& df_dv) const;
+
+  // ---- energy and output ----
+  /// Energy stored in the element [force*length].
+  virtual double potential_energy(const ElementState<double>& /*s*/) const { return 0.0; }
+  /// Names of the quantities this element adds to timeseries.csv (without the element prefix).
+  virtual std::vector<std::string> output_names() const { return {}; }
+  /// Values of those quantities; lambda are the element's constraint multipliers (if any).
+  virtual void outputs(const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*out*/) const {}
+
+  // ---- penalty representation of a constraint (explicit Euler) ----
+  struct PenaltyOverrides {
+    std::optional<double> stiffness;             // [force/length]
+    std::optional<double> damping;               // [force*time/length]
+    std::optional<double> rotational_stiffness;  // [moment/rad]
+    std::optional<double> rotational_damping;    // [moment*time/rad]
+  };
+  PenaltyOverrides penalty;
+
+  /// Called by Model::finalize with the global indices of the bodies of each point.
+  void bind_bodies();
+  /// Called by Model::finalize with the initial state: parameters left "as in the initial
+  /// configuration" (free length, free angle, ...) are set here.
+  virtual void initialize(const ElementState<double>& /*initial*/) {}
+  /// True when the element loads a body with a pure moment (so it needs rotational inertia).
+  virtual bool applies_moment() const { return false; }
+
+ protected:
+  std::string name_;
+  std::string type_;
+  std::vector<PointRef> points_;
+  SourceLocation where_;
+  std::array<int, 2> slot_body_{kGround, kGround};
+  std::vector<int> point_slot_;
+};
+
+/// Adapter: Derived provides  template <class T> void force_law(double t, const ElementState<T>&, std::array<Pose<T>,2>& f) const
+/// which adds its generalized forces to f.
+template <class Derived>
+class ForceElement : public Element {
+ public:
+  using Element::Element;
+
+  void add_force(double t, const ElementState<double>& s, std::array<Pose<double>, 2>& f) const override {
+    static_cast<const Derived*>(this)->force_law(t, s, f);
+  }
+
+  void add_force_jacobian(double t, const ElementState<double>& s, std::array<Pose<double>, 2>& f,
+                          ForceBlock& df_dq, ForceBlock& df_dv) const override {
+    using D = Dual<double, 12>;
+    ElementState<D> sd;
+    for (int k = 0; k < 2; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
+      sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
+    }
+    std::array<Pose<D>, 2> fd{};
+    static_cast<const Derived*>(this)->force_law(t, sd, fd);
+    for (int k = 0; k < 2; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      const D* comps[3] = {&fd[ks].x, &fd[ks].y, &fd[ks].theta};
+      double* out[3] = {&f[ks].x, &f[ks].y, &f[ks].theta};
+      for (int c = 0; c < 3; ++c) {
+        *out[c] += comps[c]->value;
+        const auto row = static_cast<std::size_t>(3 * k + c);
+        for (std::size_t j = 0; j < 6; ++j) {
+          df_dq[row][j] += comps[c]->grad[j];
+          df_dv[row][j] += comps[c]->grad[6 + j];
+        }
+      }
+    }
+  }
+};
+
+/// Adapter: Derived provides  static constexpr int kRows  and
+/// template <class T> void constraint_law(const std::array<Pose<T>,2>& q, T* phi) const.
+template <class Derived>
+class ConstraintElement : public Element {
+ public:
+  using Element::Element;
+  int constraint_count() const override { return Derived::kRows; }
+
+  void constraint(const std::array<Pose<double>, 2>& q, double* phi) const override {
+    static_cast<const Derived*>(this)->constraint_law(q, phi);
+  }
+
+  void constraint_gradient(const std::array<Pose<double>, 2>& q, double* phi,
+                           double gradient[kMaxConstraintRows][6]) const override {
+    using D = Dual<double, 6>;
+    std::array<Pose<D>, 2> qd;
+    for (int k = 0; k < 2; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      qd[ks] = {D(q[ks].x, 3 * k), D(q[ks].y, 3 * k + 1), D(q[ks].theta, 3 * k + 2)};
+    }
+    D phid[kMaxConstraintRows];
+    static_cast<const Derived*>(this)->constraint_law(qd, phid);
+    for (int r = 0; r < Derived::kRows; ++r) {
+      phi[r] = phid[r].value;
+      for (std::size_t j = 0; j < 6; ++j) gradient[r][j] = phid[r].grad[j];
+    }
+  }
+
+  void constraint_hessian(const std::array<Pose<double>, 2>& q, double* phi, double gradient[kMaxConstraintRows][6],
+                          double hessian[kMaxConstraintRows][6][6]) const override {
+    using D1 = Dual<double, 6>;
+    using D2 = Dual<D1, 6>;
+    std::array<Pose<D2>, 2> qd;
+    const auto seed = [](double value, int index) { return D2(D1(value, index), index); };
+    for (int k = 0; k < 2; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      qd[ks] = {seed(q[ks].x, 3 * k), seed(q[ks].y, 3 * k + 1), seed(q[ks].theta, 3 * k + 2)};
+    }
+    D2 phid[kMaxConstraintRows];
+    static_cast<const Derived*>(this)->constraint_law(qd, phid);
+    for (int r = 0; r < Derived::kRows; ++r) {
+      phi[r] = phid[r].value.value;
+      for (std::size_t i = 0; i < 6; ++i) {
+        gradient[r][i] = phid[r].value.grad[i];
+        for (std::size_t j = 0; j < 6; ++j) hessian[r][i][j] = phid[r].grad[i].grad[j];
+      }
+    }
+  }
+};
+
+/// Local state of element e gathered from the global q and v arrays (ground slots are zero).
+ElementState<double> gather_state(const Element& e, const double* q, const double* v);
+
+}  // namespace railcrash

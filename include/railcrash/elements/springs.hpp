@@ -1,0 +1,136 @@
+// Springs and dashpots (report Table 2, types 1-4).
+//
+// linear_spring (1)      between points P1 (body 1) and P2 (body 2), length L = |r2 - r1|,
+//                         unit vector u = (r2 - r1) / L:
+//                           tension  T = stiffness * (L - free_length)
+//                           force on P2 = -T u, on P1 = +T u
+//                           energy   = stiffness * (L - free_length)^2 / 2
+// linear_dashpot (2)      rate L' = u . (r2' - r1'):  T = damping * L'  (force as above)
+// torsional_spring (3)   relative angle phi = theta2 - theta1:
+//                           moment M = stiffness * (phi - free_angle),
+//                           moment on body 2 = -M, on body 1 = +M,  energy = stiffness (phi - free_angle)^2 / 2
+// torsional_dashpot (4)  M = damping * (omega2 - omega1)  (moments as above)
+//
+// A free_length / free_angle left out of the model is taken from the initial configuration.
+// The line elements are undefined at L = 0 (no direction); the model must keep the
+// points apart (a zero free length spring with coincident points is the one exception:
+// its force k (r2 - r1) is used directly).
+#pragma once
+
+#include <optional>
+
+#include "railcrash/element.hpp"
+#include "railcrash/element_registry.hpp"
+
+namespace railcrash {
+
+/// Geometry shared by the two-point line elements.
+template <class T>
+struct LineGeometry {
+  Vec2<T> d;  // r2 - r1
+  Vec2<T> d_rate;  // r2' - r1'
+  T length;
+};
+
+template <class T>
+LineGeometry<T> line_geometry(const Element& e, const ElementState<T>& s) {
+  const PointRef& p1 = e.point(0);
+  const PointRef& p2 = e.point(1);
+  const auto k1 = static_cast<std::size_t>(e.point_slot(0));
+  const auto k2 = static_cast<std::size_t>(e.point_slot(1));
+  LineGeometry<T> g;
+  g.d = point_position(s.q[k2], p2.sx, p2.sy) - point_position(s.q[k1], p1.sx, p1.sy);
+  g.d_rate = point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy) - point_velocity(s.q[k1], s.v[k1], p1.sx, p1.sy);
+  g.length = sqrt(dot(g.d, g.d));
+  return g;
+}
+
+/// Applies a force F2 at P2 and -F2 at P1.
+template <class T>
+void apply_line_force(const Element& e, const ElementState<T>& s, const Vec2<T>& force_on_p2,
+                      std::array<Pose<T>, 2>& f) {
+  const PointRef& p1 = e.point(0);
+  const PointRef& p2 = e.point(1);
+  const auto k1 = static_cast<std::size_t>(e.point_slot(0));
+  const auto k2 = static_cast<std::size_t>(e.point_slot(1));
+  add_point_force(s.q[k2], p2.sx, p2.sy, force_on_p2, f[k2]);
+  add_point_force(s.q[k1], p1.sx, p1.sy, Vec2<T>{-force_on_p2.x, -force_on_p2.y}, f[k1]);
+}
+
+class LinearSpring : public ForceElement<LinearSpring> {
+ public:
+  LinearSpring(ElementSpec& spec);
+  double stiffness;                  // [force/length]
+  std::optional<double> free_length; // [length]
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const LineGeometry<T> g = line_geometry(*this, s);
+    // force on P2 = -k (L - L0) u = -k (1 - L0 / L) d
+    T scale = (*free_length == 0.0) ? T(stiffness) : stiffness * (1.0 - *free_length / g.length);
+    apply_line_force(*this, s, Vec2<T>{-scale * g.d.x, -scale * g.d.y}, f);
+  }
+  void initialize(const ElementState<double>& initial) override;
+  double potential_energy(const ElementState<double>& s) const override;
+  std::vector<std::string> output_names() const override { return {"force", "deformation"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+};
+
+class LinearDashpot : public ForceElement<LinearDashpot> {
+ public:
+  LinearDashpot(ElementSpec& spec);
+  double damping;  // [force*time/length]
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const LineGeometry<T> g = line_geometry(*this, s);
+    // T = c L',  L' = u . d' ; force on P2 = -T u = -c (d . d') d / L^2
+    const T scale = damping * dot(g.d, g.d_rate) / (g.length * g.length);
+    apply_line_force(*this, s, Vec2<T>{-scale * g.d.x, -scale * g.d.y}, f);
+  }
+  std::vector<std::string> output_names() const override { return {"force", "rate"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+};
+
+class TorsionalSpring : public ForceElement<TorsionalSpring> {
+ public:
+  TorsionalSpring(ElementSpec& spec);
+  double stiffness;                 // [moment/rad]
+  std::optional<double> free_angle; // [rad] relative angle theta2 - theta1 at zero moment
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const T moment = stiffness * (relative_angle(s) - *free_angle);
+    f[slot2()].theta -= moment;
+    f[slot1()].theta += moment;
+  }
+  template <class T>
+  T relative_angle(const ElementState<T>& s) const { return s.q[slot2()].theta - s.q[slot1()].theta; }
+  std::size_t slot1() const { return static_cast<std::size_t>(point_slot(0)); }
+  std::size_t slot2() const { return static_cast<std::size_t>(point_slot(1)); }
+  bool applies_moment() const override { return true; }
+  void initialize(const ElementState<double>& initial) override;
+  double potential_energy(const ElementState<double>& s) const override;
+  std::vector<std::string> output_names() const override { return {"moment", "rotation"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+};
+
+class TorsionalDashpot : public ForceElement<TorsionalDashpot> {
+ public:
+  TorsionalDashpot(ElementSpec& spec);
+  double damping;  // [moment*time/rad]
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const auto k1 = static_cast<std::size_t>(point_slot(0));
+    const auto k2 = static_cast<std::size_t>(point_slot(1));
+    const T moment = damping * (s.v[k2].theta - s.v[k1].theta);
+    f[k2].theta -= moment;
+    f[k1].theta += moment;
+  }
+  bool applies_moment() const override { return true; }
+  std::vector<std::string> output_names() const override { return {"moment", "rate"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+};
+
+}  // namespace railcrash

@@ -1,0 +1,45 @@
+// IDA (SUNDIALS IDAS: IDA plus quadratures) on the GGL DAE with the KLU sparse solver.
+//
+// * Consistent start: position assembly and velocity projection (initial_conditions.hpp),
+//   then accelerations and multipliers from the acceleration-level system (consistent_rates;
+//   IDACalcIC cannot find them for the GGL form, see initial_conditions.hpp).
+// * Per-component absolute tolerances from the model's scales: lengths 0.1 rtol L (or the
+//   model's atol), angles that over L, velocities that times V / L, multipliers lambda
+//   min(1, 100 rtol) F and mu V (see the comment in run()), where L is
+//   the model's extent, F its largest initial generalized force and V the larger of its
+//   initial speeds and sqrt(2 E / M) with E = max(initial kinetic energy, F L).
+// * IDASetId marks q, v differential and lambda, mu algebraic; IDASetSuppressAlg keeps the
+//   algebraic unknowns out of the error test.
+// * Quadratures (kinetic-energy integral, load work, element work) with error control.
+// * Every SUNDIALS return code is checked; failures become SolverError with the flag's name.
+//   Callbacks never let an exception into SUNDIALS: they store it and return -1.
+#pragma once
+
+#include <memory>
+
+#include "railcrash/integrator.hpp"
+
+namespace railcrash {
+
+struct IdaSettings {
+  double rtol = 1e-6;
+  std::optional<double> atol;  // [length]
+  long max_steps_per_output = 500000;
+};
+
+class IdaIntegrator : public Integrator {
+ public:
+  IdaIntegrator(const DaeSystem& system, IdaSettings settings);
+  ~IdaIntegrator() override;
+  const char* name() const override { return "ida"; }
+  RunOutcome run(double t_end, double output_interval, RunObserver& observer,
+                 const std::atomic<bool>* stop = nullptr) override;
+
+  struct Impl;
+
+ private:
+  const DaeSystem& system_;
+  IdaSettings settings_;
+};
+
+}  // namespace railcrash

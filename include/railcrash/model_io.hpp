@@ -1,0 +1,19 @@
+// Model files (YAML, format 1; see README "Model file"). Every problem is an InputError
+// whose message starts with "file:line: " and says what to change.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "railcrash/model.hpp"
+
+namespace railcrash {
+
+/// Reads and checks a model file; the model comes back finalized.
+Model load_model(const std::string& path);
+/// Same, from text (path is only used in messages). `overrides` are KEY=VALUE settings
+/// applied before finalize (e.g. "simulation.t_end=0.5", "bodies.bob.mass=2").
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
+Model load_model(const std::string& path, const std::vector<std::string>& overrides);
+
+}  // namespace railcrash

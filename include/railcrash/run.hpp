@@ -1,0 +1,40 @@
+// One run of a model: the command line's `run`, also used by the tests and verification.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "railcrash/integrator.hpp"
+#include "railcrash/model.hpp"
+
+namespace railcrash {
+
+/// Command-line settings that override the model's simulation section.
+struct RunOverrides {
+  std::optional<IntegratorKind> integrator;
+  std::optional<double> t_end, rtol, atol, dt, output_interval;
+  bool force_dt = false;
+};
+
+/// Applies overrides (checked) to the model's simulation settings.
+void apply_overrides(Model& model, const RunOverrides& overrides);
+
+/// The integrator the model's settings ask for.
+std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const SimulationSettings& settings);
+
+/// Output interval actually used (the setting, or t_end / 500).
+double output_interval_of(const SimulationSettings& settings);
+
+struct RunReport {
+  RunOutcome outcome;
+  std::string integrator;
+};
+
+/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files).
+/// Input errors throw InputError before anything runs; solver failures come back with ok = false.
+RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
+                    bool show_progress = false);
+
+}  // namespace railcrash

@@ -1,0 +1,538 @@
+#include "railcrash/dae_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace railcrash {
+
+namespace {
+
+/// Records (row, col) of every addition: the dry run that learns the pattern.
+struct PatternRecorder {
+  std::vector<std::pair<int, int>> entries;  // (col, row)
+  void add(int row, int col, double) { entries.emplace_back(col, row); }
+};
+
+/// Adds values through the slots learned by the dry run.
+struct SlotWriter {
+  const int* slot;
+  double* values;
+  void add(int, int, double value) { values[*slot++] += value; }
+};
+
+std::array<Pose<double>, 2> gather_poses(const Element& e, const double* q) {
+  std::array<Pose<double>, 2> poses{};
+  for (int k = 0; k < 2; ++k) {
+    const int b = e.slot_body(k);
+    if (b != kGround) poses[static_cast<std::size_t>(k)] = {q[3 * b], q[3 * b + 1], q[3 * b + 2]};
+  }
+  return poses;
+}
+
+double& component(Pose<double>& p, int c) { return c == 0 ? p.x : (c == 1 ? p.y : p.theta); }
+double component(const Pose<double>& p, int c) { return c == 0 ? p.x : (c == 1 ? p.y : p.theta); }
+
+}  // namespace
+
+EnergyBalance EnergyBalance::between(const EnergyState& start, const EnergyState& now) {
+  EnergyBalance b;
+  b.kinetic = now.kinetic;
+  b.elastic = now.elastic;
+  b.gravity = now.gravity - start.gravity;
+  b.dissipated = (now.element_work - start.element_work) - (now.elastic - start.elastic);
+  b.external_work = now.load_work - start.load_work;
+  b.initial_total = start.kinetic + start.elastic;
+  return b;
+}
+
+DaeSystem::DaeSystem(const Model& model) : model_(model) {
+  RAILCRASH_DEMAND(model.finalized());
+  const int n = model.body_count();
+  mass_.resize(static_cast<std::size_t>(3 * n));
+  for (int i = 0; i < n; ++i) {
+    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
+    mass_[static_cast<std::size_t>(3 * i)] = b.mass;
+    mass_[static_cast<std::size_t>(3 * i + 1)] = b.mass;
+    mass_[static_cast<std::size_t>(3 * i + 2)] = b.inertia;
+  }
+  constraint_row_owner_.resize(static_cast<std::size_t>(model.constraint_rows()));
+  row_is_rotational_.resize(static_cast<std::size_t>(model.constraint_rows()));
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const Element& el = *model.elements()[e];
+    for (int r = 0; r < el.constraint_count(); ++r) {
+      constraint_row_owner_[static_cast<std::size_t>(model.constraint_offset(e) + r)] = static_cast<int>(e);
+      row_is_rotational_[static_cast<std::size_t>(model.constraint_offset(e) + r)] = el.constraint_row_is_rotational(r);
+    }
+    for (const std::string& q : el.output_names()) output_names_.push_back(el.name() + "." + q);
+  }
+
+  // Dry run: learn the pattern from the same assembly code, then give every addition its slot.
+  const std::vector<double> y = initial_state();
+  const std::vector<double> yp(y.size(), 0.0);
+  PatternRecorder recorder;
+  assemble_jacobian(0.0, 1.0, y.data(), yp.data(), recorder);
+  std::vector<std::pair<int, int>> unique = recorder.entries;
+  std::sort(unique.begin(), unique.end());
+  unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+  pattern_.size = size();
+  pattern_.column_start.assign(static_cast<std::size_t>(size() + 1), 0);
+  pattern_.row_index.resize(unique.size());
+  for (std::size_t k = 0; k < unique.size(); ++k) {
+    pattern_.row_index[k] = unique[k].second;
+    ++pattern_.column_start[static_cast<std::size_t>(unique[k].first + 1)];
+  }
+  for (int c = 0; c < size(); ++c)
+    pattern_.column_start[static_cast<std::size_t>(c + 1)] += pattern_.column_start[static_cast<std::size_t>(c)];
+  slots_.resize(recorder.entries.size());
+  for (std::size_t k = 0; k < recorder.entries.size(); ++k) {
+    const auto it = std::lower_bound(unique.begin(), unique.end(), recorder.entries[k]);
+    slots_[k] = static_cast<int>(it - unique.begin());
+  }
+}
+
+std::vector<double> DaeSystem::initial_state() const {
+  std::vector<double> y(static_cast<std::size_t>(size()), 0.0);
+  const int n = model_.body_count();
+  for (int i = 0; i < n; ++i) {
+    const Body& b = model_.bodies()[static_cast<std::size_t>(i)];
+    y[static_cast<std::size_t>(model_.q_index(i, 0))] = b.x;
+    y[static_cast<std::size_t>(model_.q_index(i, 1))] = b.y;
+    y[static_cast<std::size_t>(model_.q_index(i, 2))] = b.angle;
+    y[static_cast<std::size_t>(model_.v_index(i, 0))] = b.vx;
+    y[static_cast<std::size_t>(model_.v_index(i, 1))] = b.vy;
+    y[static_cast<std::size_t>(model_.v_index(i, 2))] = b.angular_velocity;
+  }
+  return y;
+}
+
+std::vector<double> DaeSystem::differential_ids() const {
+  std::vector<double> id(static_cast<std::size_t>(size()), 0.0);
+  std::fill(id.begin(), id.begin() + 6 * model_.body_count(), 1.0);
+  return id;
+}
+
+void DaeSystem::load_forces(double t, const double* q, double* f) const {
+  for (const Load& load : model_.loads()) {
+    const std::array<double, 2> value = load.value.at(t);
+    double* fb = f + 3 * load.body;
+    if (load.kind == Load::Kind::Moment) {
+      fb[2] += value[0];
+    } else {
+      const Pose<double> pose{q[3 * load.body], q[3 * load.body + 1], q[3 * load.body + 2]};
+      Pose<double> generalized{};
+      add_point_force(pose, load.sx, load.sy, Vec2<double>{value[0], value[1]}, generalized);
+      fb[0] += generalized.x;
+      fb[1] += generalized.y;
+      fb[2] += generalized.theta;
+    }
+  }
+}
+
+void DaeSystem::generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty,
+                                   double* penalty_lambda) const {
+  const int n = model_.body_count();
+  for (int i = 0; i < n; ++i) {
+    f[3 * i] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
+    f[3 * i + 1] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_y;
+    f[3 * i + 2] = 0.0;
+  }
+  load_forces(t, q, f);
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const ElementState<double> s = gather_state(el, q, v);
+    std::array<Pose<double>, 2> fe{};
+    const int m = el.constraint_count();
+    if (m == 0) {
+      el.add_force(t, s, fe);
+    } else {
+      if (penalty == nullptr) continue;
+      double phi[kMaxConstraintRows];
+      double grad[kMaxConstraintRows][6];
+      el.constraint_gradient(s.q, phi, grad);
+      const int offset = model_.constraint_offset(e);
+      for (int r = 0; r < m; ++r) {
+        const auto row = static_cast<std::size_t>(offset + r);
+        double rate = 0.0;
+        for (int k = 0; k < 2; ++k)
+          for (int c = 0; c < 3; ++c)
+            rate += grad[r][3 * k + c] * component(s.v[static_cast<std::size_t>(k)], c);
+        const double lambda = penalty->stiffness[row] * phi[r] + penalty->damping[row] * rate;
+        if (penalty_lambda) penalty_lambda[row] = lambda;
+        for (int k = 0; k < 2; ++k)
+          for (int c = 0; c < 3; ++c) component(fe[static_cast<std::size_t>(k)], c) -= grad[r][3 * k + c] * lambda;
+      }
+    }
+    for (int k = 0; k < 2; ++k) {
+      const int b = el.slot_body(k);
+      if (b == kGround) continue;
+      f[3 * b] += fe[static_cast<std::size_t>(k)].x;
+      f[3 * b + 1] += fe[static_cast<std::size_t>(k)].y;
+      f[3 * b + 2] += fe[static_cast<std::size_t>(k)].theta;
+    }
+  }
+}
+
+void DaeSystem::residual(double t, const double* y, const double* yp, double* r) const {
+  const int nq = body_unknowns();
+  const double* q = y;
+  const double* v = y + nq;
+  const double* lambda = y + 2 * nq;
+  const double* mu = lambda + constraint_rows();
+  double* r_q = r;
+  double* r_v = r + nq;
+  double* r_phi = r + 2 * nq;
+  double* r_vel = r_phi + constraint_rows();
+
+  generalized_forces(t, q, v, r_v);  // r_v = f for now
+  for (int k = 0; k < nq; ++k) {
+    r_q[k] = yp[k] - v[k];
+    r_v[k] = mass_[static_cast<std::size_t>(k)] * yp[nq + k] - r_v[k];
+  }
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const int m = el.constraint_count();
+    if (m == 0) continue;
+    const int offset = model_.constraint_offset(e);
+    const std::array<Pose<double>, 2> poses = gather_poses(el, q);
+    double phi[kMaxConstraintRows];
+    double grad[kMaxConstraintRows][6];
+    el.constraint_gradient(poses, phi, grad);
+    for (int row = 0; row < m; ++row) {
+      const int g = offset + row;
+      r_phi[g] = phi[row];
+      double rate = 0.0;
+      for (int k = 0; k < 2; ++k) {
+        const int b = el.slot_body(k);
+        if (b == kGround) continue;
+        for (int c = 0; c < 3; ++c) {
+          const double gv = grad[row][3 * k + c];
+          r_q[3 * b + c] += gv * mu[g];
+          r_v[3 * b + c] += gv * lambda[g];
+          rate += gv * v[3 * b + c];
+        }
+      }
+      r_vel[g] = rate;
+    }
+  }
+}
+
+template <class Sink>
+void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const double* yp, Sink& sink) const {
+  (void)yp;
+  const int nq = body_unknowns();
+  const int n = model_.body_count();
+  const double* q = y;
+  const double* v = y + nq;
+  const double* lambda = y + 2 * nq;
+  const double* mu = lambda + constraint_rows();
+
+  // Bodies: r_q = q' - v,  r_v = M v' - f
+  for (int k = 0; k < nq; ++k) {
+    sink.add(k, k, cj);
+    sink.add(k, nq + k, -1.0);
+    sink.add(nq + k, nq + k, cj * mass_[static_cast<std::size_t>(k)]);
+  }
+  // Loads: the moment of a force at an offset point depends on theta.
+  for (const Load& load : model_.loads()) {
+    if (load.kind != Load::Kind::Force) continue;
+    const std::array<double, 2> value = load.value.at(t);
+    const double theta = q[3 * load.body + 2];
+    const Vec2<double> arm = rotate(theta, load.sx, load.sy);
+    // M = arm x F,  d arm / d theta = perp(arm) = (-arm_y, arm_x)
+    const double dmoment = -arm.y * value[1] - arm.x * value[0];
+    sink.add(nq + 3 * load.body + 2, 3 * load.body + 2, -dmoment);
+  }
+  (void)n;
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const int m = el.constraint_count();
+    const ElementState<double> s = gather_state(el, q, v);
+    if (m == 0) {
+      std::array<Pose<double>, 2> f{};
+      ForceBlock df_dq{}, df_dv{};
+      el.add_force_jacobian(t, s, f, df_dq, df_dv);
+      for (int a = 0; a < 2; ++a) {
+        const int ba = el.slot_body(a);
+        if (ba == kGround) continue;
+        for (int b = 0; b < 2; ++b) {
+          const int bb = el.slot_body(b);
+          if (bb == kGround) continue;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+              const auto li = static_cast<std::size_t>(3 * a + i), lj = static_cast<std::size_t>(3 * b + j);
+              sink.add(nq + 3 * ba + i, 3 * bb + j, -df_dq[li][lj]);
+              sink.add(nq + 3 * ba + i, nq + 3 * bb + j, -df_dv[li][lj]);
+            }
+        }
+      }
+      continue;
+    }
+    const int offset = model_.constraint_offset(e);
+    double phi[kMaxConstraintRows];
+    double grad[kMaxConstraintRows][6];
+    double hess[kMaxConstraintRows][6][6];
+    el.constraint_hessian(s.q, phi, grad, hess);
+    double local_v[6];
+    for (int k = 0; k < 2; ++k) {
+      local_v[3 * k] = s.v[static_cast<std::size_t>(k)].x;
+      local_v[3 * k + 1] = s.v[static_cast<std::size_t>(k)].y;
+      local_v[3 * k + 2] = s.v[static_cast<std::size_t>(k)].theta;
+    }
+    // Second-derivative blocks: d(G^T mu)/dq and d(G^T lambda)/dq.
+    for (int a = 0; a < 2; ++a) {
+      const int ba = el.slot_body(a);
+      if (ba == kGround) continue;
+      for (int b = 0; b < 2; ++b) {
+        const int bb = el.slot_body(b);
+        if (bb == kGround) continue;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            double with_mu = 0.0, with_lambda = 0.0;
+            for (int row = 0; row < m; ++row) {
+              const double h = hess[row][3 * a + i][3 * b + j];
+              with_mu += mu[offset + row] * h;
+              with_lambda += lambda[offset + row] * h;
+            }
+            sink.add(3 * ba + i, 3 * bb + j, with_mu);
+            sink.add(nq + 3 * ba + i, 3 * bb + j, with_lambda);
+          }
+      }
+    }
+    for (int row = 0; row < m; ++row) {
+      const int g = offset + row;
+      const int row_phi = model_.lambda_index(g);
+      const int row_vel = model_.mu_index(g);
+      for (int a = 0; a < 2; ++a) {
+        const int ba = el.slot_body(a);
+        if (ba == kGround) continue;
+        for (int i = 0; i < 3; ++i) {
+          const double gv = grad[row][3 * a + i];
+          double dvel_dq = 0.0;  // d(G v)/dq = sum_j H[i][j] v_j (H symmetric)
+          for (int j = 0; j < 6; ++j) dvel_dq += hess[row][3 * a + i][j] * local_v[j];
+          sink.add(3 * ba + i, model_.mu_index(g), gv);          // r_q: G^T mu
+          sink.add(nq + 3 * ba + i, model_.lambda_index(g), gv); // r_v: G^T lambda
+          sink.add(row_phi, 3 * ba + i, gv);                     // r_phi: G
+          sink.add(row_vel, 3 * ba + i, dvel_dq);                // r_vel: dG v / dq
+          sink.add(row_vel, nq + 3 * ba + i, gv);                // r_vel: G
+        }
+      }
+      // Diagonal slots kept for a constraint that fails (its rows become lambda = 0, mu = 0).
+      sink.add(row_phi, model_.lambda_index(g), 0.0);
+      sink.add(row_vel, model_.mu_index(g), 0.0);
+    }
+  }
+}
+
+void DaeSystem::jacobian(double t, double cj, const double* y, const double* yp, double* values) const {
+  std::fill(values, values + pattern_.nonzeros(), 0.0);
+  SlotWriter writer{slots_.data(), values};
+  assemble_jacobian(t, cj, y, yp, writer);
+  RAILCRASH_DEMAND(writer.slot == slots_.data() + slots_.size());
+}
+
+void DaeSystem::force_jacobian(double t, const double* q, const double* v, const PenaltyRows* penalty,
+                               std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv) const {
+  df_dq.clear();
+  df_dv.clear();
+  for (const Load& load : model_.loads()) {
+    if (load.kind != Load::Kind::Force) continue;
+    const std::array<double, 2> value = load.value.at(t);
+    const Vec2<double> arm = rotate(q[3 * load.body + 2], load.sx, load.sy);
+    df_dq.push_back({3 * load.body + 2, 3 * load.body + 2, -arm.y * value[1] - arm.x * value[0]});
+  }
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const int m = el.constraint_count();
+    const ElementState<double> s = gather_state(el, q, v);
+    ForceBlock dq{}, dv{};
+    if (m == 0) {
+      std::array<Pose<double>, 2> f{};
+      el.add_force_jacobian(t, s, f, dq, dv);
+    } else {
+      if (!penalty) continue;
+      // f = -G^T (k Phi + c G v): df/dq ~ -k G^T G (curvature terms of the multiplier dropped:
+      // this Jacobian only feeds the stability estimate), df/dv = -c G^T G.
+      double phi[kMaxConstraintRows];
+      double grad[kMaxConstraintRows][6];
+      el.constraint_gradient(s.q, phi, grad);
+      const int offset = model_.constraint_offset(e);
+      for (int row = 0; row < m; ++row) {
+        const auto g = static_cast<std::size_t>(offset + row);
+        for (std::size_t i = 0; i < 6; ++i)
+          for (std::size_t j = 0; j < 6; ++j) {
+            dq[i][j] -= penalty->stiffness[g] * grad[row][i] * grad[row][j];
+            dv[i][j] -= penalty->damping[g] * grad[row][i] * grad[row][j];
+          }
+      }
+    }
+    for (int a = 0; a < 2; ++a) {
+      const int ba = el.slot_body(a);
+      if (ba == kGround) continue;
+      for (int b = 0; b < 2; ++b) {
+        const int bb = el.slot_body(b);
+        if (bb == kGround) continue;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            const auto li = static_cast<std::size_t>(3 * a + i), lj = static_cast<std::size_t>(3 * b + j);
+            df_dq.push_back({3 * ba + i, 3 * bb + j, dq[li][lj]});
+            df_dv.push_back({3 * ba + i, 3 * bb + j, dv[li][lj]});
+          }
+      }
+    }
+  }
+}
+
+void DaeSystem::constraints(const double* q, double* phi, std::vector<Triplet>* gradient) const {
+  if (gradient) gradient->clear();
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const int m = el.constraint_count();
+    if (m == 0) continue;
+    const int offset = model_.constraint_offset(e);
+    const std::array<Pose<double>, 2> poses = gather_poses(el, q);
+    double grad[kMaxConstraintRows][6];
+    el.constraint_gradient(poses, phi + offset, grad);
+    if (!gradient) continue;
+    for (int row = 0; row < m; ++row)
+      for (int k = 0; k < 2; ++k) {
+        const int b = el.slot_body(k);
+        if (b == kGround) continue;
+        for (int c = 0; c < 3; ++c) gradient->push_back({offset + row, 3 * b + c, grad[row][3 * k + c]});
+      }
+  }
+}
+
+void DaeSystem::constraint_acceleration_bias(const double* q, const double* v, double* gamma) const {
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const int m = el.constraint_count();
+    if (m == 0) continue;
+    const ElementState<double> s = gather_state(el, q, v);
+    double phi[kMaxConstraintRows];
+    double grad[kMaxConstraintRows][6];
+    double hess[kMaxConstraintRows][6][6];
+    el.constraint_hessian(s.q, phi, grad, hess);
+    double local_v[6];
+    for (int k = 0; k < 2; ++k) {
+      local_v[3 * k] = s.v[static_cast<std::size_t>(k)].x;
+      local_v[3 * k + 1] = s.v[static_cast<std::size_t>(k)].y;
+      local_v[3 * k + 2] = s.v[static_cast<std::size_t>(k)].theta;
+    }
+    for (int row = 0; row < m; ++row) {
+      double sum = 0.0;
+      for (int i = 0; i < 6; ++i)
+        for (int j = 0; j < 6; ++j) sum += local_v[i] * hess[row][i][j] * local_v[j];
+      gamma[model_.constraint_offset(e) + row] = sum;
+    }
+  }
+}
+
+double DaeSystem::constraint_residual(const double* q) const {
+  std::vector<double> phi(static_cast<std::size_t>(constraint_rows()), 0.0);
+  constraints(q, phi.data(), nullptr);
+  double worst = 0.0;
+  for (int row = 0; row < constraint_rows(); ++row) {
+    const double scale = constraint_row_is_rotational(row) ? model_.length_scale() : 1.0;
+    worst = std::max(worst, std::abs(phi[static_cast<std::size_t>(row)]) * scale);
+  }
+  return worst;
+}
+
+const Element& DaeSystem::constraint_owner(int row) const {
+  return *model_.elements()[static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)])];
+}
+
+double DaeSystem::kinetic_energy(const double* v) const {
+  double ke = 0.0;
+  for (int k = 0; k < body_unknowns(); ++k) ke += 0.5 * mass_[static_cast<std::size_t>(k)] * v[k] * v[k];
+  return ke;
+}
+
+double DaeSystem::gravity_potential(const double* q) const {
+  double pe = 0.0;
+  for (int i = 0; i < model_.body_count(); ++i)
+    pe -= mass_[static_cast<std::size_t>(3 * i)] * (model_.gravity_x * q[3 * i] + model_.gravity_y * q[3 * i + 1]);
+  return pe;
+}
+
+void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda) const {
+  const int nq = body_unknowns();
+  const double* q = y;
+  const double* v = y + nq;
+  rates[kKineticIntegral] = kinetic_energy(v);
+  // Power of the applied loads.
+  double load_power = 0.0;
+  for (const Load& load : model_.loads()) {
+    const std::array<double, 2> value = load.value.at(t);
+    const double* vb = v + 3 * load.body;
+    if (load.kind == Load::Kind::Moment) {
+      load_power += value[0] * vb[2];
+    } else {
+      const Pose<double> pose{q[3 * load.body], q[3 * load.body + 1], q[3 * load.body + 2]};
+      const Pose<double> rate{vb[0], vb[1], vb[2]};
+      const Vec2<double> point_rate = point_velocity(pose, rate, load.sx, load.sy);
+      load_power += value[0] * point_rate.x + value[1] * point_rate.y;
+    }
+  }
+  rates[kLoadWork] = load_power;
+  // Power delivered to each force element: -sum f_e . v over its bodies.
+  double penalty_power = 0.0;
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    double power = 0.0;
+    const ElementState<double> s = gather_state(el, q, v);
+    if (el.constraint_count() == 0) {
+      std::array<Pose<double>, 2> fe{};
+      el.add_force(t, s, fe);
+      for (std::size_t k = 0; k < 2; ++k)
+        power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
+    } else if (penalty_lambda) {
+      // Penalty force -G^T lambda does power -lambda . (G v) on the bodies.
+      double phi[kMaxConstraintRows];
+      double grad[kMaxConstraintRows][6];
+      el.constraint_gradient(s.q, phi, grad);
+      const int offset = model_.constraint_offset(e);
+      for (int row = 0; row < el.constraint_count(); ++row) {
+        double rate = 0.0;
+        for (std::size_t k = 0; k < 2; ++k)
+          rate += grad[row][3 * k] * s.v[k].x + grad[row][3 * k + 1] * s.v[k].y + grad[row][3 * k + 2] * s.v[k].theta;
+        penalty_power += penalty_lambda[offset + row] * rate;
+      }
+    }
+    rates[kFirstElementWork + static_cast<int>(e)] = power;
+  }
+  rates[kPenaltyWork] = penalty_power;
+}
+
+EnergyState DaeSystem::energy(const double* y, const double* quadratures, const PenaltyRows* penalty) const {
+  const int nq = body_unknowns();
+  EnergyState s;
+  s.kinetic = kinetic_energy(y + nq);
+  s.gravity = gravity_potential(y);
+  for (const auto& el : model_.elements()) s.elastic += el->potential_energy(gather_state(*el, y, y + nq));
+  if (penalty && constraint_rows() > 0) {
+    std::vector<double> phi(static_cast<std::size_t>(constraint_rows()));
+    constraints(y, phi.data(), nullptr);
+    for (std::size_t row = 0; row < phi.size(); ++row) s.elastic += 0.5 * penalty->stiffness[row] * phi[row] * phi[row];
+  }
+  s.load_work = quadratures[kLoadWork];
+  s.element_work = quadratures[kPenaltyWork];
+  for (std::size_t e = 0; e < model_.elements().size(); ++e)
+    s.element_work += quadratures[kFirstElementWork + static_cast<int>(e)];
+  return s;
+}
+
+void DaeSystem::outputs(const double* y, const double* lambda, double* out) const {
+  const int nq = body_unknowns();
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    const std::size_t count = el.output_names().size();
+    if (count == 0) continue;
+    const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
+    el.outputs(gather_state(el, y, y + nq), element_lambda, out);
+    out += count;
+  }
+}
+
+}  // namespace railcrash

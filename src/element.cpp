@@ -1,0 +1,62 @@
+#include "railcrash/element.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+
+namespace railcrash {
+
+void demand_failed(const char* condition, const char* file, int line) {
+  std::fprintf(stderr, "railcrash internal error: %s failed at %s:%d (please report this)\n", condition, file, line);
+  std::abort();
+}
+
+Element::Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where)
+    : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {}
+
+void Element::bind_bodies() {
+  // Slots in order of first appearance of a distinct body; ground always gets the slot
+  // it first appears in too, so point p's slot is stable whatever the bodies are.
+  slot_body_ = {kGround, kGround};
+  point_slot_.assign(points_.size(), 0);
+  int used = 0;
+  for (std::size_t p = 0; p < points_.size(); ++p) {
+    const int body = points_[p].body;
+    int slot = -1;
+    for (int k = 0; k < used; ++k)
+      if (slot_body_[static_cast<std::size_t>(k)] == body) slot = k;
+    if (slot < 0) {
+      if (used == 2)
+        throw InputError(where_.prefix() + "element '" + name_ + "' (" + type_ +
+                         ") connects more than two bodies; give its points on at most two bodies");
+      slot = used++;
+      slot_body_[static_cast<std::size_t>(slot)] = body;
+    }
+    point_slot_[p] = slot;
+  }
+}
+
+void Element::constraint_gradient(const std::array<Pose<double>, 2>&, double*, double[kMaxConstraintRows][6]) const {
+  RAILCRASH_DEMAND(constraint_count() == 0);
+}
+
+void Element::constraint_hessian(const std::array<Pose<double>, 2>&, double*, double[kMaxConstraintRows][6],
+                                 double[kMaxConstraintRows][6][6]) const {
+  RAILCRASH_DEMAND(constraint_count() == 0);
+}
+
+void Element::add_force_jacobian(double, const ElementState<double>&, std::array<Pose<double>, 2>&, ForceBlock&,
+                                 ForceBlock&) const {}
+
+ElementState<double> gather_state(const Element& e, const double* q, const double* v) {
+  ElementState<double> s;
+  for (int k = 0; k < 2; ++k) {
+    const int b = e.slot_body(k);
+    if (b == kGround) continue;
+    const auto ks = static_cast<std::size_t>(k);
+    s.q[ks] = {q[3 * b], q[3 * b + 1], q[3 * b + 2]};
+    s.v[ks] = {v[3 * b], v[3 * b + 1], v[3 * b + 2]};
+  }
+  return s;
+}
+
+}  // namespace railcrash

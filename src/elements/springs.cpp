@@ -1,0 +1,91 @@
+#include "railcrash/elements/springs.hpp"
+
+#include <cmath>
+
+#include "railcrash/element_registry.hpp"
+
+namespace railcrash {
+
+
+LinearSpring::LinearSpring(ElementSpec& spec)
+    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+      stiffness(spec.parameters->required_nonnegative("stiffness")),
+      free_length(spec.parameters->optional_nonnegative("free_length")) {
+  spec.require_points(2);
+}
+
+void LinearSpring::initialize(const ElementState<double>& initial) {
+  const double length = line_geometry(*this, initial).length;
+  if (!free_length) free_length = length;
+  if (*free_length > 0.0 && length == 0.0)
+    throw InputError(where_.prefix() + "linear_spring '" + name_ +
+                     "': its two points coincide in the initial configuration, so the spring has no direction; "
+                     "move the points apart or set free_length: 0");
+}
+
+double LinearSpring::potential_energy(const ElementState<double>& s) const {
+  const double stretch = line_geometry(*this, s).length - *free_length;
+  return 0.5 * stiffness * stretch * stretch;
+}
+
+void LinearSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double deformation = line_geometry(*this, s).length - *free_length;
+  out[0] = stiffness * deformation;  // tension positive
+  out[1] = deformation;
+}
+
+LinearDashpot::LinearDashpot(ElementSpec& spec)
+    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+      damping(spec.parameters->required_nonnegative("damping")) {
+  spec.require_points(2);
+}
+
+void LinearDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const LineGeometry<double> g = line_geometry(*this, s);
+  const double rate = dot(g.d, g.d_rate) / g.length;
+  out[0] = damping * rate;
+  out[1] = rate;
+}
+
+TorsionalSpring::TorsionalSpring(ElementSpec& spec)
+    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+      stiffness(spec.parameters->required_nonnegative("stiffness")),
+      free_angle(spec.parameters->number("free_angle")) {
+  spec.require_points(2);
+}
+
+void TorsionalSpring::initialize(const ElementState<double>& initial) {
+  if (!free_angle) free_angle = relative_angle(initial);
+}
+
+double TorsionalSpring::potential_energy(const ElementState<double>& s) const {
+  const double rotation = relative_angle(s) - *free_angle;
+  return 0.5 * stiffness * rotation * rotation;
+}
+
+void TorsionalSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double rotation = relative_angle(s) - *free_angle;
+  out[0] = stiffness * rotation;
+  out[1] = rotation;
+}
+
+TorsionalDashpot::TorsionalDashpot(ElementSpec& spec)
+    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+      damping(spec.parameters->required_nonnegative("damping")) {
+  spec.require_points(2);
+}
+
+void TorsionalDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double rate = s.v[static_cast<std::size_t>(point_slot(1))].theta - s.v[static_cast<std::size_t>(point_slot(0))].theta;
+  out[0] = damping * rate;
+  out[1] = rate;
+}
+
+void register_spring_elements(ElementRegistry& registry) {
+  registry.add("linear_spring", [](ElementSpec& s) { return std::make_unique<LinearSpring>(s); });
+  registry.add("linear_dashpot", [](ElementSpec& s) { return std::make_unique<LinearDashpot>(s); });
+  registry.add("torsional_spring", [](ElementSpec& s) { return std::make_unique<TorsionalSpring>(s); });
+  registry.add("torsional_dashpot", [](ElementSpec& s) { return std::make_unique<TorsionalDashpot>(s); });
+}
+
+}  // namespace railcrash

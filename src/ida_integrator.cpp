@@ -1,0 +1,290 @@
+#include "railcrash/ida_integrator.hpp"
+
+#include <idas/idas.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_klu.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <sstream>
+
+#include "railcrash/initial_conditions.hpp"
+
+namespace railcrash {
+
+namespace {
+
+std::string flag_name(int flag) {
+  char* name = IDAGetReturnFlagName(flag);
+  std::string out = name ? name : std::to_string(flag);
+  std::free(name);
+  return out;
+}
+
+}  // namespace
+
+/// Everything SUNDIALS owns for one run; destroyed in reverse order of creation.
+struct IdaIntegrator::Impl {
+  const DaeSystem& system;
+  SUNContext context = nullptr;
+  N_Vector y = nullptr, yp = nullptr, ids = nullptr, atol = nullptr, quad = nullptr, quad_atol = nullptr;
+  SUNMatrix jacobian = nullptr;
+  SUNLinearSolver linear_solver = nullptr;
+  void* ida = nullptr;
+  std::exception_ptr callback_error;
+  std::string last_sundials_message;
+
+  explicit Impl(const DaeSystem& s) : system(s) {}
+  ~Impl() {
+    if (ida) IDAFree(&ida);
+    if (linear_solver) SUNLinSolFree(linear_solver);
+    if (jacobian) SUNMatDestroy(jacobian);
+    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol})
+      if (*v) N_VDestroy(*v);
+    if (context) SUNContext_Free(&context);
+  }
+
+  void check(int flag, const char* function) const {
+    if (flag >= 0) return;
+    std::ostringstream msg;
+    msg << function << " failed with " << flag_name(flag);
+    if (!last_sundials_message.empty()) msg << ": " << last_sundials_message;
+    throw SolverError(msg.str());
+  }
+  template <class P>
+  P* created(P* pointer, const char* function) const {
+    if (!pointer) throw SolverError(std::string(function) + " could not allocate");
+    return pointer;
+  }
+
+  static int residual(realtype t, N_Vector yy, N_Vector ypv, N_Vector rr, void* user) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      self->system.residual(t, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), N_VGetArrayPointer(rr));
+      const double* r = N_VGetArrayPointer(rr);
+      for (sunindextype k = 0; k < N_VGetLength(rr); ++k)
+        if (!std::isfinite(r[k])) return 1;  // recoverable: IDA cuts the step
+      return 0;
+    } catch (...) {
+      self->callback_error = std::current_exception();
+      return -1;
+    }
+  }
+
+  static int jacobian_values(realtype t, realtype cj, N_Vector yy, N_Vector ypv, N_Vector, SUNMatrix matrix, void* user,
+                             N_Vector, N_Vector, N_Vector) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      const SparsePattern& p = self->system.pattern();
+      // SUNMatZero also clears the index arrays of a sparse matrix: write them every time.
+      sunindextype* columns = SUNSparseMatrix_IndexPointers(matrix);
+      sunindextype* rows = SUNSparseMatrix_IndexValues(matrix);
+      for (std::size_t k = 0; k < p.column_start.size(); ++k) columns[k] = p.column_start[k];
+      for (std::size_t k = 0; k < p.row_index.size(); ++k) rows[k] = p.row_index[k];
+      self->system.jacobian(t, cj, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), SUNSparseMatrix_Data(matrix));
+      return 0;
+    } catch (...) {
+      self->callback_error = std::current_exception();
+      return -1;
+    }
+  }
+
+  static int quadrature(realtype t, N_Vector yy, N_Vector, N_Vector rates, void* user) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      self->system.quadrature_rates(t, N_VGetArrayPointer(yy), N_VGetArrayPointer(rates));
+      return 0;
+    } catch (...) {
+      self->callback_error = std::current_exception();
+      return -1;
+    }
+  }
+
+  static void error_handler(int, const char* module, const char* function, char* message, void* user) {
+    auto* self = static_cast<Impl*>(user);
+    self->last_sundials_message = std::string(module) + "/" + function + ": " + message;
+  }
+
+  void rethrow_callback_error() {
+    if (callback_error) {
+      std::exception_ptr e = callback_error;
+      callback_error = nullptr;
+      std::rethrow_exception(e);
+    }
+  }
+};
+
+IdaIntegrator::IdaIntegrator(const DaeSystem& system, IdaSettings settings) : system_(system), settings_(settings) {
+  if (!(settings_.rtol > 0.0) || !std::isfinite(settings_.rtol))
+    throw InputError("rtol must be a positive number (typical: 1e-6)");
+}
+
+IdaIntegrator::~IdaIntegrator() = default;
+
+RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver& observer,
+                              const std::atomic<bool>* stop) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  RunOutcome outcome;
+  Impl impl(system_);
+  const int n = system_.size();
+  const int nq = system_.body_unknowns();
+  const int m = system_.constraint_rows();
+  const int nquad = system_.quadrature_count();
+  const Model& model = system_.model();
+
+  // ---- consistent positions and velocities ----
+  std::vector<double> y0 = system_.initial_state();
+  const AssemblyReport assembly = assemble_initial_state(system_, y0);
+  outcome.stats.assembly_correction = assembly.largest_position_change;
+
+  // ---- scales for the tolerances ----
+  const double length = model.length_scale();
+  std::vector<double> f0(static_cast<std::size_t>(nq), 0.0);
+  system_.generalized_forces(0.0, y0.data(), y0.data() + nq, f0.data());
+  double force_scale = 0.0, speed = 0.0, total_mass = 0.0;
+  for (int i = 0; i < model.body_count(); ++i) {
+    force_scale = std::max({force_scale, std::abs(f0[static_cast<std::size_t>(3 * i)]),
+                            std::abs(f0[static_cast<std::size_t>(3 * i + 1)]),
+                            std::abs(f0[static_cast<std::size_t>(3 * i + 2)]) / length});
+    speed = std::max({speed, std::abs(y0[static_cast<std::size_t>(nq + 3 * i)]),
+                      std::abs(y0[static_cast<std::size_t>(nq + 3 * i + 1)]),
+                      std::abs(y0[static_cast<std::size_t>(nq + 3 * i + 2)]) * length});
+    total_mass += model.bodies()[static_cast<std::size_t>(i)].mass;
+  }
+  const double energy_scale = std::max(system_.kinetic_energy(y0.data() + nq), force_scale * length);
+  speed = std::max(speed, std::sqrt(2.0 * energy_scale / total_mass));
+  if (!(speed > 0.0)) speed = length / t_end;
+  if (!(force_scale > 0.0)) force_scale = total_mass * speed * speed / length;
+  const double rtol = settings_.rtol;
+  const double atol_length = settings_.atol ? *settings_.atol : 0.1 * rtol * length;
+  const double atol_speed = atol_length * speed / length;
+  // Multipliers stay out of the error test (IDASetSuppressAlg); their weights only enter the
+  // Newton convergence test, where index-2 unknowns carry round-off amplified by 1/h. Weights
+  // as tight as the differential ones make that test fail at small steps (seen on the
+  // slider-crank at rtol <= 1e-8), so lambda gets 100 rtol F and mu (zero on the exact
+  // solution) the speed scale V.
+  const double atol_force = std::min(1.0, 100.0 * rtol) * force_scale;
+
+  try {
+    impl.check(SUNContext_Create(nullptr, &impl.context), "SUNContext_Create");
+    impl.y = impl.created(N_VNew_Serial(n, impl.context), "N_VNew_Serial");
+    impl.yp = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.ids = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.atol = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.quad = impl.created(N_VNew_Serial(nquad, impl.context), "N_VNew_Serial");
+    impl.quad_atol = impl.created(N_VClone(impl.quad), "N_VClone");
+
+    double* y = N_VGetArrayPointer(impl.y);
+    double* yp = N_VGetArrayPointer(impl.yp);
+    std::vector<double> yp0;
+    consistent_rates(system_, 0.0, y0, yp0);
+    std::copy(y0.begin(), y0.end(), y);
+    std::copy(yp0.begin(), yp0.end(), yp);
+    const std::vector<double> ids = system_.differential_ids();
+    std::copy(ids.begin(), ids.end(), N_VGetArrayPointer(impl.ids));
+    double* atol = N_VGetArrayPointer(impl.atol);
+    for (int i = 0; i < model.body_count(); ++i) {
+      atol[3 * i] = atol[3 * i + 1] = atol_length;
+      atol[3 * i + 2] = atol_length / length;
+      atol[nq + 3 * i] = atol[nq + 3 * i + 1] = atol_speed;
+      atol[nq + 3 * i + 2] = atol_speed / length;
+    }
+    for (int r = 0; r < m; ++r) {
+      atol[2 * nq + r] = atol_force;
+      atol[2 * nq + m + r] = speed;
+    }
+    N_VConst(0.0, impl.quad);
+    double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
+    for (int k = 0; k < nquad; ++k) quad_atol[k] = 0.1 * rtol * energy_scale;
+    quad_atol[DaeSystem::kKineticIntegral] *= t_end;
+
+    impl.ida = impl.created(IDACreate(impl.context), "IDACreate");
+    impl.check(IDASetErrHandlerFn(impl.ida, &Impl::error_handler, &impl), "IDASetErrHandlerFn");
+    impl.check(IDAInit(impl.ida, &Impl::residual, 0.0, impl.y, impl.yp), "IDAInit");
+    impl.check(IDASetUserData(impl.ida, &impl), "IDASetUserData");
+    impl.check(IDASVtolerances(impl.ida, rtol, impl.atol), "IDASVtolerances");
+    impl.check(IDASetId(impl.ida, impl.ids), "IDASetId");
+    impl.check(IDASetSuppressAlg(impl.ida, SUNTRUE), "IDASetSuppressAlg");
+    impl.check(IDASetMaxNumSteps(impl.ida, settings_.max_steps_per_output), "IDASetMaxNumSteps");
+    impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");
+    const SparsePattern& pattern = system_.pattern();
+    impl.jacobian = impl.created(SUNSparseMatrix(n, n, pattern.nonzeros(), CSC_MAT, impl.context), "SUNSparseMatrix");
+    impl.linear_solver = impl.created(SUNLinSol_KLU(impl.y, impl.jacobian, impl.context), "SUNLinSol_KLU");
+    impl.check(IDASetLinearSolver(impl.ida, impl.linear_solver, impl.jacobian), "IDASetLinearSolver");
+    impl.check(IDASetJacFn(impl.ida, &Impl::jacobian_values), "IDASetJacFn");
+    impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");
+    impl.check(IDAQuadSVtolerances(impl.ida, rtol, impl.quad_atol), "IDAQuadSVtolerances");
+    impl.check(IDASetQuadErrCon(impl.ida, SUNTRUE), "IDASetQuadErrCon");
+
+    const double* lambda = y + 2 * nq;
+    std::vector<double> quad_now(static_cast<std::size_t>(nquad), 0.0);
+    outcome.initial_energy = system_.energy(y, quad_now.data());
+    observer.sample(0.0, y, lambda, quad_now.data());
+    outcome.max_constraint_residual = system_.constraint_residual(y);
+
+    long output_index = 1;
+    double t_reached = 0.0;
+    while (t_reached < t_end) {
+      if (stop && stop->load()) {
+        outcome.message = "interrupted at t = " + std::to_string(t_reached);
+        break;
+      }
+      const double t_out = std::min(t_end, static_cast<double>(output_index) * output_interval);
+      double t_return = t_reached;
+      const int flag = IDASolve(impl.ida, t_out, &t_return, impl.y, impl.yp, IDA_NORMAL);
+      impl.rethrow_callback_error();
+      if (flag < 0) {
+        t_reached = t_return;
+        std::ostringstream msg;
+        msg << "IDA failed at t = " << t_return << " with " << flag_name(flag);
+        if (!impl.last_sundials_message.empty()) msg << " (" << impl.last_sundials_message << ")";
+        outcome.message = msg.str();
+        break;
+      }
+      impl.check(IDAGetQuad(impl.ida, &t_return, impl.quad), "IDAGetQuad");
+      t_reached = t_return;
+      const double* quad = N_VGetArrayPointer(impl.quad);
+      observer.sample(t_reached, y, lambda, quad);
+      outcome.max_constraint_residual = std::max(outcome.max_constraint_residual, system_.constraint_residual(y));
+      if (t_reached >= t_out * (1.0 - 1e-14)) ++output_index;
+    }
+    outcome.ok = outcome.message.empty();
+    outcome.t_reached = t_reached;
+    outcome.y.assign(y, y + n);
+    const double* quad = N_VGetArrayPointer(impl.quad);
+    outcome.quadratures.assign(quad, quad + nquad);
+    outcome.final_energy = system_.energy(y, quad);
+
+    long value = 0;
+    realtype step = 0.0;
+    impl.check(IDAGetNumSteps(impl.ida, &value), "IDAGetNumSteps"); outcome.stats.steps = value;
+    impl.check(IDAGetNumResEvals(impl.ida, &value), "IDAGetNumResEvals"); outcome.stats.residual_evaluations = value;
+    impl.check(IDAGetNumJacEvals(impl.ida, &value), "IDAGetNumJacEvals"); outcome.stats.jacobian_evaluations = value;
+    impl.check(IDAGetNumNonlinSolvIters(impl.ida, &value), "IDAGetNumNonlinSolvIters"); outcome.stats.nonlinear_iterations = value;
+    impl.check(IDAGetNumErrTestFails(impl.ida, &value), "IDAGetNumErrTestFails"); outcome.stats.error_test_failures = value;
+    impl.check(IDAGetNumNonlinSolvConvFails(impl.ida, &value), "IDAGetNumNonlinSolvConvFails");
+    outcome.stats.nonlinear_convergence_failures = value;
+    impl.check(IDAGetLastStep(impl.ida, &step), "IDAGetLastStep"); outcome.stats.last_step = step;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    outcome.ok = false;
+    outcome.message = e.what();
+  }
+  outcome.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return outcome;
+}
+
+double max_abs(const std::vector<double>& values) {
+  double worst = 0.0;
+  for (double v : values) worst = std::max(worst, std::abs(v));
+  return worst;
+}
+
+}  // namespace railcrash

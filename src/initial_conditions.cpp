@@ -1,0 +1,194 @@
+#include "railcrash/initial_conditions.hpp"
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <Eigen/SparseQR>
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace railcrash {
+
+namespace {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// G (m x 3n) at q, and Phi(q).
+SparseMatrix constraint_gradient(const DaeSystem& system, const double* q, Eigen::VectorXd& phi) {
+  std::vector<DaeSystem::Triplet> triplets;
+  phi.setZero(system.constraint_rows());
+  system.constraints(q, phi.data(), &triplets);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(triplets.size());
+  for (const auto& t : triplets) entries.emplace_back(t.row, t.col, t.value);
+  SparseMatrix g(system.constraint_rows(), system.body_unknowns());
+  g.setFromTriplets(entries.begin(), entries.end());
+  return g;
+}
+
+/// Weights W = diag(1, 1, L^2) per body.
+Eigen::VectorXd assembly_weights(const DaeSystem& system) {
+  const double l = system.model().length_scale();
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(system.body_unknowns());
+  for (int i = 0; i < system.model().body_count(); ++i) w[3 * i + 2] = l * l;
+  return w;
+}
+
+/// Row scale so rotational rows are measured in length units.
+double row_scale(const DaeSystem& system, int row) {
+  return system.constraint_row_is_rotational(row) ? system.model().length_scale() : 1.0;
+}
+
+std::string describe_rows(const DaeSystem& system, const std::vector<int>& rows) {
+  std::set<std::string> names;
+  for (int row : rows) {
+    const Element& e = system.constraint_owner(row);
+    names.insert("'" + e.name() + "' (" + e.type() + (e.where().line > 0 ? ", line " + std::to_string(e.where().line) : "") + ")");
+  }
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+}  // namespace
+
+void check_constraint_rank(const DaeSystem& system, const double* q) {
+  const int m = system.constraint_rows();
+  if (m == 0) return;
+  Eigen::VectorXd phi;
+  const SparseMatrix g = constraint_gradient(system, q, phi);
+  const Eigen::VectorXd root_w = assembly_weights(system).cwiseSqrt();
+  SparseMatrix scaled_transpose = (g * root_w.asDiagonal()).transpose();
+  scaled_transpose.makeCompressed();
+  Eigen::SparseQR<SparseMatrix, Eigen::COLAMDOrdering<int>> qr;
+  qr.setPivotThreshold(1e-10);
+  qr.compute(scaled_transpose);
+  if (qr.info() != Eigen::Success)
+    throw SolverError("could not factor the constraint gradient to check the joints for redundancy");
+  const int rank = static_cast<int>(qr.rank());
+  if (rank >= m) return;
+  // (A P).col(k) = A.col(P.indices()(k)): the trailing permuted columns are the dependent rows.
+  std::vector<int> dependent;
+  for (int k = rank; k < m; ++k) dependent.push_back(qr.colsPermutation().indices()(k));
+  const std::string file_prefix = SourceLocation{system.model().file, 0}.prefix();
+  std::ostringstream msg;
+  msg << file_prefix << "the joints are redundant: " << (m - rank) << " of the " << m
+      << " constraint equations repeat what the others already impose, which makes the system singular. "
+      << "Elements involved: " << describe_rows(system, dependent)
+      << ". Remove one of them or use a joint that constrains less (e.g. a sliding_pin_joint instead of a "
+         "pin_joint, or a pin_joint instead of a rigid_joint).";
+  throw InputError(msg.str());
+}
+
+AssemblyReport assemble_initial_state(const DaeSystem& system, std::vector<double>& y) {
+  AssemblyReport report;
+  const int m = system.constraint_rows();
+  const int nq = system.body_unknowns();
+  if (m == 0) return report;
+  check_constraint_rank(system, y.data());
+  const Eigen::VectorXd w = assembly_weights(system);
+  const double length = system.model().length_scale();
+  const double tolerance = 1e-12 * length;
+  Eigen::Map<Eigen::VectorXd> q(y.data(), nq);
+  const Eigen::VectorXd q_start = q;
+
+  Eigen::VectorXd phi;
+  Eigen::SimplicialLDLT<SparseMatrix> solver;
+  double worst = 0.0;
+  int worst_row = 0;
+  const auto measure = [&]() {
+    worst = 0.0;
+    for (int r = 0; r < m; ++r) {
+      const double value = std::abs(phi[r]) * row_scale(system, r);
+      if (value > worst) { worst = value; worst_row = r; }
+    }
+  };
+  const int max_iterations = 50;
+  for (int iteration = 0; iteration <= max_iterations; ++iteration) {
+    const SparseMatrix g = constraint_gradient(system, y.data(), phi);
+    measure();
+    if (worst <= tolerance) break;
+    if (iteration == max_iterations || !std::isfinite(worst)) {
+      const Element& e = system.constraint_owner(worst_row);
+      std::ostringstream msg;
+      msg << e.where().prefix() << "the joints cannot all be satisfied: after " << max_iterations
+          << " Newton iterations on the initial positions, " << e.type() << " '" << e.name() << "' still misses by "
+          << worst << " (length units). Check the points and positions of the bodies it connects, and of the "
+          << "joints around them: they contradict each other.";
+      throw InputError(msg.str());
+    }
+    const SparseMatrix gw = g * w.asDiagonal();
+    const SparseMatrix normal = gw * g.transpose();
+    solver.compute(normal);
+    if (solver.info() != Eigen::Success) {
+      check_constraint_rank(system, y.data());  // names the redundant joints if that is the cause
+      throw InputError(SourceLocation{system.model().file, 0}.prefix() +
+                       "the joints become singular while assembling the initial positions; check the joint points");
+    }
+    const Eigen::VectorXd x = solver.solve(phi);
+    q -= gw.transpose() * x;
+    report.newton_iterations = iteration + 1;
+  }
+  for (int i = 0; i < nq; ++i)
+    report.largest_position_change =
+        std::max(report.largest_position_change, std::abs(q[i] - q_start[i]) * ((i % 3 == 2) ? length : 1.0));
+
+  // Velocity projection onto G v = 0.
+  const SparseMatrix g = constraint_gradient(system, y.data(), phi);
+  const SparseMatrix gw = g * w.asDiagonal();
+  solver.compute(gw * g.transpose());
+  Eigen::Map<Eigen::VectorXd> v(y.data() + nq, nq);
+  const Eigen::VectorXd x = solver.solve(g * v);
+  const Eigen::VectorXd change = gw.transpose() * x;
+  v -= change;
+  for (int i = 0; i < nq; ++i)
+    report.largest_velocity_change = std::max(report.largest_velocity_change, std::abs(change[i]) * ((i % 3 == 2) ? length : 1.0));
+  std::fill(y.begin() + 2 * nq, y.end(), 0.0);
+  return report;
+}
+
+void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp) {
+  const int nq = system.body_unknowns();
+  const int m = system.constraint_rows();
+  yp.assign(y.size(), 0.0);
+  std::copy(y.begin() + nq, y.begin() + 2 * nq, yp.begin());  // q' = v
+  std::fill(y.begin() + 2 * nq, y.end(), 0.0);                 // lambda, mu recomputed
+  std::vector<double> force(static_cast<std::size_t>(nq));
+  system.generalized_forces(t, y.data(), y.data() + nq, force.data());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int k = 0; k < nq; ++k) entries.emplace_back(k, k, system.mass_diagonal(k));
+  Eigen::VectorXd rhs(nq + m);
+  for (int k = 0; k < nq; ++k) rhs[k] = force[static_cast<std::size_t>(k)];
+  if (m > 0) {
+    Eigen::VectorXd phi(m);
+    std::vector<DaeSystem::Triplet> gradient;
+    system.constraints(y.data(), phi.data(), &gradient);
+    for (const auto& g : gradient) {
+      entries.emplace_back(nq + g.row, g.col, g.value);
+      entries.emplace_back(g.col, nq + g.row, g.value);
+    }
+    std::vector<double> gamma(static_cast<std::size_t>(m), 0.0);
+    system.constraint_acceleration_bias(y.data(), y.data() + nq, gamma.data());
+    for (int r = 0; r < m; ++r) rhs[nq + r] = -gamma[static_cast<std::size_t>(r)];
+  }
+  SparseMatrix kkt(nq + m, nq + m);
+  kkt.setFromTriplets(entries.begin(), entries.end());
+  kkt.makeCompressed();
+  Eigen::SparseLU<SparseMatrix> lu;
+  lu.compute(kkt);
+  if (lu.info() != Eigen::Success) {
+    std::string zero;
+    for (const Body& b : system.model().bodies())
+      if (b.inertia == 0.0) zero += (zero.empty() ? "'" : ", '") + b.name + "'";
+    throw SolverError("the equations of motion are singular at the start" +
+                      (zero.empty() ? std::string(".") : ": bodies " + zero + " have zero inertia and no joint fixes their rotation; give them an inertia.") );
+  }
+  const Eigen::VectorXd solution = lu.solve(rhs);
+  for (int k = 0; k < nq; ++k) yp[static_cast<std::size_t>(nq + k)] = solution[k];
+  for (int r = 0; r < m; ++r) y[static_cast<std::size_t>(2 * nq + r)] = solution[nq + r];
+}
+
+}  // namespace railcrash

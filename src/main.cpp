@@ -1,0 +1,131 @@
+// railcrash command line: `railcrash run MODEL ...` and `railcrash check MODEL`.
+// Exit status: 0 success, 1 the run failed or was interrupted (results up to then are
+// written), 2 bad input (the message names file, line and what to change).
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include "railcrash/dae_system.hpp"
+#include "railcrash/euler_integrator.hpp"
+#include "railcrash/initial_conditions.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_interrupt(int) { g_stop.store(true); }
+
+int check_command(const std::string& path, const std::vector<std::string>& settings) {
+  using namespace railcrash;
+  const Model model = load_model(path, settings);
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const AssemblyReport assembly = assemble_initial_state(system, y);
+  int constraint_elements = 0;
+  for (const auto& e : model.elements()) constraint_elements += e->constraint_count() > 0;
+  std::printf("model      %s  (%s)\n", model.name.c_str(), path.c_str());
+  std::printf("units      %s, gravity [%g, %g]\n", unit_system_name(model.units), model.gravity_x, model.gravity_y);
+  std::printf("bodies     %d\n", model.body_count());
+  for (const Body& b : model.bodies())
+    std::printf("  %-20s mass %-12.6g inertia %-12.6g at [%g, %g]\n", b.name.c_str(), b.mass, b.inertia, b.x, b.y);
+  std::printf("elements   %zu (%d constraints)\n", model.elements().size(), constraint_elements);
+  for (const auto& e : model.elements())
+    std::printf("  %-20s %-20s%s\n", e->name().c_str(), e->type().c_str(),
+                e->constraint_count() ? (" " + std::to_string(e->constraint_count()) + " equations").c_str() : "");
+  std::printf("loads      %zu\n", model.loads().size());
+  std::printf("unknowns   %d  (3 x %d positions, 3 x %d velocities, %d multipliers lambda, %d mu)\n", system.size(),
+              model.body_count(), model.body_count(), model.constraint_rows(), model.constraint_rows());
+  std::printf("degrees of freedom  %d\n", model.degrees_of_freedom());
+  std::printf("jacobian   %d nonzeros (%.3g%% of %d x %d)\n", system.pattern().nonzeros(),
+              100.0 * system.pattern().nonzeros() / (static_cast<double>(system.size()) * system.size()), system.size(),
+              system.size());
+  std::printf("assembly   initial positions moved by at most %.3g, velocities by %.3g\n", assembly.largest_position_change,
+              assembly.largest_velocity_change);
+  bool all_inertia = true;
+  for (const Body& b : model.bodies()) all_inertia = all_inertia && b.inertia > 0.0;
+  if (all_inertia) {
+    const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
+    std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
+  }
+  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end,
+              model.simulation.integrator == IntegratorKind::Ida ? "ida" : "euler");
+  return 0;
+}
+
+int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
+                const std::string& out_dir) {
+  using namespace railcrash;
+  Model model = load_model(path, settings);
+  apply_overrides(model, overrides);
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  const RunReport report = run_model(model, out_dir, &g_stop, true);
+  const RunOutcome& o = report.outcome;
+  const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
+  std::printf("%s: %s with %s to t = %g in %.3g s (%ld steps, %ld residual evaluations)\n", model.name.c_str(),
+              o.ok ? "finished" : "FAILED", report.integrator.c_str(), o.t_reached, o.stats.wall_seconds, o.stats.steps,
+              o.stats.residual_evaluations);
+  if (!o.ok) std::printf("reason: %s\n", o.message.c_str());
+  if (o.stats.stability_limit > 0.0)
+    std::printf("euler step %.4g, stability limit %.4g\n", o.stats.last_step, o.stats.stability_limit);
+  std::printf("energy balance error %.3g (kinetic %.6g, elastic %.6g, gravity %.6g, dissipated %.6g, external work %.6g)\n",
+              energy.error(), energy.kinetic, energy.elastic, energy.gravity, energy.dissipated, energy.external_work);
+  std::printf("largest constraint residual %.3g\n", o.max_constraint_residual);
+  std::printf("results in %s/ (timeseries.csv, events.csv, summary.json)\n", out_dir.c_str());
+  return o.ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"railcrash: planar rail-vehicle crash dynamics (IDA + KLU, or explicit Euler)"};
+  app.require_subcommand(1);
+
+  std::string model_path, out_dir = "out", integrator;
+  std::vector<std::string> settings;
+  railcrash::RunOverrides overrides;
+  double t_end = 0, rtol = 0, atol = 0, dt = 0, output_interval = 0;
+
+  CLI::App* run = app.add_subcommand("run", "run a model and write DIR/timeseries.csv, events.csv, summary.json");
+  run->add_option("model", model_path, "model file (YAML)")->required();
+  run->add_option("--integrator", integrator, "ida or euler (default: the model's)")->check(CLI::IsMember({"ida", "euler"}));
+  CLI::Option* t_end_option = run->add_option("--t-end", t_end, "end time");
+  CLI::Option* rtol_option = run->add_option("--rtol", rtol, "ida relative tolerance");
+  CLI::Option* atol_option = run->add_option("--atol", atol, "ida absolute tolerance on lengths");
+  CLI::Option* dt_option = run->add_option("--dt", dt, "euler step");
+  CLI::Option* output_option = run->add_option("--output-interval", output_interval, "time between output rows");
+  run->add_flag("--force-dt", overrides.force_dt, "euler: run even above the stability limit");
+  run->add_option("--out", out_dir, "output folder")->capture_default_str();
+  run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
+
+  CLI::App* check = app.add_subcommand("check", "validate a model and print a summary");
+  check->add_option("model", model_path, "model file (YAML)")->required();
+  check->add_option("--set", settings, "override a model key");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    if (*check) return check_command(model_path, settings);
+    if (!integrator.empty())
+      overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
+    if (*t_end_option) overrides.t_end = t_end;
+    if (*rtol_option) overrides.rtol = rtol;
+    if (*atol_option) overrides.atol = atol;
+    if (*dt_option) overrides.dt = dt;
+    if (*output_option) overrides.output_interval = output_interval;
+    return run_command(model_path, settings, overrides, out_dir);
+  } catch (const railcrash::InputError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "railcrash failed: %s\n", e.what());
+    return 1;
+  }
+}

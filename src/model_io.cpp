@@ -1,0 +1,441 @@
+#include "railcrash/model_io.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "railcrash/element_registry.hpp"
+
+namespace railcrash {
+
+namespace {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> previous(b.size() + 1), current(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(previous, current);
+  }
+  return previous[b.size()];
+}
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+/// " (did you mean 'x'?)" when a known word is close to `word`.
+std::string suggestion(const std::string& word, const std::vector<std::string>& known) {
+  std::string best;
+  std::size_t best_distance = 3;
+  for (const auto& k : known) {
+    const std::size_t d = edit_distance(word, k);
+    if (d < best_distance) { best_distance = d; best = k; }
+  }
+  return best.empty() ? "" : " (did you mean '" + best + "'?)";
+}
+
+/// Reads one model file, keeping the file name for every message.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  SourceLocation at(const YAML::Node& node) const {
+    const int line = node.Mark().is_null() ? 0 : node.Mark().line + 1;
+    return {file_, line};
+  }
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
+    throw InputError(at(node).prefix() + message);
+  }
+
+  void require_map(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsMap()) fail(node, what + " must be a map of keys (key: value)");
+  }
+  void require_list(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsSequence()) fail(node, what + " must be a list (lines starting with '- ')");
+  }
+
+  /// Rejects keys outside `allowed`, naming the closest allowed one.
+  void check_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
+    for (const auto& entry : map) {
+      const std::string key = entry.first.as<std::string>();
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        fail(entry.first, context + ": unknown key '" + key + "'" + suggestion(key, allowed) +
+                              "; allowed keys: " + join(allowed));
+    }
+  }
+
+  double number(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsScalar()) fail(node, what + " must be a number");
+    double value = 0.0;
+    try {
+      value = node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(node, what + " must be a number, not '" + node.Scalar() + "'");
+    }
+    if (!std::isfinite(value)) fail(node, what + " must be a finite number, not '" + node.Scalar() + "'");
+    return value;
+  }
+
+  std::vector<double> numbers(const YAML::Node& node, std::size_t size, const std::string& what) const {
+    if (!node.IsSequence() || (size > 0 && node.size() != size)) {
+      std::string shape = size == 2 ? "[a, b]" : "a list of numbers";
+      fail(node, what + " must be " + (size > 0 ? "a list of " + std::to_string(size) + " numbers " + shape : shape) +
+                     (node.IsSequence() ? ", not a list of " + std::to_string(node.size()) : ""));
+    }
+    std::vector<double> out;
+    for (std::size_t i = 0; i < node.size(); ++i) out.push_back(number(node[i], what + " entry " + std::to_string(i + 1)));
+    return out;
+  }
+
+  std::string text(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsScalar()) fail(node, what + " must be a word");
+    return node.Scalar();
+  }
+
+  const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
+    const YAML::Node node = map[key];
+    if (!node) fail(map, context + ": missing required key '" + key + "'");
+    return node;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+class YamlParameterReader : public ParameterReader {
+ public:
+  YamlParameterReader(const Reader& reader, const YAML::Node& element, std::string context)
+      : reader_(reader), element_(element), context_(std::move(context)) {}
+
+  std::optional<double> number(const std::string& key) override {
+    used_.insert(key);
+    const YAML::Node node = element_[key];
+    if (!node) return std::nullopt;
+    return reader_.number(node, context_ + ": '" + key + "'");
+  }
+  std::optional<std::vector<double>> vector(const std::string& key, std::size_t size) override {
+    used_.insert(key);
+    const YAML::Node node = element_[key];
+    if (!node) return std::nullopt;
+    return reader_.numbers(node, size, context_ + ": '" + key + "'");
+  }
+  std::optional<bool> flag(const std::string& key) override {
+    used_.insert(key);
+    const YAML::Node node = element_[key];
+    if (!node) return std::nullopt;
+    try {
+      return node.as<bool>();
+    } catch (const YAML::Exception&) {
+      reader_.fail(node, context_ + ": '" + key + "' must be true or false");
+    }
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& what_to_change) const override {
+    const YAML::Node node = element_[key];
+    reader_.fail(node ? node : element_, context_ + ": " + what_to_change);
+  }
+  const std::set<std::string>& used() const { return used_; }
+
+ private:
+  const Reader& reader_;
+  YAML::Node element_;
+  std::string context_;
+  std::set<std::string> used_;
+};
+
+/// Applies KEY=VALUE overrides to the document: simulation.t_end=1, bodies.<name>.<key>=...,
+/// elements.<name>.<key>=..., gravity=[0,0], units=SI.
+void apply_override(YAML::Node& root, const std::string& setting) {
+  const auto equals = setting.find('=');
+  if (equals == std::string::npos || equals == 0)
+    throw InputError("--set '" + setting + "': expected KEY=VALUE, e.g. simulation.t_end=0.5 or elements.spring.stiffness=200");
+  const std::string key = setting.substr(0, equals);
+  YAML::Node value;
+  try {
+    value = YAML::Load(setting.substr(equals + 1));
+  } catch (const YAML::Exception& e) {
+    throw InputError("--set '" + setting + "': the value is not valid YAML (" + e.msg + ")");
+  }
+  std::vector<std::string> parts;
+  std::stringstream stream(key);
+  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
+  if (parts.size() == 1) {
+    root[parts[0]] = value;
+    return;
+  }
+  if (parts.size() == 2) {
+    if (!root[parts[0]] || !root[parts[0]].IsMap()) root[parts[0]] = YAML::Node(YAML::NodeType::Map);
+    YAML::Node section = root[parts[0]];
+    section[parts[1]] = value;
+    return;
+  }
+  if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
+    YAML::Node list = root[parts[0]];
+    if (list && list.IsSequence())
+      for (std::size_t i = 0; i < list.size(); ++i)
+        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].Scalar() == parts[1]) {
+          YAML::Node item = list[i];
+          item[parts[2]] = value;
+          return;
+        }
+    throw InputError("--set '" + setting + "': the model has no " + (parts[0] == "bodies" ? "body" : "element") + " named '" +
+                     parts[1] + "'");
+  }
+  throw InputError("--set '" + setting + "': KEY must be a top-level key, section.key (e.g. simulation.rtol), "
+                   "bodies.<name>.<key> or elements.<name>.<key>");
+}
+
+const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description"};
+const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity"};
+const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
+const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt",
+                                                  "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
+                                                  "penalty_rotational_damping"};
+
+Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double gravity_magnitude) {
+  r.require_map(node, "each body");
+  const std::string name = r.text(r.required(node, "name", "body"), "body name");
+  const std::string context = "body '" + name + "'";
+  r.check_keys(node, kBodyKeys, context);
+  Body b;
+  b.name = name;
+  b.where = r.at(node);
+  if (node["mass"] && node["weight"]) r.fail(node["weight"], context + ": give either mass or weight, not both");
+  if (node["weight"]) {
+    if (units != UnitSystem::InLbfS)
+      r.fail(node["weight"], context + ": 'weight' is for in-lbf-s models (weight in lbf); in SI give 'mass' in kg");
+    const double weight = r.number(node["weight"], context + ": weight");
+    if (!(weight > 0.0)) r.fail(node["weight"], context + ": weight must be positive (lbf)");
+    b.mass = weight / gravity_magnitude;  // [lbf*s^2/in] = lbf / (386.088 in/s^2)
+  } else {
+    const YAML::Node mass = r.required(node, "mass", context + " (give mass" + std::string(units == UnitSystem::InLbfS ? " or weight" : "") + ")");
+    b.mass = r.number(mass, context + ": mass");
+    if (!(b.mass > 0.0)) r.fail(mass, context + ": mass must be positive");
+  }
+  const YAML::Node inertia = r.required(node, "inertia", context);
+  b.inertia = r.number(inertia, context + ": inertia");
+  if (b.inertia < 0.0) r.fail(inertia, context + ": inertia must not be negative (0 = point mass)");
+  const auto position = r.numbers(r.required(node, "position", context), 2, context + ": position");
+  b.x = position[0];
+  b.y = position[1];
+  if (node["angle"]) b.angle = r.number(node["angle"], context + ": angle");
+  if (node["velocity"]) {
+    const auto v = r.numbers(node["velocity"], 2, context + ": velocity");
+    b.vx = v[0];
+    b.vy = v[1];
+  }
+  if (node["angular_velocity"]) b.angular_velocity = r.number(node["angular_velocity"], context + ": angular_velocity");
+  return b;
+}
+
+std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, const Model& model) {
+  r.require_map(node, "each element");
+  const std::string name = r.text(r.required(node, "name", "element"), "element name");
+  const YAML::Node type_node = r.required(node, "type", "element '" + name + "'");
+  const std::string type = r.text(type_node, "element '" + name + "': type");
+  const ElementRegistry& registry = ElementRegistry::instance();
+  const ElementFactory* factory = registry.find(type);
+  if (!factory)
+    r.fail(type_node, "element '" + name + "': unknown element type '" + type + "'" + suggestion(type, registry.types()) +
+                          "; known types: " + join(registry.types()));
+  const std::string context = "element '" + name + "' (" + type + ")";
+  ElementSpec spec;
+  spec.name = name;
+  spec.type = type;
+  spec.where = r.at(node);
+  const YAML::Node points = r.required(node, "points", context);
+  r.require_list(points, context + ": points");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const YAML::Node p = points[i];
+    const std::string pc = context + ": point " + std::to_string(i + 1);
+    r.require_map(p, pc);
+    r.check_keys(p, {"body", "at"}, pc);
+    const YAML::Node body_node = r.required(p, "body", pc);
+    const std::string body = r.text(body_node, pc + ": body");
+    const auto index = model.find_body(body);
+    if (!index) {
+      std::vector<std::string> names{"ground"};
+      for (const Body& b : model.bodies()) names.push_back(b.name);
+      r.fail(body_node, pc + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
+    }
+    PointRef ref;
+    ref.body = *index;
+    if (p["at"]) {
+      const auto at = r.numbers(p["at"], 2, pc + ": at");
+      ref.sx = at[0];
+      ref.sy = at[1];
+    }
+    spec.points.push_back(ref);
+  }
+  YamlParameterReader parameters(r, node, context);
+  spec.parameters = &parameters;
+  std::unique_ptr<Element> element = (*factory)(spec);
+  std::vector<std::string> allowed{"name", "type", "points"};
+  for (const auto& key : parameters.used()) allowed.push_back(key);
+  r.check_keys(node, allowed, context);
+  return element;
+}
+
+TimeTable read_load_value(const Reader& r, const YAML::Node& node, std::size_t width, const std::string& context) {
+  TimeTable table;
+  const auto read_value = [&](const YAML::Node& v, const std::string& what) -> std::array<double, 2> {
+    if (width == 1) return {r.number(v, what), 0.0};
+    const auto pair = r.numbers(v, 2, what);
+    return {pair[0], pair[1]};
+  };
+  const bool tabulated = node.IsSequence() && node.size() > 0 && node[0].IsSequence();
+  if (!tabulated) {
+    table.times = {0.0};
+    table.values = {read_value(node, context + ": value" + (width == 2 ? " [Fx, Fy]" : ""))};
+    return table;
+  }
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node row = node[i];
+    const std::string what = context + ": table row " + std::to_string(i + 1);
+    if (!row.IsSequence() || row.size() < 2)
+      r.fail(row, what + " must be [t, value]" + std::string(width == 2 ? " with value [Fx, Fy] (or [t, Fx, Fy])" : ""));
+    const double t = r.number(row[0], what + " time");
+    std::array<double, 2> value{};
+    if (width == 2 && row.size() == 3) {
+      value = {r.number(row[1], what + " Fx"), r.number(row[2], what + " Fy")};
+    } else if (row.size() == 2) {
+      value = read_value(row[1], what + " value");
+    } else {
+      r.fail(row, what + " must be [t, value]");
+    }
+    if (!table.times.empty() && !(t > table.times.back()))
+      r.fail(row[0], what + ": times must increase strictly down the table");
+    table.times.push_back(t);
+    table.values.push_back(value);
+  }
+  return table;
+}
+
+Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
+  r.require_map(node, "each load");
+  r.check_keys(node, kLoadKeys, "load");
+  const std::string type = r.text(r.required(node, "type", "load"), "load type");
+  const std::string body = r.text(r.required(node, "body", "load"), "load body");
+  const std::string context = type + " load on '" + body + "'";
+  Load load;
+  load.where = r.at(node);
+  if (type == "force") load.kind = Load::Kind::Force;
+  else if (type == "moment") load.kind = Load::Kind::Moment;
+  else r.fail(node["type"], "load: unknown type '" + type + "'; use force or moment");
+  const auto index = model.find_body(body);
+  if (!index) r.fail(node["body"], context + ": unknown body '" + body + "'");
+  if (*index == kGround) r.fail(node["body"], context + ": a load on the ground does nothing; name a body");
+  load.body = *index;
+  if (node["at"]) {
+    if (load.kind == Load::Kind::Moment) r.fail(node["at"], context + ": a moment has no point; remove 'at'");
+    const auto at = r.numbers(node["at"], 2, context + ": at");
+    load.sx = at[0];
+    load.sy = at[1];
+  }
+  load.value = read_load_value(r, r.required(node, "value", context), load.kind == Load::Kind::Force ? 2 : 1, context);
+  return load;
+}
+
+void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings& s) {
+  r.require_map(node, "simulation");
+  r.check_keys(node, kSimulationKeys, "simulation");
+  const YAML::Node t_end = r.required(node, "t_end", "simulation");
+  s.t_end = r.number(t_end, "simulation: t_end");
+  if (!(s.t_end > 0.0)) r.fail(t_end, "simulation: t_end must be positive (the end time of the run)");
+  if (node["integrator"]) {
+    const std::string name = r.text(node["integrator"], "simulation: integrator");
+    if (name == "ida") s.integrator = IntegratorKind::Ida;
+    else if (name == "euler") s.integrator = IntegratorKind::Euler;
+    else r.fail(node["integrator"], "simulation: integrator must be ida or euler, not '" + name + "'");
+  }
+  const auto positive = [&](const char* key) -> std::optional<double> {
+    if (!node[key]) return std::nullopt;
+    const double value = r.number(node[key], std::string("simulation: ") + key);
+    if (!(value > 0.0)) r.fail(node[key], std::string("simulation: ") + key + " must be positive");
+    return value;
+  };
+  if (auto v = positive("rtol")) s.rtol = *v;
+  s.atol = positive("atol");
+  if (auto v = positive("dt")) s.dt = *v;
+  if (auto v = positive("output_interval")) s.output_interval = *v;
+  if (node["force_dt"]) s.force_dt = node["force_dt"].as<bool>();
+  s.penalty.stiffness = positive("penalty_stiffness");
+  s.penalty.damping = positive("penalty_damping");
+  s.penalty.rotational_stiffness = positive("penalty_rotational_stiffness");
+  s.penalty.rotational_damping = positive("penalty_rotational_damping");
+}
+
+Model build(const YAML::Node& root, const Reader& r) {
+  if (!root.IsMap()) r.fail(root, "a model file must be a YAML map with keys railcrash, name, units, bodies, elements, simulation");
+  r.check_keys(root, kTopKeys, "model");
+  Model model;
+  model.file = r.file();
+  const YAML::Node version = r.required(root, "railcrash", "model (format version: add 'railcrash: 1')");
+  if (r.number(version, "railcrash (format version)") != 1.0)
+    r.fail(version, "this railcrash reads model format 1; found railcrash: " + version.Scalar());
+  model.name = r.text(r.required(root, "name", "model"), "name");
+  const YAML::Node units = r.required(root, "units", "model");
+  const std::string unit_name = r.text(units, "units");
+  if (unit_name == "SI") model.units = UnitSystem::SI;
+  else if (unit_name == "in-lbf-s") model.units = UnitSystem::InLbfS;
+  else r.fail(units, "units must be SI or in-lbf-s, not '" + unit_name + "'");
+  const double g = standard_gravity(model.units);
+  model.gravity_x = 0.0;
+  model.gravity_y = -g;
+  if (root["gravity"]) {
+    const auto gravity = r.numbers(root["gravity"], 2, "gravity");
+    model.gravity_x = gravity[0];
+    model.gravity_y = gravity[1];
+  }
+  const YAML::Node bodies = r.required(root, "bodies", "model");
+  r.require_list(bodies, "bodies");
+  for (std::size_t i = 0; i < bodies.size(); ++i) model.add_body(read_body(r, bodies[i], model.units, g));
+  if (root["elements"]) {
+    r.require_list(root["elements"], "elements");
+    for (std::size_t i = 0; i < root["elements"].size(); ++i) model.add_element(read_element(r, root["elements"][i], model));
+  }
+  if (root["loads"]) {
+    r.require_list(root["loads"], "loads");
+    for (std::size_t i = 0; i < root["loads"].size(); ++i) model.add_load(read_load(r, root["loads"][i], model));
+  }
+  read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
+  return model;
+}
+
+}  // namespace
+
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  const Reader reader(path);
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
+  }
+  for (const auto& setting : overrides) apply_override(root, setting);
+  Model model = build(root, reader);
+  model.finalize();
+  return model;
+}
+
+Model load_model(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the model file (check the path)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return load_model_text(buffer.str(), path, overrides);
+}
+
+Model load_model(const std::string& path) { return load_model(path, {}); }
+
+}  // namespace railcrash

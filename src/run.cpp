@@ -1,0 +1,85 @@
+#include "railcrash/run.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "railcrash/euler_integrator.hpp"
+#include "railcrash/ida_integrator.hpp"
+#include "railcrash/results.hpp"
+
+namespace railcrash {
+
+namespace {
+
+double checked_positive(double value, const char* option) {
+  if (!(value > 0.0) || !std::isfinite(value))
+    throw InputError(std::string(option) + " must be a positive number, not " + std::to_string(value));
+  return value;
+}
+
+/// Forwards samples to the writer (if any) and shows progress on a terminal.
+class ProgressObserver : public RunObserver {
+ public:
+  ProgressObserver(RunObserver* next, double t_end, bool show) : next_(next), t_end_(t_end), show_(show) {}
+  void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
+    if (next_) next_->sample(t, y, lambda, quadratures);
+    if (!show_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(200) && t < t_end_) return;
+    last_ = now;
+    std::fprintf(stderr, "\r  t = %-12.6g of %g  (%3.0f%%)", t, t_end_, 100.0 * t / t_end_);
+    if (t >= t_end_) std::fputs("\n", stderr);
+    std::fflush(stderr);
+  }
+
+ private:
+  RunObserver* next_;
+  double t_end_;
+  bool show_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+}  // namespace
+
+void apply_overrides(Model& model, const RunOverrides& o) {
+  SimulationSettings& s = model.simulation;
+  if (o.integrator) s.integrator = *o.integrator;
+  if (o.t_end) s.t_end = checked_positive(*o.t_end, "--t-end");
+  if (o.rtol) s.rtol = checked_positive(*o.rtol, "--rtol");
+  if (o.atol) s.atol = checked_positive(*o.atol, "--atol");
+  if (o.dt) s.dt = checked_positive(*o.dt, "--dt");
+  if (o.output_interval) s.output_interval = checked_positive(*o.output_interval, "--output-interval");
+  if (o.force_dt) s.force_dt = true;
+}
+
+double output_interval_of(const SimulationSettings& settings) {
+  return settings.output_interval > 0.0 ? settings.output_interval : settings.t_end / 500.0;
+}
+
+std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const SimulationSettings& settings) {
+  if (settings.integrator == IntegratorKind::Euler)
+    return std::make_unique<EulerIntegrator>(system, EulerSettings{settings.dt, settings.force_dt, settings.penalty});
+  IdaSettings ida;
+  ida.rtol = settings.rtol;
+  ida.atol = settings.atol;
+  return std::make_unique<IdaIntegrator>(system, ida);
+}
+
+RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress) {
+  const DaeSystem system(model);
+  std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
+  std::unique_ptr<ResultWriter> writer;
+  if (!out_dir.empty()) writer = std::make_unique<ResultWriter>(out_dir, system);
+  const bool terminal = show_progress && isatty(STDERR_FILENO);
+  ProgressObserver observer(writer.get(), model.simulation.t_end, terminal);
+  RunReport report;
+  report.integrator = integrator->name();
+  report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+  if (writer) writer->write_summary(report.outcome, report.integrator);
+  return report;
+}
+
+}  // namespace railcrash

@@ -1,0 +1,26 @@
+// Helpers shared by the unit tests.
+#pragma once
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "railcrash/dae_system.hpp"
+#include "railcrash/model.hpp"
+
+namespace railcrash::testing {
+
+/// Loads a model from YAML text (file name "test.yaml" in messages).
+Model model_from_text(const std::string& yaml);
+
+/// Largest relative difference between the assembled Jacobian dF/dy + cj dF/dy' and a
+/// central finite difference of the residual, at the given y, yp. Also checks that every
+/// nonzero of the finite-difference Jacobian lies inside the sparsity pattern
+/// (outside_pattern receives the largest |entry| found outside it).
+double jacobian_error(const DaeSystem& system, double t, double cj, const std::vector<double>& y,
+                      const std::vector<double>& yp, double* outside_pattern = nullptr);
+
+/// A random state near the model's initial one (positions, velocities, multipliers).
+std::vector<double> random_state(const DaeSystem& system, std::mt19937& rng, double spread = 0.3);
+
+}  // namespace railcrash::testing
