@@ -69,11 +69,28 @@ PenaltyRows EulerIntegrator::make_penalty(double dt) const {
   PenaltyRows rows;
   rows.stiffness.assign(static_cast<std::size_t>(m), 0.0);
   rows.damping.assign(static_cast<std::size_t>(m), 0.0);
-  std::vector<double> phi(static_cast<std::size_t>(m));
-  std::vector<DaeSystem::Triplet> gradient;
-  system_.constraints(y0_.data(), phi.data(), &gradient);
-  std::vector<double> inverse_effective_mass(static_cast<std::size_t>(m), 0.0);  // (G M^-1 G^T)_rr
-  for (const auto& t : gradient) inverse_effective_mass[static_cast<std::size_t>(t.row)] += t.value * t.value / system_.mass_diagonal(t.col);
+  // Effective mass of each row, bounded over all orientations of the bodies: a translational
+  // row moves body b's point at distance a_b from its centre, so 1 / m_eff <= sum 1/m_b + a_b^2/J_b;
+  // an angle row gives sum 1/J_b. (Taken at the start only, (G M^-1 G^T)_rr would let the
+  // penalty outrun the step once the bodies turn.)
+  std::vector<double> inverse_effective_mass(static_cast<std::size_t>(m), 0.0);
+  const Model& model = system_.model();
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const Element& el = *model.elements()[e];
+    for (int row = 0; row < el.constraint_count(); ++row) {
+      double inverse = 0.0;
+      for (int slot = 0; slot < 2; ++slot) {
+        const int b = el.slot_body(slot);
+        if (b == kGround) continue;
+        const Body& body = model.bodies()[static_cast<std::size_t>(b)];
+        double arm = 0.0;
+        for (std::size_t p = 0; p < el.points().size(); ++p)
+          if (el.point_slot(static_cast<int>(p)) == slot) arm = std::max(arm, std::hypot(el.points()[p].sx, el.points()[p].sy));
+        inverse += el.constraint_row_is_rotational(row) ? 1.0 / body.inertia : 1.0 / body.mass + arm * arm / body.inertia;
+      }
+      inverse_effective_mass[static_cast<std::size_t>(model.constraint_offset(e) + row)] = inverse;
+    }
+  }
   (void)nq;
   const double rate = kPenaltyStepAngle / dt;
   for (int r = 0; r < m; ++r) {

@@ -3,7 +3,9 @@
 // It drives the same element code as IDA. Constraints become penalty spring-dampers,
 //   lambda = k Phi + c G v,  force on the bodies -G^T lambda,
 // per constraint row. Defaults: k = m_eff (0.4 / dt)^2 and c = 2 m_eff (0.4 / dt) (critical
-// damping at 0.4 rad per step), with m_eff = 1 / (G M^-1 G^T)_rr the row's effective mass,
+// damping at 0.4 rad per step), with m_eff the row's effective mass bounded over all body
+// orientations (1/m_eff = sum over its bodies of 1/m + a^2/J, a the joint point's distance
+// from the centre of mass; angle rows: sum of 1/J),
 // so the penalty error falls as dt^2 and the penalty stiffness grows without bound as dt -> 0.
 // Joint keys / simulation keys penalty_stiffness, penalty_damping (translational rows) and
 // penalty_rotational_stiffness, penalty_rotational_damping (angle rows) override them.

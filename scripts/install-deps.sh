@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs what railcrash needs to build and test, from Debian 12's packages (as root, or
+# through sudo). Does nothing that is already installed.
+set -euo pipefail
+packages=(build-essential cmake ninja-build pkg-config
+          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "railcrash: all build dependencies are installed"
+  exit 0
+fi
+echo "railcrash: installing ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
