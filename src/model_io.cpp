@@ -48,11 +48,28 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
+  /// Marks `value` (and everything inside it) as coming from the command-line setting
+  /// `setting`: its line numbers belong to the setting, not to the file.
+  void add_override(const YAML::Node& value, const std::string& setting) {
+    overridden_.emplace_back(value, setting);
+    if (value.IsSequence() || value.IsMap())
+      for (const auto& entry : value) {
+        if (value.IsMap()) {
+          add_override(entry.first, setting);
+          add_override(entry.second, setting);
+        } else {
+          add_override(entry, setting);
+        }
+      }
+  }
+
   SourceLocation at(const YAML::Node& node) const {
-    const int line = node.Mark().is_null() ? 0 : node.Mark().line + 1;
-    return {file_, line};
+    if (!node.IsDefined() || from_override(node) || node.Mark().is_null()) return {file_, 0};
+    return {file_, node.Mark().line + 1};
   }
   [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
+    if (const std::string* setting = from_override(node))
+      throw InputError(SourceLocation{file_, 0}.prefix() + "--set '" + *setting + "': " + message);
     throw InputError(at(node).prefix() + message);
   }
 
@@ -63,13 +80,17 @@ class Reader {
     if (!node.IsSequence()) fail(node, what + " must be a list (lines starting with '- ')");
   }
 
-  /// Rejects keys outside `allowed`, naming the closest allowed one.
+  /// Rejects keys outside `allowed` (naming the closest allowed one) and repeated keys.
   void check_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
+    std::set<std::string> seen;
     for (const auto& entry : map) {
-      const std::string key = entry.first.as<std::string>();
+      if (!entry.first.IsScalar()) fail(entry.first, context + ": keys must be plain words; allowed keys: " + join(allowed));
+      const std::string key = entry.first.Scalar();
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
         fail(entry.first, context + ": unknown key '" + key + "'" + suggestion(key, allowed) +
                               "; allowed keys: " + join(allowed));
+      if (!seen.insert(key).second)
+        fail(entry.first, context + ": key '" + key + "' is given twice; keep only one");
     }
   }
 
@@ -96,6 +117,14 @@ class Reader {
     return out;
   }
 
+  bool boolean(const YAML::Node& node, const std::string& what) const {
+    try {
+      if (node.IsScalar()) return node.as<bool>();
+    } catch (const YAML::Exception&) {
+    }
+    fail(node, what + " must be true or false");
+  }
+
   std::string text(const YAML::Node& node, const std::string& what) const {
     if (!node.IsScalar()) fail(node, what + " must be a word");
     return node.Scalar();
@@ -110,7 +139,16 @@ class Reader {
   const std::string& file() const { return file_; }
 
  private:
+  /// The --set setting `node` came from, or nullptr when it is from the file.
+  const std::string* from_override(const YAML::Node& node) const {
+    if (!node.IsDefined()) return nullptr;
+    for (const auto& entry : overridden_)
+      if (entry.first.is(node)) return &entry.second;
+    return nullptr;
+  }
+
   std::string file_;
+  std::vector<std::pair<YAML::Node, std::string>> overridden_;
 };
 
 class YamlParameterReader : public ParameterReader {
@@ -134,11 +172,7 @@ class YamlParameterReader : public ParameterReader {
     used_.insert(key);
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
-    try {
-      return node.as<bool>();
-    } catch (const YAML::Exception&) {
-      reader_.fail(node, context_ + ": '" + key + "' must be true or false");
-    }
+    return reader_.boolean(node, context_ + ": '" + key + "'");
   }
   [[noreturn]] void fail(const std::string& key, const std::string& what_to_change) const override {
     const YAML::Node node = element_[key];
@@ -153,19 +187,22 @@ class YamlParameterReader : public ParameterReader {
   std::set<std::string> used_;
 };
 
-/// Applies KEY=VALUE overrides to the document: simulation.t_end=1, bodies.<name>.<key>=...,
-/// elements.<name>.<key>=..., gravity=[0,0], units=SI.
-void apply_override(YAML::Node& root, const std::string& setting) {
+/// Applies one KEY=VALUE override to the document: simulation.t_end=1, bodies.<name>.<key>=...,
+/// elements.<name>.<key>=..., gravity=[0,0], units=SI. The value is registered with the
+/// reader so that a bad value is reported against the setting rather than a file line.
+void apply_override(YAML::Node& root, const std::string& setting, Reader& reader) {
+  const std::string where = SourceLocation{reader.file(), 0}.prefix() + "--set '" + setting + "': ";
   const auto equals = setting.find('=');
   if (equals == std::string::npos || equals == 0)
-    throw InputError("--set '" + setting + "': expected KEY=VALUE, e.g. simulation.t_end=0.5 or elements.spring.stiffness=200");
+    throw InputError(where + "expected KEY=VALUE, e.g. simulation.t_end=0.5 or elements.spring.stiffness=200");
   const std::string key = setting.substr(0, equals);
   YAML::Node value;
   try {
     value = YAML::Load(setting.substr(equals + 1));
   } catch (const YAML::Exception& e) {
-    throw InputError("--set '" + setting + "': the value is not valid YAML (" + e.msg + ")");
+    throw InputError(where + "the value is not valid YAML (" + e.msg + ")");
   }
+  reader.add_override(value, setting);
   std::vector<std::string> parts;
   std::stringstream stream(key);
   for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
@@ -174,7 +211,17 @@ void apply_override(YAML::Node& root, const std::string& setting) {
     return;
   }
   if (parts.size() == 2) {
-    if (!root[parts[0]] || !root[parts[0]].IsMap()) root[parts[0]] = YAML::Node(YAML::NodeType::Map);
+    if (root[parts[0]] && !root[parts[0]].IsMap()) {
+      if (parts[0] == "bodies" || parts[0] == "elements")
+        throw InputError(where + "'" + parts[0] + "' is a list; use " + parts[0] + ".<name>.<key>, e.g. " +
+                         (parts[0] == "bodies" ? "bodies.cart.mass=2" : "elements.spring.stiffness=200"));
+      throw InputError(where + "'" + parts[0] + "' is not a section of keys; give it whole, e.g. " + parts[0] + "=VALUE");
+    }
+    if (!root[parts[0]]) {
+      if (parts[0] != "simulation")
+        throw InputError(where + "'" + parts[0] + "' is not a section of keys; the section is simulation (e.g. simulation.t_end=0.5)");
+      root[parts[0]] = YAML::Node(YAML::NodeType::Map);
+    }
     YAML::Node section = root[parts[0]];
     section[parts[1]] = value;
     return;
@@ -183,16 +230,48 @@ void apply_override(YAML::Node& root, const std::string& setting) {
     YAML::Node list = root[parts[0]];
     if (list && list.IsSequence())
       for (std::size_t i = 0; i < list.size(); ++i)
-        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].Scalar() == parts[1]) {
+        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == parts[1]) {
           YAML::Node item = list[i];
           item[parts[2]] = value;
           return;
         }
-    throw InputError("--set '" + setting + "': the model has no " + (parts[0] == "bodies" ? "body" : "element") + " named '" +
-                     parts[1] + "'");
+    throw InputError(where + "the model has no " + (parts[0] == "bodies" ? "body" : "element") + " named '" + parts[1] + "'");
   }
-  throw InputError("--set '" + setting + "': KEY must be a top-level key, section.key (e.g. simulation.rtol), "
+  throw InputError(where + "KEY must be a top-level key, section.key (e.g. simulation.rtol), "
                    "bodies.<name>.<key> or elements.<name>.<key>");
+}
+
+/// Runs an element factory on placeholder values to learn every key its type reads (the
+/// real reader stops at the first problem, so it may not have seen them all).
+class KeyProbe : public ParameterReader {
+ public:
+  struct Stop {};
+  std::optional<double> number(const std::string& key) override {
+    keys.insert(key);
+    return 1.0;
+  }
+  std::optional<std::vector<double>> vector(const std::string& key, std::size_t size) override {
+    keys.insert(key);
+    return std::vector<double>(size > 0 ? size : 2, 1.0);
+  }
+  std::optional<bool> flag(const std::string& key) override {
+    keys.insert(key);
+    return false;
+  }
+  [[noreturn]] void fail(const std::string&, const std::string&) const override { throw Stop{}; }
+  std::set<std::string> keys;
+};
+
+std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementSpec& spec) {
+  KeyProbe probe;
+  ElementSpec copy = spec;
+  copy.parameters = &probe;
+  try {
+    (void)factory(copy);
+  } catch (const KeyProbe::Stop&) {
+  } catch (const InputError&) {
+  }
+  return probe.keys;
 }
 
 const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description"};
@@ -279,8 +358,19 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
   }
   YamlParameterReader parameters(r, node, context);
   spec.parameters = &parameters;
-  std::unique_ptr<Element> element = (*factory)(spec);
   std::vector<std::string> allowed{"name", "type", "points"};
+  std::unique_ptr<Element> element;
+  try {
+    element = (*factory)(spec);
+  } catch (const InputError&) {
+    // A misspelt key first shows up as a missing one ("stifness" -> stiffness missing):
+    // report unknown keys first, against everything the type accepts.
+    std::set<std::string> keys = keys_read_by(*factory, spec);
+    keys.insert(parameters.used().begin(), parameters.used().end());
+    allowed.insert(allowed.end(), keys.begin(), keys.end());
+    r.check_keys(node, allowed, context);
+    throw;
+  }
   for (const auto& key : parameters.used()) allowed.push_back(key);
   r.check_keys(node, allowed, context);
   return element;
@@ -333,7 +423,11 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
   else if (type == "moment") load.kind = Load::Kind::Moment;
   else r.fail(node["type"], "load: unknown type '" + type + "'; use force or moment");
   const auto index = model.find_body(body);
-  if (!index) r.fail(node["body"], context + ": unknown body '" + body + "'");
+  if (!index) {
+    std::vector<std::string> names;
+    for (const Body& b : model.bodies()) names.push_back(b.name);
+    r.fail(node["body"], context + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
+  }
   if (*index == kGround) r.fail(node["body"], context + ": a load on the ground does nothing; name a body");
   load.body = *index;
   if (node["at"]) {
@@ -368,11 +462,44 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   s.atol = positive("atol");
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
-  if (node["force_dt"]) s.force_dt = node["force_dt"].as<bool>();
+  if (node["force_dt"]) s.force_dt = r.boolean(node["force_dt"], "simulation: force_dt");
   s.penalty.stiffness = positive("penalty_stiffness");
   s.penalty.damping = positive("penalty_damping");
   s.penalty.rotational_stiffness = positive("penalty_rotational_stiffness");
   s.penalty.rotational_damping = positive("penalty_rotational_damping");
+}
+
+/// Line (1-based) of the last '[' or '{' still open at `end`, or 0. Skips comments and
+/// quoted strings; outside flow collections only a bracket that starts a value counts.
+int unclosed_bracket_line(const std::string& text, std::size_t end) {
+  std::vector<int> open;
+  int line = 1;
+  char quote = 0;
+  char previous = '\n';  // last non-blank character outside quotes
+  for (std::size_t i = 0; i < std::min(end, text.size()); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (quote) {
+      if (c == quote && !(quote == '"' && i > 0 && text[i - 1] == '\\')) quote = 0;
+      if (c == '\n') previous = '\n';
+      continue;
+    }
+    const bool value_start = previous == '\n' || previous == ':' || previous == '-' || previous == ',' ||
+                             previous == '[' || previous == '{' || previous == '?';
+    if (c == '#' && (i == 0 || text[i - 1] == ' ' || text[i - 1] == '\t' || text[i - 1] == '\n')) {
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+      continue;
+    }
+    if ((c == '\'' || c == '"') && value_start) {
+      quote = c;
+      continue;
+    }
+    if ((c == '[' || c == '{') && (value_start || !open.empty())) open.push_back(line);
+    if ((c == ']' || c == '}') && !open.empty()) open.pop_back();
+    if (c == '\n') previous = '\n';
+    else if (c != ' ' && c != '\t' && c != '\r') previous = c;
+  }
+  return open.empty() ? 0 : open.back();
 }
 
 Model build(const YAML::Node& root, const Reader& r) {
@@ -399,6 +526,7 @@ Model build(const YAML::Node& root, const Reader& r) {
   }
   const YAML::Node bodies = r.required(root, "bodies", "model");
   r.require_list(bodies, "bodies");
+  if (bodies.size() == 0) r.fail(bodies, "bodies: the list is empty; add at least one body");
   for (std::size_t i = 0; i < bodies.size(); ++i) model.add_body(read_body(r, bodies[i], model.units, g));
   if (root["elements"]) {
     r.require_list(root["elements"], "elements");
@@ -415,17 +543,33 @@ Model build(const YAML::Node& root, const Reader& r) {
 }  // namespace
 
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
-  const Reader reader(path);
+  Reader reader(path);
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
+    int line = e.mark.is_null() ? 0 : e.mark.line + 1;
+    std::string hint;
+    // yaml-cpp notices a missing ']' or '}' only where the next thing starts; point at the
+    // bracket that was left open instead.
+    if (e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW || e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW) {
+      const char close = e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW ? ']' : '}';
+      if (const int open = unclosed_bracket_line(text, e.mark.is_null() ? text.size() : static_cast<std::size_t>(e.mark.pos))) {
+        line = open;
+        hint = " (a '" + std::string(1, close == ']' ? '[' : '{') + "' on this line has no matching '" + close + "')";
+      }
+    }
+    throw InputError(SourceLocation{path, line}.prefix() + "not valid YAML: " + e.msg + hint);
   }
-  for (const auto& setting : overrides) apply_override(root, setting);
-  Model model = build(root, reader);
-  model.finalize();
-  return model;
+  if (root.IsMap() || root.IsNull())  // otherwise build() says what the file should look like
+    for (const auto& setting : overrides) apply_override(root, setting, reader);
+  try {
+    Model model = build(root, reader);
+    model.finalize();
+    return model;
+  } catch (const YAML::Exception& e) {  // a check above missed a case: still an input error with a line
+    throw InputError(SourceLocation{path, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "cannot read the model: " + e.msg);
+  }
 }
 
 Model load_model(const std::string& path, const std::vector<std::string>& overrides) {

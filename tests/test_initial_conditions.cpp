@@ -1,1 +1,110 @@
 #include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+#include "railcrash/initial_conditions.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+std::string num(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+// A 1 m pendulum: pin at the origin, bob's point [-1, 0] on the pin.
+std::string pendulum(double x, double y, double angle, double vx, double vy) {
+  return "railcrash: 1\nname: p\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+         "  - {name: bob, mass: 2.0, inertia: 0.1, position: [" + num(x) + ", " + num(y) +
+         "], angle: " + num(angle) + ", velocity: [" + num(vx) + ", " + num(vy) +
+         "]}\nelements:\n  - {name: hinge, type: pin_joint, points: [{body: ground, at: [0, 0]}, {body: bob, at: [-1, 0]}]}\n"
+         "simulation: {t_end: 1}\n";
+}
+
+}  // namespace
+
+TEST_CASE("position assembly closes a joint that starts slightly open", "[initial]") {
+  // The bob starts 2 cm too far out and 1 cm low: the pin is open by about 0.022 m.
+  const Model model = testing::model_from_text(pendulum(1.02, -0.01, 0.0, 0.0, 0.0));
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  REQUIRE(system.constraint_residual(y.data()) > 0.01);
+  const AssemblyReport report = assemble_initial_state(system, y);
+  CHECK(system.constraint_residual(y.data()) < 1e-12);
+  CHECK(report.largest_position_change > 0.005);
+  CHECK(report.largest_position_change < 0.05);
+  // The pin point of the bob is back on the origin.
+  const double x = y[0], yy = y[1], theta = y[2];
+  CHECK(std::abs(x - std::cos(theta)) < 1e-12);
+  CHECK(std::abs(yy - std::sin(theta)) < 1e-12);
+}
+
+TEST_CASE("velocity projection removes the velocity that would open the joint", "[initial]") {
+  // Horizontal pendulum: the pin allows only vertical motion of the bob (with rotation).
+  const Model model = testing::model_from_text(pendulum(1.0, 0.0, 0.0, 0.5, -1.0));
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const AssemblyReport report = assemble_initial_state(system, y);
+  CHECK(std::abs(y[3]) < 1e-12);  // radial velocity removed
+  CHECK(y[4] != 0.0);             // tangential velocity kept
+  // Pin point velocity = (vx, vy) + omega perp(R s) with R s = (-1, 0): (vx, vy - omega) = 0.
+  CHECK(std::abs(y[4] - y[5]) < 1e-12);
+  CHECK(report.largest_velocity_change >= 0.5);
+}
+
+TEST_CASE("consistent rates give the joint force and acceleration of Newton's law", "[initial]") {
+  SECTION("hanging at rest: the pin carries the weight") {
+    const Model model = testing::model_from_text(pendulum(0.0, -1.0, -M_PI / 2, 0.0, 0.0));
+    const DaeSystem system(model);
+    std::vector<double> y = system.initial_state(), yp;
+    assemble_initial_state(system, y);
+    consistent_rates(system, 0.0, y, yp);
+    CHECK(std::abs(yp[3]) < 1e-12);
+    CHECK(std::abs(yp[4]) < 1e-12);
+    double out[2];
+    system.outputs(y.data(), y.data() + 6, out);
+    CHECK(out[0] == Approx(0.0).margin(1e-12));
+    CHECK(out[1] == Approx(2.0 * 9.81));  // reaction on the bob: its weight, upward
+  }
+  SECTION("horizontal at rest: free fall of the centre, no pin force") {
+    // J = 0.1, m = 2, arm 1: angular acceleration m g L / (J + m L^2), linear a = alpha L.
+    const Model model = testing::model_from_text(pendulum(1.0, 0.0, 0.0, 0.0, 0.0));
+    const DaeSystem system(model);
+    std::vector<double> y = system.initial_state(), yp;
+    consistent_rates(system, 0.0, y, yp);
+    const double alpha = -2.0 * 9.81 * 1.0 / (0.1 + 2.0);
+    CHECK(yp[5] == Approx(alpha));
+    CHECK(yp[4] == Approx(alpha));
+    CHECK(std::abs(yp[3]) < 1e-12);
+    // The residual of the DAE vanishes at the consistent (y, y').
+    std::vector<double> r(static_cast<std::size_t>(system.size()));
+    system.residual(0.0, y.data(), yp.data(), r.data());
+    for (double value : r) CHECK(std::abs(value) < 1e-12);
+  }
+  SECTION("spinning at the bottom: the pin adds the centripetal force") {
+    const double omega = 3.0;  // the bob moves right at omega * 1 m
+    const Model model = testing::model_from_text(pendulum(0.0, -1.0, -M_PI / 2, omega, 0.0));
+    const DaeSystem system(model);
+    std::vector<double> y = system.initial_state(), yp;
+    y[5] = omega;
+    assemble_initial_state(system, y);
+    consistent_rates(system, 0.0, y, yp);
+    double out[2];
+    system.outputs(y.data(), y.data() + 6, out);
+    CHECK(out[1] == Approx(2.0 * 9.81 + 2.0 * omega * omega * 1.0));
+    CHECK(yp[4] == Approx(omega * omega * 1.0));  // centripetal acceleration, toward the pin
+  }
+}
+
+TEST_CASE("a free body with zero inertia makes the equations singular, with a clear message", "[initial]") {
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: p\nunits: SI\nbodies:\n  - {name: dot, mass: 1, inertia: 0, position: [0, 0]}\n"
+      "simulation: {t_end: 1}\n");
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state(), yp;
+  CHECK_THROWS_WITH(consistent_rates(system, 0.0, y, yp), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
+}

@@ -1,1 +1,171 @@
 #include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "railcrash/euler_integrator.hpp"
+#include "railcrash/ida_integrator.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+// Mass m on a spring k (and dashpot c) from the ground along x.
+std::string oscillator(double k, double c, double t_end, const std::string& extra = "") {
+  std::ostringstream s;
+  s << "railcrash: 1\nname: osc\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: mass, mass: 2.0, inertia: 0.1, position: [1.1, 0]}\nelements:\n"
+    << "  - {name: spring, type: linear_spring, stiffness: " << k << ", free_length: 1.0, "
+    << "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n";
+  if (c > 0.0)
+    s << "  - {name: damper, type: linear_dashpot, damping: " << c
+      << ", points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n";
+  s << "simulation: {t_end: " << t_end << extra << "}\n";
+  return s.str();
+}
+
+struct CountingObserver : RunObserver {
+  std::vector<double> times;
+  void sample(double t, const double*, const double*, const double*) override { times.push_back(t); }
+};
+
+struct StopAfter : RunObserver {
+  std::atomic<bool>* stop;
+  int samples = 0;
+  void sample(double, const double*, const double*, const double*) override {
+    if (++samples == 3) stop->store(true);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Euler stability limit matches 2 / (sqrt(w^2 + (c/2m)^2) + c/2m)", "[integrators]") {
+  SECTION("undamped: 2 / omega") {
+    const Model model = testing::model_from_text(oscillator(200.0, 0.0, 1.0));
+    const DaeSystem system(model);
+    // omega = sqrt(200 / 2) = 10 along x; the other directions have no stiffness.
+    CHECK(EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr) == Approx(0.2).epsilon(1e-9));
+  }
+  SECTION("damped") {
+    const Model model = testing::model_from_text(oscillator(200.0, 4.0, 1.0));
+    const DaeSystem system(model);
+    const double half_rate = 4.0 / 2.0 / 2.0;  // c / (2 m)
+    CHECK(EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr) ==
+          Approx(2.0 / (std::sqrt(100.0 + half_rate * half_rate) + half_rate)).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("Gershgorin bound for large models is safe and close for a long chain", "[integrators]") {
+  // 250 masses in a chain of springs from the ground (750 unknowns: above the dense limit).
+  std::ostringstream s;
+  const int n = 250;
+  s << "railcrash: 1\nname: chain\nunits: SI\ngravity: [0, 0]\nbodies:\n";
+  for (int i = 0; i < n; ++i) s << "  - {name: m" << i << ", mass: 1.0, inertia: 1.0, position: [" << i + 1 << ", 0]}\n";
+  s << "elements:\n";
+  for (int i = 0; i < n; ++i)
+    s << "  - {name: k" << i << ", type: linear_spring, stiffness: 100, points: [{body: " << (i == 0 ? "ground" : "m" + std::to_string(i - 1))
+      << ", at: [" << (i == 0 ? "1" : "0") << ", 0]}, {body: m" << i << ", at: [0, 0]}]}\n";
+  s << "simulation: {t_end: 1}\n";
+  const Model model = testing::model_from_text(s.str());
+  const DaeSystem system(model);
+  const double limit = EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr);
+  // Exact largest frequency of a fixed-free chain: 2 sqrt(k/m) sin((2n-1) pi / (2(2n+1))) < 2 sqrt(k/m).
+  const double omega_max = 2.0 * 10.0 * std::sin((2.0 * n - 1.0) * M_PI / (2.0 * (2.0 * n + 1.0)));
+  CHECK(limit <= 2.0 / omega_max);
+  CHECK(limit >= 0.99 * 2.0 / omega_max);
+}
+
+TEST_CASE("Euler refuses a step above the stability limit unless forced, then reports divergence", "[integrators]") {
+  Model model = testing::model_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3"));
+  const DaeSystem system(model);
+  CHECK_THROWS_WITH(make_integrator(system, model.simulation),
+                    Catch::Contains("above the stability limit") && Catch::Contains("0.2"));
+  model.simulation.force_dt = true;
+  auto integrator = make_integrator(system, model.simulation);
+  CountingObserver observer;
+  const RunOutcome outcome = integrator->run(200.0, 1.0, observer);
+  CHECK_FALSE(outcome.ok);
+  CHECK_THAT(outcome.message, Catch::Contains("diverged"));
+  CHECK(outcome.t_reached < 200.0);
+}
+
+TEST_CASE("Euler needs positive inertia", "[integrators]") {
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: p\nunits: SI\nbodies:\n  - {name: dot, mass: 1, inertia: 0, position: [0, 0]}\n"
+      "simulation: {t_end: 1, integrator: euler}\n");
+  const DaeSystem system(model);
+  CHECK_THROWS_WITH(make_integrator(system, model.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
+}
+
+TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "[integrators]") {
+  for (const char* integrator : {"ida", "euler"}) {
+    Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    const DaeSystem system(model);
+    auto run = make_integrator(system, model.simulation);
+    CountingObserver observer;
+    const RunOutcome outcome = run->run(1.0, 0.25, observer);
+    REQUIRE(outcome.ok);
+    REQUIRE(observer.times.size() == 5);
+    for (int k = 0; k < 5; ++k) CHECK(observer.times[static_cast<std::size_t>(k)] == Approx(0.25 * k).margin(1e-12));
+    CHECK(outcome.t_reached == Approx(1.0));
+  }
+}
+
+TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
+  for (const char* integrator : {"ida", "euler"}) {
+    Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    const DaeSystem system(model);
+    auto run = make_integrator(system, model.simulation);
+    std::atomic<bool> stop{false};
+    StopAfter observer;
+    observer.stop = &stop;
+    const RunOutcome outcome = run->run(1.0, 0.1, observer, &stop);
+    CHECK_FALSE(outcome.ok);
+    CHECK_THAT(outcome.message, Catch::Contains("interrupted"));
+    CHECK(outcome.t_reached == Approx(0.2).margin(1e-9));
+  }
+}
+
+TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
+  const Model model = testing::model_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
+  const DaeSystem system(model);
+  auto run = make_integrator(system, model.simulation);
+  CountingObserver observer;
+  const RunOutcome outcome = run->run(3.0, 0.1, observer);
+  REQUIRE(outcome.ok);
+  const EnergyBalance energy = EnergyBalance::between(outcome.initial_energy, outcome.final_energy);
+  CHECK(energy.initial_total == Approx(0.5 * 200.0 * 0.01));
+  // Work done on the dashpot (its own quadrature) against the mechanical energy lost.
+  const double damper_work = outcome.quadratures[DaeSystem::kFirstElementWork + 1];
+  CHECK(damper_work == Approx(energy.initial_total - energy.kinetic - energy.elastic).epsilon(1e-6));
+  CHECK(damper_work > 0.9 * energy.initial_total);  // zeta = 0.1 over ~5 periods
+}
+
+TEST_CASE("run_model writes timeseries, events and summary, also for a failed run", "[integrators]") {
+  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_test_results").string();
+  std::filesystem::remove_all(dir);
+  Model model = testing::model_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3, force_dt: true, output_interval: 1"));
+  const RunReport report = run_model(model, dir);
+  CHECK_FALSE(report.outcome.ok);
+  std::ifstream csv(dir + "/timeseries.csv");
+  std::string header;
+  std::getline(csv, header);
+  CHECK(header == "t,mass.x,mass.y,mass.theta,mass.vx,mass.vy,mass.omega,spring.force,spring.deformation");
+  int rows = 0;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  CHECK(rows >= 2);  // t = 0 and the samples before the divergence
+  std::ifstream summary_file(dir + "/summary.json");
+  std::stringstream summary;
+  summary << summary_file.rdbuf();
+  CHECK_THAT(summary.str(), Catch::Contains("\"status\": \"failed\"") && Catch::Contains("diverged") &&
+                                Catch::Contains("\"integrator\": \"euler\""));
+  std::ifstream events(dir + "/events.csv");
+  std::getline(events, header);
+  CHECK(header == "t,element,event,value");
+  std::filesystem::remove_all(dir);
+}
