@@ -63,8 +63,25 @@ class Reader {
       }
   }
 
+  /// Remembers the line of the key of every empty value ("t_end:" with nothing after it):
+  /// yaml-cpp places an empty value where the next token starts, often the next line.
+  void index_empty_values(const YAML::Node& node) {
+    if (node.IsMap()) {
+      for (const auto& entry : node) {
+        if (entry.second.IsNull() && !entry.first.Mark().is_null()) empty_values_.emplace_back(entry.second, entry.first.Mark().line + 1);
+        index_empty_values(entry.second);
+      }
+    } else if (node.IsSequence()) {
+      for (const auto& item : node) index_empty_values(item);
+    }
+  }
+
   SourceLocation at(const YAML::Node& node) const {
-    if (!node.IsDefined() || from_override(node) || node.Mark().is_null()) return {file_, 0};
+    if (!node.IsDefined() || from_override(node)) return {file_, 0};
+    if (node.IsNull())
+      for (const auto& entry : empty_values_)
+        if (entry.first.is(node)) return {file_, entry.second};
+    if (node.Mark().is_null()) return {file_, 0};
     return {file_, node.Mark().line + 1};
   }
   [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
@@ -95,6 +112,7 @@ class Reader {
   }
 
   double number(const YAML::Node& node, const std::string& what) const {
+    if (node.IsNull()) fail(node, what + " must be a number (it is empty)");
     if (!node.IsScalar()) fail(node, what + " must be a number");
     double value = 0.0;
     try {
@@ -149,6 +167,7 @@ class Reader {
 
   std::string file_;
   std::vector<std::pair<YAML::Node, std::string>> overridden_;
+  std::vector<std::pair<YAML::Node, int>> empty_values_;
 };
 
 class YamlParameterReader : public ParameterReader {
@@ -187,6 +206,13 @@ class YamlParameterReader : public ParameterReader {
   std::set<std::string> used_;
 };
 
+/// Marks the key that now holds `value` in `map` as coming from `setting` too (so an
+/// unknown key given with --set is reported against the setting).
+void mark_override_key(const YAML::Node& map, const YAML::Node& value, const std::string& setting, Reader& reader) {
+  for (const auto& entry : map)
+    if (entry.second.is(value)) reader.add_override(entry.first, setting);
+}
+
 /// Applies one KEY=VALUE override to the document: simulation.t_end=1, bodies.<name>.<key>=...,
 /// elements.<name>.<key>=..., gravity=[0,0], units=SI. The value is registered with the
 /// reader so that a bad value is reported against the setting rather than a file line.
@@ -224,6 +250,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
     }
     YAML::Node section = root[parts[0]];
     section[parts[1]] = value;
+    mark_override_key(section, value, setting, reader);
     return;
   }
   if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
@@ -233,6 +260,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
         if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == parts[1]) {
           YAML::Node item = list[i];
           item[parts[2]] = value;
+          mark_override_key(item, value, setting, reader);
           return;
         }
     throw InputError(where + "the model has no " + (parts[0] == "bodies" ? "body" : "element") + " named '" + parts[1] + "'");
@@ -266,10 +294,14 @@ std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementS
   KeyProbe probe;
   ElementSpec copy = spec;
   copy.parameters = &probe;
-  try {
-    (void)factory(copy);
-  } catch (const KeyProbe::Stop&) {
-  } catch (const InputError&) {
+  // A wrong point count stops the factory part-way, so also try the usual point counts.
+  for (std::size_t count : {spec.points.size(), std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{4}}) {
+    copy.points.assign(count, PointRef{});
+    try {
+      (void)factory(copy);
+    } catch (const KeyProbe::Stop&) {
+    } catch (const InputError&) {
+    }
   }
   return probe.keys;
 }
@@ -469,37 +501,67 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   s.penalty.rotational_damping = positive("penalty_rotational_damping");
 }
 
-/// Line (1-based) of the last '[' or '{' still open at `end`, or 0. Skips comments and
-/// quoted strings; outside flow collections only a bracket that starts a value counts.
-int unclosed_bracket_line(const std::string& text, std::size_t end) {
-  std::vector<int> open;
-  int line = 1;
+/// The last '[' or '{' still open at offset `end` of `text` (line 0 when none). Skips
+/// comments, quoted strings and block scalars (| and >); outside flow collections only a
+/// bracket that starts a value counts (a plain scalar may contain brackets).
+struct OpenBracket {
+  int line = 0;
+  char bracket = 0;
+};
+
+OpenBracket unclosed_bracket(const std::string& text, std::size_t end) {
+  std::vector<OpenBracket> open;
+  end = std::min(end, text.size());
   char quote = 0;
-  char previous = '\n';  // last non-blank character outside quotes
-  for (std::size_t i = 0; i < std::min(end, text.size()); ++i) {
-    const char c = text[i];
-    if (c == '\n') ++line;
-    if (quote) {
-      if (c == quote && !(quote == '"' && i > 0 && text[i - 1] == '\\')) quote = 0;
-      if (c == '\n') previous = '\n';
+  int block_indent = -1;  // >= 0: inside a block scalar whose key line has this indentation
+  int line = 0;
+  for (std::size_t start = 0; start < end;) {
+    std::size_t stop = text.find('\n', start);
+    if (stop == std::string::npos) stop = text.size();
+    ++line;
+    const std::size_t first = text.find_first_not_of(" ", start);
+    const int indent = static_cast<int>((first == std::string::npos ? stop : std::min(first, stop)) - start);
+    const bool blank = first == std::string::npos || first >= stop || text[first] == '\r';
+    if (block_indent >= 0 && (blank || indent > block_indent)) {
+      start = stop + 1;
       continue;
     }
-    const bool value_start = previous == '\n' || previous == ':' || previous == '-' || previous == ',' ||
-                             previous == '[' || previous == '{' || previous == '?';
-    if (c == '#' && (i == 0 || text[i - 1] == ' ' || text[i - 1] == '\t' || text[i - 1] == '\n')) {
-      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
-      continue;
+    block_indent = -1;
+    char previous = '\n';  // last non-blank character outside quotes on this line
+    std::size_t content_end = stop;
+    for (std::size_t i = start; i < std::min(stop, end); ++i) {
+      const char c = text[i];
+      if (quote) {
+        if (c == quote && !(quote == '"' && i > start && text[i - 1] == '\\')) quote = 0;
+        continue;
+      }
+      if (c == '#' && (i == start || text[i - 1] == ' ' || text[i - 1] == '\t')) {
+        content_end = i;
+        break;
+      }
+      const bool value_start = previous == '\n' || previous == ':' || previous == '-' || previous == ',' ||
+                               previous == '[' || previous == '{' || previous == '?';
+      if ((c == '\'' || c == '"') && value_start) {
+        quote = c;
+      } else if ((c == '[' || c == '{') && (value_start || !open.empty())) {
+        open.push_back({line, c});
+      } else if ((c == ']' || c == '}') && !open.empty()) {
+        open.pop_back();
+      }
+      if (c != ' ' && c != '\t' && c != '\r') previous = c;
     }
-    if ((c == '\'' || c == '"') && value_start) {
-      quote = c;
-      continue;
+    if (!quote && open.empty()) {  // "key: |" or "- >-" starts a block scalar on the next lines
+      std::size_t last = content_end;
+      while (last > start && (text[last - 1] == ' ' || text[last - 1] == '\t' || text[last - 1] == '\r')) --last;
+      std::size_t word = last;
+      while (word > start && text[word - 1] != ' ') --word;
+      if (word < last && (text[word] == '|' || text[word] == '>') &&
+          text.find_first_not_of("+-0123456789", word + 1) >= last && word > start)
+        block_indent = indent;
     }
-    if ((c == '[' || c == '{') && (value_start || !open.empty())) open.push_back(line);
-    if ((c == ']' || c == '}') && !open.empty()) open.pop_back();
-    if (c == '\n') previous = '\n';
-    else if (c != ' ' && c != '\t' && c != '\r') previous = c;
+    start = stop + 1;
   }
-  return open.empty() ? 0 : open.back();
+  return open.empty() ? OpenBracket{} : open.back();
 }
 
 Model build(const YAML::Node& root, const Reader& r) {
@@ -548,19 +610,19 @@ Model load_model_text(const std::string& text, const std::string& path, const st
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    int line = e.mark.is_null() ? 0 : e.mark.line + 1;
-    std::string hint;
-    // yaml-cpp notices a missing ']' or '}' only where the next thing starts; point at the
-    // bracket that was left open instead.
-    if (e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW || e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW) {
-      const char close = e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW ? ']' : '}';
-      if (const int open = unclosed_bracket_line(text, e.mark.is_null() ? text.size() : static_cast<std::size_t>(e.mark.pos))) {
-        line = open;
-        hint = " (a '" + std::string(1, close == ']' ? '[' : '{') + "' on this line has no matching '" + close + "')";
-      }
-    }
-    throw InputError(SourceLocation{path, line}.prefix() + "not valid YAML: " + e.msg + hint);
+    const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
+    // A ']' or '}' left out is noticed only where the next thing starts (often the next
+    // line, as "end of sequence flow not found" or "illegal block entry"): point at the
+    // bracket that was left open.
+    const OpenBracket open = unclosed_bracket(text, e.mark.is_null() ? text.size() : static_cast<std::size_t>(e.mark.pos));
+    const bool flow_end = e.msg == YAML::ErrorMsg::END_OF_SEQ_FLOW || e.msg == YAML::ErrorMsg::END_OF_MAP_FLOW;
+    if (open.line > 0 && (flow_end || (e.msg == YAML::ErrorMsg::BLOCK_ENTRY && open.line < line)))
+      throw InputError(SourceLocation{path, open.line}.prefix() + "not valid YAML: the '" + std::string(1, open.bracket) +
+                       "' on this line is never closed; add the matching '" + (open.bracket == '[' ? "]" : "}") +
+                       "' (the parser stopped at line " + std::to_string(line) + ": " + e.msg + ")");
+    throw InputError(SourceLocation{path, line}.prefix() + "not valid YAML: " + e.msg);
   }
+  reader.index_empty_values(root);
   if (root.IsMap() || root.IsNull())  // otherwise build() says what the file should look like
     for (const auto& setting : overrides) apply_override(root, setting, reader);
   try {

@@ -1,1 +1,832 @@
+// Model files: what a valid file gives, and that every bad input is an InputError whose
+// message names the file and line, the body / element / key at fault and what to change.
 #include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "railcrash/dae_system.hpp"
+#include "railcrash/elements/joints.hpp"
+#include "railcrash/elements/springs.hpp"
+#include "railcrash/initial_conditions.hpp"
+#include "railcrash/model_io.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+using Catch::Matchers::Contains;
+using Catch::Matchers::StartsWith;
+
+namespace {
+
+// The valid SI model the bad inputs are made from, in sections so one can be left out.
+const std::string kHeader = R"(railcrash: 1
+name: io test model
+units: SI
+)";
+const std::string kBodies = R"(bodies:
+  - name: bob
+    mass: 1.0
+    inertia: 0.5
+    position: [1.0, 2.0]
+  - name: cart
+    mass: 3.0
+    inertia: 0.25
+    position: [3.0, 0.0]
+    angle: 0.1
+    velocity: [1.5, -0.5]
+    angular_velocity: 0.2
+)";
+const std::string kElements = R"(elements:
+  - name: spring
+    type: linear_spring
+    stiffness: 100.0
+    free_length: 1.5
+    points: [{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}]
+  - name: damper
+    type: linear_dashpot
+    damping: 4.0
+    points:
+      - {body: ground, at: [0, 2]}
+      - {body: bob}
+  - name: slide
+    type: slider_joint
+    axis: [1, 0]
+    points: [{body: ground, at: [0, 0]}, {body: cart, at: [0, 0]}]
+)";
+const std::string kLoads = R"(loads:
+  - {type: force, body: bob, at: [0.1, 0.0], value: [1.0, -2.0]}
+  - type: moment
+    body: cart
+    value:
+      - [0.0, 0.0]
+      - [1.0, 10.0]
+      - [3.0, -10.0]
+)";
+const std::string kSimulation = R"(simulation:
+  integrator: euler
+  t_end: 2.0
+  dt: 1.0e-4
+  output_interval: 0.01
+)";
+const std::string kBase = kHeader + kBodies + kElements + kLoads + kSimulation;
+
+/// `text` with the single occurrence of `from` replaced by `to`.
+std::string edit(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  INFO("edit: '" << from << "'");
+  REQUIRE(at != std::string::npos);
+  REQUIRE(text.find(from, at + 1) == std::string::npos);
+  text.replace(at, from.size(), to);
+  return text;
+}
+
+/// 1-based line of the single occurrence of `marker` in `text`.
+int line_of(const std::string& text, const std::string& marker) {
+  const auto at = text.find(marker);
+  INFO("marker: '" << marker << "'");
+  REQUIRE(at != std::string::npos);
+  REQUIRE(text.find(marker, at + 1) == std::string::npos);
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+/// The InputError message loading `text` gives ("" and a failed check when there is none).
+std::string load_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    (void)load_model_text(text, "test.yaml", overrides);
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    FAIL_CHECK("not an InputError: " << e.what());
+    return "";
+  }
+  FAIL_CHECK("the model was accepted");
+  return "";
+}
+
+/// Loading `text` fails with a message starting "test.yaml:LINE: " and containing every part.
+void expect_error(const std::string& what, const std::string& text, int line, const std::vector<std::string>& parts,
+                  const std::vector<std::string>& overrides = {}) {
+  INFO("case: " << what);
+  const std::string message = load_error(text, overrides);
+  INFO("message: " << message);
+  CHECK_THAT(message, StartsWith("test.yaml:" + std::to_string(line) + ": "));
+  for (const auto& part : parts) CHECK_THAT(message, Contains(part));
+}
+
+/// Loads `text` and runs the initial assembly; returns the InputError message ("" if none).
+std::string assembly_error(const std::string& text) {
+  const Model model = testing::model_from_text(text);
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  try {
+    (void)assemble_initial_state(system, y);
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    FAIL_CHECK("not an InputError: " << e.what());
+    return "";
+  }
+  FAIL_CHECK("the joints were accepted");
+  return "";
+}
+
+std::string single_body_model(const std::string& body, const std::string& elements) {
+  return "railcrash: 1\nname: constraints\nunits: SI\nbodies:\n" + body + "elements:\n" + elements +
+         "simulation:\n  t_end: 1.0\n";
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// 1. Valid models
+// ---------------------------------------------------------------------------------------
+
+TEST_CASE("a valid SI model loads with its bodies, elements, loads and settings", "[model_io]") {
+  const Model model = testing::model_from_text(kBase);
+  CHECK(model.finalized());
+  CHECK(model.name == "io test model");
+  CHECK(model.file == "test.yaml");
+  CHECK(model.units == UnitSystem::SI);
+  CHECK(model.gravity_x == 0.0);
+  CHECK(model.gravity_y == Approx(-9.80665).epsilon(1e-15));
+
+  REQUIRE(model.body_count() == 2);
+  const Body& bob = model.bodies()[0];
+  const Body& cart = model.bodies()[1];
+  CHECK(bob.name == "bob");
+  CHECK(bob.mass == 1.0);
+  CHECK(bob.inertia == 0.5);
+  CHECK(bob.x == 1.0);
+  CHECK(bob.y == 2.0);
+  CHECK(bob.angle == 0.0);
+  CHECK(bob.vx == 0.0);
+  CHECK(bob.where.line == line_of(kBase, "- name: bob"));
+  CHECK(cart.name == "cart");
+  CHECK(cart.mass == 3.0);
+  CHECK(cart.inertia == 0.25);
+  CHECK(cart.x == 3.0);
+  CHECK(cart.y == 0.0);
+  CHECK(cart.angle == 0.1);
+  CHECK(cart.vx == 1.5);
+  CHECK(cart.vy == -0.5);
+  CHECK(cart.angular_velocity == 0.2);
+  CHECK(model.find_body("cart") == 1);
+  CHECK(model.find_body("ground") == kGround);
+  CHECK_FALSE(model.find_body("nobody").has_value());
+
+  REQUIRE(model.elements().size() == 3);
+  const auto& spring_element = *model.elements()[0];
+  CHECK(spring_element.name() == "spring");
+  CHECK(spring_element.type() == "linear_spring");
+  CHECK(spring_element.where().line == line_of(kBase, "- name: spring"));
+  const auto* spring = dynamic_cast<const LinearSpring*>(&spring_element);
+  REQUIRE(spring != nullptr);
+  CHECK(spring->stiffness == 100.0);
+  REQUIRE(spring->free_length.has_value());
+  CHECK(*spring->free_length == 1.5);
+  CHECK(spring->point(1).body == 1);
+  CHECK(spring->point(1).sx == 0.5);
+  const auto* damper = dynamic_cast<const LinearDashpot*>(model.elements()[1].get());
+  REQUIRE(damper != nullptr);
+  CHECK(damper->damping == 4.0);
+  CHECK(damper->point(0).body == kGround);
+  CHECK(damper->point(0).sy == 2.0);
+  CHECK(damper->point(1).sx == 0.0);  // 'at' left out: the centre of mass
+  const auto* slide = dynamic_cast<const SliderJoint*>(model.elements()[2].get());
+  REQUIRE(slide != nullptr);
+  CHECK(slide->axis_x == 1.0);
+  CHECK(slide->axis_y == 0.0);
+  CHECK(model.constraint_rows() == 2);
+  CHECK(model.degrees_of_freedom() == 4);
+
+  REQUIRE(model.loads().size() == 2);
+  const Load& force = model.loads()[0];
+  CHECK(force.kind == Load::Kind::Force);
+  CHECK(force.body == 0);
+  CHECK(force.sx == 0.1);
+  CHECK(force.sy == 0.0);
+  CHECK(force.value.times == std::vector<double>{0.0});
+  for (double t : {-1.0, 0.0, 0.7, 100.0}) {
+    CHECK(force.value.at(t)[0] == 1.0);
+    CHECK(force.value.at(t)[1] == -2.0);
+  }
+  const Load& moment = model.loads()[1];
+  CHECK(moment.kind == Load::Kind::Moment);
+  CHECK(moment.body == 1);
+  CHECK(moment.value.times == std::vector<double>{0.0, 1.0, 3.0});
+  CHECK(moment.value.at(0.0)[0] == 0.0);
+  CHECK(moment.value.at(0.25)[0] == Approx(2.5));   // linear between rows
+  CHECK(moment.value.at(1.0)[0] == Approx(10.0));
+  CHECK(moment.value.at(1.5)[0] == Approx(5.0));
+  CHECK(moment.value.at(2.0)[0] == Approx(0.0).margin(1e-12));
+  CHECK(moment.value.at(2.5)[0] == Approx(-5.0));
+  CHECK(moment.value.at(-3.0)[0] == 0.0);           // held before the first row
+  CHECK(moment.value.at(3.0)[0] == -10.0);
+  CHECK(moment.value.at(50.0)[0] == -10.0);         // held after the last row
+  CHECK(moment.value.at(1.5)[1] == 0.0);
+
+  CHECK(model.simulation.t_end == 2.0);
+  CHECK(model.simulation.integrator == IntegratorKind::Euler);
+  CHECK(model.simulation.dt == 1.0e-4);
+  CHECK(model.simulation.output_interval == 0.01);
+  CHECK(model.simulation.rtol == 1e-6);  // default
+  CHECK_FALSE(model.simulation.atol.has_value());
+  CHECK_FALSE(model.simulation.force_dt);
+}
+
+TEST_CASE("a tabulated force takes [t, Fx, Fy] and [t, [Fx, Fy]] rows", "[model_io]") {
+  const std::string text = edit(kBase, "value: [1.0, -2.0]}", "value: [[0.0, 0.0, 0.0], [2.0, [4.0, -8.0]]]}");
+  const Model model = testing::model_from_text(text);
+  const TimeTable& table = model.loads()[0].value;
+  CHECK(table.times == std::vector<double>{0.0, 2.0});
+  CHECK(table.at(0.5)[0] == Approx(1.0));
+  CHECK(table.at(0.5)[1] == Approx(-2.0));
+  CHECK(table.at(9.0)[0] == 4.0);
+  CHECK(table.at(9.0)[1] == -8.0);
+}
+
+TEST_CASE("the verification slider-crank file loads", "[model_io]") {
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  CHECK(model.name == "SUNDIALS GGL slider-crank (idasSlCrank_dns)");
+  CHECK(model.gravity_x == 0.0);
+  CHECK(model.gravity_y == 0.0);
+  REQUIRE(model.body_count() == 2);
+  CHECK(model.bodies()[1].name == "rod");
+  CHECK(model.bodies()[1].inertia == 2.0);
+  CHECK(model.bodies()[1].x == Approx(0.8660254037844386));
+  CHECK(model.bodies()[1].angle == Approx(-0.5235987755982989));
+  CHECK(model.elements().size() == 5);
+  CHECK(model.constraint_rows() == 5);  // pin 2 + pin 2 + sliding pin 1
+  CHECK(model.loads().size() == 1);
+  CHECK(model.simulation.t_end == 10.0);
+  CHECK(model.simulation.integrator == IntegratorKind::Ida);
+  REQUIRE(model.simulation.atol.has_value());
+  CHECK(*model.simulation.atol == 1.0e-7);
+  CHECK(model.simulation.output_interval == 0.4);
+}
+
+TEST_CASE("a missing model file is an InputError naming the path", "[model_io]") {
+  const std::string path = std::string(RAILCRASH_SOURCE_DIR) + "/tests/no_such_model.yaml";
+  CHECK_THROWS_AS(load_model(path), InputError);
+  CHECK_THROWS_WITH(load_model(path), Contains(path) && Contains("cannot open"));
+}
+
+TEST_CASE("in-lbf-s models take weight in lbf and default to 386.088 in/s^2", "[model_io]") {
+  const std::string text = R"(railcrash: 1
+name: imperial
+units: in-lbf-s
+bodies:
+  - name: car
+    weight: 772.176
+    inertia: 10.0
+    position: [0.0, 20.0]
+  - name: block
+    mass: 0.5
+    inertia: 0.0
+    position: [100.0, 20.0]
+simulation:
+  t_end: 0.1
+)";
+  const Model model = testing::model_from_text(text);
+  CHECK(model.units == UnitSystem::InLbfS);
+  CHECK(model.gravity_x == 0.0);
+  CHECK(model.gravity_y == Approx(-386.088).epsilon(1e-15));
+  CHECK(standard_gravity(UnitSystem::InLbfS) == 386.088);
+  CHECK(model.bodies()[0].mass == Approx(772.176 / 386.088).epsilon(1e-15));
+  CHECK(model.bodies()[0].mass == Approx(2.0).epsilon(1e-12));
+  CHECK(model.bodies()[1].mass == 0.5);  // mass is still accepted directly
+  CHECK(model.bodies()[1].inertia == 0.0);
+
+  const Model light = testing::model_from_text(edit(text, "weight: 772.176", "weight: 1000"));
+  CHECK(light.bodies()[0].mass == Approx(1000.0 / 386.088).epsilon(1e-15));
+
+  const Model custom = testing::model_from_text(edit(text, "units: in-lbf-s\n", "units: in-lbf-s\ngravity: [0, -32.2]\n"));
+  CHECK(custom.gravity_y == -32.2);
+  CHECK(custom.bodies()[0].mass == Approx(2.0).epsilon(1e-12));  // weight still means standard gravity
+}
+
+TEST_CASE("gravity: SI default, [0, 0] switches it off, any vector is taken as given", "[model_io]") {
+  CHECK(testing::model_from_text(kBase).gravity_y == Approx(-9.80665).epsilon(1e-15));
+  CHECK(standard_gravity(UnitSystem::SI) == 9.80665);
+  const Model off = testing::model_from_text(edit(kBase, "units: SI\n", "units: SI\ngravity: [0, 0]\n"));
+  CHECK(off.gravity_x == 0.0);
+  CHECK(off.gravity_y == 0.0);
+  const Model tilted = testing::model_from_text(edit(kBase, "units: SI\n", "units: SI\ngravity: [1.5, -3.0]\n"));
+  CHECK(tilted.gravity_x == 1.5);
+  CHECK(tilted.gravity_y == -3.0);
+}
+
+TEST_CASE("--set overrides change the model before it is checked", "[model_io]") {
+  const Model model =
+      load_model_text(kBase, "test.yaml", {"simulation.t_end=0.5", "bodies.bob.mass=2", "elements.spring.stiffness=200"});
+  CHECK(model.simulation.t_end == 0.5);
+  CHECK(model.bodies()[0].mass == 2.0);
+  CHECK(model.bodies()[1].mass == 3.0);  // untouched
+  const auto* spring = dynamic_cast<const LinearSpring*>(model.elements()[0].get());
+  REQUIRE(spring != nullptr);
+  CHECK(spring->stiffness == 200.0);
+  CHECK(*spring->free_length == 1.5);
+  CHECK(model.simulation.dt == 1.0e-4);  // the rest of the section stays
+
+  const Model more = load_model_text(kBase, "test.yaml", {"gravity=[0, 0]", "simulation.integrator=ida", "simulation.rtol=1e-8",
+                                                          "bodies.cart.position=[5, 0]", "elements.slide.axis=[0, 1]"});
+  CHECK(more.gravity_y == 0.0);
+  CHECK(more.simulation.integrator == IntegratorKind::Ida);
+  CHECK(more.simulation.rtol == 1e-8);
+  CHECK(more.bodies()[1].x == 5.0);
+  const auto* slide = dynamic_cast<const SliderJoint*>(more.elements()[2].get());
+  REQUIRE(slide != nullptr);
+  CHECK(slide->axis_x == 0.0);
+  CHECK(slide->axis_y == 1.0);
+
+  // A simulation section may come entirely from the command line.
+  const Model no_section = load_model_text(kHeader + kBodies, "test.yaml", {"simulation.t_end=3"});
+  CHECK(no_section.simulation.t_end == 3.0);
+}
+
+TEST_CASE("bad --set overrides are InputErrors naming the setting", "[model_io]") {
+  const auto error = [](const std::vector<std::string>& overrides) {
+    try {
+      (void)load_model_text(kBase, "test.yaml", overrides);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    } catch (const std::exception& e) {
+      FAIL_CHECK("not an InputError: " << e.what());
+      return std::string();
+    }
+    FAIL_CHECK("the override was accepted");
+    return std::string();
+  };
+  std::string m = error({"bodies.nobody.mass=2"});
+  CHECK_THAT(m, Contains("bodies.nobody.mass=2") && Contains("no body named 'nobody'"));
+  m = error({"elements.nothing.stiffness=200"});
+  CHECK_THAT(m, Contains("no element named 'nothing'"));
+  m = error({"simulation.t_end"});
+  CHECK_THAT(m, Contains("KEY=VALUE"));
+  m = error({"simulation.t_end=[0.5"});
+  CHECK_THAT(m, Contains("not valid YAML"));
+  // A bad value is reported against the setting, not against a line of the file.
+  m = error({"simulation.t_end=-1"});
+  CHECK_THAT(m, StartsWith("test.yaml: --set 'simulation.t_end=-1': ") && Contains("t_end must be positive"));
+  m = error({"bodies.bob.mass=heavy"});
+  CHECK_THAT(m, StartsWith("test.yaml: --set 'bodies.bob.mass=heavy': ") && Contains("body 'bob': mass must be a number"));
+  m = error({"gravity=[0, down]"});
+  CHECK_THAT(m, Contains("--set 'gravity=[0, down]'") && Contains("gravity entry 2 must be a number"));
+  m = error({"elements.spring.stifness=200"});
+  CHECK_THAT(m, StartsWith("test.yaml: --set 'elements.spring.stifness=200': ") && Contains("unknown key 'stifness'") &&
+                    Contains("did you mean 'stiffness'"));
+  m = error({"simulation.tend=1"});
+  CHECK_THAT(m, StartsWith("test.yaml: --set 'simulation.tend=1': ") && Contains("did you mean 't_end'"));
+  m = error({"bodies.mass=2"});
+  CHECK_THAT(m, Contains("bodies.<name>.<key>"));
+  m = error({"gravity.x=1"});
+  CHECK_THAT(m, Contains("'gravity' is not a section"));
+  m = error({"simulation.force_dt=maybe"});
+  CHECK_THAT(m, Contains("force_dt must be true or false"));
+  m = error({"a.b.c.d=1"});
+  CHECK_THAT(m, Contains("KEY must be"));
+}
+
+// ---------------------------------------------------------------------------------------
+// 2. Bad input: file, line, culprit and what to change
+// ---------------------------------------------------------------------------------------
+
+TEST_CASE("malformed YAML is an InputError at the line at fault", "[model_io]") {
+  // An unclosed '[' is noticed by yaml-cpp only on the next line; the message points at the bracket.
+  std::string text = edit(kBase, "position: [1.0, 2.0]", "position: [1.0, 2.0");
+  expect_error("unclosed [", text, line_of(text, "position: [1.0, 2.0\n"), {"not valid YAML", "'['"});
+  text = edit(kBase, "- {type: force, body: bob, at: [0.1, 0.0], value: [1.0, -2.0]}",
+              "- {type: force, body: bob, at: [0.1, 0.0], value: [1.0, -2.0]");
+  expect_error("unclosed {", text, line_of(text, "- {type: force"), {"not valid YAML", "'{'"});
+  text = edit(kBase, "    mass: 3.0\n", "   mass: 3.0\n");
+  expect_error("bad indentation", text, line_of(text, "   mass: 3.0"), {"not valid YAML"});
+  text = edit(kBase, "    inertia: 0.25\n", "\tinertia: 0.25\n");
+  expect_error("tab", text, line_of(text, "\tinertia"), {"not valid YAML", "tab"});
+  text = edit(kBase, "    angle: 0.1\n", "    angle: 0.1\n   - stray\n");
+  expect_error("stray list item", text, line_of(text, "- stray"), {"not valid YAML"});
+  // A '[' inside a comment or a quoted name does not count as the open bracket.
+  text = edit(edit(kBase, "name: io test model", "name: 'io [test] model' # [draft"), "velocity: [1.5, -0.5]",
+              "velocity: [1.5, -0.5");
+  expect_error("unclosed [ after comment", text, line_of(text, "velocity: [1.5"), {"not valid YAML"});
+  // ... nor does one in a block scalar.
+  text = edit(edit(kBase, "units: SI\n", "units: SI\ndescription: |\n  [draft {\n   see [1\n"), "velocity: [1.5, -0.5]",
+              "velocity: [1.5, -0.5");
+  expect_error("unclosed [ after block scalar", text, line_of(text, "velocity: [1.5"),
+               {"not valid YAML", "never closed", "add the matching ']'"});
+}
+
+TEST_CASE("the file must be a map", "[model_io]") {
+  expect_error("scalar document", "just words\n", 1, {"must be a YAML map"});
+  expect_error("list document", "- a\n- b\n", 1, {"must be a YAML map"});
+  CHECK_THROWS_AS(testing::model_from_text(""), InputError);
+  CHECK_THROWS_WITH(testing::model_from_text(""), StartsWith("test.yaml: ") && Contains("must be a YAML map"));
+  CHECK_THROWS_WITH(load_model_text("just words\n", "test.yaml", {"simulation.t_end=1"}), Contains("must be a YAML map"));
+}
+
+TEST_CASE("missing required keys name the key and where it belongs", "[model_io]") {
+  expect_error("railcrash", edit(kBase, "railcrash: 1\n", ""), 1, {"missing required key 'railcrash'", "railcrash: 1"});
+  expect_error("name", edit(kBase, "name: io test model\n", ""), 1, {"missing required key 'name'"});
+  expect_error("units", edit(kBase, "units: SI\n", ""), 1, {"missing required key 'units'"});
+  expect_error("bodies", kHeader + kElements + kSimulation, 1, {"missing required key 'bodies'"});
+  expect_error("simulation", kHeader + kBodies + kElements + kLoads, 1, {"missing required key 'simulation'", "t_end"});
+  std::string text = edit(kBase, "  t_end: 2.0\n", "");
+  expect_error("t_end", text, line_of(text, "integrator: euler"), {"simulation: missing required key 't_end'"});
+
+  const int bob = line_of(kBase, "- name: bob");
+  expect_error("mass", edit(kBase, "    mass: 1.0\n", ""), bob, {"body 'bob'", "missing required key 'mass'"});
+  expect_error("inertia", edit(kBase, "    inertia: 0.5\n", ""), bob, {"body 'bob'", "missing required key 'inertia'"});
+  expect_error("position", edit(kBase, "    position: [1.0, 2.0]\n", ""), bob,
+               {"body 'bob'", "missing required key 'position'"});
+  text = edit(kBase, "  - name: bob\n", "  - mass_first: true\n");
+  expect_error("body name", text, line_of(text, "mass_first"), {"body: missing required key 'name'"});
+
+  const int spring = line_of(kBase, "- name: spring");
+  expect_error("type", edit(kBase, "    type: linear_spring\n", ""), spring,
+               {"element 'spring'", "missing required key 'type'"});
+  expect_error("points", edit(kBase, "    points: [{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}]\n", ""), spring,
+               {"element 'spring' (linear_spring)", "missing required key 'points'"});
+  expect_error("stiffness", edit(kBase, "    stiffness: 100.0\n", ""), spring,
+               {"element 'spring' (linear_spring)", "missing required parameter 'stiffness'"});
+  expect_error("damping", edit(kBase, "    damping: 4.0\n", ""), line_of(kBase, "- name: damper"),
+               {"element 'damper' (linear_dashpot)", "missing required parameter 'damping'"});
+  text = edit(kBase, "- {body: ground, at: [0, 2]}", "- {at: [0, 2]}");
+  expect_error("point body", text, line_of(text, "- {at: [0, 2]}"), {"element 'damper'", "point 1", "missing required key 'body'"});
+  text = edit(kBase, "- {type: force, body: bob, at: [0.1, 0.0], value: [1.0, -2.0]}", "- {type: force, body: bob}");
+  expect_error("load value", text, line_of(text, "- {type: force, body: bob}"), {"force load on 'bob'", "missing required key 'value'"});
+}
+
+TEST_CASE("unknown keys are rejected with the closest allowed key", "[model_io]") {
+  std::string text = edit(kBase, "units: SI\n", "units: SI\ngravty: [0, 0]\n");
+  expect_error("top level", text, line_of(text, "gravty"), {"model: unknown key 'gravty'", "did you mean 'gravity'", "allowed keys"});
+  text = edit(kBase, "inertia: 0.5", "inertai: 0.5");
+  expect_error("body", text, line_of(text, "inertai"), {"body 'bob'", "unknown key 'inertai'", "did you mean 'inertia'"});
+  text = edit(kBase, "stiffness: 100.0", "stifness: 100.0");
+  expect_error("element typo", text, line_of(text, "stifness"),
+               {"element 'spring' (linear_spring)", "unknown key 'stifness'", "did you mean 'stiffness'", "free_length"});
+  text = edit(kBase, "damping: 4.0\n", "damping: 4.0\n    colour: red\n");
+  expect_error("element extra key", text, line_of(text, "colour"), {"element 'damper' (linear_dashpot)", "unknown key 'colour'"});
+  text = edit(kBase, "axis: [1, 0]", "axes: [1, 0]");
+  expect_error("joint typo", text, line_of(text, "axes"), {"element 'slide' (slider_joint)", "did you mean 'axis'"});
+  text = edit(kBase, "{body: cart, at: [0.5, 0]}", "{body: cart, offset: [0.5, 0]}");
+  expect_error("point", text, line_of(text, "offset"), {"element 'spring' (linear_spring): point 2", "unknown key 'offset'"});
+  text = edit(kBase, "value: [1.0, -2.0]}", "value: [1.0, -2.0], scale: 2}");
+  expect_error("load", text, line_of(text, "scale"), {"load: unknown key 'scale'"});
+  text = edit(kBase, "  dt: 1.0e-4\n", "  dt: 1.0e-4\n  rtoll: 1e-6\n");
+  expect_error("simulation", text, line_of(text, "rtoll"), {"simulation: unknown key 'rtoll'", "did you mean 'rtol'"});
+  text = edit(kBase, "    mass: 3.0\n", "    mass: 3.0\n    mass: 4.0\n");
+  expect_error("repeated key", text, line_of(text, "mass: 4.0"), {"body 'cart'", "'mass' is given twice"});
+}
+
+TEST_CASE("unknown element types and body names are rejected with suggestions", "[model_io]") {
+  std::string text = edit(kBase, "type: linear_spring", "type: linear_sprin");
+  expect_error("type", text, line_of(text, "linear_sprin\n"),
+               {"element 'spring'", "unknown element type 'linear_sprin'", "did you mean 'linear_spring'", "pin_joint"});
+  text = edit(kBase, "{body: bob, at: [0, 0]}", "{body: bobb, at: [0, 0]}");
+  expect_error("point body", text, line_of(text, "bobb"),
+               {"element 'spring' (linear_spring): point 1", "unknown body 'bobb'", "did you mean 'bob'", "ground"});
+  text = edit(kBase, "    body: cart\n", "    body: kart\n");
+  expect_error("load body", text, line_of(text, "kart"), {"moment load on 'kart'", "unknown body 'kart'", "did you mean 'cart'"});
+  text = edit(kBase, "    body: cart\n", "    body: ground\n");
+  expect_error("load on ground", text, line_of(text, "body: ground\n"), {"a load on the ground does nothing"});
+  text = edit(kBase, "type: moment", "type: torque");
+  expect_error("load type", text, line_of(text, "torque"), {"unknown type 'torque'", "force or moment"});
+  text = edit(kBase, "integrator: euler", "integrator: rk4");
+  expect_error("integrator", text, line_of(text, "rk4"), {"integrator must be ida or euler", "rk4"});
+}
+
+TEST_CASE("vectors must have the right size", "[model_io]") {
+  std::string text = edit(kBase, "position: [1.0, 2.0]", "position: [1.0, 2.0, 3.0]");
+  expect_error("position", text, line_of(text, "position: [1.0, 2.0, 3.0]"),
+               {"body 'bob': position", "list of 2 numbers", "not a list of 3"});
+  text = edit(kBase, "{body: cart, at: [0.5, 0]}", "{body: cart, at: [0.5]}");
+  expect_error("point at", text, line_of(text, "at: [0.5]"), {"element 'spring' (linear_spring): point 2: at", "list of 2 numbers"});
+  text = edit(kBase, "at: [0.1, 0.0]", "at: [0.1]");
+  expect_error("load at", text, line_of(text, "at: [0.1]"), {"force load on 'bob': at", "list of 2 numbers"});
+  text = edit(kBase, "units: SI\n", "units: SI\ngravity: [-9.8]\n");
+  expect_error("gravity", text, line_of(text, "gravity"), {"gravity must be a list of 2 numbers"});
+  text = edit(kBase, "velocity: [1.5, -0.5]", "velocity: 1.5");
+  expect_error("velocity scalar", text, line_of(text, "velocity: 1.5"), {"body 'cart': velocity", "list of 2 numbers"});
+  text = edit(kBase, "axis: [1, 0]", "axis: [1, 0, 0]");
+  expect_error("axis", text, line_of(text, "axis"), {"element 'slide' (slider_joint): 'axis'", "list of 2 numbers"});
+  text = edit(kBase, "value: [1.0, -2.0]}", "value: 1.0}");
+  expect_error("force value", text, line_of(text, "value: 1.0}"), {"force load on 'bob': value [Fx, Fy]"});
+  text = edit(kBase, "      - [1.0, 10.0]\n", "      - [1.0]\n");
+  expect_error("table row", text, line_of(text, "- [1.0]"), {"moment load on 'cart': table row 2 must be [t, value]"});
+}
+
+TEST_CASE("numbers out of range say which limit they break", "[model_io]") {
+  std::string text = edit(kBase, "mass: 1.0", "mass: 0");
+  expect_error("zero mass", text, line_of(text, "mass: 0"), {"body 'bob': mass must be positive"});
+  text = edit(kBase, "mass: 1.0", "mass: -1.0");
+  expect_error("negative mass", text, line_of(text, "mass: -1.0"), {"body 'bob': mass must be positive"});
+  text = edit(kBase, "inertia: 0.5", "inertia: -0.5");
+  expect_error("negative inertia", text, line_of(text, "inertia: -0.5"), {"body 'bob': inertia must not be negative"});
+  text = edit(kBase, "stiffness: 100.0", "stiffness: -100.0");
+  expect_error("negative stiffness", text, line_of(text, "stiffness: -100.0"),
+               {"element 'spring' (linear_spring)", "'stiffness' must not be negative"});
+  text = edit(kBase, "damping: 4.0", "damping: -4.0");
+  expect_error("negative damping", text, line_of(text, "damping: -4.0"),
+               {"element 'damper' (linear_dashpot)", "'damping' must not be negative"});
+  text = edit(kBase, "t_end: 2.0", "t_end: 0");
+  expect_error("zero t_end", text, line_of(text, "t_end"), {"simulation: t_end must be positive"});
+  text = edit(kBase, "t_end: 2.0", "t_end: -1.0");
+  expect_error("negative t_end", text, line_of(text, "t_end"), {"simulation: t_end must be positive"});
+  text = edit(kBase, "dt: 1.0e-4", "dt: 0");
+  expect_error("zero dt", text, line_of(text, "dt: 0"), {"simulation: dt must be positive"});
+  text = edit(kBase, "units: SI", "units: in-lbf-s");
+  text = edit(text, "mass: 1.0", "weight: -5");
+  expect_error("negative weight", text, line_of(text, "weight"), {"body 'bob': weight must be positive"});
+  text = edit(kBase, "free_length: 1.5", "free_length: -1.5");
+  expect_error("negative free length", text, line_of(text, "free_length"), {"'free_length' must not be negative"});
+}
+
+TEST_CASE("NaN, infinite and non-numeric values are rejected", "[model_io]") {
+  std::string text = edit(kBase, "mass: 1.0", "mass: .nan");
+  expect_error("nan mass", text, line_of(text, ".nan"), {"body 'bob': mass must be a finite number", ".nan"});
+  text = edit(kBase, "stiffness: 100.0", "stiffness: .inf");
+  expect_error("inf stiffness", text, line_of(text, ".inf"), {"element 'spring' (linear_spring): 'stiffness' must be a finite number"});
+  text = edit(kBase, "position: [1.0, 2.0]", "position: [.NaN, 2.0]");
+  expect_error("nan position", text, line_of(text, ".NaN"), {"body 'bob': position entry 1 must be a finite number"});
+  text = edit(kBase, "t_end: 2.0", "t_end: .inf");
+  expect_error("inf t_end", text, line_of(text, "t_end"), {"simulation: t_end must be a finite number"});
+  text = edit(kBase, "      - [1.0, 10.0]\n", "      - [1.0, -.inf]\n");
+  expect_error("inf table value", text, line_of(text, "-.inf"), {"table row 2 value must be a finite number"});
+  text = edit(kBase, "units: SI\n", "units: SI\ngravity: [0, .nan]\n");
+  expect_error("nan gravity", text, line_of(text, "gravity"), {"gravity entry 2 must be a finite number"});
+
+  text = edit(kBase, "mass: 1.0", "mass: heavy");
+  expect_error("word mass", text, line_of(text, "heavy"), {"body 'bob': mass must be a number, not 'heavy'"});
+  text = edit(kBase, "stiffness: 100.0", "stiffness: [100.0]");
+  expect_error("list stiffness", text, line_of(text, "stiffness"), {"'stiffness' must be a number"});
+  text = edit(kBase, "position: [1.0, 2.0]", "position: [1.0, up]");
+  expect_error("word in position", text, line_of(text, "up]"), {"position entry 2 must be a number, not 'up'"});
+  text = edit(kBase, "t_end: 2.0", "t_end:");
+  expect_error("empty t_end", text, line_of(text, "t_end"), {"simulation: t_end must be a number"});
+  text = edit(kBase, "railcrash: 1", "railcrash: one");
+  expect_error("version word", text, 1, {"railcrash (format version) must be a number"});
+  text = edit(kBase, "railcrash: 1", "railcrash: 2");
+  expect_error("version 2", text, 1, {"reads model format 1", "railcrash: 2"});
+  text = edit(kBase, "  dt: 1.0e-4\n", "  dt: 1.0e-4\n  force_dt: perhaps\n");
+  expect_error("force_dt", text, line_of(text, "perhaps"), {"simulation: force_dt must be true or false"});
+  text = edit(kBase, "  - name: bob\n", "  - name: [bob]\n");
+  expect_error("list name", text, line_of(text, "[bob]"), {"body name must be a word"});
+}
+
+TEST_CASE("names must be unique and 'ground' is reserved", "[model_io]") {
+  std::string text = edit(kBase, "- name: cart", "- name: bob");
+  expect_error("duplicate body", text, line_of(kBase, "- name: cart"), {"body 'bob' is defined twice", "unique"});
+  text = edit(kBase, "- name: damper", "- name: spring");
+  expect_error("duplicate element", text, line_of(kBase, "- name: damper"),
+               {"element 'spring' is defined twice", "first at line " + std::to_string(line_of(kBase, "- name: spring"))});
+  text = edit(kBase, "- name: cart", "- name: ground");
+  expect_error("ground body", text, line_of(text, "- name: ground"), {"'ground' is reserved", "rename the body"});
+}
+
+TEST_CASE("unit systems and weight", "[model_io]") {
+  std::string text = edit(kBase, "units: SI", "units: imperial");
+  expect_error("units", text, 3, {"units must be SI or in-lbf-s, not 'imperial'"});
+  text = edit(kBase, "units: SI", "units: si");
+  expect_error("units case", text, 3, {"units must be SI or in-lbf-s"});
+  text = edit(kBase, "mass: 1.0", "weight: 10.0");
+  expect_error("weight in SI", text, line_of(text, "weight"), {"body 'bob'", "'weight' is for in-lbf-s models", "'mass' in kg"});
+  text = edit(edit(kBase, "units: SI", "units: in-lbf-s"), "mass: 1.0", "mass: 1.0\n    weight: 386.088");
+  expect_error("mass and weight", text, line_of(text, "weight"), {"body 'bob': give either mass or weight, not both"});
+  text = edit(edit(kBase, "units: SI", "units: in-lbf-s"), "    mass: 1.0\n", "");
+  expect_error("neither", text, line_of(text, "- name: bob"), {"body 'bob' (give mass or weight)", "missing required key 'mass'"});
+}
+
+TEST_CASE("elements need the right points and a usable axis", "[model_io]") {
+  std::string text = edit(kBase, "points: [{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}]", "points: [{body: bob}]");
+  expect_error("one point", text, line_of(text, "- name: spring"),
+               {"element 'spring' (linear_spring) needs exactly 2 points, found 1"});
+  text = edit(kBase, "points: [{body: ground, at: [0, 0]}, {body: cart, at: [0, 0]}]",
+              "points: [{body: ground}, {body: cart}, {body: bob}]");
+  expect_error("three points", text, line_of(text, "- name: slide"), {"element 'slide' (slider_joint) needs exactly 2 points, found 3"});
+  text = edit(kBase, "points: [{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}]", "points: []");
+  expect_error("no points", text, line_of(text, "- name: spring"), {"needs exactly 2 points, found 0"});
+  text = edit(kBase, "points: [{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}]", "points: {body: bob}");
+  expect_error("points map", text, line_of(text, "points: {body: bob}"), {"element 'spring' (linear_spring): points must be a list"});
+  text = edit(kBase, "axis: [1, 0]", "axis: [0, 0]");
+  expect_error("zero axis", text, line_of(text, "axis"), {"element 'slide' (slider_joint)", "axis must be a non-zero direction"});
+  text = edit(kBase, "axis: [1, 0]", "axis: [0.0, -0.0]");
+  expect_error("signed zero axis", text, line_of(text, "axis"), {"axis must be a non-zero direction"});
+  text = edit(kBase, "{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}", "{body: bob, at: [0, 0]}, {body: bob, at: [0, 0]}");
+  expect_error("coincident spring points", text, line_of(text, "- name: spring"), {"linear_spring 'spring'", "coincide"});
+}
+
+TEST_CASE("tabulated loads need strictly increasing times", "[model_io]") {
+  std::string text = edit(kBase, "      - [3.0, -10.0]\n", "      - [1.0, -10.0]\n");
+  expect_error("repeated time", text, line_of(text, "- [1.0, -10.0]"),
+               {"moment load on 'cart': table row 3", "times must increase strictly"});
+  text = edit(kBase, "      - [3.0, -10.0]\n", "      - [0.5, -10.0]\n");
+  expect_error("decreasing time", text, line_of(text, "- [0.5, -10.0]"), {"table row 3", "times must increase strictly"});
+  text = edit(kBase, "value: [1.0, -2.0]}", "value: [[0.0, 1.0, 1.0], [0.0, 2.0, 2.0]]}");
+  expect_error("force table", text, line_of(text, "value: [[0.0"), {"force load on 'bob': table row 2", "times must increase"});
+  text = edit(kBase, "      - [1.0, 10.0]\n", "      - [1.0, 10.0, 5.0]\n");
+  expect_error("moment row of 3", text, line_of(text, "10.0, 5.0"), {"table row 2 must be [t, value]"});
+}
+
+TEST_CASE("structural problems: empty lists, wrong section shapes, offset loads on point masses", "[model_io]") {
+  std::string text = edit(kBase, kBodies, "bodies: []\n");
+  expect_error("no bodies", text, line_of(text, "bodies: []"), {"add at least one body"});
+  text = edit(kBase, kBodies, "bodies:\n  name: bob\n");
+  expect_error("bodies map", text, line_of(text, "  name: bob"), {"bodies must be a list"});
+  text = edit(kBase, kSimulation, "simulation: 2.0\n");
+  expect_error("simulation scalar", text, line_of(text, "simulation: 2.0"), {"simulation must be a map"});
+  text = edit(kBase, "  - name: bob\n    mass: 1.0\n    inertia: 0.5\n    position: [1.0, 2.0]\n", "  - bob\n");
+  expect_error("body scalar", text, line_of(text, "- bob"), {"each body must be a map"});
+  text = edit(kBase, "inertia: 0.5", "inertia: 0");
+  expect_error("offset load on point mass", text, line_of(text, "- {type: force"), {"body 'bob'", "zero inertia"});
+}
+
+// ---------------------------------------------------------------------------------------
+// Robustness: no input crashes, hangs or leaks a non-InputError exception
+// ---------------------------------------------------------------------------------------
+
+TEST_CASE("truncated and edited files are either loaded or rejected with an InputError", "[model_io]") {
+  int rejected = 0, loaded = 0;
+  const auto try_load = [&](const std::string& text) {
+    try {
+      (void)load_model_text(text, "test.yaml");
+      ++loaded;
+    } catch (const InputError& e) {
+      ++rejected;
+      const std::string message = e.what();
+      if (message.rfind("test.yaml:", 0) != 0) FAIL_CHECK("message without the file name: " << message << "\nfor:\n" << text);
+    } catch (const std::exception& e) {
+      FAIL_CHECK("not an InputError: " << e.what() << "\nfor:\n" << text);
+    }
+  };
+  // Every prefix of the file (cuts inside keys, lists, flow maps, ...).
+  for (std::size_t n = 0; n < kBase.size(); ++n) try_load(kBase.substr(0, n));
+  // Every line left out, and every line doubled.
+  std::vector<std::string> lines;
+  for (std::size_t start = 0; start < kBase.size();) {
+    const auto end = kBase.find('\n', start);
+    lines.push_back(kBase.substr(start, end - start + 1));
+    start = end + 1;
+  }
+  for (std::size_t skip = 0; skip < lines.size(); ++skip) {
+    std::string without, doubled;
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      if (i != skip) without += lines[i];
+      doubled += lines[i];
+      if (i == skip) doubled += lines[i];
+    }
+    try_load(without);
+    try_load(doubled);
+  }
+  // Each character replaced by YAML punctuation.
+  for (std::size_t i = 0; i < kBase.size(); i += 3)
+    for (const char c : {'[', '{', ':', '-', '#', '\'', '&', '*'}) {
+      std::string text = kBase;
+      text[i] = c;
+      try_load(text);
+    }
+  CHECK(rejected > 1000);
+  CHECK(loaded > 10);
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. Redundant and contradictory constraints
+// ---------------------------------------------------------------------------------------
+
+namespace {
+const std::string kBar = R"(  - name: bar
+    mass: 1.0
+    inertia: 0.1
+    position: [1.0, 0.0]
+)";
+const std::string kPinA = R"(  - name: pin_a
+    type: pin_joint
+    points: [{body: ground, at: [0, 0]}, {body: bar, at: [-1, 0]}]
+)";
+const std::string kPinB = R"(  - name: pin_b
+    type: pin_joint
+    points: [{body: ground, at: [0, 0]}, {body: bar, at: [-1, 0]}]
+)";
+const std::string kWeld = R"(  - name: weld
+    type: rigid_joint
+    points: [{body: ground, at: [0, 0]}, {body: bar, at: [-1, 0]}]
+)";
+}  // namespace
+
+TEST_CASE("a properly constrained model assembles", "[model_io]") {
+  const Model model = testing::model_from_text(single_body_model(kBar, kPinA));
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  CHECK_NOTHROW(check_constraint_rank(system, y.data()));
+  const AssemblyReport report = assemble_initial_state(system, y);
+  CHECK(report.largest_position_change < 1e-12);
+
+  const Model crank = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  const DaeSystem crank_system(crank);
+  std::vector<double> yc = crank_system.initial_state();
+  CHECK_NOTHROW(assemble_initial_state(crank_system, yc));
+}
+
+TEST_CASE("redundant joints are InputErrors naming the elements", "[model_io]") {
+  SECTION("two pins at the same ground point plus a rigid joint") {
+    const std::string text = single_body_model(kBar, kPinA + kPinB + kWeld);
+    const std::string message = assembly_error(text);
+    INFO(message);
+    CHECK_THAT(message, StartsWith("test.yaml: ") && Contains("redundant") && Contains("4 of the 7 constraint equations"));
+    CHECK_THAT(message, Contains("'pin_b' (pin_joint, line " + std::to_string(line_of(text, "- name: pin_b")) + ")"));
+    CHECK_THAT(message, Contains("'weld' (rigid_joint, line " + std::to_string(line_of(text, "- name: weld")) + ")"));
+    CHECK_THAT(message, Contains("Remove one of them"));
+    // check_constraint_rank alone says the same.
+    const Model model = testing::model_from_text(text);
+    const DaeSystem system(model);
+    const std::vector<double> y = system.initial_state();
+    CHECK_THROWS_WITH(check_constraint_rank(system, y.data()), Contains("redundant") && Contains("'weld'"));
+  }
+  SECTION("a body pinned twice at the same point") {
+    const std::string text = single_body_model(kBar, kPinA + kPinB);
+    const std::string message = assembly_error(text);
+    INFO(message);
+    CHECK_THAT(message, Contains("redundant") && Contains("2 of the 4 constraint equations") && Contains("'pin_b' (pin_joint"));
+  }
+  SECTION("a rigid joint and a pin on the same body") {
+    const std::string message = assembly_error(single_body_model(kBar, kWeld + kPinA));
+    INFO(message);
+    CHECK_THAT(message, Contains("redundant") && Contains("2 of the 5 constraint equations") && Contains("'pin_a'"));
+  }
+}
+
+TEST_CASE("contradictory joints are InputErrors naming the elements", "[model_io]") {
+  SECTION("a two-link chain pinned to ground at points further apart than it can reach") {
+    const std::string text = R"(railcrash: 1
+name: chain too short
+units: SI
+bodies:
+  - name: link_a
+    mass: 1.0
+    inertia: 0.1
+    position: [1.0, 0.5]
+    angle: 0.3
+  - name: link_b
+    mass: 1.0
+    inertia: 0.1
+    position: [4.0, 0.5]
+    angle: -0.3
+elements:
+  - name: left_pin
+    type: pin_joint
+    points: [{body: ground, at: [0, 0]}, {body: link_a, at: [-1, 0]}]
+  - name: middle_pin
+    type: pin_joint
+    points: [{body: link_a, at: [1, 0]}, {body: link_b, at: [-1, 0]}]
+  - name: right_pin
+    type: pin_joint
+    points: [{body: ground, at: [6, 0]}, {body: link_b, at: [1, 0]}]
+simulation:
+  t_end: 1.0
+)";
+    const std::string message = assembly_error(text);
+    INFO(message);
+    CHECK_THAT(message, StartsWith("test.yaml:") && Contains("the joints cannot all be satisfied") && Contains("'middle_pin'") &&
+                            Contains("contradict"));
+  }
+  SECTION("a pivoted bar whose end should slide on a line out of its reach") {
+    const std::string text = single_body_model(R"(  - name: bar
+    mass: 1.0
+    inertia: 0.1
+    position: [0.0, 0.0]
+    angle: 0.5
+)",
+                                               R"(  - name: pivot
+    type: pin_joint
+    points: [{body: ground, at: [0, 0]}, {body: bar, at: [0, 0]}]
+  - name: guide
+    type: sliding_pin_joint
+    axis: [1, 0]
+    points: [{body: ground, at: [0, 3]}, {body: bar, at: [1, 0]}]
+)");
+    const std::string message = assembly_error(text);
+    INFO(message);
+    CHECK_THAT(message, StartsWith("test.yaml:" + std::to_string(line_of(text, "- name: guide")) + ": ") &&
+                            Contains("the joints cannot all be satisfied") && Contains("sliding_pin_joint 'guide'"));
+  }
+  SECTION("a body pinned to ground at two points further apart than its attachment points") {
+    // 4 equations on 3 coordinates: this is caught as redundant before assembly is tried
+    // (see the final report); either way it must be an InputError naming a joint.
+    const std::string text = single_body_model(R"(  - name: bar
+    mass: 1.0
+    inertia: 0.1
+    position: [0.0, 0.0]
+)",
+                                               R"(  - name: left_pin
+    type: pin_joint
+    points: [{body: ground, at: [-1, 0]}, {body: bar, at: [-1, 0]}]
+  - name: right_pin
+    type: pin_joint
+    points: [{body: ground, at: [2, 0]}, {body: bar, at: [1, 0]}]
+)");
+    const std::string message = assembly_error(text);
+    INFO(message);
+    CHECK_THAT(message, StartsWith("test.yaml:") && (Contains("cannot all be satisfied") || Contains("redundant")) &&
+                            (Contains("'left_pin'") || Contains("'right_pin'")));
+  }
+}

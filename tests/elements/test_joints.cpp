@@ -289,7 +289,7 @@ TEST_CASE("joints without relative_angle lock the initial relative angle", "[ele
   for (const JointType& joint : kJoints) {
     if (!joint.locks_angle) continue;
     INFO(joint.type);
-    // Unsatisfied translation is irrelevant here; only the angle row is checked.
+    // Relative angle in the layout: 0.75 - 0.4.
     const JointLayout layout = satisfied_layout(joint, Ends::BodyBody);
     const Model model = testing::model_from_text(joint_model(joint, layout, /*default_angle=*/true));
     const auto* locking = dynamic_cast<const AngleLockingJoint*>(model.elements().front().get());

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <random>
 #include <sstream>
 #include <string>
@@ -24,7 +23,7 @@ struct Attachment {
   double sx, sy;
 };
 
-enum class Ends { GroundBody, BodyBody };
+enum class Ends { GroundBody, BodyGround, BodyBody };
 
 /// Where the element's two points sit in each configuration (the YAML is generated from this).
 struct Layout {
@@ -33,6 +32,7 @@ struct Layout {
 
 Layout layout(Ends ends) {
   if (ends == Ends::GroundBody) return {{kGround, -0.5, 0.4}, {0, 0.35, -0.15}};
+  if (ends == Ends::BodyGround) return {{0, 0.35, -0.15}, {kGround, -0.5, 0.4}};
   return {{0, 0.45, 0.2}, {1, -0.3, 0.25}};
 }
 
@@ -45,6 +45,7 @@ std::string point_yaml(const Attachment& a) {
 
 /// A model with one element `e` of the given type; `parameters` are its YAML lines.
 /// Body a: rotated and moving; body b (body-body only): rotated the other way.
+/// Ground-body has the ground point first, body-ground the body point first.
 std::string element_model(const std::string& type, const std::string& parameters, Ends ends) {
   const Layout points = layout(ends);
   std::ostringstream text;
@@ -60,8 +61,10 @@ std::string element_model(const std::string& type, const std::string& parameters
   return text.str();
 }
 
-const Ends kAllEnds[] = {Ends::GroundBody, Ends::BodyBody};
-const char* ends_name(Ends ends) { return ends == Ends::GroundBody ? "ground-body" : "body-body"; }
+const Ends kAllEnds[] = {Ends::GroundBody, Ends::BodyGround, Ends::BodyBody};
+const char* ends_name(Ends ends) {
+  return ends == Ends::GroundBody ? "ground-body" : (ends == Ends::BodyGround ? "body-ground" : "body-body");
+}
 
 constexpr double kStiffness = 40.0;
 constexpr double kFreeLength = 0.9;
@@ -348,7 +351,7 @@ TEST_CASE("spring potential energy is half stiffness times deformation squared",
     const Model linear = testing::model_from_text(element_model("linear_spring", linear_spring_parameters(), ends));
     const Model torsional =
         testing::model_from_text(element_model("torsional_spring", torsional_spring_parameters(), ends));
-    const DaeSystem system(linear);
+    const DaeSystem system(linear);  // both models have the same bodies: the states fit either
     at_several_states(system, [&](const BodyState& s) {
       const Element& spring = *linear.elements().front();
       const double stretch = distance(s.q, l) - kFreeLength;
@@ -395,8 +398,9 @@ TEST_CASE("torsional_spring without free_angle is unstressed in the initial conf
     const BodyState start = split(system, system.initial_state());
     const auto& spring = dynamic_cast<const TorsionalSpring&>(*model.elements().front());
     REQUIRE(spring.free_angle.has_value());
-    // Initial angles: a 0.4, b -0.6 (ground 0).
-    CHECK(*spring.free_angle == Approx(ends == Ends::GroundBody ? 0.4 : -1.0).epsilon(1e-12));
+    // Initial angles: a 0.4, b -0.6 (ground 0); free_angle is theta2 - theta1.
+    const double expected = ends == Ends::GroundBody ? 0.4 : (ends == Ends::BodyGround ? -0.4 : -1.0);
+    CHECK(*spring.free_angle == Approx(expected).epsilon(1e-12));
     CHECK(largest(forces(system, start)) < 1e-12);
 
     BodyState turned = start;
