@@ -70,15 +70,31 @@ void check_constraint_rank(const DaeSystem& system, const double* q) {
     throw SolverError("could not factor the constraint gradient to check the joints for redundancy");
   const int rank = static_cast<int>(qr.rank());
   if (rank >= m) return;
-  // (A P).col(k) = A.col(P.indices()(k)): the trailing permuted columns are the dependent rows.
-  std::vector<int> dependent;
-  for (int k = rank; k < m; ++k) dependent.push_back(qr.colsPermutation().indices()(k));
+  // (A P).col(k) = A.col(P.indices()(k)): the trailing permuted columns are the dependent
+  // rows. Each is a combination x of the leading ones, R11 x = R12(:, k); the rows with a
+  // non-zero weight in x are the joints it repeats.
+  const Eigen::VectorXi& permutation = qr.colsPermutation().indices();
+  const SparseMatrix r = qr.matrixR();
+  const SparseMatrix r11 = r.topLeftCorner(rank, rank);
+  std::vector<int> involved;
+  for (int k = rank; k < m; ++k) {
+    involved.push_back(permutation(k));
+    const Eigen::VectorXd column = Eigen::VectorXd(r.block(0, k, rank, 1));
+    const Eigen::VectorXd weights = r11.triangularView<Eigen::Upper>().solve(column);
+    const double largest = weights.cwiseAbs().maxCoeff();
+    for (int i = 0; i < rank; ++i)
+      if (std::abs(weights[i]) > 1e-8 * largest) involved.push_back(permutation(i));
+  }
+  double worst = 0.0;
+  for (int row : involved) worst = std::max(worst, std::abs(phi[row]) * row_scale(system, row));
   const std::string file_prefix = SourceLocation{system.model().file, 0}.prefix();
   std::ostringstream msg;
   msg << file_prefix << "the joints are redundant: " << (m - rank) << " of the " << m
       << " constraint equations repeat what the others already impose, which makes the system singular. "
-      << "Elements involved: " << describe_rows(system, dependent)
-      << ". Remove one of them or use a joint that constrains less (e.g. a sliding_pin_joint instead of a "
+      << "Elements involved: " << describe_rows(system, involved) << ".";
+  if (worst > 1e-9 * system.model().length_scale())
+    msg << " As placed they also contradict each other (they miss by up to " << worst << " length units).";
+  msg << " Remove one of them or use a joint that constrains less (e.g. a sliding_pin_joint instead of a "
          "pin_joint, or a pin_joint instead of a rigid_joint).";
   throw InputError(msg.str());
 }
@@ -113,11 +129,14 @@ AssemblyReport assemble_initial_state(const DaeSystem& system, std::vector<doubl
     if (worst <= tolerance) break;
     if (iteration == max_iterations || !std::isfinite(worst)) {
       const Element& e = system.constraint_owner(worst_row);
+      std::vector<int> missing;
+      for (int r = 0; r < m; ++r)
+        if (std::abs(phi[r]) * row_scale(system, r) > 1e-3 * worst) missing.push_back(r);
       std::ostringstream msg;
       msg << e.where().prefix() << "the joints cannot all be satisfied: after " << max_iterations
           << " Newton iterations on the initial positions, " << e.type() << " '" << e.name() << "' still misses by "
-          << worst << " (length units). Check the points and positions of the bodies it connects, and of the "
-          << "joints around them: they contradict each other.";
+          << worst << " (length units); joints still open: " << describe_rows(system, missing)
+          << ". Check the points and positions of the bodies they connect: they contradict each other.";
       throw InputError(msg.str());
     }
     const SparseMatrix gw = g * w.asDiagonal();
