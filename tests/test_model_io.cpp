@@ -318,7 +318,7 @@ TEST_CASE("gravity: SI default, [0, 0] switches it off, any vector is taken as g
   CHECK(tilted.gravity_y == -3.0);
 }
 
-TEST_CASE("--set overrides change the model before it is checked", "[model_io]") {
+TEST_CASE("overrides given with --set change the model before it is checked", "[model_io]") {
   const Model model =
       load_model_text(kBase, "test.yaml", {"simulation.t_end=0.5", "bodies.bob.mass=2", "elements.spring.stiffness=200"});
   CHECK(model.simulation.t_end == 0.5);

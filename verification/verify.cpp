@@ -239,7 +239,7 @@ TEST_CASE("SUNDIALS slider-crank: kinetic energy integral and final state", "[ve
         "idasSlCrank_dns prints 3.3366160662934146");
 }
 
-TEST_CASE("explicit Euler converges at first order; IDA error follows the tolerance", "[verification]") {
+TEST_CASE("explicit Euler converges at first order and IDA error follows the tolerance", "[verification]") {
   start_case("convergence");
   // Reference: the physical pendulum's state at t = 2 s from IDA at rtol 1e-12.
   const Trajectory reference = simulate("physical_pendulum", {"simulation.integrator=ida", "simulation.rtol=1e-12"});

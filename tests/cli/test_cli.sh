@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The command line's contract: exit status 0 (success), 1 (run failed, results kept),
+# 2 (bad input, one-line message with file and line); files written by `run`.
+# Usage: test_cli.sh RAILCRASH_BINARY SOURCE_DIR
+set -u
+bin=$1
+src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+passes=0
+
+expect_status() {  # description expected-status command...
+  local description=$1 expected=$2
+  shift 2
+  "$@" > "$tmp/stdout" 2> "$tmp/stderr"
+  local status=$?
+  if [ "$status" -ne "$expected" ]; then
+    echo "FAIL: $description: exit status $status, expected $expected"
+    sed 's/^/  | /' "$tmp/stderr"
+    failures=$((failures + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+
+expect_text() {  # description file pattern
+  if grep -q -- "$3" "$2"; then
+    passes=$((passes + 1))
+  else
+    echo "FAIL: $1: '$3' not found in $2"
+    sed 's/^/  | /' "$2" | head -20
+    failures=$((failures + 1))
+  fi
+}
+
+crank=$src/verification/cases/slider_crank.yaml
+
+expect_status "check a valid model" 0 "$bin" check "$crank"
+expect_text "check prints degrees of freedom" "$tmp/stdout" "degrees of freedom  1"
+
+expect_status "run a valid model" 0 "$bin" run "$crank" --out "$tmp/crank" --t-end 1
+expect_text "summary status" "$tmp/crank/summary.json" '"status": "ok"'
+expect_text "summary t_reached" "$tmp/crank/summary.json" '"t_reached": 1,'
+expect_text "timeseries header" "$tmp/crank/timeseries.csv" '^t,crank.x,crank.y,crank.theta,crank.vx,crank.vy,crank.omega,rod.x'
+expect_text "events header" "$tmp/crank/events.csv" '^t,element,event,value$'
+
+expect_status "euler run" 0 "$bin" run "$crank" --integrator euler --dt 1e-3 --t-end 0.5 --out "$tmp/euler"
+expect_text "euler prints its step and limit" "$tmp/stdout" "euler step 0.001, stability limit"
+expect_text "summary integrator" "$tmp/euler/summary.json" '"integrator": "euler"'
+
+expect_status "--set changes a model key" 0 "$bin" run "$crank" --set simulation.t_end=0.25 --out "$tmp/set"
+expect_text "--set took effect" "$tmp/set/summary.json" '"t_reached": 0.25,'
+
+printf 'railcrash: 1\nname: bad\nunits: SI\nbodies:\n  - {name: b, mass: -1, inertia: 1, position: [0, 0]}\nsimulation: {t_end: 1}\n' > "$tmp/bad.yaml"
+expect_status "bad input exits 2" 2 "$bin" run "$tmp/bad.yaml" --out "$tmp/bad"
+expect_text "bad input names file, line and what to change" "$tmp/stderr" "bad.yaml:5: body 'b': mass must be positive"
+[ ! -e "$tmp/bad/summary.json" ] && passes=$((passes + 1)) || { echo "FAIL: bad input wrote results"; failures=$((failures + 1)); }
+
+expect_status "missing model file exits 2" 2 "$bin" check "$tmp/nothing.yaml"
+expect_status "unknown option exits 2" 2 "$bin" run "$crank" --no-such-option
+expect_status "bad command-line value exits 2" 2 "$bin" run "$crank" --t-end -1
+expect_text "bad --t-end says so" "$tmp/stderr" "t-end must be a positive number"
+
+# Euler above its stability limit: refused (2) unless forced; forced, it diverges (1) and
+# still leaves its results.
+printf 'railcrash: 1\nname: stiff\nunits: SI\ngravity: [0, 0]\nbodies:\n  - {name: m, mass: 2, inertia: 0.1, position: [1.1, 0]}\nelements:\n  - {name: k, type: linear_spring, stiffness: 200, free_length: 1, points: [{body: ground, at: [0, 0]}, {body: m, at: [0, 0]}]}\nsimulation: {t_end: 300, integrator: euler, dt: 0.3, output_interval: 1}\n' > "$tmp/stiff.yaml"
+expect_status "euler step above the limit exits 2" 2 "$bin" run "$tmp/stiff.yaml" --out "$tmp/stiff"
+expect_text "the refusal gives the limit" "$tmp/stderr" "above the stability limit 0.2"
+expect_status "forced euler divergence exits 1" 1 "$bin" run "$tmp/stiff.yaml" --force-dt --out "$tmp/stiff"
+expect_text "failed summary" "$tmp/stiff/summary.json" '"status": "failed"'
+expect_text "failed summary says why" "$tmp/stiff/summary.json" 'diverged'
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
