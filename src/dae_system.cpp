@@ -65,6 +65,8 @@ DaeSystem::DaeSystem(const Model& model) : model_(model) {
       row_is_rotational_[static_cast<std::size_t>(model.constraint_offset(e) + r)] = el.constraint_row_is_rotational(r);
     }
     for (const std::string& q : el.output_names()) output_names_.push_back(el.name() + "." + q);
+    root_offset_.push_back(root_count_);
+    root_count_ += el.root_count();
   }
 
   // Dry run: learn the pattern from the same assembly code, then give every addition its slot.
@@ -147,10 +149,15 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
       el.add_force(t, s, fe);
     } else {
       if (penalty == nullptr) continue;
+      const int offset = model_.constraint_offset(e);
+      if (el.failed()) {
+        if (penalty_lambda)
+          for (int r = 0; r < m; ++r) penalty_lambda[offset + r] = 0.0;
+        continue;
+      }
       double phi[kMaxConstraintRows];
       double grad[kMaxConstraintRows][6];
       el.constraint_gradient(s.q, phi, grad);
-      const int offset = model_.constraint_offset(e);
       for (int r = 0; r < m; ++r) {
         const auto row = static_cast<std::size_t>(offset + r);
         double rate = 0.0;
@@ -194,6 +201,13 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* r)
     const int m = el.constraint_count();
     if (m == 0) continue;
     const int offset = model_.constraint_offset(e);
+    if (el.failed()) {  // rows become lambda = 0, mu = 0
+      for (int row = 0; row < m; ++row) {
+        r_phi[offset + row] = lambda[offset + row];
+        r_vel[offset + row] = mu[offset + row];
+      }
+      continue;
+    }
     const std::array<Pose<double>, 2> poses = gather_poses(el, q);
     double phi[kMaxConstraintRows];
     double grad[kMaxConstraintRows][6];
@@ -273,6 +287,16 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
     double grad[kMaxConstraintRows][6];
     double hess[kMaxConstraintRows][6][6];
     el.constraint_hessian(s.q, phi, grad, hess);
+    // A failed constraint writes the same entries (the pattern never changes) as zeros,
+    // and ones on its lambda and mu diagonals.
+    const double active = el.failed() ? 0.0 : 1.0;
+    if (el.failed()) {
+      for (auto& row : grad)
+        for (double& value : row) value = 0.0;
+      for (auto& row : hess)
+        for (auto& line : row)
+          for (double& value : line) value = 0.0;
+    }
     double local_v[6];
     for (int k = 0; k < 2; ++k) {
       local_v[3 * k] = s.v[static_cast<std::size_t>(k)].x;
@@ -317,9 +341,9 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
           sink.add(row_vel, nq + 3 * ba + i, gv);                // r_vel: G
         }
       }
-      // Diagonal slots kept for a constraint that fails (its rows become lambda = 0, mu = 0).
-      sink.add(row_phi, model_.lambda_index(g), 0.0);
-      sink.add(row_vel, model_.mu_index(g), 0.0);
+      // Diagonal slots of a constraint that fails (its rows become lambda = 0, mu = 0).
+      sink.add(row_phi, model_.lambda_index(g), 1.0 - active);
+      sink.add(row_vel, model_.mu_index(g), 1.0 - active);
     }
   }
 }
@@ -350,7 +374,7 @@ void DaeSystem::force_jacobian(double t, const double* q, const double* v, const
       std::array<Pose<double>, 2> f{};
       el.add_force_jacobian(t, s, f, dq, dv);
     } else {
-      if (!penalty) continue;
+      if (!penalty || el.failed()) continue;
       // f = -G^T (k Phi + c G v): df/dq ~ -k G^T G (curvature terms of the multiplier dropped:
       // this Jacobian only feeds the stability estimate), df/dv = -c G^T G.
       double phi[kMaxConstraintRows];
@@ -390,6 +414,10 @@ void DaeSystem::constraints(const double* q, double* phi, std::vector<Triplet>* 
     const int m = el.constraint_count();
     if (m == 0) continue;
     const int offset = model_.constraint_offset(e);
+    if (el.failed()) {  // no equation left: Phi = 0, no gradient
+      for (int row = 0; row < m; ++row) phi[offset + row] = 0.0;
+      continue;
+    }
     const std::array<Pose<double>, 2> poses = gather_poses(el, q);
     double grad[kMaxConstraintRows][6];
     el.constraint_gradient(poses, phi + offset, grad);
@@ -408,6 +436,10 @@ void DaeSystem::constraint_acceleration_bias(const double* q, const double* v, d
     const Element& el = *model_.elements()[e];
     const int m = el.constraint_count();
     if (m == 0) continue;
+    if (el.failed()) {
+      for (int row = 0; row < m; ++row) gamma[model_.constraint_offset(e) + row] = 0.0;
+      continue;
+    }
     const ElementState<double> s = gather_state(el, q, v);
     double phi[kMaxConstraintRows];
     double grad[kMaxConstraintRows][6];
@@ -521,6 +553,41 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   for (std::size_t e = 0; e < model_.elements().size(); ++e)
     s.element_work += quadratures[kFirstElementWork + static_cast<int>(e)];
   return s;
+}
+
+void DaeSystem::roots(double t, const double* y, double* g) const {
+  const int nq = body_unknowns();
+  const double* lambda = y + 2 * nq;
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    if (el.root_count() == 0) continue;
+    const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
+    el.roots(t, gather_state(el, y, y + nq), element_lambda, g + root_offset_[e]);
+  }
+}
+
+bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const {
+  const int nq = body_unknowns();
+  const double* lambda = y + 2 * nq;
+  bool changed = false;
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    Element& el = *model_.elements()[e];
+    for (int k = 0; k < el.root_count(); ++k) {
+      const int d = direction[root_offset_[e] + k];
+      if (d == 0) continue;
+      const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
+      Element::Event event;
+      if (el.commit(k, d, t, gather_state(el, y, y + nq), element_lambda, event)) {
+        changed = true;
+        events.push_back({t, el.name(), event.what, event.value});
+      }
+    }
+  }
+  return changed;
+}
+
+void DaeSystem::reset_modes() const {
+  for (const auto& el : model_.elements()) el->reset_modes();
 }
 
 void DaeSystem::outputs(const double* y, const double* lambda, double* out) const {

@@ -118,6 +118,7 @@ EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings
       throw InputError(b.where.prefix() + "body '" + b.name +
                        "' has zero inertia: explicit Euler needs every body's inertia to be positive "
                        "(use integrator: ida, or give the body an inertia)");
+  system.reset_modes();
   y0_ = system.initial_state();
   assembly_correction_ = assemble_initial_state(system, y0_).largest_position_change;
 
@@ -168,8 +169,17 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   // The multipliers stored in y (for output) are the penalty forces.
   double* y_lambda = y.data() + 2 * nq;
 
+  system_.reset_modes();
   system_.generalized_forces(0.0, q, v, force.data(), &penalty_, lambda.data());
   std::copy(lambda.begin(), lambda.end(), y_lambda);
+  // Mode changes: the same root functions as IDA, checked at the end of every step (what
+  // IITRAIN's "internal logic checks at each time step" did). A root that sits at zero right
+  // after its commit is ignored until it leaves zero.
+  const int root_count = system_.root_count();
+  std::vector<double> g_before(static_cast<std::size_t>(root_count)), g_after(g_before.size());
+  std::vector<int> direction(g_before.size(), 0);
+  std::vector<EventRecord> events;
+  if (root_count > 0) system_.roots(0.0, y.data(), g_before.data());
   outcome.initial_energy = system_.energy(y.data(), quad.data(), &penalty_);
   observer.sample(0.0, y.data(), y_lambda, quad.data());
   outcome.max_constraint_residual = system_.constraint_residual(q);
@@ -193,6 +203,26 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
     t = (step == total_steps) ? t_end : static_cast<double>(step) * dt_;
     ++outcome.stats.steps;
     outcome.stats.residual_evaluations += 1;
+    if (root_count > 0) {
+      std::copy(lambda.begin(), lambda.end(), y_lambda);
+      system_.roots(t, y.data(), g_after.data());
+      bool fired = false;
+      for (std::size_t k = 0; k < g_after.size(); ++k) {
+        const double before = g_before[k], after = g_after[k];
+        direction[k] = (before > 0.0 && after <= 0.0) ? -1 : (before < 0.0 && after >= 0.0) ? 1 : 0;
+        fired = fired || direction[k] != 0;
+      }
+      if (fired) {
+        events.clear();
+        if (system_.commit_roots(t, y.data(), direction.data(), events)) {
+          ++outcome.stats.reinitializations;
+          system_.roots(t, y.data(), g_after.data());
+        }
+        for (const EventRecord& record : events) observer.event(record);
+        outcome.stats.events += static_cast<long>(events.size());
+      }
+      std::swap(g_before, g_after);
+    }
     bool finite = true;
     for (int k = 0; k < 2 * nq; ++k) finite = finite && std::isfinite(y[static_cast<std::size_t>(k)]);
     if (!finite) {

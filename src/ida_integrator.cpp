@@ -106,6 +106,37 @@ struct IdaIntegrator::Impl {
     }
   }
 
+  static int root_functions(realtype t, N_Vector yy, N_Vector, realtype* g, void* user) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      self->system.roots(t, N_VGetArrayPointer(yy), g);
+      return 0;
+    } catch (...) {
+      self->callback_error = std::current_exception();
+      return -1;
+    }
+  }
+
+  /// Adds IDA's counters to stats (they restart at every IDAReInit).
+  void accumulate(RunStatistics& stats) const {
+    long value = 0;
+    check(IDAGetNumSteps(ida, &value), "IDAGetNumSteps");
+    stats.steps += value;
+    check(IDAGetNumResEvals(ida, &value), "IDAGetNumResEvals");
+    stats.residual_evaluations += value;
+    check(IDAGetNumJacEvals(ida, &value), "IDAGetNumJacEvals");
+    stats.jacobian_evaluations += value;
+    check(IDAGetNumNonlinSolvIters(ida, &value), "IDAGetNumNonlinSolvIters");
+    stats.nonlinear_iterations += value;
+    check(IDAGetNumErrTestFails(ida, &value), "IDAGetNumErrTestFails");
+    stats.error_test_failures += value;
+    check(IDAGetNumNonlinSolvConvFails(ida, &value), "IDAGetNumNonlinSolvConvFails");
+    stats.nonlinear_convergence_failures += value;
+    realtype step = 0.0;
+    check(IDAGetLastStep(ida, &step), "IDAGetLastStep");
+    if (step > 0.0) stats.last_step = step;
+  }
+
   static void error_handler(int, const char* module, const char* function, char* message, void* user) {
     auto* self = static_cast<Impl*>(user);
     self->last_sundials_message = std::string(module) + "/" + function + ": " + message;
@@ -139,6 +170,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
   const Model& model = system_.model();
 
   // ---- consistent positions and velocities ----
+  system_.reset_modes();
   std::vector<double> y0 = system_.initial_state();
   const AssemblyReport assembly = assemble_initial_state(system_, y0);
   outcome.stats.assembly_correction = assembly.largest_position_change;
@@ -221,6 +253,13 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");
     impl.check(IDAQuadSVtolerances(impl.ida, rtol, impl.quad_atol), "IDAQuadSVtolerances");
     impl.check(IDASetQuadErrCon(impl.ida, SUNTRUE), "IDASetQuadErrCon");
+    const int root_count = system_.root_count();
+    std::vector<int> root_info(static_cast<std::size_t>(root_count), 0);
+    std::vector<EventRecord> events;
+    if (root_count > 0) {
+      impl.check(IDARootInit(impl.ida, root_count, &Impl::root_functions), "IDARootInit");
+      impl.check(IDASetNoInactiveRootWarn(impl.ida), "IDASetNoInactiveRootWarn");
+    }
 
     const double* lambda = y + 2 * nq;
     std::vector<double> quad_now(static_cast<std::size_t>(nquad), 0.0);
@@ -250,6 +289,27 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
       impl.check(IDAGetQuad(impl.ida, &t_return, impl.quad), "IDAGetQuad");
       t_reached = t_return;
       const double* quad = N_VGetArrayPointer(impl.quad);
+      if (flag == IDA_ROOT_RETURN) {
+        // A mode change: commit it, then restart from consistent values (accelerations and
+        // joint forces jump with the new law). A root exactly at the restart point is left
+        // inactive by IDA, so the same crossing cannot fire twice.
+        impl.check(IDAGetRootInfo(impl.ida, root_info.data()), "IDAGetRootInfo");
+        events.clear();
+        const bool changed = system_.commit_roots(t_reached, y, root_info.data(), events);
+        for (const EventRecord& record : events) observer.event(record);
+        outcome.stats.events += static_cast<long>(events.size());
+        if (changed) {
+          std::vector<double> y_now(y, y + n), yp_now;
+          consistent_rates(system_, t_reached, y_now, yp_now);
+          std::copy(y_now.begin(), y_now.end(), y);
+          std::copy(yp_now.begin(), yp_now.end(), yp);
+          impl.accumulate(outcome.stats);
+          impl.check(IDAReInit(impl.ida, t_reached, impl.y, impl.yp), "IDAReInit");
+          impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
+          ++outcome.stats.reinitializations;
+        }
+        if (t_reached < t_out * (1.0 - 1e-14)) continue;
+      }
       observer.sample(t_reached, y, lambda, quad);
       outcome.max_constraint_residual = std::max(outcome.max_constraint_residual, system_.constraint_residual(y));
       if (t_reached >= t_out * (1.0 - 1e-14)) ++output_index;
@@ -261,16 +321,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     outcome.quadratures.assign(quad, quad + nquad);
     outcome.final_energy = system_.energy(y, quad);
 
-    long value = 0;
-    realtype step = 0.0;
-    impl.check(IDAGetNumSteps(impl.ida, &value), "IDAGetNumSteps"); outcome.stats.steps = value;
-    impl.check(IDAGetNumResEvals(impl.ida, &value), "IDAGetNumResEvals"); outcome.stats.residual_evaluations = value;
-    impl.check(IDAGetNumJacEvals(impl.ida, &value), "IDAGetNumJacEvals"); outcome.stats.jacobian_evaluations = value;
-    impl.check(IDAGetNumNonlinSolvIters(impl.ida, &value), "IDAGetNumNonlinSolvIters"); outcome.stats.nonlinear_iterations = value;
-    impl.check(IDAGetNumErrTestFails(impl.ida, &value), "IDAGetNumErrTestFails"); outcome.stats.error_test_failures = value;
-    impl.check(IDAGetNumNonlinSolvConvFails(impl.ida, &value), "IDAGetNumNonlinSolvConvFails");
-    outcome.stats.nonlinear_convergence_failures = value;
-    impl.check(IDAGetLastStep(impl.ida, &step), "IDAGetLastStep"); outcome.stats.last_step = step;
+    impl.accumulate(outcome.stats);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {

@@ -191,7 +191,10 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
     }
     std::vector<double> gamma(static_cast<std::size_t>(m), 0.0);
     system.constraint_acceleration_bias(y.data(), y.data() + nq, gamma.data());
-    for (int r = 0; r < m; ++r) rhs[nq + r] = -gamma[static_cast<std::size_t>(r)];
+    for (int r = 0; r < m; ++r) {
+      rhs[nq + r] = -gamma[static_cast<std::size_t>(r)];
+      if (!system.constraint_row_active(r)) entries.emplace_back(nq + r, nq + r, 1.0);  // lambda = 0
+    }
   }
   SparseMatrix kkt(nq + m, nq + m);
   kkt.setFromTriplets(entries.begin(), entries.end());

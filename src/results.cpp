@@ -85,6 +85,17 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
 }
 
+void ResultWriter::event(const EventRecord& record) {
+  std::string element = record.element, what = record.what;
+  for (std::string* text : {&element, &what})
+    if (text->find_first_of(",\"") != std::string::npos) {
+      std::string quoted = "\"";
+      for (char c : *text) quoted += (c == '"') ? std::string("\"\"") : std::string(1, c);
+      *text = quoted + "\"";
+    }
+  std::fprintf(events_, "%.12g,%s,%s,%.12g\n", record.t, element.c_str(), what.c_str(), record.value);
+}
+
 void ResultWriter::write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json) {
   std::fflush(timeseries_);
   std::fflush(events_);

@@ -35,6 +35,10 @@ class ProgressObserver : public RunObserver {
     std::fflush(stderr);
   }
 
+  void event(const EventRecord& record) override {
+    if (next_) next_->event(record);
+  }
+
  private:
   RunObserver* next_;
   double t_end_;

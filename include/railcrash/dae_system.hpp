@@ -30,6 +30,14 @@ struct SparsePattern {
   int nonzeros() const { return static_cast<int>(row_index.size()); }
 };
 
+/// One committed mode change, for events.csv.
+struct EventRecord {
+  double t = 0.0;
+  std::string element;
+  std::string what;
+  double value = 0.0;
+};
+
 /// Penalty stiffness and damping per constraint row (explicit Euler).
 struct PenaltyRows {
   std::vector<double> stiffness;  // [force/length] or [moment/rad]
@@ -93,6 +101,8 @@ class DaeSystem {
   double constraint_residual(const double* q) const;
   /// Element owning constraint row `row`.
   const Element& constraint_owner(int row) const;
+  /// False once the element owning constraint row `row` has failed (its rows: lambda = mu = 0).
+  bool constraint_row_active(int row) const { return !constraint_owner(row).failed(); }
   /// True when constraint row `row` is an angle equation.
   bool constraint_row_is_rotational(int row) const { return row_is_rotational_[static_cast<std::size_t>(row)]; }
 
@@ -107,6 +117,17 @@ class DaeSystem {
 
   double kinetic_energy(const double* v) const;
   EnergyState energy(const double* y, const double* quadratures, const PenaltyRows* penalty = nullptr) const;
+
+  // ---- modes and events ----
+  int root_count() const { return root_count_; }
+  /// All elements' root functions at y, in element order.
+  void roots(double t, const double* y, double* g) const;
+  /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
+  /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
+  /// any mode changed (the integrator must then re-initialize).
+  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
+  /// Puts every element back in its starting mode.
+  void reset_modes() const;
 
   /// Element output columns "<element>.<quantity>" and their values at y.
   const std::vector<std::string>& output_names() const { return output_names_; }
@@ -128,6 +149,8 @@ class DaeSystem {
   std::vector<std::string> output_names_;
   std::vector<int> constraint_row_owner_;  // element index of each constraint row
   std::vector<bool> row_is_rotational_;
+  std::vector<int> root_offset_;  // first root of each element
+  int root_count_ = 0;
 };
 
 }  // namespace railcrash

@@ -11,6 +11,13 @@
 //
 // Concrete elements derive from ForceElement<Derived> or ConstraintElement<Derived> and
 // write their law once, as a template over the scalar type.
+//
+// Piecewise laws (contact, yield, unloading, bottoming, rupture, ...) are hybrid: between
+// events the element is in a fixed mode and its law is smooth. The element exposes root
+// functions g of its current mode; a sign change of one of them means "leave this mode".
+// The integrator locates the root (IDA) or sees it at the end of a step (Euler), then calls
+// commit(), which changes the mode and its history (plastic offsets, ...). History never
+// changes inside a residual evaluation.
 #pragma once
 
 #include <array>
@@ -82,6 +89,28 @@ class Element {
   /// The same forces and their derivatives with respect to (q, v) of both slots.
   virtual void add_force_jacobian(double t, const ElementState<double>& s, std::array<Pose<double>, 2>& f,
                                   ForceBlock& df_dq, ForceBlock& df_dv) const;
+
+  // ---- modes and events ----
+  /// Number of root functions; fixed for the element's life (an inactive one returns 1).
+  virtual int root_count() const { return 0; }
+  /// Root functions of the current mode at state s (lambda: the element's multipliers).
+  virtual void roots(double /*t*/, const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*g*/) const {}
+  /// What happened at an event, for events.csv.
+  struct Event {
+    std::string what;   // e.g. "contact closed", "yield", "rupture"
+    double value = 0.0; // the quantity that triggered it (deformation, force, ...)
+  };
+  /// Root `index` changed sign (direction +1: increasing, -1: decreasing) at state s:
+  /// commit the mode change. Returns false when the crossing needs no change (the element
+  /// may then log nothing).
+  virtual bool commit(int /*index*/, int /*direction*/, double /*t*/, const ElementState<double>& /*s*/,
+                      const double* /*lambda*/, Event& /*event*/) {
+    return false;
+  }
+  /// Back to the mode the element starts a run in.
+  virtual void reset_modes() {}
+  /// A failed constraint keeps its rows as lambda = 0, mu = 0 (so the pattern never changes).
+  virtual bool failed() const { return false; }
 
   // ---- energy and output ----
   /// Energy stored in the element [force*length].
