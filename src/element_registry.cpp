@@ -43,6 +43,12 @@ const ElementRegistry& ElementRegistry::instance() {
     ElementRegistry r;
     register_spring_elements(r);
     register_joint_elements(r);
+    register_crush_elements(r);
+    register_nonlinear_elements(r);
+    register_couplers_elements(r);
+    register_beams_elements(r);
+    register_anticlimber_elements(r);
+    register_contact_elements(r);
     return r;
   }();
   return registry;

@@ -219,6 +219,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
           system_.roots(t, y.data(), g_after.data());
         }
         for (const EventRecord& record : events) observer.event(record);
+        outcome.events.insert(outcome.events.end(), events.begin(), events.end());
         outcome.stats.events += static_cast<long>(events.size());
       }
       std::swap(g_before, g_after);

@@ -297,6 +297,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
         events.clear();
         const bool changed = system_.commit_roots(t_reached, y, root_info.data(), events);
         for (const EventRecord& record : events) observer.event(record);
+        outcome.events.insert(outcome.events.end(), events.begin(), events.end());
         outcome.stats.events += static_cast<long>(events.size());
         if (changed) {
           std::vector<double> y_now(y, y + n), yp_now;

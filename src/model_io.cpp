@@ -187,6 +187,17 @@ class YamlParameterReader : public ParameterReader {
     if (!node) return std::nullopt;
     return reader_.numbers(node, size, context_ + ": '" + key + "'");
   }
+  std::optional<std::vector<std::vector<double>>> table(const std::string& key, std::size_t width) override {
+    used_.insert(key);
+    const YAML::Node node = element_[key];
+    if (!node) return std::nullopt;
+    if (!node.IsSequence() || node.size() == 0)
+      reader_.fail(node, context_ + ": '" + key + "' must be a table of rows [[a, b], ...]");
+    std::vector<std::vector<double>> rows;
+    for (std::size_t i = 0; i < node.size(); ++i)
+      rows.push_back(reader_.numbers(node[i], width, context_ + ": '" + key + "' row " + std::to_string(i + 1)));
+    return rows;
+  }
   std::optional<bool> flag(const std::string& key) override {
     used_.insert(key);
     const YAML::Node node = element_[key];
@@ -281,6 +292,10 @@ class KeyProbe : public ParameterReader {
   std::optional<std::vector<double>> vector(const std::string& key, std::size_t size) override {
     keys.insert(key);
     return std::vector<double>(size > 0 ? size : 2, 1.0);
+  }
+  std::optional<std::vector<std::vector<double>>> table(const std::string& key, std::size_t width) override {
+    keys.insert(key);
+    return std::vector<std::vector<double>>{std::vector<double>(width, 0.0), std::vector<double>(width, 1.0)};
   }
   std::optional<bool> flag(const std::string& key) override {
     keys.insert(key);

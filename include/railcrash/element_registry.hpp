@@ -23,6 +23,8 @@ class ParameterReader {
   virtual std::optional<double> number(const std::string& key) = 0;
   /// A list of exactly `size` finite numbers (size 0: any length), or nullopt.
   virtual std::optional<std::vector<double>> vector(const std::string& key, std::size_t size) = 0;
+  /// A table of rows of exactly `width` finite numbers ([[a, b], ...]), or nullopt.
+  virtual std::optional<std::vector<std::vector<double>>> table(const std::string& key, std::size_t width) = 0;
   virtual std::optional<bool> flag(const std::string& key) = 0;
   /// Throws an InputError located at `key` (or at the element when the key is absent).
   [[noreturn]] virtual void fail(const std::string& key, const std::string& what_to_change) const = 0;
@@ -63,5 +65,11 @@ class ElementRegistry {
 // One registration function per element family (src/elements/*.cpp).
 void register_spring_elements(ElementRegistry& registry);
 void register_joint_elements(ElementRegistry& registry);
+void register_crush_elements(ElementRegistry& registry);
+void register_nonlinear_elements(ElementRegistry& registry);
+void register_couplers_elements(ElementRegistry& registry);
+void register_beams_elements(ElementRegistry& registry);
+void register_anticlimber_elements(ElementRegistry& registry);
+void register_contact_elements(ElementRegistry& registry);
 
 }  // namespace railcrash

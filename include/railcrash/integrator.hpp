@@ -45,6 +45,7 @@ struct RunOutcome {
   EnergyState initial_energy;
   EnergyState final_energy;
   double max_constraint_residual = 0.0;  // largest |Phi| over the output samples [length]
+  std::vector<EventRecord> events;       // every committed mode change, in order
 };
 
 class Integrator {

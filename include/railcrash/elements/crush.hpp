@@ -1,0 +1,103 @@
+// Crushable structure: crush_spring (not in the 1980 report; the force-crush
+// characteristic every modern lumped-mass crash model uses, e.g. the lead car's front end
+// in the two-car barrier test).
+//
+// Between points P1 (body 1) and P2 (body 2), length L = |r2 - r1|, u = (r2 - r1) / L:
+//   crush          d = free_length - L          (positive when shortened)
+//   crush force    P >= 0 pushes the points apart: force on P2 = +P u, on P1 = -P u
+// Modes (history: largest crush d_max, permanent crush d_p; changed only at events):
+//   loading, segment k   P = F_k + (F_k+1 - F_k)(d - d_k)/(d_k+1 - d_k) on the `curve`
+//                         [[d_0, F_0], [d_1, F_1], ...] (beyond the last point, the last
+//                         segment's slope continues)
+//                         leaves when d' < 0 (unloading), d < d_k or d > d_k+1 (next segment)
+//   elastic               P = unloading_stiffness (d - d_p), below the curve; on leaving
+//                         the curve d_p = d_max - F(d_max) / unloading_stiffness
+//                         leaves when d > d_max (back on the curve) or d < d_p (force zero)
+//   open                  P = 0, or tension_stiffness * (d - d_p) (< 0) when that is given
+//                         leaves when d > d_p (contact again: elastic, or loading if the
+//                         structure has never been crushed)
+// Elastic energy is P^2 / (2 unloading_stiffness) (what unloading would give back); the
+// rest of the work done on the element is dissipated in crushing.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "railcrash/element.hpp"
+#include "railcrash/element_registry.hpp"
+#include "railcrash/elements/springs.hpp"
+
+namespace railcrash {
+
+class CrushSpring : public ForceElement<CrushSpring> {
+ public:
+  explicit CrushSpring(ElementSpec& spec);
+
+  std::vector<double> curve_crush;      // [length] d_k, increasing, d_0 >= 0
+  std::vector<double> curve_force;      // [force] F_k >= 0
+  double unloading_stiffness;           // [force/length]
+  std::optional<double> tension_stiffness;  // [force/length]; none: no tension
+  std::optional<double> free_length;    // [length]; default: initial length
+
+  enum class Mode { Loading, Elastic, Open };
+  struct State {
+    Mode mode = Mode::Open;
+    int segment = 0;        // loading: curve segment k (d_k .. d_k+1)
+    double max_crush = 0.0; // [length] d_max
+    double permanent_crush = 0.0;  // [length] d_p
+    bool crushed = false;   // has ever been on the curve
+  };
+  const State& state() const { return state_; }
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const LineGeometry<T> g = line_geometry(*this, s);
+    const T crush = *free_length - g.length;
+    const T force = crush_force(crush);
+    // force on P2 = +P u = P d / L
+    const T scale = force / g.length;
+    apply_line_force(*this, s, Vec2<T>{scale * g.d.x, scale * g.d.y}, f);
+  }
+
+  /// Crush force P(d) in the current mode.
+  template <class T>
+  T crush_force(const T& crush) const {
+    switch (state_.mode) {
+      case Mode::Loading: {
+        const auto k = static_cast<std::size_t>(state_.segment);
+        return curve_force[k] + segment_slope(state_.segment) * (crush - curve_crush[k]);
+      }
+      case Mode::Elastic:
+        return unloading_stiffness * (crush - state_.permanent_crush);
+      case Mode::Open:
+        break;
+    }
+    if (tension_stiffness) return *tension_stiffness * (crush - state_.permanent_crush);
+    return T(0.0);
+  }
+
+  /// Force on the loading curve at crush d (extrapolated with the last slope).
+  double curve_at(double crush) const;
+  double segment_slope(int segment) const;
+
+  void initialize(const ElementState<double>& initial) override;
+  int root_count() const override { return 3; }
+  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
+              Event& event) override;
+  void reset_modes() override;
+  double potential_energy(const ElementState<double>& s) const override;
+  std::vector<std::string> output_names() const override { return {"force", "crush", "permanent_crush"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+
+ private:
+  /// Mode for a state at crush d with crush rate rate, given the history.
+  void enter_mode_at(double crush, double rate);
+  double crush_of(const ElementState<double>& s) const;
+  double crush_rate_of(const ElementState<double>& s) const;
+
+  State state_;
+  State initial_state_;
+};
+
+}  // namespace railcrash

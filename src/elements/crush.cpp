@@ -1,0 +1,157 @@
+#include "railcrash/elements/crush.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace railcrash {
+
+CrushSpring::CrushSpring(ElementSpec& spec)
+    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+      unloading_stiffness(spec.parameters->required_positive("unloading_stiffness")),
+      tension_stiffness(spec.parameters->optional_positive("tension_stiffness")),
+      free_length(spec.parameters->optional_positive("free_length")) {
+  spec.require_points(2);
+  const auto table = spec.parameters->table("curve", 2);
+  if (!table) spec.parameters->fail("curve", "missing required parameter 'curve': the loading curve [[crush, force], ...]");
+  if (table->size() < 2) spec.parameters->fail("curve", "'curve' needs at least two points [[crush, force], ...]");
+  for (std::size_t k = 0; k < table->size(); ++k) {
+    const double crush = (*table)[k][0], force = (*table)[k][1];
+    if (crush < 0.0 || force < 0.0)
+      spec.parameters->fail("curve", "'curve' point " + std::to_string(k + 1) + ": crush and force must not be negative");
+    if (k > 0 && !(crush > curve_crush.back()))
+      spec.parameters->fail("curve", "'curve' point " + std::to_string(k + 1) + ": crush values must increase strictly");
+    curve_crush.push_back(crush);
+    curve_force.push_back(force);
+  }
+}
+
+double CrushSpring::segment_slope(int segment) const {
+  const auto k = static_cast<std::size_t>(segment);
+  return (curve_force[k + 1] - curve_force[k]) / (curve_crush[k + 1] - curve_crush[k]);
+}
+
+double CrushSpring::curve_at(double crush) const {
+  int k = 0;
+  const int last = static_cast<int>(curve_crush.size()) - 2;
+  while (k < last && crush > curve_crush[static_cast<std::size_t>(k + 1)]) ++k;
+  return curve_force[static_cast<std::size_t>(k)] + segment_slope(k) * (crush - curve_crush[static_cast<std::size_t>(k)]);
+}
+
+double CrushSpring::crush_of(const ElementState<double>& s) const { return *free_length - line_geometry(*this, s).length; }
+
+double CrushSpring::crush_rate_of(const ElementState<double>& s) const {
+  const LineGeometry<double> g = line_geometry(*this, s);
+  return -dot(g.d, g.d_rate) / g.length;
+}
+
+void CrushSpring::enter_mode_at(double crush, double rate) {
+  State& st = state_;
+  if (crush < st.permanent_crush || (crush == st.permanent_crush && rate <= 0.0)) {
+    st.mode = Mode::Open;
+    return;
+  }
+  if (st.crushed && (crush < st.max_crush || (crush == st.max_crush && rate <= 0.0))) {
+    st.mode = Mode::Elastic;
+    return;
+  }
+  st.mode = Mode::Loading;
+  st.crushed = true;
+  st.segment = 0;
+  const int last = static_cast<int>(curve_crush.size()) - 2;
+  while (st.segment < last && crush >= curve_crush[static_cast<std::size_t>(st.segment + 1)]) ++st.segment;
+}
+
+void CrushSpring::initialize(const ElementState<double>& initial) {
+  const double length = line_geometry(*this, initial).length;
+  if (length == 0.0)
+    throw InputError(where_.prefix() + "crush_spring '" + name_ +
+                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
+  if (!free_length) free_length = length;
+  state_ = State{};
+  enter_mode_at(crush_of(initial), crush_rate_of(initial));
+  if (state_.mode == Mode::Loading && crush_of(initial) > 0.0)
+    throw InputError(where_.prefix() + "crush_spring '" + name_ + "' starts crushed by " + std::to_string(crush_of(initial)) +
+                     "; start it at or beyond its free_length (it has no crush history)");
+  initial_state_ = state_;
+}
+
+void CrushSpring::reset_modes() { state_ = initial_state_; }
+
+void CrushSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  const double crush = crush_of(s);
+  g[0] = g[1] = g[2] = 1.0;
+  switch (state_.mode) {
+    case Mode::Loading: {
+      const auto k = static_cast<std::size_t>(state_.segment);
+      g[0] = crush_rate_of(s);
+      if (state_.segment > 0) g[1] = crush - curve_crush[k];
+      if (state_.segment + 2 < static_cast<int>(curve_crush.size())) g[2] = curve_crush[k + 1] - crush;
+      break;
+    }
+    case Mode::Elastic:
+      g[0] = state_.max_crush - crush;
+      g[1] = crush - state_.permanent_crush;
+      break;
+    case Mode::Open:
+      g[0] = crush - state_.permanent_crush;
+      break;
+  }
+}
+
+bool CrushSpring::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+  const double crush = crush_of(s);
+  State& st = state_;
+  switch (st.mode) {
+    case Mode::Loading:
+      if (direction > 0) return false;
+      if (index == 0) {  // crush rate reversed: unload elastically from here
+        st.max_crush = crush;
+        st.permanent_crush = crush - curve_at(crush) / unloading_stiffness;
+        st.mode = Mode::Elastic;
+        event = {"unloading", crush};
+      } else if (index == 1) {
+        --st.segment;
+        event = {"curve segment " + std::to_string(st.segment + 1), crush};
+      } else {
+        ++st.segment;
+        event = {"curve segment " + std::to_string(st.segment + 1), crush};
+      }
+      return true;
+    case Mode::Elastic:
+      if (direction > 0) return false;
+      if (index == 0) {
+        enter_mode_at(crush, 1.0);  // back on the curve at d_max
+        event = {"reloading on the curve", crush};
+      } else {
+        st.mode = Mode::Open;
+        event = {"separation", crush};
+      }
+      return true;
+    case Mode::Open:
+      if (direction < 0 || index != 0) return false;
+      enter_mode_at(crush, 1.0);
+      event = {st.mode == Mode::Loading ? "contact, crushing" : "contact", crush};
+      return true;
+  }
+  return false;
+}
+
+double CrushSpring::potential_energy(const ElementState<double>& s) const {
+  const double force = crush_force(crush_of(s));
+  if (state_.mode != Mode::Open) return force * force / (2.0 * unloading_stiffness);
+  // Open: only a tension spring (if any) stores energy, k (d - d_p)^2 / 2 = P^2 / (2 k).
+  return tension_stiffness ? force * force / (2.0 * *tension_stiffness) : 0.0;
+}
+
+void CrushSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double crush = crush_of(s);
+  out[0] = crush_force(crush);
+  out[1] = crush;
+  out[2] = state_.permanent_crush;
+}
+
+void register_crush_elements(ElementRegistry& registry) {
+  registry.add("crush_spring", [](ElementSpec& s) { return std::make_unique<CrushSpring>(s); });
+}
+
+}  // namespace railcrash
