@@ -356,7 +356,7 @@ void DaeSystem::jacobian(double t, double cj, const double* y, const double* yp,
 }
 
 void DaeSystem::force_jacobian(double t, const double* q, const double* v, const PenaltyRows* penalty,
-                               std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv) const {
+                               std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv, bool stiffest) const {
   df_dq.clear();
   df_dv.clear();
   for (const Load& load : model_.loads()) {
@@ -372,7 +372,10 @@ void DaeSystem::force_jacobian(double t, const double* q, const double* v, const
     ForceBlock dq{}, dv{};
     if (m == 0) {
       std::array<Pose<double>, 2> f{};
-      el.add_force_jacobian(t, s, f, dq, dv);
+      if (stiffest)
+        model_.elements()[e]->stiffest_force_jacobian(t, s, dq, dv);
+      else
+        el.add_force_jacobian(t, s, f, dq, dv);
     } else {
       if (!penalty || el.failed()) continue;
       // f = -G^T (k Phi + c G v): df/dq ~ -k G^T G (curvature terms of the multiplier dropped:
@@ -580,6 +583,7 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
       if (el.commit(k, d, t, gather_state(el, y, y + nq), element_lambda, event)) {
         changed = true;
         events.push_back({t, el.name(), event.what, event.value});
+        break;  // the element's other roots belonged to the mode it just left
       }
     }
   }

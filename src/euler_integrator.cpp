@@ -53,7 +53,7 @@ double EulerIntegrator::estimate_stability_limit(const DaeSystem& system, const 
   Eigen::VectorXd inv_root_mass(nq);
   for (int k = 0; k < nq; ++k) inv_root_mass[k] = 1.0 / std::sqrt(system.mass_diagonal(k));
   std::vector<DaeSystem::Triplet> df_dq, df_dv;
-  system.force_jacobian(0.0, y.data(), y.data() + nq, penalty, df_dq, df_dv);
+  system.force_jacobian(0.0, y.data(), y.data() + nq, penalty, df_dq, df_dv, /*stiffest=*/true);
   for (auto& t : df_dq) t.value = -t.value;  // K = -df/dq
   for (auto& t : df_dv) t.value = -t.value;  // C = -df/dv
   const double omega_squared = largest_scaled_eigenvalue(df_dq, inv_root_mass);

@@ -93,12 +93,22 @@ using std::sin;
 using std::cos;
 using std::sqrt;
 using std::atan2;
+using std::tanh;
+using std::exp;
 
 RAILCRASH_DUAL_T RAILCRASH_D sin(const RAILCRASH_D& a) { return chain(a, S(sin(a.value)), S(cos(a.value))); }
 RAILCRASH_DUAL_T RAILCRASH_D cos(const RAILCRASH_D& a) { return chain(a, S(cos(a.value)), S(-sin(a.value))); }
 RAILCRASH_DUAL_T RAILCRASH_D sqrt(const RAILCRASH_D& a) {
   const S root = sqrt(a.value);
   return chain(a, root, S(0.5) / root);
+}
+RAILCRASH_DUAL_T RAILCRASH_D tanh(const RAILCRASH_D& a) {
+  const S value = tanh(a.value);
+  return chain(a, value, S(1.0) - value * value);
+}
+RAILCRASH_DUAL_T RAILCRASH_D exp(const RAILCRASH_D& a) {
+  const S value = exp(a.value);
+  return chain(a, value, value);
 }
 // atan2(y, x): d = (x dy - y dx) / (x^2 + y^2)
 RAILCRASH_DUAL_T RAILCRASH_D atan2(const RAILCRASH_D& y, const RAILCRASH_D& x) {

@@ -88,10 +88,11 @@ class DaeSystem {
   /// given, constraints add -G^T (k Phi + c G v) and penalty_lambda receives k Phi + c G v.
   void generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty = nullptr,
                           double* penalty_lambda = nullptr) const;
-  /// Triplets of df/dq and df/dv (same force definition as generalized_forces).
+  /// Triplets of df/dq and df/dv (same force definition as generalized_forces); with
+  /// `stiffest`, each element in its stiffest mode (Euler's stability estimate).
   struct Triplet { int row, col; double value; };
   void force_jacobian(double t, const double* q, const double* v, const PenaltyRows* penalty,
-                      std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv) const;
+                      std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv, bool stiffest = false) const;
 
   /// Phi(q) and G = dPhi/dq (triplets, row = constraint row, col = q index).
   void constraints(const double* q, double* phi, std::vector<Triplet>* gradient) const;

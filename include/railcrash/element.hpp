@@ -107,6 +107,13 @@ class Element {
                       const double* /*lambda*/, Event& /*event*/) {
     return false;
   }
+  /// The force Jacobian in the element's stiffest mode at state s, for explicit Euler's
+  /// stability limit (an element that starts open has no stiffness at t = 0). Default: the
+  /// current mode's.
+  virtual void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+    std::array<Pose<double>, 2> f{};
+    add_force_jacobian(t, s, f, df_dq, df_dv);
+  }
   /// Back to the mode the element starts a run in.
   virtual void reset_modes() {}
   /// A failed constraint keeps its rows as lambda = 0, mu = 0 (so the pattern never changes).

@@ -1,5 +1,6 @@
 #include "railcrash/elements/crush.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -76,6 +77,22 @@ void CrushSpring::initialize(const ElementState<double>& initial) {
 }
 
 void CrushSpring::reset_modes() { state_ = initial_state_; }
+
+void CrushSpring::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+  // Stiffest of: the unloading stiffness, the curve's slopes, the tension stiffness.
+  const State saved = state_;
+  double stiffest = unloading_stiffness;
+  for (int k = 0; k + 1 < static_cast<int>(curve_crush.size()); ++k) stiffest = std::max(stiffest, segment_slope(k));
+  if (tension_stiffness) stiffest = std::max(stiffest, *tension_stiffness);
+  const double saved_stiffness = unloading_stiffness;
+  unloading_stiffness = stiffest;
+  state_.mode = Mode::Elastic;
+  state_.permanent_crush = crush_of(s);
+  std::array<Pose<double>, 2> f{};
+  add_force_jacobian(t, s, f, df_dq, df_dv);
+  unloading_stiffness = saved_stiffness;
+  state_ = saved;
+}
 
 void CrushSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
   const double crush = crush_of(s);

@@ -86,6 +86,7 @@ class CrushSpring : public ForceElement<CrushSpring> {
   bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
               Event& event) override;
   void reset_modes() override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "crush", "permanent_crush"}; }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
