@@ -590,6 +590,32 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
   return changed;
 }
 
+bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events) const {
+  if (root_count_ == 0) return false;
+  std::vector<double> g(static_cast<std::size_t>(root_count_)), ahead(g.size());
+  roots(t, y, g.data());
+  if (std::find(g.begin(), g.end(), 0.0) == g.end()) return false;
+  // Second-order Taylor step (q + h v + h^2 a / 2, v + h a): a body at rest on a boundary
+  // leaves it through its acceleration alone. h is small against the run's time scale but
+  // large enough for h^2 a / 2 to survive round-off in q.
+  const double h = 1e-6 * std::min(1.0, model_.simulation.t_end);
+  const int nq = body_unknowns();
+  std::vector<double> y_ahead(y, y + size());
+  for (int k = 0; k < nq; ++k) {
+    y_ahead[static_cast<std::size_t>(k)] += h * yp[k] + 0.5 * h * h * yp[nq + k];
+    y_ahead[static_cast<std::size_t>(nq + k)] += h * yp[nq + k];
+  }
+  roots(t + h, y_ahead.data(), ahead.data());
+  std::vector<int> direction(g.size(), 0);
+  bool any = false;
+  for (std::size_t k = 0; k < g.size(); ++k)
+    if (g[k] == 0.0 && ahead[k] < 0.0) {
+      direction[k] = -1;
+      any = true;
+    }
+  return any && commit_roots(t, y, direction.data(), events);
+}
+
 void DaeSystem::reset_modes() const {
   for (const auto& el : model_.elements()) el->reset_modes();
 }

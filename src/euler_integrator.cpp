@@ -179,7 +179,20 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   std::vector<double> g_before(static_cast<std::size_t>(root_count)), g_after(g_before.size());
   std::vector<int> direction(g_before.size(), 0);
   std::vector<EventRecord> events;
-  if (root_count > 0) system_.roots(0.0, y.data(), g_before.data());
+  if (root_count > 0) {
+    // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
+    std::vector<double> yp(y.size(), 0.0);
+    for (int k = 0; k < nq; ++k) {
+      yp[static_cast<std::size_t>(k)] = v[k];
+      yp[static_cast<std::size_t>(nq + k)] = force[static_cast<std::size_t>(k)] * inverse_mass[static_cast<std::size_t>(k)];
+    }
+    if (system_.commit_boundary_roots(0.0, y.data(), yp.data(), events)) {
+      for (const EventRecord& record : events) observer.event(record);
+      outcome.events = events;
+      outcome.stats.events += static_cast<long>(events.size());
+    }
+    system_.roots(0.0, y.data(), g_before.data());
+  }
   outcome.initial_energy = system_.energy(y.data(), quad.data(), &penalty_);
   observer.sample(0.0, y.data(), y_lambda, quad.data());
   outcome.max_constraint_residual = system_.constraint_residual(q);
@@ -209,7 +222,8 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
       bool fired = false;
       for (std::size_t k = 0; k < g_after.size(); ++k) {
         const double before = g_before[k], after = g_after[k];
-        direction[k] = (before > 0.0 && after <= 0.0) ? -1 : (before < 0.0 && after >= 0.0) ? 1 : 0;
+        // Roots are positive inside their mode (element.hpp): a fall from >= 0 to < 0 leaves it.
+        direction[k] = (before >= 0.0 && after < 0.0) ? -1 : (before < 0.0 && after >= 0.0) ? 1 : 0;
         fired = fired || direction[k] != 0;
       }
       if (fired) {

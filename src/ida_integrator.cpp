@@ -27,6 +27,15 @@ std::string flag_name(int flag) {
   return out;
 }
 
+/// Consistent rates at a (re)start, after committing the roots that sit exactly on a mode
+/// boundary and are about to leave it (IDA would leave them inactive).
+void restart_state(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
+                   std::vector<EventRecord>& events) {
+  consistent_rates(system, t, y, yp);
+  for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events); ++pass)
+    consistent_rates(system, t, y, yp);
+}
+
 }  // namespace
 
 /// Everything SUNDIALS owns for one run; destroyed in reverse order of creation.
@@ -215,7 +224,8 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     double* y = N_VGetArrayPointer(impl.y);
     double* yp = N_VGetArrayPointer(impl.yp);
     std::vector<double> yp0;
-    consistent_rates(system_, 0.0, y0, yp0);
+    std::vector<EventRecord> start_events;
+    restart_state(system_, 0.0, y0, yp0, start_events);
     std::copy(y0.begin(), y0.end(), y);
     std::copy(yp0.begin(), yp0.end(), yp);
     const std::vector<double> ids = system_.differential_ids();
@@ -264,6 +274,9 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     const double* lambda = y + 2 * nq;
     std::vector<double> quad_now(static_cast<std::size_t>(nquad), 0.0);
     outcome.initial_energy = system_.energy(y, quad_now.data());
+    for (const EventRecord& record : start_events) observer.event(record);
+    outcome.events = start_events;
+    outcome.stats.events += static_cast<long>(start_events.size());
     observer.sample(0.0, y, lambda, quad_now.data());
     outcome.max_constraint_residual = system_.constraint_residual(y);
 
@@ -296,12 +309,12 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
         impl.check(IDAGetRootInfo(impl.ida, root_info.data()), "IDAGetRootInfo");
         events.clear();
         const bool changed = system_.commit_roots(t_reached, y, root_info.data(), events);
+        std::vector<double> y_now(y, y + n), yp_now;
+        if (changed) restart_state(system_, t_reached, y_now, yp_now, events);
         for (const EventRecord& record : events) observer.event(record);
         outcome.events.insert(outcome.events.end(), events.begin(), events.end());
         outcome.stats.events += static_cast<long>(events.size());
         if (changed) {
-          std::vector<double> y_now(y, y + n), yp_now;
-          consistent_rates(system_, t_reached, y_now, yp_now);
           std::copy(y_now.begin(), y_now.end(), y);
           std::copy(yp_now.begin(), yp_now.end(), yp);
           impl.accumulate(outcome.stats);

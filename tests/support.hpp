@@ -14,7 +14,8 @@ namespace railcrash::testing {
 Model model_from_text(const std::string& yaml);
 
 /// Largest relative difference between the assembled Jacobian dF/dy + cj dF/dy' and a
-/// central finite difference of the residual, at the given y, yp. Also checks that every
+/// central finite difference of the residual, at the given y, yp, beyond the difference
+/// quotient's round-off floor (100 eps |r| / h for residual entries of size |r|). Also checks that every
 /// nonzero of the finite-difference Jacobian lies inside the sparsity pattern
 /// (outside_pattern receives the largest |entry| found outside it).
 double jacobian_error(const DaeSystem& system, double t, double cj, const std::vector<double>& y,

@@ -127,6 +127,10 @@ class DaeSystem {
   /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
   /// any mode changed (the integrator must then re-initialize).
   bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
+  /// At a (re)start: IDA leaves a root that is exactly zero inactive, so a state sitting on a
+  /// mode boundary and moving out of the mode would never be reported. Looks a tiny step
+  /// ahead along y' and commits such roots now. Returns true when a mode changed.
+  bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events) const;
   /// Puts every element back in its starting mode.
   void reset_modes() const;
 

@@ -94,6 +94,9 @@ class Element {
   /// Number of root functions; fixed for the element's life (an inactive one returns 1).
   virtual int root_count() const { return 0; }
   /// Root functions of the current mode at state s (lambda: the element's multipliers).
+  /// Convention: every root is positive inside the mode and the mode is left when a root
+  /// falls through zero (commit then gets direction -1). The integrators rely on it at a
+  /// (re)start, where a root that is exactly zero and about to fall is committed at once.
   virtual void roots(double /*t*/, const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*g*/) const {}
   /// What happened at an event, for events.csv.
   struct Event {

@@ -1,7 +1,346 @@
-#include "railcrash/element_registry.hpp"
+#include "railcrash/elements/anticlimber.hpp"
+
+#include <cmath>
+#include <string>
 
 namespace railcrash {
 
-void register_anticlimber_elements(ElementRegistry& /*registry*/) {}
+// ---- one direction's elastic-plastic law -----------------------------------------------------
+
+ElasticPlasticLaw::State ElasticPlasticLaw::fresh() const {
+  State st;
+  st.mode = Mode::Elastic;
+  st.offset = 0.0;
+  st.lower = one_sided ? 0.0 : -yield_deflection;
+  st.upper = yield_deflection;
+  st.yielded = false;
+  return st;
+}
+
+void ElasticPlasticLaw::roots(const State& st, double d, double rate, double* g) const {
+  g[0] = g[1] = g[2] = 1.0;
+  switch (st.mode) {
+    case Mode::Elastic:
+      g[0] = st.upper - d;
+      g[1] = d - st.lower;
+      break;
+    case Mode::PlasticUp:
+      g[0] = rate;
+      break;
+    case Mode::PlasticDown:
+      g[1] = -rate;
+      break;
+    case Mode::Failed:
+      return;
+  }
+  if (rupture_deflection) g[2] = *rupture_deflection - std::abs(d);
+}
+
+bool ElasticPlasticLaw::active(const State& st, int index) const {
+  if (st.mode == Mode::Failed) return false;
+  if (index == 2) return rupture_deflection.has_value();
+  if (st.mode == Mode::Elastic) return index == 0 || index == 1;
+  return (st.mode == Mode::PlasticUp) ? index == 0 : index == 1;
+}
+
+ElasticPlasticLaw::Outcome ElasticPlasticLaw::leave(State& st, int index, double d) const {
+  if (index == 2) {
+    st.mode = Mode::Failed;
+    return Outcome::Rupture;
+  }
+  if (st.mode == Mode::Elastic) {
+    if (index == 1 && one_sided) return Outcome::Release;  // force down to zero: the faces open
+    st.mode = index == 0 ? Mode::PlasticUp : Mode::PlasticDown;
+    const Outcome outcome = st.yielded ? Outcome::Reloading : Outcome::Yield;
+    st.yielded = true;
+    return outcome;
+  }
+  // Plastic flow stops (the deformation rate reversed): elastic from here, with the offset
+  // at which the elastic line through the current point reaches zero force.
+  const double f = force(st, d);
+  st.offset = d - f / elastic_stiffness;
+  if (st.mode == Mode::PlasticUp) {
+    st.upper = d;
+    st.lower = one_sided ? st.offset : d - 2.0 * yield_deflection;
+  } else {
+    st.lower = d;
+    st.upper = d + 2.0 * yield_deflection;
+  }
+  st.mode = Mode::Elastic;
+  return Outcome::Unloading;
+}
+
+double ElasticPlasticLaw::elastic_energy(const State& st, double d) const {
+  const double f = force(st, d);
+  return f * f / (2.0 * elastic_stiffness);
+}
+
+// ---- parameters -------------------------------------------------------------------------------
+
+namespace {
+
+const char* const kDirections[3] = {"horizontal", "vertical", "torsional"};
+
+struct LawInput {
+  std::optional<double> elastic, plastic, yield, rupture;
+};
+
+LawInput read_law_input(ParameterReader& p, const std::string& direction) {
+  // Every key is read before any is checked, so that the loader learns all the keys the type
+  // accepts (it reports misspelt keys against them).
+  LawInput in;
+  in.elastic = p.number(direction + "_elastic_stiffness");
+  in.plastic = p.number(direction + "_plastic_stiffness");
+  in.yield = p.number(direction + "_yield_deflection");
+  in.rupture = p.number(direction + "_rupture_deflection");
+  return in;
+}
+
+ElasticPlasticLaw make_law(ParameterReader& p, const std::string& direction, const LawInput& in, bool one_sided) {
+  const bool rotation = direction == "torsional";
+  const std::string slope_unit = rotation ? " [moment/rad]" : " [force/length]";
+  const std::string deflection_unit = rotation ? " [rad]" : " [length]";
+  const std::string elastic = direction + "_elastic_stiffness", plastic = direction + "_plastic_stiffness";
+  const std::string yield = direction + "_yield_deflection", rupture = direction + "_rupture_deflection";
+  if (!in.elastic) p.fail(elastic, "missing required parameter '" + elastic + "'" + slope_unit + ": the elastic slope");
+  if (!(*in.elastic > 0.0)) p.fail(elastic, "'" + elastic + "' must be positive");
+  if (!in.plastic)
+    p.fail(plastic, "missing required parameter '" + plastic + "'" + slope_unit + ": the slope after yield (0: perfectly plastic)");
+  if (*in.plastic < 0.0) p.fail(plastic, "'" + plastic + "' must not be negative");
+  if (!(*in.plastic < *in.elastic))
+    p.fail(plastic, "'" + plastic + "' must be below '" + elastic + "' (the law must soften at yield)");
+  if (!in.yield) p.fail(yield, "missing required parameter '" + yield + "'" + deflection_unit);
+  if (!(*in.yield > 0.0)) p.fail(yield, "'" + yield + "' must be positive");
+  if (in.rupture && !(*in.rupture > *in.yield))
+    p.fail(rupture, "'" + rupture + "' must exceed '" + yield + "' (rupture happens in plastic flow); leave it out for no rupture");
+  ElasticPlasticLaw law;
+  law.elastic_stiffness = *in.elastic;
+  law.plastic_stiffness = *in.plastic;
+  law.yield_deflection = *in.yield;
+  law.rupture_deflection = in.rupture;
+  law.one_sided = one_sided;
+  return law;
+}
+
+}  // namespace
+
+Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+  ParameterReader& p = *spec.parameters;
+  LawInput inputs[3];
+  for (int k = 0; k < 3; ++k) inputs[k] = read_law_input(p, kDirections[k]);
+  const std::optional<double> height = p.number("face_height");
+  length = p.number("length");
+  const std::optional<double> misalignment = p.number("initial_misalignment");
+  facing = p.number("facing");
+  spec.require_points(2);
+
+  if (length && !(*length > 0.0)) p.fail("length", "'length' must be positive");
+  if (!inputs[0].rupture && length) inputs[0].rupture = length;  // crushed through over its whole length
+  horizontal = make_law(p, kDirections[0], inputs[0], true);
+  vertical = make_law(p, kDirections[1], inputs[1], false);
+  torsional = make_law(p, kDirections[2], inputs[2], false);
+  if (length && *horizontal.rupture_deflection > *length)
+    p.fail("horizontal_rupture_deflection",
+           "'horizontal_rupture_deflection' must not exceed 'length' (the structure cannot crush further than its length)");
+  if (!height) p.fail("face_height", "missing required parameter 'face_height' [length]: the height of each anticlimber face");
+  if (!(*height > 0.0)) p.fail("face_height", "'face_height' must be positive");
+  face_height = *height;
+  initial_misalignment = misalignment.value_or(0.0);
+  if (facing && *facing != 1.0 && *facing != -1.0)
+    p.fail("facing", "'facing' must be 1 (body 1's face looks along its +x axis) or -1 (along -x)");
+}
+
+// ---- geometry and modes -----------------------------------------------------------------------
+
+Anticlimber::Deformations Anticlimber::deformations(const ElementState<double>& s) const {
+  const Kinematics<double> k = kinematics(s);
+  const PointRef& p1 = point(0);
+  const PointRef& p2 = point(1);
+  const Pose<double>& q1 = s.q[slot1()];
+  const Pose<double>& q2 = s.q[slot2()];
+  const Pose<double>& v1 = s.v[slot1()];
+  const Pose<double>& v2 = s.v[slot2()];
+  const Vec2<double> d = point_position(q2, p2.sx, p2.sy) - point_position(q1, p1.sx, p1.sy);
+  const Vec2<double> d_rate = point_velocity(q2, v2, p2.sx, p2.sy) - point_velocity(q1, v1, p1.sx, p1.sy);
+  // e1' = omega1 n1, n1' = -omega1 e1.
+  const double along_rate = dot(d_rate, k.e1) + v1.theta * dot(d, k.n1);
+  const double across_rate = dot(d_rate, k.n1) - v1.theta * dot(d, k.e1);
+  Deformations out;
+  out.offset = k.vertical;
+  out.rotation = k.rotation;
+  out.d[0] = k.horizontal;
+  out.d[1] = k.vertical - state_.vertical_reference;
+  out.d[2] = k.rotation - state_.torsional_reference;
+  out.rate[0] = -(*facing) * along_rate;
+  out.rate[1] = across_rate;
+  out.rate[2] = v2.theta - v1.theta;
+  return out;
+}
+
+void Anticlimber::roots_of(const Deformations& k, double* g) const {
+  for (int i = 0; i < kRootCount; ++i) g[i] = 1.0;
+  switch (state_.contact) {
+    case Contact::Open:
+      g[kContactRoot] = state_.horizontal.offset - k.d[0];
+      break;
+    case Contact::Engaged:
+      horizontal.roots(state_.horizontal, k.d[0], k.rate[0], g + kHorizontalRoots);
+      vertical.roots(state_.vertical, k.d[1], k.rate[1], g + kVerticalRoots);
+      torsional.roots(state_.torsional, k.d[2], k.rate[2], g + kTorsionalRoots);
+      g[kOverrideRoot] = face_height - std::abs(k.offset);
+      break;
+    case Contact::Overridden:
+    case Contact::Crushed:
+      break;
+  }
+}
+
+bool Anticlimber::active(int index) const {
+  switch (state_.contact) {
+    case Contact::Open:
+      return index == kContactRoot;
+    case Contact::Engaged:
+      if (index == kOverrideRoot) return true;
+      if (index == kContactRoot) return false;
+      if (index < kVerticalRoots) return horizontal.active(state_.horizontal, index - kHorizontalRoots);
+      if (index < kTorsionalRoots) return vertical.active(state_.vertical, index - kVerticalRoots);
+      return torsional.active(state_.torsional, index - kTorsionalRoots);
+    case Contact::Overridden:
+    case Contact::Crushed:
+      break;
+  }
+  return false;
+}
+
+void Anticlimber::transition(int index, double t, const Deformations& k, std::string& what) {
+  const auto add = [&what](const std::string& text) { what += (what.empty() ? "" : ", ") + text; };
+  if (index == kContactRoot) {
+    if (std::abs(k.offset) >= face_height) {  // the faces miss each other
+      state_.contact = Contact::Overridden;
+      state_.override_time = t;
+      add("override");
+      return;
+    }
+    state_.contact = Contact::Engaged;
+    state_.vertical_reference = k.offset;
+    state_.torsional_reference = k.rotation;
+    if (state_.vertical.mode != ElasticPlasticLaw::Mode::Failed) state_.vertical = vertical.fresh();
+    if (state_.torsional.mode != ElasticPlasticLaw::Mode::Failed) state_.torsional = torsional.fresh();
+    add("contact");
+    return;
+  }
+  if (index == kOverrideRoot) {
+    state_.contact = Contact::Overridden;
+    state_.override_time = t;
+    add("override");
+    return;
+  }
+  const int direction = index / 3;
+  const ElasticPlasticLaw& law = direction == 0 ? horizontal : (direction == 1 ? vertical : torsional);
+  ElasticPlasticLaw::State& st = direction == 0 ? state_.horizontal : (direction == 1 ? state_.vertical : state_.torsional);
+  const std::string name = kDirections[direction];
+  switch (law.leave(st, index % 3, k.d[direction])) {
+    case ElasticPlasticLaw::Outcome::Yield: add(name + " yield"); break;
+    case ElasticPlasticLaw::Outcome::Reloading: add(name + " reloading"); break;
+    case ElasticPlasticLaw::Outcome::Unloading: add(name + " unloading"); break;
+    case ElasticPlasticLaw::Outcome::Rupture:
+      if (direction == 0) state_.contact = Contact::Crushed;
+      add(direction == 0 ? "crushing failure" : (direction == 1 ? "shear failure" : "bending failure"));
+      break;
+    case ElasticPlasticLaw::Outcome::Release:
+      state_.contact = Contact::Open;
+      add("separation");
+      break;
+    case ElasticPlasticLaw::Outcome::None: break;
+  }
+}
+
+void Anticlimber::settle(double t, const ElementState<double>& s, std::string& what) {
+  // Each pass makes one transition; every chain of them ends in a terminal or elastic mode
+  // well within this bound.
+  for (int pass = 0; pass < 4 * kRootCount; ++pass) {
+    const Deformations k = deformations(s);
+    double g[kRootCount];
+    roots_of(k, g);
+    int index = -1;
+    for (int i = 0; i < kRootCount && index < 0; ++i)
+      if (active(i) && g[i] < 0.0) index = i;
+    if (index < 0) return;
+    transition(index, t, k, what);
+  }
+}
+
+void Anticlimber::initialize(const ElementState<double>& initial) {
+  const std::string who = where_.prefix() + "anticlimber '" + name_ + "'";
+  if (point_slot(0) == point_slot(1))
+    throw InputError(who + ": both points are on the same body; put point 1 on one car end and point 2 on the other");
+  if (!facing) {
+    facing = 1.0;
+    const double along = -kinematics(initial).horizontal;  // d . e1
+    if (along == 0.0)
+      throw InputError(who + ": the faces touch in the initial configuration, so which way they face is unknown; "
+                             "give facing: 1 (body 1's face looks along its +x axis) or -1");
+    facing = along > 0.0 ? 1.0 : -1.0;
+  }
+  const double gap = -kinematics(initial).horizontal;
+  if (gap < 0.0)
+    throw InputError(who + ": the faces overlap by " + std::to_string(-gap) +
+                     " in the initial configuration; start them apart or just touching (there is no crush history to start from)");
+  state_ = State{};
+  state_.contact = Contact::Open;
+  state_.horizontal = horizontal.fresh();
+  state_.vertical = vertical.fresh();
+  state_.torsional = torsional.fresh();
+  const Deformations k = deformations(initial);
+  if (gap == 0.0 && k.rate[0] > 0.0) {  // touching and closing: engaged from the start
+    std::string what;
+    transition(kContactRoot, 0.0, k, what);
+    settle(0.0, initial, what);
+  }
+  initial_state_ = state_;
+}
+
+void Anticlimber::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  roots_of(deformations(s), g);
+}
+
+bool Anticlimber::commit(int index, int direction, double t, const ElementState<double>& s, const double*,
+                         Event& event) {
+  if (direction > 0 || !active(index)) return false;
+  const Deformations k = deformations(s);
+  double g[kRootCount];
+  roots_of(k, g);
+  if (g[index] > 0.0) return false;  // an earlier commit at this instant already changed the mode
+  const double value = index == kOverrideRoot ? k.offset : k.d[index == kContactRoot ? 0 : index / 3];
+  std::string what;
+  transition(index, t, k, what);
+  settle(t, s, what);
+  event = {what, value};
+  return true;
+}
+
+double Anticlimber::potential_energy(const ElementState<double>& s) const {
+  if (state_.contact != Contact::Engaged) return 0.0;
+  const Deformations k = deformations(s);
+  return horizontal.elastic_energy(state_.horizontal, k.d[0]) + vertical.elastic_energy(state_.vertical, k.d[1]) +
+         torsional.elastic_energy(state_.torsional, k.d[2]);
+}
+
+void Anticlimber::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const Deformations k = deformations(s);
+  const bool engaged = state_.contact == Contact::Engaged;
+  out[0] = engaged ? horizontal.force(state_.horizontal, k.d[0]) : 0.0;
+  out[1] = engaged ? vertical.force(state_.vertical, k.d[1]) : 0.0;
+  out[2] = engaged ? torsional.force(state_.torsional, k.d[2]) : 0.0;
+  out[3] = k.d[0];
+  out[4] = engaged ? k.d[1] : 0.0;
+  out[5] = engaged ? k.d[2] : 0.0;
+  out[6] = k.offset;
+  out[7] = overridden() ? 1.0 : 0.0;
+}
+
+void register_anticlimber_elements(ElementRegistry& registry) {
+  registry.add("anticlimber", [](ElementSpec& s) { return std::make_unique<Anticlimber>(s); });
+}
 
 }  // namespace railcrash

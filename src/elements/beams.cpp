@@ -1,7 +1,258 @@
-#include "railcrash/element_registry.hpp"
+#include "railcrash/elements/beams.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace railcrash {
 
-void register_beams_elements(ElementRegistry& /*registry*/) {}
+namespace {
+
+BeamMaterial read_material(ElementSpec& spec) {
+  ParameterReader& p = *spec.parameters;
+  BeamMaterial m{};
+  m.elastic_modulus = p.required_positive("elastic_modulus");
+  m.plastic_modulus = p.required_nonnegative("plastic_modulus");
+  m.yield_stress = p.required_positive("yield_stress");
+  m.ultimate_stress = p.required_positive("ultimate_stress");
+  if (!(m.plastic_modulus < m.elastic_modulus))
+    p.fail("plastic_modulus", "'plastic_modulus' (the tangent modulus after yield) must be less than 'elastic_modulus'");
+  if (!(m.ultimate_stress > m.yield_stress))
+    p.fail("ultimate_stress", "'ultimate_stress' must be greater than 'yield_stress'");
+  return m;
+}
+
+/// int_0^1 f(s) ds by composite 5-point Gauss-Legendre, panels doubled until two
+/// successive results agree to 1e-14 (f smooth and positive on [0, 1]).
+template <class F>
+double integrate(F f) {
+  static const double node[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+  static const double weight[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                                   0.2369268850561891};
+  const auto rule = [&](int panels) {
+    double sum = 0.0;
+    const double h = 1.0 / panels;
+    for (int i = 0; i < panels; ++i)
+      for (int k = 0; k < 5; ++k) sum += weight[k] * f(h * (i + 0.5 + 0.5 * node[k]));
+    return 0.5 * h * sum;
+  };
+  double previous = rule(1);
+  for (int panels = 2; panels <= (1 << 16); panels *= 2) {
+    const double next = rule(panels);
+    if (std::abs(next - previous) <= 1e-14 * std::abs(next)) return next;
+    previous = next;
+  }
+  return previous;
+}
+
+/// Section of a rectangle whose height and width vary linearly along the beam.
+BeamSection tapered_section(double h1, double h2, double w1, double w2) {
+  const auto height = [=](double s) { return h1 + (h2 - h1) * s; };
+  const auto width = [=](double s) { return w1 + (w2 - w1) * s; };
+  const auto inverse_i = [&](double s) {
+    const double h = height(s);
+    return 12.0 / (width(s) * h * h * h);
+  };
+  BeamSection section;
+  section.axial_flexibility = integrate([&](double s) { return 1.0 / (height(s) * width(s)); });
+  section.bending_flexibility = {integrate([&](double s) { return (1.0 - s) * (1.0 - s) * inverse_i(s); }),
+                                 integrate([&](double s) { return s * (1.0 - s) * inverse_i(s); }),
+                                 integrate([&](double s) { return s * s * inverse_i(s); })};
+  section.yield_area = std::min(h1 * w1, h2 * w2);
+  section.plastic_section_modulus = {w1 * h1 * h1 / 4.0, w2 * h2 * h2 / 4.0};
+  return section;
+}
+
+const char* const kComponentName[3] = {"axial", "end 1", "end 2"};
+
+}  // namespace
+
+// ---- the two section types ---------------------------------------------------------------
+
+ElasticPlasticBeam::ElasticPlasticBeam(ElementSpec& spec) : BeamElement(spec, read_material(spec)) {
+  ParameterReader& p = *spec.parameters;
+  height = p.optional_positive("height");
+  width = p.optional_positive("width");
+  const std::optional<double> given_area = p.optional_positive("area");
+  const std::optional<double> given_second_moment = p.optional_positive("second_moment");
+  const std::optional<double> given_modulus = p.optional_positive("plastic_section_modulus");
+  const bool rectangle = height || width;
+  const bool properties = given_area || given_second_moment;
+  if (rectangle && properties)
+    p.fail(height ? "height" : "width",
+           "give the section either as 'height' and 'width' or as 'area' and 'second_moment', not both");
+  if (rectangle) {
+    if (!height) p.fail("height", "missing 'height' (the section height in the plane of bending) next to 'width'");
+    if (!width) p.fail("width", "missing 'width' (the section width) next to 'height'");
+    area = *width * *height;
+    second_moment = *width * *height * *height * *height / 12.0;
+    plastic_section_modulus = *width * *height * *height / 4.0;
+  } else {
+    if (!given_area || !given_second_moment)
+      p.fail(given_area ? "second_moment" : "area",
+             "give the section as 'height' and 'width', or as 'area' and 'second_moment' (both)");
+    area = *given_area;
+    second_moment = *given_second_moment;
+    plastic_section_modulus = std::sqrt(3.0 * area * second_moment) / 2.0;  // rectangle with the same A and I
+  }
+  if (given_modulus) plastic_section_modulus = *given_modulus;
+  section_.axial_flexibility = 1.0 / area;
+  section_.bending_flexibility = {1.0 / (3.0 * second_moment), 1.0 / (6.0 * second_moment), 1.0 / (3.0 * second_moment)};
+  section_.yield_area = area;
+  section_.plastic_section_modulus = {plastic_section_modulus, plastic_section_modulus};
+}
+
+TaperedBeam::TaperedBeam(ElementSpec& spec)
+    : BeamElement(spec, read_material(spec)),
+      height_1(spec.parameters->required_positive("height_1")),
+      height_2(spec.parameters->required_positive("height_2")),
+      width_1(spec.parameters->required_positive("width_1")),
+      width_2(spec.parameters->required_positive("width_2")) {
+  section_ = tapered_section(height_1, height_2, width_1, width_2);
+}
+
+// ---- the common law ----------------------------------------------------------------------
+
+BeamElement::BeamElement(ElementSpec& spec, BeamMaterial beam_material)
+    : ForceElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {
+  spec.require_points(2);
+}
+
+void BeamElement::initialize(const ElementState<double>& initial) {
+  if (point_slot(0) == point_slot(1))
+    throw InputError(where_.prefix() + type_ + " '" + name_ +
+                     "': both points are on the same body; a beam connects two bodies (or a body and ground)");
+  const auto k1 = static_cast<std::size_t>(point_slot(0));
+  const auto k2 = static_cast<std::size_t>(point_slot(1));
+  const Vec2<double> d = point_position(initial.q[k2], point(1).sx, point(1).sy) -
+                         point_position(initial.q[k1], point(0).sx, point(0).sy);
+  length_ = std::sqrt(dot(d, d));
+  if (!(length_ > 0.0))
+    throw InputError(where_.prefix() + type_ + " '" + name_ +
+                     "': its two points coincide in the initial configuration; a beam needs a length, move them apart");
+  direction_ = {d.x / length_, d.y / length_};
+  initial_angle_ = {initial.q[k1].theta, initial.q[k2].theta};
+
+  const double e = material.elastic_modulus;
+  axial_stiffness_ = e / (length_ * section_.axial_flexibility);
+  const auto& f = section_.bending_flexibility;  // flexibility (L0 / E) [f0 -f1; -f1 f2]
+  const double scale = e / (length_ * (f[0] * f[2] - f[1] * f[1]));
+  bending_stiffness_ = {scale * f[2], scale * f[1], scale * f[0]};
+  yield_ = {material.yield_stress * section_.yield_area, material.yield_stress * section_.plastic_section_modulus[0],
+            material.yield_stress * section_.plastic_section_modulus[1]};
+  const double ratio = material.plastic_modulus / (e - material.plastic_modulus);
+  hardening_ = {axial_stiffness_ * ratio, bending_stiffness_[0] * ratio, bending_stiffness_[2] * ratio};
+  state_ = State{};
+}
+
+void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
+                           std::array<double, 3>* offset_rate) const {
+  // One pass with a single directional derivative along the velocities gives the rates.
+  using D = Dual<double, 1>;
+  ElementState<D> sd;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const double* q[3] = {&s.q[k].x, &s.q[k].y, &s.q[k].theta};
+    const double* v[3] = {&s.v[k].x, &s.v[k].y, &s.v[k].theta};
+    D* out[3] = {&sd.q[k].x, &sd.q[k].y, &sd.q[k].theta};
+    for (int c = 0; c < 3; ++c) {
+      *out[c] = D(*q[c]);
+      out[c]->grad[0] = *v[c];
+    }
+  }
+  const std::array<D, 3> x = kinematics(sd).strain;
+  const std::array<D, 3> p = plastic_offsets(x);
+  const std::array<D, 3> r = resultants(x, p);
+  for (std::size_t k = 0; k < 3; ++k) {
+    force[k] = r[k].value;
+    offset[k] = p[k].value;
+    if (offset_rate) (*offset_rate)[k] = p[k].grad[0];
+  }
+}
+
+double BeamElement::stress(const std::array<double, 3>& force) const {
+  return std::max({std::abs(force[0]) / section_.yield_area, std::abs(force[1]) / section_.plastic_section_modulus[0],
+                   std::abs(force[2]) / section_.plastic_section_modulus[1]});
+}
+
+void BeamElement::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  g[0] = g[1] = g[2] = g[3] = 1.0;
+  if (state_.failed) return;
+  std::array<double, 3> force{}, offset{}, rate{};
+  evaluate(s, force, offset, &rate);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const int sign = state_.sign[k];
+    g[k] = sign == 0 ? 1.0 - std::abs(force[k] - hardening_[k] * offset[k]) / yield_[k] : sign * rate[k];
+  }
+  g[3] = 1.0 - stress(force) / material.ultimate_stress;
+}
+
+bool BeamElement::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+  if (state_.failed || direction > 0) return false;
+  std::array<double, 3> force{}, offset{};
+  evaluate(s, force, offset);
+  if (index == 3) {
+    state_.failed = true;
+    event = {"fracture", stress(force)};
+    return true;
+  }
+  const auto k = static_cast<std::size_t>(index);
+  const std::string component = kComponentName[k];
+  if (state_.sign[k] == 0) {
+    state_.sign[k] = force[k] - hardening_[k] * offset[k] > 0.0 ? 1 : -1;
+    if (k == 0)
+      event = {state_.sign[k] > 0 ? "axial yield in tension" : "axial yield in compression", force[k]};
+    else
+      event = {"plastic hinge at " + component, force[k]};
+  } else {
+    state_.offset[k] = offset[k];
+    state_.sign[k] = 0;
+    event = {k == 0 ? std::string("axial unloading") : "hinge at " + component + " unloading", force[k]};
+  }
+  return true;
+}
+
+void BeamElement::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+  // Elastic in every component is the stiffest mode (plastic slopes are E_t / E times smaller).
+  const State saved = state_;
+  state_.sign = {0, 0, 0};
+  state_.failed = false;
+  std::array<Pose<double>, 2> f{};
+  add_force_jacobian(t, s, f, df_dq, df_dv);
+  state_ = saved;
+}
+
+double BeamElement::potential_energy(const ElementState<double>& s) const {
+  if (state_.failed) return 0.0;
+  const std::array<double, 3> x = kinematics(s).strain;
+  const std::array<double, 3> p = plastic_offsets(x);
+  const std::array<double, 3> r = resultants(x, p);
+  double energy = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) energy += 0.5 * r[k] * (x[k] - p[k]);
+  return energy;
+}
+
+std::vector<std::string> BeamElement::output_names() const {
+  return {"force",           "moment_1",          "moment_2",          "stretch", "rotation_1", "rotation_2",
+          "plastic_stretch", "hinge_rotation_1", "hinge_rotation_2", "stress",  "failed"};
+}
+
+void BeamElement::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const std::array<double, 3> x = kinematics(s).strain;
+  std::array<double, 3> force{}, offset{};
+  evaluate(s, force, offset);
+  if (state_.failed) force = {0.0, 0.0, 0.0};
+  for (std::size_t k = 0; k < 3; ++k) {
+    out[k] = force[k];
+    out[3 + k] = x[k];
+    out[6 + k] = offset[k];
+  }
+  out[9] = stress(force);
+  out[10] = state_.failed ? 1.0 : 0.0;
+}
+
+void register_beams_elements(ElementRegistry& registry) {
+  registry.add("elastic_plastic_beam", [](ElementSpec& s) { return std::make_unique<ElasticPlasticBeam>(s); });
+  registry.add("tapered_beam", [](ElementSpec& s) { return std::make_unique<TaperedBeam>(s); });
+}
 
 }  // namespace railcrash

@@ -105,7 +105,7 @@ bool SurfaceContact::commit(int index, int direction, double, const ElementState
         event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate};
       } else if (index == 1) {
         state_.mode = Mode::Released;
-        event = {"released (damper would pull)", k.penetration};
+        event = {wheel_rail_ ? "wheel unloaded (damper would pull)" : "released (damper would pull)", k.penetration};
       } else {
         state_.segment = 1 - state_.segment;
         event = {state_.segment == 1 ? "above breakpoint" : "below breakpoint", k.penetration};

@@ -110,7 +110,7 @@ void CrushSpring::roots(double, const ElementState<double>& s, const double*, do
       g[1] = crush - state_.permanent_crush;
       break;
     case Mode::Open:
-      g[0] = crush - state_.permanent_crush;
+      g[0] = state_.permanent_crush - crush;
       break;
   }
 }
@@ -145,7 +145,7 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
       }
       return true;
     case Mode::Open:
-      if (direction < 0 || index != 0) return false;
+      if (direction > 0 || index != 0) return false;
       enter_mode_at(crush, 1.0);
       event = {st.mode == Mode::Loading ? "contact, crushing" : "contact", crush};
       return true;

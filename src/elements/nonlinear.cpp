@@ -1,7 +1,305 @@
+#include "railcrash/elements/nonlinear.hpp"
+
+#include <cmath>
+#include <string>
+
 #include "railcrash/element_registry.hpp"
 
 namespace railcrash {
 
-void register_nonlinear_elements(ElementRegistry& /*registry*/) {}
+// ---- PiecewiseLinearLaw ------------------------------------------------------------------
+
+PiecewiseLinearLaw::PiecewiseLinearLaw(const std::vector<double>& breakpoints, const std::vector<Segment>& segments) {
+  RAILCRASH_DEMAND(segments.size() == breakpoints.size() + 1);
+  const std::size_t n = breakpoints.size();
+  segments_.push_back(segments[0]);
+  for (std::size_t i = 0; i < n; ++i) {
+    RAILCRASH_DEMAND(i == 0 || breakpoints[i] >= breakpoints[i - 1]);
+    // Segment i + 1 lies between breakpoints i and i + 1: empty when they coincide.
+    if (i + 1 < n && breakpoints[i + 1] == breakpoints[i]) continue;
+    const Segment& next = segments[i + 1];
+    Segment& last = segments_.back();
+    const double b = breakpoints[i];
+    const double below = last.intercept + last.slope * b, above = next.intercept + next.slope * b;
+    if (next.slope == last.slope && std::abs(below - above) <= 1e-12 * (std::abs(below) + std::abs(above))) {
+      last.name += " / " + next.name;  // the same straight line: no kink here
+      continue;
+    }
+    breakpoints_.push_back(b);
+    segments_.push_back(next);
+  }
+  // Antiderivatives G_k(x) = C_k + a_k x + s_k x^2 / 2, with G(0) = 0 and G continuous.
+  const auto line_integral = [this](int k, double x) {
+    const Segment& s = segment(k);
+    return s.intercept * x + 0.5 * s.slope * x * x;
+  };
+  integral_constant_.assign(segments_.size(), 0.0);
+  const int home = segment_at(0.0, 1);
+  for (int k = home; k + 1 < segment_count(); ++k) {
+    const double b = upper(k);
+    integral_constant_[static_cast<std::size_t>(k + 1)] =
+        integral_constant_[static_cast<std::size_t>(k)] + line_integral(k, b) - line_integral(k + 1, b);
+  }
+  for (int k = home; k > 0; --k) {
+    const double b = lower(k);
+    integral_constant_[static_cast<std::size_t>(k - 1)] =
+        integral_constant_[static_cast<std::size_t>(k)] + line_integral(k, b) - line_integral(k - 1, b);
+  }
+}
+
+PiecewiseLinearLaw PiecewiseLinearLaw::two_branch(double value_at_zero, const Branch& negative,
+                                                  const std::string& negative_name, const Branch& positive,
+                                                  const std::string& positive_name) {
+  std::vector<double> breakpoints;
+  std::vector<Segment> segments;
+  if (negative.breakpoint) {
+    const double distance = *negative.breakpoint;
+    const double value = value_at_zero - negative.slope_1 * distance;  // f(-distance)
+    segments.push_back({value + *negative.slope_2 * distance, *negative.slope_2, negative_name + " segment 2"});
+    breakpoints.push_back(-distance);
+  }
+  segments.push_back({value_at_zero, negative.slope_1, negative_name + " segment 1"});
+  breakpoints.push_back(0.0);
+  segments.push_back({value_at_zero, positive.slope_1, positive_name + " segment 1"});
+  if (positive.breakpoint) {
+    const double distance = *positive.breakpoint;
+    const double value = value_at_zero + positive.slope_1 * distance;  // f(+distance)
+    segments.push_back({value - *positive.slope_2 * distance, *positive.slope_2, positive_name + " segment 2"});
+    breakpoints.push_back(distance);
+  }
+  return PiecewiseLinearLaw(breakpoints, segments);
+}
+
+double PiecewiseLinearLaw::integral(double x, int k) const {
+  const Segment& s = segment(k);
+  return integral_constant_[static_cast<std::size_t>(k)] + s.intercept * x + 0.5 * s.slope * x * x;
+}
+
+int PiecewiseLinearLaw::segment_at(double x, int direction) const {
+  const int n = segment_count();
+  if (direction > 0) {  // the highest segment whose lower breakpoint is at or below x
+    int k = 0;
+    while (k + 1 < n && upper(k) <= x) ++k;
+    return k;
+  }
+  int k = n - 1;  // the lowest segment whose upper breakpoint is at or above x
+  while (k > 0 && lower(k) >= x) --k;
+  return k;
+}
+
+// ---- PiecewiseLineElement ----------------------------------------------------------------
+
+template <class Derived>
+PiecewiseLineElement<Derived>::PiecewiseLineElement(ElementSpec& spec, int fracture_sides)
+    : ForceElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {
+  spec.require_points(2);
+}
+
+template <class Derived>
+void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initial) {
+  Derived& self = *static_cast<Derived*>(this);
+  const LineGeometry<double> g = line_geometry(*this, initial);
+  if (g.length == 0.0)
+    throw InputError(this->where_.prefix() + this->type_ + " '" + this->name_ +
+                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
+  self.prepare(g.length);
+  double scale = self.kink_scale();
+  for (double b : law_.breakpoints()) scale = std::max(scale, std::abs(b));
+  kink_tolerance_ = 1e-9 * scale;
+
+  const double x = self.measure(g);
+  const int rate = self.rate_sign(g);
+  mode_ = SegmentMode{};
+  mode_.segment = law_.segment_at(x, rate > 0 ? 1 : -1);
+  // On a breakpoint with no rate information: the lower segment, left a kink tolerance
+  // beyond the breakpoint (a root exactly zero at the start would never fire).
+  if (rate == 0 && law_.has_upper(mode_.segment) && x == law_.upper(mode_.segment)) mode_.upper_shift = kink_tolerance_;
+  if (fracture_roots() > 0) {
+    const double f = law_.value(x, mode_.segment);
+    if (f >= *fracture_load || (fracture_roots() > 1 && -f >= *fracture_load))
+      throw InputError(this->where_.prefix() + this->type_ + " '" + this->name_ + "' starts at a force of " +
+                       std::to_string(f) + ", beyond its fracture_load " + std::to_string(*fracture_load) +
+                       "; raise fracture_load or start it less deformed");
+  }
+  initial_mode_ = mode_;
+}
+
+template <class Derived>
+void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  for (int k = 0; k < root_count(); ++k) g[k] = 1.0;
+  if (mode_.broken) return;
+  const double x = measure_of(s);
+  const int k = mode_.segment;
+  if (law_.has_lower(k)) g[0] = x - law_.lower(k);
+  if (law_.has_upper(k)) g[1] = law_.upper(k) + mode_.upper_shift - x;
+  if (fracture_roots() > 0) {
+    const double f = law_.value(x, k);
+    g[2] = *fracture_load - f;
+    if (fracture_roots() > 1) g[3] = *fracture_load + f;
+  }
+}
+
+template <class Derived>
+bool PiecewiseLineElement<Derived>::commit(int index, int direction, double, const ElementState<double>& s,
+                                           const double*, Element::Event& event) {
+  if (mode_.broken) return false;
+  const double x = measure_of(s);
+  if (index >= 2) {  // fracture roots: leave when they fall through zero
+    if (direction > 0) return false;
+    event = {"fracture", law_.value(x, mode_.segment)};
+    mode_.broken = true;
+    return true;
+  }
+  // Root 0 (x - lower) falls when x moves down, root 1 (upper - x) when x moves up. The new
+  // segment comes from x itself, so a step over several breakpoints (Euler) lands right,
+  // and a second root of the same crossing finds nothing left to do.
+  const int x_direction = index == 0 ? direction : -direction;
+  const int to = law_.segment_at(x, x_direction);
+  if (to == mode_.segment) return false;
+  const int from = mode_.segment;
+  mode_.segment = to;
+  mode_.upper_shift = 0.0;
+  event = static_cast<const Derived*>(this)->segment_event(from, to, x);
+  return true;
+}
+
+namespace {
+
+int sign_of(double value) { return (value > 0.0) - (value < 0.0); }
+
+/// Rate of length L' = u . (r2' - r1').
+double length_rate(const LineGeometry<double>& g) { return dot(g.d, g.d_rate) / g.length; }
+
+/// slope_1 (required), slope_2 and breakpoint (together or neither), all >= 0.
+PiecewiseLinearLaw::Branch read_branch(ParameterReader& p, const std::string& slope_1, const std::string& slope_2,
+                                       const std::string& breakpoint) {
+  PiecewiseLinearLaw::Branch branch;
+  branch.slope_1 = p.required_nonnegative(slope_1);
+  branch.slope_2 = p.optional_nonnegative(slope_2);
+  branch.breakpoint = p.optional_nonnegative(breakpoint);
+  if (branch.slope_2 && !branch.breakpoint)
+    p.fail(slope_2, "'" + slope_2 + "' needs '" + breakpoint + "' (where it takes over from '" + slope_1 +
+                        "'): give both or neither");
+  if (branch.breakpoint && !branch.slope_2)
+    p.fail(breakpoint, "'" + breakpoint + "' needs '" + slope_2 + "' (the slope beyond it): give both or neither");
+  return branch;
+}
+
+}  // namespace
+
+// ---- nonlinear_spring --------------------------------------------------------------------
+
+NonlinearSpring::NonlinearSpring(ElementSpec& spec)
+    : PiecewiseLineElement<NonlinearSpring>(spec, 2),
+      compression(read_branch(*spec.parameters, "compression_stiffness_1", "compression_stiffness_2",
+                              "compression_breakpoint")),
+      extension(read_branch(*spec.parameters, "extension_stiffness_1", "extension_stiffness_2", "extension_breakpoint")),
+      preload(spec.parameters->number("preload").value_or(0.0)),
+      free_length(spec.parameters->optional_positive("free_length")) {
+  fracture_load = spec.parameters->optional_positive("fracture_load");
+  if (fracture_load && std::abs(preload) >= *fracture_load)
+    spec.parameters->fail("preload", "'preload' must be smaller in size than 'fracture_load' (the spring would break at once)");
+  set_law(PiecewiseLinearLaw::two_branch(-preload, compression, "compression", extension, "extension"));
+}
+
+int NonlinearSpring::rate_sign(const LineGeometry<double>& g) const { return sign_of(length_rate(g)); }
+
+void NonlinearSpring::prepare(double initial_length) {
+  if (!free_length) free_length = initial_length;
+}
+
+Element::Event NonlinearSpring::segment_event(int, int to, double x) const { return {law().segment(to).name, x}; }
+
+double NonlinearSpring::potential_energy(const ElementState<double>& s) const {
+  if (mode().broken) return 0.0;
+  return law().integral(measure_of(s), mode().segment);
+}
+
+void NonlinearSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double deformation = measure_of(s);
+  out[0] = law_value(deformation);  // tension positive
+  out[1] = deformation;
+}
+
+// ---- nonlinear_dashpot -------------------------------------------------------------------
+
+NonlinearDashpot::NonlinearDashpot(ElementSpec& spec)
+    : PiecewiseLineElement<NonlinearDashpot>(spec, 0),
+      compression(read_branch(*spec.parameters, "damping_compression_1", "damping_compression_2",
+                              "compression_switch_velocity")),
+      extension(read_branch(*spec.parameters, "damping_extension_1", "damping_extension_2", "extension_switch_velocity")) {
+  set_law(PiecewiseLinearLaw::two_branch(0.0, compression, "compression", extension, "extension"));
+}
+
+void NonlinearDashpot::prepare(double) {}
+
+Element::Event NonlinearDashpot::segment_event(int, int to, double x) const { return {law().segment(to).name, x}; }
+
+void NonlinearDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double rate = measure_of(s);
+  out[0] = law_value(rate);  // tension positive
+  out[1] = rate;
+}
+
+// ---- special_spring ----------------------------------------------------------------------
+
+SpecialSpring::SpecialSpring(ElementSpec& spec) : PiecewiseLineElement<SpecialSpring>(spec, 1) {
+  ParameterReader& p = *spec.parameters;
+  const double kind_value = p.number("kind").value_or(1.0);
+  if (kind_value != 1.0 && kind_value != 2.0)
+    p.fail("kind", "'kind' must be 1 (acts in compression, pushes the points apart) or 2 (acts in tension, pulls them together)");
+  kind = static_cast<int>(kind_value);
+  closed = read_branch(p, "stiffness_1", "stiffness_2", "breakpoint");
+  preload = p.optional_nonnegative("preload").value_or(0.0);
+  free_length = p.optional_positive("free_length");
+  fracture_load = p.optional_positive("fracture_load");
+  if (fracture_load && preload >= *fracture_load)
+    p.fail("preload", "'preload' must be below 'fracture_load' (the spring would break as soon as it closes)");
+
+  std::vector<double> breakpoints{0.0};
+  std::vector<PiecewiseLinearLaw::Segment> segments{{0.0, 0.0, "open"}, {preload, closed.slope_1, "segment 1"}};
+  if (closed.breakpoint) {
+    const double b = *closed.breakpoint;
+    const double value = preload + closed.slope_1 * b;  // P(breakpoint)
+    segments.push_back({value - *closed.slope_2 * b, *closed.slope_2, "segment 2"});
+    breakpoints.push_back(b);
+  }
+  set_law(PiecewiseLinearLaw(breakpoints, segments));
+}
+
+int SpecialSpring::rate_sign(const LineGeometry<double>& g) const {
+  return sign_of(-direction() * length_rate(g));
+}
+
+void SpecialSpring::prepare(double initial_length) {
+  if (!free_length) free_length = initial_length;
+}
+
+Element::Event SpecialSpring::segment_event(int from, int to, double x) const {
+  if (to == 0) return {"opening", x};
+  if (from == 0) return {"closing (" + law().segment(to).name + ")", x};
+  return {law().segment(to).name, x};
+}
+
+double SpecialSpring::potential_energy(const ElementState<double>& s) const {
+  if (mode().broken) return 0.0;
+  return law().integral(measure_of(s), mode().segment);
+}
+
+void SpecialSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double deflection = measure_of(s);
+  out[0] = law_value(deflection);  // in the working direction, >= 0
+  out[1] = deflection;
+}
+
+template class PiecewiseLineElement<NonlinearSpring>;
+template class PiecewiseLineElement<NonlinearDashpot>;
+template class PiecewiseLineElement<SpecialSpring>;
+
+void register_nonlinear_elements(ElementRegistry& registry) {
+  registry.add("nonlinear_spring", [](ElementSpec& s) { return std::make_unique<NonlinearSpring>(s); });
+  registry.add("nonlinear_dashpot", [](ElementSpec& s) { return std::make_unique<NonlinearDashpot>(s); });
+  registry.add("special_spring", [](ElementSpec& s) { return std::make_unique<SpecialSpring>(s); });
+}
 
 }  // namespace railcrash

@@ -1,1 +1,154 @@
 #include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+
+#include "railcrash/elements/crush.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+// A 100 kg mass moving at -speed toward a crush spring anchored at the origin: free length
+// 1 m, the mass starts at x = 1 + gap. Elastic-perfectly-plastic curve: F0 = 1e5 N reached at
+// d_y = 0.01 m, unloading with the same stiffness 1e7 N/m.
+std::string impact(double speed, double gap, const std::string& integrator, const std::string& extra = "") {
+  std::ostringstream s;
+  s.precision(17);
+  s << "railcrash: 1\nname: crush\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: mass, mass: 100, inertia: 1, position: [" << 1.0 + gap << ", 0], velocity: [" << -speed << ", 0]}\n"
+    << "elements:\n  - name: crush\n    type: crush_spring\n    free_length: 1.0\n"
+    << "    curve: [[0, 0], [0.01, 1.0e5], [1.0, 1.0e5]]\n    unloading_stiffness: 1.0e7\n" << extra
+    << "    points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]\n"
+    << "simulation: {t_end: 0.2, integrator: " << integrator << ", rtol: 1e-9, dt: 2e-6, output_interval: 0.001}\n";
+  return s.str();
+}
+
+struct Run {
+  RunOutcome outcome;
+  double final_vx = 0.0;
+};
+
+Run run(const Model& model) {
+  const DaeSystem system(model);
+  struct Null : RunObserver {
+    void sample(double, const double*, const double*, const double*) override {}
+  } observer;
+  Run r;
+  r.outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, 0.01, observer);
+  REQUIRE(r.outcome.ok);
+  r.final_vx = r.outcome.y[3];
+  return r;
+}
+
+CrushSpring& crush_of(const Model& model) { return dynamic_cast<CrushSpring&>(*model.elements()[0]); }
+
+}  // namespace
+
+TEST_CASE("crush spring: mass into an elastic-perfectly-plastic structure, closed form", "[elements][crush]") {
+  // Energy: m v^2 / 2 = F0 d_y / 2 + F0 (d_max - d_y)  ->  d_max = 0.055 m for v = 10 m/s;
+  // permanent crush d_max - F0 / k = 0.045 m; rebound speed sqrt(F0 d_y / m) = sqrt(10) m/s.
+  const double speed = 10.0, gap = 0.5;
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const Model model = testing::model_from_text(impact(speed, gap, integrator));
+    const Run r = run(model);
+    const bool ida = std::string(integrator) == "ida";
+    const double tolerance = ida ? 1e-7 : 2e-4;
+    REQUIRE(r.outcome.events.size() == 4);
+    CHECK(r.outcome.events[0].what == "contact, crushing");
+    CHECK(r.outcome.events[0].t == Approx(gap / speed).margin(ida ? 1e-10 : 2e-6));
+    CHECK(r.outcome.events[1].what == "curve segment 2");
+    CHECK(r.outcome.events[2].what == "unloading");
+    CHECK(r.outcome.events[2].value == Approx(0.055).margin(tolerance));
+    CHECK(r.outcome.events[3].what == "separation");
+    CHECK(crush_of(model).state().permanent_crush == Approx(0.045).margin(tolerance));
+    CHECK(r.final_vx == Approx(std::sqrt(10.0)).epsilon(ida ? 1e-7 : 1e-3));
+    // Energy: all but the rebound's kinetic energy is dissipated by crushing.
+    const EnergyBalance e = EnergyBalance::between(r.outcome.initial_energy, r.outcome.final_energy);
+    CHECK(e.dissipated == Approx(5000.0 - 500.0).epsilon(ida ? 1e-7 : 2e-3));
+    const double element_work = r.outcome.quadratures[DaeSystem::kFirstElementWork];
+    CHECK(element_work == Approx(e.dissipated).epsilon(ida ? 1e-7 : 2e-3));
+  }
+}
+
+TEST_CASE("crush spring: reloading follows the unloading line back to the curve", "[elements][crush]") {
+  // Drive the element by hand through its modes and check the force at each stage.
+  const Model model = testing::model_from_text(impact(10.0, 0.0, "ida"));
+  CrushSpring& c = crush_of(model);
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const auto state_at = [&](double crush, double rate) {
+    y[0] = 1.0 - crush;
+    y[3] = -rate;
+    return gather_state(c, y.data(), y.data() + 3);
+  };
+  REQUIRE(c.state().mode == CrushSpring::Mode::Loading);  // starts in contact, closing
+  Element::Event event;
+  CHECK(c.commit(2, -1, 0.0, state_at(0.01, 1.0), nullptr, event));  // past the first point
+  CHECK(c.crush_force(0.03) == Approx(1e5));
+  CHECK(c.commit(0, -1, 0.0, state_at(0.03, 0.0), nullptr, event));  // reversal at 0.03
+  CHECK(event.what == "unloading");
+  CHECK(c.state().permanent_crush == Approx(0.02));
+  CHECK(c.crush_force(0.025) == Approx(0.5e5));
+  CHECK(c.commit(0, -1, 0.0, state_at(0.03, 1.0), nullptr, event));  // back on the curve
+  CHECK(c.state().mode == CrushSpring::Mode::Loading);
+  CHECK(c.state().segment == 1);
+  CHECK(c.crush_force(0.04) == Approx(1e5));
+  c.reset_modes();
+  CHECK(c.state().mode == CrushSpring::Mode::Loading);
+  CHECK(c.state().segment == 0);
+}
+
+TEST_CASE("crush spring Jacobian matches central differences in every mode", "[elements][crush]") {
+  Model model = testing::model_from_text(impact(10.0, 0.0, "ida", "    tension_stiffness: 2.0e6\n"));
+  CrushSpring& c = crush_of(model);
+  const DaeSystem system(model);
+  std::mt19937 rng(3);
+  std::vector<double> base = system.initial_state();
+  const auto check_here = [&](double crush) {
+    for (int trial = 0; trial < 3; ++trial) {
+      std::vector<double> y = testing::random_state(system, rng, 1e-3);
+      y[0] = 1.0 - crush + 1e-4 * trial;
+      const std::vector<double> yp = testing::random_state(system, rng, 0.3);
+      double outside = 0.0;
+      CHECK(testing::jacobian_error(system, 0.0, 50.0, y, yp, &outside) < 1e-6);
+      CHECK(outside == 0.0);
+    }
+  };
+  std::vector<double> y = base;
+  Element::Event event;
+  check_here(0.005);  // loading, segment 1
+  y[0] = 1.0 - 0.01;
+  c.commit(2, -1, 0.0, gather_state(c, y.data(), y.data() + 3), nullptr, event);
+  check_here(0.02);  // loading, segment 2
+  y[0] = 1.0 - 0.02;
+  y[3] = 0.0;
+  c.commit(0, -1, 0.0, gather_state(c, y.data(), y.data() + 3), nullptr, event);
+  REQUIRE(c.state().mode == CrushSpring::Mode::Elastic);
+  check_here(0.015);  // elastic
+  y[0] = 1.0 - c.state().permanent_crush;
+  c.commit(1, -1, 0.0, gather_state(c, y.data(), y.data() + 3), nullptr, event);
+  REQUIRE(c.state().mode == CrushSpring::Mode::Open);
+  check_here(0.0);  // open with a tension spring
+}
+
+TEST_CASE("crush spring input errors name the problem", "[elements][crush]") {
+  const auto message = [](const std::string& curve) {
+    const std::string good = "[[0, 0], [0.01, 1.0e5], [1.0, 1.0e5]]";
+    std::string text = impact(10.0, 0.5, "ida");
+    text.replace(text.find(good), good.size(), curve);
+    try {
+      testing::model_from_text(text);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(message("[[0, 0], [0, 1.0e5]]"), Catch::Contains("must increase strictly"));
+  CHECK_THAT(message("[[0, 0], [0.1, -5]]"), Catch::Contains("must not be negative"));
+  CHECK_THAT(message("[[0, 0]]"), Catch::Contains("at least two points"));
+  CHECK_THAT(message("[[0, 0, 1], [1, 2, 3]]"), Catch::Contains("test.yaml:") && Catch::Contains("curve"));
+}

@@ -16,6 +16,7 @@
 //   open                  P = 0, or tension_stiffness * (d - d_p) (< 0) when that is given
 //                         leaves when d > d_p (contact again: elastic, or loading if the
 //                         structure has never been crushed)
+// Roots are written positive inside their mode (element.hpp's convention).
 // Elastic energy is P^2 / (2 unloading_stiffness) (what unloading would give back); the
 // rest of the work done on the element is dissipated in crushing.
 #pragma once
