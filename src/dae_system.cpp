@@ -132,7 +132,7 @@ void DaeSystem::load_forces(double t, const double* q, double* f) const {
 }
 
 void DaeSystem::generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty,
-                                   double* penalty_lambda) const {
+                                   double* penalty_lambda, const double* lambda) const {
   const int n = model_.body_count();
   for (int i = 0; i < n; ++i) {
     f[3 * i] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
@@ -148,27 +148,33 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
     if (m == 0) {
       el.add_force(t, s, fe);
     } else {
-      if (penalty == nullptr) continue;
       const int offset = model_.constraint_offset(e);
-      if (el.failed()) {
-        if (penalty_lambda)
-          for (int r = 0; r < m; ++r) penalty_lambda[offset + r] = 0.0;
+      double reactions[kMaxConstraintRows] = {};  // multipliers the joint's friction sees
+      if (penalty != nullptr) {
+        if (el.failed()) {
+          if (penalty_lambda)
+            for (int r = 0; r < m; ++r) penalty_lambda[offset + r] = 0.0;
+          continue;
+        }
+        double phi[kMaxConstraintRows];
+        double grad[kMaxConstraintRows][6];
+        el.constraint_gradient(s.q, phi, grad);
+        for (int r = 0; r < m; ++r) {
+          const auto row = static_cast<std::size_t>(offset + r);
+          double rate = 0.0;
+          for (int k = 0; k < 2; ++k)
+            for (int c = 0; c < 3; ++c) rate += grad[r][3 * k + c] * component(s.v[static_cast<std::size_t>(k)], c);
+          reactions[r] = penalty->stiffness[row] * phi[r] + penalty->damping[row] * rate;
+          if (penalty_lambda) penalty_lambda[row] = reactions[r];
+          for (int k = 0; k < 2; ++k)
+            for (int c = 0; c < 3; ++c) component(fe[static_cast<std::size_t>(k)], c) -= grad[r][3 * k + c] * reactions[r];
+        }
+      } else if (lambda != nullptr) {
+        for (int r = 0; r < m; ++r) reactions[r] = lambda[offset + r];
+      } else {
         continue;
       }
-      double phi[kMaxConstraintRows];
-      double grad[kMaxConstraintRows][6];
-      el.constraint_gradient(s.q, phi, grad);
-      for (int r = 0; r < m; ++r) {
-        const auto row = static_cast<std::size_t>(offset + r);
-        double rate = 0.0;
-        for (int k = 0; k < 2; ++k)
-          for (int c = 0; c < 3; ++c)
-            rate += grad[r][3 * k + c] * component(s.v[static_cast<std::size_t>(k)], c);
-        const double lambda = penalty->stiffness[row] * phi[r] + penalty->damping[row] * rate;
-        if (penalty_lambda) penalty_lambda[row] = lambda;
-        for (int k = 0; k < 2; ++k)
-          for (int c = 0; c < 3; ++c) component(fe[static_cast<std::size_t>(k)], c) -= grad[r][3 * k + c] * lambda;
-      }
+      if (el.has_joint_force() && !el.failed()) el.add_joint_force(t, s, reactions, fe);
     }
     for (int k = 0; k < 2; ++k) {
       const int b = el.slot_body(k);
@@ -191,7 +197,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* r)
   double* r_phi = r + 2 * nq;
   double* r_vel = r_phi + constraint_rows();
 
-  generalized_forces(t, q, v, r_v);  // r_v = f for now
+  generalized_forces(t, q, v, r_v, nullptr, nullptr, lambda);  // r_v = f for now
   for (int k = 0; k < nq; ++k) {
     r_q[k] = yp[k] - v[k];
     r_v[k] = mass_[static_cast<std::size_t>(k)] * yp[nq + k] - r_v[k];
@@ -344,6 +350,29 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
       // Diagonal slots of a constraint that fails (its rows become lambda = 0, mu = 0).
       sink.add(row_phi, model_.lambda_index(g), 1.0 - active);
       sink.add(row_vel, model_.mu_index(g), 1.0 - active);
+    }
+    if (!el.has_joint_force()) continue;
+    // Friction: r_v -= f(q, v, lambda).
+    std::array<Pose<double>, 2> f{};
+    ForceBlock df_dq{}, df_dv{};
+    double df_dlambda[6][kMaxConstraintRows] = {};
+    if (!el.failed()) el.add_joint_force_jacobian(t, s, lambda + offset, f, df_dq, df_dv, df_dlambda);
+    for (int a = 0; a < 2; ++a) {
+      const int ba = el.slot_body(a);
+      if (ba == kGround) continue;
+      for (int i = 0; i < 3; ++i) {
+        const auto li = static_cast<std::size_t>(3 * a + i);
+        for (int b = 0; b < 2; ++b) {
+          const int bb = el.slot_body(b);
+          if (bb == kGround) continue;
+          for (int j = 0; j < 3; ++j) {
+            const auto lj = static_cast<std::size_t>(3 * b + j);
+            sink.add(nq + 3 * ba + i, 3 * bb + j, -df_dq[li][lj]);
+            sink.add(nq + 3 * ba + i, nq + 3 * bb + j, -df_dv[li][lj]);
+          }
+        }
+        for (int row = 0; row < m; ++row) sink.add(nq + 3 * ba + i, model_.lambda_index(offset + row), -df_dlambda[li][row]);
+      }
     }
   }
 }
@@ -522,7 +551,15 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
       el.add_force(t, s, fe);
       for (std::size_t k = 0; k < 2; ++k)
         power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
-    } else if (penalty_lambda) {
+    } else if (el.has_joint_force() && !el.failed()) {
+      // Friction of a joint: its reactions are the multipliers (ida) or penalty forces (euler).
+      const double* reactions = (penalty_lambda ? penalty_lambda : y + 2 * nq) + model_.constraint_offset(e);
+      std::array<Pose<double>, 2> fe{};
+      el.add_joint_force(t, s, reactions, fe);
+      for (std::size_t k = 0; k < 2; ++k)
+        power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
+    }
+    if (el.constraint_count() > 0 && penalty_lambda) {
       // Penalty force -G^T lambda does power -lambda . (G v) on the bodies.
       double phi[kMaxConstraintRows];
       double grad[kMaxConstraintRows][6];

@@ -175,12 +175,9 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
   yp.assign(y.size(), 0.0);
   std::copy(y.begin() + nq, y.begin() + 2 * nq, yp.begin());  // q' = v
   std::fill(y.begin() + 2 * nq, y.end(), 0.0);                 // lambda, mu recomputed
-  std::vector<double> force(static_cast<std::size_t>(nq));
-  system.generalized_forces(t, y.data(), y.data() + nq, force.data());
   std::vector<Eigen::Triplet<double>> entries;
   for (int k = 0; k < nq; ++k) entries.emplace_back(k, k, system.mass_diagonal(k));
-  Eigen::VectorXd rhs(nq + m);
-  for (int k = 0; k < nq; ++k) rhs[k] = force[static_cast<std::size_t>(k)];
+  Eigen::VectorXd constraint_rhs = Eigen::VectorXd::Zero(m);
   if (m > 0) {
     Eigen::VectorXd phi(m);
     std::vector<DaeSystem::Triplet> gradient;
@@ -192,7 +189,7 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
     std::vector<double> gamma(static_cast<std::size_t>(m), 0.0);
     system.constraint_acceleration_bias(y.data(), y.data() + nq, gamma.data());
     for (int r = 0; r < m; ++r) {
-      rhs[nq + r] = -gamma[static_cast<std::size_t>(r)];
+      constraint_rhs[r] = -gamma[static_cast<std::size_t>(r)];
       if (!system.constraint_row_active(r)) entries.emplace_back(nq + r, nq + r, 1.0);  // lambda = 0
     }
   }
@@ -208,9 +205,24 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
     throw SolverError("the equations of motion are singular at the start" +
                       (zero.empty() ? std::string(".") : ": bodies " + zero + " have zero inertia and no joint fixes their rotation; give them an inertia.") );
   }
-  const Eigen::VectorXd solution = lu.solve(rhs);
+  // Joint friction depends on the reactions: iterate on them (a contraction for friction
+  // coefficients below one; a handful of passes reach round-off).
+  bool friction = false;
+  for (const auto& e : system.model().elements()) friction = friction || e->has_joint_force();
+  std::vector<double> force(static_cast<std::size_t>(nq));
+  Eigen::VectorXd rhs(nq + m), solution;
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(m);
+  for (int pass = 0; pass < (friction ? 50 : 1); ++pass) {
+    system.generalized_forces(t, y.data(), y.data() + nq, force.data(), nullptr, nullptr, y.data() + 2 * nq);
+    for (int k = 0; k < nq; ++k) rhs[k] = force[static_cast<std::size_t>(k)];
+    rhs.tail(m) = constraint_rhs;
+    solution = lu.solve(rhs);
+    for (int r = 0; r < m; ++r) y[static_cast<std::size_t>(2 * nq + r)] = solution[nq + r];
+    const double change = (solution.tail(m) - previous).cwiseAbs().maxCoeff();
+    previous = solution.tail(m);
+    if (m == 0 || change <= 1e-12 * std::max(1.0, previous.cwiseAbs().maxCoeff())) break;
+  }
   for (int k = 0; k < nq; ++k) yp[static_cast<std::size_t>(nq + k)] = solution[k];
-  for (int r = 0; r < m; ++r) y[static_cast<std::size_t>(2 * nq + r)] = solution[nq + r];
 }
 
 }  // namespace railcrash

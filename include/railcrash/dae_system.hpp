@@ -86,8 +86,10 @@ class DaeSystem {
 
   /// Generalized forces f(t, q, v) from gravity, loads and force elements; when penalty is
   /// given, constraints add -G^T (k Phi + c G v) and penalty_lambda receives k Phi + c G v.
+  /// Joint friction needs the reactions: the penalty forces, or else `lambda` (the DAE's
+  /// multipliers; without either, joint friction is left out).
   void generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty = nullptr,
-                          double* penalty_lambda = nullptr) const;
+                          double* penalty_lambda = nullptr, const double* lambda = nullptr) const;
   /// Triplets of df/dq and df/dv (same force definition as generalized_forces); with
   /// `stiffest`, each element in its stiffest mode (Euler's stability estimate).
   struct Triplet { int row, col; double value; };

@@ -83,6 +83,16 @@ class Element {
                                   double gradient[kMaxConstraintRows][6],
                                   double hessian[kMaxConstraintRows][6][6]) const;
 
+  /// Joints with friction also apply forces that depend on their multipliers (reactions).
+  virtual bool has_joint_force() const { return false; }
+  /// Adds those forces f(t, q, v, lambda) to f.
+  virtual void add_joint_force(double /*t*/, const ElementState<double>& /*s*/, const double* /*lambda*/,
+                               std::array<Pose<double>, 2>& /*f*/) const {}
+  /// The same with derivatives; df_dlambda[3*slot + component][row].
+  virtual void add_joint_force_jacobian(double /*t*/, const ElementState<double>& /*s*/, const double* /*lambda*/,
+                                        std::array<Pose<double>, 2>& /*f*/, ForceBlock& /*df_dq*/, ForceBlock& /*df_dv*/,
+                                        double /*df_dlambda*/[6][kMaxConstraintRows]) const {}
+
   // ---- force elements ----
   /// Generalized forces on slot 0 and 1 (force x, force y, moment), added to f.
   virtual void add_force(double /*t*/, const ElementState<double>& /*s*/, std::array<Pose<double>, 2>& /*f*/) const {}
@@ -196,11 +206,52 @@ class ForceElement : public Element {
 
 /// Adapter: Derived provides  static constexpr int kRows  and
 /// template <class T> void constraint_law(const std::array<Pose<T>,2>& q, T* phi) const.
+/// A joint with friction also defines
+/// template <class T> void joint_force_law(double t, const ElementState<T>&, const T* lambda, std::array<Pose<T>,2>& f) const
+/// and returns true from has_joint_force(); AD over (q, v, lambda) gives its derivatives.
 template <class Derived>
 class ConstraintElement : public Element {
  public:
   using Element::Element;
   int constraint_count() const override { return Derived::kRows; }
+
+  template <class T>
+  void joint_force_law(double, const ElementState<T>&, const T*, std::array<Pose<T>, 2>&) const {}
+
+  void add_joint_force(double t, const ElementState<double>& s, const double* lambda,
+                       std::array<Pose<double>, 2>& f) const override {
+    static_cast<const Derived*>(this)->joint_force_law(t, s, lambda, f);
+  }
+
+  void add_joint_force_jacobian(double t, const ElementState<double>& s, const double* lambda,
+                                std::array<Pose<double>, 2>& f, ForceBlock& df_dq, ForceBlock& df_dv,
+                                double df_dlambda[6][kMaxConstraintRows]) const override {
+    using D = Dual<double, 12 + kMaxConstraintRows>;
+    ElementState<D> sd;
+    for (int k = 0; k < 2; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
+      sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
+    }
+    D lambda_d[kMaxConstraintRows];
+    for (int r = 0; r < Derived::kRows; ++r) lambda_d[r] = D(lambda[r], 12 + r);
+    std::array<Pose<D>, 2> fd{};
+    static_cast<const Derived*>(this)->joint_force_law(t, sd, lambda_d, fd);
+    for (int k = 0; k < 2; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      const D* comps[3] = {&fd[ks].x, &fd[ks].y, &fd[ks].theta};
+      double* out[3] = {&f[ks].x, &f[ks].y, &f[ks].theta};
+      for (int c = 0; c < 3; ++c) {
+        *out[c] += comps[c]->value;
+        const auto row = static_cast<std::size_t>(3 * k + c);
+        for (std::size_t j = 0; j < 6; ++j) {
+          df_dq[row][j] += comps[c]->grad[j];
+          df_dv[row][j] += comps[c]->grad[6 + j];
+        }
+        for (int r = 0; r < Derived::kRows; ++r) df_dlambda[row][r] += comps[c]->grad[12 + static_cast<std::size_t>(r)];
+      }
+    }
+  }
 
   void constraint(const std::array<Pose<double>, 2>& q, double* phi) const override {
     static_cast<const Derived*>(this)->constraint_law(q, phi);

@@ -35,6 +35,8 @@ std::unique_ptr<Element> make_joint(ElementSpec& spec) {
 
 PinJoint::PinJoint(ElementSpec& spec) : ConstraintElement(spec.name, spec.type, spec.points, spec.where) {
   spec.require_points(2);
+  friction_radius = spec.parameters->optional_nonnegative("friction_radius").value_or(0.0);
+  friction_velocity = spec.parameters->optional_positive("friction_velocity").value_or(0.01);
 }
 
 // Reaction on body 2 is -G2^T lambda; for r2 - r1 rows that is (-lambda_x, -lambda_y).
@@ -50,6 +52,13 @@ SliderJoint::SliderJoint(ElementSpec& spec)
   const auto axis = read_axis(spec);
   axis_x = axis[0];
   axis_y = axis[1];
+  friction = spec.parameters->optional_nonnegative("friction").value_or(0.0);
+  friction_velocity = spec.parameters->optional_positive("friction_velocity").value_or(0.01);
+  const auto length = spec.parameters->optional_positive("slider_length");
+  if (friction > 0.0 && !length)
+    spec.parameters->fail("friction", "a slider_joint with friction needs 'slider_length' (the distance between the "
+                                      "slider's bearing ends, which carry the joint's moment)");
+  if (length) slider_length = *length;
 }
 
 void SliderJoint::outputs(const ElementState<double>& s, const double* lambda, double* out) const {

@@ -15,6 +15,19 @@
 //
 // a0 (`relative_angle`) is the locked relative angle; left out, it is taken from the
 // initial configuration. Row sign convention: the reaction on body 2 is -G2^T lambda.
+//
+// Friction (report: pin joint "friction parameter muR"; slider joint coefficient of friction
+// and slider length), Coulomb regularized smoothly below a slip speed v_f: tanh(v / v_f).
+//   pin_joint     moment on body 2 = -muR |R| tanh(w_rel / w_f), +that on body 1; |R| the
+//                 reaction's magnitude, w_rel = omega2 - omega1; `friction_radius` muR
+//                 [length], `friction_velocity` w_f [rad/time] (default 0.01)
+//   slider_joint  force on body 2 at P2 along the axis a = R(theta1) axis:
+//                 -mu N tanh(v_rel / v_f), the opposite on body 1 at the same place, where
+//                 N = sqrt(Rn^2 + (2 M / l)^2) combines the normal reaction Rn and the
+//                 moment M of the angle lock carried by the slider's two ends l apart
+//                 (`friction` mu, `slider_length` l [length], `friction_velocity` v_f
+//                 [length/time], default 0.01), v_rel the slip of P2 along a relative to body 1.
+// |R| and N are evaluated as sqrt(x^2 + 1e-30) so their derivative exists at zero load.
 #pragma once
 
 #include <optional>
@@ -50,12 +63,23 @@ class PinJoint : public ConstraintElement<PinJoint> {
  public:
   static constexpr int kRows = 2;
   explicit PinJoint(ElementSpec& spec);
+  double friction_radius = 0.0;    // [length] muR
+  double friction_velocity = 0.01; // [rad/time] w_f
   template <class T>
   void constraint_law(const std::array<Pose<T>, 2>& q, T* phi) const {
     const Vec2<T> d = Joint::separation(*this, q);
     phi[0] = d.x;
     phi[1] = d.y;
   }
+  template <class T>
+  void joint_force_law(double, const ElementState<T>& s, const T* lambda, std::array<Pose<T>, 2>& f) const {
+    const auto k1 = static_cast<std::size_t>(point_slot(0)), k2 = static_cast<std::size_t>(point_slot(1));
+    const T reaction = sqrt(lambda[0] * lambda[0] + lambda[1] * lambda[1] + 1e-30);
+    const T moment = friction_radius * reaction * tanh((s.v[k2].theta - s.v[k1].theta) / friction_velocity);
+    f[k2].theta -= moment;
+    f[k1].theta += moment;
+  }
+  bool has_joint_force() const override { return friction_radius > 0.0; }
   std::vector<std::string> output_names() const override { return {"reaction_x", "reaction_y"}; }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 };
@@ -76,12 +100,36 @@ class SliderJoint : public ConstraintElement<SliderJoint>, public AngleLockingJo
  public:
   static constexpr int kRows = 2;
   explicit SliderJoint(ElementSpec& spec);
-  double axis_x, axis_y;  // unit sliding direction in body 1's frame
+  double axis_x, axis_y;            // unit sliding direction in body 1's frame
+  double friction = 0.0;            // [-] mu
+  double slider_length = 1.0;       // [length] l
+  double friction_velocity = 0.01;  // [length/time] v_f
   template <class T>
   void constraint_law(const std::array<Pose<T>, 2>& q, T* phi) const {
     phi[0] = Joint::normal_offset(*this, q, axis_x, axis_y);
     phi[1] = Joint::relative_angle(*this, q) - *locked_angle;
   }
+  template <class T>
+  void joint_force_law(double, const ElementState<T>& s, const T* lambda, std::array<Pose<T>, 2>& f) const {
+    const auto k1 = static_cast<std::size_t>(point_slot(0)), k2 = static_cast<std::size_t>(point_slot(1));
+    const PointRef& p2 = point(1);
+    const Vec2<T> r2 = point_position(s.q[k2], p2.sx, p2.sy);
+    const Vec2<T> v2 = point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy);
+    // Velocity of the material point of body 1 under P2, and the axis in global axes.
+    const Vec2<T> arm1{r2.x - s.q[k1].x, r2.y - s.q[k1].y};
+    const Vec2<T> v1{s.v[k1].x - s.v[k1].theta * arm1.y, s.v[k1].y + s.v[k1].theta * arm1.x};
+    const Vec2<T> axis = rotate(s.q[k1].theta, axis_x, axis_y);
+    const T slip = dot(axis, v2 - v1);
+    const T couple = 2.0 * lambda[1] / slider_length;
+    const T normal = sqrt(lambda[0] * lambda[0] + couple * couple + 1e-30);
+    const T magnitude = -friction * normal * tanh(slip / friction_velocity);
+    const Vec2<T> force{magnitude * axis.x, magnitude * axis.y};
+    add_point_force(s.q[k2], p2.sx, p2.sy, force, f[k2]);
+    f[k1].x -= force.x;
+    f[k1].y -= force.y;
+    f[k1].theta -= cross(arm1, force);
+  }
+  bool has_joint_force() const override { return friction > 0.0; }
   bool constraint_row_is_rotational(int row) const override { return row == 1; }
   void initialize(const ElementState<double>& initial) override { initialize_angle(*this, initial); }
   std::vector<std::string> output_names() const override { return {"normal_reaction", "moment", "travel"}; }

@@ -1,0 +1,444 @@
+// Couplers and draft gears (report Table 2, types 11-14; Section 3.1 and Figure 11).
+//
+// Three elements share two building blocks (declared first below):
+//   AxialHysteresis  a hysteretic force-deflection law along one axis, used by draft_gear
+//                    and by the horizontal law of coupling;
+//   DeadBand         a linear spring that acts only outside a band of free play, used by
+//                    the faces of coupler_end and the vertical law of coupling.
+// Every element is hybrid (element.hpp): between events it is in a fixed mode whose law
+// is smooth; every kink or switch is a root function, positive inside the mode, whose
+// crossing (IDA: located; Euler: seen at the end of a step) commits the next mode and is
+// logged in events.csv. If a commit lands in a mode where another root is already
+// negative (crossings that coincide, or an Euler step that went past several), that
+// change is applied in the same commit and the event names are joined with ", ".
+//
+// ---- AxialHysteresis ------------------------------------------------------------------
+// Signed deflection u (> 0: buff, compression; < 0: draft, extension), signed force F
+// (> 0 pushes the points apart). Total free play `slack` about u = 0; on side sigma
+// (+1 buff, -1 draft) the side deflection is x = sigma u - slack / 2 and the side force
+// P = sigma F >= 0. Curves of x >= 0, piecewise linear on shared breakpoints:
+//   U(x) loading (upper) curve,  Lw(x) <= U(x) unloading (lower) curve,
+// and a transition stiffness K_t >= every slope of U and Lw, the elastic line followed
+// between the curves after a reversal (so the law stays continuous).
+// Modes:
+//   open        |u| < slack / 2             F = 0          leaves at x = 0 on a side
+//                                                          -> loading (or transition
+//                                                          from zero when U(0) > 0)
+//   neutral     (U(0) > 0: preloaded,       F = K_t u      leaves when K_t |u| reaches
+//                no slack) through u = 0                   U(|u|) -> loading on that side
+//   loading     on segment k of U           P = U_k(x)     x' < 0 -> transition; segment
+//                                                          ends -> next segment
+//   transition  from (x0, P0)               P = P0 + K_t (x - x0)
+//                                                          P = U(x) -> loading; P = Lw(x)
+//                                                          -> unloading; P = 0 -> released
+//                                                          (x > 0) or leaves the side
+//   unloading   on segment k of Lw          P = Lw_k(x)    x' > 0 -> transition; P = 0
+//                                                          (where Lw < 0) -> released;
+//                                                          x = 0 (where Lw(0) = 0) -> leaves
+//                                                          the side; segment ends
+//   released    Lw(x) < 0: the follower     P = 0          x' > 0 -> transition from zero;
+//               no longer pushes                           x = 0 -> leaves the side
+// Leaving a side: to neutral (preloaded law), to open (slack > 0), otherwise straight to
+// loading on the other side (the force passes through zero continuously).
+// Stored energy: what unloading from the current state would give back (down the
+// transition line to Lw or to zero force, then along Lw to zero force); the rest of the
+// work done on the law is dissipated. A closed cycle therefore dissipates its loop area.
+//
+// ---- DeadBand ---------------------------------------------------------------------------
+// Coordinate z, band [lo, hi], stiffness k; the side below and the side above can each be
+// switched off. Force f = k (z - lo) < 0 below, 0 inside, k (z - hi) > 0 above; energy
+// f^2 / (2 k). Modes below / inside / above, roots at z = lo and z = hi. A band of zero
+// width with both sides active is one straight line (below and above meet at lo = hi).
+//
+// ---- draft_gear (report type 13) --------------------------------------------------------
+// Between P1 and P2 (the report's model: the yoke mass and the draft pocket / drawbar mass,
+// alongside a slider joint), length L, u = (r2 - r1) / L; compression d = free_length - L.
+// A friction draft gear works in buff (d > 0) and, through its yoke, in draft (d < 0): the
+// law is AxialHysteresis with u = d, no slack, mirror-symmetric in draft, with
+//   U(x)  = S(x) + H,   Lw(x) = S(x) - H,   S(x) = k x (x <= travel), k travel + K (x - travel)
+// (k initial_stiffness, K stiffness_after_bottoming, H hysteresis_load: friction-type
+// hysteresis; the gear is bottomed beyond `travel`), K_t = transition_stiffness (default K).
+// So: at rest the gear is stuck by friction (neutral, F = K_t d) until K_t |d| = U(|d|);
+// it then loads on k d + H, bottoms at d = travel (event "bottomed", stiffness K); after a
+// reversal it unloads elastically with K_t down to k d - H, follows that line, and once it
+// would pull (k d - H < 0) it is "released" (F = 0, never negative in buff) until d = 0.
+// A cycle 0 -> d_max -> 0 below travel dissipates its loop area, 2 H d_max less the corner
+// triangles cut by the neutral and transition lines and by the release at d = H / k.
+// Shear pin (buff only: the pin anchors the gear against buff overload): when F reaches
+// pin_shear_load ("pin shear") the gear's stored energy is lost and the coupler slides
+// freely (F = 0, in either direction) for post_shear_travel; then it is solid,
+// F = K (d - d_solid) ("solid", "off solid" if it backs off). Fracture: when |F| reaches
+// fracture_load (buff or draft, before or after pin shear) the element carries no force
+// from then on ("fracture"). Force on P2 = +F (r2 - r1) / L, on P1 the opposite.
+//
+// ---- coupler_end (report type 14) -------------------------------------------------------
+// Contact between two coupler faces; P1 on coupler K, P2 on coupler L, each point
+// free_length behind its face (the report's connection points sit 1 in behind the faces).
+// The faces are vertical planes (normal: global x): Dx = x2 - x1, Dy = y2 - y1 of the
+// points; sigma = side of P2 (sign of Dx at the start; if zero, of the bodies' centres),
+// spacing h = sigma Dx, contact spacing c = free_length_K + free_length_L.
+//   faces (DeadBand in z = h, k = series of the two horizontal stiffnesses):
+//     buff contact h < c: tension T = k (h - c) < 0 (the faces push)
+//     coupled: true -> knuckles carry draft once the total horizontal slack s is taken
+//       up: T = k (h - c - s) for h > c + s; otherwise no tension ever (and s must be 0).
+//   vertical overlap: the faces (heights a_K, a_L, centred on the points) touch only while
+//     |Dy| < (a_K + a_L) / 2. Losing the overlap ends the contact ("vertical overlap lost");
+//     regaining it with the faces already past each other horizontally gives no force until
+//     they are clear again ("blocked" until the band is back inside).
+//   friction between the faces: F_t = -mu |T| tanh(Dy' / v_f) on P2 (vertical), Coulomb
+//     regularized below friction_velocity v_f; |F_t| <= mu |T|.
+//   force on P2 = (-sigma T, F_t), on P1 the opposite. Energy T^2 / (2 k) in contact.
+//
+// ---- coupling (report types 11 and 12: the freight coupler of the validation runs) ------
+// Between a point on each car (P1, P2). Horizontal (global x, sigma as for coupler_end):
+// u = free_length - sigma Dx (> 0 buff), free_length = spacing at the centre of the
+// horizontal slack (default: the initial spacing). Horizontal force F = AxialHysteresis of
+// u with slack = horizontal_slack, mirror-symmetric in draft, U(0) = 0:
+//   kind 1 (report type 11): one loading `curve` [[deflection, force], ...] and an
+//     `unloading_factor` r (0 <= r <= 1): Lw = r U;
+//   kind 2 (report type 12): separate `loading_curve` and `unloading_curve`.
+// (The report does not define the two types; this is the documented choice.)
+// Vertical: offset of the heads w = Dy + misalignment (misalignment: initial vertical
+// offset of the coupler heads when the points are level); DeadBand in w with band
+// [-vertical_slack / 2, vertical_slack / 2] and vertical_stiffness: F_v = k_v (w -+ s_v/2).
+// Sliding friction between the heads, proportional to the horizontal force:
+// F_f = -mu |F| tanh(Dy' / v_f). Force on P2 = (sigma F, -F_v + F_f), on P1 the opposite.
+// Energy: the horizontal law's stored energy plus F_v^2 / (2 k_v).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "railcrash/element.hpp"
+#include "railcrash/element_registry.hpp"
+#include "railcrash/elements/springs.hpp"
+
+namespace railcrash {
+
+// ---- shared pieces ------------------------------------------------------------------------
+
+/// Piecewise-linear curve y(x), x >= 0: segment j starts at start[j] (start[0] = 0) with
+/// value value[j] and slope slope[j]; the last segment goes on without end.
+struct PiecewiseLinear {
+  std::vector<double> start;  // [length]
+  std::vector<double> value;  // [force]
+  std::vector<double> slope;  // [force/length]
+
+  /// Through the points (x_0 = 0, x increasing), the last slope extended.
+  static PiecewiseLinear through(const std::vector<double>& x, const std::vector<double>& y);
+  int segments() const { return static_cast<int>(start.size()); }
+  /// Segment holding x (the first one below its start, the last one beyond).
+  int segment_of(double x) const;
+  template <class T>
+  T on_segment(int j, const T& x) const {
+    const auto k = static_cast<std::size_t>(j);
+    return value[k] + slope[k] * (x - start[k]);
+  }
+  double at(double x) const { return on_segment(segment_of(x), x); }
+  double max_slope() const;
+};
+
+/// Offset r2 - r1 of the element's two points and its rate, in global axes.
+template <class T>
+struct PointOffset {
+  Vec2<T> d, d_rate;
+};
+template <class T>
+PointOffset<T> point_offset(const Element& e, const ElementState<T>& s) {
+  const PointRef& p1 = e.point(0);
+  const PointRef& p2 = e.point(1);
+  const auto k1 = static_cast<std::size_t>(e.point_slot(0));
+  const auto k2 = static_cast<std::size_t>(e.point_slot(1));
+  return {point_position(s.q[k2], p2.sx, p2.sy) - point_position(s.q[k1], p1.sx, p1.sy),
+          point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy) - point_velocity(s.q[k1], s.v[k1], p1.sx, p1.sy)};
+}
+
+/// Hysteretic force-deflection law along one axis (see the header comment).
+class AxialHysteresis {
+ public:
+  PiecewiseLinear upper;          // U(x) [force], loading curve
+  PiecewiseLinear lower;          // Lw(x) [force], unloading curve, same breakpoints as upper
+  double transition_stiffness = 0.0;  // [force/length] K_t
+  double slack = 0.0;             // [length] total free play about u = 0
+
+  enum class Mode { Open, Neutral, Loading, Transition, Unloading, Released };
+  struct State {
+    Mode mode = Mode::Open;
+    int side = 1;       // +1 buff, -1 draft
+    int segment = 0;    // loading / unloading: curve segment
+    double x0 = 0.0;    // [length] transition: side deflection where it started
+    double f0 = 0.0;    // [force] transition: side force there
+  };
+  /// What a transition did (the elements name it in events.csv).
+  enum class Change { Engaged, Sliding, Reversal, OnLowerCurve, Reloading, OnUpperCurve, Released, Centre, SideChange,
+                      SegmentUp, SegmentDown };
+  static constexpr int kRoots = 4;
+
+  /// True for a preloaded law (U(0) > 0): it has the neutral mode and no slack.
+  bool preloaded() const { return upper.value[0] > 0.0; }
+  template <class T>
+  T side_deflection(const State& st, const T& u) const { return static_cast<double>(st.side) * u - 0.5 * slack; }
+
+  /// Signed force F(u) in mode st (> 0 buff).
+  template <class T>
+  T force(const State& st, const T& u) const {
+    const double sigma = st.side;
+    const T x = side_deflection(st, u);
+    switch (st.mode) {
+      case Mode::Neutral: return transition_stiffness * u;
+      case Mode::Loading: return sigma * upper.on_segment(st.segment, x);
+      case Mode::Transition: return sigma * (st.f0 + transition_stiffness * (x - st.x0));
+      case Mode::Unloading: return sigma * lower.on_segment(st.segment, x);
+      case Mode::Open:
+      case Mode::Released: break;
+    }
+    return T(0.0);
+  }
+  /// |F| in mode st, smooth in the mode (a side mode; neutral is not used where this is).
+  template <class T>
+  T magnitude(const State& st, const T& u) const {
+    return static_cast<double>(st.side) * force(st, u);
+  }
+
+  /// Roots g[0..3] of mode st at deflection u and rate u'.
+  void roots(const State& st, double u, double rate, double* g) const;
+  /// Applies the change of root `index` (crossed downward) and says what it was.
+  Change transition(State& st, int index, double u, double rate) const;
+  /// Mode at the start of a run at (u, u'): for a deflected start, as if loaded monotonically.
+  State initial(double u, double rate) const;
+  /// Recoverable energy in mode st at u [force*length].
+  double energy(const State& st, double u) const;
+  /// Throws through `fail` unless the curves and K_t make a valid law (context: parameter names).
+  void check(const std::string& curve_key, const std::string& stiffness_key, ParameterReader& p) const;
+
+ private:
+  Change engage(State& st, int side, double u) const;
+  Change leave_at_zero(State& st, double u) const;
+  Change leave_side(State& st, double u) const;
+  double unload_from(double x, double force) const;
+  double lower_tail(double x) const;
+};
+
+/// Linear spring outside a band of free play (see the header comment).
+struct DeadBand {
+  double lo = 0.0, hi = 0.0;   // [length] band
+  double stiffness = 0.0;      // [force/length]
+  bool below_active = true, above_active = true;
+
+  enum class Mode { Below, Inside, Above };
+  static constexpr int kRoots = 2;
+
+  template <class T>
+  T force(Mode m, const T& z) const {
+    if (m == Mode::Below) return stiffness * (z - lo);
+    if (m == Mode::Above) return stiffness * (z - hi);
+    return T(0.0);
+  }
+  /// |force|, smooth in the mode.
+  template <class T>
+  T magnitude(Mode m, const T& z) const { return m == Mode::Below ? -force(m, z) : force(m, z); }
+  void roots(Mode m, double z, double* g) const;
+  Mode transition(Mode m, int index) const;
+  Mode initial(double z, double rate) const;
+  double energy(Mode m, double z) const;
+};
+
+// ---- the elements -----------------------------------------------------------------------
+
+class DraftGear : public ForceElement<DraftGear> {
+ public:
+  explicit DraftGear(ElementSpec& spec);
+
+  double initial_stiffness;           // [force/length] k
+  double travel;                      // [length] compression at which the gear bottoms
+  double stiffness_after_bottoming;   // [force/length] K
+  double hysteresis_load;             // [force] H
+  std::optional<double> pin_shear_load;  // [force]; none: no shear pin
+  double post_shear_travel = 0.0;     // [length] free travel after pin shear
+  std::optional<double> fracture_load;   // [force]; none: never fractures
+  double transition_stiffness;        // [force/length] K_t (default K)
+  std::optional<double> free_length;  // [length]; default: initial length
+
+  enum class Stage { Intact, Sheared, Solid, Fractured };
+  struct State {
+    Stage stage = Stage::Intact;
+    AxialHysteresis::State law;     // intact
+    double solid_compression = 0.0;  // [length] sheared / solid: d at which it goes solid
+  };
+  const State& state() const { return state_; }
+  /// Puts the element in a given mode (tests, tools); a run starts from initialize()'s.
+  void set_state(const State& st) { state_ = st; }
+  const AxialHysteresis& law() const { return law_; }
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const LineGeometry<T> g = line_geometry(*this, s);
+    const T scale = gear_force(*free_length - g.length) / g.length;  // force on P2 = F (r2 - r1) / L
+    apply_line_force(*this, s, Vec2<T>{scale * g.d.x, scale * g.d.y}, f);
+  }
+  /// Signed gear force F(d) in the current mode (> 0: compression pushes the points apart).
+  template <class T>
+  T gear_force(const T& d) const {
+    switch (state_.stage) {
+      case Stage::Intact: return law_.force(state_.law, d);
+      case Stage::Solid: return stiffness_after_bottoming * (d - state_.solid_compression);
+      case Stage::Sheared:
+      case Stage::Fractured: break;
+    }
+    return T(0.0);
+  }
+
+  void initialize(const ElementState<double>& initial) override;
+  static constexpr int kRoots = AxialHysteresis::kRoots + 2;  // + pin shear, fracture
+  int root_count() const override { return kRoots; }
+  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
+              Event& event) override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
+  void reset_modes() override { state_ = initial_state_; }
+  double potential_energy(const ElementState<double>& s) const override;
+  std::vector<std::string> output_names() const override { return {"force", "compression"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+
+ private:
+  struct Kinematics {
+    double d, rate;  // compression and its rate
+  };
+  Kinematics kinematics(const ElementState<double>& s) const;
+  void roots_at(const Kinematics& k, double* g) const;
+  void apply(int index, const Kinematics& k, Event& event);
+
+  AxialHysteresis law_;
+  State state_;
+  State initial_state_;
+};
+
+class CouplerEnd : public ForceElement<CouplerEnd> {
+ public:
+  explicit CouplerEnd(ElementSpec& spec);
+
+  std::array<double, 2> horizontal_stiffness;  // [force/length] end K, end L
+  std::array<double, 2> free_length;           // [length] point to face, end K, end L
+  std::array<double, 2> coupler_height;        // [length] face height, end K, end L
+  double total_horizontal_slack = 0.0;         // [length] knuckle free play (coupled only)
+  double friction = 0.0;                       // [-] mu between the faces
+  double friction_velocity = 0.01;             // [length/time] v_f
+  bool coupled = false;                        // knuckles carry draft
+
+  struct State {
+    DeadBand::Mode band = DeadBand::Mode::Inside;  // below: buff contact, above: draft contact
+    bool overlapping = true;  // the faces overlap vertically
+    bool blocked = false;     // overlap regained with the faces past each other: no force
+  };
+  const State& state() const { return state_; }
+  void set_state(const State& st) { state_ = st; }
+  const DeadBand& faces() const { return faces_; }
+  /// +1 when P2 lies in +x of P1 (faces meet along +x), -1 otherwise.
+  double side() const { return side_; }
+  double series_stiffness() const { return faces_.stiffness; }
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    if (!active()) return;
+    const PointOffset<T> o = point_offset(*this, s);
+    const T tension = faces_.force(state_.band, side_ * o.d.x);
+    Vec2<T> on_p2{-side_ * tension, T(0.0)};
+    if (friction > 0.0)
+      on_p2.y = -friction * faces_.magnitude(state_.band, side_ * o.d.x) * tanh(o.d_rate.y / friction_velocity);
+    apply_line_force(*this, s, on_p2, f);
+  }
+  bool active() const { return state_.overlapping && !state_.blocked && state_.band != DeadBand::Mode::Inside; }
+
+  void initialize(const ElementState<double>& initial) override;
+  static constexpr int kRoots = DeadBand::kRoots + 1;  // + vertical overlap
+  int root_count() const override { return kRoots; }
+  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
+              Event& event) override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
+  void reset_modes() override { state_ = initial_state_; }
+  double potential_energy(const ElementState<double>& s) const override;
+  std::vector<std::string> output_names() const override { return {"normal_force", "friction_force", "gap"}; }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+
+ private:
+  struct Kinematics {
+    double h, h_rate, dy, dy_rate;  // spacing along the faces' normal, vertical offset, rates
+  };
+  Kinematics kinematics(const ElementState<double>& s) const;
+  void roots_at(const Kinematics& k, double* g) const;
+  void apply(int index, const Kinematics& k, Event& event);
+  double half_overlap() const { return 0.5 * (coupler_height[0] + coupler_height[1]); }
+
+  DeadBand faces_;
+  double side_ = 1.0;
+  State state_;
+  State initial_state_;
+};
+
+class Coupling : public ForceElement<Coupling> {
+ public:
+  explicit Coupling(ElementSpec& spec);
+
+  int kind = 1;                       // 1: curve + unloading_factor, 2: loading_curve + unloading_curve
+  double horizontal_slack = 0.0;      // [length] total horizontal free play
+  double vertical_slack = 0.0;        // [length] total vertical free play of the heads
+  double vertical_stiffness = 0.0;    // [force/length] once the vertical slack is taken up
+  double misalignment = 0.0;          // [length] vertical offset of head L above head K with the points level
+  double friction = 0.0;              // [-] mu between the heads
+  double friction_velocity = 0.01;    // [length/time] v_f
+  std::optional<double> free_length;  // [length] spacing at the centre of the slack; default: initial
+
+  struct State {
+    AxialHysteresis::State horizontal;
+    DeadBand::Mode vertical = DeadBand::Mode::Inside;
+  };
+  const State& state() const { return state_; }
+  void set_state(const State& st) { state_ = st; }
+  const AxialHysteresis& horizontal_law() const { return law_; }
+  const DeadBand& vertical_law() const { return vertical_; }
+  double side() const { return side_; }
+
+  template <class T>
+  void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const PointOffset<T> o = point_offset(*this, s);
+    const T u = *free_length - side_ * o.d.x;
+    const T horizontal = law_.force(state_.horizontal, u);
+    Vec2<T> on_p2{side_ * horizontal, -vertical_.force(state_.vertical, o.d.y + misalignment)};
+    if (friction > 0.0 && law_.magnitude_defined(state_.horizontal))
+      on_p2.y = on_p2.y - friction * law_.magnitude(state_.horizontal, u) * tanh(o.d_rate.y / friction_velocity);
+    apply_line_force(*this, s, on_p2, f);
+  }
+
+  void initialize(const ElementState<double>& initial) override;
+  static constexpr int kRoots = AxialHysteresis::kRoots + DeadBand::kRoots;
+  int root_count() const override { return kRoots; }
+  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
+              Event& event) override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
+  void reset_modes() override { state_ = initial_state_; }
+  double potential_energy(const ElementState<double>& s) const override;
+  std::vector<std::string> output_names() const override {
+    return {"horizontal_force", "deflection", "vertical_force", "vertical_offset", "friction_force"};
+  }
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+
+ private:
+  struct Kinematics {
+    double u, u_rate, w, w_rate;  // horizontal deflection, vertical head offset, rates
+  };
+  Kinematics kinematics(const ElementState<double>& s) const;
+  void roots_at(const Kinematics& k, double* g) const;
+  void apply(int index, const Kinematics& k, Event& event);
+
+  AxialHysteresis law_;
+  DeadBand vertical_;
+  double side_ = 1.0;
+  State state_;
+  State initial_state_;
+};
+
+}  // namespace railcrash
