@@ -217,10 +217,11 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
     for (int k = 0; k < nq; ++k) rhs[k] = force[static_cast<std::size_t>(k)];
     rhs.tail(m) = constraint_rhs;
     solution = lu.solve(rhs);
+    if (m == 0) break;
     for (int r = 0; r < m; ++r) y[static_cast<std::size_t>(2 * nq + r)] = solution[nq + r];
     const double change = (solution.tail(m) - previous).cwiseAbs().maxCoeff();
     previous = solution.tail(m);
-    if (m == 0 || change <= 1e-12 * std::max(1.0, previous.cwiseAbs().maxCoeff())) break;
+    if (change <= 1e-12 * std::max(1.0, previous.cwiseAbs().maxCoeff())) break;
   }
   for (int k = 0; k < nq; ++k) yp[static_cast<std::size_t>(nq + k)] = solution[k];
 }

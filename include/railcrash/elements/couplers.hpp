@@ -196,7 +196,8 @@ class AxialHysteresis {
     }
     return T(0.0);
   }
-  /// |F| in mode st, smooth in the mode (a side mode; neutral is not used where this is).
+  /// |F| in mode st, smooth in the mode: the side force (not |F| in neutral, which only a
+  /// preloaded law has; the coupling's law is never preloaded).
   template <class T>
   T magnitude(const State& st, const T& u) const {
     return static_cast<double>(st.side) * force(st, u);
@@ -210,8 +211,6 @@ class AxialHysteresis {
   State initial(double u, double rate) const;
   /// Recoverable energy in mode st at u [force*length].
   double energy(const State& st, double u) const;
-  /// Throws through `fail` unless the curves and K_t make a valid law (context: parameter names).
-  void check(const std::string& curve_key, const std::string& stiffness_key, ParameterReader& p) const;
 
  private:
   Change engage(State& st, int side, double u) const;
@@ -407,7 +406,7 @@ class Coupling : public ForceElement<Coupling> {
     const T u = *free_length - side_ * o.d.x;
     const T horizontal = law_.force(state_.horizontal, u);
     Vec2<T> on_p2{side_ * horizontal, -vertical_.force(state_.vertical, o.d.y + misalignment)};
-    if (friction > 0.0 && law_.magnitude_defined(state_.horizontal))
+    if (friction > 0.0)
       on_p2.y = on_p2.y - friction * law_.magnitude(state_.horizontal, u) * tanh(o.d_rate.y / friction_velocity);
     apply_line_force(*this, s, on_p2, f);
   }
