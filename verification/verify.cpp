@@ -266,3 +266,24 @@ TEST_CASE("explicit Euler converges at first order and IDA error follows the tol
           ida_errors[k] / ida_errors[k - 1], 0.1, false, "error follows the tolerance");
   }
 }
+
+TEST_CASE("crush spring impact: contact time, crush, permanent set, rebound and absorbed energy", "[verification]") {
+  start_case("crush_impact");
+  for (const char* integrator : {"ida", "euler"}) {
+    const std::string name = integrator;
+    const bool ida = name == "ida";
+    const Trajectory tr = simulate("crush_impact", {std::string("simulation.integrator=") + integrator});
+    const auto& events = tr.outcome.events;
+    REQUIRE(events.size() == 4);
+    check("crush_impact", name + " contact time [s]", 0.05, events[0].t, ida ? 1e-10 : 2e-6, false, "gap / speed");
+    check("crush_impact", name + " maximum crush [m]", 0.055, events[2].value, ida ? 1e-8 : 1e-5, false,
+          "energy: (m v^2/2 - F0 dy/2) / F0 + dy");
+    check("crush_impact", name + " permanent crush [m]", 0.045, events[3].value,
+          ida ? 1e-8 : 1e-4, false, "maximum crush - F0 / k (crush at separation)");
+    check("crush_impact", name + " rebound speed [m/s]", std::sqrt(10.0), tr.y.back()[3], ida ? 1e-7 : 1e-3, true,
+          "elastic energy F0 dy / 2 returned");
+    const EnergyBalance e = EnergyBalance::between(tr.outcome.initial_energy, tr.outcome.final_energy);
+    check("crush_impact", name + " energy absorbed by crushing [J]", 4500.0, e.dissipated, ida ? 1e-7 : 1e-3, true,
+          "m v^2/2 - m v_r^2/2");
+  }
+}

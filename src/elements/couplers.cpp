@@ -1,7 +1,780 @@
-#include "railcrash/element_registry.hpp"
+#include "railcrash/elements/couplers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
 
 namespace railcrash {
 
-void register_couplers_elements(ElementRegistry& /*registry*/) {}
+namespace {
+
+const char* side_name(int side) { return side > 0 ? "buff" : "draft"; }
+
+/// Text for events.csv of a change of an AxialHysteresis; `segment_names` gives the names of
+/// entering segment 1 and leaving it (nullptr: "curve segment n").
+std::string describe(AxialHysteresis::Change change, const AxialHysteresis::State& st, const AxialHysteresis& law,
+                     const char* const* segment_names = nullptr) {
+  using C = AxialHysteresis::Change;
+  const std::string side = std::string(" (") + side_name(st.side) + ")";
+  switch (change) {
+    case C::Engaged: return "slack taken up" + side;
+    case C::Sliding: return "sliding" + side;
+    case C::Reversal: return "reversal" + side;
+    case C::OnLowerCurve: return "unloading" + side;
+    case C::Reloading: return "reloading" + side;
+    case C::OnUpperCurve: return "back on the loading curve" + side;
+    case C::Released: return "released" + side;
+    case C::Centre: return law.preloaded() ? "neutral" : "in the slack";
+    case C::SideChange: return "through zero force to" + side.substr(1, side.size() - 2);
+    case C::SegmentUp:
+    case C::SegmentDown: break;
+  }
+  if (segment_names) return segment_names[change == C::SegmentUp ? 0 : 1] + side;
+  return "curve segment " + std::to_string(st.segment + 1) + side;
+}
+
+/// Commits root `index` of an element whose roots are all positive inside its mode: applies
+/// its change (apply(i, event)), then the changes of roots that are already negative in the
+/// new mode (crossings that coincided, or an Euler step that went past several), a few at
+/// most, joining their names.
+template <int N, class Roots, class Apply>
+bool commit_crossing(int index, int direction, Roots roots, Apply apply, Element::Event& event) {
+  if (direction > 0) return false;  // every root is positive inside its mode
+  std::array<double, N> g{};
+  roots(g.data());
+  if (g[static_cast<std::size_t>(index)] > 0.0) return false;  // not crossed in the current mode
+  apply(index, event);
+  for (int pass = 0; pass < 8; ++pass) {
+    roots(g.data());
+    const auto next = std::find_if(g.begin(), g.end(), [](double value) { return value < 0.0; });
+    if (next == g.end()) break;
+    Element::Event more;
+    apply(static_cast<int>(next - g.begin()), more);
+    event.what += ", " + more.what;
+  }
+  return true;
+}
+
+/// Which way the faces of a two-point element meet along global x: the side of P2 relative
+/// to P1 at the start (by the points, or by the bodies' centres when the points are level).
+double facing_side(const Element& e, const ElementState<double>& s) {
+  const double dx = point_offset(e, s).d.x;
+  if (dx != 0.0) return dx > 0.0 ? 1.0 : -1.0;
+  const double centres = s.q[static_cast<std::size_t>(e.point_slot(1))].x - s.q[static_cast<std::size_t>(e.point_slot(0))].x;
+  return centres < 0.0 ? -1.0 : 1.0;
+}
+
+/// A force-deflection table [[deflection, force], ...] starting at [0, 0], deflections
+/// strictly increasing, forces not negative.
+void read_curve(ParameterReader& p, const std::string& key, const std::vector<std::vector<double>>& table,
+                std::vector<double>& x, std::vector<double>& y) {
+  if (table.size() < 2) p.fail(key, "'" + key + "' needs at least two points [[deflection, force], ...]");
+  if (table[0][0] != 0.0 || table[0][1] != 0.0)
+    p.fail(key, "'" + key + "' must start at [0, 0] (deflection beyond the slack, force)");
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    if (k > 0 && !(table[k][0] > table[k - 1][0]))
+      p.fail(key, "'" + key + "' point " + std::to_string(k + 1) + ": deflections must increase strictly");
+    if (table[k][1] < 0.0) p.fail(key, "'" + key + "' point " + std::to_string(k + 1) + ": force must not be negative");
+    x.push_back(table[k][0]);
+    y.push_back(table[k][1]);
+  }
+}
+
+}  // namespace
+
+// ---- PiecewiseLinear ----------------------------------------------------------------------
+
+PiecewiseLinear PiecewiseLinear::through(const std::vector<double>& x, const std::vector<double>& y) {
+  PiecewiseLinear c;
+  for (std::size_t k = 0; k + 1 < x.size(); ++k) {
+    c.start.push_back(x[k]);
+    c.value.push_back(y[k]);
+    c.slope.push_back((y[k + 1] - y[k]) / (x[k + 1] - x[k]));
+  }
+  return c;
+}
+
+int PiecewiseLinear::segment_of(double x) const {
+  int j = 0;
+  while (j + 1 < segments() && x >= start[static_cast<std::size_t>(j + 1)]) ++j;
+  return j;
+}
+
+double PiecewiseLinear::max_slope() const { return *std::max_element(slope.begin(), slope.end()); }
+
+// ---- AxialHysteresis ------------------------------------------------------------------------
+
+void AxialHysteresis::roots(const State& st, double u, double rate, double* g) const {
+  std::fill(g, g + kRoots, 1.0);
+  const double x = side_deflection(st, u);
+  const double x_rate = st.side * rate;
+  const double kt = transition_stiffness;
+  const auto segment_ends = [&](int j) {
+    if (j > 0) g[2] = x - upper.start[static_cast<std::size_t>(j)];
+    if (j + 1 < upper.segments()) g[3] = upper.start[static_cast<std::size_t>(j + 1)] - x;
+  };
+  switch (st.mode) {
+    case Mode::Open:
+      g[0] = 0.5 * slack - u;
+      g[1] = 0.5 * slack + u;
+      break;
+    case Mode::Neutral:
+      g[0] = upper.at(std::max(u, 0.0)) - kt * u;
+      g[1] = upper.at(std::max(-u, 0.0)) + kt * u;
+      break;
+    case Mode::Loading:
+      g[0] = x_rate;
+      segment_ends(st.segment);
+      break;
+    case Mode::Transition: {
+      const double force = st.f0 + kt * (x - st.x0);
+      g[0] = upper.at(x) - force;
+      g[1] = force - lower.at(x);
+      g[2] = force;
+      break;
+    }
+    case Mode::Unloading:
+      g[0] = -x_rate;
+      if (lower.value[static_cast<std::size_t>(st.segment)] < 0.0) g[1] = lower.on_segment(st.segment, x);
+      else if (st.segment == 0) g[1] = x;
+      segment_ends(st.segment);
+      break;
+    case Mode::Released:
+      g[0] = -x_rate;
+      g[1] = x;
+      break;
+  }
+}
+
+AxialHysteresis::Change AxialHysteresis::transition(State& st, int index, double u, double /*rate*/) const {
+  const double x = side_deflection(st, u);
+  switch (st.mode) {
+    case Mode::Open:
+      return engage(st, index == 0 ? 1 : -1, u);
+    case Mode::Neutral:
+      st.side = index == 0 ? 1 : -1;
+      st.mode = Mode::Loading;
+      st.segment = upper.segment_of(side_deflection(st, u));
+      return Change::Sliding;
+    case Mode::Loading:
+      if (index == 0) {
+        st.f0 = upper.on_segment(st.segment, x);
+        st.x0 = x;
+        st.mode = Mode::Transition;
+        return Change::Reversal;
+      }
+      break;
+    case Mode::Transition:
+      if (index == 0) {
+        st.mode = Mode::Loading;
+        st.segment = upper.segment_of(x);
+        return Change::OnUpperCurve;
+      }
+      if (index == 1) {
+        st.mode = Mode::Unloading;
+        st.segment = lower.segment_of(x);
+        return Change::OnLowerCurve;
+      }
+      return leave_at_zero(st, u);
+    case Mode::Unloading:
+      if (index == 0) {
+        st.f0 = lower.on_segment(st.segment, x);
+        st.x0 = x;
+        st.mode = Mode::Transition;
+        return Change::Reloading;
+      }
+      if (index == 1) return leave_at_zero(st, u);
+      break;
+    case Mode::Released:
+      if (index == 0) {
+        st.mode = Mode::Transition;
+        st.x0 = x;
+        st.f0 = 0.0;
+        return Change::Reloading;
+      }
+      return leave_side(st, u);
+  }
+  // Loading / unloading past a segment end.
+  if (index == 2) {
+    --st.segment;
+    return Change::SegmentDown;
+  }
+  ++st.segment;
+  return Change::SegmentUp;
+}
+
+AxialHysteresis::Change AxialHysteresis::engage(State& st, int side, double u) const {
+  st = State{};
+  st.side = side;
+  const double x = side_deflection(st, u);
+  if (preloaded()) {  // the preload builds up along the transition line
+    st.mode = Mode::Transition;
+    st.x0 = x;
+  } else {
+    st.mode = Mode::Loading;
+    st.segment = upper.segment_of(x);
+  }
+  return Change::Engaged;
+}
+
+AxialHysteresis::Change AxialHysteresis::leave_at_zero(State& st, double u) const {
+  if (side_deflection(st, u) > 0.0) {
+    st.mode = Mode::Released;
+    return Change::Released;
+  }
+  return leave_side(st, u);
+}
+
+AxialHysteresis::Change AxialHysteresis::leave_side(State& st, double u) const {
+  if (preloaded() || slack > 0.0) {
+    st = State{};
+    st.mode = preloaded() ? Mode::Neutral : Mode::Open;
+    return Change::Centre;
+  }
+  st.side = -st.side;
+  st.mode = Mode::Loading;
+  st.segment = upper.segment_of(side_deflection(st, u));
+  return Change::SideChange;
+}
+
+AxialHysteresis::State AxialHysteresis::initial(double u, double rate) const {
+  State st;
+  const double a = std::abs(u);
+  if (preloaded()) {
+    const double stick = transition_stiffness * a, limit = upper.at(a);
+    if (stick < limit || (stick == limit && rate * u <= 0.0)) {
+      st.mode = Mode::Neutral;
+      return st;
+    }
+    st.side = u > 0.0 ? 1 : -1;
+  } else {
+    if (slack > 0.0 && (a < 0.5 * slack || (a == 0.5 * slack && rate * u <= 0.0))) {
+      st.mode = Mode::Open;
+      return st;
+    }
+    st.side = u > 0.0 ? 1 : (u < 0.0 ? -1 : (rate >= 0.0 ? 1 : -1));
+  }
+  const double x = side_deflection(st, u);
+  st.segment = upper.segment_of(x);
+  if (st.side * rate >= 0.0) {
+    st.mode = Mode::Loading;
+  } else {  // loaded to here, now unloading: on the transition line from the curve
+    st.mode = Mode::Transition;
+    st.x0 = x;
+    st.f0 = upper.at(x);
+  }
+  return st;
+}
+
+double AxialHysteresis::energy(const State& st, double u) const {
+  const double x = side_deflection(st, u);
+  switch (st.mode) {
+    case Mode::Neutral: return 0.5 * transition_stiffness * u * u;
+    case Mode::Loading: return unload_from(x, upper.on_segment(st.segment, x));
+    case Mode::Transition: return unload_from(x, st.f0 + transition_stiffness * (x - st.x0));
+    case Mode::Unloading: return lower_tail(x);
+    case Mode::Open:
+    case Mode::Released: break;
+  }
+  return 0.0;
+}
+
+double AxialHysteresis::unload_from(double x, double force) const {
+  if (force <= 0.0) return 0.0;
+  const double kt = transition_stiffness;
+  const double triangle = 0.5 * force * force / kt;  // down the transition line to zero force
+  const double x_zero = x - force / kt;
+  for (int j = lower.segment_of(x); j >= 0; --j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double l = lower.slope[k];
+    if (!(kt > l)) continue;  // parallel to this segment: no meeting on it
+    // force + kt (xi - x) = value_k + l (xi - start_k)
+    const double xi = (lower.value[k] - l * lower.start[k] - force + kt * x) / (kt - l);
+    const double low_end = j > 0 ? lower.start[k] : -std::numeric_limits<double>::infinity();
+    const double high_end = j + 1 < lower.segments() ? std::min(lower.start[k + 1], x) : x;
+    if (xi < low_end || xi > high_end) continue;
+    if (xi <= x_zero) return triangle;  // the line reaches zero force before the curve
+    const double meet = force + kt * (xi - x);
+    return 0.5 * (force + meet) * (x - xi) + lower_tail(xi);
+  }
+  return triangle;
+}
+
+double AxialHysteresis::lower_tail(double x) const {
+  double total = 0.0, high = x;
+  for (int j = lower.segment_of(x); j >= 0 && high > 0.0; --j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double f_high = lower.on_segment(j, high);
+    if (f_high <= 0.0) break;
+    const double low = j > 0 ? lower.start[k] : 0.0;
+    const double f_low = lower.on_segment(j, low);
+    if (f_low <= 0.0) {  // Lw reaches zero inside the segment
+      total += 0.5 * f_high * f_high / lower.slope[k];
+      break;
+    }
+    total += 0.5 * (f_low + f_high) * (high - low);
+    high = low;
+  }
+  return total;
+}
+
+// ---- DeadBand ---------------------------------------------------------------------------------
+
+void DeadBand::roots(Mode m, double z, double* g) const {
+  g[0] = g[1] = 1.0;
+  switch (m) {
+    case Mode::Below: g[0] = lo - z; break;
+    case Mode::Above: g[1] = z - hi; break;
+    case Mode::Inside:
+      if (below_active) g[0] = z - lo;
+      if (above_active) g[1] = hi - z;
+      break;
+  }
+}
+
+DeadBand::Mode DeadBand::transition(Mode m, int index) const {
+  const bool straight = lo == hi && below_active && above_active;  // no band: one line
+  if (m == Mode::Inside) return index == 0 ? Mode::Below : Mode::Above;
+  if (m == Mode::Below) return straight ? Mode::Above : Mode::Inside;
+  return straight ? Mode::Below : Mode::Inside;
+}
+
+DeadBand::Mode DeadBand::initial(double z, double rate) const {
+  if (below_active && (z < lo || (z == lo && rate < 0.0))) return Mode::Below;
+  if (above_active && (z > hi || (z == hi && rate > 0.0))) return Mode::Above;
+  if (lo == hi && below_active && above_active) return rate < 0.0 ? Mode::Below : Mode::Above;
+  return Mode::Inside;
+}
+
+double DeadBand::energy(Mode m, double z) const {
+  if (m == Mode::Inside || !(stiffness > 0.0)) return 0.0;
+  const double f = force(m, z);
+  return 0.5 * f * f / stiffness;
+}
+
+// ---- draft_gear ------------------------------------------------------------------------------
+
+namespace {
+constexpr int kPinRoot = AxialHysteresis::kRoots;
+constexpr int kFractureRoot = AxialHysteresis::kRoots + 1;
+const char* const kGearSegments[] = {"bottomed", "off bottom"};
+}  // namespace
+
+DraftGear::DraftGear(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+  ParameterReader& p = *spec.parameters;
+  initial_stiffness = p.required_positive("initial_stiffness");
+  travel = p.required_positive("travel");
+  stiffness_after_bottoming = p.required_positive("stiffness_after_bottoming");
+  hysteresis_load = p.required_positive("hysteresis_load");
+  pin_shear_load = p.optional_positive("pin_shear_load");
+  const auto post_shear = p.optional_nonnegative("post_shear_travel");
+  fracture_load = p.optional_positive("fracture_load");
+  const auto transition = p.optional_positive("transition_stiffness");
+  free_length = p.optional_positive("free_length");
+  spec.require_points(2);
+  if (post_shear && !pin_shear_load)
+    p.fail("post_shear_travel", "'post_shear_travel' is the travel after the shear pin fails: give 'pin_shear_load' too");
+  post_shear_travel = post_shear.value_or(0.0);
+  transition_stiffness = transition.value_or(stiffness_after_bottoming);
+  const double steepest = std::max(initial_stiffness, stiffness_after_bottoming);
+  if (transition_stiffness < steepest || !(transition_stiffness > initial_stiffness))
+    p.fail(transition ? "transition_stiffness" : "stiffness_after_bottoming",
+           "the transition stiffness (default: stiffness_after_bottoming) must exceed initial_stiffness and be at least "
+           "stiffness_after_bottoming, so that the elastic line between the loading and unloading branches meets them; "
+           "give a larger 'transition_stiffness'");
+  const double k = initial_stiffness, h = hysteresis_load;
+  law_.upper = {{0.0, travel}, {h, k * travel + h}, {k, stiffness_after_bottoming}};
+  law_.lower = {{0.0, travel}, {-h, k * travel - h}, {k, stiffness_after_bottoming}};
+  law_.transition_stiffness = transition_stiffness;
+}
+
+DraftGear::Kinematics DraftGear::kinematics(const ElementState<double>& s) const {
+  const LineGeometry<double> g = line_geometry(*this, s);
+  return {*free_length - g.length, -dot(g.d, g.d_rate) / g.length};
+}
+
+void DraftGear::initialize(const ElementState<double>& initial) {
+  const double length = line_geometry(*this, initial).length;
+  if (length == 0.0)
+    throw InputError(where_.prefix() + "draft_gear '" + name_ +
+                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
+  if (!free_length) free_length = length;
+  const Kinematics k = kinematics(initial);
+  state_ = State{};
+  state_.law = law_.initial(k.d, k.rate);
+  const double force = std::abs(gear_force(k.d));
+  const auto reject = [&](const char* what, double limit) {
+    std::ostringstream msg;
+    msg << where_.prefix() << "draft_gear '" << name_ << "' starts with a force " << force << " at or above its " << what
+        << " " << limit << "; start it closer to its free_length";
+    throw InputError(msg.str());
+  };
+  if (pin_shear_load && gear_force(k.d) >= *pin_shear_load) reject("pin_shear_load", *pin_shear_load);
+  if (fracture_load && force >= *fracture_load) reject("fracture_load", *fracture_load);
+  initial_state_ = state_;
+}
+
+void DraftGear::roots_at(const Kinematics& k, double* g) const {
+  std::fill(g, g + kRoots, 1.0);
+  const double force = gear_force(k.d);
+  switch (state_.stage) {
+    case Stage::Intact:
+      law_.roots(state_.law, k.d, k.rate, g);
+      if (pin_shear_load) g[kPinRoot] = *pin_shear_load - force;
+      if (fracture_load) g[kFractureRoot] = *fracture_load - std::abs(force);
+      break;
+    case Stage::Sheared:
+      g[0] = state_.solid_compression - k.d;
+      break;
+    case Stage::Solid:
+      g[1] = force;
+      if (fracture_load) g[kFractureRoot] = *fracture_load - force;
+      break;
+    case Stage::Fractured:
+      break;
+  }
+}
+
+void DraftGear::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
+
+void DraftGear::apply(int index, const Kinematics& k, Event& event) {
+  State& st = state_;
+  const double force = gear_force(k.d);
+  if (index == kFractureRoot) {
+    st.stage = Stage::Fractured;
+    event = {"fracture", std::abs(force)};
+    return;
+  }
+  switch (st.stage) {
+    case Stage::Intact:
+      if (index == kPinRoot) {
+        // The pin lets go: the stored energy of the gear is lost, the coupler slides freely.
+        st.solid_compression = k.d + post_shear_travel;
+        st.stage = (post_shear_travel > 0.0 || k.rate <= 0.0) ? Stage::Sheared : Stage::Solid;
+        event = {"pin shear", force};
+        return;
+      }
+      event = {describe(law_.transition(st.law, index, k.d, k.rate), st.law, law_, kGearSegments), k.d};
+      return;
+    case Stage::Sheared:
+      st.stage = Stage::Solid;
+      event = {"solid", k.d};
+      return;
+    case Stage::Solid:
+      st.stage = Stage::Sheared;
+      event = {"off solid", k.d};
+      return;
+    case Stage::Fractured:
+      return;
+  }
+}
+
+bool DraftGear::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+  const Kinematics k = kinematics(s);
+  return commit_crossing<kRoots>(
+      index, direction, [&](double* g) { roots_at(k, g); }, [&](int i, Event& e) { apply(i, k, e); }, event);
+}
+
+void DraftGear::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+  // Stiffest: the transition stiffness (>= every slope), e.g. the neutral stick line.
+  const State saved = state_;
+  state_ = State{};
+  state_.law.mode = AxialHysteresis::Mode::Neutral;
+  std::array<Pose<double>, 2> f{};
+  add_force_jacobian(t, s, f, df_dq, df_dv);
+  state_ = saved;
+}
+
+double DraftGear::potential_energy(const ElementState<double>& s) const {
+  const double d = kinematics(s).d;
+  if (state_.stage == Stage::Intact) return law_.energy(state_.law, d);
+  if (state_.stage == Stage::Solid) {
+    const double force = gear_force(d);
+    return 0.5 * force * force / stiffness_after_bottoming;
+  }
+  return 0.0;
+}
+
+void DraftGear::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double d = kinematics(s).d;
+  out[0] = gear_force(d);
+  out[1] = d;
+}
+
+// ---- coupler_end -------------------------------------------------------------------------
+
+CouplerEnd::CouplerEnd(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+  ParameterReader& p = *spec.parameters;
+  const auto stiffness = p.vector("horizontal_stiffness", 2);
+  const auto lengths = p.vector("free_length", 2);
+  const auto heights = p.vector("coupler_height", 2);
+  total_horizontal_slack = p.optional_nonnegative("total_horizontal_slack").value_or(0.0);
+  friction = p.optional_nonnegative("friction").value_or(0.0);
+  friction_velocity = p.optional_positive("friction_velocity").value_or(0.01);
+  coupled = p.flag("coupled").value_or(false);
+  spec.require_points(2);
+  const auto per_end = [&](const std::optional<std::vector<double>>& values, const char* key, bool zero_allowed) {
+    if (!values) p.fail(key, std::string("missing required parameter '") + key + "': [end K, end L]");
+    for (double v : *values)
+      if (v < 0.0 || (!zero_allowed && v == 0.0))
+        p.fail(key, std::string("'") + key + "' values must be " + (zero_allowed ? "non-negative" : "positive"));
+    return std::array<double, 2>{(*values)[0], (*values)[1]};
+  };
+  horizontal_stiffness = per_end(stiffness, "horizontal_stiffness", false);
+  free_length = per_end(lengths, "free_length", true);
+  coupler_height = per_end(heights, "coupler_height", false);
+  if (total_horizontal_slack > 0.0 && !coupled)
+    p.fail("total_horizontal_slack",
+           "'total_horizontal_slack' is the free play of coupled knuckles between buff and draft contact; uncoupled "
+           "faces touch at their geometric gap: set 'coupled: true' or remove it");
+  faces_.lo = free_length[0] + free_length[1];
+  faces_.hi = faces_.lo + total_horizontal_slack;
+  faces_.stiffness = horizontal_stiffness[0] * horizontal_stiffness[1] / (horizontal_stiffness[0] + horizontal_stiffness[1]);
+  faces_.above_active = coupled;
+}
+
+CouplerEnd::Kinematics CouplerEnd::kinematics(const ElementState<double>& s) const {
+  const PointOffset<double> o = point_offset(*this, s);
+  return {side_ * o.d.x, side_ * o.d_rate.x, o.d.y, o.d_rate.y};
+}
+
+void CouplerEnd::initialize(const ElementState<double>& initial) {
+  side_ = facing_side(*this, initial);
+  const Kinematics k = kinematics(initial);
+  state_ = State{};
+  state_.overlapping = std::abs(k.dy) < half_overlap();
+  state_.band = faces_.initial(k.h, k.h_rate);
+  initial_state_ = state_;
+}
+
+void CouplerEnd::roots_at(const Kinematics& k, double* g) const {
+  g[0] = g[1] = 1.0;
+  if (state_.overlapping) {
+    faces_.roots(state_.band, k.h, g);
+    g[2] = half_overlap() - std::abs(k.dy);
+  } else {
+    g[2] = std::abs(k.dy) - half_overlap();
+  }
+}
+
+void CouplerEnd::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
+
+void CouplerEnd::apply(int index, const Kinematics& k, Event& event) {
+  State& st = state_;
+  if (index == 2) {
+    if (st.overlapping) {
+      st.overlapping = false;
+      event = {"vertical overlap lost", k.dy};
+    } else {
+      st.overlapping = true;
+      st.band = faces_.initial(k.h, k.h_rate);
+      st.blocked = st.band != DeadBand::Mode::Inside;
+      event = {st.blocked ? "vertical overlap regained, faces past each other" : "vertical overlap regained", k.dy};
+    }
+    return;
+  }
+  using M = DeadBand::Mode;
+  const M before = st.band;
+  st.band = faces_.transition(before, index);
+  const double gap = k.h - faces_.lo;
+  if (st.blocked) {
+    st.blocked = st.band != M::Inside;
+    event = {st.blocked ? "faces pass (blocked)" : "faces clear", gap};
+    return;
+  }
+  const char* what = "";
+  if (before == M::Inside) what = st.band == M::Below ? "contact" : "slack taken up (draft)";
+  else if (before == M::Below) what = st.band == M::Inside ? "separation" : "buff to draft";
+  else what = st.band == M::Inside ? "draft released" : "draft to buff";
+  event = {what, gap};
+}
+
+bool CouplerEnd::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+  const Kinematics k = kinematics(s);
+  return commit_crossing<kRoots>(
+      index, direction, [&](double* g) { roots_at(k, g); }, [&](int i, Event& e) { apply(i, k, e); }, event);
+}
+
+void CouplerEnd::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+  const State saved = state_;
+  state_ = {DeadBand::Mode::Below, true, false};
+  std::array<Pose<double>, 2> f{};
+  add_force_jacobian(t, s, f, df_dq, df_dv);
+  state_ = saved;
+}
+
+double CouplerEnd::potential_energy(const ElementState<double>& s) const {
+  return active() ? faces_.energy(state_.band, kinematics(s).h) : 0.0;
+}
+
+void CouplerEnd::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const Kinematics k = kinematics(s);
+  const bool on = active();
+  out[0] = on ? -faces_.force(state_.band, k.h) : 0.0;
+  out[1] = on && friction > 0.0
+               ? -friction * faces_.magnitude(state_.band, k.h) * std::tanh(k.dy_rate / friction_velocity)
+               : 0.0;
+  out[2] = k.h - faces_.lo;
+}
+
+// ---- coupling ----------------------------------------------------------------------------
+
+Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+  ParameterReader& p = *spec.parameters;
+  const double kind_value = p.number("kind").value_or(1.0);
+  const auto curve = p.table("curve", 2);
+  const auto factor = p.optional_nonnegative("unloading_factor");
+  const auto loading = p.table("loading_curve", 2);
+  const auto unloading = p.table("unloading_curve", 2);
+  horizontal_slack = p.optional_nonnegative("horizontal_slack").value_or(0.0);
+  vertical_slack = p.optional_nonnegative("vertical_slack").value_or(0.0);
+  vertical_stiffness = p.optional_nonnegative("vertical_stiffness").value_or(0.0);
+  misalignment = p.number("misalignment").value_or(0.0);
+  friction = p.optional_nonnegative("friction").value_or(0.0);
+  friction_velocity = p.optional_positive("friction_velocity").value_or(0.01);
+  const auto transition = p.optional_positive("transition_stiffness");
+  free_length = p.optional_nonnegative("free_length");
+  spec.require_points(2);
+
+  if (kind_value != 1.0 && kind_value != 2.0)
+    p.fail("kind", "'kind' must be 1 (curve + unloading_factor, report type 11) or 2 (loading_curve + unloading_curve, "
+                   "report type 12)");
+  kind = static_cast<int>(kind_value);
+  if (kind == 1) {
+    if (loading || unloading)
+      p.fail(loading ? "loading_curve" : "unloading_curve",
+             "kind 1 takes one 'curve' and an 'unloading_factor'; 'loading_curve' / 'unloading_curve' are for kind: 2");
+    if (!curve) p.fail("curve", "missing required parameter 'curve': the loading curve [[deflection, force], ...]");
+    if (!factor) p.fail("unloading_factor", "missing required parameter 'unloading_factor' (unloading force / loading force, 0 to 1)");
+    if (*factor > 1.0) p.fail("unloading_factor", "'unloading_factor' must not exceed 1 (unloading below loading)");
+    std::vector<double> x, y;
+    read_curve(p, "curve", *curve, x, y);
+    law_.upper = PiecewiseLinear::through(x, y);
+    for (double& value : y) value *= *factor;
+    law_.lower = PiecewiseLinear::through(x, y);
+  } else {
+    if (curve || factor)
+      p.fail(curve ? "curve" : "unloading_factor",
+             "kind 2 takes 'loading_curve' and 'unloading_curve'; 'curve' / 'unloading_factor' are for kind: 1");
+    if (!loading) p.fail("loading_curve", "missing required parameter 'loading_curve' [[deflection, force], ...]");
+    if (!unloading) p.fail("unloading_curve", "missing required parameter 'unloading_curve' [[deflection, force], ...]");
+    std::vector<double> lx, ly, ux, uy;
+    read_curve(p, "loading_curve", *loading, lx, ly);
+    read_curve(p, "unloading_curve", *unloading, ux, uy);
+    const PiecewiseLinear up = PiecewiseLinear::through(lx, ly), down = PiecewiseLinear::through(ux, uy);
+    // Both curves on the union of their breakpoints (the laws' segments are shared).
+    std::vector<double> x = lx;
+    x.insert(x.end(), ux.begin(), ux.end());
+    std::sort(x.begin(), x.end());
+    x.erase(std::unique(x.begin(), x.end()), x.end());
+    for (const double at : x)
+      if (down.at(at) > up.at(at) * (1.0 + 1e-12))
+        p.fail("unloading_curve", "the unloading curve must not lie above the loading curve (it does at deflection " +
+                                      std::to_string(at) + ")");
+    if (down.slope.back() > up.slope.back())
+      p.fail("unloading_curve", "beyond the last points the unloading curve would rise above the loading curve: end it "
+                                "with a slope no steeper than the loading curve's");
+    const auto resample = [&](const PiecewiseLinear& c) {
+      std::vector<double> y;
+      for (const double at : x) y.push_back(c.at(at));
+      x.push_back(x.back() + 1.0);  // one more point on the last slope
+      y.push_back(c.at(x.back()));
+      PiecewiseLinear out = PiecewiseLinear::through(x, y);
+      x.pop_back();
+      return out;
+    };
+    law_.upper = resample(up);
+    law_.lower = resample(down);
+  }
+  const double steepest = std::max(law_.upper.max_slope(), law_.lower.max_slope());
+  law_.transition_stiffness = transition.value_or(steepest);
+  if (!(law_.transition_stiffness >= steepest) || !(law_.transition_stiffness > 0.0))
+    p.fail(transition ? "transition_stiffness" : (kind == 1 ? "curve" : "loading_curve"),
+           "the transition stiffness must be positive and at least the steepest slope of the curves (" +
+               std::to_string(steepest) + "), so that the elastic line between them meets them");
+  law_.slack = horizontal_slack;
+  vertical_.lo = -0.5 * vertical_slack;
+  vertical_.hi = 0.5 * vertical_slack;
+  vertical_.stiffness = vertical_stiffness;
+  vertical_.below_active = vertical_.above_active = vertical_stiffness > 0.0;
+}
+
+Coupling::Kinematics Coupling::kinematics(const ElementState<double>& s) const {
+  const PointOffset<double> o = point_offset(*this, s);
+  return {*free_length - side_ * o.d.x, -side_ * o.d_rate.x, o.d.y + misalignment, o.d_rate.y};
+}
+
+void Coupling::initialize(const ElementState<double>& initial) {
+  side_ = facing_side(*this, initial);
+  if (!free_length) free_length = side_ * point_offset(*this, initial).d.x;
+  const Kinematics k = kinematics(initial);
+  state_ = State{};
+  state_.horizontal = law_.initial(k.u, k.u_rate);
+  state_.vertical = vertical_.initial(k.w, k.w_rate);
+  initial_state_ = state_;
+}
+
+void Coupling::roots_at(const Kinematics& k, double* g) const {
+  law_.roots(state_.horizontal, k.u, k.u_rate, g);
+  vertical_.roots(state_.vertical, k.w, g + AxialHysteresis::kRoots);
+}
+
+void Coupling::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
+
+void Coupling::apply(int index, const Kinematics& k, Event& event) {
+  if (index < AxialHysteresis::kRoots) {
+    event = {describe(law_.transition(state_.horizontal, index, k.u, k.u_rate), state_.horizontal, law_), k.u};
+    return;
+  }
+  using M = DeadBand::Mode;
+  state_.vertical = vertical_.transition(state_.vertical, index - AxialHysteresis::kRoots);
+  const char* what = state_.vertical == M::Inside ? "vertical slack"
+                     : state_.vertical == M::Above ? "vertical slack taken up (head L above)"
+                                                   : "vertical slack taken up (head L below)";
+  event = {what, k.w};
+}
+
+bool Coupling::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+  const Kinematics k = kinematics(s);
+  return commit_crossing<kRoots>(
+      index, direction, [&](double* g) { roots_at(k, g); }, [&](int i, Event& e) { apply(i, k, e); }, event);
+}
+
+void Coupling::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+  // Horizontal: the transition line (K_t >= every slope); vertical: beyond the slack.
+  const State saved = state_;
+  const Kinematics k = kinematics(s);
+  state_.horizontal = AxialHysteresis::State{};
+  state_.horizontal.mode = AxialHysteresis::Mode::Transition;
+  state_.horizontal.x0 = law_.side_deflection(state_.horizontal, k.u);
+  if (vertical_stiffness > 0.0) state_.vertical = DeadBand::Mode::Above;
+  std::array<Pose<double>, 2> f{};
+  add_force_jacobian(t, s, f, df_dq, df_dv);
+  state_ = saved;
+}
+
+double Coupling::potential_energy(const ElementState<double>& s) const {
+  const Kinematics k = kinematics(s);
+  return law_.energy(state_.horizontal, k.u) + vertical_.energy(state_.vertical, k.w);
+}
+
+void Coupling::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const Kinematics k = kinematics(s);
+  out[0] = law_.force(state_.horizontal, k.u);
+  out[1] = k.u;
+  out[2] = vertical_.force(state_.vertical, k.w);
+  out[3] = k.w;
+  out[4] = friction > 0.0
+               ? -friction * law_.magnitude(state_.horizontal, k.u) * std::tanh(k.w_rate / friction_velocity)
+               : 0.0;
+}
+
+void register_couplers_elements(ElementRegistry& registry) {
+  registry.add("draft_gear", [](ElementSpec& s) { return std::make_unique<DraftGear>(s); });
+  registry.add("coupler_end", [](ElementSpec& s) { return std::make_unique<CouplerEnd>(s); });
+  registry.add("coupling", [](ElementSpec& s) { return std::make_unique<Coupling>(s); });
+}
 
 }  // namespace railcrash

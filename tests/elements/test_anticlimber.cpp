@@ -1,1 +1,870 @@
+// Type 1 anticlimber: parameters, force laws against hand computations, energy consistency,
+// Jacobians in every mode, and runs under both integrators against closed-form impacts
+// (contact time, elastic-plastic crush and rebound, shear / bending / crushing failure,
+// override).
 #include <catch2/catch.hpp>
+
+#include <cmath>
+#include <iomanip>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "railcrash/elements/anticlimber.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+const double kPi = std::acos(-1.0);
+
+// ---- model text ----------------------------------------------------------------------------
+
+struct LawValues {
+  double elastic, plastic, yield;
+  std::optional<double> rupture;
+  double yield_force() const { return elastic * yield; }
+};
+
+/// The test anticlimber (SI). Defaults: no ruptures, faces 0.2 m tall.
+struct Parameters {
+  LawValues horizontal{1e6, 1e4, 0.01, std::nullopt};
+  LawValues vertical{2e5, 2e3, 0.02, std::nullopt};
+  LawValues torsional{1e4, 1e2, 0.01, std::nullopt};
+  double face_height = 0.2;
+  double misalignment = 0.0;
+  std::optional<double> facing;
+  std::optional<double> length;
+};
+
+std::string number(double x) {
+  std::ostringstream s;
+  s << std::setprecision(17) << x;
+  return s.str();
+}
+
+std::string law_yaml(const std::string& direction, const LawValues& law) {
+  std::string s = "    " + direction + "_elastic_stiffness: " + number(law.elastic) + "\n" + "    " + direction +
+                  "_plastic_stiffness: " + number(law.plastic) + "\n" + "    " + direction +
+                  "_yield_deflection: " + number(law.yield) + "\n";
+  if (law.rupture) s += "    " + direction + "_rupture_deflection: " + number(*law.rupture) + "\n";
+  return s;
+}
+
+std::string parameters_yaml(const Parameters& p) {
+  std::string s = law_yaml("horizontal", p.horizontal) + law_yaml("vertical", p.vertical) + law_yaml("torsional", p.torsional);
+  s += "    face_height: " + number(p.face_height) + "\n";
+  if (p.misalignment != 0.0) s += "    initial_misalignment: " + number(p.misalignment) + "\n";
+  if (p.facing) s += "    facing: " + number(*p.facing) + "\n";
+  if (p.length) s += "    length: " + number(*p.length) + "\n";
+  return s;
+}
+
+/// A body line for the bodies section.
+struct BodySpec {
+  std::string name;
+  double mass, inertia, x, y, angle, vx, vy, omega;
+};
+
+std::string body_yaml(const BodySpec& b) {
+  return "  - {name: " + b.name + ", mass: " + number(b.mass) + ", inertia: " + number(b.inertia) + ", position: [" +
+         number(b.x) + ", " + number(b.y) + "], angle: " + number(b.angle) + ", velocity: [" + number(b.vx) + ", " +
+         number(b.vy) + "], angular_velocity: " + number(b.omega) + "}\n";
+}
+
+struct Point {
+  std::string body;
+  double sx, sy;
+};
+
+/// A model with bodies, one anticlimber `ac` between points p1 and p2, extra element / load
+/// YAML and simulation settings.
+std::string model_yaml(const std::vector<BodySpec>& bodies, const Parameters& parameters, const Point& p1, const Point& p2,
+                       const std::string& simulation, const std::string& extra_elements = "",
+                       const std::string& loads = "") {
+  std::string s = "railcrash: 1\nname: anticlimber test\nunits: SI\ngravity: [0, 0]\nbodies:\n";
+  for (const BodySpec& b : bodies) s += body_yaml(b);
+  s += "elements:\n  - name: ac\n    type: anticlimber\n" + parameters_yaml(parameters) + "    points: [{body: " + p1.body +
+       ", at: [" + number(p1.sx) + ", " + number(p1.sy) + "]}, {body: " + p2.body + ", at: [" + number(p2.sx) + ", " +
+       number(p2.sy) + "]}]\n" + extra_elements;
+  if (!loads.empty()) s += "loads:\n" + loads;
+  s += "simulation: {" + simulation + "}\n";
+  return s;
+}
+
+Anticlimber& anticlimber_of(const Model& model) { return dynamic_cast<Anticlimber&>(*model.elements().front()); }
+
+// ---- running -------------------------------------------------------------------------------
+
+struct Samples : RunObserver {
+  std::vector<double> t;
+  std::vector<std::vector<double>> y;
+  void sample(double time, const double* state, const double*, const double*) override {
+    t.push_back(time);
+    y.emplace_back(state, state + size);
+  }
+  int size = 0;
+};
+
+struct Run {
+  RunOutcome outcome;
+  Samples samples;
+};
+
+Run simulate(const Model& model) {
+  const DaeSystem system(model);
+  Run run;
+  run.samples.size = system.size();
+  auto integrator = make_integrator(system, model.simulation);
+  run.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), run.samples);
+  REQUIRE(run.outcome.ok);
+  return run;
+}
+
+/// The n-th (1-based) event whose text is exactly `what`, or nullptr.
+const EventRecord* find_event(const RunOutcome& outcome, const std::string& what, int occurrence = 1) {
+  for (const EventRecord& e : outcome.events)
+    if (e.what == what && --occurrence == 0) return &e;
+  return nullptr;
+}
+
+std::string event_list(const RunOutcome& outcome) {
+  std::ostringstream s;
+  for (const EventRecord& e : outcome.events) s << std::setprecision(12) << e.t << " " << e.what << " " << e.value << "\n";
+  return s.str();
+}
+
+/// Work done on the element `index` over the run.
+double element_work(const RunOutcome& outcome, int index = 0) {
+  return outcome.quadratures[static_cast<std::size_t>(DaeSystem::kFirstElementWork + index)];
+}
+
+/// Work to deform a bilinear law monotonically from 0 to d (d >= yield).
+double bilinear_work(const LawValues& law, double d) {
+  const double plastic = d - law.yield;
+  return 0.5 * law.yield_force() * law.yield + law.yield_force() * plastic + 0.5 * law.plastic * plastic * plastic;
+}
+
+// ---- closed form: a mass m hits a rigid wall through the horizontal law -----------------------
+
+struct Crush {
+  double yield_time;    // after contact
+  double peak_time;     // after contact: unloading
+  double separation_time;
+  double max_crush, peak_force, permanent_crush, rebound_speed, dissipated;
+};
+
+Crush crush_of(const LawValues& law, double mass, double speed) {
+  Crush c;
+  const double omega = std::sqrt(law.elastic / mass), omega_p = std::sqrt(law.plastic / mass);
+  REQUIRE(speed / omega > law.yield);  // it does yield
+  // Elastic: d = (u0/w) sin(w t).
+  c.yield_time = std::asin(law.yield * omega / speed) / omega;
+  const double speed_at_yield = std::sqrt(speed * speed - omega * omega * law.yield * law.yield);
+  // Plastic: x = d - d_y, m x'' = -(F_y + k_p x): x = a (cos w_p t - 1) + (u_y / w_p) sin w_p t, a = F_y / k_p.
+  const double a = law.yield_force() / law.plastic;
+  c.peak_time = c.yield_time + std::atan2(speed_at_yield, omega_p * a) / omega_p;
+  const double x_max = std::hypot(a, speed_at_yield / omega_p) - a;
+  c.max_crush = law.yield + x_max;
+  c.peak_force = law.yield_force() + law.plastic * x_max;
+  c.permanent_crush = c.max_crush - c.peak_force / law.elastic;
+  // Elastic rebound: a quarter period back to zero force.
+  c.separation_time = c.peak_time + kPi / (2.0 * omega);
+  c.rebound_speed = c.peak_force / std::sqrt(law.elastic * mass);
+  c.dissipated = 0.5 * mass * (speed * speed - c.rebound_speed * c.rebound_speed);
+  return c;
+}
+
+// ---- hand kinematics for the force checks ------------------------------------------------------
+
+struct Vec {
+  double x, y;
+};
+Vec rotated(double angle, double sx, double sy) {
+  return {std::cos(angle) * sx - std::sin(angle) * sy, std::sin(angle) * sx + std::cos(angle) * sy};
+}
+
+/// Generalized forces of the element alone at body coordinates q (velocities zero).
+std::vector<double> element_forces(const Model& model, const std::vector<double>& q) {
+  const Element& e = *model.elements().front();
+  const std::vector<double> v(q.size(), 0.0);
+  const ElementState<double> s = gather_state(e, q.data(), v.data());
+  std::array<Pose<double>, 2> f{};
+  e.add_force(0.0, s, f);
+  std::vector<double> out(q.size(), 0.0);
+  for (int k = 0; k < 2; ++k) {
+    const int body = e.slot_body(k);
+    if (body == kGround) continue;
+    out[static_cast<std::size_t>(3 * body)] += f[static_cast<std::size_t>(k)].x;
+    out[static_cast<std::size_t>(3 * body + 1)] += f[static_cast<std::size_t>(k)].y;
+    out[static_cast<std::size_t>(3 * body + 2)] += f[static_cast<std::size_t>(k)].theta;
+  }
+  return out;
+}
+
+double energy_at(const Model& model, const std::vector<double>& q) {
+  const Element& e = *model.elements().front();
+  const std::vector<double> v(q.size(), 0.0);
+  return e.potential_energy(gather_state(e, q.data(), v.data()));
+}
+
+std::vector<double> positions(const DaeSystem& system, const std::vector<double>& y) {
+  return {y.begin(), y.begin() + system.body_unknowns()};
+}
+
+std::vector<double> element_outputs(const DaeSystem& system, const std::vector<double>& y) {
+  std::vector<double> out(system.output_names().size(), 0.0);
+  system.outputs(y.data(), y.data() + 2 * system.body_unknowns(), out.data());
+  return out;
+}
+
+using Mode = ElasticPlasticLaw::Mode;
+
+/// A law state in a given mode with a plastic offset (elastic range consistent with it).
+ElasticPlasticLaw::State law_state(const ElasticPlasticLaw& law, Mode mode, double offset) {
+  ElasticPlasticLaw::State st = law.fresh();
+  st.mode = mode;
+  st.offset = offset;
+  const double shift = law.elastic_stiffness * offset / (law.elastic_stiffness - law.plastic_stiffness);
+  st.upper = law.yield_deflection + shift;
+  st.lower = law.one_sided ? offset : -law.yield_deflection + shift;
+  return st;
+}
+
+// Two cars: body 1 turned by 0.15 rad, body 2 by -0.1 rad; face points away from the centres.
+const Point kCar1Face{"car1", 0.6, -0.1};
+const Point kCar2Face{"car2", -0.7, 0.05};
+std::vector<BodySpec> two_cars() {
+  return {{"car1", 50.0, 4.0, 0.0, 0.0, 0.15, 0.3, -0.1, 0.05}, {"car2", 70.0, 6.0, 1.45, 0.3, -0.1, -0.2, 0.1, -0.04}};
+}
+
+}  // namespace
+
+// ---- parameters ------------------------------------------------------------------------------
+
+TEST_CASE("anticlimber reads the report's Table 5 values and gives their yield forces", "[elements][anticlimber]") {
+  // Report Table 5 / 8 as read in anticlimber.hpp (in-lbf-s): vertical 175,000 lb/in, 1633 lb/in,
+  // 0.20 in, 5 in; horizontal 4,450,000 lb/in, 20,620 lb/in, 0.053 in, 56 in; torsional
+  // 110,800 in-lb/rad, 25,500 in-lb/rad, 0.001 rad, 1 rad; face height 6 in, length 58.125 in.
+  const std::string text =
+      "railcrash: 1\nname: table 5\nunits: in-lbf-s\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: a, weight: 6180, inertia: 4000, position: [0, 0]}\n"
+      "  - {name: b, weight: 6180, inertia: 4000, position: [100, 0]}\n"
+      "elements:\n  - name: ac\n    type: anticlimber\n"
+      "    vertical_elastic_stiffness: 175000\n    vertical_plastic_stiffness: 1633\n"
+      "    vertical_yield_deflection: 0.20\n    vertical_rupture_deflection: 5\n"
+      "    horizontal_elastic_stiffness: 4450000\n    horizontal_plastic_stiffness: 20620\n"
+      "    horizontal_yield_deflection: 0.053\n    horizontal_rupture_deflection: 56\n"
+      "    torsional_elastic_stiffness: 110800\n    torsional_plastic_stiffness: 25500\n"
+      "    torsional_yield_deflection: 0.001\n    torsional_rupture_deflection: 1\n"
+      "    face_height: 6\n    length: 58.125\n"
+      "    points: [{body: a, at: [17.5, -11.9]}, {body: b, at: [-17.5, -11.9]}]\n"
+      "simulation: {t_end: 0.1}\n";
+  const Model model = testing::model_from_text(text);
+  const Anticlimber& ac = anticlimber_of(model);
+  CHECK(ac.vertical_yield_force() == Approx(35000.0).epsilon(1e-12));  // 175,000 lb/in x 0.20 in
+  CHECK(ac.horizontal.yield_force() == Approx(235850.0).epsilon(1e-12));  // 4,450,000 lb/in x 0.053 in
+  CHECK(ac.torsional.yield_force() == Approx(110.8).epsilon(1e-12));  // 110,800 in-lb/rad x 0.001 rad
+  CHECK(*ac.horizontal.rupture_deflection == 56.0);
+  CHECK(*ac.vertical.rupture_deflection == 5.0);
+  CHECK(*ac.torsional.rupture_deflection == 1.0);
+  CHECK(ac.vertical.plastic_stiffness == 1633.0);
+  CHECK(ac.face_height == 6.0);
+  CHECK(*ac.length == 58.125);
+  CHECK(*ac.facing == 1.0);  // b lies ahead of a along a's x axis
+  CHECK(ac.horizontal.one_sided);
+  CHECK_FALSE(ac.vertical.one_sided);
+}
+
+TEST_CASE("anticlimber rejects bad parameters and starting configurations", "[elements][anticlimber]") {
+  const std::vector<BodySpec> bodies{{"b", 1.0, 1.0, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0}};
+  const Point ground{"ground", 0.0, 0.0}, body{"b", 0.0, 0.0};
+  const auto load = [&](const Parameters& p, const Point& p1 = Point{"ground", 0.0, 0.0}, const Point& p2 = Point{"b", 0.0, 0.0},
+                        const std::vector<BodySpec>& b = {}) {
+    return testing::model_from_text(model_yaml(b.empty() ? bodies : b, p, p1, p2, "t_end: 1"));
+  };
+  Parameters good;
+  CHECK_NOTHROW(load(good));
+  {
+    Parameters p;
+    p.horizontal.plastic = p.horizontal.elastic;
+    CHECK_THROWS_WITH(load(p), Catch::Contains("horizontal_plastic_stiffness") && Catch::Contains("below"));
+  }
+  {
+    Parameters p;
+    p.vertical.rupture = p.vertical.yield;
+    CHECK_THROWS_WITH(load(p), Catch::Contains("vertical_rupture_deflection") && Catch::Contains("exceed"));
+  }
+  {
+    Parameters p;
+    p.torsional.yield = 0.0;
+    CHECK_THROWS_WITH(load(p), Catch::Contains("torsional_yield_deflection") && Catch::Contains("positive"));
+  }
+  {
+    Parameters p;
+    p.facing = 0.5;
+    CHECK_THROWS_WITH(load(p), Catch::Contains("facing"));
+  }
+  {
+    Parameters p;
+    p.length = 0.3;
+    p.horizontal.rupture = 0.5;
+    CHECK_THROWS_WITH(load(p), Catch::Contains("horizontal_rupture_deflection") && Catch::Contains("length"));
+  }
+  {
+    Parameters p;
+    p.length = 0.3;  // without a horizontal rupture deflection: crushed through over the length
+    const Model model = load(p);
+    CHECK(*anticlimber_of(model).horizontal.rupture_deflection == 0.3);
+  }
+  {
+    std::string text = model_yaml(bodies, good, ground, body, "t_end: 1");
+    text.replace(text.find("    face_height"), text.find('\n', text.find("    face_height")) - text.find("    face_height") + 1, "");
+    CHECK_THROWS_WITH(testing::model_from_text(text), Catch::Contains("face_height"));
+  }
+  CHECK_THROWS_WITH(load(good, Point{"b", 0.0, 0.0}, Point{"b", 0.2, 0.0}), Catch::Contains("same body"));
+  // Faces overlapping at the start (facing given, body behind the face).
+  {
+    Parameters p;
+    p.facing = -1.0;
+    CHECK_THROWS_WITH(load(p), Catch::Contains("overlap"));
+  }
+  // Touching at the start: which way they face must be given.
+  const std::vector<BodySpec> touching{{"b", 1.0, 1.0, 0.0, 0.05, 0.0, -1.0, 0.0, 0.0}};
+  CHECK_THROWS_WITH(load(good, ground, body, touching), Catch::Contains("facing"));
+  Parameters faced;
+  faced.facing = 1.0;
+  const Model engaged = load(faced, ground, body, touching);  // closing at 1 m/s: engaged from the start
+  CHECK(anticlimber_of(engaged).state().contact == Anticlimber::Contact::Engaged);
+  const std::vector<BodySpec> touching_still{{"b", 1.0, 1.0, 0.0, 0.05, 0.0, 0.0, 0.0, 0.0}};
+  const Model open = load(faced, ground, body, touching_still);
+  CHECK(anticlimber_of(open).state().contact == Anticlimber::Contact::Open);
+}
+
+// ---- force laws ----------------------------------------------------------------------------
+
+TEST_CASE("anticlimber applies no force while open, after override and once crushed", "[elements][anticlimber]") {
+  const Model model =
+      testing::model_from_text(model_yaml(two_cars(), Parameters{}, kCar1Face, kCar2Face, "t_end: 1"));
+  const DaeSystem system(model);
+  Anticlimber& ac = anticlimber_of(model);
+  REQUIRE(ac.state().contact == Anticlimber::Contact::Open);
+  std::mt19937 rng(7);
+  for (const Anticlimber::Contact contact :
+       {Anticlimber::Contact::Open, Anticlimber::Contact::Overridden, Anticlimber::Contact::Crushed}) {
+    Anticlimber::State st = ac.state();
+    st.contact = contact;
+    ac.set_state(st);
+    for (int trial = 0; trial < 5; ++trial) {
+      // Random states, also ones where the faces are pressed together (gap < 0).
+      const std::vector<double> y = testing::random_state(system, rng, 0.4);
+      for (double f : element_forces(model, positions(system, y))) CHECK(f == 0.0);
+      CHECK(ac.potential_energy(gather_state(ac, y.data(), y.data() + 6)) == 0.0);
+      const std::vector<double> out = element_outputs(system, y);
+      CHECK(out[0] == 0.0);
+      CHECK(out[1] == 0.0);
+      CHECK(out[2] == 0.0);
+      CHECK(out[7] == (contact == Anticlimber::Contact::Overridden ? 1.0 : 0.0));
+    }
+  }
+}
+
+TEST_CASE("anticlimber forces follow the three laws at a known configuration", "[elements][anticlimber]") {
+  // Ground face at (0, 0) looking along +x; car face 0.5 m ahead of the car's centre, pointing back.
+  // Car at (0.47, 0.13) turned by 0.02 rad: its face centre is at
+  //   r2 = (0.47 - 0.5 cos 0.02 - 0.02 sin 0.02... ) computed below from the rotation.
+  const std::vector<BodySpec> bodies{{"b", 10.0, 1.0, 0.6, 0.0, 0.0, 0.0, 0.0, 0.0}};
+  Parameters p;
+  p.misalignment = 0.01;
+  const Model model =
+      testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", -0.5, 0.02}, "t_end: 1"));
+  const DaeSystem system(model);
+  Anticlimber& ac = anticlimber_of(model);
+  // Engaged at v_e = 0.03, phi_e = 0.005; horizontal plastic, vertical elastic with offset
+  // 0.004, torsional plastic downwards.
+  Anticlimber::State st = ac.state();
+  st.contact = Anticlimber::Contact::Engaged;
+  st.vertical_reference = 0.03;
+  st.torsional_reference = 0.005;
+  st.horizontal = law_state(ac.horizontal, Mode::PlasticUp, 0.0);
+  st.vertical = law_state(ac.vertical, Mode::Elastic, 0.004);
+  st.torsional = law_state(ac.torsional, Mode::PlasticDown, 0.0);
+  ac.set_state(st);
+
+  const double x = 0.47, y = 0.13, theta = 0.02;
+  const Vec arm = rotated(theta, -0.5, 0.02);
+  const Vec r2{x + arm.x, y + arm.y};
+  const double d_h = -r2.x;               // gap = r2 . (1, 0)
+  const double v = r2.y + 0.01;           // + initial misalignment
+  REQUIRE(d_h > 0.01);                    // beyond the horizontal yield deflection
+  const double h = 1e4 + 1e4 * (d_h - 0.01);                      // F_y + k_p (d - d_y)
+  const double vf = 2e5 * ((v - 0.03) - 0.004);                    // k_e (d_v - p)
+  const double m = -100.0 + 1e2 * ((theta - 0.005) + 0.01);       // -F_y + k_p (d + d_y)
+  // Force on the car at its face: (H, -V); moment arm x F, minus the torsional moment.
+  const double fx = h, fy = -vf;
+  const std::vector<double> expected{fx, fy, arm.x * fy - arm.y * fx - m};
+  const std::vector<double> actual = element_forces(model, {x, y, theta});
+  for (std::size_t k = 0; k < 3; ++k) {
+    INFO("component " << k);
+    CHECK(actual[k] == Approx(expected[k]).epsilon(1e-12).margin(1e-9));
+  }
+  // Outputs at the same state.
+  std::vector<double> state = system.initial_state();
+  state[0] = x;
+  state[1] = y;
+  state[2] = theta;
+  CHECK(system.output_names() ==
+        std::vector<std::string>{"ac.horizontal_force", "ac.vertical_force", "ac.moment", "ac.horizontal_deformation",
+                                 "ac.vertical_deformation", "ac.torsional_deformation", "ac.vertical_offset",
+                                 "ac.override"});
+  const std::vector<double> out = element_outputs(system, state);
+  CHECK(out[0] == Approx(h).epsilon(1e-12));
+  CHECK(out[1] == Approx(vf).epsilon(1e-12));
+  CHECK(out[2] == Approx(m).epsilon(1e-12));
+  CHECK(out[3] == Approx(d_h).epsilon(1e-12));
+  CHECK(out[4] == Approx(v - 0.03).epsilon(1e-12));
+  CHECK(out[5] == Approx(theta - 0.005).epsilon(1e-12));
+  CHECK(out[6] == Approx(v).epsilon(1e-12));
+  CHECK(out[7] == 0.0);
+  // Elastic energy: each law's F^2 / (2 k_e).
+  CHECK(ac.potential_energy(gather_state(ac, state.data(), state.data() + 3)) ==
+        Approx(h * h / 2e6 + vf * vf / 4e5 + m * m / 2e4).epsilon(1e-12));
+}
+
+TEST_CASE("anticlimber forces are minus the gradient of the elastic energy and conserve momentum",
+          "[elements][anticlimber]") {
+  for (const double facing : {1.0, -1.0}) {
+    INFO("facing " << facing);
+    // facing -1: car 2 behind car 1's face point along car 1's axis.
+    std::vector<BodySpec> bodies = two_cars();
+    if (facing < 0.0) bodies[1].x = -1.45;
+    const Point p2{"car2", facing > 0.0 ? -0.7 : 0.7, 0.05};
+    const Point p1{"car1", facing > 0.0 ? 0.6 : -0.6, -0.1};
+    const Model model = testing::model_from_text(model_yaml(bodies, Parameters{}, p1, p2, "t_end: 1"));
+    const DaeSystem system(model);
+    Anticlimber& ac = anticlimber_of(model);
+    REQUIRE(*ac.facing == facing);
+    // Engaged, all three laws elastic with plastic offsets: there U is the potential of the forces.
+    Anticlimber::State st = ac.state();
+    st.contact = Anticlimber::Contact::Engaged;
+    st.vertical_reference = 0.25;
+    st.torsional_reference = -0.2;
+    st.horizontal = law_state(ac.horizontal, Mode::Elastic, -0.08);
+    st.vertical = law_state(ac.vertical, Mode::Elastic, 0.01);
+    st.torsional = law_state(ac.torsional, Mode::Elastic, -0.02);
+    ac.set_state(st);
+    std::mt19937 rng(11);
+    for (int trial = 0; trial < 4; ++trial) {
+      const std::vector<double> q = positions(system, testing::random_state(system, rng, 0.1));
+      REQUIRE(energy_at(model, q) > 1.0);  // deformed: the check is not vacuous
+      const std::vector<double> f = element_forces(model, q);
+      for (std::size_t k = 0; k < q.size(); ++k) {
+        const double step = 1e-6;
+        std::vector<double> plus = q, minus = q;
+        plus[k] += step;
+        minus[k] -= step;
+        const double gradient = (energy_at(model, plus) - energy_at(model, minus)) / (2.0 * step);
+        INFO("trial " << trial << " component " << k);
+        CHECK(f[k] == Approx(-gradient).epsilon(1e-6).margin(1e-4));
+      }
+      // Momentum: forces sum to zero; angular momentum: moments about the origin sum to zero.
+      CHECK(f[0] + f[3] == Approx(0.0).margin(1e-8));
+      CHECK(f[1] + f[4] == Approx(0.0).margin(1e-8));
+      const double moment = (q[0] * f[1] - q[1] * f[0] + f[2]) + (q[3] * f[4] - q[4] * f[3] + f[5]);
+      CHECK(moment == Approx(0.0).margin(1e-7));
+    }
+  }
+}
+
+TEST_CASE("anticlimber Jacobian matches finite differences in every mode", "[elements][anticlimber]") {
+  const Mode law_modes[] = {Mode::Elastic, Mode::PlasticUp, Mode::PlasticDown, Mode::Failed};
+  struct Layout {
+    const char* name;
+    std::vector<BodySpec> bodies;
+    Point p1, p2;
+  };
+  const Layout layouts[] = {
+      {"two cars", two_cars(), kCar1Face, kCar2Face},
+      {"ground and car", {{"car2", 70.0, 6.0, 1.45, 0.3, -0.1, -0.2, 0.1, -0.04}}, Point{"ground", 0.6, -0.1}, kCar2Face},
+      {"car and ground", {{"car1", 50.0, 4.0, 0.0, 0.0, 0.15, 0.3, -0.1, 0.05}}, kCar1Face, Point{"ground", 1.45, 0.3}},
+  };
+  for (const Layout& layout : layouts) {
+    INFO(layout.name);
+    const Model model = testing::model_from_text(model_yaml(layout.bodies, Parameters{}, layout.p1, layout.p2, "t_end: 1"));
+    const DaeSystem system(model);
+    Anticlimber& ac = anticlimber_of(model);
+    std::mt19937 rng(3);
+    int checked = 0;
+    const auto check_here = [&]() {
+      for (int trial = 0; trial < 3; ++trial) {
+        const std::vector<double> y = testing::random_state(system, rng, 0.05);
+        const std::vector<double> yp = testing::random_state(system, rng, 0.05);
+        double outside = -1.0;
+        CHECK(testing::jacobian_error(system, 0.1, 30.0 * (trial + 1), y, yp, &outside) < 1e-6);
+        CHECK(outside == 0.0);
+      }
+      ++checked;
+    };
+    for (const Mode h : {Mode::Elastic, Mode::PlasticUp})
+      for (const Mode v : law_modes)
+        for (const Mode m : law_modes) {
+          INFO("modes " << static_cast<int>(h) << static_cast<int>(v) << static_cast<int>(m));
+          Anticlimber::State st = ac.state();
+          st.contact = Anticlimber::Contact::Engaged;
+          st.vertical_reference = 0.2;
+          st.torsional_reference = -0.1;
+          st.horizontal = law_state(ac.horizontal, h, 0.003);
+          st.vertical = law_state(ac.vertical, v, -0.005);
+          st.torsional = law_state(ac.torsional, m, 0.002);
+          ac.set_state(st);
+          // The law of each of these modes has forces that depend on the state:
+          if (h == Mode::Elastic && v == Mode::Elastic && m == Mode::Elastic) {
+            const std::vector<double> y = system.initial_state();
+            double norm = 0.0;
+            for (double f : element_forces(model, positions(system, y))) norm += std::abs(f);
+            REQUIRE(norm > 1.0);
+          }
+          check_here();
+        }
+    for (const Anticlimber::Contact contact :
+         {Anticlimber::Contact::Open, Anticlimber::Contact::Overridden, Anticlimber::Contact::Crushed}) {
+      Anticlimber::State st = ac.state();
+      st.contact = contact;
+      ac.set_state(st);
+      check_here();
+    }
+    CHECK(checked == 2 * 4 * 4 + 3);
+  }
+}
+
+// ---- runs -----------------------------------------------------------------------------------
+
+TEST_CASE("anticlimber contact fires at gap / closing speed", "[elements][anticlimber]") {
+  // Car 1 turned by 0.3 rad and fixed in place by its huge mass? No: car 1 is the ground here,
+  // its face axis turned by placing car 2 on a line at 0.3 rad (facing inferred) or behind it.
+  for (const double facing : {1.0, -1.0}) {
+    for (const char* integrator : {"ida", "euler"}) {
+      INFO("facing " << facing << ", " << integrator);
+      const double angle = 0.3, gap = 0.12, speed = 1.7;
+      // Body 1: a massive car turned by `angle`, at rest; body 2 approaches along body 1's axis.
+      const Vec axis{std::cos(angle), std::sin(angle)};
+      const double start = facing * (0.5 + gap);  // distance of car 2's face from car 1's centre along the axis
+      const std::vector<BodySpec> bodies{
+          {"car1", 1e3, 1e3, 0.0, 0.0, angle, 0.0, 0.0, 0.0},
+          {"car2", 2.0, 0.5, axis.x * start, axis.y * start, angle, -facing * speed * axis.x, -facing * speed * axis.y, 0.0}};
+      const std::string sim = std::string("t_end: 0.1, integrator: ") + integrator + ", rtol: 1e-10, dt: 1e-6";
+      const Model model = testing::model_from_text(
+          model_yaml(bodies, Parameters{}, Point{"car1", facing * 0.5, 0.0}, Point{"car2", 0.0, 0.0}, sim));
+      REQUIRE(*anticlimber_of(model).facing == facing);
+      const Run run = simulate(model);
+      const EventRecord* contact = find_event(run.outcome, "contact");
+      INFO(event_list(run.outcome));
+      REQUIRE(contact != nullptr);
+      CHECK(run.outcome.events.front().what == "contact");
+      if (std::string(integrator) == "ida") {
+        CHECK(contact->t == Approx(gap / speed).epsilon(0).margin(1e-8));
+        CHECK(contact->value == Approx(0.0).margin(1e-8));
+      } else {
+        // Euler sees the contact at the end of the step that closes the gap.
+        CHECK(contact->t >= gap / speed);
+        CHECK(contact->t <= gap / speed + 1.0001e-6);
+      }
+    }
+  }
+}
+
+TEST_CASE("anticlimber crush of a mass: yield, plastic flow, unloading and rebound match the closed form",
+          "[elements][anticlimber]") {
+  const double mass = 100.0, speed = 2.0, gap = 0.1;
+  const Parameters p;
+  const Crush c = crush_of(p.horizontal, mass, speed);
+  const double contact_time = gap / speed;
+  for (const char* integrator : {"ida", "euler"}) {
+    const bool ida = std::string(integrator) == "ida";
+    INFO(integrator);
+    const std::vector<BodySpec> bodies{{"b", mass, 1.0, gap, 0.0, 0.0, -speed, 0.0, 0.0}};
+    const std::string sim = std::string("t_end: 0.15, integrator: ") + integrator + ", rtol: 1e-10, dt: 1e-6";
+    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim));
+    const Run run = simulate(model);
+    const RunOutcome& o = run.outcome;
+    INFO(event_list(o));
+    REQUIRE(o.events.size() == 4);
+    CHECK(o.events[0].what == "contact");
+    CHECK(o.events[1].what == "horizontal yield");
+    CHECK(o.events[2].what == "horizontal unloading");
+    CHECK(o.events[3].what == "separation");
+    const double time_tol = ida ? 1e-8 : 3e-6, crush_tol = ida ? 1e-8 : 4e-6;
+    CHECK(o.events[0].t == Approx(contact_time).epsilon(0).margin(time_tol));
+    CHECK(o.events[1].t == Approx(contact_time + c.yield_time).epsilon(0).margin(time_tol));
+    CHECK(o.events[1].value == Approx(p.horizontal.yield).epsilon(0).margin(crush_tol));
+    CHECK(o.events[2].t == Approx(contact_time + c.peak_time).epsilon(0).margin(ida ? 1e-7 : 3e-5));
+    CHECK(o.events[2].value == Approx(c.max_crush).epsilon(0).margin(crush_tol));
+    CHECK(o.events[3].t == Approx(contact_time + c.separation_time).epsilon(0).margin(ida ? 1e-7 : 3e-5));
+    CHECK(o.events[3].value == Approx(c.permanent_crush).epsilon(0).margin(crush_tol));
+    // Rebound speed (momentum after the elastic return of the peak force) and the energy: all
+    // but the rebound's kinetic energy is dissipated by plastic flow in the element.
+    const double rel = ida ? 1e-7 : 2e-4;
+    CHECK(o.y[3] == Approx(c.rebound_speed).epsilon(rel));
+    CHECK(element_work(o) == Approx(c.dissipated).epsilon(rel));
+    const EnergyBalance balance = EnergyBalance::between(o.initial_energy, o.final_energy);
+    CHECK(balance.dissipated == Approx(c.dissipated).epsilon(rel));
+    CHECK(balance.elastic == Approx(0.0).margin(1e-9));
+    CHECK(std::abs(balance.error()) < (ida ? 1e-6 : 1e-2));
+    // The permanent crush is remembered while the faces are apart.
+    const Anticlimber& ac = anticlimber_of(model);
+    CHECK(ac.state().contact == Anticlimber::Contact::Open);
+    CHECK(ac.state().horizontal.offset == Approx(c.permanent_crush).epsilon(0).margin(crush_tol));
+  }
+}
+
+TEST_CASE("two cars crush through the anticlimber with the reduced mass and conserve momentum", "[elements][anticlimber]") {
+  const double m1 = 100.0, m2 = 300.0, speed = 2.0, gap = 0.1;
+  const double reduced = m1 * m2 / (m1 + m2);
+  const Parameters p;
+  const Crush c = crush_of(p.horizontal, reduced, speed);
+  for (const char* integrator : {"ida", "euler"}) {
+    const bool ida = std::string(integrator) == "ida";
+    INFO(integrator);
+    // Faces at the centres' height: the impact is central, nothing turns.
+    const std::vector<BodySpec> bodies{{"car1", m1, 5.0, 0.0, 0.0, 0.0, speed, 0.0, 0.0},
+                                       {"car2", m2, 9.0, 0.9 + gap, 0.0, 0.0, 0.0, 0.0, 0.0}};
+    const std::string sim = std::string("t_end: 0.15, integrator: ") + integrator + ", rtol: 1e-10, dt: 1e-6";
+    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"car1", 0.4, 0.0}, Point{"car2", -0.5, 0.0}, sim));
+    const Run run = simulate(model);
+    const RunOutcome& o = run.outcome;
+    INFO(event_list(o));
+    REQUIRE(find_event(o, "separation") != nullptr);
+    CHECK(find_event(o, "separation")->t == Approx(gap / speed + c.separation_time).epsilon(0).margin(ida ? 1e-7 : 3e-5));
+    // Centre-of-mass velocity unchanged; relative velocity reversed to the rebound speed.
+    const double vcm = m1 * speed / (m1 + m2);
+    const double rel = ida ? 1e-7 : 2e-4;
+    CHECK(o.y[6] == Approx(vcm - m2 / (m1 + m2) * c.rebound_speed).epsilon(rel));
+    CHECK(o.y[9] == Approx(vcm + m1 / (m1 + m2) * c.rebound_speed).epsilon(rel));
+    CHECK(m1 * o.y[6] + m2 * o.y[9] == Approx(m1 * speed).epsilon(1e-12));
+    CHECK(o.y[7] == Approx(0.0).margin(1e-12));
+    CHECK(o.y[8] == Approx(0.0).margin(1e-12));
+    CHECK(element_work(o) == Approx(c.dissipated).epsilon(rel));
+  }
+}
+
+namespace {
+
+// A massive car 2 driven at constant velocity (u toward the face, w up, omega) into a
+// ground-fixed anticlimber: its motion is prescribed to within F t / M ~ 1e-6 m.
+struct Drive {
+  double u, w, omega;
+};
+constexpr double kHeavy = 1e9;  // [kg] and [kg m^2]
+
+Model driven_model(const Parameters& p, const Drive& drive, const std::string& integrator, double t_end) {
+  const std::vector<BodySpec> bodies{{"car2", kHeavy, kHeavy, 0.1, 0.0, 0.0, -drive.u, drive.w, drive.omega}};
+  const std::string sim = "t_end: " + number(t_end) + ", integrator: " + integrator + ", rtol: 1e-10, dt: 1e-5";
+  return testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"car2", 0.0, 0.0}, sim));
+}
+
+}  // namespace
+
+TEST_CASE("anticlimber shear failure, bending failure then override under prescribed motion",
+          "[elements][anticlimber]") {
+  Parameters p;
+  p.horizontal.rupture = 0.5;
+  p.vertical.rupture = 0.1;
+  p.torsional.rupture = 0.05;
+  p.misalignment = 0.02;
+  p.face_height = 0.2;
+  const Drive drive{1.0, 0.5, 0.2};
+  // Contact at t = 0.1 (gap 0.1 at 1 m/s) with v = 0.02 + 0.5 * 0.1 = 0.07 < 0.2: engaged.
+  // Then d_h = t - 0.1, d_v = 0.5 (t - 0.1), d_t = 0.2 (t - 0.1):
+  struct Expected {
+    const char* what;
+    double t, value;
+  };
+  const Expected expected[] = {
+      {"contact", 0.1, 0.0},
+      {"horizontal yield", 0.11, 0.01},   // d_h = 0.01
+      {"vertical yield", 0.14, 0.02},     // d_v = 0.02
+      {"torsional yield", 0.15, 0.01},    // d_t = 0.01
+      {"shear failure", 0.30, 0.1},       // d_v = vertical rupture
+      {"bending failure", 0.35, 0.05},    // d_t = torsional rupture
+      {"override", 0.36, 0.2},            // v = 0.07 + 0.5 (t - 0.1) reaches the face height
+  };
+  for (const char* integrator : {"ida", "euler"}) {
+    const bool ida = std::string(integrator) == "ida";
+    INFO(integrator);
+    const Model model = driven_model(p, drive, integrator, 0.4);
+    const Run run = simulate(model);
+    const RunOutcome& o = run.outcome;
+    INFO(event_list(o));
+    REQUIRE(o.events.size() == std::size(expected));
+    // Prescribed to ~1e-6 m by the heavy car (Euler: also within one step of 1e-5 s).
+    const double time_tol = ida ? 5e-6 : 3e-5, value_tol = ida ? 1e-8 : 2e-5;
+    for (std::size_t k = 0; k < std::size(expected); ++k) {
+      INFO("event " << k);
+      CHECK(o.events[k].what == expected[k].what);
+      CHECK(o.events[k].t == Approx(expected[k].t).epsilon(0).margin(time_tol));
+      CHECK(o.events[k].value == Approx(expected[k].value).epsilon(0).margin(value_tol));
+    }
+    const Anticlimber& ac = anticlimber_of(model);
+    CHECK(ac.overridden());
+    CHECK(ac.override_time() == Approx(0.36).epsilon(0).margin(time_tol));
+    CHECK(ac.state().vertical.mode == Mode::Failed);
+    CHECK(ac.state().torsional.mode == Mode::Failed);
+    const DaeSystem system(model);
+    const std::vector<double> out = element_outputs(system, o.y);
+    CHECK(out[7] == 1.0);
+    CHECK(out[0] == 0.0);
+    // All the work done is dissipated: the three areas under the bilinear curves up to the
+    // crush at override (0.26), the vertical and the torsional rupture.
+    const double work = bilinear_work(p.horizontal, 0.26) + bilinear_work(p.vertical, 0.1) + bilinear_work(p.torsional, 0.05);
+    CHECK(work == Approx(2862.5 + 366.4 + 4.58).epsilon(1e-12));  // by hand: the test's own arithmetic
+    CHECK(element_work(o) == Approx(work).epsilon(ida ? 2e-5 : 1e-3));
+    const EnergyBalance balance = EnergyBalance::between(o.initial_energy, o.final_energy);
+    CHECK(balance.elastic == 0.0);
+  }
+}
+
+TEST_CASE("anticlimber crushing failure at the horizontal rupture deflection ends all forces", "[elements][anticlimber]") {
+  for (const bool from_length : {false, true}) {
+    INFO(from_length ? "rupture from length" : "rupture given");
+    Parameters p;
+    if (from_length)
+      p.length = 0.5;
+    else
+      p.horizontal.rupture = 0.5;
+    const Model model = driven_model(p, Drive{1.0, 0.0, 0.0}, "ida", 0.7);
+    const Run run = simulate(model);
+    const RunOutcome& o = run.outcome;
+    INFO(event_list(o));
+    REQUIRE(o.events.size() == 3);
+    CHECK(o.events[0].what == "contact");
+    CHECK(o.events[1].what == "horizontal yield");
+    CHECK(o.events[2].what == "crushing failure");
+    CHECK(o.events[2].t == Approx(0.6).epsilon(0).margin(5e-6));
+    CHECK(o.events[2].value == Approx(0.5).epsilon(0).margin(1e-8));
+    const Anticlimber& ac = anticlimber_of(model);
+    CHECK(ac.state().contact == Anticlimber::Contact::Crushed);
+    CHECK_FALSE(ac.overridden());
+    CHECK(element_work(o) == Approx(6150.5).epsilon(2e-5));  // 50 + 1e4 * 0.49 + 1e4 * 0.49^2 / 2
+    CHECK(bilinear_work(p.horizontal, 0.5) == Approx(6150.5).epsilon(1e-12));
+    const DaeSystem system(model);
+    const std::vector<double> out = element_outputs(system, o.y);
+    CHECK(out[0] == 0.0);
+    CHECK(out[3] > 0.55);  // the car kept going through the crushed structure
+  }
+}
+
+TEST_CASE("anticlimber faces that miss each other override at contact", "[elements][anticlimber]") {
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    Parameters p;
+    p.misalignment = 0.25;  // above the face height 0.2
+    const std::vector<BodySpec> bodies{{"b", 10.0, 1.0, 0.1, 0.0, 0.0, -1.0, 0.0, 0.0}};
+    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0},
+                                                            std::string("t_end: 0.3, integrator: ") + integrator + ", dt: 1e-5"));
+    const Run run = simulate(model);
+    INFO(event_list(run.outcome));
+    REQUIRE(run.outcome.events.size() == 1);
+    CHECK(run.outcome.events[0].what == "override");
+    CHECK(run.outcome.events[0].t == Approx(0.1).epsilon(0).margin(2e-5));
+    CHECK(run.outcome.events[0].value == Approx(0.25).epsilon(1e-12));
+    CHECK(run.outcome.y[3] == -1.0);  // never touched
+    CHECK(anticlimber_of(model).overridden());
+  }
+}
+
+TEST_CASE("anticlimber re-contact starts at the permanent crush and reloading at the largest crush",
+          "[elements][anticlimber]") {
+  // A mass hits the anticlimber, rebounds and is pushed back by a growing load: the second
+  // contact is at the permanent crush p = d_u - F_u(d_u) / k_e of the first unloading at d_u,
+  // and plastic flow resumes exactly at d_u.
+  const Parameters p;
+  const std::vector<BodySpec> bodies{{"b", 100.0, 1.0, 0.1, 0.0, 0.0, -2.0, 0.0, 0.0}};
+  const std::string load = "  - {type: force, body: b, value: [[0, 0, 0], [1, -20000, 0]]}\n";
+  const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0},
+                                                          "t_end: 0.6, rtol: 1e-10", "", load));
+  const Run run = simulate(model);
+  const RunOutcome& o = run.outcome;
+  INFO(event_list(o));
+  const EventRecord* unloading = find_event(o, "horizontal unloading");
+  const EventRecord* separation = find_event(o, "separation");
+  const EventRecord* second = find_event(o, "contact", 2);
+  const EventRecord* reloading = find_event(o, "horizontal reloading");
+  REQUIRE(unloading != nullptr);
+  REQUIRE(separation != nullptr);
+  REQUIRE(second != nullptr);
+  REQUIRE(reloading != nullptr);
+  CHECK(unloading->t < separation->t);
+  CHECK(separation->t < second->t);
+  CHECK(second->t < reloading->t);
+  const double d_u = unloading->value;
+  const LawValues& h = p.horizontal;
+  const double permanent = d_u - (h.yield_force() + h.plastic * (d_u - h.yield)) / h.elastic;
+  REQUIRE(permanent > 1e-3);  // a real offset, not zero
+  CHECK(separation->value == Approx(permanent).epsilon(0).margin(1e-9));
+  CHECK(second->value == Approx(permanent).epsilon(0).margin(1e-9));
+  CHECK(reloading->value == Approx(d_u).epsilon(0).margin(1e-9));
+}
+
+TEST_CASE("anticlimber commit engages a fresh interlock after a separation and ignores stale crossings",
+          "[elements][anticlimber]") {
+  Parameters p;
+  p.misalignment = 0.01;
+  const std::vector<BodySpec> bodies{{"b", 10.0, 1.0, 0.1, 0.03, 0.0, 0.0, 0.0, 0.0}};
+  const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, "t_end: 1"));
+  Anticlimber& ac = anticlimber_of(model);
+  const auto state_at = [](double x, double y, double vx) {
+    ElementState<double> s;
+    s.q[1] = {x, y, 0.0};  // slot 0 is the ground (point 1), slot 1 the body
+    s.v[1] = {vx, 0.0, 0.0};
+    return s;
+  };
+  Element::Event event;
+  // Still apart: the contact root is positive, nothing to commit.
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.0, state_at(0.01, 0.03, -1.0), nullptr, event));
+  // A rising crossing never leaves a mode.
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, 1, 0.0, state_at(0.0, 0.03, -1.0), nullptr, event));
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, event));
+  CHECK(event.what == "contact");
+  CHECK(ac.state().contact == Anticlimber::Contact::Engaged);
+  CHECK(ac.state().vertical_reference == Approx(0.04).epsilon(1e-15));  // y + misalignment
+  // A root of the open mode is no longer active.
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, event));
+  // Faces open again (d_h < 0): separation through the horizontal law's lower bound.
+  REQUIRE(ac.commit(Anticlimber::kHorizontalRoots + 1, -1, 0.2, state_at(0.001, 0.05, 1.0), nullptr, event));
+  CHECK(event.what == "separation");
+  CHECK(ac.state().contact == Anticlimber::Contact::Open);
+  // Re-contact higher up: the interlock takes the new offset as its reference.
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.3, state_at(0.0, 0.08, -1.0), nullptr, event));
+  CHECK(ac.state().vertical_reference == Approx(0.09).epsilon(1e-15));
+  // An Euler step that lands beyond yield in one go: contact and yield in one commit.
+  ac.reset_modes();
+  REQUIRE(ac.state().contact == Anticlimber::Contact::Open);
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(-0.02, 0.03, -1.0), nullptr, event));
+  CHECK(event.what == "contact, horizontal yield");
+  CHECK(event.value == Approx(0.02).epsilon(1e-12));
+  CHECK(ac.state().horizontal.mode == Mode::PlasticUp);
+}
+
+TEST_CASE("anticlimber crush under Euler converges to the closed form as the step shrinks", "[elements][anticlimber]") {
+  const double mass = 100.0, speed = 2.0, gap = 0.1;
+  const Parameters p;
+  const Crush c = crush_of(p.horizontal, mass, speed);
+  const auto rebound_error = [&](const std::string& integrator, double dt) {
+    const std::vector<BodySpec> bodies{{"b", mass, 1.0, gap, 0.0, 0.0, -speed, 0.0, 0.0}};
+    const std::string sim = "t_end: 0.15, integrator: " + integrator + ", rtol: 1e-10, dt: " + number(dt);
+    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim));
+    const Run run = simulate(model);
+    return std::abs(run.outcome.y[3] - c.rebound_speed);
+  };
+  const double e1 = rebound_error("euler", 4e-5), e2 = rebound_error("euler", 1e-5), e3 = rebound_error("euler", 2.5e-6);
+  const double ida = rebound_error("ida", 0.0 + 1e-6);
+  INFO("errors " << e1 << " " << e2 << " " << e3 << " ida " << ida);
+  CHECK(e2 < 0.5 * e1);
+  CHECK(e3 < 0.5 * e2);
+  CHECK(e3 < 1e-3 * c.rebound_speed);
+  CHECK(ida < 1e-7 * c.rebound_speed);
+}
