@@ -317,11 +317,14 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
         if (changed) {
           std::copy(y_now.begin(), y_now.end(), y);
           std::copy(yp_now.begin(), yp_now.end(), yp);
-          impl.accumulate(outcome.stats);
-          impl.check(IDAReInit(impl.ida, t_reached, impl.y, impl.yp), "IDAReInit");
-          impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
-          ++outcome.stats.reinitializations;
         }
+        // Restart even when no mode changed: a root that stays at zero (e.g. a rate that
+        // remains zero) would otherwise stop IDA with "root found at and very near t"; at a
+        // restart IDA leaves it inactive until it moves.
+        impl.accumulate(outcome.stats);
+        impl.check(IDAReInit(impl.ida, t_reached, impl.y, impl.yp), "IDAReInit");
+        impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
+        ++outcome.stats.reinitializations;
         if (t_reached < t_out * (1.0 - 1e-14)) continue;
       }
       observer.sample(t_reached, y, lambda, quad);

@@ -251,7 +251,6 @@ void Anticlimber::transition(int index, double t, const Deformations& k, std::st
       state_.contact = Contact::Open;
       add("separation");
       break;
-    case ElasticPlasticLaw::Outcome::None: break;
   }
 }
 
@@ -311,9 +310,13 @@ bool Anticlimber::commit(int index, int direction, double t, const ElementState<
   double g[kRootCount];
   roots_of(k, g);
   if (g[index] > 0.0) return false;  // an earlier commit at this instant already changed the mode
-  const double value = index == kOverrideRoot ? k.offset : k.d[index == kContactRoot ? 0 : index / 3];
   std::string what;
   transition(index, t, k, what);
+  // The event's value: the offset v for an override (also faces missing each other at
+  // contact), else the deformation of the direction concerned (d_h for contact).
+  const double value = (index == kOverrideRoot || (index == kContactRoot && overridden()))
+                           ? k.offset
+                           : k.d[index == kContactRoot ? 0 : index / 3];
   settle(t, s, what);
   event = {what, value};
   return true;

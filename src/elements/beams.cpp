@@ -65,6 +65,14 @@ BeamSection tapered_section(double h1, double h2, double w1, double w2) {
 
 const char* const kComponentName[3] = {"axial", "end 1", "end 2"};
 
+// The elastic-mode yield root fires at |F - c p| = (1 + kYieldMargin) Y. Right after an
+// unloading (a turning point: the flow rate is zero there) the yield function starts at zero
+// and leaves it only quadratically; a rounding-level negative start would then look to IDA
+// like a crossing right at the restart that it cannot separate from it ("root found at and
+// very near t"). The margin keeps the root strictly positive at every restart; the yield
+// level it shifts (1e-9 relative) is far below any tolerance a model runs at.
+constexpr double kYieldMargin = 1e-9;
+
 }  // namespace
 
 // ---- the two section types ---------------------------------------------------------------
@@ -181,7 +189,7 @@ void BeamElement::roots(double, const ElementState<double>& s, const double*, do
   evaluate(s, force, offset, &rate);
   for (std::size_t k = 0; k < 3; ++k) {
     const int sign = state_.sign[k];
-    g[k] = sign == 0 ? 1.0 - std::abs(force[k] - hardening_[k] * offset[k]) / yield_[k] : sign * rate[k];
+    g[k] = sign == 0 ? 1.0 + kYieldMargin - std::abs(force[k] - hardening_[k] * offset[k]) / yield_[k] : sign * rate[k];
   }
   g[3] = 1.0 - stress(force) / material.ultimate_stress;
 }

@@ -27,7 +27,7 @@ std::string describe(AxialHysteresis::Change change, const AxialHysteresis::Stat
     case C::OnUpperCurve: return "back on the loading curve" + side;
     case C::Released: return "released" + side;
     case C::Centre: return law.preloaded() ? "neutral" : "in the slack";
-    case C::SideChange: return "through zero force to" + side.substr(1, side.size() - 2);
+    case C::SideChange: return std::string("through zero force to ") + side_name(st.side);
     case C::SegmentUp:
     case C::SegmentDown: break;
   }
@@ -129,10 +129,10 @@ void AxialHysteresis::roots(const State& st, double u, double rate, double* g) c
       segment_ends(st.segment);
       break;
     case Mode::Transition: {
-      const double force = st.f0 + kt * (x - st.x0);
-      g[0] = upper.at(x) - force;
-      g[1] = force - lower.at(x);
-      g[2] = force;
+      // Leaves where the line rejoins U going up, or meets Lw / zero force going down.
+      const double up = rejoin_upper(st.x0, st.f0);
+      if (std::isfinite(up)) g[0] = up - x;
+      g[1] = x - std::max(rejoin_lower(st.x0, st.f0), st.x0 - st.f0 / kt);
       break;
     }
     case Mode::Unloading:
@@ -172,12 +172,12 @@ AxialHysteresis::Change AxialHysteresis::transition(State& st, int index, double
         st.segment = upper.segment_of(x);
         return Change::OnUpperCurve;
       }
-      if (index == 1) {
+      if (rejoin_lower(st.x0, st.f0) > st.x0 - st.f0 / transition_stiffness && x > 0.0) {
         st.mode = Mode::Unloading;
         st.segment = lower.segment_of(x);
         return Change::OnLowerCurve;
       }
-      return leave_at_zero(st, u);
+      return leave_at_zero(st, u);  // zero force before the unloading curve
     case Mode::Unloading:
       if (index == 0) {
         st.f0 = lower.on_segment(st.segment, x);
@@ -281,25 +281,40 @@ double AxialHysteresis::energy(const State& st, double u) const {
   return 0.0;
 }
 
+double AxialHysteresis::rejoin_upper(double x0, double f0) const {
+  const double kt = transition_stiffness;
+  for (int j = upper.segment_of(x0); j < upper.segments(); ++j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double low = std::max(x0, upper.start[k]);
+    const double high = j + 1 < upper.segments() ? upper.start[k + 1] : std::numeric_limits<double>::infinity();
+    const double gap = f0 + kt * (low - x0) - upper.on_segment(j, low);  // line - U, non-decreasing in x
+    if (gap >= 0.0) return low;
+    const double closing = kt - upper.slope[k];
+    if (closing > 0.0 && low - gap / closing <= high) return low - gap / closing;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+double AxialHysteresis::rejoin_lower(double x0, double f0) const {
+  const double kt = transition_stiffness;
+  for (int j = lower.segment_of(x0); j >= 0; --j) {
+    const auto k = static_cast<std::size_t>(j);
+    const double high = j + 1 < lower.segments() ? std::min(x0, lower.start[k + 1]) : x0;
+    const double low = j > 0 ? lower.start[k] : -std::numeric_limits<double>::infinity();
+    const double gap = f0 + kt * (high - x0) - lower.on_segment(j, high);  // line - Lw, non-decreasing in x
+    if (gap <= 0.0) return high;
+    const double closing = kt - lower.slope[k];
+    if (closing > 0.0 && high - gap / closing >= low) return high - gap / closing;
+  }
+  return -std::numeric_limits<double>::infinity();
+}
+
 double AxialHysteresis::unload_from(double x, double force) const {
   if (force <= 0.0) return 0.0;
-  const double kt = transition_stiffness;
-  const double triangle = 0.5 * force * force / kt;  // down the transition line to zero force
-  const double x_zero = x - force / kt;
-  for (int j = lower.segment_of(x); j >= 0; --j) {
-    const auto k = static_cast<std::size_t>(j);
-    const double l = lower.slope[k];
-    if (!(kt > l)) continue;  // parallel to this segment: no meeting on it
-    // force + kt (xi - x) = value_k + l (xi - start_k)
-    const double xi = (lower.value[k] - l * lower.start[k] - force + kt * x) / (kt - l);
-    const double low_end = j > 0 ? lower.start[k] : -std::numeric_limits<double>::infinity();
-    const double high_end = j + 1 < lower.segments() ? std::min(lower.start[k + 1], x) : x;
-    if (xi < low_end || xi > high_end) continue;
-    if (xi <= x_zero) return triangle;  // the line reaches zero force before the curve
-    const double meet = force + kt * (xi - x);
-    return 0.5 * (force + meet) * (x - xi) + lower_tail(xi);
-  }
-  return triangle;
+  const double meet = rejoin_lower(x, force);
+  if (meet <= x - force / transition_stiffness)  // the line reaches zero force before Lw
+    return 0.5 * force * force / transition_stiffness;
+  return 0.5 * (force + lower.at(meet)) * (x - meet) + lower_tail(meet);
 }
 
 double AxialHysteresis::lower_tail(double x) const {

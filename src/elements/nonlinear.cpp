@@ -98,22 +98,12 @@ PiecewiseLineElement<Derived>::PiecewiseLineElement(ElementSpec& spec, int fract
 template <class Derived>
 void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initial) {
   Derived& self = *static_cast<Derived*>(this);
-  const LineGeometry<double> g = line_geometry(*this, initial);
-  if (g.length == 0.0)
-    throw InputError(this->where_.prefix() + this->type_ + " '" + this->name_ +
-                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
-  self.prepare(g.length);
-  double scale = self.kink_scale();
-  for (double b : law_.breakpoints()) scale = std::max(scale, std::abs(b));
-  kink_tolerance_ = 1e-9 * scale;
-
-  const double x = self.measure(g);
-  const int rate = self.rate_sign(g);
+  self.prepare(initial);
+  const double x = self.measure(initial);
   mode_ = SegmentMode{};
-  mode_.segment = law_.segment_at(x, rate > 0 ? 1 : -1);
-  // On a breakpoint with no rate information: the lower segment, left a kink tolerance
-  // beyond the breakpoint (a root exactly zero at the start would never fire).
-  if (rate == 0 && law_.has_upper(mode_.segment) && x == law_.upper(mode_.segment)) mode_.upper_shift = kink_tolerance_;
+  // On a breakpoint: the segment x moves into; the lower one when that is unknown (the
+  // integrators' start check commits the crossing if the motion goes up).
+  mode_.segment = law_.segment_at(x, self.rate_sign(initial) > 0 ? 1 : -1);
   if (fracture_roots() > 0) {
     const double f = law_.value(x, mode_.segment);
     if (f >= *fracture_load || (fracture_roots() > 1 && -f >= *fracture_load))
@@ -131,7 +121,7 @@ void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s,
   const double x = measure_of(s);
   const int k = mode_.segment;
   if (law_.has_lower(k)) g[0] = x - law_.lower(k);
-  if (law_.has_upper(k)) g[1] = law_.upper(k) + mode_.upper_shift - x;
+  if (law_.has_upper(k)) g[1] = law_.upper(k) - x;
   if (fracture_roots() > 0) {
     const double f = law_.value(x, k);
     g[2] = *fracture_load - f;
@@ -158,9 +148,20 @@ bool PiecewiseLineElement<Derived>::commit(int index, int direction, double, con
   if (to == mode_.segment) return false;
   const int from = mode_.segment;
   mode_.segment = to;
-  mode_.upper_shift = 0.0;
   event = static_cast<const Derived*>(this)->segment_event(from, to, x);
   return true;
+}
+
+template <class Derived>
+double PiecewiseLineElement<Derived>::law_integral(const ElementState<double>& s) const {
+  return mode_.broken ? 0.0 : law_.integral(measure_of(s), mode_.segment);
+}
+
+template <class Derived>
+void PiecewiseLineElement<Derived>::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const double x = measure_of(s);
+  out[0] = law_value(x);
+  out[1] = x;
 }
 
 namespace {
@@ -168,7 +169,18 @@ namespace {
 int sign_of(double value) { return (value > 0.0) - (value < 0.0); }
 
 /// Rate of length L' = u . (r2' - r1').
-double length_rate(const LineGeometry<double>& g) { return dot(g.d, g.d_rate) / g.length; }
+double length_rate(const ElementState<double>& s, const Element& e) {
+  const LineGeometry<double> g = line_geometry(e, s);
+  return dot(g.d, g.d_rate) / g.length;
+}
+
+/// The line elements need a direction: their points must not coincide at the start.
+void require_direction(const Element& e, const ElementState<double>& initial) {
+  if (line_geometry(e, initial).length == 0.0)
+    throw InputError(e.where().prefix() + e.type() + " '" + e.name() +
+                     "': its two points coincide in the initial configuration, so it has no direction; move them apart" +
+                     (e.type() == "special_spring" ? " or give it an axis" : ""));
+}
 
 /// slope_1 (required), slope_2 and breakpoint (together or neither), all >= 0.
 PiecewiseLinearLaw::Branch read_branch(ParameterReader& p, const std::string& slope_1, const std::string& slope_2,
@@ -202,24 +214,14 @@ NonlinearSpring::NonlinearSpring(ElementSpec& spec)
   set_law(PiecewiseLinearLaw::two_branch(-preload, compression, "compression", extension, "extension"));
 }
 
-int NonlinearSpring::rate_sign(const LineGeometry<double>& g) const { return sign_of(length_rate(g)); }
+int NonlinearSpring::rate_sign(const ElementState<double>& s) const { return sign_of(length_rate(s, *this)); }
 
-void NonlinearSpring::prepare(double initial_length) {
-  if (!free_length) free_length = initial_length;
+void NonlinearSpring::prepare(const ElementState<double>& initial) {
+  require_direction(*this, initial);
+  if (!free_length) free_length = line_geometry(*this, initial).length;
 }
 
 Element::Event NonlinearSpring::segment_event(int, int to, double x) const { return {law().segment(to).name, x}; }
-
-double NonlinearSpring::potential_energy(const ElementState<double>& s) const {
-  if (mode().broken) return 0.0;
-  return law().integral(measure_of(s), mode().segment);
-}
-
-void NonlinearSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
-  const double deformation = measure_of(s);
-  out[0] = law_value(deformation);  // tension positive
-  out[1] = deformation;
-}
 
 // ---- nonlinear_dashpot -------------------------------------------------------------------
 
@@ -231,15 +233,11 @@ NonlinearDashpot::NonlinearDashpot(ElementSpec& spec)
   set_law(PiecewiseLinearLaw::two_branch(0.0, compression, "compression", extension, "extension"));
 }
 
-void NonlinearDashpot::prepare(double) {}
+double NonlinearDashpot::measure(const ElementState<double>& s) const { return length_rate(s, *this); }
+
+void NonlinearDashpot::prepare(const ElementState<double>& initial) { require_direction(*this, initial); }
 
 Element::Event NonlinearDashpot::segment_event(int, int to, double x) const { return {law().segment(to).name, x}; }
-
-void NonlinearDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
-  const double rate = measure_of(s);
-  out[0] = law_value(rate);  // tension positive
-  out[1] = rate;
-}
 
 // ---- special_spring ----------------------------------------------------------------------
 
@@ -251,7 +249,13 @@ SpecialSpring::SpecialSpring(ElementSpec& spec) : PiecewiseLineElement<SpecialSp
   kind = static_cast<int>(kind_value);
   closed = read_branch(p, "stiffness_1", "stiffness_2", "breakpoint");
   preload = p.optional_nonnegative("preload").value_or(0.0);
-  free_length = p.optional_positive("free_length");
+  if (const auto a = p.vector("axis", 2)) {
+    const double size = std::hypot((*a)[0], (*a)[1]);
+    if (!(size > 0.0)) p.fail("axis", "'axis' must be a nonzero direction [ax, ay]");
+    axis = Vec2<double>{(*a)[0] / size, (*a)[1] / size};
+  }
+  // Along an axis the separation s has a sign, so any free length will do.
+  free_length = axis ? p.number("free_length") : p.optional_positive("free_length");
   fracture_load = p.optional_positive("fracture_load");
   if (fracture_load && preload >= *fracture_load)
     p.fail("preload", "'preload' must be below 'fracture_load' (the spring would break as soon as it closes)");
@@ -267,29 +271,33 @@ SpecialSpring::SpecialSpring(ElementSpec& spec) : PiecewiseLineElement<SpecialSp
   set_law(PiecewiseLinearLaw(breakpoints, segments));
 }
 
-int SpecialSpring::rate_sign(const LineGeometry<double>& g) const {
-  return sign_of(-direction() * length_rate(g));
+double SpecialSpring::separation(const ElementState<double>& s) const {
+  return axis ? axis_geometry(s).along : line_geometry(*this, s).length;
 }
 
-void SpecialSpring::prepare(double initial_length) {
-  if (!free_length) free_length = initial_length;
+int SpecialSpring::rate_sign(const ElementState<double>& s) const {
+  if (!axis) return sign_of(-direction() * length_rate(s, *this));
+  // s' = (r2' - r1') . a + (r2 - r1) . a',  a' = omega_1 perp(a)
+  const AxisGeometry<double> g = axis_geometry(s);
+  const PointRef& p1 = point(0);
+  const PointRef& p2 = point(1);
+  const std::size_t k1 = slot_of(0), k2 = slot_of(1);
+  const Vec2<double> r1 = point_position(s.q[k1], p1.sx, p1.sy);
+  const Vec2<double> relative_rate =
+      point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy) - point_velocity(s.q[k1], s.v[k1], p1.sx, p1.sy);
+  const Vec2<double> a_rate{-s.v[k1].theta * g.a.y, s.v[k1].theta * g.a.x};
+  return sign_of(-direction() * (dot(relative_rate, g.a) + dot(g.r2 - r1, a_rate)));
+}
+
+void SpecialSpring::prepare(const ElementState<double>& initial) {
+  if (!axis) require_direction(*this, initial);
+  if (!free_length) free_length = separation(initial);
 }
 
 Element::Event SpecialSpring::segment_event(int from, int to, double x) const {
   if (to == 0) return {"opening", x};
   if (from == 0) return {"closing (" + law().segment(to).name + ")", x};
   return {law().segment(to).name, x};
-}
-
-double SpecialSpring::potential_energy(const ElementState<double>& s) const {
-  if (mode().broken) return 0.0;
-  return law().integral(measure_of(s), mode().segment);
-}
-
-void SpecialSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
-  const double deflection = measure_of(s);
-  out[0] = law_value(deflection);  // in the working direction, >= 0
-  out[1] = deflection;
 }
 
 template class PiecewiseLineElement<NonlinearSpring>;

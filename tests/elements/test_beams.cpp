@@ -179,7 +179,14 @@ Run simulate(const std::string& yaml) {
   return run;
 }
 
-std::string ida(double t_end) { return "t_end: " + num(t_end) + ", integrator: ida, rtol: 1.0e-10, atol: 1.0e-13"; }
+std::string ida(double t_end, double rtol = 1e-10) {
+  return "t_end: " + num(t_end) + ", integrator: ida, rtol: " + num(rtol) + ", atol: 1.0e-13";
+}
+// The heavy-body tests (a 1e15 kg body driven at a known speed) move exactly linearly in time,
+// so only the error test of the work quadratures limits IDA's steps, and IDA scales that by
+// the model's energy (here the huge kinetic energy): those runs need a tighter rtol for the
+// elements' work to be accurate.
+constexpr double kHeavyRtol = 1e-12;
 std::string euler(double t_end, double dt) {
   return "t_end: " + num(t_end) + ", integrator: euler, dt: " + num(dt) + ", output_interval: " + num(t_end);
 }
@@ -444,14 +451,24 @@ TEST_CASE("a plastic hinge forms at M_p under a growing tip moment and hardens w
     } else {
       CHECK(std::abs(hinge.t - t_hinge) < 3.0 * dt);
       CHECK(hinge.value == Approx(mp).epsilon(1e-3));
-      CHECK(run.q[2] - theta_h == Approx(u).epsilon(1e-2));
-      CHECK(run.outputs[kMoment2] - mp == Approx(kt * u).epsilon(1e-2));
+      CHECK(run.q[2] - theta_h == Approx(u).epsilon(1e-3));
+      CHECK(run.outputs[kMoment2] - mp == Approx(kt * u).epsilon(1e-3));
     }
     CHECK(run.outputs[kMoment1] == Approx(0.5 * run.outputs[kMoment2]).epsilon(1e-6));
-    // The hinge rotation is what the elastic beam does not take: theta - M_2 / k... with the
-    // far end fixed, phi_2p = theta - (M_2 - k12 phi_1) / k22 = theta - M_2 / k.
+    // The hinge rotation is what the elastic beam does not take: with phi_1 = 0,
+    // M_2 = k22 (phi_2 - phi_2p), so phi_2p = theta - M_2 / k.
     CHECK(run.outputs[kHinge2] == Approx(run.q[2] - run.outputs[kMoment2] / k).epsilon(1e-9));
     CHECK(run.outputs[kHinge1] == 0.0);
+    // Energy: the work of M_2 (M_1 acts on the ground) is M_p theta_h / 2 + M_p u + k_t u^2 / 2;
+    // the beam keeps M_2^2 / (2 k) elastically, the rest is dissipated in the hinge.
+    const double m2 = mp + kt * u;
+    const double work = 0.5 * mp * theta_h + mp * u + 0.5 * kt * u * u;
+    const double dissipated = work - m2 * m2 / (2.0 * k);
+    REQUIRE(dissipated > 0.1 * work);
+    CHECK(run.outcome.quadratures[DaeSystem::kFirstElementWork] == Approx(work).epsilon(use_ida ? 1e-6 : 1e-3));
+    CHECK(run.potential == Approx(m2 * m2 / (2.0 * k)).epsilon(use_ida ? 1e-6 : 1e-3));
+    const EnergyBalance balance = EnergyBalance::between(run.outcome.initial_energy, run.outcome.final_energy);
+    CHECK(balance.dissipated == Approx(dissipated).epsilon(use_ida ? 1e-6 : 1e-3));
   }
 }
 
@@ -516,9 +533,9 @@ TEST_CASE("axial yield then unloading with the plastic offset remembered then re
     CHECK(half.outputs[kForce] == Approx(c.ka * (half.outputs[kStretch] - c.plastic_stretch)).margin(tolerance * c.ny));
     // Dissipated energy: the loop area so far (loading work minus what unloading gives back).
     const double work = half.outcome.quadratures[DaeSystem::kFirstElementWork];
-    CHECK(work - half.potential == Approx(c.dissipated).epsilon(use_ida ? 1e-7 : 2e-3));
+    CHECK(work - half.potential == Approx(c.dissipated).epsilon(use_ida ? 1e-7 : 1e-3));
     const EnergyBalance balance = EnergyBalance::between(half.outcome.initial_energy, half.outcome.final_energy);
-    CHECK(balance.dissipated == Approx(c.dissipated).epsilon(use_ida ? 1e-7 : 2e-3));
+    CHECK(balance.dissipated == Approx(c.dissipated).epsilon(use_ida ? 1e-7 : 1e-3));
     CHECK(std::abs(balance.error()) < (use_ida ? 1e-6 : 1e-3) * balance.initial_total);
 
     // Kinematic hardening: the reversed yield comes at N_max - 2 N_y, not at -N_y.
@@ -559,7 +576,7 @@ TEST_CASE("the beam fractures when the axial stress reaches the ultimate stress"
   for (const bool use_ida : {true, false}) {
     const double dt = 1e-4, t_end = 1.0;
     INFO((use_ida ? "ida" : "euler"));
-    const Run run = simulate(cantilever_model(body, steel.parameters(), use_ida ? ida(t_end) : euler(t_end, dt)));
+    const Run run = simulate(cantilever_model(body, steel.parameters(), use_ida ? ida(t_end, kHeavyRtol) : euler(t_end, dt)));
     REQUIRE(run.outcome.events.size() == 2);
     const double time_tolerance = use_ida ? 1e-7 : 2.0 * dt;
     const EventRecord& yield = event_at(run.outcome, 0);
@@ -591,7 +608,7 @@ TEST_CASE("a plastic hinge forms at M_p and fractures at sigma_u Z under a stead
   for (const bool use_ida : {true, false}) {
     const double dt = 1e-4, t_end = 1.5;
     INFO((use_ida ? "ida" : "euler"));
-    const Run run = simulate(cantilever_model(body, steel.parameters(), use_ida ? ida(t_end) : euler(t_end, dt)));
+    const Run run = simulate(cantilever_model(body, steel.parameters(), use_ida ? ida(t_end, kHeavyRtol) : euler(t_end, dt)));
     REQUIRE(run.outcome.events.size() == 2);
     const double time_tolerance = use_ida ? 1e-7 : 2.0 * dt;
     const EventRecord& hinge = event_at(run.outcome, 0);
@@ -603,6 +620,64 @@ TEST_CASE("a plastic hinge forms at M_p and fractures at sigma_u Z under a stead
     CHECK(std::abs(fracture.t - theta_f / w0) < time_tolerance);
     CHECK(run.outputs[kFailed] == 1.0);
     CHECK(run.outputs[kMoment2] == 0.0);
+    // All the work of M_2 on the turning tip (M_1 does none: phi_1 = 0) was dissipated.
+    const double work = 0.5 * mp * theta_h + 0.5 * (mp + mu) * (theta_f - theta_h);
+    CHECK(run.outcome.quadratures[DaeSystem::kFirstElementWork] == Approx(work).epsilon(use_ida ? 1e-6 : 1e-3));
+  }
+}
+
+TEST_CASE("a hinge unloads when the tip turns back and yields again in reverse at M_max - 2 M_p", "[elements][beams]") {
+  // A very heavy tip rotor slowed by a constant moment: theta = w0 t - a t^2 / 2 exactly (the
+  // beam's moments are 1e-11 of the load), phi_1 = 0, phi_2 = theta. Hinge 2 forms at
+  // theta_h = M_p / k22, unloads at the turning point t = w0 / a with
+  // M_max = M_p + k_t (theta_max - theta_h), keeps phi_2p = theta_max - M_max / k22, and yields
+  // in reverse where M_2 = M_max - 2 M_p, i.e. at theta = theta_max - 2 theta_h.
+  Steel steel;
+  steel.et = 2e10;
+  const double w0 = 0.1, accel = 0.2, big = 1e15, length = 1.0;
+  const double k22 = 4.0 * steel.e * steel.second_moment() / length, kt = k22 * steel.et / steel.e;
+  const double mp = steel.yield * steel.z(), theta_h = mp / k22;
+  const double t_turn = w0 / accel, theta_max = w0 * w0 / (2.0 * accel);
+  REQUIRE(theta_max > theta_h);
+  const double t_hinge = (w0 - std::sqrt(w0 * w0 - 2.0 * accel * theta_h)) / accel;
+  const double m_max = mp + kt * (theta_max - theta_h), hinge_rotation = theta_max - m_max / k22;
+  const double t_reverse = t_turn + std::sqrt(2.0 * (2.0 * theta_h) / accel);
+  const double dissipated = 0.5 * mp * theta_h + 0.5 * (mp + m_max) * (theta_max - theta_h) - m_max * m_max / (2.0 * k22);
+  const std::string body = "mass: " + num(big) + ", inertia: " + num(big) + ", position: [1.0, 0.0], angular_velocity: " + num(w0);
+  const std::string loads = "  - {type: moment, body: a, value: " + num(-big * accel) + "}\n";
+  for (const bool use_ida : {true, false}) {
+    const double dt = 1e-5;
+    INFO((use_ida ? "ida" : "euler"));
+    const auto settings = [&](double t_end) { return use_ida ? ida(t_end, kHeavyRtol) : euler(t_end, dt); };
+    const double time_tolerance = use_ida ? 1e-7 : 3.0 * dt;
+    const double tolerance = use_ida ? 1e-7 : 1e-3;
+    // Between the unloading and the reversed yield.
+    const double t_mid = 0.5 * (t_turn + t_reverse);
+    const Run mid = simulate(cantilever_model(body, steel.parameters(), settings(t_mid), "", loads));
+    REQUIRE(mid.outcome.events.size() == 2);
+    const EventRecord& hinge = event_at(mid.outcome, 0);
+    CHECK(hinge.what == "plastic hinge at end 2");
+    CHECK(std::abs(hinge.t - t_hinge) < time_tolerance);
+    const EventRecord& unload = event_at(mid.outcome, 1);
+    CHECK(unload.what == "hinge at end 2 unloading");
+    CHECK(std::abs(unload.t - t_turn) < time_tolerance);
+    CHECK(unload.value == Approx(m_max).epsilon(tolerance));
+    CHECK(mid.outputs[kHinge2] == Approx(hinge_rotation).epsilon(tolerance));
+    CHECK(mid.outputs[kMoment2] == Approx(k22 * (mid.q[2] - hinge_rotation)).epsilon(tolerance));
+    // The loop area. (Under IDA the work quadrature's tolerance scales with the model's energy,
+    // here that of the 2e14 N m decelerating load, far too loose for an 18 J loop: the IDA
+    // hinge energy is checked in the growing-moment test instead.)
+    if (!use_ida) {
+      const double work = mid.outcome.quadratures[DaeSystem::kFirstElementWork];
+      CHECK(work - mid.potential == Approx(dissipated).epsilon(1e-3));
+    }
+
+    const Run full = simulate(cantilever_model(body, steel.parameters(), settings(t_reverse + 0.05), "", loads));
+    REQUIRE(full.outcome.events.size() == 3);
+    const EventRecord& reverse = event_at(full.outcome, 2);
+    CHECK(reverse.what == "plastic hinge at end 2");
+    CHECK(std::abs(reverse.t - t_reverse) < time_tolerance);
+    CHECK(reverse.value == Approx(m_max - 2.0 * mp).epsilon(tolerance));
   }
 }
 

@@ -1,1 +1,921 @@
+// Couplers and draft gears: closed-form runs under both integrators (event times and values,
+// rebound speeds, loop areas, dissipated energy), forces against hand computations, the
+// Jacobian in every mode, Euler converging to IDA, and input errors.
+//
+// The closed forms: in every mode the element's force is linear in its deflection, so a
+// single mass tied to ground by the element moves harmonically (or uniformly) within each
+// mode; the walkers below chain these motions from mode to mode, computing each switch
+// time and position from the law stated in couplers.hpp.
 #include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "railcrash/elements/couplers.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kPi = std::acos(-1.0);
+
+std::string num(double value) {
+  std::ostringstream s;
+  s.precision(17);
+  s << value;
+  return s.str();
+}
+
+// ---- closed-form motion of one mass --------------------------------------------------------
+
+/// Motion of a mass m in a coordinate x under a force F = a + b x opposing x (m x'' = -F).
+struct LinearPhase {
+  double m, a, b;
+
+  /// Time until x reaches `target` moving towards it; NaN target: until the velocity is zero.
+  double time_to(double x, double v, double target) const {
+    if (b == 0.0) {
+      const double acc = -a / m;
+      if (std::isnan(target)) return -v / acc;
+      const double gap = target - x;
+      // x + v t + acc t^2 / 2 = target, first crossing (stable form)
+      return 2.0 * gap / (v + (v > 0.0 ? 1.0 : -1.0) * std::sqrt(v * v + 2.0 * acc * gap));
+    }
+    const double omega = std::sqrt(b / m), u0 = x + a / b, w = v / omega;
+    const double radius = std::hypot(u0, w), alpha = std::atan2(w, u0);
+    // u = x + a/b = R cos(omega t - alpha)
+    if (std::isnan(target)) return (v > 0.0 ? alpha : alpha + kPi) / omega;
+    const double angle = std::acos((target + a / b) / radius);
+    return (v > 0.0 ? alpha - angle : alpha + angle) / omega;
+  }
+  void advance(double& x, double& v, double t) const {
+    if (b == 0.0) {
+      const double acc = -a / m;
+      x += v * t + 0.5 * acc * t * t;
+      v += acc * t;
+      return;
+    }
+    const double omega = std::sqrt(b / m), u0 = x + a / b;
+    const double c = std::cos(omega * t), s = std::sin(omega * t);
+    x = u0 * c + v / omega * s - a / b;
+    v = -u0 * omega * s + v * c;
+  }
+};
+
+struct ExpectedEvent {
+  std::string what;
+  double t;
+  double value;
+};
+
+/// Chains linear phases; records the events and the force-deflection path.
+struct Walker {
+  Walker(double mass, double speed) : m(mass), v(speed) {}
+  double m;
+  double t = 0.0, x = 0.0, v;
+  std::vector<ExpectedEvent> events;
+  std::vector<std::array<double, 2>> path{{0.0, 0.0}};  // (x, force) corners
+
+  /// Moves under F = a + b x to `target` (NaN: to rest); logs `what` with `value_of(x)`.
+  template <class Value>
+  void go(double a, double b, double target, const std::string& what, Value value_of) {
+    const LinearPhase phase{m, a, b};
+    const double dt = phase.time_to(x, v, target);
+    REQUIRE(dt >= 0.0);
+    phase.advance(x, v, dt);
+    t += dt;
+    if (std::isnan(target)) v = 0.0;
+    else x = target;
+    events.push_back({what, t, value_of(x)});
+    path.push_back({x, a + b * x});
+  }
+  /// Area enclosed by the path (closed back to the origin along zero force).
+  double loop_area() const {
+    double twice = 0.0;
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      const auto& p = path[k];
+      const auto& q = path[(k + 1) % path.size()];
+      twice += p[0] * q[1] - q[0] * p[1];
+    }
+    return std::abs(0.5 * twice);
+  }
+};
+
+// ---- runs ---------------------------------------------------------------------------------
+
+struct Run {
+  RunOutcome outcome;
+  double x = 0.0, y = 0.0, vx = 0.0, vy = 0.0;  // the mass at t_end
+};
+
+Run run(const Model& model) {
+  const DaeSystem system(model);
+  struct Null : RunObserver {
+    void sample(double, const double*, const double*, const double*) override {}
+  } observer;
+  Run r;
+  r.outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, model.simulation.t_end / 4.0, observer);
+  INFO(r.outcome.message);
+  REQUIRE(r.outcome.ok);
+  r.x = r.outcome.y[0];
+  r.y = r.outcome.y[1];
+  r.vx = r.outcome.y[3];
+  r.vy = r.outcome.y[4];
+  return r;
+}
+
+/// A mass tied to ground by element `e`: the ground point at the origin, the mass's point at
+/// its centre; `element` holds the element's type and parameter lines.
+std::string one_mass(const std::string& element, double mass, double x, double y, double vx, double vy, double t_end,
+                     const std::string& integrator, double dt = 1e-6, const std::string& units = "SI",
+                     const std::string& loads = "") {
+  std::ostringstream s;
+  s << "railcrash: 1\nname: coupler test\nunits: " << units << "\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: mass, mass: " << num(mass) << ", inertia: 1, position: [" << num(x) << ", " << num(y)
+    << "], velocity: [" << num(vx) << ", " << num(vy) << "]}\n"
+    << "elements:\n  - name: e\n" << element << "    points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]\n"
+    << loads << "simulation: {t_end: " << num(t_end) << ", integrator: " << integrator
+    << ", rtol: 1e-10, dt: " << num(dt) << "}\n";
+  return s.str();
+}
+
+void check_events(const RunOutcome& outcome, const std::vector<ExpectedEvent>& expected, double t_margin,
+                  double value_margin) {
+  std::ostringstream seen;
+  for (const EventRecord& e : outcome.events) seen << e.t << " " << e.what << " " << e.value << "\n";
+  INFO("events seen:\n" << seen.str());
+  REQUIRE(outcome.events.size() == expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    INFO("event " << k << ": " << expected[k].what);
+    CHECK(outcome.events[k].what == expected[k].what);
+    CHECK(outcome.events[k].t == Approx(expected[k].t).margin(t_margin).epsilon(0));
+    CHECK(outcome.events[k].value ==
+          Approx(expected[k].value).margin(value_margin * std::max(1.0, std::abs(expected[k].value))).epsilon(0));
+  }
+}
+
+double element_work(const RunOutcome& o) { return o.quadratures[DaeSystem::kFirstElementWork]; }
+double dissipated(const RunOutcome& o) { return EnergyBalance::between(o.initial_energy, o.final_energy).dissipated; }
+double balance_error(const RunOutcome& o) { return EnergyBalance::between(o.initial_energy, o.final_energy).error(); }
+
+// ---- draft gear ------------------------------------------------------------------------------
+
+struct Gear {
+  double k, s, K, H, Kt;  // initial_stiffness, travel, stiffness_after_bottoming, hysteresis_load, transition
+  double U(double x) const { return x <= s ? k * x + H : k * s + H + K * (x - s); }
+  double Lw(double x) const { return U(x) - 2.0 * H; }
+};
+
+std::string gear_yaml(const Gear& g, const std::string& extra = "") {
+  return "    type: draft_gear\n    initial_stiffness: " + num(g.k) + "\n    travel: " + num(g.s) +
+         "\n    stiffness_after_bottoming: " + num(g.K) + "\n    hysteresis_load: " + num(g.H) +
+         "\n    transition_stiffness: " + num(g.Kt) + "\n" + extra;
+}
+
+const Gear kGear{1.0e6, 0.05, 2.0e7, 2.0e4, 2.0e7};
+constexpr double kGearMass = 500.0;
+
+/// A mass m hitting the gear at v0 on `side` (+1 buff, -1 draft), up to the release of the
+/// mass; the side deflection x = side * compression.
+Walker gear_bounce(const Gear& g, double m, double v0, int side) {
+  const std::string label = side > 0 ? " (buff)" : " (draft)";
+  const auto value = [side](double x) { return side * x; };  // events report the compression
+  Walker w(m, v0);
+  // stuck by friction: F = Kt x until it meets the loading line k x + H
+  w.go(0.0, g.Kt, g.H / (g.Kt - g.k), "sliding" + label, value);
+  // loading on k x + H; bottoming at travel if the energy left suffices
+  if (0.5 * w.m * w.v * w.v > 0.5 * g.k * (g.s * g.s - w.x * w.x) + g.H * (g.s - w.x)) {
+    w.go(g.H, g.k, g.s, "bottomed" + label, value);
+    w.go(g.k * g.s + g.H - g.K * g.s, g.K, kNaN, "reversal" + label, value);
+  } else {
+    w.go(g.H, g.k, kNaN, "reversal" + label, value);
+  }
+  // back down the transition line F = U(xm) + Kt (x - xm) to the unloading line U - 2H
+  const double xm = w.x, fm = g.U(xm);
+  double meet = (fm - g.Kt * xm + g.H) / (g.k - g.Kt);  // on the initial part, k x - H
+  if (g.Kt > g.K) {
+    const double bottomed = (fm - g.Kt * xm - (g.k * g.s - g.H - g.K * g.s)) / (g.K - g.Kt);
+    if (bottomed >= g.s) meet = bottomed;
+  }
+  if (g.Lw(meet) <= 0.0) {  // the transition line reaches zero force first
+    w.go(fm - g.Kt * xm, g.Kt, xm - fm / g.Kt, "released" + label, value);
+    return w;
+  }
+  w.go(fm - g.Kt * xm, g.Kt, meet, "unloading" + label, value);
+  if (w.x > g.s) w.go(g.k * g.s - g.H - g.K * g.s, g.K, g.s, "off bottom" + label, value);
+  w.go(-g.H, g.k, g.H / g.k, "released" + label, value);  // k x - H reaches zero
+  return w;
+}
+
+DraftGear& gear_of(const Model& model) { return dynamic_cast<DraftGear&>(*model.elements()[0]); }
+
+// ---- couplings -----------------------------------------------------------------------------
+
+/// Piecewise-linear curve through points, the last slope extended (test-side, by hand).
+struct Curve {
+  std::vector<double> x, y;
+  int segment(double at) const {
+    int j = 0;
+    while (j + 2 < static_cast<int>(x.size()) && at >= x[static_cast<std::size_t>(j + 1)]) ++j;
+    return j;
+  }
+  double slope(int j) const {
+    const auto k = static_cast<std::size_t>(j);
+    return (y[k + 1] - y[k]) / (x[k + 1] - x[k]);
+  }
+  double at(double v) const {
+    const int j = segment(v);
+    return y[static_cast<std::size_t>(j)] + slope(j) * (v - x[static_cast<std::size_t>(j)]);
+  }
+  /// F = a + b x on segment j
+  double a(int j) const { return y[static_cast<std::size_t>(j)] - slope(j) * x[static_cast<std::size_t>(j)]; }
+};
+
+/// A mass at v0 through the horizontal slack into a coupling (U loading, Lw unloading, both
+/// on the breakpoints of U, transition stiffness Kt), back out into the slack (or, without
+/// slack, straight into draft). Events report the deflection u = x + slack / 2.
+Walker coupling_bounce(const Curve& U, const Curve& Lw, double Kt, double slack, double m, double v0) {
+  const auto value = [slack](double x) { return x + 0.5 * slack; };
+  Walker w(m, v0);
+  if (slack > 0.0) {
+    w.x = -0.5 * slack;
+    w.go(0.0, 0.0, 0.0, "slack taken up (buff)", value);
+    w.path = {{0.0, 0.0}};
+  }
+  int j = 0;
+  for (;; ++j) {  // loading, segment by segment
+    const bool last = j + 2 >= static_cast<int>(U.x.size());
+    const double end = U.x[static_cast<std::size_t>(j + 1)];
+    const double work_to_end = 0.5 * (U.at(w.x) + U.at(end)) * (end - w.x);
+    if (last || 0.5 * m * w.v * w.v <= work_to_end) break;
+    w.go(U.a(j), U.slope(j), end, "curve segment " + std::to_string(j + 2) + " (buff)", value);
+  }
+  w.go(U.a(j), U.slope(j), kNaN, "reversal (buff)", value);
+  const double xm = w.x, fm = U.at(xm);
+  // transition down to Lw: search the segments from xm's downward
+  double meet = 0.0;
+  for (int i = Lw.segment(xm); i >= 0; --i) {
+    const double xi = (Lw.a(i) - fm + Kt * xm) / (Kt - Lw.slope(i));
+    if (xi >= Lw.x[static_cast<std::size_t>(i)] && xi <= xm) {
+      meet = xi;
+      break;
+    }
+  }
+  w.go(fm - Kt * xm, Kt, meet, "unloading (buff)", value);
+  for (int i = Lw.segment(meet); i > 0; --i)
+    w.go(Lw.a(i), Lw.slope(i), Lw.x[static_cast<std::size_t>(i)], "curve segment " + std::to_string(i) + " (buff)", value);
+  w.go(Lw.a(0), Lw.slope(0), 0.0, slack > 0.0 ? "in the slack" : "through zero force to draft", value);
+  return w;
+}
+
+std::string table(const Curve& c) {
+  std::string s = "[";
+  for (std::size_t k = 0; k < c.x.size(); ++k) s += (k ? ", [" : "[") + num(c.x[k]) + ", " + num(c.y[k]) + "]";
+  return s + "]";
+}
+
+// ---- Jacobian checks ---------------------------------------------------------------------------
+
+/// Two rotated, moving bodies (or ground and one body) joined by element `e`.
+std::string two_bodies(const std::string& element, bool ground_first) {
+  std::ostringstream s;
+  s << "railcrash: 1\nname: jacobian\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: a, mass: 2.0, inertia: 0.5, position: [0.3, -0.2], angle: 0.3, velocity: [0.5, -0.3], "
+       "angular_velocity: 0.8}\n"
+    << "  - {name: b, mass: 3.0, inertia: 0.7, position: [1.5, 0.1], angle: -0.2, velocity: [-0.4, 0.2], "
+       "angular_velocity: -1.1}\n"
+    << "elements:\n  - name: e\n" << element << "    points: ["
+    << (ground_first ? "{body: ground, at: [0.1, -0.15]}" : "{body: a, at: [0.25, 0.1]}")
+    << ", {body: b, at: [-0.3, 0.05]}]\nsimulation: {t_end: 1.0}\n";
+  return s.str();
+}
+
+/// Jacobian against central differences at random states near the start, in the mode the
+/// element is in now.
+void check_jacobian_here(const DaeSystem& system, std::mt19937& rng) {
+  for (int trial = 0; trial < 3; ++trial) {
+    INFO("trial " << trial);
+    const std::vector<double> y = testing::random_state(system, rng, 1e-3);
+    const std::vector<double> yp = testing::random_state(system, rng, 0.3);
+    double outside = -1.0;
+    CHECK(testing::jacobian_error(system, 0.0, 40.0 * (trial + 1), y, yp, &outside) < 1e-6);
+    CHECK(outside == 0.0);
+  }
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    testing::model_from_text(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+}  // namespace
+
+// =================================================================================================
+// draft_gear
+// =================================================================================================
+
+TEST_CASE("draft_gear: a mass bounces off it in buff and in draft, closed form under both integrators",
+          "[elements][couplers]") {
+  const double v0 = 2.0;
+  for (const int side : {1, -1}) {
+    const Walker expected = gear_bounce(kGear, kGearMass, v0, side);
+    const double speed = -expected.v;  // rebound speed when the gear lets go
+    // Stop while the mass coasts away, before the gear comes back through zero compression.
+    const double t_end = expected.t + 0.5 * (kGear.H / kGear.k) / speed;
+    // The loop: 2 H x_max less the corners cut by the stick and transition lines and by the
+    // release at x = H / k (H^2 / 2k): between these bounds.
+    const double area = expected.loop_area(), xm = expected.events[1].value * side;
+    REQUIRE(area < 2.0 * kGear.H * xm);
+    REQUIRE(area > 2.0 * kGear.H * xm - kGear.H * kGear.H / (2.0 * kGear.k) - 3.0 * kGear.H * kGear.H / (kGear.Kt - kGear.k));
+    // Energy: what the mass lost is the loop area.
+    REQUIRE(0.5 * kGearMass * (v0 * v0 - speed * speed) == Approx(area).epsilon(1e-12));
+    for (const char* integrator : {"ida", "euler"}) {
+      INFO((side > 0 ? "buff " : "draft ") << integrator);
+      const bool ida = std::string(integrator) == "ida";
+      const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -side * v0, 0.0, t_end, integrator));
+      const Run r = run(model);
+      check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
+      CHECK(r.vx == Approx(side * speed).epsilon(ida ? 1e-8 : 1e-3));
+      CHECK(element_work(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
+      CHECK(dissipated(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
+      CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-6 : 1.0) * area);
+      CHECK(gear_of(model).state().law.mode == AxialHysteresis::Mode::Released);
+    }
+  }
+}
+
+TEST_CASE("draft_gear: released gear returns to neutral at zero compression and sticks in draft",
+          "[elements][couplers]") {
+  // After the buff bounce the mass coasts away; at zero compression the gear is neutral again
+  // (event at t_release + (H / k) / v) and then stuck in draft: F = Kt d (harmonic).
+  const Walker bounce = gear_bounce(kGear, kGearMass, 2.0, 1);
+  const double speed = -bounce.v, t_neutral = bounce.t + (kGear.H / kGear.k) / speed, extra = 2e-4;
+  std::vector<ExpectedEvent> expected = bounce.events;
+  expected.push_back({"neutral", t_neutral, 0.0});
+  double d = 0.0, v = -speed;
+  LinearPhase{kGearMass, 0.0, kGear.Kt}.advance(d, v, extra);
+  REQUIRE(-kGear.Kt * d < kGear.H * (1.0 + kGear.k / (kGear.Kt - kGear.k)));  // still stuck
+  const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -2.0, 0.0, t_neutral + extra, "ida"));
+  const Run r = run(model);
+  check_events(r.outcome, expected, 1e-8, 1e-9);
+  CHECK(r.x == Approx(1.0 - d).epsilon(1e-10));
+  CHECK(r.vx == Approx(-v).epsilon(1e-7));
+  // The cycle is closed: the work done on the gear is still its loop area, plus the stick
+  // spring's (stored) energy.
+  CHECK(element_work(r.outcome) == Approx(bounce.loop_area() + 0.5 * kGear.Kt * d * d).epsilon(1e-7));
+  CHECK(dissipated(r.outcome) == Approx(bounce.loop_area()).epsilon(1e-7));
+}
+
+TEST_CASE("draft_gear: bottoms at exactly its travel", "[elements][couplers]") {
+  const Walker expected = gear_bounce(kGear, kGearMass, 5.0, 1);
+  REQUIRE(expected.events[1].what == "bottomed (buff)");
+  const double t_end = expected.t + 0.5 * (kGear.H / kGear.k) / -expected.v;
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator));
+    const Run r = run(model);
+    check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-5);
+    REQUIRE(r.outcome.events.size() > 1);
+    CHECK(r.outcome.events[1].value == Approx(kGear.s).margin(ida ? 1e-9 : 1e-5));
+    CHECK(r.vx == Approx(-expected.v).epsilon(ida ? 1e-8 : 1e-3));
+    CHECK(dissipated(r.outcome) == Approx(expected.loop_area()).epsilon(ida ? 1e-7 : 2e-3));
+  }
+}
+
+TEST_CASE("draft_gear: the pin shears at the pin shear load, travels, goes solid and fractures at the fracture load",
+          "[elements][couplers]") {
+  const double pin = 1.2e5, post = 0.02, fracture = 2.0e5, v0 = 10.0;
+  const std::string extra = "    pin_shear_load: " + num(pin) + "\n    post_shear_travel: " + num(post) +
+                            "\n    fracture_load: " + num(fracture) + "\n";
+  const Gear& g = kGear;
+  const auto compression = [](double x) { return x; };
+  Walker w(kGearMass, v0);
+  w.go(0.0, g.Kt, g.H / (g.Kt - g.k), "sliding (buff)", compression);
+  w.go(g.H, g.k, g.s, "bottomed (buff)", compression);
+  const double x_pin = g.s + (pin - g.U(g.s)) / g.K;
+  w.go(g.k * g.s + g.H - g.K * g.s, g.K, x_pin, "pin shear", [&](double) { return pin; });
+  w.go(0.0, 0.0, x_pin + post, "solid", compression);  // free sliding: uniform motion
+  const double x_solid = x_pin + post;
+  w.go(-g.K * x_solid, g.K, x_solid + fracture / g.K, "fracture", [&](double) { return fracture; });
+  // Dissipated: the work on the gear up to the pin shear (its stored energy is lost there)
+  // and the solid spring's energy lost at fracture.
+  const double x1 = g.H / (g.Kt - g.k);
+  const double to_pin = 0.5 * g.Kt * x1 * x1 + 0.5 * (g.U(x1) + g.U(g.s)) * (g.s - x1) + 0.5 * (g.U(g.s) + pin) * (x_pin - g.s);
+  const double lost = to_pin + 0.5 * fracture * fracture / g.K;
+  const double speed = std::sqrt(v0 * v0 - 2.0 * lost / kGearMass);
+  REQUIRE(w.v == Approx(speed).epsilon(1e-12));
+  const double t_end = w.t + 0.01;
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Model model = testing::model_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, -v0, 0.0, t_end, integrator));
+    const Run r = run(model);
+    check_events(r.outcome, w.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-3);
+    // The pin lets go at the pin shear load, the gear breaks at the fracture load.
+    REQUIRE(r.outcome.events.size() == 5);
+    // Euler sees a crossing at the end of its step: the force overshoots by up to K v dt.
+    CHECK(r.outcome.events[2].value == Approx(pin).epsilon(ida ? 1e-9 : 3e-3));
+    CHECK(r.outcome.events[4].value == Approx(fracture).epsilon(ida ? 1e-9 : 3e-3));
+    CHECK(r.vx == Approx(-speed).epsilon(ida ? 1e-8 : 1e-4));  // coasting on after fracture
+    CHECK(dissipated(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
+    CHECK(gear_of(model).state().stage == DraftGear::Stage::Fractured);
+  }
+}
+
+TEST_CASE("draft_gear: in draft the pin does not shear; the gear fractures at the fracture load",
+          "[elements][couplers]") {
+  const double fracture = 1.0e5, v0 = 10.0;
+  const std::string extra = "    pin_shear_load: 8.0e4\n    fracture_load: " + num(fracture) + "\n";
+  const Gear& g = kGear;
+  const auto extension = [](double x) { return -x; };
+  Walker w(kGearMass, v0);
+  w.go(0.0, g.Kt, g.H / (g.Kt - g.k), "sliding (draft)", extension);
+  w.go(g.H, g.k, g.s, "bottomed (draft)", extension);
+  w.go(g.k * g.s + g.H - g.K * g.s, g.K, g.s + (fracture - g.U(g.s)) / g.K, "fracture", [&](double) { return fracture; });
+  const Model model = testing::model_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, v0, 0.0, w.t + 0.01, "ida"));
+  const Run r = run(model);
+  check_events(r.outcome, w.events, 1e-8, 1e-9);
+  CHECK(r.vx == Approx(w.v).epsilon(1e-8));
+}
+
+TEST_CASE("draft_gear with the report's Table 5 values (in-lbf-s): rebound closed form", "[elements][couplers]") {
+  // Report Table 5 / 8: initial stiffness 24,000 lb/in, travel 1.25 in, stiffness after
+  // bottoming 320,000 lb/in, hysteresis load 10,000 lb, pin shear load 150,000 lb,
+  // post-shear travel 1.375 in, fracture load 250,000 lb.
+  const Gear report{24000.0, 1.25, 320000.0, 10000.0, 320000.0};
+  const std::string element = "    type: draft_gear\n    initial_stiffness: 24000\n    travel: 1.25\n"
+                              "    stiffness_after_bottoming: 320000\n    hysteresis_load: 10000\n"
+                              "    pin_shear_load: 150000\n    post_shear_travel: 1.375\n    fracture_load: 250000\n";
+  // A 10 lbf s^2/in mass (3861 lbf) at 50 in/s: stays below travel and the pin shear load.
+  const double mass = 10.0, v0 = 50.0;
+  const Walker w = gear_bounce(report, mass, v0, 1);
+  REQUIRE(w.events[1].value < report.s);
+  REQUIRE(w.events.size() == 4);
+  const Model model = testing::model_from_text(
+      one_mass(element, mass, 1.0, 0.0, -v0, 0.0, w.t + 0.001, "ida", 1e-6, "in-lbf-s"));
+  const DraftGear& gear = gear_of(model);
+  CHECK(gear.transition_stiffness == 320000.0);  // default: the stiffness after bottoming
+  const Run r = run(model);
+  check_events(r.outcome, w.events, 1e-8, 1e-9);
+  CHECK(r.vx == Approx(-w.v).epsilon(1e-8));
+  CHECK(dissipated(r.outcome) == Approx(w.loop_area()).epsilon(1e-7));
+}
+
+TEST_CASE("draft_gear: explicit Euler converges to IDA as the step shrinks", "[elements][couplers]") {
+  const Walker expected = gear_bounce(kGear, kGearMass, 5.0, 1);
+  const double t_end = expected.t + 0.5 * (kGear.H / kGear.k) / -expected.v;
+  const auto final_vx = [&](const std::string& integrator, double dt) {
+    return run(testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator, dt))).vx;
+  };
+  const double ida = final_vx("ida", 1e-6);
+  CHECK(ida == Approx(-expected.v).epsilon(1e-8));
+  double previous = std::numeric_limits<double>::infinity();
+  for (const double dt : {1.6e-5, 4e-6, 1e-6}) {
+    INFO("dt " << dt);
+    const double error = std::abs(final_vx("euler", dt) - ida);
+    CHECK(error < previous);
+    CHECK(error < 2000.0 * dt);  // first order: about 2e-3 per microsecond of step or less
+    previous = error;
+  }
+  CHECK(previous < 2e-3);
+}
+
+TEST_CASE("draft_gear: stored energy is what unloading gives back, and forces follow the stated law",
+          "[elements][couplers]") {
+  const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, 0.0, 0.0, 1.0, "ida"));
+  DraftGear& gear = gear_of(model);
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const auto at = [&](double d) {
+    y[0] = 1.0 - d;
+    return gather_state(gear, y.data(), y.data() + 3);
+  };
+  const auto force_on_mass = [&](double d) {
+    std::array<Pose<double>, 2> f{};
+    gear.add_force(0.0, at(d), f);
+    return f[static_cast<std::size_t>(gear.point_slot(1))].x;
+  };
+  using M = AxialHysteresis::Mode;
+  const Gear& g = kGear;
+  DraftGear::State st;
+  // Loading, bottomed (draft): F = -(k s + H + K (x - s)) at compression -x.
+  st.law = {M::Loading, -1, 1, 0.0, 0.0};
+  gear.set_state(st);
+  CHECK(force_on_mass(-0.06) == Approx(-g.U(0.06)));
+  CHECK(gear.potential_energy(at(-0.06)) > 0.0);
+  // Unloading (buff) at x: energy = integral of k x - H down to H / k.
+  st.law = {M::Unloading, 1, 0, 0.0, 0.0};
+  gear.set_state(st);
+  const double x = 0.03;
+  CHECK(force_on_mass(x) == Approx(g.k * x - g.H));
+  CHECK(gear.potential_energy(at(x)) == Approx(0.5 * (g.k * x - g.H) * (x - g.H / g.k)));
+  // Transition from (0.04, U(0.04)) at 0.0395: energy = trapezoid down to the unloading line + tail.
+  st.law = {M::Transition, 1, 0, 0.04, g.U(0.04)};
+  gear.set_state(st);
+  const double f = g.U(0.04) + g.Kt * (0.0395 - 0.04);
+  const double meet = (g.U(0.04) - g.Kt * 0.04 + g.H) / (g.k - g.Kt);
+  const double f_meet = g.k * meet - g.H;
+  CHECK(force_on_mass(0.0395) == Approx(f));
+  CHECK(gear.potential_energy(at(0.0395)) ==
+        Approx(0.5 * (f + f_meet) * (0.0395 - meet) + 0.5 * f_meet * (meet - g.H / g.k)).epsilon(1e-12));
+  // Neutral: Kt d^2 / 2; released, sheared, fractured: nothing.
+  st.law = {M::Neutral, 1, 0, 0.0, 0.0};
+  gear.set_state(st);
+  CHECK(force_on_mass(-1e-4) == Approx(-g.Kt * 1e-4));
+  CHECK(gear.potential_energy(at(-1e-4)) == Approx(0.5 * g.Kt * 1e-8));
+  st.law = {M::Released, 1, 0, 0.0, 0.0};
+  gear.set_state(st);
+  CHECK(force_on_mass(0.01) == 0.0);
+  CHECK(gear.potential_energy(at(0.01)) == 0.0);
+  st.stage = DraftGear::Stage::Solid;
+  st.solid_compression = 0.07;
+  gear.set_state(st);
+  CHECK(force_on_mass(0.075) == Approx(g.K * 0.005));
+  CHECK(gear.potential_energy(at(0.075)) == Approx(0.5 * g.K * 0.005 * 0.005));
+  st.stage = DraftGear::Stage::Fractured;
+  gear.set_state(st);
+  CHECK(force_on_mass(0.075) == 0.0);
+}
+
+TEST_CASE("draft_gear Jacobian matches central differences in every mode", "[elements][couplers]") {
+  using M = AxialHysteresis::Mode;
+  using S = DraftGear::Stage;
+  const std::vector<DraftGear::State> modes = {
+      {S::Intact, {M::Neutral, 1, 0, 0.0, 0.0}, 0.0},       {S::Intact, {M::Loading, 1, 0, 0.0, 0.0}, 0.0},
+      {S::Intact, {M::Loading, -1, 1, 0.0, 0.0}, 0.0},      {S::Intact, {M::Transition, 1, 0, 0.01, 3e4}, 0.0},
+      {S::Intact, {M::Transition, -1, 0, 0.06, 2e5}, 0.0},  {S::Intact, {M::Unloading, 1, 0, 0.0, 0.0}, 0.0},
+      {S::Intact, {M::Unloading, -1, 1, 0.0, 0.0}, 0.0},    {S::Intact, {M::Released, 1, 0, 0.0, 0.0}, 0.0},
+      {S::Sheared, {}, 0.1},                                {S::Solid, {}, -0.2},
+      {S::Fractured, {}, 0.0}};
+  for (const bool ground_first : {true, false}) {
+    Model model = testing::model_from_text(two_bodies(gear_yaml(kGear, "    free_length: 1.0\n"), ground_first));
+    DraftGear& gear = gear_of(model);
+    const DaeSystem system(model);
+    std::mt19937 rng(5);
+    for (std::size_t k = 0; k < modes.size(); ++k) {
+      INFO((ground_first ? "ground-body" : "body-body") << ", mode " << k);
+      gear.set_state(modes[k]);
+      check_jacobian_here(system, rng);
+    }
+  }
+}
+
+// =================================================================================================
+// coupler_end
+// =================================================================================================
+
+namespace {
+// Faces: 360,000 and 360,000 (series 180,000), 0.05 behind each face (contact spacing 0.1).
+std::string coupler_end_yaml(const std::string& extra = "") {
+  return "    type: coupler_end\n    horizontal_stiffness: [3.6e5, 3.6e5]\n    free_length: [0.05, 0.05]\n"
+         "    coupler_height: [0.3, 0.3]\n" + extra;
+}
+constexpr double kFaceStiffness = 1.8e5, kContact = 0.1;
+}  // namespace
+
+TEST_CASE("coupler_end: the gap closes at gap / speed; uncoupled faces never pull, coupled ones do after the slack",
+          "[elements][couplers]") {
+  const double m = 100.0, v = 2.0, gap = 0.03, slack = 0.05;
+  const double half_period = kPi * std::sqrt(m / kFaceStiffness);
+  const double t_contact = gap / v, t_separation = t_contact + half_period;
+  const double t_draft = t_separation + slack / v;  // from the contact spacing to c + s
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const double t_margin = ida ? 1e-8 : 3e-6;
+    const double t_end = t_draft + half_period + 0.01;
+    // Uncoupled: an elastic bounce, then the mass goes away for good at +v.
+    {
+      const Run r = run(testing::model_from_text(
+          one_mass(coupler_end_yaml("    friction: 0.3\n"), m, kContact + gap, 0.0, -v, 0.0, t_end, integrator)));
+      check_events(r.outcome, {{"contact", t_contact, 0.0}, {"separation", t_separation, 0.0}}, t_margin, ida ? 1e-9 : 1e-5);
+      CHECK(r.vx == Approx(v).epsilon(ida ? 1e-8 : 1e-4));
+      CHECK(r.x == Approx(kContact + v * (t_end - t_separation)).epsilon(ida ? 1e-8 : 1e-4));
+    }
+    // Coupled with slack: caught in draft after the slack, pulled back at -v.
+    {
+      const Run r = run(testing::model_from_text(one_mass(
+          coupler_end_yaml("    coupled: true\n    total_horizontal_slack: " + num(slack) + "\n"), m, kContact + gap, 0.0, -v,
+          0.0, t_end, integrator)));
+      check_events(r.outcome,
+                   {{"contact", t_contact, 0.0},
+                    {"separation", t_separation, 0.0},
+                    {"slack taken up (draft)", t_separation + slack / v, slack},
+                    {"draft released", t_separation + slack / v + half_period, slack}},
+                   t_margin, ida ? 1e-9 : 1e-5);
+      CHECK(r.vx == Approx(-v).epsilon(ida ? 1e-8 : 1e-4));
+      // Elastic both ways: nothing dissipated.
+      CHECK(std::abs(dissipated(r.outcome)) < (ida ? 1e-7 : 1e-2) * 0.5 * m * v * v);
+    }
+  }
+}
+
+TEST_CASE("coupler_end friction: regularized Coulomb, bounded by mu times the normal force", "[elements][couplers]") {
+  const double mu = 0.3, vf = 0.01;
+  const Model model = testing::model_from_text(
+      one_mass(coupler_end_yaml("    friction: 0.3\n    friction_velocity: 0.01\n"), 10.0, 0.09, 0.02, 0.0, 0.0, 1.0, "ida"));
+  const Element& e = *model.elements()[0];
+  const DaeSystem system(model);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> gap(-0.02, -1e-4), slip(-0.05, 0.05), lateral(-0.1, 0.1);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<double> y = system.initial_state();
+    y[0] = kContact + gap(rng);  // in contact (the initial mode is contact: the mass starts at 0.09)
+    y[1] = lateral(rng);
+    y[3] = slip(rng);
+    y[4] = slip(rng);
+    std::array<Pose<double>, 2> f{};
+    e.add_force(0.0, gather_state(e, y.data(), y.data() + 3), f);
+    const Pose<double>& on_mass = f[static_cast<std::size_t>(e.point_slot(1))];
+    const double normal = kFaceStiffness * (kContact - y[0]);
+    INFO("trial " << trial);
+    CHECK(on_mass.x == Approx(normal).epsilon(1e-12));
+    CHECK(on_mass.y == Approx(-mu * normal * std::tanh(y[4] / vf)).epsilon(1e-12));
+    CHECK(std::abs(on_mass.y) <= mu * normal);
+  }
+}
+
+TEST_CASE("coupler_end: a face pressed and sliding decelerates by the regularized friction law, closed form",
+          "[elements][couplers]") {
+  // Load P presses the mass onto the face at equilibrium (compression P / k); it slides
+  // vertically at v0: m v' = -mu P tanh(v / vf)  ->  sinh(v / vf) = sinh(v0 / vf) exp(-mu P t / (m vf)).
+  const double m = 10.0, P = 1000.0, mu = 0.3, vf = 0.01, v0 = 1.0, T = 0.02;
+  const double vT = vf * std::asinh(std::sinh(v0 / vf) * std::exp(-mu * P * T / (m * vf)));
+  REQUIRE(vT > 0.2);
+  const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(-P) + ", 0]}\n";
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml("    friction: 0.3\n    friction_velocity: 0.01\n"),
+                                                          m, kContact - P / kFaceStiffness, 0.0, 0.0, v0, T, integrator, 1e-6,
+                                                          "SI", load)));
+    CHECK(r.outcome.events.empty());
+    CHECK(r.vy == Approx(vT).epsilon(ida ? 1e-7 : 1e-3));
+    CHECK(r.x == Approx(kContact - P / kFaceStiffness).epsilon(1e-9));  // stays pressed, at rest in x
+    // Friction dissipates the kinetic energy lost.
+    CHECK(dissipated(r.outcome) == Approx(0.5 * m * (v0 * v0 - vT * vT)).epsilon(ida ? 1e-7 : 2e-3));
+  }
+}
+
+TEST_CASE("coupler_end: contact ends when the faces lose vertical overlap", "[elements][couplers]") {
+  // Frictionless, pressed at equilibrium, sliding up at 1: the faces (0.3 high each) part at
+  // Dy = 0.3; from then on the load pushes the mass freely: x = x0 - P/(2m) (t - t_lost)^2.
+  const double m = 10.0, P = 1000.0, vy = 1.0, y0 = 0.1, T = 0.25;
+  const double t_lost = (0.3 - y0) / vy, x0 = kContact - P / kFaceStiffness;
+  const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(-P) + ", 0]}\n";
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Run r = run(testing::model_from_text(
+        one_mass(coupler_end_yaml(), m, x0, y0, 0.0, vy, T, integrator, 1e-6, "SI", load)));
+    check_events(r.outcome, {{"vertical overlap lost", t_lost, 0.3}}, ida ? 1e-8 : 2e-6, ida ? 1e-9 : 2e-6);
+    CHECK(r.x == Approx(x0 - 0.5 * P / m * (T - t_lost) * (T - t_lost)).epsilon(ida ? 1e-8 : 1e-4));
+  }
+}
+
+TEST_CASE("coupler_end: overlap regained with the faces past each other gives no force until they clear",
+          "[elements][couplers]") {
+  const Model model = testing::model_from_text(one_mass(coupler_end_yaml(), 10.0, 0.09, 0.5, 0.0, 0.0, 1.0, "ida"));
+  CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
+  REQUIRE_FALSE(e.state().overlapping);  // starts 0.5 above: no overlap
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const auto state_at = [&](double x, double dy, double vx) {
+    y[0] = x;
+    y[1] = dy;
+    y[3] = vx;
+    return gather_state(e, y.data(), y.data() + 3);
+  };
+  const auto force_x = [&](double x, double dy) {
+    std::array<Pose<double>, 2> f{};
+    e.add_force(0.0, state_at(x, dy, 0.0), f);
+    return f[1].x;
+  };
+  CHECK(force_x(0.08, 0.5) == 0.0);
+  Element::Event event;
+  // Coming down into overlap while horizontally 0.02 past contact: blocked.
+  CHECK(e.commit(2, -1, 0.0, state_at(0.08, 0.29, 0.0), nullptr, event));
+  CHECK(event.what == "vertical overlap regained, faces past each other");
+  CHECK(e.state().blocked);
+  CHECK(force_x(0.08, 0.2) == 0.0);
+  // A stale crossing (a root that is positive in the current mode) changes nothing.
+  CHECK_FALSE(e.commit(2, -1, 0.0, state_at(0.08, 0.1, 0.0), nullptr, event));
+  // Moving apart to the contact spacing: clear, then a new approach makes contact.
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1, 0.1, 1.0), nullptr, event));
+  CHECK(event.what == "faces clear");
+  CHECK_FALSE(e.state().blocked);
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1, 0.1, -1.0), nullptr, event));
+  CHECK(event.what == "contact");
+  CHECK(force_x(0.09, 0.1) == Approx(kFaceStiffness * 0.01));
+  e.reset_modes();
+  CHECK_FALSE(e.state().overlapping);
+}
+
+TEST_CASE("coupler_end Jacobian matches central differences in every mode", "[elements][couplers]") {
+  using B = DeadBand::Mode;
+  const std::vector<CouplerEnd::State> modes = {{B::Below, true, false}, {B::Inside, true, false}, {B::Above, true, false},
+                                                {B::Below, false, false}, {B::Below, true, true}};
+  for (const bool ground_first : {true, false}) {
+    Model model = testing::model_from_text(two_bodies(
+        coupler_end_yaml("    friction: 0.3\n    coupled: true\n    total_horizontal_slack: 0.02\n"), ground_first));
+    CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
+    const DaeSystem system(model);
+    std::mt19937 rng(7);
+    for (std::size_t k = 0; k < modes.size(); ++k) {
+      INFO((ground_first ? "ground-body" : "body-body") << ", mode " << k);
+      e.set_state(modes[k]);
+      check_jacobian_here(system, rng);
+    }
+  }
+}
+
+// =================================================================================================
+// coupling
+// =================================================================================================
+
+namespace {
+const Curve kCouplingCurve{{0.0, 0.01, 0.05}, {0.0, 1.0e5, 3.0e5}};  // slopes 1e7, 5e6
+std::string coupling_kind1(double factor, double slack, const std::string& extra = "") {
+  return "    type: coupling\n    kind: 1\n    curve: " + table(kCouplingCurve) + "\n    unloading_factor: " + num(factor) +
+         "\n    horizontal_slack: " + num(slack) + "\n" + extra;
+}
+Curve scaled(const Curve& c, double factor) {
+  Curve out = c;
+  for (double& y : out.y) y *= factor;
+  return out;
+}
+}  // namespace
+
+TEST_CASE("coupling kind 1: slack, loading curve, unloading at a fraction of it, closed form under both integrators",
+          "[elements][couplers]") {
+  const double m = 1000.0, v0 = 3.0, slack = 0.04, factor = 0.5;
+  const Walker expected = coupling_bounce(kCouplingCurve, scaled(kCouplingCurve, factor), 1.0e7, slack, m, v0);
+  const double speed = -expected.v;
+  REQUIRE(0.5 * m * (v0 * v0 - speed * speed) == Approx(expected.loop_area()).epsilon(1e-12));
+  const double t_end = expected.t + 0.5 * slack / speed;  // coasting back across the slack
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Model model = testing::model_from_text(one_mass(coupling_kind1(factor, slack), m, 1.0, 0.0, -v0, 0.0, t_end, integrator));
+    const Run r = run(model);
+    check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
+    CHECK(r.vx == Approx(speed).epsilon(ida ? 1e-8 : 1e-3));
+    CHECK(element_work(r.outcome) == Approx(expected.loop_area()).epsilon(ida ? 1e-7 : 2e-3));
+    CHECK(dissipated(r.outcome) == Approx(expected.loop_area()).epsilon(ida ? 1e-7 : 2e-3));
+  }
+}
+
+TEST_CASE("coupling kind 2: separate loading and unloading curves, closed form", "[elements][couplers]") {
+  const Curve loading{{0.0, 0.02}, {0.0, 2.0e5}};
+  const Curve unloading{{0.0, 0.01, 0.02}, {0.0, 0.0, 1.0e5}};
+  const Curve loading_on_union{{0.0, 0.01, 0.02}, {0.0, 1.0e5, 2.0e5}};
+  const double m = 1000.0, v0 = 1.5, kt = 4.0e7, slack = 0.02;
+  const Walker expected = coupling_bounce(loading_on_union, unloading, kt, slack, m, v0);
+  const std::string element = "    type: coupling\n    kind: 2\n    loading_curve: " + table(loading) +
+                              "\n    unloading_curve: " + table(unloading) + "\n    transition_stiffness: " + num(kt) +
+                              "\n    horizontal_slack: " + num(slack) + "\n";
+  const double t_end = expected.t + 0.5 * slack / -expected.v;
+  const Run r = run(testing::model_from_text(one_mass(element, m, 1.0, 0.0, -v0, 0.0, t_end, "ida")));
+  check_events(r.outcome, expected.events, 1e-8, 1e-9);
+  CHECK(r.vx == Approx(-expected.v).epsilon(1e-8));
+  CHECK(dissipated(r.outcome) == Approx(expected.loop_area()).epsilon(1e-7));
+}
+
+TEST_CASE("coupling without slack passes through zero force into draft", "[elements][couplers]") {
+  // No slack: after the bounce in buff the force passes through zero at zero deflection and
+  // the mass goes on into draft, where the mirror-image curve takes it: F = -1e7 u.
+  const double m = 1000.0, v0 = 0.5, kt = 3.0e7, omega = std::sqrt(1.0e7 / m);
+  const Walker expected = coupling_bounce(kCouplingCurve, scaled(kCouplingCurve, 0.5), kt, 0.0, m, v0);
+  const double extra = 0.25 * (0.5 * kPi / omega);  // a quarter of the way to the draft extreme
+  double x = 0.0, v = -expected.v;
+  LinearPhase{m, 0.0, 1.0e7}.advance(x, v, extra);
+  const std::string element = coupling_kind1(0.5, 0.0, "    transition_stiffness: " + num(kt) + "\n");
+  const Run r = run(testing::model_from_text(one_mass(element, m, 1.0, 0.0, -v0, 0.0, expected.t + extra, "ida")));
+  check_events(r.outcome, expected.events, 1e-8, 1e-9);
+  CHECK(r.x == Approx(1.0 + x).epsilon(1e-9));
+  CHECK(r.vx == Approx(v).epsilon(1e-7));
+  // Work done: the loop area plus the draft loading so far. Stored: only what unloading from
+  // here would give back (down the transition line to Lw = 0.5 U at xi, then along Lw).
+  const double xi = (kt - 1.0e7) * x / (kt - 0.5e7);
+  const double recoverable = 0.5 * (1.0e7 * x + 0.5e7 * xi) * (x - xi) + 0.5 * 0.5e7 * xi * xi;
+  CHECK(element_work(r.outcome) == Approx(expected.loop_area() + 0.5 * 1.0e7 * x * x).epsilon(1e-7));
+  CHECK(dissipated(r.outcome) == Approx(expected.loop_area() + 0.5 * 1.0e7 * x * x - recoverable).epsilon(1e-7));
+}
+
+TEST_CASE("coupling vertical: slack, flexibility and misalignment; friction proportional to the horizontal force",
+          "[elements][couplers]") {
+  const double kv = 2.0e6, sv = 0.02, e = 0.004, mu = 0.25, vf = 0.01;
+  const auto element = [&](double slack) {
+    return coupling_kind1(0.5, slack,
+                          "    vertical_slack: " + num(sv) + "\n    vertical_stiffness: " + num(kv) + "\n    misalignment: " +
+                              num(e) + "\n    friction: " + num(mu) + "\n    friction_velocity: " + num(vf) + "\n");
+  };
+  SECTION("forces at given states") {
+    // The mass at 1.0 - 0.004 (buff deflection 0.004 on the first segment), head L at Dy + e.
+    const Model model = testing::model_from_text(one_mass(element(0.0), 1000.0, 1.0, 0.0, -0.1, 0.0, 1.0, "ida"));
+    Coupling& c = dynamic_cast<Coupling&>(*model.elements()[0]);
+    const DaeSystem system(model);
+    std::vector<double> y = system.initial_state();
+    for (const double dy : {0.03, -0.03, 0.001}) {
+      for (const double vy : {0.05, -0.004}) {
+        y[0] = 1.0 - 0.004;
+        y[1] = dy;
+        y[4] = vy;
+        const ElementState<double> s = gather_state(c, y.data(), y.data() + 3);
+        Coupling::State st = c.state();
+        st.horizontal = {AxialHysteresis::Mode::Loading, 1, 0, 0.0, 0.0};
+        const double w = dy + e;
+        st.vertical = w > 0.5 * sv ? DeadBand::Mode::Above : (w < -0.5 * sv ? DeadBand::Mode::Below : DeadBand::Mode::Inside);
+        c.set_state(st);
+        std::array<Pose<double>, 2> f{};
+        c.add_force(0.0, s, f);
+        const double horizontal = 1.0e7 * 0.004;
+        const double vertical = w > 0.5 * sv ? kv * (w - 0.5 * sv) : (w < -0.5 * sv ? kv * (w + 0.5 * sv) : 0.0);
+        const double friction = -mu * horizontal * std::tanh(vy / vf);
+        INFO("dy " << dy << " vy " << vy);
+        CHECK(f[1].x == Approx(horizontal));
+        CHECK(f[1].y == Approx(-vertical + friction));
+        CHECK(std::abs(friction) <= mu * horizontal);
+        CHECK(c.potential_energy(s) == Approx(0.5 * 1.0e7 * 0.004 * 0.004 + 0.5 * vertical * vertical / kv));
+      }
+    }
+  }
+  SECTION("vertical slack taken up at the closed-form time, elastic vertical bounce") {
+    // Horizontally in the slack (no horizontal force, so no friction); vertical speed 0.5 up.
+    const double m = 100.0, vy = 0.5, y0 = 0.0;
+    const double t_up = (0.5 * sv - (y0 + e)) / vy, half_period = kPi * std::sqrt(m / kv);
+    const Run r = run(testing::model_from_text(one_mass(element(0.02), m, 1.0, y0, 0.0, vy, t_up + half_period + 0.01, "ida")));
+    check_events(r.outcome,
+                 {{"vertical slack taken up (head L above)", t_up, 0.5 * sv},
+                  {"vertical slack", t_up + half_period, 0.5 * sv}},
+                 1e-8, 1e-9);
+    CHECK(r.vy == Approx(-vy).epsilon(1e-8));
+  }
+}
+
+TEST_CASE("coupling Jacobian matches central differences in every mode", "[elements][couplers]") {
+  using M = AxialHysteresis::Mode;
+  using B = DeadBand::Mode;
+  const std::vector<AxialHysteresis::State> horizontal = {
+      {M::Open, 1, 0, 0.0, 0.0},         {M::Loading, 1, 0, 0.0, 0.0},     {M::Loading, -1, 1, 0.0, 0.0},
+      {M::Transition, 1, 0, 0.03, 2e5},  {M::Unloading, -1, 1, 0.0, 0.0}, {M::Unloading, 1, 0, 0.0, 0.0}};
+  for (const bool ground_first : {true, false}) {
+    Model model = testing::model_from_text(two_bodies(
+        coupling_kind1(0.5, 0.02,
+                       "    vertical_slack: 0.01\n    vertical_stiffness: 2e6\n    misalignment: 0.003\n    friction: 0.3\n"
+                       "    free_length: 1.0\n"),
+        ground_first));
+    Coupling& c = dynamic_cast<Coupling&>(*model.elements()[0]);
+    const DaeSystem system(model);
+    std::mt19937 rng(13);
+    for (const auto& h : horizontal)
+      for (const B v : {B::Below, B::Inside, B::Above}) {
+        INFO((ground_first ? "ground-body" : "body-body") << ", horizontal mode " << static_cast<int>(h.mode) << " side "
+                                                          << h.side << ", vertical " << static_cast<int>(v));
+        c.set_state({h, v});
+        check_jacobian_here(system, rng);
+      }
+  }
+}
+
+// =================================================================================================
+// input errors
+// =================================================================================================
+
+TEST_CASE("coupler elements: input errors name the parameter and what to change", "[elements][couplers]") {
+  const auto with = [](const std::string& element) { return one_mass(element, 10.0, 1.0, 0.0, 0.0, 0.0, 1.0, "ida"); };
+  CHECK_THAT(error_of(with(gear_yaml({1e6, 0.05, 2e7, 2e4, 5e5}))), Catch::Contains("transition_stiffness"));
+  CHECK_THAT(error_of(with(gear_yaml(kGear, "    post_shear_travel: 0.1\n"))), Catch::Contains("pin_shear_load"));
+  CHECK_THAT(error_of(with("    type: draft_gear\n    initial_stiffness: 1e6\n    travel: 0\n"
+                           "    stiffness_after_bottoming: 2e7\n    hysteresis_load: 2e4\n")),
+             Catch::Contains("'travel' must be positive") && Catch::Contains("test.yaml:"));
+  CHECK_THAT(error_of(with(gear_yaml(kGear, "    fracture_load: 1e4\n    free_length: 1.01\n"))),
+             Catch::Contains("fracture_load"));  // starts compressed beyond it
+  CHECK_THAT(error_of(with(coupler_end_yaml("    total_horizontal_slack: 0.1\n"))), Catch::Contains("coupled: true"));
+  CHECK_THAT(error_of(with("    type: coupler_end\n    horizontal_stiffness: 3e5\n    free_length: [1, 1]\n"
+                           "    coupler_height: [1, 1]\n")),
+             Catch::Contains("horizontal_stiffness"));
+  CHECK_THAT(error_of(with("    type: coupling\n    kind: 3\n")), Catch::Contains("'kind' must be 1"));
+  CHECK_THAT(error_of(with("    type: coupling\n    curve: [[0, 0], [1, 5]]\n")), Catch::Contains("unloading_factor"));
+  CHECK_THAT(error_of(with("    type: coupling\n    curve: [[0.1, 0], [1, 5]]\n    unloading_factor: 0.5\n")),
+             Catch::Contains("must start at [0, 0]"));
+  CHECK_THAT(error_of(with("    type: coupling\n    kind: 2\n    loading_curve: [[0, 0], [1, 5]]\n"
+                           "    unloading_curve: [[0, 0], [1, 6]]\n")),
+             Catch::Contains("must not lie above the loading curve"));
+  CHECK_THAT(error_of(with("    type: coupling\n    kind: 2\n    curve: [[0, 0], [1, 5]]\n")), Catch::Contains("kind 2 takes"));
+  CHECK_THAT(error_of(with(coupling_kind1(0.5, 0.0, "    transition_stiffness: 1e3\n"))),
+             Catch::Contains("steepest slope"));
+}

@@ -36,6 +36,14 @@ struct Axial {
   std::string simulation;  // the simulation map's contents
 };
 
+Axial axial(const std::string& type, const std::string& parameters, double mass = 1.0) {
+  Axial a;
+  a.type = type;
+  a.parameters = parameters;
+  a.mass = mass;
+  return a;
+}
+
 std::string axial_yaml(const Axial& a) {
   std::ostringstream s;
   s.precision(17);
@@ -203,11 +211,11 @@ void check_jacobian_near(const DaeSystem& system, const std::vector<double>& y, 
   }
 }
 
-/// Runs check_jacobian_near in every mode of the element (each segment, and broken when
-/// it can break), at a state whose x lies inside that segment. place(element, y, x) moves
-/// the element's reference (free length) or the velocities so that x(y) = x.
-template <class Element, class Place>
-void check_every_mode(const std::string& type, const std::string& parameters, Place place) {
+/// Runs check(system, element, y) in every mode of the element (each segment, and broken
+/// when it can break), at a state y whose x lies inside that segment. place(element, y, x)
+/// moves the element's reference (free length) or the velocities so that x(y) = x.
+template <class Element, class Place, class Check>
+void for_every_mode(const std::string& type, const std::string& parameters, Place place, Check check) {
   for (const Ends ends : {Ends::GroundBody, Ends::BodyBody}) {
     INFO(type << (ends == Ends::GroundBody ? " ground-body" : " body-body"));
     const Model model = testing::model_from_text(general_yaml(type, parameters, ends));
@@ -223,14 +231,47 @@ void check_every_mode(const std::string& type, const std::string& parameters, Pl
       place(element, y, x);
       const int nq = system.body_unknowns();
       REQUIRE(element.measure_of(gather_state(element, y.data(), y.data() + nq)) == Approx(x).margin(1e-12));
-      element.set_mode(SegmentMode{broken ? 0 : k, broken, 0.0});
-      check_jacobian_near(system, y, 7u + static_cast<unsigned>(k));
+      element.set_mode(SegmentMode{broken ? 0 : k, broken});
+      check(system, element, y, k);
     }
   }
 }
 
-double length_at(const Element& e, const std::vector<double>& y, int nq) {
-  return line_geometry(e, gather_state(e, y.data(), y.data() + nq)).length;
+template <class Element, class Place>
+void check_every_mode(const std::string& type, const std::string& parameters, Place place) {
+  for_every_mode<Element>(type, parameters, place, [](const DaeSystem& system, const Element&, const std::vector<double>& y, int k) {
+    check_jacobian_near(system, y, 7u + static_cast<unsigned>(k));
+  });
+}
+
+/// Generalized forces of the model's only element equal minus the gradient of its energy
+/// (central differences), at y.
+void check_force_is_energy_gradient(const DaeSystem& system, const Element& element, const std::vector<double>& y) {
+  const int nq = system.body_unknowns();
+  const std::vector<double> q(y.begin(), y.begin() + nq), v(y.begin() + nq, y.begin() + 2 * nq);
+  std::vector<double> f(static_cast<std::size_t>(nq), 0.0);
+  system.generalized_forces(0.0, q.data(), v.data(), f.data());
+  const auto energy = [&](const std::vector<double>& at) { return element.potential_energy(gather_state(element, at.data(), v.data())); };
+  double largest = 0.0;
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    const double h = 1e-6;
+    std::vector<double> plus = q, minus = q;
+    plus[k] += h;
+    minus[k] -= h;
+    INFO("component " << k);
+    CHECK(f[k] == Approx(-(energy(plus) - energy(minus)) / (2.0 * h)).epsilon(1e-6).margin(1e-5));
+    largest = std::max(largest, std::abs(f[k]));
+  }
+  // Loaded (a force of at least 1) exactly when it stores energy: open and broken modes neither.
+  CHECK((largest > 1.0) == (energy(q) != 0.0));
+}
+
+/// Moves the free length of a spring so that x(y) = x (x = direction (free_length - s)).
+template <class Spring>
+void place_spring(Spring& e, std::vector<double>& y, double x, double direction) {
+  const int nq = static_cast<int>(y.size()) / 2;
+  const double now = e.measure_of(gather_state(e, y.data(), y.data() + nq));
+  e.free_length = *e.free_length + direction * (x - now);
 }
 
 }  // namespace
@@ -239,21 +280,17 @@ double length_at(const Element& e, const std::vector<double>& y, int nq) {
 
 TEST_CASE("nonlinear element Jacobians match central differences in every mode", "[elements][nonlinear]") {
   SECTION("nonlinear_spring") {
-    check_every_mode<NonlinearSpring>(
-        "nonlinear_spring", std::string(kSpringParameters) + ", fracture_load: 1e6",
-        [](NonlinearSpring& e, std::vector<double>& y, double x) {
-          const int nq = static_cast<int>(y.size()) / 2;
-          e.free_length = length_at(e, y, nq) - x;  // x = L - free_length
-        });
+    check_every_mode<NonlinearSpring>("nonlinear_spring", std::string(kSpringParameters) + ", fracture_load: 1e6",
+                                      [](NonlinearSpring& e, std::vector<double>& y, double x) { place_spring(e, y, x, -1.0); });
   }
   for (int kind : {1, 2}) {
-    SECTION("special_spring kind " + std::to_string(kind)) {
-      check_every_mode<SpecialSpring>(
-          "special_spring", special_parameters(kind) + ", fracture_load: 1e6",
-          [](SpecialSpring& e, std::vector<double>& y, double x) {
-            const int nq = static_cast<int>(y.size()) / 2;
-            e.free_length = length_at(e, y, nq) + e.direction() * x;  // x = direction (free_length - L)
-          });
+    for (const std::string axis : {"", ", axis: [0.6, -0.8]"}) {
+      SECTION("special_spring kind " + std::to_string(kind) + axis) {
+        check_every_mode<SpecialSpring>("special_spring", special_parameters(kind) + ", fracture_load: 1e6" + axis,
+                                        [](SpecialSpring& e, std::vector<double>& y, double x) {
+                                          place_spring(e, y, x, e.direction());
+                                        });
+      }
     }
   }
   SECTION("nonlinear_dashpot") {
@@ -269,6 +306,24 @@ TEST_CASE("nonlinear element Jacobians match central differences in every mode",
           y[static_cast<std::size_t>(nq + 1)] = sign * x * uy;
         });
   }
+}
+
+TEST_CASE("nonlinear spring forces are minus the gradient of their energy in every mode", "[elements][nonlinear]") {
+  // On a body-body pair with offsets and rotations: also checks that the special spring
+  // along an axis (which turns with body 1) is conservative.
+  const auto gradient = [](const DaeSystem& system, const auto& element, const std::vector<double>& y, int) {
+    check_force_is_energy_gradient(system, element, y);
+  };
+  for_every_mode<NonlinearSpring>("nonlinear_spring", std::string(kSpringParameters) + ", fracture_load: 1e6",
+                                  [](NonlinearSpring& e, std::vector<double>& y, double x) { place_spring(e, y, x, -1.0); },
+                                  gradient);
+  for (int kind : {1, 2})
+    for (const std::string axis : {"", ", axis: [0.6, -0.8]"}) {
+      INFO("kind " << kind << axis);
+      for_every_mode<SpecialSpring>("special_spring", special_parameters(kind) + ", fracture_load: 1e6" + axis,
+                                    [](SpecialSpring& e, std::vector<double>& y, double x) { place_spring(e, y, x, e.direction()); },
+                                    gradient);
+    }
 }
 
 // ---- laws against hand values ---------------------------------------------------------------------
@@ -288,7 +343,7 @@ TEST_CASE("nonlinear_spring force and energy follow both branches past both brea
   for (const Point& p : points) {
     for (bool flip : {false, true}) {  // body on +x or on -x of the ground point
       INFO("deformation " << p.deformation << (flip ? " (body on -x)" : ""));
-      Axial a{"nonlinear_spring", kSpringParameters};
+      Axial a = axial("nonlinear_spring", kSpringParameters);
       a.position = (flip ? -1.0 : 1.0) * (1.0 + p.deformation);
       a.simulation = ida(1.0);
       const Model model = testing::model_from_text(axial_yaml(a));
@@ -313,7 +368,7 @@ TEST_CASE("nonlinear_dashpot force follows both branches past both switch veloci
   const std::pair<double, double> points[] = {{-0.8, -50.0 - 6.0}, {-0.2, -20.0}, {0.1, 4.0}, {0.65, 10.0 + 4.0}};
   for (const auto& [rate, tension] : points) {
     INFO("rate " << rate);
-    Axial a{"nonlinear_dashpot", kDashpotParameters};
+    Axial a = axial("nonlinear_dashpot", kDashpotParameters);
     a.velocity = rate;  // body at +1 on x: its velocity is the rate of length
     a.simulation = ida(1.0);
     const Model model = testing::model_from_text(axial_yaml(a));
@@ -336,7 +391,7 @@ TEST_CASE("special_spring acts one way only: compression (kind 1) or tension (ki
   for (int kind : {1, 2}) {
     for (const auto& [deflection, force] : points) {
       INFO("kind " << kind << " deflection " << deflection);
-      Axial a{"special_spring", special_parameters(kind)};
+      Axial a = axial("special_spring", special_parameters(kind));
       a.position = kind == 1 ? 1.0 - deflection : 1.0 + deflection;
       a.simulation = ida(1.0);
       const Model model = testing::model_from_text(axial_yaml(a));
@@ -360,12 +415,40 @@ TEST_CASE("special_spring acts one way only: compression (kind 1) or tension (ki
   }
 }
 
+TEST_CASE("special_spring along an axis: force along the turned axis, lever arm on the stop's body",
+          "[elements][nonlinear]") {
+  // Body a at the origin turned by 90 degrees: its axis [1, 0] points along global +y.
+  // P2 on body b at (0.5, 0.8): s = 0.8, d = 1 - 0.8 = 0.2, P = 100 * 0.2 = 20.
+  // On b: (0, +20) at its centre. On a: (0, -20) at r2, arm (0.5, 0.8): moment 0.5 * -20 = -10.
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: axis\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: a, mass: 1, inertia: 1, position: [0, 0], angle: 1.5707963267948966}\n"
+      "  - {name: b, mass: 1, inertia: 1, position: [0.5, 0.8]}\n"
+      "elements:\n  - {name: e, type: special_spring, stiffness_1: 100, free_length: 1.0, axis: [1, 0], "
+      "points: [{body: a, at: [0, 0]}, {body: b, at: [0, 0]}]}\n"
+      "simulation: {t_end: 1}\n");
+  const DaeSystem system(model);
+  const std::vector<double> y = system.initial_state();
+  std::vector<double> f(6, 0.0), out(2, 0.0);
+  system.generalized_forces(0.0, y.data(), y.data() + 6, f.data());
+  system.outputs(y.data(), nullptr, out.data());
+  const double expected[] = {0.0, -20.0, -10.0, 0.0, 20.0, 0.0};
+  for (std::size_t k = 0; k < 6; ++k) {
+    INFO("component " << k);
+    CHECK(f[k] == Approx(expected[k]).margin(1e-12));
+  }
+  CHECK(out[0] == Approx(20.0));
+  CHECK(out[1] == Approx(0.2));
+  const Element& e = *model.elements().front();
+  CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 6)) == Approx(2.0));
+}
+
 TEST_CASE("a breakpoint that is no kink is merged: the report's symmetric dashpot and gap spring",
           "[elements][nonlinear]") {
   // Report Table 5 nonlinear dashpot: 1180 lb-s/in below 4.5 in/s, 173 above, both ways.
-  Axial dashpot{"nonlinear_dashpot",
+  Axial dashpot = axial("nonlinear_dashpot",
                 "damping_compression_1: 1180, damping_compression_2: 173, compression_switch_velocity: 4.5, "
-                "damping_extension_1: 1180, damping_extension_2: 173, extension_switch_velocity: 4.5"};
+                "damping_extension_1: 1180, damping_extension_2: 173, extension_switch_velocity: 4.5");
   dashpot.velocity = 10.0;
   dashpot.simulation = ida(1.0);
   const Model model = testing::model_from_text(axial_yaml(dashpot));
@@ -377,22 +460,46 @@ TEST_CASE("a breakpoint that is no kink is merged: the report's symmetric dashpo
   CHECK(law.value(2.0, 1) == Approx(2360.0));
 
   // Report Table 5 special spring (Type 2): 0 below 4 in of deflection, 175,000 above, no
-  // preload: force-free up to the breakpoint, so it closes there. A body approaching at
-  // 2 from 1 beyond the free length (4) touches when the deflection reaches 4: t = (1 + 4) / 2.
-  Axial gap{"special_spring", "stiffness_1: 0, stiffness_2: 175000, breakpoint: 4.0, fracture_load: 700000, free_length: 4.0"};
-  gap.position = 5.0 + 4.0;  // ground point at 0: the line from the origin; 1 beyond the free length... see below
-  gap.position = 4.0 + 1.0;
+  // preload, free length 4: force-free until the point has crossed the stop plane (deflection
+  // 4, along the axis), then stiff. Mass 10 from s = 4 at 2 towards the plane: closes at
+  // t = 2, comes back after half a period pi / sqrt(175000 / 10) with the same speed.
+  Axial gap = axial("special_spring",
+            "stiffness_1: 0, stiffness_2: 175000, breakpoint: 4.0, fracture_load: 700000, free_length: 4.0, axis: [1, 0]");
+  gap.position = 4.0;
   gap.velocity = -2.0;
   gap.mass = 10.0;
-  gap.simulation = ida(2.55);
+  const double half_period = kPi / std::sqrt(17500.0), t_end = 2.1;
+  gap.simulation = ida(t_end);
   const Model gap_model = testing::model_from_text(axial_yaml(gap));
-  REQUIRE(dynamic_cast<const SpecialSpring&>(*gap_model.elements().front()).law().segment_count() == 2);
-  // The free length 4 equals the breakpoint: contact would be at zero length; use a shorter
-  // approach instead: stop the run before, and check no event fired in the force-free range.
-  const RunOutcome outcome = run(axial_yaml(gap));
-  INFO(event_list(outcome));
-  CHECK(outcome.events.empty());
-  CHECK(final_velocity(outcome) == Approx(-2.0).epsilon(1e-12));
+  const auto& gap_law = dynamic_cast<const SpecialSpring&>(*gap_model.elements().front()).law();
+  REQUIRE(gap_law.segment_count() == 2);
+  CHECK(gap_law.breakpoints() == std::vector<double>{4.0});
+  const RunOutcome o = run(axial_yaml(gap));
+  INFO(event_list(o));
+  REQUIRE(o.events.size() == 2);
+  CHECK(o.events[0].what == "closing (segment 2)");
+  CHECK(o.events[0].t == Approx(2.0).margin(1e-9));
+  CHECK(o.events[1].what == "opening");
+  CHECK(o.events[1].t == Approx(2.0 + half_period).margin(1e-8));
+  CHECK(final_velocity(o) == Approx(2.0).epsilon(1e-8));
+  CHECK(final_position(o) == Approx(2.0 * (t_end - 2.0 - half_period)).margin(1e-8));
+}
+
+TEST_CASE("a zero breakpoint leaves no empty segment: the report's nonlinear spring type 5", "[elements][nonlinear]") {
+  // Table 5, type 5: compression 0 lb/in up to 1.25 in, then 3e6; extension 0 up to 0 in, then 3e6.
+  PiecewiseLinearLaw::Branch compression{0.0, 3e6, 1.25}, extension{0.0, 3e6, 0.0};
+  const PiecewiseLinearLaw law = PiecewiseLinearLaw::two_branch(0.0, compression, "compression", extension, "extension");
+  REQUIRE(law.segment_count() == 3);
+  CHECK(law.breakpoints() == std::vector<double>{-1.25, 0.0});
+  CHECK(law.segment(2).name == "extension segment 2");
+  CHECK(law.segment_at(0.0, 1) == 2);
+  CHECK(law.segment_at(0.0, -1) == 1);
+  CHECK(law.value(0.1, 2) == Approx(3e5));
+  CHECK(law.value(-1.0, 1) == 0.0);
+  CHECK(law.value(-1.5, 0) == Approx(-7.5e5));
+  CHECK(law.integral(0.1, 2) == Approx(15000.0));
+  CHECK(law.integral(-1.0, 1) == 0.0);
+  CHECK(law.integral(-1.5, 0) == Approx(3e6 * 0.25 * 0.25 / 2.0));
 }
 
 // ---- events and closed forms ---------------------------------------------------------------------
@@ -408,7 +515,7 @@ TEST_CASE("special_spring contact at constant speed: closing at gap / speed, bre
   for (int kind : {1, 2}) {
     for (const bool use_euler : {false, true}) {
       INFO("kind " << kind << (use_euler ? " euler" : " ida"));
-      Axial a{"special_spring", special_parameters(kind), m};
+      Axial a = axial("special_spring", special_parameters(kind), m);
       // kind 1: body beyond the free length, moving in; kind 2: inside it, moving out.
       const double s = kind == 1 ? 1.0 : -1.0;
       a.position = 1.0 + s * gap;
@@ -446,7 +553,7 @@ TEST_CASE("a mass bouncing on a special_spring under gravity: contact time and r
   const double tau = t_end - t_open;
   for (const bool use_euler : {false, true}) {
     INFO((use_euler ? "euler" : "ida"));
-    Axial a{"special_spring", special_parameters(1), m};
+    Axial a = axial("special_spring", special_parameters(1), m);
     a.vertical = true;
     a.gravity = g;
     a.position = 1.0 + h;
@@ -461,10 +568,11 @@ TEST_CASE("a mass bouncing on a special_spring under gravity: contact time and r
     CHECK(o.events[3].what == "opening");
     CHECK(o.events[3].t == Approx(t_open).margin(2.0 * tolerance));
     // Rebound with the impact speed (no dissipation): free flight from the free length.
-    CHECK(final_velocity(o, true) == Approx(v_in - g * tau).epsilon(use_euler ? 1e-4 : 1e-8));
+    CHECK(final_velocity(o, true) == Approx(v_in - g * tau).epsilon(use_euler ? 1e-4 : 1e-7));
     CHECK(final_position(o, true) == Approx(1.0 + v_in * tau - 0.5 * g * tau * tau).margin(use_euler ? 1e-5 : 1e-9));
     const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
-    CHECK(std::abs(energy.dissipated) < (use_euler ? 1e-4 : 1e-8) * m * g * h);
+    // Euler's rectangle-rule work quadrature errs by about omega dt = 1e-4 of the energy.
+    CHECK(std::abs(energy.dissipated) < (use_euler ? 5e-4 : 1e-7) * m * g * h);
   }
 }
 
@@ -495,7 +603,7 @@ TEST_CASE("nonlinear_spring undamped oscillation across all breakpoints: period,
   };
   for (const bool use_euler : {false, true}) {
     INFO((use_euler ? "euler" : "ida"));
-    Axial a{"nonlinear_spring", parameters, m};
+    Axial a = axial("nonlinear_spring", parameters, m);
     a.velocity = v0;
     a.simulation = use_euler ? euler(t_end, 1e-6) : ida(t_end);
     const RunOutcome o = run(axial_yaml(a));
@@ -513,15 +621,15 @@ TEST_CASE("nonlinear_spring undamped oscillation across all breakpoints: period,
     const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
     const double e0 = 0.5 * m * v0 * v0;
     CHECK(energy.initial_total == Approx(e0));
-    CHECK(std::abs(energy.dissipated) < (use_euler ? 1e-4 : 1e-8) * e0);
-    CHECK(std::abs(energy.error()) < (use_euler ? 1e-4 : 1e-8) * e0);
+    CHECK(std::abs(energy.dissipated) < (use_euler ? 5e-4 : 1e-7) * e0);
+    CHECK(std::abs(energy.error()) < (use_euler ? 5e-4 : 1e-7) * e0);
   }
 }
 
 TEST_CASE("nonlinear_spring with preload conserves energy across its breakpoints (IDA, tight)", "[elements][nonlinear]") {
   // Preload 5 and the laws of kSpringParameters; started at the free length at 3 (inwards):
   // the motion crosses both breakpoints (checked through the events).
-  Axial a{"nonlinear_spring", kSpringParameters, 1.0};
+  Axial a = axial("nonlinear_spring", kSpringParameters, 1.0);
   a.velocity = -3.0;
   a.simulation = ida(1.5);
   const RunOutcome o = run(axial_yaml(a));
@@ -531,10 +639,10 @@ TEST_CASE("nonlinear_spring with preload conserves energy across its breakpoints
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
   const double e0 = 0.5 * 1.0 * 9.0;
   CHECK(energy.initial_total == Approx(e0));
-  CHECK(std::abs(energy.dissipated) < 1e-8 * e0);
-  CHECK(std::abs(energy.error()) < 1e-8 * e0);
+  CHECK(std::abs(energy.dissipated) < 1e-7 * e0);
+  CHECK(std::abs(energy.error()) < 1e-7 * e0);
   // Work done on the spring equals its stored energy (both zero at the free length).
-  CHECK(element_work(o) == Approx(energy.elastic).margin(1e-8 * e0));
+  CHECK(element_work(o) == Approx(energy.elastic).margin(1e-7 * e0));
   CHECK(energy.elastic > 0.01 * e0);  // the end is not at a trivial state
 }
 
@@ -550,7 +658,7 @@ TEST_CASE("nonlinear_dashpot decelerating a mass: switch time, final state, diss
   const double dissipated = 0.5 * m * (v0 * v0 - v_end * v_end);
   for (const bool use_euler : {false, true}) {
     INFO((use_euler ? "euler" : "ida"));
-    Axial a{"nonlinear_dashpot", kDashpotParameters, m};
+    Axial a = axial("nonlinear_dashpot", kDashpotParameters, m);
     a.velocity = v0;
     a.simulation = use_euler ? euler(t_end, 1e-6) : ida(t_end);
     const RunOutcome o = run(axial_yaml(a));
@@ -570,7 +678,7 @@ TEST_CASE("nonlinear_dashpot decelerating a mass: switch time, final state, diss
 }
 
 TEST_CASE("Euler converges to the IDA solution of the nonlinear dashpot as the step shrinks", "[elements][nonlinear]") {
-  Axial a{"nonlinear_dashpot", kDashpotParameters, 2.0};
+  Axial a = axial("nonlinear_dashpot", kDashpotParameters, 2.0);
   a.velocity = -1.2;  // compression: through the 0.5 switch velocity
   a.simulation = ida(0.2);
   const RunOutcome reference = run(axial_yaml(a));
@@ -582,7 +690,7 @@ TEST_CASE("Euler converges to the IDA solution of the nonlinear dashpot as the s
     const RunOutcome o = run(axial_yaml(a));
     const double error = std::abs(final_position(o) - final_position(reference)) +
                          std::abs(final_velocity(o) - final_velocity(reference)) * 0.2;
-    CHECK(error < 2e-3 * dt / 1e-4 * 1.0);  // first order, with room
+    CHECK(error < 2.0 * dt);  // first order: about 1 x dt here
     if (previous > 0.0) CHECK(error < 0.35 * previous);
     previous = error;
   }
@@ -600,7 +708,7 @@ TEST_CASE("nonlinear_spring fractures when its force reaches the fracture load",
   for (const double sign : {1.0, -1.0}) {  // extension, compression
     for (const bool use_euler : {false, true}) {
       INFO((sign > 0 ? "tension" : "compression") << (use_euler ? " euler" : " ida"));
-      Axial a{"nonlinear_spring", "compression_stiffness_1: 100, extension_stiffness_1: 100, fracture_load: 3"};
+      Axial a = axial("nonlinear_spring", "compression_stiffness_1: 100, extension_stiffness_1: 100, fracture_load: 3");
       a.velocity = sign;
       a.simulation = use_euler ? euler(t_end, 1e-6) : ida(t_end);
       const RunOutcome o = run(axial_yaml(a));
@@ -624,7 +732,7 @@ TEST_CASE("special_spring fractures at its fracture load", "[elements][nonlinear
   const double w = std::sqrt(1000.0);
   const double t_close = 0.01 / 2.0;
   const double t_fracture = t_close + std::asin(50.0 / (2.0 * w)) / w;
-  Axial a{"special_spring", "stiffness_1: 1000, fracture_load: 50, free_length: 1.0"};
+  Axial a = axial("special_spring", "stiffness_1: 1000, fracture_load: 50, free_length: 1.0");
   a.position = 1.01;
   a.velocity = -2.0;
   a.simulation = ida(0.1);
@@ -642,22 +750,26 @@ TEST_CASE("special_spring fractures at its fracture load", "[elements][nonlinear
 
 TEST_CASE("starting at rest on a kink, the element follows the branch the motion takes", "[elements][nonlinear]") {
   // Mass 1 at rest, pulled (+2) or pushed (-2) by a constant load.
+  const double t_end = 0.2;
   for (const double load : {2.0, -2.0}) {
     for (const bool use_euler : {false, true}) {
       INFO("load " << load << (use_euler ? " euler" : " ida"));
-      const double t_end = 0.2;
-      SECTION("nonlinear_dashpot: extension 10, compression 100") {
-        Axial a{"nonlinear_dashpot", "damping_compression_1: 100, damping_extension_1: 10"};
+      {
+        INFO("nonlinear_dashpot: extension 10, compression 100");
+        Axial a = axial("nonlinear_dashpot", "damping_compression_1: 100, damping_extension_1: 10");
         a.load = load;
         a.simulation = use_euler ? euler(t_end, 1e-5) : ida(t_end);
         const RunOutcome o = run(axial_yaml(a));
         INFO(event_list(o));
         const double c = load > 0.0 ? 10.0 : 100.0;  // v = (F / c)(1 - exp(-c t / m))
         CHECK(final_velocity(o) == Approx(load / c * (1.0 - std::exp(-c * t_end))).epsilon(use_euler ? 1e-3 : 1e-7));
+        // It starts in compression (the lower segment) and leaves it at once when pulled.
         CHECK(o.events.size() == (load > 0.0 ? 1u : 0u));
+        if (load > 0.0 && !o.events.empty()) CHECK(o.events.front().t == 0.0);
       }
-      SECTION("nonlinear_spring at its free length: extension 100, compression 400") {
-        Axial a{"nonlinear_spring", "compression_stiffness_1: 400, extension_stiffness_1: 100"};
+      {
+        INFO("nonlinear_spring at its free length: extension 100, compression 400");
+        Axial a = axial("nonlinear_spring", "compression_stiffness_1: 400, extension_stiffness_1: 100");
         a.load = load;
         a.simulation = use_euler ? euler(t_end, 1e-5) : ida(t_end);
         const RunOutcome o = run(axial_yaml(a));
@@ -665,8 +777,13 @@ TEST_CASE("starting at rest on a kink, the element follows the branch the motion
         const double k = load > 0.0 ? 100.0 : 400.0;  // x = (F / k)(1 - cos(w t)), w = sqrt(k / m)
         const double expected = load / k * (1.0 - std::cos(std::sqrt(k) * t_end));
         CHECK(final_position(o) - 1.0 == Approx(expected).epsilon(use_euler ? 1e-3 : 1e-7));
-        REQUIRE(!o.events.empty());
-        CHECK(o.events.front().what == (load > 0.0 ? "extension segment 1" : "compression segment 1"));
+        if (load > 0.0) {
+          REQUIRE(!o.events.empty());
+          CHECK(o.events.front().what == "extension segment 1");
+          CHECK(o.events.front().t == 0.0);  // committed by the start check, not found later
+        } else {
+          CHECK(o.events.empty());  // 0.2 s is less than a period: it never comes back to the kink
+        }
       }
     }
   }
@@ -676,7 +793,7 @@ TEST_CASE("starting at rest on a kink, the element follows the branch the motion
 
 TEST_CASE("nonlinear elements reject incomplete or inconsistent parameters", "[elements][nonlinear]") {
   const auto load = [](const std::string& type, const std::string& parameters) {
-    Axial a{type, parameters};
+    Axial a = axial(type, parameters);
     a.simulation = "t_end: 1";
     return testing::model_from_text(axial_yaml(a));
   };

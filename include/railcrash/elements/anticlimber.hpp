@@ -48,8 +48,11 @@
 //                                  would leave the couple d x F unbalanced: with the faces
 //                                  offset by v it is H v, not small.)
 //   torsional couple               -M on body 2, +M on body 1 (a pure couple).
-// Outputs: vertical_force = V (positive when it pushes face 2 down, i.e. resists d_v > 0),
-// horizontal_force = H (compression positive), moment = M.
+// Outputs (timeseries columns <element>.<name>): horizontal_force H (compression positive),
+// vertical_force V (positive when it pushes face 2 down, i.e. resists d_v > 0), moment M
+// (positive when it turns body 2 back, i.e. resists d_t > 0), horizontal_deformation d_h
+// (= -gap, also while open), vertical_deformation d_v and torsional_deformation d_t (0 when
+// not engaged), vertical_offset v, override (0 / 1). All three forces are 0 unless engaged.
 //
 // ---- Modes (history changes only at events) ----------------------------------------------
 // contact:
@@ -151,7 +154,7 @@ struct ElasticPlasticLaw {
     bool yielded = false; // has flowed plastically before
   };
   /// What leaving a mode through a root did.
-  enum class Outcome { None, Yield, Reloading, Unloading, Rupture, Release };
+  enum class Outcome { Yield, Reloading, Unloading, Rupture, Release };
 
   double yield_force() const { return elastic_stiffness * yield_deflection; }
   /// Elastic, no plastic offset.

@@ -53,7 +53,7 @@
 //
 // Modes and events (4 root functions; an inactive one returns 1):
 //   g_k, k = 0 axial, 1 hinge 1, 2 hinge 2:
-//     elastic   1 - |F_k - c_k p_k| / Y_k   goes negative: yield (event "axial yield in
+//     elastic   1 + 1e-9 - |F_k - c_k p_k| / Y_k  goes negative: yield (event "axial yield in
 //               tension|compression" with N, "plastic hinge at end i" with M_i)
 //     plastic   s_k dp_k/dt (the plastic flow rate) goes negative: unloading (event
 //               "axial unloading" / "hinge at end i unloading"), p_k is stored
@@ -230,7 +230,7 @@ class BeamElement : public ForceElement<BeamElement> {
   BeamSection section_;
 
  private:
-  /// Resultants F and offsets p at state s, and (when rates is given) dp/dt along s.v.
+  /// Resultants F and offsets p at state s, and (when offset_rate is given) dp/dt along s.v.
   void evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
                 std::array<double, 3>* offset_rate = nullptr) const;
   /// Largest of |N| / A_min, |M_i| / Z_i [force/length^2].

@@ -29,9 +29,13 @@
 //   loading     on segment k of U           P = U_k(x)     x' < 0 -> transition; segment
 //                                                          ends -> next segment
 //   transition  from (x0, P0)               P = P0 + K_t (x - x0)
-//                                                          P = U(x) -> loading; P = Lw(x)
-//                                                          -> unloading; P = 0 -> released
-//                                                          (x > 0) or leaves the side
+//                                                          rejoins U going up -> loading;
+//                                                          meets Lw going down -> unloading,
+//                                                          or P = 0 first -> released (x > 0)
+//                                                          or leaves the side. (Where K_t
+//                                                          equals a curve's slope the line
+//                                                          runs parallel to it: a bottomed
+//                                                          gear stays elastic, solid.)
 //   unloading   on segment k of Lw          P = Lw_k(x)    x' > 0 -> transition; P = 0
 //                                                          (where Lw < 0) -> released;
 //                                                          x = 0 (where Lw(0) = 0) -> leaves
@@ -216,6 +220,11 @@ class AxialHysteresis {
   Change engage(State& st, int side, double u) const;
   Change leave_at_zero(State& st, double u) const;
   Change leave_side(State& st, double u) const;
+  /// Where the transition line through (x0, f0) rejoins U going up (first x >= x0 with the
+  /// line at or above U; infinity if never), and where it meets Lw going down (last x <= x0
+  /// with the line at or below Lw; -infinity if never).
+  double rejoin_upper(double x0, double f0) const;
+  double rejoin_lower(double x0, double f0) const;
   double unload_from(double x, double force) const;
   double lower_tail(double x) const;
 };

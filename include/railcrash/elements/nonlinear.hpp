@@ -34,6 +34,13 @@
 //     open   (d < 0):                 P = 0
 //     closed (0 <= d <= breakpoint):  P = preload + stiffness_1 * d
 //            (d > breakpoint):        P = preload + stiffness_1 * breakpoint + stiffness_2 * (d - breakpoint)
+//     axis (optional, [ax, ay] in the frame of P1's body, global when P1 is on ground): the
+//     length measure is then s = (r2 - r1) . a instead of L, with a = R(theta_1) axis / |axis|,
+//     d = free_length - s (kind 1) or s - free_length (kind 2), and the force acts along a:
+//     P2 against a stop plane of body 1 with normal a. s passes through zero and changes sign
+//     where L cannot, which the report's property sets need (both have breakpoint = free
+//     length: the second stiffness acts once the points have met and passed). The force
+//     acts at r2 on both bodies, so it is the exact gradient of the energy.
 //     With a preload the force jumps from 0 to the preload at d = 0 (an installed, caged
 //     spring: the stop carries loads up to the preload rigidly); the energy
 //     (the integral of P dd) stays continuous. Closing and opening are events;
@@ -45,8 +52,9 @@
 //     spring: 5000 / 3,000,000 lb/in, breakpoint 1.25 in, preload 1250 lb, fracture
 //     400,000 lb, free length 1.25 in; the coupler-to-end-sill interference: 0 / 175,000
 //     lb/in, breakpoint 4.0 in, no preload, fracture 700,000 lb, free length 4.0 in), so
-//     both are written with kind: 1. kind: 2 is this program's addition (the report does not
-//     say what distinguishes its types), the same law acting in tension.
+//     both are written with kind: 1 (and an axis: their breakpoints equal their free lengths).
+//     kind: 2 is this program's addition (the report does not say what distinguishes its
+//     types), the same law acting in tension.
 //
 // Breakpoints may be zero (the report's nonlinear spring type 5 has an extension breakpoint
 // of 0 in): the first segment is then empty and the second slope acts from the start. A
@@ -56,13 +64,10 @@
 // kink raises no event.
 //
 // Starting exactly on a breakpoint: with a nonzero rate of x the run starts in the segment x
-// moves into. With no rate information (at rest, and always for the dashpot, whose x' is an
-// acceleration) the element starts in the lower segment and leaves it when x passes the
-// breakpoint by a kink tolerance of 1e-9 times the element's size (free length or largest
-// breakpoint; 1e-12 in model units for a dashpot without switch velocities). A root that is
-// exactly zero at the start would be ignored by IDA and Euler alike, so the element would
-// otherwise never notice which way x went; the lower segment's law, continued over that
-// tolerance, differs from the true one by a negligible amount.
+// moves into; with none (at rest, and always for the dashpot, whose x' is an acceleration)
+// in the lower segment. A root exactly zero at a (re)start is then committed by the
+// integrators' look-ahead (DaeSystem::commit_boundary_roots) when the motion leaves the
+// segment, so the element follows the branch the motion actually takes.
 //
 // Limitations: a mass at rest on a preloaded special spring with a weight below the preload
 // chatters between open and closed (the stop is rigid up to the preload, which no
@@ -70,7 +75,6 @@
 // sees an event at every velocity reversal.
 #pragma once
 
-#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -134,18 +138,15 @@ class PiecewiseLinearLaw {
 struct SegmentMode {
   int segment = 0;
   bool broken = false;
-  double upper_shift = 0.0;  // [x] kink tolerance while the run started on the upper breakpoint
 };
 
 /// Shared hybrid machinery of the line elements below: the law in x = measure(state), the
 /// segment roots (0: lower breakpoint, 1: upper breakpoint), fracture roots (2: fracture_load - f,
 /// 3: fracture_load + f, as many as fracture sides) and the mode bookkeeping.
 /// Derived provides
-///   double measure(const LineGeometry<double>&) const;    x
-///   int rate_sign(const LineGeometry<double>&) const;     sign of x', 0 when unknown
-///   void prepare(double initial_length);                   defaults from the initial configuration
-///   double kink_scale() const;                             size for the kink tolerance [x]
-///                                                          (the largest |breakpoint| counts too)
+///   double measure(const ElementState<double>&) const;    x
+///   int rate_sign(const ElementState<double>&) const;     sign of x', 0 when unknown
+///   void prepare(const ElementState<double>& initial);     checks and defaults from the initial configuration
 ///   Element::Event segment_event(int from, int to, double x) const;
 template <class Derived>
 class PiecewiseLineElement : public ForceElement<Derived> {
@@ -170,10 +171,9 @@ class PiecewiseLineElement : public ForceElement<Derived> {
     return mode_.broken ? T(0.0) : law_.value(x, mode_.segment);
   }
   /// x of the state.
-  double measure_of(const ElementState<double>& s) const {
-    return static_cast<const Derived*>(this)->measure(line_geometry(*this, s));
-  }
-  double kink_tolerance() const { return kink_tolerance_; }
+  double measure_of(const ElementState<double>& s) const { return static_cast<const Derived*>(this)->measure(s); }
+  /// Outputs: the law value f (force) and x.
+  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  protected:
   /// fracture_sides: 0 (no fracture_load), 1 (f reaching +fracture_load) or 2 (|f|).
@@ -181,13 +181,15 @@ class PiecewiseLineElement : public ForceElement<Derived> {
   void set_law(PiecewiseLinearLaw law) { law_ = std::move(law); }
   /// Number of fracture roots (fixed once the constructor has read fracture_load).
   int fracture_roots() const { return fracture_load ? fracture_sides_ : 0; }
+  /// Integral of f dx from x = 0 to the state's x in the current mode (0 once broken): the
+  /// elastic energy of the springs.
+  double law_integral(const ElementState<double>& s) const;
 
  private:
   PiecewiseLinearLaw law_;
   SegmentMode mode_;
   SegmentMode initial_mode_;
   int fracture_sides_ = 0;
-  double kink_tolerance_ = 0.0;  // [x]
 };
 
 class NonlinearSpring : public PiecewiseLineElement<NonlinearSpring> {
@@ -208,15 +210,13 @@ class NonlinearSpring : public PiecewiseLineElement<NonlinearSpring> {
     apply_line_force(*this, s, Vec2<T>{-scale * g.d.x, -scale * g.d.y}, f);
   }
 
-  double measure(const LineGeometry<double>& g) const { return g.length - *free_length; }
-  int rate_sign(const LineGeometry<double>& g) const;
-  void prepare(double initial_length);
-  double kink_scale() const { return *free_length; }
+  double measure(const ElementState<double>& s) const { return line_geometry(*this, s).length - *free_length; }
+  int rate_sign(const ElementState<double>& s) const;
+  void prepare(const ElementState<double>& initial);
   Event segment_event(int from, int to, double x) const;
 
-  double potential_energy(const ElementState<double>& s) const override;
-  std::vector<std::string> output_names() const override { return {"force", "deformation"}; }
-  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+  double potential_energy(const ElementState<double>& s) const override { return law_integral(s); }
+  std::vector<std::string> output_names() const override { return {"force", "deformation"}; }  // tension positive
 };
 
 class NonlinearDashpot : public PiecewiseLineElement<NonlinearDashpot> {
@@ -234,14 +234,12 @@ class NonlinearDashpot : public PiecewiseLineElement<NonlinearDashpot> {
     apply_line_force(*this, s, Vec2<T>{-scale * g.d.x, -scale * g.d.y}, f);
   }
 
-  double measure(const LineGeometry<double>& g) const { return dot(g.d, g.d_rate) / g.length; }
-  int rate_sign(const LineGeometry<double>&) const { return 0; }  // x' is an acceleration
-  void prepare(double initial_length);
-  double kink_scale() const { return 1e-3; }
+  double measure(const ElementState<double>& s) const;
+  int rate_sign(const ElementState<double>&) const { return 0; }  // x' is an acceleration
+  void prepare(const ElementState<double>& initial);
   Event segment_event(int from, int to, double x) const;
 
-  std::vector<std::string> output_names() const override { return {"force", "rate"}; }
-  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+  std::vector<std::string> output_names() const override { return {"force", "rate"}; }  // tension positive
 };
 
 class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
@@ -253,11 +251,27 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
   // breakpoint [length] (stiffness_2 and breakpoint together, or neither: one stiffness)
   PiecewiseLinearLaw::Branch closed;
   double preload = 0.0;               // [force] force at zero deflection once closed (>= 0)
-  std::optional<double> free_length;  // [length]; default: initial length
+  std::optional<double> free_length;  // [length]; default: initial length (or initial s with an axis)
+  std::optional<Vec2<double>> axis;   // [-] unit vector in the frame of P1's body (global for ground)
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
     if (mode().broken) return;
+    if (axis) {
+      // A point (P2) against a stop plane on body 1 with normal a: the force acts along a at r2
+      // on both bodies, so it is the exact gradient of the energy (body 1 feels the lever arm r2 - c1).
+      const AxisGeometry<T> g = axis_geometry(s);
+      const T force = direction() * law_value(T(direction() * (*free_length - g.along)));
+      const Vec2<T> on_2{force * g.a.x, force * g.a.y};
+      const PointRef& p2 = point(1);
+      add_point_force(s.q[slot_of(1)], p2.sx, p2.sy, on_2, f[slot_of(1)]);
+      Pose<T>& body_1 = f[slot_of(0)];
+      const Vec2<T> arm = g.r2 - Vec2<T>{s.q[slot_of(0)].x, s.q[slot_of(0)].y};
+      body_1.x -= on_2.x;
+      body_1.y -= on_2.y;
+      body_1.theta -= cross(arm, on_2);
+      return;
+    }
     const LineGeometry<T> g = line_geometry(*this, s);
     const T force = law_value(T(direction() * (*free_length - g.length)));
     // kind 1: force on P2 = +P u; kind 2: -P u
@@ -267,15 +281,37 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
   /// +1 for kind 1 (deflection = shortening), -1 for kind 2 (deflection = lengthening).
   double direction() const { return kind == 1 ? 1.0 : -1.0; }
 
-  double measure(const LineGeometry<double>& g) const { return direction() * (*free_length - g.length); }
-  int rate_sign(const LineGeometry<double>& g) const;
-  void prepare(double initial_length);
-  double kink_scale() const { return *free_length; }
+  /// With an axis: a = R(theta_1) axis, r2, and s = (r2 - r1) . a.
+  template <class T>
+  struct AxisGeometry {
+    Vec2<T> a, r2;
+    T along;
+  };
+  template <class T>
+  AxisGeometry<T> axis_geometry(const ElementState<T>& s) const {
+    const PointRef& p1 = point(0);
+    const PointRef& p2 = point(1);
+    AxisGeometry<T> g;
+    const Vec2<T> r1 = point_position(s.q[slot_of(0)], p1.sx, p1.sy);
+    g.r2 = point_position(s.q[slot_of(1)], p2.sx, p2.sy);
+    g.a = rotate(s.q[slot_of(0)].theta, axis->x, axis->y);
+    g.along = dot(g.r2 - r1, g.a);
+    return g;
+  }
+  /// Length measure: s along the axis, or the distance L.
+  double separation(const ElementState<double>& s) const;
+
+  double measure(const ElementState<double>& s) const { return direction() * (*free_length - separation(s)); }
+  int rate_sign(const ElementState<double>& s) const;
+  void prepare(const ElementState<double>& initial);
   Event segment_event(int from, int to, double x) const;
 
-  double potential_energy(const ElementState<double>& s) const override;
+  double potential_energy(const ElementState<double>& s) const override { return law_integral(s); }
+  // force >= 0 in the working direction (kind 1: compression, kind 2: tension)
   std::vector<std::string> output_names() const override { return {"force", "deflection"}; }
-  void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+
+ private:
+  std::size_t slot_of(int p) const { return static_cast<std::size_t>(point_slot(p)); }
 };
 
 extern template class PiecewiseLineElement<NonlinearSpring>;
