@@ -198,7 +198,9 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
                       std::abs(y0[static_cast<std::size_t>(nq + 3 * i + 2)]) * length});
     total_mass += model.bodies()[static_cast<std::size_t>(i)].mass;
   }
-  const double energy_scale = std::max(system_.kinetic_energy(y0.data() + nq), force_scale * length);
+  double energy_scale = std::max(system_.kinetic_energy(y0.data() + nq), force_scale * length);
+  // A model at rest with no load still needs positive tolerances.
+  if (!(energy_scale > 0.0)) energy_scale = total_mass * (length / t_end) * (length / t_end);
   speed = std::max(speed, std::sqrt(2.0 * energy_scale / total_mass));
   if (!(speed > 0.0)) speed = length / t_end;
   if (!(force_scale > 0.0)) force_scale = total_mass * speed * speed / length;

@@ -131,7 +131,9 @@ class DaeSystem {
   bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
   /// At a (re)start: IDA leaves a root that is exactly zero inactive, so a state sitting on a
   /// mode boundary and moving out of the mode would never be reported. Looks a tiny step
-  /// ahead along y' and commits such roots now. Returns true when a mode changed.
+  /// ahead along y' and commits such roots now, and also roots already negative (the state
+  /// is outside its mode, e.g. after the initial assembly moved it). Returns true when a
+  /// mode changed.
   bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events) const;
   /// Puts every element back in its starting mode.
   void reset_modes() const;
