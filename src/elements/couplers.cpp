@@ -112,13 +112,13 @@ void AxialHysteresis::roots(const State& st, double u, double rate, double* g) c
   const double x_rate = st.side * rate;
   const double kt = transition_stiffness;
   const auto segment_ends = [&](int j) {
-    if (j > 0) g[2] = x - upper.start[static_cast<std::size_t>(j)];
-    if (j + 1 < upper.segments()) g[3] = upper.start[static_cast<std::size_t>(j + 1)] - x;
+    if (j > 0) g[2] = x - upper.start[static_cast<std::size_t>(j)] + tolerance;
+    if (j + 1 < upper.segments()) g[3] = upper.start[static_cast<std::size_t>(j + 1)] - x + tolerance;
   };
   switch (st.mode) {
     case Mode::Open:
-      g[0] = 0.5 * slack - u;
-      g[1] = 0.5 * slack + u;
+      g[0] = 0.5 * slack - u + tolerance;
+      g[1] = 0.5 * slack + u + tolerance;
       break;
     case Mode::Neutral:
       g[0] = upper.at(std::max(u, 0.0)) - kt * u;
@@ -131,24 +131,24 @@ void AxialHysteresis::roots(const State& st, double u, double rate, double* g) c
     case Mode::Transition: {
       // Leaves where the line rejoins U going up, or meets Lw / zero force going down.
       const double up = rejoin_upper(st.x0, st.f0);
-      if (std::isfinite(up)) g[0] = up - x;
-      g[1] = x - std::max(rejoin_lower(st.x0, st.f0), st.x0 - st.f0 / kt);
+      if (std::isfinite(up)) g[0] = up - x + tolerance;
+      g[1] = x - std::max(rejoin_lower(st.x0, st.f0), st.x0 - st.f0 / kt) + tolerance;
       break;
     }
     case Mode::Unloading:
       g[0] = -x_rate;
       if (lower.value[static_cast<std::size_t>(st.segment)] < 0.0) g[1] = lower.on_segment(st.segment, x);
-      else if (st.segment == 0) g[1] = x;
+      else if (st.segment == 0) g[1] = x + tolerance;
       segment_ends(st.segment);
       break;
     case Mode::Released:
       g[0] = -x_rate;
-      g[1] = x;
+      g[1] = x + tolerance;
       break;
   }
 }
 
-AxialHysteresis::Change AxialHysteresis::transition(State& st, int index, double u, double /*rate*/) const {
+AxialHysteresis::Change AxialHysteresis::transition(State& st, int index, double u) const {
   const double x = side_deflection(st, u);
   switch (st.mode) {
     case Mode::Open:
@@ -250,7 +250,7 @@ AxialHysteresis::State AxialHysteresis::initial(double u, double rate) const {
     }
     st.side = u > 0.0 ? 1 : -1;
   } else {
-    if (slack > 0.0 && (a < 0.5 * slack || (a == 0.5 * slack && rate * u <= 0.0))) {
+    if (slack > 0.0 && (a < 0.5 * slack || (a == 0.5 * slack && rate * u <= 0.0))) {  // on the edge at rest: open
       st.mode = Mode::Open;
       return st;
     }
@@ -258,9 +258,9 @@ AxialHysteresis::State AxialHysteresis::initial(double u, double rate) const {
   }
   const double x = side_deflection(st, u);
   st.segment = upper.segment_of(x);
-  if (st.side * rate >= 0.0) {
+  if (st.side * rate > 0.0) {
     st.mode = Mode::Loading;
-  } else {  // loaded to here, now unloading: on the transition line from the curve
+  } else {  // loaded to here, at rest or unloading: on the transition line from the curve
     st.mode = Mode::Transition;
     st.x0 = x;
     st.f0 = upper.at(x);
@@ -340,11 +340,11 @@ double AxialHysteresis::lower_tail(double x) const {
 void DeadBand::roots(Mode m, double z, double* g) const {
   g[0] = g[1] = 1.0;
   switch (m) {
-    case Mode::Below: g[0] = lo - z; break;
-    case Mode::Above: g[1] = z - hi; break;
+    case Mode::Below: g[0] = lo - z + tolerance; break;
+    case Mode::Above: g[1] = z - hi + tolerance; break;
     case Mode::Inside:
-      if (below_active) g[0] = z - lo;
-      if (above_active) g[1] = hi - z;
+      if (below_active) g[0] = z - lo + tolerance;
+      if (above_active) g[1] = hi - z + tolerance;
       break;
   }
 }
@@ -403,6 +403,7 @@ DraftGear::DraftGear(ElementSpec& spec) : ForceElement(spec.name, spec.type, spe
   law_.upper = {{0.0, travel}, {h, k * travel + h}, {k, stiffness_after_bottoming}};
   law_.lower = {{0.0, travel}, {-h, k * travel - h}, {k, stiffness_after_bottoming}};
   law_.transition_stiffness = transition_stiffness;
+  law_.tolerance = kRootBand * travel;
 }
 
 DraftGear::Kinematics DraftGear::kinematics(const ElementState<double>& s) const {
@@ -471,7 +472,7 @@ void DraftGear::apply(int index, const Kinematics& k, Event& event) {
         event = {"pin shear", force};
         return;
       }
-      event = {describe(law_.transition(st.law, index, k.d, k.rate), st.law, law_, kGearSegments), k.d};
+      event = {describe(law_.transition(st.law, index, k.d), st.law, law_, kGearSegments), k.d};
       return;
     case Stage::Sheared:
       st.stage = Stage::Solid;
@@ -548,6 +549,7 @@ CouplerEnd::CouplerEnd(ElementSpec& spec) : ForceElement(spec.name, spec.type, s
   faces_.hi = faces_.lo + total_horizontal_slack;
   faces_.stiffness = horizontal_stiffness[0] * horizontal_stiffness[1] / (horizontal_stiffness[0] + horizontal_stiffness[1]);
   faces_.above_active = coupled;
+  faces_.tolerance = kRootBand * std::max({faces_.hi, coupler_height[0], coupler_height[1]});
 }
 
 CouplerEnd::Kinematics CouplerEnd::kinematics(const ElementState<double>& s) const {
@@ -559,7 +561,7 @@ void CouplerEnd::initialize(const ElementState<double>& initial) {
   side_ = facing_side(*this, initial);
   const Kinematics k = kinematics(initial);
   state_ = State{};
-  state_.overlapping = std::abs(k.dy) < half_overlap();
+  state_.overlapping = std::abs(k.dy) <= half_overlap();
   state_.band = faces_.initial(k.h, k.h_rate);
   initial_state_ = state_;
 }
@@ -568,9 +570,9 @@ void CouplerEnd::roots_at(const Kinematics& k, double* g) const {
   g[0] = g[1] = 1.0;
   if (state_.overlapping) {
     faces_.roots(state_.band, k.h, g);
-    g[2] = half_overlap() - std::abs(k.dy);
+    g[2] = half_overlap() - std::abs(k.dy) + faces_.tolerance;
   } else {
-    g[2] = std::abs(k.dy) - half_overlap();
+    g[2] = std::abs(k.dy) - half_overlap() + faces_.tolerance;
   }
 }
 
@@ -657,6 +659,7 @@ Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.
     p.fail("kind", "'kind' must be 1 (curve + unloading_factor, report type 11) or 2 (loading_curve + unloading_curve, "
                    "report type 12)");
   kind = static_cast<int>(kind_value);
+  double extent = 0.0;  // [length] largest deflection in the curves
   if (kind == 1) {
     if (loading || unloading)
       p.fail(loading ? "loading_curve" : "unloading_curve",
@@ -666,6 +669,7 @@ Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.
     if (*factor > 1.0) p.fail("unloading_factor", "'unloading_factor' must not exceed 1 (unloading below loading)");
     std::vector<double> x, y;
     read_curve(p, "curve", *curve, x, y);
+    extent = x.back();
     law_.upper = PiecewiseLinear::through(x, y);
     for (double& value : y) value *= *factor;
     law_.lower = PiecewiseLinear::through(x, y);
@@ -684,6 +688,7 @@ Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.
     x.insert(x.end(), ux.begin(), ux.end());
     std::sort(x.begin(), x.end());
     x.erase(std::unique(x.begin(), x.end()), x.end());
+    extent = x.back();
     for (const double at : x)
       if (down.at(at) > up.at(at) * (1.0 + 1e-12))
         p.fail("unloading_curve", "the unloading curve must not lie above the loading curve (it does at deflection " +
@@ -710,6 +715,8 @@ Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.
            "the transition stiffness must be positive and at least the steepest slope of the curves (" +
                std::to_string(steepest) + "), so that the elastic line between them meets them");
   law_.slack = horizontal_slack;
+  law_.tolerance = kRootBand * (horizontal_slack + extent);
+  vertical_.tolerance = kRootBand * vertical_slack;
   vertical_.lo = -0.5 * vertical_slack;
   vertical_.hi = 0.5 * vertical_slack;
   vertical_.stiffness = vertical_stiffness;
@@ -740,7 +747,7 @@ void Coupling::roots(double, const ElementState<double>& s, const double*, doubl
 
 void Coupling::apply(int index, const Kinematics& k, Event& event) {
   if (index < AxialHysteresis::kRoots) {
-    event = {describe(law_.transition(state_.horizontal, index, k.u, k.u_rate), state_.horizontal, law_), k.u};
+    event = {describe(law_.transition(state_.horizontal, index, k.u), state_.horizontal, law_), k.u};
     return;
   }
   using M = DeadBand::Mode;

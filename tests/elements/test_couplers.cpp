@@ -350,7 +350,7 @@ TEST_CASE("draft_gear: a mass bounces off it in buff and in draft, closed form u
       CHECK(r.vx == Approx(side * speed).epsilon(ida ? 1e-8 : 1e-3));
       CHECK(element_work(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
       CHECK(dissipated(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
-      CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-6 : 1.0) * area);
+      CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-7 : 1e-4) * area);
       CHECK(gear_of(model).state().law.mode == AxialHysteresis::Mode::Released);
     }
   }
@@ -379,19 +379,28 @@ TEST_CASE("draft_gear: released gear returns to neutral at zero compression and 
 }
 
 TEST_CASE("draft_gear: bottoms at exactly its travel", "[elements][couplers]") {
-  const Walker expected = gear_bounce(kGear, kGearMass, 5.0, 1);
-  REQUIRE(expected.events[1].what == "bottomed (buff)");
-  const double t_end = expected.t + 0.5 * (kGear.H / kGear.k) / -expected.v;
-  for (const char* integrator : {"ida", "euler"}) {
-    INFO(integrator);
-    const bool ida = std::string(integrator) == "ida";
-    const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator));
-    const Run r = run(model);
-    check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-5);
-    REQUIRE(r.outcome.events.size() > 1);
-    CHECK(r.outcome.events[1].value == Approx(kGear.s).margin(ida ? 1e-9 : 1e-5));
-    CHECK(r.vx == Approx(-expected.v).epsilon(ida ? 1e-8 : 1e-3));
-    CHECK(dissipated(r.outcome) == Approx(expected.loop_area()).epsilon(ida ? 1e-7 : 2e-3));
+  // With the default transition stiffness (= K) the gear unloads from the bottom along its
+  // loading line; with a stiffer transition it meets the unloading line while still
+  // bottomed and comes "off bottom" at exactly its travel too.
+  for (const double kt : {kGear.K, 2.0 * kGear.K}) {
+    Gear g = kGear;
+    g.Kt = kt;
+    const Walker expected = gear_bounce(g, kGearMass, 5.0, 1);
+    REQUIRE(expected.events[1].what == "bottomed (buff)");
+    REQUIRE(expected.events.size() == (kt > g.K ? 6u : 5u));
+    const double t_end = expected.t + 0.5 * (g.H / g.k) / -expected.v;
+    for (const char* integrator : {"ida", "euler"}) {
+      INFO(integrator << ", transition stiffness " << kt);
+      const bool ida = std::string(integrator) == "ida";
+      const Model model = testing::model_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator));
+      const Run r = run(model);
+      check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-5);
+      REQUIRE(r.outcome.events.size() > 1);
+      CHECK(r.outcome.events[1].value == Approx(g.s).margin(ida ? 1e-9 : 1e-5));
+      if (kt > g.K) CHECK(r.outcome.events[4].value == Approx(g.s).margin(ida ? 1e-9 : 1e-5));
+      CHECK(r.vx == Approx(-expected.v).epsilon(ida ? 1e-8 : 1e-3));
+      CHECK(dissipated(r.outcome) == Approx(expected.loop_area()).epsilon(ida ? 1e-7 : 2e-3));
+    }
   }
 }
 
@@ -548,6 +557,75 @@ TEST_CASE("draft_gear: stored energy is what unloading gives back, and forces fo
   st.stage = DraftGear::Stage::Fractured;
   gear.set_state(st);
   CHECK(force_on_mass(0.075) == 0.0);
+}
+
+TEST_CASE("draft_gear: reloading, rejoining the loading curve, and crossings committed together", "[elements][couplers]") {
+  const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, 0.0, 0.0, 1.0, "ida"));
+  DraftGear& gear = gear_of(model);
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const auto at = [&](double d, double rate) {  // compression d, compression rate
+    y[0] = 1.0 - d;
+    y[3] = -rate;
+    return gather_state(gear, y.data(), y.data() + 3);
+  };
+  const auto force = [&](double d) {
+    std::array<Pose<double>, 2> f{};
+    gear.add_force(0.0, at(d, 0.0), f);
+    return f[1].x;
+  };
+  const Gear& g = kGear;
+  using M = AxialHysteresis::Mode;
+  REQUIRE(gear.state().law.mode == M::Neutral);
+  Element::Event event;
+  const double x1 = g.H / (g.Kt - g.k);
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(0.5 * x1, 1.0), nullptr, event));  // not crossed: stale
+  CHECK_FALSE(gear.commit(0, 1, 0.0, at(2.0 * x1, 1.0), nullptr, event));   // upward crossings never leave a mode
+  CHECK(gear.commit(0, -1, 0.0, at(x1, 1.0), nullptr, event));
+  CHECK(event.what == "sliding (buff)");
+  // Reversal at 0.03, partial unloading to the lower line, reloading at 0.025.
+  CHECK(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, event));
+  CHECK(event.what == "reversal (buff)");
+  CHECK(force(0.0295) == Approx(g.U(0.03) - g.Kt * 0.0005));
+  const double meet = 0.03 - 2.0 * g.H / (g.Kt - g.k);
+  // (Position roots switch a band of 1e-12 x travel past their boundary: step just past it.)
+  const double past = 1e-12;
+  CHECK(gear.commit(1, -1, 0.0, at(meet - past, -1.0), nullptr, event));
+  CHECK(event.what == "unloading (buff)");
+  CHECK(force(0.026) == Approx(g.Lw(0.026)));
+  CHECK(gear.commit(0, -1, 0.0, at(0.025, 1.0), nullptr, event));
+  CHECK(event.what == "reloading (buff)");
+  CHECK(force(0.026) == Approx(g.Lw(0.025) + g.Kt * 0.001));
+  // Elastic back up until the line meets k x + H again, 2 H / (Kt - k) further on.
+  const double rejoin = 0.025 + 2.0 * g.H / (g.Kt - g.k);
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(rejoin - 1e-6, 1.0), nullptr, event));
+  CHECK(gear.commit(0, -1, 0.0, at(rejoin + past, 1.0), nullptr, event));
+  CHECK(event.what == "back on the loading curve (buff)");
+  CHECK(force(0.04) == Approx(g.U(0.04)));
+  // An Euler step that goes past several boundaries (breakaway, then the reversal): each
+  // change is applied in one commit.
+  gear.reset_modes();
+  CHECK(gear.commit(0, -1, 0.0, at(0.03, -1.0), nullptr, event));
+  CHECK(event.what == "sliding (buff), reversal (buff)");
+  CHECK(gear.state().law.mode == M::Transition);
+  CHECK(force(0.03) == Approx(g.U(0.03)));
+  gear.reset_modes();
+  CHECK(gear.commit(0, -1, 0.0, at(0.06, 1.0), nullptr, event));
+  CHECK(event.what == "sliding (buff)");
+  CHECK(gear.state().law.segment == 1);  // on the bottomed part
+  CHECK(force(0.06) == Approx(g.U(0.06)));
+  // Bottomed, the transition stiffness equals K: the gear unloads along its loading line
+  // (solid, the friction does not slip) until it is back off the bottom.
+  CHECK(gear.commit(0, -1, 0.0, at(0.06, 0.0), nullptr, event));
+  CHECK(force(0.055) == Approx(g.U(0.055)));
+  double g_roots[DraftGear::kRoots];
+  gear.roots(0.0, at(0.055, -1.0), nullptr, g_roots);
+  for (const double value : g_roots) CHECK(value > 0.0);
+  // Outputs: force and compression.
+  double out[2];
+  gear.outputs(at(0.055, 0.0), nullptr, out);
+  CHECK(out[0] == Approx(g.U(0.055)));
+  CHECK(out[1] == Approx(0.055));
 }
 
 TEST_CASE("draft_gear Jacobian matches central differences in every mode", "[elements][couplers]") {
@@ -713,15 +791,51 @@ TEST_CASE("coupler_end: overlap regained with the faces past each other gives no
   CHECK(force_x(0.08, 0.2) == 0.0);
   // A stale crossing (a root that is positive in the current mode) changes nothing.
   CHECK_FALSE(e.commit(2, -1, 0.0, state_at(0.08, 0.1, 0.0), nullptr, event));
-  // Moving apart to the contact spacing: clear, then a new approach makes contact.
-  CHECK(e.commit(0, -1, 0.0, state_at(0.1, 0.1, 1.0), nullptr, event));
+  // Moving apart past the contact spacing: clear, then a new approach makes contact.
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1 + 1e-9, 0.1, 1.0), nullptr, event));
   CHECK(event.what == "faces clear");
   CHECK_FALSE(e.state().blocked);
-  CHECK(e.commit(0, -1, 0.0, state_at(0.1, 0.1, -1.0), nullptr, event));
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1 - 1e-9, 0.1, -1.0), nullptr, event));
   CHECK(event.what == "contact");
   CHECK(force_x(0.09, 0.1) == Approx(kFaceStiffness * 0.01));
   e.reset_modes();
   CHECK_FALSE(e.state().overlapping);
+}
+
+TEST_CASE("coupler_end: faces touching at rest at the start; a load closes them, a pull does not", "[elements][couplers]") {
+  // Exactly at the contact spacing, at rest. Pushed by P: h = c - (P / k)(1 - cos w t).
+  // Pulled by P: no force from the faces, x = c + P t^2 / (2 m).
+  const double m = 10.0, P = 1000.0, omega = std::sqrt(kFaceStiffness / m), T = 0.6 * kPi / omega;
+  for (const double sign : {-1.0, 1.0}) {
+    INFO((sign < 0 ? "pushed" : "pulled"));
+    const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(sign * P) + ", 0]}\n";
+    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml(), m, kContact, 0.0, 0.0, 0.0, T, "ida", 1e-6, "SI", load)));
+    if (sign < 0) {
+      REQUIRE(r.outcome.events.size() == 1);
+      CHECK(r.outcome.events[0].what == "contact");
+      CHECK(r.outcome.events[0].t < 1e-4);
+      CHECK(r.x == Approx(kContact - P / kFaceStiffness * (1.0 - std::cos(omega * T))).epsilon(1e-9));
+    } else {
+      CHECK(r.outcome.events.empty());
+      CHECK(r.x == Approx(kContact + 0.5 * P / m * T * T).epsilon(1e-9));
+    }
+  }
+}
+
+TEST_CASE("coupler_end: Euler's stability estimate sees the face stiffness while the faces are apart",
+          "[elements][couplers]") {
+  const Model model = testing::model_from_text(one_mass(coupler_end_yaml(), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
+  Element& e = *model.elements()[0];
+  const DaeSystem system(model);
+  const std::vector<double> y = system.initial_state();
+  const ElementState<double> s = gather_state(e, y.data(), y.data() + 3);
+  ForceBlock now{}, now_v{}, stiffest{}, stiffest_v{};
+  std::array<Pose<double>, 2> f{};
+  e.add_force_jacobian(0.0, s, f, now, now_v);
+  e.stiffest_force_jacobian(0.0, s, stiffest, stiffest_v);
+  const auto x = static_cast<std::size_t>(3 * e.point_slot(1));
+  CHECK(now[x][x] == 0.0);  // open
+  CHECK(stiffest[x][x] == Approx(-kFaceStiffness));
 }
 
 TEST_CASE("coupler_end Jacobian matches central differences in every mode", "[elements][couplers]") {
@@ -813,6 +927,21 @@ TEST_CASE("coupling without slack passes through zero force into draft", "[eleme
   const double recoverable = 0.5 * (1.0e7 * x + 0.5e7 * xi) * (x - xi) + 0.5 * 0.5e7 * xi * xi;
   CHECK(element_work(r.outcome) == Approx(expected.loop_area() + 0.5 * 1.0e7 * x * x).epsilon(1e-7));
   CHECK(dissipated(r.outcome) == Approx(expected.loop_area() + 0.5 * 1.0e7 * x * x - recoverable).epsilon(1e-7));
+}
+
+TEST_CASE("coupling without slack, at rest at zero deflection: either direction engages its side", "[elements][couplers]") {
+  // A constant load P from rest: x = (P / k1)(1 - cos w t) on the first segment (k1 = 1e7),
+  // pulled into draft or pushed into buff; at a quarter period x = P / k1.
+  const double m = 1000.0, P = 2.0e4, k1 = 1.0e7, omega = std::sqrt(k1 / m), T = 0.5 * kPi / omega;
+  for (const double sign : {-1.0, 1.0}) {
+    INFO((sign < 0 ? "pushed into buff" : "pulled into draft"));
+    const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(sign * P) + ", 0]}\n";
+    const Run r = run(testing::model_from_text(one_mass(coupling_kind1(0.5, 0.0), m, 1.0, 0.0, 0.0, 0.0, T, "ida", 1e-6, "SI", load)));
+    REQUIRE(r.outcome.events.size() == 1);
+    CHECK(r.outcome.events[0].what == (sign < 0 ? "back on the loading curve (buff)" : "through zero force to draft"));
+    CHECK(r.outcome.events[0].t < 1e-4);
+    CHECK(r.x == Approx(1.0 + sign * P / k1).epsilon(1e-9));
+  }
 }
 
 TEST_CASE("coupling vertical: slack, flexibility and misalignment; friction proportional to the horizontal force",

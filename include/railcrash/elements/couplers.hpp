@@ -11,6 +11,8 @@
 // logged in events.csv. If a commit lands in a mode where another root is already
 // negative (crossings that coincide, or an Euler step that went past several), that
 // change is applied in the same commit and the event names are joined with ", ".
+// Position roots switch kRootBand (1e-12) of the element's size past their boundary, so
+// that a model starting exactly on a boundary at rest (faces just touching) is handled.
 //
 // ---- AxialHysteresis ------------------------------------------------------------------
 // Signed deflection u (> 0: buff, compression; < 0: draft, extension), signed force F
@@ -43,7 +45,9 @@
 //   released    Lw(x) < 0: the follower     P = 0          x' > 0 -> transition from zero;
 //               no longer pushes                           x = 0 -> leaves the side
 // Leaving a side: to neutral (preloaded law), to open (slack > 0), otherwise straight to
-// loading on the other side (the force passes through zero continuously).
+// loading on the other side (the force passes through zero continuously). A run that
+// starts deflected is taken as loaded monotonically to there (loading if still loading,
+// else on the transition line from U).
 // Stored energy: what unloading from the current state would give back (down the
 // transition line to Lw or to zero force, then along Lw to zero force); the rest of the
 // work done on the law is dissipated. A closed cycle therefore dissipates its loop area.
@@ -56,7 +60,8 @@
 //
 // ---- draft_gear (report type 13) --------------------------------------------------------
 // Between P1 and P2 (the report's model: the yoke mass and the draft pocket / drawbar mass,
-// alongside a slider joint), length L, u = (r2 - r1) / L; compression d = free_length - L.
+// alongside a slider joint), length L = |r2 - r1|; compression d = free_length - L
+// (free_length default: the initial length, the gear at rest).
 // A friction draft gear works in buff (d > 0) and, through its yoke, in draft (d < 0): the
 // law is AxialHysteresis with u = d, no slack, mirror-symmetric in draft, with
 //   U(x)  = S(x) + H,   Lw(x) = S(x) - H,   S(x) = k x (x <= travel), k travel + K (x - travel)
@@ -65,7 +70,10 @@
 // So: at rest the gear is stuck by friction (neutral, F = K_t d) until K_t |d| = U(|d|);
 // it then loads on k d + H, bottoms at d = travel (event "bottomed", stiffness K); after a
 // reversal it unloads elastically with K_t down to k d - H, follows that line, and once it
-// would pull (k d - H < 0) it is "released" (F = 0, never negative in buff) until d = 0.
+// would pull (k d - H < 0) it is "released" (F = 0, never negative in buff) until d = 0,
+// where it is "neutral" (stuck) again. Events: "sliding", "bottomed", "off bottom",
+// "reversal", "unloading", "reloading", "back on the loading curve", "released" (each
+// with " (buff)" or " (draft)"), "neutral"; value: the compression d.
 // A cycle 0 -> d_max -> 0 below travel dissipates its loop area, 2 H d_max less the corner
 // triangles cut by the neutral and transition lines and by the release at d = H / k.
 // Shear pin (buff only: the pin anchors the gear against buff overload): when F reaches
@@ -73,7 +81,12 @@
 // freely (F = 0, in either direction) for post_shear_travel; then it is solid,
 // F = K (d - d_solid) ("solid", "off solid" if it backs off). Fracture: when |F| reaches
 // fracture_load (buff or draft, before or after pin shear) the element carries no force
-// from then on ("fracture"). Force on P2 = +F (r2 - r1) / L, on P1 the opposite.
+// from then on ("fracture"). Event value for "pin shear" and "fracture": the force.
+// Force on P2 = +F (r2 - r1) / L, on P1 the opposite.
+// Report values (Table 5, repeated in Table 8; they read cleanly in both scans): initial
+// stiffness 24,000 lb/in, travel 1.25 in, stiffness after bottoming 320,000 lb/in,
+// hysteresis load 10,000 lb, pin shear load 150,000 lb, post-shear travel 1.375 in,
+// fracture load 250,000 lb. The report gives no transition stiffness: default K.
 //
 // ---- coupler_end (report type 14) -------------------------------------------------------
 // Contact between two coupler faces; P1 on coupler K, P2 on coupler L, each point
@@ -92,6 +105,15 @@
 //   friction between the faces: F_t = -mu |T| tanh(Dy' / v_f) on P2 (vertical), Coulomb
 //     regularized below friction_velocity v_f; |F_t| <= mu |T|.
 //   force on P2 = (-sigma T, F_t), on P1 the opposite. Energy T^2 / (2 k) in contact.
+//   The report's "shear" between the faces is this vertical (friction) force; the faces
+//   have no failure load of their own.
+// Events: "contact", "separation", "slack taken up (draft)", "draft released", "buff to
+// draft" / "draft to buff" (coupled, no slack), value h - c; "vertical overlap lost",
+// "vertical overlap regained[, faces past each other]", value Dy; "faces clear".
+// Report values (Tables 5 and 8): horizontal stiffness 360,000 lb/in, free length 1 in and
+// coupler height 12 in at each end, total horizontal slack 0.0 in. The "Friction parameter
+// (muR) = 0.3" printed under them in Table 8 is the pin joint's (Table 5 lists it under
+// "Pin Joint"), so the report gives no face friction: `friction` defaults to 0.
 //
 // ---- coupling (report types 11 and 12: the freight coupler of the validation runs) ------
 // Between a point on each car (P1, P2). Horizontal (global x, sigma as for coupler_end):
@@ -108,6 +130,11 @@
 // Sliding friction between the heads, proportional to the horizontal force:
 // F_f = -mu |F| tanh(Dy' / v_f). Force on P2 = (sigma F, -F_v + F_f), on P1 the opposite.
 // Energy: the horizontal law's stored energy plus F_v^2 / (2 k_v).
+// Events: "slack taken up", "curve segment n", "reversal", "unloading", "reloading", "back
+// on the loading curve" (with " (buff)" / " (draft)"), "in the slack", "through zero force
+// to buff|draft", value u; "vertical slack taken up (head L above|below)", "vertical
+// slack", value w. A coupling without slack that starts at rest at u = 0 takes the
+// direction of its first motion.
 #pragma once
 
 #include <array>
@@ -122,6 +149,12 @@
 namespace railcrash {
 
 // ---- shared pieces ------------------------------------------------------------------------
+
+/// Position roots g = (distance to a boundary) + kRootBand x (the element's size): a state
+/// exactly on a boundary at rest (a model that starts with its faces just touching) then lies
+/// inside its mode, and a departure either way is seen (IDA ignores a root that is exactly
+/// zero at the start). The switch happens that far past the boundary: 1e-12 of the size.
+constexpr double kRootBand = 1e-12;
 
 /// Piecewise-linear curve y(x), x >= 0: segment j starts at start[j] (start[0] = 0) with
 /// value value[j] and slope slope[j]; the last segment goes on without end.
@@ -166,6 +199,7 @@ class AxialHysteresis {
   PiecewiseLinear lower;          // Lw(x) [force], unloading curve, same breakpoints as upper
   double transition_stiffness = 0.0;  // [force/length] K_t
   double slack = 0.0;             // [length] total free play about u = 0
+  double tolerance = 0.0;         // [length] band on the position roots (kRootBand x size)
 
   enum class Mode { Open, Neutral, Loading, Transition, Unloading, Released };
   struct State {
@@ -210,8 +244,10 @@ class AxialHysteresis {
   /// Roots g[0..3] of mode st at deflection u and rate u'.
   void roots(const State& st, double u, double rate, double* g) const;
   /// Applies the change of root `index` (crossed downward) and says what it was.
-  Change transition(State& st, int index, double u, double rate) const;
-  /// Mode at the start of a run at (u, u'): for a deflected start, as if loaded monotonically.
+  Change transition(State& st, int index, double u) const;
+  /// Mode at the start of a run at (u, u'): a deflected start is taken as loaded monotonically
+  /// to there: loading if still loading, else (at rest or unloading) on the transition line
+  /// from the loading curve, which is left either way.
   State initial(double u, double rate) const;
   /// Recoverable energy in mode st at u [force*length].
   double energy(const State& st, double u) const;
@@ -234,6 +270,7 @@ struct DeadBand {
   double lo = 0.0, hi = 0.0;   // [length] band
   double stiffness = 0.0;      // [force/length]
   bool below_active = true, above_active = true;
+  double tolerance = 0.0;      // [length] band on the roots (kRootBand x size)
 
   enum class Mode { Below, Inside, Above };
   static constexpr int kRoots = 2;
