@@ -33,6 +33,12 @@ std::array<Pose<double>, 2> gather_poses(const Element& e, const double* q) {
 double& component(Pose<double>& p, int c) { return c == 0 ? p.x : (c == 1 ? p.y : p.theta); }
 double component(const Pose<double>& p, int c) { return c == 0 ? p.x : (c == 1 ? p.y : p.theta); }
 
+/// The element's rates as one local vector (vx, vy, omega of slot 0, then slot 1).
+void flatten_rates(const ElementState<double>& s, double local_v[6]) {
+  for (int k = 0; k < 2; ++k)
+    for (int c = 0; c < 3; ++c) local_v[3 * k + c] = component(s.v[static_cast<std::size_t>(k)], c);
+}
+
 }  // namespace
 
 EnergyBalance EnergyBalance::between(const EnergyState& start, const EnergyState& now) {
@@ -304,11 +310,7 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
           for (double& value : line) value = 0.0;
     }
     double local_v[6];
-    for (int k = 0; k < 2; ++k) {
-      local_v[3 * k] = s.v[static_cast<std::size_t>(k)].x;
-      local_v[3 * k + 1] = s.v[static_cast<std::size_t>(k)].y;
-      local_v[3 * k + 2] = s.v[static_cast<std::size_t>(k)].theta;
-    }
+    flatten_rates(s, local_v);
     // Second-derivative blocks: d(G^T mu)/dq and d(G^T lambda)/dq.
     for (int a = 0; a < 2; ++a) {
       const int ba = el.slot_body(a);
@@ -478,11 +480,7 @@ void DaeSystem::constraint_acceleration_bias(const double* q, const double* v, d
     double hess[kMaxConstraintRows][6][6];
     el.constraint_hessian(s.q, phi, grad, hess);
     double local_v[6];
-    for (int k = 0; k < 2; ++k) {
-      local_v[3 * k] = s.v[static_cast<std::size_t>(k)].x;
-      local_v[3 * k + 1] = s.v[static_cast<std::size_t>(k)].y;
-      local_v[3 * k + 2] = s.v[static_cast<std::size_t>(k)].theta;
-    }
+    flatten_rates(s, local_v);
     for (int row = 0; row < m; ++row) {
       double sum = 0.0;
       for (int i = 0; i < 6; ++i)

@@ -4,7 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#include <catch2/catch.hpp>
+
 #include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
 
 namespace railcrash::testing {
 
@@ -51,6 +54,17 @@ double jacobian_error(const DaeSystem& system, double t, double cj, const std::v
   }
   if (outside_pattern) *outside_pattern = outside;
   return worst;
+}
+
+RunOutcome simulate(const Model& model, double output_interval) {
+  const DaeSystem system(model);
+  struct Quiet : RunObserver {
+    void sample(double, const double*, const double*, const double*) override {}
+  } observer;
+  RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval, observer);
+  INFO(outcome.message);
+  REQUIRE(outcome.ok);
+  return outcome;
 }
 
 std::vector<double> random_state(const DaeSystem& system, std::mt19937& rng, double spread) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "railcrash/dae_system.hpp"
+#include "railcrash/integrator.hpp"
 #include "railcrash/model.hpp"
 
 namespace railcrash::testing {
@@ -20,6 +21,10 @@ Model model_from_text(const std::string& yaml);
 /// (outside_pattern receives the largest |entry| found outside it).
 double jacobian_error(const DaeSystem& system, double t, double cj, const std::vector<double>& y,
                       const std::vector<double>& yp, double* outside_pattern = nullptr);
+
+/// Runs the model with the integrator its settings ask for (no files, output every
+/// output_interval) and requires success.
+RunOutcome simulate(const Model& model, double output_interval = 0.01);
 
 /// A random state near the model's initial one (positions, velocities, multipliers).
 std::vector<double> random_state(const DaeSystem& system, std::mt19937& rng, double spread = 0.3);

@@ -166,6 +166,41 @@ class Element {
   std::vector<int> point_slot_;
 };
 
+namespace ad {
+/// The element state with q seeded as unknowns 0..5 and v as 6..11 of a dual number.
+template <class D>
+ElementState<D> seeded_state(const ElementState<double>& s) {
+  ElementState<D> sd;
+  for (int k = 0; k < 2; ++k) {
+    const auto ks = static_cast<std::size_t>(k);
+    sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
+    sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
+  }
+  return sd;
+}
+
+/// Adds the values of dual forces to f and their q- and v-derivatives to df_dq, df_dv;
+/// derivatives with respect to further seeds (12, 13, ...) go to `extra` (rows x extra_count).
+template <class D>
+void extract_forces(const std::array<Pose<D>, 2>& fd, std::array<Pose<double>, 2>& f, ForceBlock& df_dq, ForceBlock& df_dv,
+                    double (*extra)[kMaxConstraintRows] = nullptr, int extra_count = 0) {
+  for (int k = 0; k < 2; ++k) {
+    const auto ks = static_cast<std::size_t>(k);
+    const D* comps[3] = {&fd[ks].x, &fd[ks].y, &fd[ks].theta};
+    double* out[3] = {&f[ks].x, &f[ks].y, &f[ks].theta};
+    for (int c = 0; c < 3; ++c) {
+      *out[c] += comps[c]->value;
+      const auto row = static_cast<std::size_t>(3 * k + c);
+      for (std::size_t j = 0; j < 6; ++j) {
+        df_dq[row][j] += comps[c]->grad[j];
+        df_dv[row][j] += comps[c]->grad[6 + j];
+      }
+      for (int r = 0; r < extra_count; ++r) extra[row][r] += comps[c]->grad[12 + static_cast<std::size_t>(r)];
+    }
+  }
+}
+}  // namespace ad
+
 /// Adapter: Derived provides  template <class T> void force_law(double t, const ElementState<T>&, std::array<Pose<T>,2>& f) const
 /// which adds its generalized forces to f.
 template <class Derived>
@@ -180,27 +215,10 @@ class ForceElement : public Element {
   void add_force_jacobian(double t, const ElementState<double>& s, std::array<Pose<double>, 2>& f,
                           ForceBlock& df_dq, ForceBlock& df_dv) const override {
     using D = Dual<double, 12>;
-    ElementState<D> sd;
-    for (int k = 0; k < 2; ++k) {
-      const auto ks = static_cast<std::size_t>(k);
-      sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
-      sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
-    }
+    const ElementState<D> sd = ad::seeded_state<D>(s);
     std::array<Pose<D>, 2> fd{};
     static_cast<const Derived*>(this)->force_law(t, sd, fd);
-    for (int k = 0; k < 2; ++k) {
-      const auto ks = static_cast<std::size_t>(k);
-      const D* comps[3] = {&fd[ks].x, &fd[ks].y, &fd[ks].theta};
-      double* out[3] = {&f[ks].x, &f[ks].y, &f[ks].theta};
-      for (int c = 0; c < 3; ++c) {
-        *out[c] += comps[c]->value;
-        const auto row = static_cast<std::size_t>(3 * k + c);
-        for (std::size_t j = 0; j < 6; ++j) {
-          df_dq[row][j] += comps[c]->grad[j];
-          df_dv[row][j] += comps[c]->grad[6 + j];
-        }
-      }
-    }
+    ad::extract_forces(fd, f, df_dq, df_dv);
   }
 };
 
@@ -227,30 +245,12 @@ class ConstraintElement : public Element {
                                 std::array<Pose<double>, 2>& f, ForceBlock& df_dq, ForceBlock& df_dv,
                                 double df_dlambda[6][kMaxConstraintRows]) const override {
     using D = Dual<double, 12 + kMaxConstraintRows>;
-    ElementState<D> sd;
-    for (int k = 0; k < 2; ++k) {
-      const auto ks = static_cast<std::size_t>(k);
-      sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
-      sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
-    }
+    const ElementState<D> sd = ad::seeded_state<D>(s);
     D lambda_d[kMaxConstraintRows];
     for (int r = 0; r < Derived::kRows; ++r) lambda_d[r] = D(lambda[r], 12 + r);
     std::array<Pose<D>, 2> fd{};
     static_cast<const Derived*>(this)->joint_force_law(t, sd, lambda_d, fd);
-    for (int k = 0; k < 2; ++k) {
-      const auto ks = static_cast<std::size_t>(k);
-      const D* comps[3] = {&fd[ks].x, &fd[ks].y, &fd[ks].theta};
-      double* out[3] = {&f[ks].x, &f[ks].y, &f[ks].theta};
-      for (int c = 0; c < 3; ++c) {
-        *out[c] += comps[c]->value;
-        const auto row = static_cast<std::size_t>(3 * k + c);
-        for (std::size_t j = 0; j < 6; ++j) {
-          df_dq[row][j] += comps[c]->grad[j];
-          df_dv[row][j] += comps[c]->grad[6 + j];
-        }
-        for (int r = 0; r < Derived::kRows; ++r) df_dlambda[row][r] += comps[c]->grad[12 + static_cast<std::size_t>(r)];
-      }
-    }
+    ad::extract_forces(fd, f, df_dq, df_dv, df_dlambda, Derived::kRows);
   }
 
   void constraint(const std::array<Pose<double>, 2>& q, double* phi) const override {

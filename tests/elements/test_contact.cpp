@@ -26,15 +26,7 @@ std::string body_on(const std::string& element, double x, double y, double vx, d
 const std::string kFloor =
     "  - {name: floor, type: contact, line_point: [0, 0], line_normal: [0, 1], stiffness: 1.0e6, points: [{body: ball, at: [0, 0]}]}\n";
 
-RunOutcome run(const Model& model) {
-  const DaeSystem system(model);
-  struct Null : RunObserver {
-    void sample(double, const double*, const double*, const double*) override {}
-  } observer;
-  RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, 0.01, observer);
-  REQUIRE(outcome.ok);
-  return outcome;
-}
+RunOutcome run(const Model& model) { return testing::simulate(model); }
 
 }  // namespace
 

@@ -32,13 +32,8 @@ struct Run {
 };
 
 Run run(const Model& model) {
-  const DaeSystem system(model);
-  struct Null : RunObserver {
-    void sample(double, const double*, const double*, const double*) override {}
-  } observer;
   Run r;
-  r.outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, 0.01, observer);
-  REQUIRE(r.outcome.ok);
+  r.outcome = testing::simulate(model);
   r.final_vx = r.outcome.y[3];
   return r;
 }

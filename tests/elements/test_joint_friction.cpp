@@ -12,15 +12,7 @@ namespace {
 
 const double kG = 9.81;
 
-RunOutcome run(const Model& model) {
-  const DaeSystem system(model);
-  struct Null : RunObserver {
-    void sample(double, const double*, const double*, const double*) override {}
-  } observer;
-  RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, 0.01, observer);
-  REQUIRE(outcome.ok);
-  return outcome;
-}
+RunOutcome run(const Model& model) { return testing::simulate(model); }
 
 // A 3 kg block on a horizontal ground slider (friction mu, slider length 0.5 m), pushed
 // off at v0; P2 is its centre of mass, so the lock carries no moment and N = m g.
