@@ -118,9 +118,10 @@ EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings
       throw InputError(b.where.prefix() + "body '" + b.name +
                        "' has zero inertia: explicit Euler needs every body's inertia to be positive "
                        "(use integrator: ida, or give the body an inertia)");
-  system.reset_modes();
-  y0_ = system.initial_state();
-  assembly_correction_ = assemble_initial_state(system, y0_).largest_position_change;
+  const StartReport start = prepare_start(system, y0_, start_events_);
+  assembly_correction_ = start.assembly.largest_position_change;
+  settling_steps_ = start.equilibrium.steps;
+  settling_displacement_ = start.equilibrium.largest_position_change;
 
   if (settings_.dt < 0.0 || !std::isfinite(settings_.dt)) throw InputError("dt must be a positive step (or 0 for automatic)");
   if (settings_.dt > 0.0) {
@@ -154,6 +155,8 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   RunOutcome outcome;
   outcome.stats.stability_limit = stability_limit_;
   outcome.stats.assembly_correction = assembly_correction_;
+  outcome.stats.settling_steps = settling_steps_;
+  outcome.stats.settling_displacement = settling_displacement_;
   outcome.stats.last_step = dt_;
   const int nq = system_.body_unknowns();
   const int m = system_.constraint_rows();
@@ -169,7 +172,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   // The multipliers stored in y (for output) are the penalty forces.
   double* y_lambda = y.data() + 2 * nq;
 
-  system_.reset_modes();
+  // Modes as prepared (and settled) in the constructor; a second run starts from them too.
   system_.generalized_forces(0.0, q, v, force.data(), &penalty_, lambda.data());
   std::copy(lambda.begin(), lambda.end(), y_lambda);
   // Mode changes: the same root functions as IDA, checked at the end of every step (what
@@ -179,6 +182,9 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   std::vector<double> g_before(static_cast<std::size_t>(root_count)), g_after(g_before.size());
   std::vector<int> direction(g_before.size(), 0);
   std::vector<EventRecord> events;
+  outcome.events = start_events_;
+  for (const EventRecord& record : start_events_) observer.event(record);
+  outcome.stats.events += static_cast<long>(start_events_.size());
   if (root_count > 0) {
     // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
     std::vector<double> yp(y.size(), 0.0);
@@ -188,7 +194,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
     }
     if (system_.commit_boundary_roots(0.0, y.data(), yp.data(), events)) {
       for (const EventRecord& record : events) observer.event(record);
-      outcome.events = events;
+      outcome.events.insert(outcome.events.end(), events.begin(), events.end());
       outcome.stats.events += static_cast<long>(events.size());
     }
     system_.roots(0.0, y.data(), g_before.data());

@@ -179,10 +179,12 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
   const Model& model = system_.model();
 
   // ---- consistent positions and velocities ----
-  system_.reset_modes();
-  std::vector<double> y0 = system_.initial_state();
-  const AssemblyReport assembly = assemble_initial_state(system_, y0);
-  outcome.stats.assembly_correction = assembly.largest_position_change;
+  std::vector<double> y0;
+  std::vector<EventRecord> settling_events;
+  const StartReport start = prepare_start(system_, y0, settling_events);
+  outcome.stats.assembly_correction = start.assembly.largest_position_change;
+  outcome.stats.settling_steps = start.equilibrium.steps;
+  outcome.stats.settling_displacement = start.equilibrium.largest_position_change;
 
   // ---- scales for the tolerances ----
   const double length = model.length_scale();
@@ -226,7 +228,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     double* y = N_VGetArrayPointer(impl.y);
     double* yp = N_VGetArrayPointer(impl.yp);
     std::vector<double> yp0;
-    std::vector<EventRecord> start_events;
+    std::vector<EventRecord> start_events = settling_events;
     restart_state(system_, 0.0, y0, yp0, start_events);
     std::copy(y0.begin(), y0.end(), y);
     std::copy(yp0.begin(), yp0.end(), yp);

@@ -226,4 +226,136 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
   for (int k = 0; k < nq; ++k) yp[static_cast<std::size_t>(nq + k)] = solution[k];
 }
 
+EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector<double>& y,
+                                            std::vector<EventRecord>& events) {
+  EquilibriumReport report;
+  const int n = system.size();
+  const int nq = system.body_unknowns();
+  const int m = system.constraint_rows();
+  const double length = system.model().length_scale();
+  const std::vector<double> start(y.begin(), y.begin() + nq);
+  const std::vector<double> velocities(y.begin() + nq, y.begin() + 2 * nq);
+  std::fill(y.begin() + nq, y.begin() + 2 * nq, 0.0);  // a static state has no velocity
+  const std::vector<double> yp(static_cast<std::size_t>(n), 0.0);
+  std::vector<double> r(static_cast<std::size_t>(n));
+
+  // Scale of the forces to balance: the weights, or else the largest initial force.
+  std::vector<double> f(static_cast<std::size_t>(nq));
+  system.generalized_forces(0.0, y.data(), y.data() + nq, f.data(), nullptr, nullptr, y.data() + 2 * nq);
+  double force_scale = 0.0;
+  for (const Body& b : system.model().bodies())
+    force_scale += b.mass * std::hypot(system.model().gravity_x, system.model().gravity_y);
+  for (double value : f) force_scale = std::max(force_scale, std::abs(value));
+  if (!(force_scale > 0.0)) {  // nothing to balance
+    std::copy(velocities.begin(), velocities.end(), y.begin() + nq);
+    return report;
+  }
+  // Unbalance measure: forces over their scale, joint gaps over the model size.
+  const auto unbalance = [&](const std::vector<double>& state, double* residual_force) {
+    system.residual(0.0, state.data(), yp.data(), r.data());
+    double forces = 0.0, gaps = 0.0;
+    for (int k = 0; k < nq; ++k) forces = std::max(forces, std::abs(r[static_cast<std::size_t>(nq + k)]) * (k % 3 == 2 ? 1.0 / length : 1.0));
+    for (int k = 0; k < m; ++k) gaps = std::max(gaps, std::abs(r[static_cast<std::size_t>(2 * nq + k)]));
+    if (residual_force) *residual_force = forces;
+    return std::max(forces / force_scale, gaps / length);
+  };
+
+  const SparsePattern& pattern = system.pattern();
+  std::vector<double> values(static_cast<std::size_t>(pattern.nonzeros()));
+  // Unknown / equation map: q -> 0..nq-1, lambda -> nq..nq+m-1; rows: r_v -> 0..nq-1, r_phi -> nq..
+  const auto local_column = [&](int col) { return col < nq ? col : (col >= 2 * nq && col < 2 * nq + m ? nq + col - 2 * nq : -1); };
+  const auto local_row = [&](int row) {
+    return (row >= nq && row < 2 * nq) ? row - nq : (row >= 2 * nq && row < 2 * nq + m ? nq + row - 2 * nq : -1);
+  };
+  double step = 1e-3 * std::min(1.0, system.model().simulation.t_end);  // pseudo-time step h
+  double current = unbalance(y, &report.residual_force);
+  const double tolerance = 1e-10;
+  Eigen::SparseLU<SparseMatrix> lu;
+  std::vector<int> direction(static_cast<std::size_t>(system.root_count()));
+  std::vector<double> g(direction.size());
+  const int max_steps = 2000;
+  for (; report.steps < max_steps && current > tolerance; ++report.steps) {
+    system.jacobian(0.0, 0.0, y.data(), yp.data(), values.data());
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int col = 0; col < n; ++col) {
+      const int lc = local_column(col);
+      if (lc < 0) continue;
+      for (int k = pattern.column_start[static_cast<std::size_t>(col)]; k < pattern.column_start[static_cast<std::size_t>(col + 1)]; ++k) {
+        const int lr = local_row(pattern.row_index[static_cast<std::size_t>(k)]);
+        if (lr >= 0) entries.emplace_back(lr, lc, values[static_cast<std::size_t>(k)]);
+      }
+    }
+    for (int k = 0; k < nq; ++k) entries.emplace_back(k, k, system.mass_diagonal(k) / (step * step));
+    SparseMatrix a(nq + m, nq + m);
+    a.setFromTriplets(entries.begin(), entries.end());
+    a.makeCompressed();
+    lu.compute(a);
+    system.residual(0.0, y.data(), yp.data(), r.data());
+    Eigen::VectorXd rhs(nq + m);
+    for (int k = 0; k < nq; ++k) rhs[k] = -r[static_cast<std::size_t>(nq + k)];
+    for (int k = 0; k < m; ++k) rhs[nq + k] = -r[static_cast<std::size_t>(2 * nq + k)];
+    Eigen::VectorXd delta;
+    if (lu.info() == Eigen::Success) delta = lu.solve(rhs);
+    if (lu.info() != Eigen::Success || !delta.allFinite()) {
+      step *= 0.25;
+      continue;
+    }
+    std::vector<double> trial = y;
+    for (int k = 0; k < nq; ++k) trial[static_cast<std::size_t>(k)] += delta[k];
+    for (int k = 0; k < m; ++k) trial[static_cast<std::size_t>(2 * nq + k)] += delta[nq + k];
+    // Accept a step that does not increase the unbalance: while a body falls toward an open
+    // contact the unbalance stays at its weight until the contact closes.
+    const double next = unbalance(trial, nullptr);
+    if (!(next <= current) && step > 1e-12) {
+      step *= 0.25;
+      continue;
+    }
+    y = trial;
+    current = next;
+    step = std::min(step * 2.0, 1e6);
+    // Keep every element in the mode its state belongs to (roots are positive inside).
+    if (!direction.empty()) {
+      system.roots(0.0, y.data(), g.data());
+      bool outside = false;
+      for (std::size_t k = 0; k < g.size(); ++k) {
+        direction[k] = g[k] < 0.0 ? -1 : 0;
+        outside = outside || g[k] < 0.0;
+      }
+      std::vector<EventRecord> changes;
+      if (outside && system.commit_roots(0.0, y.data(), direction.data(), changes)) {
+        for (EventRecord& e : changes) e.what = "static equilibrium: " + e.what;
+        events.insert(events.end(), changes.begin(), changes.end());
+        current = unbalance(y, nullptr);
+      }
+    }
+  }
+  current = unbalance(y, &report.residual_force);
+  if (current > tolerance) {
+    std::ostringstream msg;
+    msg << "no static equilibrium found: after " << report.steps << " steps the largest unbalanced force is "
+        << report.residual_force << " (the weights total " << force_scale << "). A body with nothing to hold it against gravity (a missing wheel, spring or joint) "
+        << "has no equilibrium; set static_equilibrium: false to start from the given positions";
+    throw SolverError(msg.str());
+  }
+  for (int k = 0; k < nq; ++k)
+    report.largest_position_change = std::max(report.largest_position_change,
+                                              std::abs(y[static_cast<std::size_t>(k)] - start[static_cast<std::size_t>(k)]) *
+                                                  ((k % 3 == 2) ? length : 1.0));
+  std::copy(velocities.begin(), velocities.end(), y.begin() + nq);
+  return report;
+}
+
+StartReport prepare_start(const DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events) {
+  StartReport report;
+  system.reset_modes();
+  y = system.initial_state();
+  report.assembly = assemble_initial_state(system, y);
+  if (system.model().simulation.static_equilibrium) {
+    report.equilibrium = settle_static_equilibrium(system, y, events);
+    const AssemblyReport projection = assemble_initial_state(system, y);
+    report.assembly.largest_velocity_change = std::max(report.assembly.largest_velocity_change, projection.largest_velocity_change);
+  }
+  return report;
+}
+
 }  // namespace railcrash

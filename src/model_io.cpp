@@ -325,6 +325,7 @@ const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravit
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
 const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt",
+                                                  "static_equilibrium",
                                                   "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
                                                   "penalty_rotational_damping"};
 
@@ -510,6 +511,8 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
   if (node["force_dt"]) s.force_dt = r.boolean(node["force_dt"], "simulation: force_dt");
+  if (node["static_equilibrium"])
+    s.static_equilibrium = r.boolean(node["static_equilibrium"], "simulation: static_equilibrium");
   s.penalty.stiffness = positive("penalty_stiffness");
   s.penalty.damping = positive("penalty_damping");
   s.penalty.rotational_stiffness = positive("penalty_rotational_stiffness");

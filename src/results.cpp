@@ -121,6 +121,7 @@ void ResultWriter::write_summary(const RunOutcome& outcome, const std::string& i
     << ", \"reinitializations\": " << s.reinitializations << ", \"wall_seconds\": " << json_number(s.wall_seconds)
     << ", \"last_step\": " << json_number(s.last_step) << ", \"stability_limit\": " << json_number(s.stability_limit)
     << ", \"assembly_correction\": " << json_number(s.assembly_correction)
+    << ", \"settling_steps\": " << s.settling_steps << ", \"settling_displacement\": " << json_number(s.settling_displacement)
     << ", \"unknowns\": " << system_.size() << ", \"jacobian_nonzeros\": " << system_.pattern().nonzeros() << "},\n";
   j << "  \"constraint_residual_max\": " << json_number(outcome.max_constraint_residual) << ",\n";
   const double scale = std::max({std::abs(energy.initial_total), std::abs(energy.kinetic) + std::abs(energy.elastic) +

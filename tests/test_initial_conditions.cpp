@@ -108,3 +108,52 @@ TEST_CASE("a free body with zero inertia makes the equations singular, with a cl
   std::vector<double> y = system.initial_state(), yp;
   CHECK_THROWS_WITH(consistent_rates(system, 0.0, y, yp), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
 }
+
+TEST_CASE("static equilibrium settles a body onto its wheels before the run", "[initial]") {
+  // 1000 kg on two wheel-rail contacts 1.5 m ahead of and 1.0 m behind its centre of mass.
+  // Vertical balance: N_f + N_r = W; moment balance: N_f 1.5 = N_r 1.0 (to the small pitch).
+  const std::string text =
+      "railcrash: 1\nname: s\nunits: SI\nbodies:\n"
+      "  - {name: body, mass: 1000, inertia: 800, position: [0, 1.0], velocity: [5, 0]}\nelements:\n"
+      "  - {name: front, type: wheel_rail, wheel_radius: 0.5, stiffness: 1.0e6, stiffness_above: 3.0e6, breakpoint: 0.003, "
+      "damping: 1.0e4, points: [{body: body, at: [1.5, -0.5]}]}\n"
+      "  - {name: rear, type: wheel_rail, wheel_radius: 0.5, stiffness: 1.0e6, stiffness_above: 3.0e6, breakpoint: 0.003, "
+      "damping: 1.0e4, points: [{body: body, at: [-1.0, -0.5]}]}\n"
+      "simulation: {t_end: 0.5, static_equilibrium: true, rtol: 1e-8}\n";
+  const double weight = 1000.0 * 9.80665;
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    Model model = testing::model_from_text(text);
+    model.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    model.simulation.dt = 2e-5;
+    const RunOutcome o = testing::simulate(model);
+    // Both wheels close and pass their breakpoint while settling, at t = 0.
+    REQUIRE(o.events.size() >= 4);
+    for (const EventRecord& e : o.events) {
+      CHECK(e.t == 0.0);
+      CHECK_THAT(e.what, Catch::StartsWith("static equilibrium: "));
+    }
+    // It stays at rest vertically: no bounce at t = 0, and the forward speed is kept.
+    CHECK(std::abs(o.y[4]) < 1e-6);
+    CHECK(o.y[3] == Approx(5.0));
+    const DaeSystem system(model);
+    double out[6];
+    system.outputs(o.y.data(), o.y.data() + 6, out);
+    const double front = out[0], rear = out[3];
+    CHECK(front + rear == Approx(weight).epsilon(1e-6));
+    CHECK(front == Approx(weight * 1.0 / 2.5).epsilon(1e-3));
+    // Above the breakpoint: N = k1 d_L + k2 (d - d_L).
+    CHECK(out[2] == Approx(0.003 + (front - 3000.0) / 3.0e6).epsilon(1e-6));
+    CHECK(out[5] == Approx(0.003 + (rear - 3000.0) / 3.0e6).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("static equilibrium reports a body that nothing holds", "[initial]") {
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: stone, mass: 1, inertia: 1, position: [0, 1]}\n"
+      "simulation: {t_end: 1, static_equilibrium: true}\n");
+  const DaeSystem system(model);
+  std::vector<double> y;
+  std::vector<EventRecord> events;
+  CHECK_THROWS_WITH(prepare_start(system, y, events), Catch::Contains("no static equilibrium"));
+}

@@ -52,6 +52,9 @@ class EulerIntegrator : public Integrator {
   double dt_ = 0.0;
   double stability_limit_ = 0.0;
   double assembly_correction_ = 0.0;
+  long settling_steps_ = 0;
+  double settling_displacement_ = 0.0;
+  std::vector<EventRecord> start_events_;  // mode changes while settling
   PenaltyRows penalty_;
 };
 

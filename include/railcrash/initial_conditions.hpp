@@ -32,6 +32,38 @@ AssemblyReport assemble_initial_state(const DaeSystem& system, std::vector<doubl
 /// that no joint holds).
 void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp);
 
+struct EquilibriumReport {
+  int steps = 0;                         // pseudo-time steps taken
+  double largest_position_change = 0.0;  // [length] (angles times the length scale)
+  double residual_force = 0.0;           // [force] largest unbalanced generalized force left
+};
+
+/// Static equilibrium under gravity and the loads at t = 0: moves the bodies of y (from
+/// DaeSystem::initial_state, joints assembled) until forces and joint reactions balance,
+/// with every element's mode kept consistent (contacts close, springs pass breakpoints);
+/// committed mode changes are appended to `events`. Velocities in y are kept, and ignored
+/// while settling (a static state has none).
+///
+/// Pseudo-transient continuation: each step solves
+///   [ M / h^2 + K   G^T ] [ dq ]     [ f(q) - G^T lambda ]
+///   [ G             0   ] [ dl ] = - [ Phi(q)            ]   (signs as in the DAE residual)
+/// with K = -df/dq + d(G^T lambda)/dq from the DAE Jacobian; h grows while the residual
+/// falls (toward Newton) and shrinks when it does not. M / h^2 keeps free directions (a car
+/// on its rails) regular. Roots that turn negative are committed after each step.
+/// Throws SolverError when it does not settle.
+EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector<double>& y,
+                                            std::vector<EventRecord>& events);
+
+struct StartReport {
+  AssemblyReport assembly;
+  EquilibriumReport equilibrium;
+};
+
+/// The state a run starts from: every element in its starting mode, the model's coordinates
+/// with the joints assembled, then (simulation.static_equilibrium) settled under gravity
+/// with the model's velocities projected onto the joints.
+StartReport prepare_start(const DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events);
+
 /// Throws InputError when the constraint rows are linearly dependent at q, naming them.
 void check_constraint_rank(const DaeSystem& system, const double* q);
 

@@ -23,6 +23,8 @@ struct RunStatistics {
   double last_step = 0.0;          // [time]
   double stability_limit = 0.0;    // euler: [time] estimated largest stable step
   double assembly_correction = 0.0;  // [length] largest move of the initial position assembly
+  long settling_steps = 0;           // static equilibrium: pseudo-time steps
+  double settling_displacement = 0.0;  // [length] static equilibrium: largest move
 };
 
 /// Receives the state at every output time (t = 0 included).

@@ -61,6 +61,7 @@ struct SimulationSettings {
   double dt = 0.0;                  // euler: step [time]; 0 = 0.5 x stability limit
   double output_interval = 0.0;     // [time]; 0 = t_end / 500
   bool force_dt = false;            // euler: accept a step above the stability limit
+  bool static_equilibrium = false;  // settle the bodies under gravity and loads at t = 0 first
   Element::PenaltyOverrides penalty;  // euler: model-wide penalty settings
 };
 
