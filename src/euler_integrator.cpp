@@ -183,7 +183,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   std::vector<int> direction(g_before.size(), 0);
   std::vector<EventRecord> events;
   outcome.events = start_events_;
-  for (const EventRecord& record : start_events_) observer.event(record);
+  for (const EventRecord& record : start_events_) observer.event(record, y.data());
   outcome.stats.events += static_cast<long>(start_events_.size());
   if (root_count > 0) {
     // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
@@ -193,7 +193,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
       yp[static_cast<std::size_t>(nq + k)] = force[static_cast<std::size_t>(k)] * inverse_mass[static_cast<std::size_t>(k)];
     }
     if (system_.commit_boundary_roots(0.0, y.data(), yp.data(), events)) {
-      for (const EventRecord& record : events) observer.event(record);
+      for (const EventRecord& record : events) observer.event(record, y.data());
       outcome.events.insert(outcome.events.end(), events.begin(), events.end());
       outcome.stats.events += static_cast<long>(events.size());
     }
@@ -238,7 +238,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
           ++outcome.stats.reinitializations;
           system_.roots(t, y.data(), g_after.data());
         }
-        for (const EventRecord& record : events) observer.event(record);
+        for (const EventRecord& record : events) observer.event(record, y.data());
         outcome.events.insert(outcome.events.end(), events.begin(), events.end());
         outcome.stats.events += static_cast<long>(events.size());
       }

@@ -278,7 +278,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     const double* lambda = y + 2 * nq;
     std::vector<double> quad_now(static_cast<std::size_t>(nquad), 0.0);
     outcome.initial_energy = system_.energy(y, quad_now.data());
-    for (const EventRecord& record : start_events) observer.event(record);
+    for (const EventRecord& record : start_events) observer.event(record, y);
     outcome.events = start_events;
     outcome.stats.events += static_cast<long>(start_events.size());
     observer.sample(0.0, y, lambda, quad_now.data());
@@ -315,7 +315,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
         const bool changed = system_.commit_roots(t_reached, y, root_info.data(), events);
         std::vector<double> y_now(y, y + n), yp_now;
         if (changed) restart_state(system_, t_reached, y_now, yp_now, events);
-        for (const EventRecord& record : events) observer.event(record);
+        for (const EventRecord& record : events) observer.event(record, y);
         outcome.events.insert(outcome.events.end(), events.begin(), events.end());
         outcome.stats.events += static_cast<long>(events.size());
         if (changed) {

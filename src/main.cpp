@@ -75,6 +75,11 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   std::printf("energy balance error %.3g (kinetic %.6g, elastic %.6g, gravity %.6g, dissipated %.6g, external work %.6g)\n",
               energy.error(), energy.kinetic, energy.elastic, energy.gravity, energy.dissipated, energy.external_work);
   std::printf("largest constraint residual %.3g\n", o.max_constraint_residual);
+  if (report.has_responses) {
+    const Responses& r = report.responses;
+    std::printf("responses  R1 %.3f (crush)  R2 %.3f (override)  R3 %.3f  override: %s\n", r.r1, r.r2, r.r3,
+                r.overridden ? ("yes, at t = " + std::to_string(r.override_time)).c_str() : "no");
+  }
   std::printf("results in %s/ (timeseries.csv, events.csv, summary.json)\n", out_dir.c_str());
   return o.ok ? 0 : 1;
 }

@@ -321,7 +321,8 @@ std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementS
   return probe.keys;
 }
 
-const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description"};
+const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description",
+                                           "responses"};
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
 const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt",
@@ -488,6 +489,72 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
   return load;
 }
 
+PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, const std::string& context) {
+  r.require_map(p, context);
+  r.check_keys(p, {"body", "at"}, context);
+  const YAML::Node body_node = r.required(p, "body", context);
+  const std::string body = r.text(body_node, context + ": body");
+  const auto index = model.find_body(body);
+  if (!index) r.fail(body_node, context + ": unknown body '" + body + "'");
+  PointRef ref;
+  ref.body = *index;
+  if (p["at"]) {
+    const auto at = r.numbers(p["at"], 2, context + ": at");
+    ref.sx = at[0];
+    ref.sy = at[1];
+  }
+  return ref;
+}
+
+void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
+  r.require_map(node, "responses");
+  r.check_keys(node, {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force", "reference_velocity"},
+               "responses");
+  ResponseSettings& s = model.responses;
+  if (node["crush_gauges"]) {
+    r.require_list(node["crush_gauges"], "responses: crush_gauges");
+    for (std::size_t i = 0; i < node["crush_gauges"].size(); ++i) {
+      const YAML::Node g = node["crush_gauges"][i];
+      const std::string context = "responses: crush gauge " + std::to_string(i + 1);
+      r.require_map(g, context);
+      r.check_keys(g, {"name", "points"}, context);
+      CrushGauge gauge;
+      gauge.name = r.text(r.required(g, "name", context), context + ": name");
+      const YAML::Node points = r.required(g, "points", context);
+      if (!points.IsSequence() || points.size() != 2) r.fail(points, context + ": points must be two points [{body, at}, {body, at}]");
+      gauge.front = read_point(r, points[0], model, context + ": point 1");
+      gauge.rear = read_point(r, points[1], model, context + ": point 2");
+      s.crush_gauges.push_back(gauge);
+    }
+  }
+  if (node["crush"]) {
+    const std::string how = r.text(node["crush"], "responses: crush");
+    if (how != "total" && how != "largest") r.fail(node["crush"], "responses: crush must be total or largest");
+    s.total_crush = how == "total";
+  }
+  const auto positive = [&](const char* key) -> std::optional<double> {
+    if (!node[key]) return std::nullopt;
+    const double value = r.number(node[key], std::string("responses: ") + key);
+    if (!(value > 0.0)) r.fail(node[key], std::string("responses: ") + key + " must be positive");
+    return value;
+  };
+  if (!s.crush_gauges.empty()) {
+    if (!node["reference_crush"]) r.fail(node, "responses: crush gauges need 'reference_crush' (the maximum safe crush, R1 = crush / it)");
+    s.reference_crush = *positive("reference_crush");
+  }
+  if (node["anticlimber"]) {
+    s.anticlimber = r.text(node["anticlimber"], "responses: anticlimber");
+    const auto& elements = model.elements();
+    const auto it = std::find_if(elements.begin(), elements.end(), [&](const auto& e) { return e->name() == s.anticlimber; });
+    if (it == elements.end() || (*it)->type() != "anticlimber")
+      r.fail(node["anticlimber"], "responses: 'anticlimber: " + s.anticlimber + "' must name an element of type anticlimber");
+    s.vertical_yield_force = positive("vertical_yield_force");
+    if (!node["reference_velocity"])
+      r.fail(node, "responses: an anticlimber needs 'reference_velocity' (the velocity that fails the collision post, for R2 after override)");
+    s.reference_velocity = *positive("reference_velocity");
+  }
+}
+
 void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings& s) {
   r.require_map(node, "simulation");
   r.check_keys(node, kSimulationKeys, "simulation");
@@ -616,6 +683,7 @@ Model build(const YAML::Node& root, const Reader& r) {
     r.require_list(root["loads"], "loads");
     for (std::size_t i = 0; i < root["loads"].size(); ++i) model.add_load(read_load(r, root["loads"][i], model));
   }
+  if (root["responses"]) read_responses(r, root["responses"], model);
   read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
   return model;
 }

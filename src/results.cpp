@@ -85,7 +85,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
 }
 
-void ResultWriter::event(const EventRecord& record) {
+void ResultWriter::event(const EventRecord& record, const double*) {
   std::string element = record.element, what = record.what;
   for (std::string* text : {&element, &what})
     if (text->find_first_of(",\"") != std::string::npos) {

@@ -8,6 +8,7 @@
 
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/ida_integrator.hpp"
+#include "railcrash/responses.hpp"
 #include "railcrash/results.hpp"
 
 namespace railcrash {
@@ -20,12 +21,12 @@ double checked_positive(double value, const char* option) {
   return value;
 }
 
-/// Forwards samples to the writer (if any) and shows progress on a terminal.
+/// Forwards samples to the writer and the response tracker (if any) and shows progress on a terminal.
 class ProgressObserver : public RunObserver {
  public:
-  ProgressObserver(RunObserver* next, double t_end, bool show) : next_(next), t_end_(t_end), show_(show) {}
+  ProgressObserver(std::vector<RunObserver*> next, double t_end, bool show) : next_(std::move(next)), t_end_(t_end), show_(show) {}
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
-    if (next_) next_->sample(t, y, lambda, quadratures);
+    for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures);
     if (!show_) return;
     const auto now = std::chrono::steady_clock::now();
     if (now - last_ < std::chrono::milliseconds(200) && t < t_end_) return;
@@ -35,12 +36,12 @@ class ProgressObserver : public RunObserver {
     std::fflush(stderr);
   }
 
-  void event(const EventRecord& record) override {
-    if (next_) next_->event(record);
+  void event(const EventRecord& record, const double* y) override {
+    for (RunObserver* o : next_) o->event(record, y);
   }
 
  private:
-  RunObserver* next_;
+  std::vector<RunObserver*> next_;
   double t_end_;
   bool show_;
   std::chrono::steady_clock::time_point last_{};
@@ -76,13 +77,21 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   const DaeSystem system(model);
   std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
   std::unique_ptr<ResultWriter> writer;
-  if (!out_dir.empty()) writer = std::make_unique<ResultWriter>(out_dir, system);
+  std::unique_ptr<ResponseTracker> responses;
+  std::vector<RunObserver*> observers;
+  if (!out_dir.empty()) observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system)).get());
+  if (model.responses.defined())
+    observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
   const bool terminal = show_progress && isatty(STDERR_FILENO);
-  ProgressObserver observer(writer.get(), model.simulation.t_end, terminal);
+  ProgressObserver observer(observers, model.simulation.t_end, terminal);
   RunReport report;
   report.integrator = integrator->name();
   report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
-  if (writer) writer->write_summary(report.outcome, report.integrator);
+  if (responses) {
+    report.responses = responses->result();
+    report.has_responses = true;
+  }
+  if (writer) writer->write_summary(report.outcome, report.integrator, responses ? ",\n  \"responses\": " + responses->json() : "");
   return report;
 }
 

@@ -33,8 +33,8 @@ class RunObserver {
   virtual ~RunObserver() = default;
   /// lambda: constraint multipliers (ida) or penalty forces (euler); quadratures as in DaeSystem.
   virtual void sample(double t, const double* y, const double* lambda, const double* quadratures) = 0;
-  /// A committed mode change (contact, yield, rupture, ...).
-  virtual void event(const EventRecord& /*record*/) {}
+  /// A committed mode change (contact, yield, rupture, ...); y is the state at that instant.
+  virtual void event(const EventRecord& /*record*/, const double* /*y*/) {}
 };
 
 struct RunOutcome {

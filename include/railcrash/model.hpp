@@ -51,6 +51,22 @@ struct Load {
   SourceLocation where;
 };
 
+/// What the report's response parameters R1-R3 are measured on (responses.hpp).
+struct CrushGauge {
+  std::string name;
+  PointRef front, rear;  // two points along one car
+};
+
+struct ResponseSettings {
+  std::vector<CrushGauge> crush_gauges;
+  bool total_crush = true;                    // R1 uses the sum over gauges (else the largest)
+  double reference_crush = 0.0;               // [length] maximum "safe" crush
+  std::string anticlimber;                    // element whose vertical force and override make R2
+  std::optional<double> vertical_yield_force; // [force] default: the anticlimber's own
+  double reference_velocity = 0.0;            // [length/time] velocity that fails the collision post
+  bool defined() const { return !crush_gauges.empty() || !anticlimber.empty(); }
+};
+
 enum class IntegratorKind { Ida, Euler };
 
 struct SimulationSettings {
@@ -76,6 +92,7 @@ class Model {
   UnitSystem units = UnitSystem::SI;
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
   SimulationSettings simulation;
+  ResponseSettings responses;
 
   int add_body(Body body);
   Element& add_element(std::unique_ptr<Element> element);

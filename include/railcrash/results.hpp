@@ -23,7 +23,7 @@ class ResultWriter : public RunObserver {
   ResultWriter& operator=(const ResultWriter&) = delete;
 
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
-  void event(const EventRecord& record) override;
+  void event(const EventRecord& record, const double* y) override;
   /// Writes summary.json (call once, at the end, whatever the outcome).
   void write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json = "");
   const std::string& directory() const { return directory_; }

@@ -8,6 +8,7 @@
 
 #include "railcrash/integrator.hpp"
 #include "railcrash/model.hpp"
+#include "railcrash/responses.hpp"
 
 namespace railcrash {
 
@@ -30,6 +31,8 @@ double output_interval_of(const SimulationSettings& settings);
 struct RunReport {
   RunOutcome outcome;
   std::string integrator;
+  bool has_responses = false;  // the model has a responses section
+  Responses responses;         // R1-R3 and what they are made of
 };
 
 /// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files).

@@ -1,0 +1,58 @@
+// The report's response parameters (Section 4.1; see models/report/TRANSCRIPTION.md §10):
+//   R1 = axial crush / reference deformation
+//        axial crush: the largest shortening of the model's crush gauges (point pairs along
+//        each car), summed over the cars ("the total crush of the cars", Section 5) or, with
+//        `crush: largest`, the largest single car's
+//   R2 = largest vertical anticlimber force / vertical yield force        (no override)
+//      = 1 + relative horizontal velocity / reference velocity             (override)
+//        the yield force is the typical anticlimber's (elastic slope x yield deflection, or
+//        `vertical_yield_force`), fixed for every run of a study (report Section 5); the
+//        relative velocity is that of the two anticlimber bodies along x at the override
+//        event (the report takes it when the overriding end sill reaches the collision post,
+//        which the planar model has no mass for: an approximation, stated in summary.json)
+//   R3 = max(R1, R2) when both are below 1, else R1 + R2 (reading R-1)
+// The largest force and crush are taken over the output samples (finer output, finer peaks).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "railcrash/integrator.hpp"
+
+namespace railcrash {
+
+struct Responses {
+  double r1 = 0.0, r2 = 0.0, r3 = 0.0;
+  std::vector<double> max_crush;        // [length] per gauge
+  double max_vertical_force = 0.0;      // [force] anticlimber, |vertical force|
+  double vertical_yield_force = 0.0;    // [force]
+  bool overridden = false;
+  double override_time = -1.0;          // [time]
+  double override_relative_velocity = 0.0;  // [length/time]
+};
+
+/// Follows a run and computes the responses; add it as an observer.
+class ResponseTracker : public RunObserver {
+ public:
+  ResponseTracker(const DaeSystem& system, const ResponseSettings& settings);
+  void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
+  void event(const EventRecord& record, const double* y) override;
+  Responses result() const;
+  /// The responses as a JSON object (for summary.json).
+  std::string json() const;
+
+ private:
+  double gauge_length(const CrushGauge& gauge, const double* y) const;
+
+  const DaeSystem& system_;
+  ResponseSettings settings_;
+  int anticlimber_element_ = -1;   // element index
+  int vertical_force_column_ = -1; // index into DaeSystem::outputs
+  std::vector<double> initial_length_;
+  std::vector<double> outputs_;
+  Responses responses_;
+  bool started_ = false;
+};
+
+}  // namespace railcrash

@@ -1,0 +1,96 @@
+#include "railcrash/responses.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "railcrash/elements/anticlimber.hpp"
+#include "railcrash/results.hpp"
+
+namespace railcrash {
+
+ResponseTracker::ResponseTracker(const DaeSystem& system, const ResponseSettings& settings)
+    : system_(system), settings_(settings), outputs_(system.output_names().size()) {
+  responses_.max_crush.assign(settings.crush_gauges.size(), 0.0);
+  if (settings.anticlimber.empty()) return;
+  const auto& elements = system.model().elements();
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    if (elements[e]->name() == settings.anticlimber) anticlimber_element_ = static_cast<int>(e);
+  const auto* anticlimber =
+      anticlimber_element_ < 0 ? nullptr : dynamic_cast<const Anticlimber*>(elements[static_cast<std::size_t>(anticlimber_element_)].get());
+  if (!anticlimber)
+    throw InputError(SourceLocation{system.model().file, 0}.prefix() + "responses: 'anticlimber: " + settings.anticlimber +
+                     "' must name an element of type anticlimber");
+  const std::string column = settings.anticlimber + ".vertical_force";
+  const auto& names = system.output_names();
+  vertical_force_column_ = static_cast<int>(std::find(names.begin(), names.end(), column) - names.begin());
+  RAILCRASH_DEMAND(vertical_force_column_ < static_cast<int>(names.size()));
+  responses_.vertical_yield_force = settings.vertical_yield_force.value_or(anticlimber->vertical_yield_force());
+}
+
+double ResponseTracker::gauge_length(const CrushGauge& gauge, const double* y) const {
+  const auto position = [&](const PointRef& p) {
+    if (p.body == kGround) return Vec2<double>{p.sx, p.sy};
+    const Pose<double> q{y[3 * p.body], y[3 * p.body + 1], y[3 * p.body + 2]};
+    return point_position(q, p.sx, p.sy);
+  };
+  const Vec2<double> d = position(gauge.front) - position(gauge.rear);
+  return std::sqrt(dot(d, d));
+}
+
+void ResponseTracker::sample(double, const double* y, const double* lambda, const double*) {
+  if (!started_) {  // lengths at the start of the run (after any settling)
+    for (const CrushGauge& g : settings_.crush_gauges) initial_length_.push_back(gauge_length(g, y));
+    started_ = true;
+  }
+  for (std::size_t k = 0; k < settings_.crush_gauges.size(); ++k)
+    responses_.max_crush[k] = std::max(responses_.max_crush[k], initial_length_[k] - gauge_length(settings_.crush_gauges[k], y));
+  if (vertical_force_column_ >= 0) {
+    system_.outputs(y, lambda, outputs_.data());
+    responses_.max_vertical_force =
+        std::max(responses_.max_vertical_force, std::abs(outputs_[static_cast<std::size_t>(vertical_force_column_)]));
+  }
+}
+
+void ResponseTracker::event(const EventRecord& record, const double* y) {
+  if (record.element != settings_.anticlimber || responses_.overridden) return;
+  if (record.what.find("override") == std::string::npos) return;
+  const Element& e = *system_.model().elements()[static_cast<std::size_t>(anticlimber_element_)];
+  const int nq = system_.body_unknowns();
+  const auto vx = [&](int slot) { return e.slot_body(slot) == kGround ? 0.0 : y[nq + 3 * e.slot_body(slot)]; };
+  responses_.overridden = true;
+  responses_.override_time = record.t;
+  responses_.override_relative_velocity = std::abs(vx(1) - vx(0));
+}
+
+Responses ResponseTracker::result() const {
+  Responses r = responses_;
+  double crush = 0.0;
+  for (double c : r.max_crush) crush = settings_.total_crush ? crush + c : std::max(crush, c);
+  r.r1 = settings_.reference_crush > 0.0 ? crush / settings_.reference_crush : 0.0;
+  if (r.overridden)
+    r.r2 = 1.0 + (settings_.reference_velocity > 0.0 ? r.override_relative_velocity / settings_.reference_velocity : 0.0);
+  else
+    r.r2 = r.vertical_yield_force > 0.0 ? r.max_vertical_force / r.vertical_yield_force : 0.0;
+  r.r3 = (r.r1 < 1.0 && r.r2 < 1.0) ? std::max(r.r1, r.r2) : r.r1 + r.r2;
+  return r;
+}
+
+std::string ResponseTracker::json() const {
+  const Responses r = result();
+  std::ostringstream j;
+  j << "{\"R1\": " << json_number(r.r1) << ", \"R2\": " << json_number(r.r2) << ", \"R3\": " << json_number(r.r3)
+    << ", \"override\": " << (r.overridden ? "true" : "false")
+    << ", \"override_time\": " << (r.overridden ? json_number(r.override_time) : "null")
+    << ", \"override_relative_velocity\": " << json_number(r.override_relative_velocity)
+    << ", \"max_vertical_anticlimber_force\": " << json_number(r.max_vertical_force)
+    << ", \"vertical_yield_force\": " << json_number(r.vertical_yield_force) << ", \"max_crush\": {";
+  for (std::size_t k = 0; k < settings_.crush_gauges.size(); ++k)
+    j << (k ? ", " : "") << json_string(settings_.crush_gauges[k].name) << ": " << json_number(r.max_crush[k]);
+  j << "}, \"crush_measure\": " << json_string(settings_.total_crush ? "total" : "largest")
+    << ", \"reference_crush\": " << json_number(settings_.reference_crush)
+    << ", \"reference_velocity\": " << json_number(settings_.reference_velocity) << "}";
+  return j.str();
+}
+
+}  // namespace railcrash

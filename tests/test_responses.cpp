@@ -1,0 +1,87 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+// The crush-impact case (a 100 kg mass crushing an elastic-perfectly-plastic structure:
+// largest crush 0.055 m after a 0.5 m gap) with a crush gauge from the anchor to the mass.
+Model crush_model(const std::string& responses) {
+  std::ifstream in(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/crush_impact.yaml");
+  std::stringstream text;
+  text << in.rdbuf() << responses;
+  return testing::model_from_text(text.str());
+}
+
+}  // namespace
+
+TEST_CASE("R1 is the largest shortening of the crush gauges over the reference crush", "[responses]") {
+  const Model model = crush_model(
+      "responses:\n  crush_gauges:\n    - {name: structure, points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+      "  reference_crush: 0.5\n");
+  const RunReport report = run_model(model, "");
+  REQUIRE(report.outcome.ok);
+  REQUIRE(report.has_responses);
+  // Gauge from 1.5 m down to 1 - 0.055 m: shortening 0.555 m (the gap plus the crush),
+  // sampled every millisecond: the peak lies within v dt^2-ish of a sample.
+  CHECK(report.responses.max_crush.at(0) == Approx(0.555).margin(2e-4));
+  CHECK(report.responses.r1 == Approx(0.555 / 0.5).margin(4e-4));
+  CHECK(report.responses.r2 == 0.0);                      // no anticlimber
+  CHECK(report.responses.r3 == Approx(report.responses.r1 + report.responses.r2));  // R1 >= 1: the sum
+}
+
+TEST_CASE("R3 is the larger of R1 and R2 while both are below one", "[responses]") {
+  const Model model = crush_model(
+      "responses:\n  crush_gauges:\n    - {name: structure, points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+      "  reference_crush: 2.0\n");
+  const RunReport report = run_model(model, "");
+  CHECK(report.responses.r1 == Approx(0.555 / 2.0).margin(1e-4));
+  CHECK(report.responses.r3 == Approx(report.responses.r1));
+}
+
+TEST_CASE("R2 from the anticlimber: vertical force over yield, or 1 + relative speed after override", "[responses]") {
+  // A car end (1000 kg) driven into a fixed anticlimber face while sliding up at 3 m/s: the
+  // faces meet 0.05 m apart vertically and interlock, the vertical law yields (its plastic
+  // force, about 1e4 N, cannot stop 4500 J of vertical motion), and the ends override when
+  // the offset passes the 0.1 m face height. Vertical yield force = 1e6 N/m x 0.01 m = 1e4 N.
+  const std::string text =
+      "railcrash: 1\nname: r2\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: car, mass: 1000, inertia: 100, position: [0.1, -0.1], velocity: [-2, 3]}\nelements:\n"
+      "  - name: ac\n    type: anticlimber\n"
+      "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n    horizontal_yield_deflection: 0.01\n"
+      "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
+      "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n    torsional_yield_deflection: 0.01\n"
+      "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
+      "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n"
+      "simulation: {t_end: 0.5, rtol: 1e-8, output_interval: 0.0005}\n";
+  const Model model = testing::model_from_text(text);
+  const RunReport report = run_model(model, "");
+  REQUIRE(report.outcome.ok);
+  const Responses& r = report.responses;
+  CHECK(r.vertical_yield_force == Approx(1.0e4));
+  INFO("max vertical force " << r.max_vertical_force << ", override " << r.overridden << " at " << r.override_time);
+  REQUIRE(r.overridden);
+  CHECK(r.max_vertical_force > r.vertical_yield_force);  // it yielded before overriding
+  // After override: R2 = 1 + |relative horizontal velocity| / reference velocity.
+  CHECK(r.r2 == Approx(1.0 + r.override_relative_velocity / 4.0));
+  CHECK(r.override_relative_velocity > 0.0);
+  CHECK(r.override_relative_velocity < 2.0);  // the crush slowed it down
+  CHECK(r.r3 == Approx(r.r1 + r.r2));
+}
+
+TEST_CASE("responses input errors", "[responses]") {
+  CHECK_THROWS_WITH(crush_model("responses:\n  crush_gauges:\n    - {name: s, points: [{body: ground}, {body: mass}]}\n"),
+                    Catch::Contains("reference_crush"));
+  CHECK_THROWS_WITH(crush_model("responses:\n  anticlimber: crush\n  reference_velocity: 1\n"),
+                    Catch::Contains("must name an element of type anticlimber") || Catch::Contains("anticlimber"));
+  CHECK_THROWS_WITH(crush_model("responses:\n  crush_gauges: []\n  crush: average\n"), Catch::Contains("total or largest"));
+}
