@@ -250,14 +250,20 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     std::copy(velocities.begin(), velocities.end(), y.begin() + nq);
     return report;
   }
-  // Unbalance measure: forces over their scale, joint gaps over the model size.
+  // Unbalance measure: root-sum-square of the forces over their scale and the joint gaps
+  // over the model size (a sum, so one component may grow while the whole falls);
+  // residual_force receives the largest single unbalanced force.
   const auto unbalance = [&](const std::vector<double>& state, double* residual_force) {
     system.residual(0.0, state.data(), yp.data(), r.data());
-    double forces = 0.0, gaps = 0.0;
-    for (int k = 0; k < nq; ++k) forces = std::max(forces, std::abs(r[static_cast<std::size_t>(nq + k)]) * (k % 3 == 2 ? 1.0 / length : 1.0));
-    for (int k = 0; k < m; ++k) gaps = std::max(gaps, std::abs(r[static_cast<std::size_t>(2 * nq + k)]));
-    if (residual_force) *residual_force = forces;
-    return std::max(forces / force_scale, gaps / length);
+    double sum = 0.0, largest = 0.0;
+    for (int k = 0; k < nq; ++k) {
+      const double force = std::abs(r[static_cast<std::size_t>(nq + k)]) * (k % 3 == 2 ? 1.0 / length : 1.0);
+      largest = std::max(largest, force);
+      sum += (force / force_scale) * (force / force_scale);
+    }
+    for (int k = 0; k < m; ++k) sum += std::pow(r[static_cast<std::size_t>(2 * nq + k)] / length, 2);
+    if (residual_force) *residual_force = largest;
+    return std::sqrt(sum);
   };
 
   const SparsePattern& pattern = system.pattern();
@@ -267,7 +273,13 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
   const auto local_row = [&](int row) {
     return (row >= nq && row < 2 * nq) ? row - nq : (row >= 2 * nq && row < 2 * nq + m ? nq + row - 2 * nq : -1);
   };
-  double step = 1e-3 * std::min(1.0, system.model().simulation.t_end);  // pseudo-time step h
+  double step = 1e-3;                // pseudo-time step h [time]
+  const double smallest_step = 1e-12;
+  // Trust region per step: translations within 5 % of the model size, rotations 0.1 rad
+  // (a light body in a stiff, nearly singular corner must not spin or fly off in one step).
+  const double largest_move = 0.05 * length, largest_turn = 0.1;
+  std::vector<int> commits_per_element(system.model().elements().size(), 0);
+  const int most_commits = 25;  // beyond: the element chatters on a kink; keep its mode
   double current = unbalance(y, &report.residual_force);
   const double tolerance = 1e-10;
   Eigen::SparseLU<SparseMatrix> lu;
@@ -297,17 +309,23 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     Eigen::VectorXd delta;
     if (lu.info() == Eigen::Success) delta = lu.solve(rhs);
     if (lu.info() != Eigen::Success || !delta.allFinite()) {
-      step *= 0.25;
+      if ((step *= 0.25) < smallest_step) break;
       continue;
     }
+    double shrink = 1.0;
+    for (int k = 0; k < nq; ++k) {
+      const double limit = (k % 3 == 2) ? largest_turn : largest_move;
+      if (std::abs(delta[k]) * shrink > limit) shrink = limit / std::abs(delta[k]);
+    }
+    delta *= shrink;
     std::vector<double> trial = y;
     for (int k = 0; k < nq; ++k) trial[static_cast<std::size_t>(k)] += delta[k];
     for (int k = 0; k < m; ++k) trial[static_cast<std::size_t>(2 * nq + k)] += delta[nq + k];
     // Accept a step that does not increase the unbalance: while a body falls toward an open
     // contact the unbalance stays at its weight until the contact closes.
     const double next = unbalance(trial, nullptr);
-    if (!(next <= current) && step > 1e-12) {
-      step *= 0.25;
+    if (!(next <= current)) {
+      if ((step *= 0.25) < smallest_step) break;
       continue;
     }
     y = trial;
@@ -317,13 +335,23 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     if (!direction.empty()) {
       system.roots(0.0, y.data(), g.data());
       bool outside = false;
-      for (std::size_t k = 0; k < g.size(); ++k) {
-        direction[k] = g[k] < 0.0 ? -1 : 0;
-        outside = outside || g[k] < 0.0;
+      int root = 0;
+      for (std::size_t e = 0; e < commits_per_element.size(); ++e) {
+        const int count = system.model().elements()[e]->root_count();
+        const bool frozen = commits_per_element[e] >= most_commits;
+        for (int k = 0; k < count; ++k, ++root) {
+          const auto kk = static_cast<std::size_t>(root);
+          direction[kk] = (!frozen && g[kk] < 0.0) ? -1 : 0;
+          outside = outside || direction[kk] != 0;
+        }
       }
       std::vector<EventRecord> changes;
       if (outside && system.commit_roots(0.0, y.data(), direction.data(), changes)) {
-        for (EventRecord& e : changes) e.what = "static equilibrium: " + e.what;
+        for (EventRecord& e : changes) {
+          for (std::size_t k = 0; k < commits_per_element.size(); ++k)
+            if (system.model().elements()[k]->name() == e.element) ++commits_per_element[k];
+          e.what = "static equilibrium: " + e.what;
+        }
         events.insert(events.end(), changes.begin(), changes.end());
         current = unbalance(y, nullptr);
       }
@@ -331,9 +359,16 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
   }
   current = unbalance(y, &report.residual_force);
   if (current > tolerance) {
+    int worst = 0;
+    for (int k = 0; k < nq; ++k)
+      if (std::abs(r[static_cast<std::size_t>(nq + k)]) * (k % 3 == 2 ? 1.0 / length : 1.0) >
+          std::abs(r[static_cast<std::size_t>(nq + worst)]) * (worst % 3 == 2 ? 1.0 / length : 1.0))
+        worst = k;
     std::ostringstream msg;
     msg << "no static equilibrium found: after " << report.steps << " steps the largest unbalanced force is "
-        << report.residual_force << " (the weights total " << force_scale << "). A body with nothing to hold it against gravity (a missing wheel, spring or joint) "
+        << report.residual_force << ", on body '" << system.model().bodies()[static_cast<std::size_t>(worst / 3)].name << "' ("
+        << (worst % 3 == 0 ? "x" : worst % 3 == 1 ? "y" : "moment / length scale") << "; the weights total " << force_scale
+        << "). A body with nothing to hold it against gravity (a missing wheel, spring or joint) "
         << "has no equilibrium; set static_equilibrium: false to start from the given positions";
     throw SolverError(msg.str());
   }
