@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# One command: install dependencies, build, and run the flagship model.
+# One command: install dependencies, build, and run the flagship crash: the report's final
+# two-car model, a loaded transit car at 35 mph into a standing unloaded car.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
-model=models/examples/coupled_cars.yaml
+model=models/report/final_two_car.yaml
 echo "== railcrash check $model"
 build/railcrash check "$model"
-echo "== railcrash run $model --out results/coupled_cars"
-build/railcrash run "$model" --out results/coupled_cars
+echo "== railcrash run $model --out results/final_two_car"
+build/railcrash run "$model" --out results/final_two_car

@@ -529,8 +529,12 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
   }
   if (node["crush"]) {
     const std::string how = r.text(node["crush"], "responses: crush");
-    if (how != "total" && how != "largest") r.fail(node["crush"], "responses: crush must be total or largest");
-    s.total_crush = how == "total";
+    if (how != "total" && how != "largest" && how != "anticlimber")
+      r.fail(node["crush"], "responses: crush must be total or largest (of the crush gauges) or anticlimber");
+    s.total_crush = how != "largest";
+    s.crush_from_anticlimber = how == "anticlimber";
+    if (s.crush_from_anticlimber && !node["anticlimber"])
+      r.fail(node["crush"], "responses: crush: anticlimber needs 'anticlimber: <element name>'");
   }
   const auto positive = [&](const char* key) -> std::optional<double> {
     if (!node[key]) return std::nullopt;
@@ -538,7 +542,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     if (!(value > 0.0)) r.fail(node[key], std::string("responses: ") + key + " must be positive");
     return value;
   };
-  if (!s.crush_gauges.empty()) {
+  if (!s.crush_gauges.empty() || s.crush_from_anticlimber) {
     if (!node["reference_crush"]) r.fail(node, "responses: crush gauges need 'reference_crush' (the maximum safe crush, R1 = crush / it)");
     s.reference_crush = *positive("reference_crush");
   }

@@ -21,10 +21,14 @@ ResponseTracker::ResponseTracker(const DaeSystem& system, const ResponseSettings
   if (!anticlimber)
     throw InputError(SourceLocation{system.model().file, 0}.prefix() + "responses: 'anticlimber: " + settings.anticlimber +
                      "' must name an element of type anticlimber");
-  const std::string column = settings.anticlimber + ".vertical_force";
   const auto& names = system.output_names();
-  vertical_force_column_ = static_cast<int>(std::find(names.begin(), names.end(), column) - names.begin());
-  RAILCRASH_DEMAND(vertical_force_column_ < static_cast<int>(names.size()));
+  const auto column_of = [&](const std::string& quantity) {
+    const auto it = std::find(names.begin(), names.end(), settings.anticlimber + "." + quantity);
+    RAILCRASH_DEMAND(it != names.end());
+    return static_cast<int>(it - names.begin());
+  };
+  vertical_force_column_ = column_of("vertical_force");
+  horizontal_deformation_column_ = column_of("horizontal_deformation");
   responses_.vertical_yield_force = settings.vertical_yield_force.value_or(anticlimber->vertical_yield_force());
 }
 
@@ -49,6 +53,8 @@ void ResponseTracker::sample(double, const double* y, const double* lambda, cons
     system_.outputs(y, lambda, outputs_.data());
     responses_.max_vertical_force =
         std::max(responses_.max_vertical_force, std::abs(outputs_[static_cast<std::size_t>(vertical_force_column_)]));
+    responses_.max_anticlimber_crush =
+        std::max(responses_.max_anticlimber_crush, outputs_[static_cast<std::size_t>(horizontal_deformation_column_)]);
   }
 }
 
@@ -67,6 +73,7 @@ Responses ResponseTracker::result() const {
   Responses r = responses_;
   double crush = 0.0;
   for (double c : r.max_crush) crush = settings_.total_crush ? crush + c : std::max(crush, c);
+  if (settings_.crush_from_anticlimber) crush = r.max_anticlimber_crush;
   r.r1 = settings_.reference_crush > 0.0 ? crush / settings_.reference_crush : 0.0;
   if (r.overridden)
     r.r2 = 1.0 + (settings_.reference_velocity > 0.0 ? r.override_relative_velocity / settings_.reference_velocity : 0.0);
@@ -84,10 +91,12 @@ std::string ResponseTracker::json() const {
     << ", \"override_time\": " << (r.overridden ? json_number(r.override_time) : "null")
     << ", \"override_relative_velocity\": " << json_number(r.override_relative_velocity)
     << ", \"max_vertical_anticlimber_force\": " << json_number(r.max_vertical_force)
+    << ", \"max_anticlimber_crush\": " << json_number(r.max_anticlimber_crush)
     << ", \"vertical_yield_force\": " << json_number(r.vertical_yield_force) << ", \"max_crush\": {";
   for (std::size_t k = 0; k < settings_.crush_gauges.size(); ++k)
     j << (k ? ", " : "") << json_string(settings_.crush_gauges[k].name) << ": " << json_number(r.max_crush[k]);
-  j << "}, \"crush_measure\": " << json_string(settings_.total_crush ? "total" : "largest")
+  j << "}, \"crush_measure\": "
+    << json_string(settings_.crush_from_anticlimber ? "anticlimber" : settings_.total_crush ? "total" : "largest")
     << ", \"reference_crush\": " << json_number(settings_.reference_crush)
     << ", \"reference_velocity\": " << json_number(settings_.reference_velocity) << "}";
   return j.str();

@@ -60,6 +60,7 @@ struct CrushGauge {
 struct ResponseSettings {
   std::vector<CrushGauge> crush_gauges;
   bool total_crush = true;                    // R1 uses the sum over gauges (else the largest)
+  bool crush_from_anticlimber = false;        // R1 uses the anticlimber's largest horizontal deformation
   double reference_crush = 0.0;               // [length] maximum "safe" crush
   std::string anticlimber;                    // element whose vertical force and override make R2
   std::optional<double> vertical_yield_force; // [force] default: the anticlimber's own

@@ -2,7 +2,9 @@
 //   R1 = axial crush / reference deformation
 //        axial crush: the largest shortening of the model's crush gauges (point pairs along
 //        each car), summed over the cars ("the total crush of the cars", Section 5) or, with
-//        `crush: largest`, the largest single car's
+//        `crush: largest`, the largest single car's; with `crush: anticlimber`, the
+//        anticlimber's largest horizontal deformation (the crush of both car ends when the
+//        element carries the two ends in series, as the report's two-car model does)
 //   R2 = largest vertical anticlimber force / vertical yield force        (no override)
 //      = 1 + relative horizontal velocity / reference velocity             (override)
 //        the yield force is the typical anticlimber's (elastic slope x yield deflection, or
@@ -26,6 +28,7 @@ struct Responses {
   double r1 = 0.0, r2 = 0.0, r3 = 0.0;
   std::vector<double> max_crush;        // [length] per gauge
   double max_vertical_force = 0.0;      // [force] anticlimber, |vertical force|
+  double max_anticlimber_crush = 0.0;   // [length] anticlimber, largest horizontal deformation
   double vertical_yield_force = 0.0;    // [force]
   bool overridden = false;
   double override_time = -1.0;          // [time]
@@ -49,6 +52,7 @@ class ResponseTracker : public RunObserver {
   ResponseSettings settings_;
   int anticlimber_element_ = -1;   // element index
   int vertical_force_column_ = -1; // index into DaeSystem::outputs
+  int horizontal_deformation_column_ = -1;
   std::vector<double> initial_length_;
   std::vector<double> outputs_;
   Responses responses_;
