@@ -33,6 +33,24 @@ std::array<Pose<double>, 2> gather_poses(const Element& e, const double* q) {
 double& component(Pose<double>& p, int c) { return c == 0 ? p.x : (c == 1 ? p.y : p.theta); }
 double component(const Pose<double>& p, int c) { return c == 0 ? p.x : (c == 1 ? p.y : p.theta); }
 
+/// Calls visit(global_row, global_col, local_row, local_col) for every pair of components
+/// of the element's non-ground bodies: global indices are body unknowns (3 body + component),
+/// local ones the element's 6 (3 slot + component).
+template <class Visit>
+void for_each_body_pair(const Element& el, Visit visit) {
+  for (int a = 0; a < 2; ++a) {
+    const int ba = el.slot_body(a);
+    if (ba == kGround) continue;
+    for (int b = 0; b < 2; ++b) {
+      const int bb = el.slot_body(b);
+      if (bb == kGround) continue;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          visit(3 * ba + i, 3 * bb + j, static_cast<std::size_t>(3 * a + i), static_cast<std::size_t>(3 * b + j));
+    }
+  }
+}
+
 /// The element's rates as one local vector (vx, vy, omega of slot 0, then slot 1).
 void flatten_rates(const ElementState<double>& s, double local_v[6]) {
   for (int k = 0; k < 2; ++k)
@@ -278,20 +296,10 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
       std::array<Pose<double>, 2> f{};
       ForceBlock df_dq{}, df_dv{};
       el.add_force_jacobian(t, s, f, df_dq, df_dv);
-      for (int a = 0; a < 2; ++a) {
-        const int ba = el.slot_body(a);
-        if (ba == kGround) continue;
-        for (int b = 0; b < 2; ++b) {
-          const int bb = el.slot_body(b);
-          if (bb == kGround) continue;
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) {
-              const auto li = static_cast<std::size_t>(3 * a + i), lj = static_cast<std::size_t>(3 * b + j);
-              sink.add(nq + 3 * ba + i, 3 * bb + j, -df_dq[li][lj]);
-              sink.add(nq + 3 * ba + i, nq + 3 * bb + j, -df_dv[li][lj]);
-            }
-        }
-      }
+      for_each_body_pair(el, [&](int row, int col, std::size_t li, std::size_t lj) {
+        sink.add(nq + row, col, -df_dq[li][lj]);
+        sink.add(nq + row, nq + col, -df_dv[li][lj]);
+      });
       continue;
     }
     const int offset = model_.constraint_offset(e);
@@ -359,22 +367,16 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
     ForceBlock df_dq{}, df_dv{};
     double df_dlambda[6][kMaxConstraintRows] = {};
     if (!el.failed()) el.add_joint_force_jacobian(t, s, lambda + offset, f, df_dq, df_dv, df_dlambda);
+    for_each_body_pair(el, [&](int row, int col, std::size_t li, std::size_t lj) {
+      sink.add(nq + row, col, -df_dq[li][lj]);
+      sink.add(nq + row, nq + col, -df_dv[li][lj]);
+    });
     for (int a = 0; a < 2; ++a) {
       const int ba = el.slot_body(a);
       if (ba == kGround) continue;
-      for (int i = 0; i < 3; ++i) {
-        const auto li = static_cast<std::size_t>(3 * a + i);
-        for (int b = 0; b < 2; ++b) {
-          const int bb = el.slot_body(b);
-          if (bb == kGround) continue;
-          for (int j = 0; j < 3; ++j) {
-            const auto lj = static_cast<std::size_t>(3 * b + j);
-            sink.add(nq + 3 * ba + i, 3 * bb + j, -df_dq[li][lj]);
-            sink.add(nq + 3 * ba + i, nq + 3 * bb + j, -df_dv[li][lj]);
-          }
-        }
-        for (int row = 0; row < m; ++row) sink.add(nq + 3 * ba + i, model_.lambda_index(offset + row), -df_dlambda[li][row]);
-      }
+      for (int i = 0; i < 3; ++i)
+        for (int row = 0; row < m; ++row)
+          sink.add(nq + 3 * ba + i, model_.lambda_index(offset + row), -df_dlambda[static_cast<std::size_t>(3 * a + i)][row]);
     }
   }
 }
@@ -424,20 +426,10 @@ void DaeSystem::force_jacobian(double t, const double* q, const double* v, const
           }
       }
     }
-    for (int a = 0; a < 2; ++a) {
-      const int ba = el.slot_body(a);
-      if (ba == kGround) continue;
-      for (int b = 0; b < 2; ++b) {
-        const int bb = el.slot_body(b);
-        if (bb == kGround) continue;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) {
-            const auto li = static_cast<std::size_t>(3 * a + i), lj = static_cast<std::size_t>(3 * b + j);
-            df_dq.push_back({3 * ba + i, 3 * bb + j, dq[li][lj]});
-            df_dv.push_back({3 * ba + i, 3 * bb + j, dv[li][lj]});
-          }
-      }
-    }
+    for_each_body_pair(el, [&](int row, int col, std::size_t li, std::size_t lj) {
+      df_dq.push_back({row, col, dq[li][lj]});
+      df_dv.push_back({row, col, dv[li][lj]});
+    });
   }
 }
 
