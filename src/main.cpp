@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -13,6 +14,10 @@
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
+#include "railcrash/sensitivity.hpp"
+
+#include <sstream>
+#include <thread>
 
 namespace {
 
@@ -84,6 +89,28 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   return o.ok ? 0 : 1;
 }
 
+int sensitivity_command(const std::string& path, const std::string& design_path, int jobs, double central,
+                        const std::string& only, const std::string& out_dir) {
+  using namespace railcrash;
+  const SensitivityDesign design = load_design(design_path);
+  SensitivityOptions options;
+  options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.central_step = central;
+  std::stringstream names(only);
+  for (std::string name; std::getline(names, name, ',');)
+    if (!name.empty()) options.only.push_back(name);
+  const auto start = std::chrono::steady_clock::now();
+  const SensitivityResult result = run_sensitivity(path, design, options);
+  const std::string table = write_sensitivity(result, design, out_dir);
+  std::fputs(table.c_str(), stdout);
+  int failed = result.base.ok ? 0 : 1;
+  for (const auto& r : result.runs) failed += r.ok ? 0 : 1;
+  std::printf("\n%zu runs with %d jobs in %.1f s; %d failed; results in %s/ (sensitivity.csv, sensitivity.md)\n",
+              result.runs.size() + 1, options.jobs,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str());
+  return failed == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,6 +134,17 @@ int main(int argc, char** argv) {
   run->add_option("--out", out_dir, "output folder")->capture_default_str();
   run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
 
+  std::string design_path, only;
+  int jobs = 0;
+  double central = 0.0;
+  CLI::App* sensitivity = app.add_subcommand("sensitivity", "parameter study of R1-R3 (report Section 4)");
+  sensitivity->add_option("model", model_path, "model file with a responses section")->required();
+  sensitivity->add_option("--design", design_path, "design file: parameters and what they scale")->required();
+  sensitivity->add_option("--jobs", jobs, "runs in parallel (default: all cores)");
+  sensitivity->add_option("--central", central, "central differences at 1 +- H instead of the design's factor");
+  sensitivity->add_option("--only", only, "comma-separated parameter names to run");
+  sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
+
   CLI::App* check = app.add_subcommand("check", "validate a model and print a summary");
   check->add_option("model", model_path, "model file (YAML)")->required();
   check->add_option("--set", settings, "override a model key");
@@ -118,6 +156,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*check) return check_command(model_path, settings);
+    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, out_dir);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
     if (*t_end_option) overrides.t_end = t_end;

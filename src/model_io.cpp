@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -227,8 +228,50 @@ void mark_override_key(const YAML::Node& map, const YAML::Node& value, const std
 /// Applies one KEY=VALUE override to the document: simulation.t_end=1, bodies.<name>.<key>=...,
 /// elements.<name>.<key>=..., gravity=[0,0], units=SI. The value is registered with the
 /// reader so that a bad value is reported against the setting rather than a file line.
+/// KEY*=FACTOR: multiplies an existing number of the model (a sensitivity run's +20 %).
+bool apply_scaling(YAML::Node& root, const std::string& setting, const std::string& where) {
+  const auto star = setting.find("*=");
+  if (star == std::string::npos) return false;
+  double factor = 0.0;
+  try {
+    factor = std::stod(setting.substr(star + 2));
+  } catch (const std::exception&) {
+    throw InputError(where + "expected KEY*=FACTOR with a number, e.g. elements.spring.stiffness*=1.2");
+  }
+  std::vector<std::string> parts;
+  std::stringstream stream(setting.substr(0, star));
+  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
+  // The map that holds the key (a section, or a named body / element).
+  YAML::Node holder;
+  std::string key;
+  if (parts.size() == 2 && root[parts[0]] && root[parts[0]].IsMap()) {
+    holder = root[parts[0]];
+    key = parts[1];
+  } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements") && root[parts[0]].IsSequence()) {
+    for (std::size_t i = 0; i < root[parts[0]].size(); ++i) {
+      const YAML::Node item = root[parts[0]][i];
+      if (item.IsMap() && item["name"] && item["name"].IsScalar() && item["name"].Scalar() == parts[1]) holder = item;
+    }
+    key = parts[2];
+  }
+  if (!holder || !holder.IsMap() || !holder[key] || !holder[key].IsScalar())
+    throw InputError(where + "there is no number at '" + setting.substr(0, star) +
+                     "' to scale (KEY is section.key, bodies.<name>.<key> or elements.<name>.<key>)");
+  double value = 0.0;
+  try {
+    value = holder[key].as<double>();
+  } catch (const YAML::Exception&) {
+    throw InputError(where + "'" + holder[key].Scalar() + "' is not a number");
+  }
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value * factor);
+  holder[key] = std::string(text);
+  return true;
+}
+
 void apply_override(YAML::Node& root, const std::string& setting, Reader& reader) {
   const std::string where = SourceLocation{reader.file(), 0}.prefix() + "--set '" + setting + "': ";
+  if (apply_scaling(root, setting, where)) return;
   const auto equals = setting.find('=');
   if (equals == std::string::npos || equals == 0)
     throw InputError(where + "expected KEY=VALUE, e.g. simulation.t_end=0.5 or elements.spring.stiffness=200");
