@@ -323,7 +323,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
                    "bodies.<name>.<key> or elements.<name>.<key>");
 }
 
-/// Runs an element factory on placeholder values to learn every key its type reads (the
+/// Runs an element factory on stand-in values to learn every key its type reads (the
 /// real reader stops at the first problem, so it may not have seen them all).
 class KeyProbe : public ParameterReader {
  public:
