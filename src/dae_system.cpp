@@ -320,25 +320,16 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
     double local_v[6];
     flatten_rates(s, local_v);
     // Second-derivative blocks: d(G^T mu)/dq and d(G^T lambda)/dq.
-    for (int a = 0; a < 2; ++a) {
-      const int ba = el.slot_body(a);
-      if (ba == kGround) continue;
-      for (int b = 0; b < 2; ++b) {
-        const int bb = el.slot_body(b);
-        if (bb == kGround) continue;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) {
-            double with_mu = 0.0, with_lambda = 0.0;
-            for (int row = 0; row < m; ++row) {
-              const double h = hess[row][3 * a + i][3 * b + j];
-              with_mu += mu[offset + row] * h;
-              with_lambda += lambda[offset + row] * h;
-            }
-            sink.add(3 * ba + i, 3 * bb + j, with_mu);
-            sink.add(nq + 3 * ba + i, 3 * bb + j, with_lambda);
-          }
+    for_each_body_pair(el, [&](int row_q, int col_q, std::size_t li, std::size_t lj) {
+      double with_mu = 0.0, with_lambda = 0.0;
+      for (int row = 0; row < m; ++row) {
+        const double h = hess[row][li][lj];
+        with_mu += mu[offset + row] * h;
+        with_lambda += lambda[offset + row] * h;
       }
-    }
+      sink.add(row_q, col_q, with_mu);
+      sink.add(nq + row_q, col_q, with_lambda);
+    });
     for (int row = 0; row < m; ++row) {
       const int g = offset + row;
       const int row_phi = model_.lambda_index(g);

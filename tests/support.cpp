@@ -67,6 +67,17 @@ RunOutcome simulate(const Model& model, double output_interval) {
   return outcome;
 }
 
+BodyState split(const DaeSystem& system, const std::vector<double>& y) {
+  const auto nq = static_cast<std::ptrdiff_t>(system.body_unknowns());
+  return {{y.begin(), y.begin() + nq}, {y.begin() + nq, y.begin() + 2 * nq}};
+}
+
+std::vector<double> forces(const DaeSystem& system, const BodyState& s) {
+  std::vector<double> f(s.q.size(), 0.0);
+  system.generalized_forces(0.0, s.q.data(), s.v.data(), f.data());
+  return f;
+}
+
 std::vector<double> random_state(const DaeSystem& system, std::mt19937& rng, double spread) {
   std::uniform_real_distribution<double> u(-spread, spread);
   std::vector<double> y = system.initial_state();

@@ -26,6 +26,14 @@ double jacobian_error(const DaeSystem& system, double t, double cj, const std::v
 /// output_interval) and requires success.
 RunOutcome simulate(const Model& model, double output_interval = 0.01);
 
+/// Positions and velocities of a DAE state.
+struct BodyState {
+  std::vector<double> q, v;
+};
+BodyState split(const DaeSystem& system, const std::vector<double>& y);
+/// Generalized forces (gravity, loads, force elements) at that state, t = 0.
+std::vector<double> forces(const DaeSystem& system, const BodyState& s);
+
 /// A random state near the model's initial one (positions, velocities, multipliers).
 std::vector<double> random_state(const DaeSystem& system, std::mt19937& rng, double spread = 0.3);
 

@@ -124,22 +124,9 @@ std::string mode_name(const BeamElement::State& st) {
   return "signs " + std::to_string(st.sign[0]) + " " + std::to_string(st.sign[1]) + " " + std::to_string(st.sign[2]);
 }
 
-// ---- access to the DAE system ---------------------------------------------------------------
-
-struct BodyState {
-  std::vector<double> q, v;
-};
-
-BodyState split(const DaeSystem& system, const std::vector<double>& y) {
-  const auto nq = static_cast<std::ptrdiff_t>(system.body_unknowns());
-  return {{y.begin(), y.begin() + nq}, {y.begin() + nq, y.begin() + 2 * nq}};
-}
-
-std::vector<double> forces(const DaeSystem& system, const BodyState& s) {
-  std::vector<double> f(s.q.size(), 0.0);
-  system.generalized_forces(0.0, s.q.data(), s.v.data(), f.data());
-  return f;
-}
+using testing::BodyState;
+using testing::forces;
+using testing::split;
 
 /// The beam's outputs at a state (names in BeamElement::output_names()).
 std::vector<double> beam_outputs(const Element& e, const std::vector<double>& q, const std::vector<double>& v) {

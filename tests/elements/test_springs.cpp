@@ -151,23 +151,9 @@ std::vector<double> torsion_forces(std::size_t size, const Layout& l, double mom
 double relative_angle(const std::vector<double>& q, const Layout& l) { return theta_of(q, l.p2) - theta_of(q, l.p1); }
 double relative_rate(const std::vector<double>& v, const Layout& l) { return theta_of(v, l.p2) - theta_of(v, l.p1); }
 
-// ---- access to the DAE system ----------------------------------------------------------
-
-/// Positions and velocities of a DAE state.
-struct BodyState {
-  std::vector<double> q, v;
-};
-
-BodyState split(const DaeSystem& system, const std::vector<double>& y) {
-  const auto nq = static_cast<std::ptrdiff_t>(system.body_unknowns());
-  return {{y.begin(), y.begin() + nq}, {y.begin() + nq, y.begin() + 2 * nq}};
-}
-
-std::vector<double> forces(const DaeSystem& system, const BodyState& s) {
-  std::vector<double> f(s.q.size(), 0.0);
-  system.generalized_forces(0.0, s.q.data(), s.v.data(), f.data());
-  return f;
-}
+using testing::BodyState;
+using testing::forces;
+using testing::split;
 
 void check_forces(const std::vector<double>& actual, const std::vector<double>& expected, double tolerance = 1e-10) {
   REQUIRE(actual.size() == expected.size());
