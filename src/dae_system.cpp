@@ -612,7 +612,6 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
   if (root_count_ == 0) return false;
   std::vector<double> g(static_cast<std::size_t>(root_count_)), ahead(g.size());
   roots(t, y, g.data());
-  if (std::all_of(g.begin(), g.end(), [](double value) { return value > 0.0; })) return false;
   // Second-order Taylor step (q + h v + h^2 a / 2, v + h a): a body at rest on a boundary
   // leaves it through its acceleration alone. h is small against the run's time scale but
   // large enough for h^2 a / 2 to survive round-off in q.
@@ -627,7 +626,7 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
   std::vector<int> direction(g.size(), 0);
   bool any = false;
   for (std::size_t k = 0; k < g.size(); ++k)
-    if (g[k] < 0.0 || (g[k] == 0.0 && ahead[k] < 0.0)) {
+    if (g[k] < 0.0 || ahead[k] < 0.0) {
       direction[k] = -1;
       any = true;
     }

@@ -36,6 +36,18 @@ void restart_state(const DaeSystem& system, double t, std::vector<double>& y, st
     consistent_rates(system, t, y, yp);
 }
 
+/// SUNLinSol_KLU's initialize (called by IDA at the first solve after every IDAInit or
+/// IDAReInit) discards the symbolic analysis, so each restart would redo the ordering of a
+/// matrix whose pattern never changes. This replacement keeps a symbolic analysis once made;
+/// the next setup then refactors numerically (with the library's own fall-back to a full
+/// factorization when the pivots degrade).
+int klu_initialize_keeping_symbolic(SUNLinearSolver solver) {
+  auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
+  content->first_factorize = content->symbolic == nullptr ? 1 : 0;
+  content->last_flag = SUNLS_SUCCESS;
+  return SUNLS_SUCCESS;
+}
+
 }  // namespace
 
 /// Everything SUNDIALS owns for one run; destroyed in reverse order of creation.
@@ -43,6 +55,7 @@ struct IdaIntegrator::Impl {
   const DaeSystem& system;
   SUNContext context = nullptr;
   N_Vector y = nullptr, yp = nullptr, ids = nullptr, atol = nullptr, quad = nullptr, quad_atol = nullptr;
+  N_Vector y_internal = nullptr, yp_internal = nullptr;  // IDA's solution at its own time t_n
   SUNMatrix jacobian = nullptr;
   SUNLinearSolver linear_solver = nullptr;
   void* ida = nullptr;
@@ -54,7 +67,7 @@ struct IdaIntegrator::Impl {
     if (ida) IDAFree(&ida);
     if (linear_solver) SUNLinSolFree(linear_solver);
     if (jacobian) SUNMatDestroy(jacobian);
-    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol})
+    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &y_internal, &yp_internal})
       if (*v) N_VDestroy(*v);
     if (context) SUNContext_Free(&context);
   }
@@ -262,6 +275,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     const SparsePattern& pattern = system_.pattern();
     impl.jacobian = impl.created(SUNSparseMatrix(n, n, pattern.nonzeros(), CSC_MAT, impl.context), "SUNSparseMatrix");
     impl.linear_solver = impl.created(SUNLinSol_KLU(impl.y, impl.jacobian, impl.context), "SUNLinSol_KLU");
+    impl.linear_solver->ops->initialize = &klu_initialize_keeping_symbolic;
     impl.check(IDASetLinearSolver(impl.ida, impl.linear_solver, impl.jacobian), "IDASetLinearSolver");
     impl.check(IDASetJacFn(impl.ida, &Impl::jacobian_values), "IDASetJacFn");
     impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");
@@ -275,6 +289,39 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
       impl.check(IDASetNoInactiveRootWarn(impl.ida), "IDASetNoInactiveRootWarn");
     }
 
+    // The lag test of a mode change without restart: the velocity error of having used the
+    // old law over [t_root, t_n] is about |change of M v' - f| / M (t_n - t_root), the error
+    // of the work quadratures |change of their rates| (t_n - t_root); both must stay within
+    // their tolerances. An algebraic equation that changed (a joint failed) always restarts.
+    impl.y_internal = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.yp_internal = impl.created(N_VClone(impl.y), "N_VClone");
+    std::vector<double> residual_before(static_cast<std::size_t>(n)), residual_after(static_cast<std::size_t>(n));
+    std::vector<double> root_residual_before(static_cast<std::size_t>(n)), root_residual_after(static_cast<std::size_t>(n));
+    std::vector<double> root_work_rates_before(static_cast<std::size_t>(nquad)), root_work_rates_after(root_work_rates_before),
+        work_rates_before(root_work_rates_before), work_rates_after(root_work_rates_before);
+    const auto lag_within_tolerance = [&](const double* state, const double* quadratures, double lag) {
+      const auto at = [](const std::vector<double>& v, int k) { return v[static_cast<std::size_t>(k)]; };
+      // The energy bookkeeping (element work, load work) over the lag, likewise.
+      for (int k = 0; k < nquad; ++k) {
+        const double rate_change = 0.5 * (std::abs(at(root_work_rates_after, k) - at(root_work_rates_before, k)) +
+                                          std::abs(at(work_rates_after, k) - at(work_rates_before, k)));
+        if (rate_change * lag > rtol * std::abs(quadratures[k]) + quad_atol[k]) return false;
+      }
+      for (int k = 2 * nq; k < n; ++k)  // the same code on the same state: bit-identical unless a law changed
+        if (at(root_residual_after, k) != at(root_residual_before, k) || at(residual_after, k) != at(residual_before, k))
+          return false;
+      for (int k = 0; k < nq; ++k) {
+        // Trapezoid over the lag: a kink (no jump at t_root) gives half the end value.
+        const double force_change = 0.5 * (std::abs(at(root_residual_after, nq + k) - at(root_residual_before, nq + k)) +
+                                           std::abs(at(residual_after, nq + k) - at(residual_before, nq + k)));
+        if (force_change == 0.0) continue;
+        const double mass = system_.mass_diagonal(k);
+        if (!(mass > 0.0)) return false;  // a zero-inertia rotation: no estimate, restart
+        if (force_change / mass * lag > rtol * std::abs(state[nq + k]) + atol[nq + k]) return false;
+      }
+      return true;
+    };
+
     const double* lambda = y + 2 * nq;
     std::vector<double> quad_now(static_cast<std::size_t>(nquad), 0.0);
     outcome.initial_energy = system_.energy(y, quad_now.data());
@@ -284,6 +331,8 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     observer.sample(0.0, y, lambda, quad_now.data());
     outcome.max_constraint_residual = system_.constraint_residual(y);
 
+    bool continued_after_root = false;  // the last return was a root IDA went on from
+    std::vector<double> y_at_root;      // the state there
     long output_index = 1;
     double t_reached = 0.0;
     while (t_reached < t_end) {
@@ -293,8 +342,31 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
       }
       const double t_out = std::min(t_end, static_cast<double>(output_index) * output_interval);
       double t_return = t_reached;
+      impl.last_sundials_message.clear();
       const int flag = IDASolve(impl.ida, t_out, &t_return, impl.y, impl.yp, IDA_NORMAL);
       impl.rethrow_callback_error();
+      if (flag == IDA_ILL_INPUT && continued_after_root &&
+          impl.last_sundials_message.find("very near") != std::string::npos) {
+        // A root of the new modes sits at zero and stays there (a body resting exactly on
+        // a kink): IDA refuses to go on from the root return. Restart there instead; at a
+        // restart IDA leaves such a root inactive until it moves.
+        continued_after_root = false;
+        std::copy(y_at_root.begin(), y_at_root.end(), y);
+        std::vector<double> yp_now;
+        std::vector<EventRecord> restart_events;
+        restart_state(system_, t_reached, y_at_root, yp_now, restart_events);
+        for (const EventRecord& record : restart_events) observer.event(record, y);
+        outcome.events.insert(outcome.events.end(), restart_events.begin(), restart_events.end());
+        outcome.stats.events += static_cast<long>(restart_events.size());
+        std::copy(y_at_root.begin(), y_at_root.end(), y);
+        std::copy(yp_now.begin(), yp_now.end(), yp);
+        impl.accumulate(outcome.stats);
+        impl.check(IDAReInit(impl.ida, t_reached, impl.y, impl.yp), "IDAReInit");
+        impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
+        ++outcome.stats.reinitializations;
+        continue;
+      }
+      continued_after_root = false;
       if (flag < 0) {
         t_reached = t_return;
         std::ostringstream msg;
@@ -307,28 +379,53 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
       t_reached = t_return;
       const double* quad = N_VGetArrayPointer(impl.quad);
       if (flag == IDA_ROOT_RETURN) {
-        // A mode change: commit it, then restart from consistent values (accelerations and
-        // joint forces jump with the new law). A root exactly at the restart point is left
-        // inactive by IDA, so the same crossing cannot fire twice.
+        // A mode change. IDA's own solution is already at t_n >= t_root, computed with the
+        // old law over [t_root, t_n]. When the new law agrees with the old one there within
+        // the local tolerance (a kink: a stiffness changes, the force does not jump), IDA
+        // simply goes on, as over any non-smooth right-hand side: no restart, so an event in
+        // one car of a long train does not reset the step size of the whole train. A jump
+        // (rupture, joint failure, preload) or a root left exactly at zero (IDA would stop on
+        // it) restarts from consistent values at t_root instead.
         impl.check(IDAGetRootInfo(impl.ida, root_info.data()), "IDAGetRootInfo");
+        ++outcome.stats.root_returns;
+        realtype t_internal = t_reached;
+        impl.check(IDAGetCurrentTime(impl.ida, &t_internal), "IDAGetCurrentTime");
+        impl.check(IDAGetDky(impl.ida, t_internal, 0, impl.y_internal), "IDAGetDky");
+        impl.check(IDAGetDky(impl.ida, t_internal, 1, impl.yp_internal), "IDAGetDky");
+        const double* y_internal = N_VGetArrayPointer(impl.y_internal);
+        const double* yp_internal = N_VGetArrayPointer(impl.yp_internal);
+        system_.residual(t_reached, y, yp, root_residual_before.data());
+        system_.residual(t_internal, y_internal, yp_internal, residual_before.data());
+        system_.quadrature_rates(t_reached, y, root_work_rates_before.data());
+        system_.quadrature_rates(t_internal, y_internal, work_rates_before.data());
         events.clear();
         const bool changed = system_.commit_roots(t_reached, y, root_info.data(), events);
+        bool restart = false;
+        if (changed) {
+          system_.residual(t_reached, y, yp, root_residual_after.data());
+          system_.residual(t_internal, y_internal, yp_internal, residual_after.data());
+          system_.quadrature_rates(t_reached, y, root_work_rates_after.data());
+          system_.quadrature_rates(t_internal, y_internal, work_rates_after.data());
+          restart = !lag_within_tolerance(y_internal, quad, t_internal - t_reached);
+        }
         std::vector<double> y_now(y, y + n), yp_now;
-        if (changed) restart_state(system_, t_reached, y_now, yp_now, events);
+        if (restart && changed) restart_state(system_, t_reached, y_now, yp_now, events);
         for (const EventRecord& record : events) observer.event(record, y);
         outcome.events.insert(outcome.events.end(), events.begin(), events.end());
         outcome.stats.events += static_cast<long>(events.size());
-        if (changed) {
-          std::copy(y_now.begin(), y_now.end(), y);
-          std::copy(yp_now.begin(), yp_now.end(), yp);
+        continued_after_root = !restart;
+        if (!restart) y_at_root.assign(y, y + n);
+        if (restart) {
+          if (changed) {
+            std::copy(y_now.begin(), y_now.end(), y);
+            std::copy(yp_now.begin(), yp_now.end(), yp);
+          }
+          // At a restart IDA leaves a root that is exactly zero inactive until it moves.
+          impl.accumulate(outcome.stats);
+          impl.check(IDAReInit(impl.ida, t_reached, impl.y, impl.yp), "IDAReInit");
+          impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
+          ++outcome.stats.reinitializations;
         }
-        // Restart even when no mode changed: a root that stays at zero (e.g. a rate that
-        // remains zero) would otherwise stop IDA with "root found at and very near t"; at a
-        // restart IDA leaves it inactive until it moves.
-        impl.accumulate(outcome.stats);
-        impl.check(IDAReInit(impl.ida, t_reached, impl.y, impl.yp), "IDAReInit");
-        impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
-        ++outcome.stats.reinitializations;
         if (t_reached < t_out * (1.0 - 1e-14)) continue;
       }
       observer.sample(t_reached, y, lambda, quad);

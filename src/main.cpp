@@ -7,8 +7,10 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 
+#include "railcrash/consist.hpp"
 #include "railcrash/dae_system.hpp"
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
@@ -111,6 +113,19 @@ int sensitivity_command(const std::string& path, const std::string& design_path,
   return failed == 0 ? 0 : 1;
 }
 
+int consist_command(const std::string& template_path, int cars, const std::string& out_path) {
+  const std::string text = railcrash::make_consist_model(template_path, cars);
+  if (out_path.empty()) {
+    std::fputs(text.c_str(), stdout);
+    return 0;
+  }
+  std::ofstream file(out_path);
+  file << text;
+  if (!file) throw railcrash::InputError("cannot write " + out_path + "; check that its folder exists");
+  std::fprintf(stderr, "%d + %d cars written to %s\n", cars, cars, out_path.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -145,6 +160,14 @@ int main(int argc, char** argv) {
   sensitivity->add_option("--only", only, "comma-separated parameter names to run");
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
 
+  std::string consist_out;
+  int consist_cars = 2;
+  CLI::App* consist = app.add_subcommand("consist", "write a model of N coupled striking cars into N standing cars, "
+                                                    "built from a two-car model (car1_* striking, car2_* standing)");
+  consist->add_option("model", model_path, "two-car template, e.g. models/report/final_two_car.yaml")->required();
+  consist->add_option("--cars", consist_cars, "cars per consist")->capture_default_str()->check(CLI::Range(1, 100000));
+  consist->add_option("--out", consist_out, "model file to write (default: standard output)");
+
   CLI::App* check = app.add_subcommand("check", "validate a model and print a summary");
   check->add_option("model", model_path, "model file (YAML)")->required();
   check->add_option("--set", settings, "override a model key");
@@ -156,6 +179,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*check) return check_command(model_path, settings);
+    if (*consist) return consist_command(model_path, consist_cars, consist_out);
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, out_dir);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;

@@ -129,10 +129,13 @@ class DaeSystem {
   /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
   /// any mode changed (the integrator must then re-initialize).
   bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
-  /// At a (re)start: IDA leaves a root that is exactly zero inactive, so a state sitting on a
-  /// mode boundary and moving out of the mode would never be reported. Looks a tiny step
-  /// ahead along y' and commits such roots now, and also roots already negative (the state
-  /// is outside its mode, e.g. after the initial assembly moved it). Returns true when a
+  /// At a (re)start: commits the roots that sit on their mode's boundary and are about to
+  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y'
+  /// (roots that fire within h are taken as simultaneous with the restart), and roots
+  /// already negative (the state is outside its mode, e.g. after the initial assembly moved
+  /// it). Elements switch a small band past their boundaries (1e-14 to 1e-12 of their size),
+  /// so a state exactly on a boundary has a small positive root that the look-ahead sees
+  /// cross; IDA itself would leave a root that is exactly zero inactive. Returns true when a
   /// mode changed.
   bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events) const;
   /// Puts every element back in its starting mode.

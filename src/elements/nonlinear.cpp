@@ -96,6 +96,14 @@ PiecewiseLineElement<Derived>::PiecewiseLineElement(ElementSpec& spec, int fract
 }
 
 template <class Derived>
+void PiecewiseLineElement<Derived>::set_law(PiecewiseLinearLaw law) {
+  law_ = std::move(law);
+  double size = 0.0;
+  for (double b : law_.breakpoints()) size = std::max(size, std::abs(b));
+  root_band_ = 1e-14 * std::max(1.0, size);
+}
+
+template <class Derived>
 void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initial) {
   Derived& self = *static_cast<Derived*>(this);
   self.prepare(initial);
@@ -120,8 +128,8 @@ void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s,
   if (mode_.broken) return;
   const double x = measure_of(s);
   const int k = mode_.segment;
-  if (law_.has_lower(k)) g[0] = x - law_.lower(k);
-  if (law_.has_upper(k)) g[1] = law_.upper(k) - x;
+  if (law_.has_lower(k)) g[0] = x - law_.lower(k) + root_band_;
+  if (law_.has_upper(k)) g[1] = law_.upper(k) - x + root_band_;
   if (fracture_roots() > 0) {
     const double f = law_.value(x, k);
     g[2] = *fracture_load - f;

@@ -141,7 +141,12 @@ struct SegmentMode {
 };
 
 /// Shared hybrid machinery of the line elements below: the law in x = measure(state), the
-/// segment roots (0: lower breakpoint, 1: upper breakpoint), fracture roots (2: fracture_load - f,
+/// segment roots (0: x - lower breakpoint + band, 1: upper breakpoint - x + band, with band =
+/// 1e-14 max(1, largest |breakpoint|) in the unit of x: a segment is left just past its end, so
+/// that a state resting exactly on a breakpoint, e.g. a leveler whose points sit exactly at its
+/// free length while both bodies move together, is inside a mode rather than on a root that
+/// stays at zero; the band stays below what the restart look-ahead of DaeSystem moves),
+/// fracture roots (2: fracture_load - f,
 /// 3: fracture_load + f, as many as fracture sides) and the mode bookkeeping.
 /// Derived provides
 ///   double measure(const ElementState<double>&) const;    x
@@ -178,7 +183,7 @@ class PiecewiseLineElement : public ForceElement<Derived> {
  protected:
   /// fracture_sides: 0 (no fracture_load), 1 (f reaching +fracture_load) or 2 (|f|).
   PiecewiseLineElement(ElementSpec& spec, int fracture_sides);
-  void set_law(PiecewiseLinearLaw law) { law_ = std::move(law); }
+  void set_law(PiecewiseLinearLaw law);
   /// Number of fracture roots (fixed once the constructor has read fracture_load).
   int fracture_roots() const { return fracture_load ? fracture_sides_ : 0; }
   /// Integral of f dx from x = 0 to the state's x in the current mode (0 once broken): the
@@ -187,6 +192,7 @@ class PiecewiseLineElement : public ForceElement<Derived> {
 
  private:
   PiecewiseLinearLaw law_;
+  double root_band_ = 0.0;  // [unit of x] distance past a breakpoint at which a segment root fires
   SegmentMode mode_;
   SegmentMode initial_mode_;
   int fracture_sides_ = 0;

@@ -1,0 +1,197 @@
+// railcrash benchmarks (not part of the test suite): `bench/run.sh` builds and runs them.
+//
+//   railcrash_bench consist [--cars 2,5,10,20,50,100] [--t-end 0.1]
+//       consists of the report's car (railcrash consist) striking a standing consist: wall and
+//       CPU time per simulated second, steps, residual evaluations, events, root returns,
+//       integrator restarts, peak memory; then the fitted exponent of cost against cars.
+//   railcrash_bench sensitivity [--design FILE]
+//       the report's sensitivity study (base + first-order + second-order runs) with 1 and 2
+//       jobs: wall time and speed-up.
+// Every benchmark prints a table and appends it, with the machine's core count, the commit
+// and the date, to bench/results.md.
+#include <CLI/CLI.hpp>
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "railcrash/consist.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "railcrash/sensitivity.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double peak_memory_mib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+std::string today() {
+  const std::time_t now = std::time(nullptr);
+  char buffer[32];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  return buffer;
+}
+
+std::vector<int> parse_list(const std::string& text) {
+  std::vector<int> values;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) values.push_back(std::stoi(item));
+  return values;
+}
+
+/// Least-squares slope of log(y) against log(x).
+double log_log_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double lx = std::log(x[i]), ly = std::log(y[i]);
+    sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly;
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+void append_results(const std::string& path, const std::string& heading, const std::string& table,
+                    const std::string& commit) {
+  std::ofstream file(path, std::ios::app);
+  file << "\n### " << heading << "\n\n" << today() << ", commit " << commit << ", "
+       << std::thread::hardware_concurrency() << " cores\n\n" << table;
+  if (!file) std::fprintf(stderr, "warning: could not append to %s\n", path.c_str());
+  else std::printf("appended to %s\n", path.c_str());
+}
+
+int consist_benchmark(const std::string& template_path, const std::vector<int>& cars, double t_end,
+                      const std::string& results, const std::string& commit) {
+  std::ostringstream table;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "| cars per consist | bodies | unknowns | wall s | CPU s | CPU s per simulated s | steps | residuals | "
+                "events | root returns | restarts | peak MiB | R1 |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  table << line;
+  std::fputs(line, stdout);
+  std::vector<double> fit_cars, fit_cost;
+  bool all_ok = true;
+  for (const int n : cars) {
+    const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_consist_" + std::to_string(n) + ".yaml");
+    {
+      std::ofstream out(file);
+      out << make_consist_model(template_path, n);
+    }
+    Model model = load_model(file.string());
+    RunOverrides overrides;
+    overrides.t_end = t_end;
+    overrides.output_interval = t_end / 100.0;
+    apply_overrides(model, overrides);
+    const double cpu_start = cpu_seconds();
+    const auto wall_start = std::chrono::steady_clock::now();
+    const RunReport report = run_model(model, "");
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double cpu = cpu_seconds() - cpu_start;
+    const RunStatistics& s = report.outcome.stats;
+    std::snprintf(line, sizeof line, "| %d | %d | %d | %.2f | %.2f | %.1f | %ld | %ld | %ld | %ld | %ld | %.0f | %.3f |%s\n", n,
+                  model.body_count(), model.size(), wall, cpu, cpu / report.outcome.t_reached, s.steps,
+                  s.residual_evaluations, s.events, s.root_returns, s.reinitializations, peak_memory_mib(),
+                  report.responses.r1, report.outcome.ok ? "" : (" FAILED: " + report.outcome.message).c_str());
+    table << line;
+    std::fputs(line, stdout);
+    std::fflush(stdout);
+    all_ok = all_ok && report.outcome.ok;
+    if (n >= 10 && report.outcome.ok) {
+      fit_cars.push_back(n);
+      fit_cost.push_back(cpu / report.outcome.t_reached);
+    }
+    std::filesystem::remove(file);
+  }
+  if (fit_cars.size() >= 2) {
+    std::snprintf(line, sizeof line, "\nCPU time per simulated second grows as cars^%.2f (least squares, %g to %g cars per consist; goal <= 1.1)\n",
+                  log_log_slope(fit_cars, fit_cost), fit_cars.front(), fit_cars.back());
+    table << line;
+    std::fputs(line, stdout);
+  }
+  std::snprintf(line, sizeof line, "(simulated %g s of each; peak MiB is the process's peak so far, i.e. this size's, "
+                "as sizes grow)\n", t_end);
+  table << line;
+  append_results(results, "Consist length (IDA)", table.str(), commit);
+  return all_ok ? 0 : 1;
+}
+
+int sensitivity_benchmark(const std::string& model_path, const std::string& design_path, const std::string& results,
+                          const std::string& commit) {
+  const SensitivityDesign design = load_design(design_path);
+  std::ostringstream table;
+  table << "| jobs | runs | failed | wall s |\n|---|---|---|---|\n";
+  std::printf("| jobs | runs | failed | wall s |\n|---|---|---|---|\n");
+  double one_job = 0.0;
+  for (const int jobs : {1, 2}) {
+    SensitivityOptions options;
+    options.jobs = jobs;
+    const auto start = std::chrono::steady_clock::now();
+    const SensitivityResult result = run_sensitivity(model_path, design, options);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    int failed = result.base.ok ? 0 : 1;
+    for (const auto& r : result.runs) failed += r.ok ? 0 : 1;
+    char line[256];
+    std::snprintf(line, sizeof line, "| %d | %zu | %d | %.1f |\n", jobs, result.runs.size() + 1, failed, wall);
+    table << line;
+    std::fputs(line, stdout);
+    std::fflush(stdout);
+    if (jobs == 1) one_job = wall;
+    else {
+      std::snprintf(line, sizeof line, "\nspeed-up with 2 jobs: %.2f\n", one_job / wall);
+      table << line;
+      std::fputs(line, stdout);
+    }
+  }
+  append_results(results, "Sensitivity study (" + model_path + ")", table.str(), commit);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"railcrash benchmarks (bench/README.md)"};
+  app.require_subcommand(1);
+  std::string source = RAILCRASH_SOURCE_DIR;
+  std::string commit = "unknown", results = source + "/bench/results.md";
+  app.add_option("--commit", commit, "commit id written with the figures");
+  app.add_option("--results", results, "Markdown file the figures are appended to")->capture_default_str();
+
+  std::string template_path = source + "/models/report/final_two_car.yaml", cars_text = "2,5,10,20,50,100";
+  double t_end = 0.1;
+  CLI::App* consist = app.add_subcommand("consist", "cost against consist length");
+  consist->add_option("--template", template_path, "two-car model the consists are built from")->capture_default_str();
+  consist->add_option("--cars", cars_text, "cars per consist, comma-separated")->capture_default_str();
+  consist->add_option("--t-end", t_end, "simulated time of each run [s]")->capture_default_str();
+
+  std::string design_path = source + "/models/report/sensitivity_design.yaml";
+  CLI::App* sensitivity = app.add_subcommand("sensitivity", "the report's sensitivity study with 1 and 2 jobs");
+  sensitivity->add_option("--design", design_path, "design file")->capture_default_str();
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*consist) return consist_benchmark(template_path, parse_list(cars_text), t_end, results, commit);
+    if (*sensitivity) return sensitivity_benchmark(template_path, design_path, results, commit);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "railcrash_bench: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,22 @@
+#!/bin/sh
+# Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
+# bench/results.md with the core count and the commit. Usage:
+#   bench/run.sh [consist|sensitivity|converge|all] [extra options for railcrash_bench]
+# e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
+set -eu
+cd "$(dirname "$0")/.."
+what=${1:-all}
+[ $# -gt 0 ] && shift
+scripts/build.sh >/dev/null
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git status --porcelain 2>/dev/null | grep -v '^??' || true)" ]; then commit="$commit+changes"; fi
+bench=build/railcrash_bench
+case $what in
+  consist|sensitivity) $bench --commit "$commit" "$what" "$@" ;;
+  converge) build/railcrash converge models/report/final_two_car.yaml --out bench/converge_final_two_car "$@" ;;
+  all)
+    $bench --commit "$commit" consist
+    $bench --commit "$commit" sensitivity
+    build/railcrash converge models/report/final_two_car.yaml --out bench/converge_final_two_car ;;
+  *) echo "usage: bench/run.sh [consist|sensitivity|converge|all] [options]" >&2; exit 2 ;;
+esac

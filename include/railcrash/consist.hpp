@@ -1,0 +1,34 @@
+// Consists built from a two-car crash model: the scaling benchmark's trains.
+//
+// The template is a model of one striking car and one standing car whose bodies and
+// elements are named `car1_*` (striking) and `car2_*` (standing), joined by interface
+// elements with other names (the report's final two-car model: coupler faces and
+// anticlimber). make_consist_model writes a model of N striking cars coupled behind each
+// other, moving at the striking car's velocity, and N standing cars coupled behind the
+// struck car:
+//   striking car k (k = 1..N): the car1_* bodies and elements renamed s<k>_*, shifted by
+//                              -(k-1) L in x;
+//   standing car k:            the car2_* ones renamed t<k>_*, shifted by +(k-1) L;
+//   interface elements:        once, between s1 and t1 (car1_ -> s1_, car2_ -> t1_);
+//   couplings:                 s<k>_coupling joins car k's coupler face (the template's
+//                              coupler_faces point on its coupler) to car k-1's rear body, at
+//                              the car's rear face: a coupler_end with coupled: true, no slack,
+//                              faces touching (gap 0) at the start, the template's
+//                              coupler_faces stiffness, free lengths and heights.
+// L, the length over the coupler faces, follows from the template: the coupler faces meet
+// at x = 0 (the interface coupler_end's two points lie free_length behind their faces), and
+// the rear face is the front face mirrored about the centre body's centre of gravity,
+// L = 2 |x_centre body|. The rear faces' height is the front coupler's. A car's rear end
+// carries no draft gear of its own: the front coupler's draft gear, slider and leveler act
+// for the coupling (a simplification of the benchmark trains, not a vehicle model).
+#pragma once
+
+#include <string>
+
+namespace railcrash {
+
+/// YAML text of the 2N-car model (N >= 1) built from a two-car template file. Throws
+/// InputError naming the template and what is missing when it is not of the expected shape.
+std::string make_consist_model(const std::string& template_path, int cars_per_consist);
+
+}  // namespace railcrash
