@@ -587,7 +587,35 @@ void DaeSystem::roots(double t, const double* y, double* g) const {
   }
 }
 
-bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const {
+std::vector<int> DaeSystem::elements_of_roots(const int* direction) const {
+  std::vector<int> owners;
+  for (std::size_t e = 0; e < model_.elements().size(); ++e)
+    for (int k = 0; k < model_.elements()[e]->root_count(); ++k)
+      if (direction[root_offset_[e] + k] != 0) {
+        owners.push_back(static_cast<int>(e));
+        break;
+      }
+  return owners;
+}
+
+DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y) const {
+  const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
+  const int nq = body_unknowns();
+  const ElementState<double> s = gather_state(el, y, y + nq);
+  ElementLoad load;
+  load.body = {el.slot_body(0), el.slot_body(1)};
+  if (el.constraint_count() == 0) {
+    el.add_force(t, s, load.force);
+  } else if (el.has_joint_force() && !el.failed()) {
+    el.add_joint_force(t, s, y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)), load.force);
+  }
+  for (std::size_t k = 0; k < 2; ++k)
+    load.power -= load.force[k].x * s.v[k].x + load.force[k].y * s.v[k].y + load.force[k].theta * s.v[k].theta;
+  return load;
+}
+
+bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                             std::vector<int>* changed_elements) const {
   const int nq = body_unknowns();
   const double* lambda = y + 2 * nq;
   bool changed = false;
@@ -601,6 +629,7 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
       if (el.commit(k, d, t, gather_state(el, y, y + nq), element_lambda, event)) {
         changed = true;
         events.push_back({t, el.name(), event.what, event.value});
+        if (changed_elements) changed_elements->push_back(static_cast<int>(e));
         break;  // the element's other roots belonged to the mode it just left
       }
     }

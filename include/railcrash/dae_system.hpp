@@ -15,6 +15,7 @@
 // with constraints replaced by penalty spring-dampers.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -128,7 +129,21 @@ class DaeSystem {
   /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
   /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
   /// any mode changed (the integrator must then re-initialize).
-  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
+  /// changed_elements (optional) receives the indices of the elements that changed mode.
+  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                    std::vector<int>* changed_elements = nullptr) const;
+  /// Indices of the elements owning a root with direction[k] != 0.
+  std::vector<int> elements_of_roots(const int* direction) const;
+  /// What element e alone contributes at y: its generalized forces on its two body slots (force
+  /// elements, and joint friction from the multipliers in y; not the constraint rows) and the
+  /// power delivered to it (its work quadrature's rate). Lets an integrator judge a mode change
+  /// from the elements that changed instead of the whole model.
+  struct ElementLoad {
+    std::array<int, 2> body{kGround, kGround};  // slot bodies (kGround: none)
+    std::array<Pose<double>, 2> force{};        // [force], [force*length]
+    double power = 0.0;                         // [force*length/time]
+  };
+  ElementLoad element_load(int e, double t, const double* y) const;
   /// At a (re)start: commits the roots that sit on their mode's boundary and are about to
   /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y'
   /// (roots that fire within h are taken as simultaneous with the restart), and roots
