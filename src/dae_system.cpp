@@ -91,6 +91,18 @@ DaeSystem::DaeSystem(const Model& model) : model_(model) {
     for (const std::string& q : el.output_names()) output_names_.push_back(el.name() + "." + q);
     root_offset_.push_back(root_count_);
     root_count_ += el.root_count();
+    root_owner_.insert(root_owner_.end(), static_cast<std::size_t>(el.root_count()), static_cast<int>(e));
+    std::vector<int> unknowns;
+    for (int slot = 0; slot < 2; ++slot) {
+      const int b = el.slot_body(slot);
+      if (b == kGround) continue;
+      for (int c = 0; c < 3; ++c) {
+        unknowns.push_back(3 * b + c);
+        unknowns.push_back(3 * model.body_count() + 3 * b + c);
+      }
+    }
+    for (int r = 0; r < el.constraint_count(); ++r) unknowns.push_back(6 * model.body_count() + model.constraint_offset(e) + r);
+    element_unknowns_.push_back(std::move(unknowns));
   }
 
   // Dry run: learn the pattern from the same assembly code, then give every addition its slot.
@@ -585,6 +597,26 @@ void DaeSystem::roots(double t, const double* y, double* g) const {
     const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
     el.roots(t, gather_state(el, y, y + nq), element_lambda, g + root_offset_[e]);
   }
+}
+
+void DaeSystem::element_roots(int e, double t, const double* y, double* g) const {
+  const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
+  const int nq = body_unknowns();
+  const double* element_lambda =
+      el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)) : nullptr;
+  el.roots(t, gather_state(el, y, y + nq), element_lambda, g);
+}
+
+bool DaeSystem::commit_element_root(int e, int local, int direction, double t, const double* y,
+                                    std::vector<EventRecord>& events) const {
+  Element& el = *model_.elements()[static_cast<std::size_t>(e)];
+  const int nq = body_unknowns();
+  const double* element_lambda =
+      el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)) : nullptr;
+  Element::Event event;
+  if (!el.commit(local, direction, t, gather_state(el, y, y + nq), element_lambda, event)) return false;
+  events.push_back({t, el.name(), event.what, event.value});
+  return true;
 }
 
 std::vector<int> DaeSystem::elements_of_roots(const int* direction) const {

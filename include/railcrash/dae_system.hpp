@@ -132,6 +132,18 @@ class DaeSystem {
   /// changed_elements (optional) receives the indices of the elements that changed mode.
   bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
                     std::vector<int>* changed_elements = nullptr) const;
+  /// Element-level access for integrators that locate events element by element.
+  int root_offset(int e) const { return root_offset_[static_cast<std::size_t>(e)]; }
+  /// Element owning root k.
+  int root_owner(int k) const { return root_owner_[static_cast<std::size_t>(k)]; }
+  /// Element e's root functions at y (only its bodies' q, v and its multipliers are read).
+  void element_roots(int e, double t, const double* y, double* g) const;
+  /// The unknowns element e reads: its bodies' positions and velocities and its multipliers.
+  const std::vector<int>& element_unknowns(int e) const { return element_unknowns_[static_cast<std::size_t>(e)]; }
+  /// Commits element e's root `local` (direction -1: it fell through zero) at y; appends the
+  /// event. Returns true when the element changed mode.
+  bool commit_element_root(int e, int local, int direction, double t, const double* y,
+                           std::vector<EventRecord>& events) const;
   /// Indices of the elements owning a root with direction[k] != 0.
   std::vector<int> elements_of_roots(const int* direction) const;
   /// What element e alone contributes at y: its generalized forces on its two body slots (force
@@ -177,6 +189,8 @@ class DaeSystem {
   std::vector<int> constraint_row_owner_;  // element index of each constraint row
   std::vector<bool> row_is_rotational_;
   std::vector<int> root_offset_;  // first root of each element
+  std::vector<int> root_owner_;   // element of each root
+  std::vector<std::vector<int>> element_unknowns_;  // y indices each element reads
   int root_count_ = 0;
 };
 

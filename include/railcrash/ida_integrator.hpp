@@ -11,6 +11,15 @@
 // * IDASetId marks q, v differential and lambda, mu algebraic; IDASetSuppressAlg keeps the
 //   algebraic unknowns out of the error test.
 // * Quadratures (kinetic-energy integral, load work, element work) with error control.
+// * Events: IDA takes one step at a time; after each step every root function is evaluated
+//   once and a root that fell through zero is located element by element on IDA's own
+//   interpolating polynomial (its Taylor form at t_n from IDAGetDky, evaluated only for the
+//   unknowns the element reads), so locating an event costs the same in any model size.
+//   Events are committed in time order; IDA goes on without a restart when the new law agrees
+//   with the old one over the rest of the step within the local tolerances (kinks), and
+//   restarts from consistent values at the event otherwise (jumps, joint failures).
+// * KLU: the symbolic analysis is kept across restarts, the pivot order across Jacobian
+//   updates while the pivot growth stays small (see ida_integrator.cpp).
 // * Every SUNDIALS return code is checked; failures become SolverError with the flag's name.
 //   Callbacks never let an exception into SUNDIALS: they store it and return -1.
 #pragma once

@@ -607,9 +607,13 @@ TEST_CASE("a plastic hinge forms at M_p and fractures at sigma_u Z under a stead
     CHECK(std::abs(fracture.t - theta_f / w0) < time_tolerance);
     CHECK(run.outputs[kFailed] == 1.0);
     CHECK(run.outputs[kMoment2] == 0.0);
-    // All the work of M_2 on the turning tip (M_1 does none: phi_1 = 0) was dissipated.
+    // All the work of M_2 on the turning tip (M_1 does none: phi_1 = 0) was dissipated. IDA
+    // controls the work quadratures to 0.1 rtol x the model's energy scale (here the tip's
+    // kinetic energy, 5e12 J: 0.5 J absolute per step), so that is the accuracy to ask for.
     const double work = 0.5 * mp * theta_h + 0.5 * (mp + mu) * (theta_f - theta_h);
-    CHECK(run.outcome.quadratures[DaeSystem::kFirstElementWork] == Approx(work).epsilon(use_ida ? 1e-6 : 1e-3));
+    const double quadrature_tolerance = 0.1 * kHeavyRtol * 0.5 * 1.0e15 * w0 * w0;  // [J]
+    CHECK(std::abs(run.outcome.quadratures[DaeSystem::kFirstElementWork] - work) <
+          (use_ida ? 4.0 * quadrature_tolerance : 1e-3 * work));
   }
 }
 
