@@ -226,6 +226,56 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
   for (int k = 0; k < nq; ++k) yp[static_cast<std::size_t>(nq + k)] = solution[k];
 }
 
+namespace {
+
+/// Puts every element in the mode its state y belongs to: commits the roots that are
+/// negative (outside their mode), repeatedly, since one commit moves a piecewise law by one
+/// segment. Returns true when a mode changed.
+bool follow_modes(const DaeSystem& system, const std::vector<double>& y, std::vector<EventRecord>& events) {
+  const std::size_t count = static_cast<std::size_t>(system.root_count());
+  if (count == 0) return false;
+  std::vector<double> g(count);
+  std::vector<int> direction(count);
+  bool changed = false;
+  for (int pass = 0; pass < 50; ++pass) {
+    system.roots(0.0, y.data(), g.data());
+    bool outside = false;
+    for (std::size_t k = 0; k < count; ++k) {
+      direction[k] = g[k] < 0.0 ? -1 : 0;
+      outside = outside || direction[k] != 0;
+    }
+    if (!outside || !system.commit_roots(0.0, y.data(), direction.data(), events)) break;
+    changed = true;
+  }
+  return changed;
+}
+
+/// Weighted Newton projection of the positions of y onto Phi(q) = 0 (as the assembly);
+/// false when it does not converge.
+bool project_positions(const DaeSystem& system, std::vector<double>& y) {
+  const int m = system.constraint_rows();
+  if (m == 0) return true;
+  const Eigen::VectorXd w = assembly_weights(system);
+  const double tolerance = 1e-12 * system.model().length_scale();
+  Eigen::Map<Eigen::VectorXd> q(y.data(), system.body_unknowns());
+  Eigen::VectorXd phi;
+  Eigen::SimplicialLDLT<SparseMatrix> solver;
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    const SparseMatrix g = constraint_gradient(system, y.data(), phi);
+    double worst = 0.0;
+    for (int r = 0; r < m; ++r) worst = std::max(worst, std::abs(phi[r]) * row_scale(system, r));
+    if (worst <= tolerance) return true;
+    if (!std::isfinite(worst)) return false;
+    const SparseMatrix gw = g * w.asDiagonal();
+    solver.compute(gw * g.transpose());
+    if (solver.info() != Eigen::Success) return false;
+    q -= gw.transpose() * solver.solve(phi);
+  }
+  return false;
+}
+
+}  // namespace
+
 EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector<double>& y,
                                             std::vector<EventRecord>& events) {
   EquilibriumReport report;
@@ -239,6 +289,12 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
   const std::vector<double> yp(static_cast<std::size_t>(n), 0.0);
   std::vector<double> r(static_cast<std::size_t>(n));
 
+  // Every element in the mode of the starting state (a spring assembled past a breakpoint).
+  std::vector<EventRecord> changes;
+  follow_modes(system, y, changes);
+  for (EventRecord& e : changes) e.what = "static equilibrium: " + e.what;
+  events.insert(events.end(), changes.begin(), changes.end());
+
   // Scale of the forces to balance: the weights, or else the largest initial force.
   std::vector<double> f(static_cast<std::size_t>(nq));
   system.generalized_forces(0.0, y.data(), y.data() + nq, f.data(), nullptr, nullptr, y.data() + 2 * nq);
@@ -251,8 +307,7 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     return report;
   }
   // Unbalance measure: root-sum-square of the forces over their scale and the joint gaps
-  // over the model size (a sum, so one component may grow while the whole falls);
-  // residual_force receives the largest single unbalanced force.
+  // over the model size; residual_force receives the largest single unbalanced force.
   const auto unbalance = [&](const std::vector<double>& state, double* residual_force) {
     system.residual(0.0, state.data(), yp.data(), r.data());
     double sum = 0.0, largest = 0.0;
@@ -275,16 +330,17 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
   };
   double step = 1e-3;                // pseudo-time step h [time]
   const double smallest_step = 1e-12;
-  // Trust region per step: translations within 5 % of the model size, rotations 0.1 rad
-  // (a light body in a stiff, nearly singular corner must not spin or fly off in one step).
-  const double largest_move = 0.05 * length, largest_turn = 0.1;
-  std::vector<int> commits_per_element(system.model().elements().size(), 0);
-  const int most_commits = 25;  // beyond: the element chatters on a kink; keep its mode
+  // Trust region per step: translations within 0.05 % of the model size, rotations 0.01 rad,
+  // so that the settle follows the state down as a heavily damped motion would (a light body
+  // in a stiff, nearly singular corner must not spin or fly off in one step, and a long
+  // step must not jump to a distant equilibrium of a model that has several). While it
+  // binds, h shrinks (M / h^2 then holds back the soft directions) instead of growing.
+  const double largest_move = 5e-4 * length, largest_turn = 0.01;
+  // Work below this is round-off (and the joints' own residual times their reactions) [force*length].
+  const double work_noise = 1e-10 * force_scale * length;
   double current = unbalance(y, &report.residual_force);
   const double tolerance = 1e-10;
   Eigen::SparseLU<SparseMatrix> lu;
-  std::vector<int> direction(static_cast<std::size_t>(system.root_count()));
-  std::vector<double> g(direction.size());
   const int max_steps = 2000;
   for (; report.steps < max_steps && current > tolerance; ++report.steps) {
     system.jacobian(0.0, 0.0, y.data(), yp.data(), values.data());
@@ -321,41 +377,40 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     std::vector<double> trial = y;
     for (int k = 0; k < nq; ++k) trial[static_cast<std::size_t>(k)] += delta[k];
     for (int k = 0; k < m; ++k) trial[static_cast<std::size_t>(2 * nq + k)] += delta[nq + k];
-    // Accept a step that does not increase the unbalance: while a body falls toward an open
-    // contact the unbalance stays at its weight until the contact closes.
-    const double next = unbalance(trial, nullptr);
-    if (!(next <= current)) {
+    // The trial state on the joints, with every element in the mode the trial state is in.
+    changes.clear();
+    const bool on_joints = project_positions(system, trial);
+    if (on_joints) follow_modes(system, trial, changes);
+    double work = 0.0, next = 0.0;
+    if (on_joints) {
+      const std::vector<double> r_here = r;  // residual at y (from the Newton right-hand side)
+      next = unbalance(trial, nullptr);     // leaves the residual at the trial state in r
+      for (int k = 0; k < nq; ++k) {
+        const auto kk = static_cast<std::size_t>(k);
+        work -= 0.5 * (r_here[kk + static_cast<std::size_t>(nq)] + r[kk + static_cast<std::size_t>(nq)]) * (trial[kk] - y[kk]);
+      }
+    }
+    // Accept a step along which the unbalanced forces do work (trapezoidal rule over the
+    // step: exact for a quadratic energy, and it needs no energy of non-conservative laws).
+    // The forces then push the state down the energy of the model, which is continuously
+    // differentiable across the kinks of piecewise-linear laws where the force balance is
+    // not, so the descent does not stall on a kink; a step that overshoots into a stiff
+    // segment meets a large opposing force at its end and is shortened. Once the work is
+    // round-off, the unbalance must fall instead (Newton's last steps).
+    const bool accept = on_joints && std::isfinite(next) &&
+                        (work > work_noise || (work >= -work_noise && next <= current));
+    if (!accept) {
+      std::vector<EventRecord> undone;
+      follow_modes(system, y, undone);  // back to the modes of y
+      current = unbalance(y, nullptr);
       if ((step *= 0.25) < smallest_step) break;
       continue;
     }
     y = trial;
     current = next;
-    step = std::min(step * 2.0, 1e6);
-    // Keep every element in the mode its state belongs to (roots are positive inside).
-    if (!direction.empty()) {
-      system.roots(0.0, y.data(), g.data());
-      bool outside = false;
-      int root = 0;
-      for (std::size_t e = 0; e < commits_per_element.size(); ++e) {
-        const int count = system.model().elements()[e]->root_count();
-        const bool frozen = commits_per_element[e] >= most_commits;
-        for (int k = 0; k < count; ++k, ++root) {
-          const auto kk = static_cast<std::size_t>(root);
-          direction[kk] = (!frozen && g[kk] < 0.0) ? -1 : 0;
-          outside = outside || direction[kk] != 0;
-        }
-      }
-      std::vector<EventRecord> changes;
-      if (outside && system.commit_roots(0.0, y.data(), direction.data(), changes)) {
-        for (EventRecord& e : changes) {
-          for (std::size_t k = 0; k < commits_per_element.size(); ++k)
-            if (system.model().elements()[k]->name() == e.element) ++commits_per_element[k];
-          e.what = "static equilibrium: " + e.what;
-        }
-        events.insert(events.end(), changes.begin(), changes.end());
-        current = unbalance(y, nullptr);
-      }
-    }
+    step = shrink < 1.0 ? step * 0.5 : std::min(step * 2.0, 1e6);
+    for (EventRecord& e : changes) e.what = "static equilibrium: " + e.what;
+    events.insert(events.end(), changes.begin(), changes.end());
   }
   current = unbalance(y, &report.residual_force);
   if (current > tolerance) {

@@ -17,6 +17,7 @@
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/sensitivity.hpp"
+#include "railcrash/converge.hpp"
 
 #include <sstream>
 #include <thread>
@@ -87,17 +88,40 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
     std::printf("responses  R1 %.3f (crush)  R2 %.3f (override)  R3 %.3f  override: %s\n", r.r1, r.r2, r.r3,
                 r.overridden ? ("yes, at t = " + std::to_string(r.override_time)).c_str() : "no");
   }
+  // Each car's largest crush and the peak accelerations of its car-body masses (bodies whose
+  // names contain "body" or "end"; every body's are in summary.json).
+  for (const CarCrush& car : report.car_crush) {
+    std::printf("%-10s max crush %.4g at t = %.4g; peak acceleration [g]:", car.car.c_str(), car.max_crush, car.t);
+    for (std::size_t i = 0; i < report.acceleration_peaks.size(); ++i) {
+      const std::string& name = model.bodies()[i].name;
+      const bool in_car = report.car_crush.size() == 1 || name.rfind(car.car + "_", 0) == 0;
+      if (!in_car || (name.find("body") == std::string::npos && name.find("end") == std::string::npos)) continue;
+      std::printf(" %s %.3g", name.c_str(), report.acceleration_peaks[i].magnitude / standard_gravity(model));
+    }
+    std::printf("\n");
+  }
   std::printf("results in %s/ (timeseries.csv, events.csv, summary.json)\n", out_dir.c_str());
   return o.ok ? 0 : 1;
 }
 
-int sensitivity_command(const std::string& path, const std::string& design_path, int jobs, double central,
-                        const std::string& only, const std::string& out_dir) {
+int sensitivity_command(const std::string& path, const std::string& design_option, int jobs, double central,
+                        const std::string& only, bool first_order_only, double run_limit, const std::string& out_dir) {
   using namespace railcrash;
+  // "report" (the default): the report's design for this model, sensitivity_design.yaml beside it.
+  const std::string design_path = design_option == "report" ? default_design_path(path) : design_option;
   const SensitivityDesign design = load_design(design_path);
   SensitivityOptions options;
   options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options.central_step = central;
+  options.second_order = !first_order_only;
+  options.run_time_limit = run_limit;
+  options.progress = [](const SensitivityRun& run, std::size_t number, std::size_t done, std::size_t total) {
+    std::string varied = run.variation.empty() ? "base" : "";
+    for (const auto& [name, value] : run.variation)
+      varied += (varied.empty() ? "" : " ") + name + "=" + std::to_string(value).substr(0, 4);
+    std::fprintf(stderr, "[%zu/%zu] run %zu (%s) %s in %.1f s\n", done, total, number, varied.c_str(),
+                 run.ok ? "done" : "FAILED", run.wall_seconds);
+  };
   std::stringstream names(only);
   for (std::string name; std::getline(names, name, ',');)
     if (!name.empty()) options.only.push_back(name);
@@ -107,10 +131,46 @@ int sensitivity_command(const std::string& path, const std::string& design_path,
   std::fputs(table.c_str(), stdout);
   int failed = result.base.ok ? 0 : 1;
   for (const auto& r : result.runs) failed += r.ok ? 0 : 1;
-  std::printf("\n%zu runs with %d jobs in %.1f s; %d failed; results in %s/ (sensitivity.csv, sensitivity.md)\n",
-              result.runs.size() + 1, options.jobs,
+  for (const auto& r : result.second_order_runs) failed += r.ok ? 0 : 1;
+  std::printf("\n%s: %zu runs with %d jobs in %.1f s; %d failed; results in %s/ (sensitivity.md, sensitivity.csv, "
+              "sensitivity_first_order.csv, sensitivity_second_order.csv, sensitivity_derivatives.csv, "
+              "sensitivity_ranking.csv)\n",
+              design_path.c_str(), result.runs.size() + result.second_order_runs.size() + 1, options.jobs,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str());
   return failed == 0 ? 0 : 1;
+}
+
+
+int converge_command(const std::string& path, const railcrash::ConvergeOptions& options, const std::string& out_dir) {
+  using namespace railcrash;
+  const ConvergePlan plan = plan_convergence(path, options);
+  std::printf("convergence study of %s (%s): t_end %g s, output every %g s\n", path.c_str(), plan.model_name.c_str(), plan.t_end,
+              plan.output_interval);
+  for (const ConvergeQuantity& q : plan.quantities)
+    std::printf("  %-24s %s\n", q.name.c_str(), q.applicable ? q.description.c_str() : ("not applicable: " + q.note).c_str());
+  if (!plan.euler_steps.empty()) {
+    std::printf("euler: stability limit %.4g s (elements), %.4g s with the penalty joints at the first step; steps %.4g s "
+                "down to %.4g s (%zu runs); %.3g us per step measured, about %.3g s for the Euler runs on one job\n",
+                plan.element_stability_limit, plan.stability_limit, plan.euler_steps.front(), plan.euler_steps.back(), plan.euler_steps.size(),
+                1e6 * plan.euler_seconds_per_step, plan.euler_estimate_seconds);
+  }
+  std::printf("ida: reference rtol %g, runs at rtol", options.reference_rtol);
+  for (double r : options.rtols) std::printf(" %g", r);
+  std::printf("; %d job%s%s\n", options.jobs, options.jobs > 1 ? "s" : "",
+              options.jobs > 1 ? " (wall times are noisier under parallel load)" : "");
+  std::fflush(stdout);
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  const auto progress = [](const ConvergeRun& run) {
+    char setting[32];
+    std::snprintf(setting, sizeof setting, run.method == "euler" ? "dt %.4g" : "rtol %.0e", run.method == "euler" ? run.step : run.rtol);
+    std::printf("  %-9s %-12s %-6s %8.3g s  %ld steps%s%s\n", run.method.c_str(), setting, run.ok ? "ok" : "FAILED", run.wall_seconds, run.stats.steps, run.ok ? "" : ": ", run.ok ? "" : run.message.c_str());
+    std::fflush(stdout);
+  };
+  const ConvergeResult result = run_convergence(plan, progress, &g_stop);
+  const std::string summary = write_convergence(result, out_dir);
+  std::printf("\n%s\nresults in %s/ (converge.csv, converge.svg, converge.md)\n", summary.c_str(), out_dir.c_str());
+  return result.reference.ok && !g_stop.load() ? 0 : 1;
 }
 
 int consist_command(const std::string& template_path, int cars, const std::string& out_path) {
@@ -149,16 +209,54 @@ int main(int argc, char** argv) {
   run->add_option("--out", out_dir, "output folder")->capture_default_str();
   run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
 
-  std::string design_path, only;
+  std::string design_path = "report", only;
   int jobs = 0;
   double central = 0.0;
+  bool first_order_only = false;
+  double run_limit = 0.0;
   CLI::App* sensitivity = app.add_subcommand("sensitivity", "parameter study of R1-R3 (report Section 4)");
   sensitivity->add_option("model", model_path, "model file with a responses section")->required();
-  sensitivity->add_option("--design", design_path, "design file: parameters and what they scale")->required();
+  sensitivity->add_option("--design", design_path,
+                          "design file: parameters, what they scale, second-order runs and terms; 'report' = "
+                          "sensitivity_design.yaml beside the model")
+      ->capture_default_str();
   sensitivity->add_option("--jobs", jobs, "runs in parallel (default: all cores)");
   sensitivity->add_option("--central", central, "central differences at 1 +- H instead of the design's factor");
   sensitivity->add_option("--only", only, "comma-separated parameter names to run");
+  sensitivity->add_flag("--first-order", first_order_only, "skip the design's second-order runs and fit");
+  sensitivity->add_option("--run-limit", run_limit, "stop a run after this many seconds and report it failed (default: no limit)")
+      ->check(CLI::NonNegativeNumber);
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
+
+  railcrash::ConvergeOptions converge_options;
+  std::string converge_out = "out";
+  CLI::App* converge = app.add_subcommand(
+      "converge", "convergence study: IDA reference, Euler at halving steps, IDA at tolerances; error versus cost");
+  converge->add_option("model", model_path, "model file (YAML)")->required();
+  converge->add_option("--quantities", converge_options.quantities,
+                       "comma list of max_crush, peak_anticlimber_force, peak_coupler_force, R1, R2, displacement_rms, "
+                       "element.NAME.OUTPUT (peak |value|), body.NAME.x|y|theta (displacement at the end); default: the first six")
+      ->delimiter(',');
+  converge->add_option("--euler-steps", converge_options.euler_runs, "number of Euler runs: dt_0 and its halvings (0: none)")
+      ->capture_default_str();
+  converge->add_option("--euler-safety", converge_options.euler_safety, "dt_0 = this x the Euler stability limit")
+      ->capture_default_str();
+  converge->add_option("--euler-dt", converge_options.euler_first_step, "first Euler step instead (must be stable)");
+  converge->add_option("--rtols", converge_options.rtols, "comma list of IDA tolerances")->delimiter(',')->capture_default_str();
+  converge->add_option("--reference-rtol", converge_options.reference_rtol, "IDA reference tolerance")->capture_default_str();
+  CLI::Option* converge_t_end = converge->add_option("--t-end", t_end, "end time (default: the model's)");
+  CLI::Option* converge_output = converge->add_option("--output-interval", output_interval, "time between samples (default: the model's)");
+  converge->add_option("--headline", converge_options.headline, "quantity for the cost ratio (default: the first applicable)");
+  converge->add_option("--levels", converge_options.levels, "comma list of relative error levels for the cost ratio")
+      ->delimiter(',')->capture_default_str();
+  converge->add_option("--jobs", converge_options.jobs,
+                       "runs in parallel (default 1: parallel load makes the wall times noisier)")->capture_default_str();
+  converge->add_option("--run-timeout", converge_options.run_time_limit,
+                       "stop a run after this many seconds of wall time and report it failed (0: no limit; IDA is stopped "
+                       "at its next output time)")
+      ->capture_default_str();
+  converge->add_option("--out", converge_out, "output folder")->capture_default_str();
+  converge->add_option("--set", settings, "override a model key (KEY=VALUE or KEY*=FACTOR)");
 
   std::string consist_out;
   int consist_cars = 2;
@@ -180,7 +278,13 @@ int main(int argc, char** argv) {
   try {
     if (*check) return check_command(model_path, settings);
     if (*consist) return consist_command(model_path, consist_cars, consist_out);
-    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, out_dir);
+    if (*converge) {
+      if (*converge_t_end) converge_options.t_end = t_end;
+      if (*converge_output) converge_options.output_interval = output_interval;
+      converge_options.settings = settings;
+      return converge_command(model_path, converge_options, converge_out);
+    }
+    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, out_dir);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
     if (*t_end_option) overrides.t_end = t_end;

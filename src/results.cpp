@@ -4,9 +4,69 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <regex>
 #include <sstream>
 
 namespace railcrash {
+
+void body_accelerations(const DaeSystem& system, double t, const double* y, const double* lambda, double* acceleration) {
+  const int nq = system.body_unknowns();
+  const int m = system.constraint_rows();
+  system.generalized_forces(t, y, y + nq, acceleration, nullptr, nullptr, lambda);
+  if (m > 0 && lambda != nullptr) {
+    std::vector<double> phi(static_cast<std::size_t>(m));
+    std::vector<DaeSystem::Triplet> gradient;
+    system.constraints(y, phi.data(), &gradient);
+    for (const DaeSystem::Triplet& g : gradient) acceleration[g.col] -= g.value * lambda[g.row];
+  }
+  for (int k = 0; k < nq; ++k) acceleration[k] /= system.mass_diagonal(k);
+}
+
+double standard_gravity(const Model& model) { return model.units == UnitSystem::SI ? 9.80665 : 386.088; }
+
+std::vector<CarCrush> cars_of(const DaeSystem& system) {
+  const Model& model = system.model();
+  const std::regex prefix("^(car[0-9]+)_.*");
+  std::vector<std::string> car_of_body;
+  std::vector<CarCrush> cars;
+  bool named = false;
+  for (const Body& b : model.bodies()) {
+    std::smatch match;
+    const bool is_car = std::regex_match(b.name, match, prefix);
+    named = named || is_car;
+    car_of_body.push_back(is_car ? match[1].str() : std::string());
+  }
+  for (std::string& c : car_of_body)
+    if (!named) c = "car";
+  for (const std::string& c : car_of_body)
+    if (!c.empty() && std::none_of(cars.begin(), cars.end(), [&](const CarCrush& k) { return k.car == c; }))
+      cars.push_back(CarCrush{c, {}, {}, {}, 0.0, 0.0});
+  const auto& names = system.output_names();
+  for (const auto& e : model.elements()) {
+    std::string quantity;
+    if (e->type() == "anticlimber") quantity = "horizontal_deformation";
+    else if (e->type() == "crush_spring") quantity = "crush";
+    else continue;
+    const auto it = std::find(names.begin(), names.end(), e->name() + "." + quantity);
+    if (it == names.end()) continue;
+    std::vector<std::string> touched;
+    for (int slot = 0; slot < 2; ++slot) {
+      const int body = e->slot_body(slot);
+      if (body == kGround) continue;
+      const std::string& c = car_of_body[static_cast<std::size_t>(body)];
+      if (!c.empty() && std::find(touched.begin(), touched.end(), c) == touched.end()) touched.push_back(c);
+    }
+    for (const std::string& c : touched)
+      for (CarCrush& car : cars)
+        if (car.car == c) {
+          car.elements.push_back(e->name());
+          car.columns.push_back(static_cast<int>(it - names.begin()));
+          car.shares.push_back(1.0 / static_cast<double>(touched.size()));
+        }
+  }
+  return cars;
+}
 
 std::string json_string(const std::string& text) {
   std::string out = "\"";
@@ -53,6 +113,9 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
   output_values_.assign(system.output_names().size(), 0.0);
   peak_output_.assign(system.output_names().size(), 0.0);
   peak_time_.assign(system.output_names().size(), 0.0);
+  acceleration_.assign(static_cast<std::size_t>(system.body_unknowns()), 0.0);
+  acceleration_peaks_.assign(static_cast<std::size_t>(system.model().body_count()), AccelerationPeaks{});
+  cars_ = cars_of(system);
 }
 
 ResultWriter::~ResultWriter() {
@@ -76,6 +139,21 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     }
   }
   std::fputs("\n", timeseries_);
+  body_accelerations(system_, t, y, lambda, acceleration_.data());
+  for (int i = 0; i < n; ++i) {
+    AccelerationPeaks& p = acceleration_peaks_[static_cast<std::size_t>(i)];
+    const double ax = acceleration_[static_cast<std::size_t>(3 * i)], ay = acceleration_[static_cast<std::size_t>(3 * i + 1)];
+    const double magnitude = std::hypot(ax, ay);
+    if (std::abs(ax) > p.x) { p.x = std::abs(ax); p.t_x = t; }
+    if (std::abs(ay) > p.y) { p.y = std::abs(ay); p.t_y = t; }
+    if (magnitude > p.magnitude) { p.magnitude = magnitude; p.t_magnitude = t; }
+  }
+  for (CarCrush& car : cars_) {
+    double crush = 0.0;
+    for (std::size_t k = 0; k < car.columns.size(); ++k)
+      crush += car.shares[k] * std::max(0.0, output_values_[static_cast<std::size_t>(car.columns[k])]);
+    if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
+  }
   // Keep what is on disk current without flushing every row.
   const auto now = std::chrono::steady_clock::now();
   if (now - last_flush_ > std::chrono::milliseconds(500)) {
@@ -118,7 +196,7 @@ void ResultWriter::write_summary(const RunOutcome& outcome, const std::string& i
     << ", \"jacobian_evaluations\": " << s.jacobian_evaluations << ", \"nonlinear_iterations\": " << s.nonlinear_iterations
     << ", \"error_test_failures\": " << s.error_test_failures
     << ", \"nonlinear_convergence_failures\": " << s.nonlinear_convergence_failures << ", \"events\": " << s.events
-    << ", \"reinitializations\": " << s.reinitializations << ", \"wall_seconds\": " << json_number(s.wall_seconds)
+    << ", \"located_mode_changes\": " << s.root_returns << ", \"reinitializations\": " << s.reinitializations << ", \"wall_seconds\": " << json_number(s.wall_seconds)
     << ", \"last_step\": " << json_number(s.last_step) << ", \"stability_limit\": " << json_number(s.stability_limit)
     << ", \"assembly_correction\": " << json_number(s.assembly_correction)
     << ", \"settling_steps\": " << s.settling_steps << ", \"settling_displacement\": " << json_number(s.settling_displacement)
@@ -138,6 +216,27 @@ void ResultWriter::write_summary(const RunOutcome& outcome, const std::string& i
   for (std::size_t k = 0; k < peak_output_.size(); ++k)
     j << (k ? ", " : "") << json_string(system_.output_names()[k]) << ": {\"abs_max\": " << json_number(peak_output_[k])
       << ", \"t\": " << json_number(peak_time_[k]) << "}";
+  j << "},\n";
+  const double g = standard_gravity(model);
+  j << "  \"peak_accelerations\": {\"standard_gravity\": " << json_number(g) << ", \"bodies\": {";
+  for (std::size_t i = 0; i < acceleration_peaks_.size(); ++i) {
+    const AccelerationPeaks& p = acceleration_peaks_[i];
+    j << (i ? ", " : "") << json_string(model.bodies()[i].name) << ": {\"x\": {\"abs_max\": " << json_number(p.x)
+      << ", \"g\": " << json_number(p.x / g) << ", \"t\": " << json_number(p.t_x) << "}, \"y\": {\"abs_max\": "
+      << json_number(p.y) << ", \"g\": " << json_number(p.y / g) << ", \"t\": " << json_number(p.t_y)
+      << "}, \"magnitude\": {\"max\": " << json_number(p.magnitude) << ", \"g\": " << json_number(p.magnitude / g)
+      << ", \"t\": " << json_number(p.t_magnitude) << "}}";
+  }
+  j << "}},\n";
+  j << "  \"car_crush\": {";
+  for (std::size_t c = 0; c < cars_.size(); ++c) {
+    const CarCrush& car = cars_[c];
+    j << (c ? ", " : "") << json_string(car.car) << ": {\"max_crush\": " << json_number(car.max_crush)
+      << ", \"t\": " << json_number(car.t) << ", \"elements\": [";
+    for (std::size_t k = 0; k < car.elements.size(); ++k)
+      j << (k ? ", " : "") << "{\"element\": " << json_string(car.elements[k]) << ", \"share\": " << json_number(car.shares[k]) << "}";
+    j << "]}";
+  }
   j << "}" << extra_json << "\n}\n";
   std::ofstream out(directory_ + "/summary.json");
   out << j.str();

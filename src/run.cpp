@@ -92,6 +92,10 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     report.has_responses = true;
   }
   if (writer) writer->write_summary(report.outcome, report.integrator, responses ? ",\n  \"responses\": " + responses->json() : "");
+  if (writer) {
+    report.acceleration_peaks = writer->acceleration_peaks();
+    report.car_crush = writer->car_crush();
+  }
   return report;
 }
 

@@ -2,16 +2,21 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
+#include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 
@@ -19,35 +24,163 @@ namespace railcrash {
 
 namespace {
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// A singular value below this fraction of the largest counts as zero (the design matrix's
+// entries are products of nondimensional values near 1, so round-off is near 1e-16).
+constexpr double kRankTolerance = 1e-10;
+
 [[noreturn]] void design_error(const std::string& path, const YAML::Node& node, const std::string& message) {
   const int line = node && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
   throw InputError(SourceLocation{path, line}.prefix() + message);
 }
 
+const SensitivityParameter* find_parameter(const SensitivityDesign& design, const std::string& name) {
+  for (const SensitivityParameter& p : design.parameters)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+std::string parameter_names(const SensitivityDesign& design) {
+  std::string names;
+  for (const SensitivityParameter& p : design.parameters) names += (names.empty() ? "" : ", ") + p.name;
+  return names;
+}
+
+void require_parameter(const std::string& path, const YAML::Node& node, const SensitivityDesign& design,
+                       const std::string& name, const std::string& context) {
+  if (!find_parameter(design, name))
+    design_error(path, node,
+                 context + ": no parameter '" + name + "' in 'parameters' (use one of " + parameter_names(design) + ")");
+}
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) return "";
+  return text.substr(first, text.find_last_not_of(" \t") - first + 1);
+}
+
+// "P6" | "P6^2" | "P6*P7" (a product of a parameter with itself is its square).
+SensitivityTerm parse_term(const std::string& path, const YAML::Node& node, const SensitivityDesign& design) {
+  const std::string text = node.IsScalar() ? node.as<std::string>() : "";
+  const std::string context = "second_order term '" + text + "'";
+  SensitivityTerm term;
+  if (const auto caret = text.find('^'); caret != std::string::npos) {
+    if (trim(text.substr(caret + 1)) != "2") design_error(path, node, context + ": only squares are allowed (P6^2)");
+    term.first = term.second = trim(text.substr(0, caret));
+  } else if (const auto star = text.find('*'); star != std::string::npos) {
+    term.first = trim(text.substr(0, star));
+    term.second = trim(text.substr(star + 1));
+  } else {
+    term.first = trim(text);
+  }
+  if (term.first.empty() || (text.find('*') != std::string::npos && term.second.empty()))
+    design_error(path, node, context + ": write a term as P6, P6^2 or P6*P7");
+  require_parameter(path, node, design, term.first, context);
+  if (!term.linear()) require_parameter(path, node, design, term.second, context);
+  return term;
+}
+
+bool same_term(const SensitivityTerm& a, const SensitivityTerm& b) {
+  return (a.first == b.first && a.second == b.second) ||
+         (!a.linear() && !b.linear() && a.first == b.second && a.second == b.first);
+}
+
+void load_second_order(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
+  if (!node.IsMap() || !node["terms"] || !node["terms"].IsSequence() || !node["runs"] || !node["runs"].IsSequence())
+    design_error(path, node,
+                 "'second_order' needs 'terms' (a list such as [P6, P6^2, P6*P7]) and 'runs' (a list of "
+                 "{parameter: value} maps, e.g. - {P6: 0.8})");
+  for (const YAML::Node& t : node["terms"]) {
+    SensitivityTerm term = parse_term(path, t, design);
+    for (const SensitivityTerm& other : design.second_order.terms)
+      if (same_term(term, other)) design_error(path, t, "second_order term '" + term.label() + "' is listed twice");
+    design.second_order.terms.push_back(std::move(term));
+  }
+  std::size_t number = 0;
+  for (const YAML::Node& r : node["runs"]) {
+    ++number;
+    const std::string context = "second_order run " + std::to_string(number);
+    if (!r.IsMap() || r.size() == 0)
+      design_error(path, r, context + ": write a run as a map of parameter values, e.g. {P6: 1.2, P7: 1.2}");
+    SensitivityPoint point;
+    for (auto it = r.begin(); it != r.end(); ++it) {
+      const std::string name = it->first.as<std::string>();
+      require_parameter(path, it->first, design, name, context);
+      double value = 0.0;
+      try {
+        value = it->second.as<double>();
+      } catch (const YAML::Exception&) {
+        design_error(path, it->second, context + ": the value of " + name + " must be a number (e.g. 0.8)");
+      }
+      if (!(value > 0.0)) design_error(path, it->second, context + ": the value of " + name + " must be positive");
+      point.emplace_back(name, value);
+    }
+    design.second_order.runs.push_back(std::move(point));
+  }
+}
+
+std::string number_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
 struct Job {
-  const SensitivityParameter* parameter = nullptr;  // null: base run
+  SensitivityPoint variation;
+  std::string parameter;  // SensitivityRun::parameter
   double factor = 1.0;
 };
 
-SensitivityRun run_one(const std::string& model_path, const Job& job) {
+// model_text: the model file as read once at the start of the study, so that every run sees the
+// same model even if the file is edited while the study runs.
+SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
+                       const Job& job, double time_limit) {
   SensitivityRun run;
-  run.parameter = job.parameter ? job.parameter->name : "";
+  run.variation = job.variation;
+  run.parameter = job.parameter;
   run.factor = job.factor;
   const auto start = std::chrono::steady_clock::now();
   try {
     std::vector<std::string> settings;
-    if (job.parameter)
-      for (const auto& [key, power] : job.parameter->scales) {
+    for (const auto& [name, value] : job.variation) {
+      const SensitivityParameter* parameter = find_parameter(design, name);
+      RAILCRASH_DEMAND(parameter != nullptr);  // load_design and run_sensitivity checked the names
+      for (const auto& [key, power] : parameter->scales) {
         char text[64];
-        std::snprintf(text, sizeof text, "%.17g", std::pow(job.factor, power));
+        std::snprintf(text, sizeof text, "%.17g", std::pow(value, power));
         settings.push_back(key + "*=" + text);
       }
-    const Model model = load_model(model_path, settings);
+    }
+    const Model model = load_model_text(model_text, model_path, settings);
     if (!model.responses.defined())
       throw InputError(model_path + ": a parameter study needs a 'responses' section (R1-R3) in the model");
-    const RunReport report = run_model(model, "");
-    run.ok = report.outcome.ok;
-    run.message = report.outcome.message;
+    // A watchdog raises the stop flag once the run has had its time limit.
+    std::atomic<bool> stop{false};
+    std::mutex mutex;
+    std::condition_variable finished;
+    bool done = false;
+    std::thread watchdog;
+    if (time_limit > 0.0)
+      watchdog = std::thread([&]() {
+        std::unique_lock<std::mutex> lock(mutex);
+        if (!finished.wait_for(lock, std::chrono::duration<double>(time_limit), [&] { return done; })) stop = true;
+      });
+    RunReport report;
+    try {
+      report = run_model(model, "", &stop);
+    } catch (...) {
+      { const std::lock_guard<std::mutex> lock(mutex); done = true; }
+      finished.notify_all();
+      if (watchdog.joinable()) watchdog.join();
+      throw;
+    }
+    { const std::lock_guard<std::mutex> lock(mutex); done = true; }
+    finished.notify_all();
+    if (watchdog.joinable()) watchdog.join();
+    run.ok = report.outcome.ok;  // a run that finished just as the limit passed still counts
+    run.message = !run.ok && stop ? "stopped at the run time limit of " + number_text(time_limit) + " s (t = " +
+                                        number_text(report.outcome.t_reached) + ")"
+                                  : report.outcome.message;
     run.responses = report.responses;
   } catch (const std::exception& e) {
     run.ok = false;
@@ -59,7 +192,42 @@ SensitivityRun run_one(const std::string& model_path, const Job& job) {
 
 double response(const Responses& r, int k) { return k == 0 ? r.r1 : (k == 1 ? r.r2 : r.r3); }
 
+std::array<double, 3> responses_of(const SensitivityRun& run) {
+  return {run.responses.r1, run.responses.r2, run.responses.r3};
+}
+
+std::string point_text(const SensitivityPoint& point, const char* separator = " ") {
+  std::string text;
+  for (const auto& [name, value] : point) {
+    char item[64];
+    std::snprintf(item, sizeof item, "%s%s=%g", text.empty() ? "" : separator, name.c_str(), value);
+    text += item;
+  }
+  return text.empty() ? "base" : text;
+}
+
 }  // namespace
+
+std::string SensitivityTerm::label() const {
+  if (linear()) return first;
+  if (square()) return first + "^2";
+  return first + "*" + second;
+}
+
+double SensitivityTerm::value(const SensitivityPoint& values) const {
+  const auto of = [&](const std::string& name) {
+    for (const auto& [n, v] : values)
+      if (n == name) return v;
+    return 1.0;
+  };
+  return linear() ? of(first) : of(first) * of(second);
+}
+
+std::string SensitivityDerivative::label() const {
+  if (second.empty()) return "d/d" + first;
+  if (second == first) return "d2/d" + first + "^2";
+  return "d2/d" + first + "d" + second;
+}
 
 SensitivityDesign load_design(const std::string& path) {
   YAML::Node root;
@@ -85,6 +253,7 @@ SensitivityDesign load_design(const std::string& path) {
       design_error(path, p, "each parameter needs 'name' and a 'scale' list of {key, power}");
     SensitivityParameter parameter;
     parameter.name = p["name"].as<std::string>();
+    if (find_parameter(design, parameter.name)) design_error(path, p["name"], "parameter '" + parameter.name + "' is listed twice");
     parameter.description = p["description"] ? p["description"].as<std::string>() : "";
     for (std::size_t k = 0; k < p["scale"].size(); ++k) {
       const YAML::Node s = p["scale"][k];
@@ -93,35 +262,156 @@ SensitivityDesign load_design(const std::string& path) {
     }
     design.parameters.push_back(std::move(parameter));
   }
+  if (root["second_order"]) load_second_order(path, root["second_order"], design);
   return design;
+}
+
+std::string default_design_path(const std::string& model_path) {
+  const std::filesystem::path model(model_path);
+  const std::filesystem::path design = model.parent_path() / "sensitivity_design.yaml";
+  if (!std::filesystem::exists(design))
+    throw InputError(model_path + ": the report's design is the file sensitivity_design.yaml beside the model, and " +
+                     design.string() + " does not exist; pass --design FILE");
+  return design.string();
+}
+
+QuadraticFit fit_quadratic(const std::vector<SensitivityTerm>& terms, const std::vector<SensitivitySample>& samples) {
+  QuadraticFit fit;
+  fit.terms = terms;
+  const int n = static_cast<int>(terms.size()) + 1;  // + the constant
+  const int m = static_cast<int>(samples.size());
+  fit.unknowns = n;
+  fit.equations = m;
+  for (const SensitivitySample& s : samples) fit.samples.push_back(s.label);
+  const auto term_label = [&](int column) { return column == 0 ? std::string("1") : terms[column - 1].label(); };
+
+  Eigen::MatrixXd design_matrix(m, n);
+  Eigen::MatrixXd right(m, 3);
+  for (int i = 0; i < m; ++i) {
+    design_matrix(i, 0) = 1.0;
+    for (int k = 1; k < n; ++k) design_matrix(i, k) = terms[k - 1].value(samples[i].point);
+    for (int r = 0; r < 3; ++r) right(i, r) = samples[i].responses[r];
+  }
+  Eigen::MatrixXd solution = Eigen::MatrixXd::Constant(n, 3, kNaN);
+  if (m == 0) {
+    fit.rank = 0;
+    fit.condition_number = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < n; ++k) fit.undetermined.push_back(term_label(k));
+  } else {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(design_matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXd& sigma = svd.singularValues();
+    int rank = 0;
+    for (int k = 0; k < sigma.size(); ++k) rank += sigma(k) > kRankTolerance * sigma(0);
+    fit.rank = rank;
+    fit.condition_number = rank == n ? sigma(0) / sigma(n - 1) : std::numeric_limits<double>::infinity();
+    if (rank == n) {
+      if (m == n)
+        solution = Eigen::FullPivLU<Eigen::MatrixXd>(design_matrix).solve(right);
+      else
+        solution = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(design_matrix).solve(right);
+      fit.largest_residual = (design_matrix * solution - right).cwiseAbs().maxCoeff();
+    } else {
+      // Minimum-norm solution; a constant with a component in the null space is not determined.
+      Eigen::MatrixXd pseudo_solution = Eigen::MatrixXd::Zero(n, 3);
+      const Eigen::MatrixXd& u = svd.matrixU();
+      const Eigen::MatrixXd& v = svd.matrixV();
+      for (int k = 0; k < rank; ++k) pseudo_solution += v.col(k) * (u.col(k).transpose() * right) / sigma(k);
+      for (int j = 0; j < n; ++j) {
+        const double in_null_space = v.row(j).tail(n - rank).norm();
+        if (in_null_space > 1e-8) {
+          fit.undetermined.push_back(term_label(j));
+        } else {
+          solution.row(j) = pseudo_solution.row(j);
+        }
+      }
+    }
+  }
+  for (int r = 0; r < 3; ++r) fit.constant[r] = solution(0, r);
+  for (int k = 1; k < n; ++k) fit.coefficients.push_back({solution(k, 0), solution(k, 1), solution(k, 2)});
+
+  // Derivatives at P = 1: first by every parameter of the form, then 2 B_ii, then B_ij.
+  std::vector<std::string> parameters;
+  for (const SensitivityTerm& t : terms)
+    for (const std::string& name : {t.first, t.second})
+      if (!name.empty() && std::find(parameters.begin(), parameters.end(), name) == parameters.end())
+        parameters.push_back(name);
+  for (const std::string& p : parameters) {
+    SensitivityDerivative d{p, "", {0.0, 0.0, 0.0}};
+    for (std::size_t k = 0; k < terms.size(); ++k) {
+      const SensitivityTerm& t = terms[k];
+      const double slope = t.linear() ? (t.first == p ? 1.0 : 0.0)
+                                      : (t.square() ? (t.first == p ? 2.0 : 0.0) : (t.first == p || t.second == p ? 1.0 : 0.0));
+      if (slope != 0.0)
+        for (int r = 0; r < 3; ++r) d.value[r] += slope * fit.coefficients[k][r];
+    }
+    fit.derivatives.push_back(d);
+  }
+  for (const bool squares : {true, false})
+    for (std::size_t k = 0; k < terms.size(); ++k) {
+      const SensitivityTerm& t = terms[k];
+      if (t.linear() || t.square() != squares) continue;
+      SensitivityDerivative d{t.first, t.second, {}};
+      for (int r = 0; r < 3; ++r) d.value[r] = (squares ? 2.0 : 1.0) * fit.coefficients[k][r];
+      fit.derivatives.push_back(d);
+    }
+  return fit;
 }
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
                                   const SensitivityOptions& options) {
   if (options.central_step < 0.0 || options.central_step >= 1.0)
     throw InputError("--central H: H must be between 0 and 1 (e.g. 0.05 for runs at 0.95 and 1.05)");
-  std::vector<const SensitivityParameter*> chosen;
-  for (const SensitivityParameter& p : design.parameters)
-    if (options.only.empty() || std::find(options.only.begin(), options.only.end(), p.name) != options.only.end())
-      chosen.push_back(&p);
   for (const std::string& name : options.only)
-    if (std::none_of(design.parameters.begin(), design.parameters.end(), [&](const auto& p) { return p.name == name; }))
-      throw InputError("--only: the design has no parameter '" + name + "'");
+    if (!find_parameter(design, name))
+      throw InputError("--only: the design has no parameter '" + name + "' (it has " + parameter_names(design) + ")");
+  const auto chosen = [&](const std::string& name) {
+    return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+  };
+  std::string model_text;
+  {
+    std::ifstream in(model_path);
+    if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    model_text = buffer.str();
+  }
   SensitivityResult result;
   result.central = options.central_step > 0.0;
+
   std::vector<Job> jobs{Job{}};
-  for (const SensitivityParameter* p : chosen) {
-    if (result.central) {
-      jobs.push_back({p, 1.0 + options.central_step});
-      jobs.push_back({p, 1.0 - options.central_step});
-    } else {
-      jobs.push_back({p, design.factor});
-    }
+  std::size_t first_order_count = 0;
+  for (const SensitivityParameter& p : design.parameters) {
+    if (!chosen(p.name)) continue;
+    const std::vector<double> values =
+        result.central ? std::vector<double>{1.0 + options.central_step, 1.0 - options.central_step}
+                       : std::vector<double>{design.factor};
+    for (double value : values) jobs.push_back(Job{{{p.name, value}}, p.name, value});
+    first_order_count += values.size();
   }
+  std::vector<SensitivityTerm> terms;
+  if (options.second_order) {
+    for (const SensitivityPoint& point : design.second_order.runs) {
+      if (!std::all_of(point.begin(), point.end(), [&](const auto& entry) { return chosen(entry.first); })) continue;
+      Job job{point, "", point.size() == 1 ? point[0].second : kNaN};
+      for (const auto& entry : point) job.parameter += (job.parameter.empty() ? "" : "+") + entry.first;
+      jobs.push_back(job);
+    }
+    for (const SensitivityTerm& t : design.second_order.terms)
+      if (chosen(t.first) && (t.linear() || chosen(t.second))) terms.push_back(t);
+  }
+
   std::vector<SensitivityRun> runs(jobs.size());
   std::atomic<std::size_t> next{0};
+  std::size_t done = 0;
+  std::mutex progress_mutex;
   const auto worker = [&]() {
-    for (std::size_t k = next++; k < jobs.size(); k = next++) runs[k] = run_one(model_path, jobs[k]);
+    for (std::size_t k = next++; k < jobs.size(); k = next++) {
+      runs[k] = run_one(model_path, model_text, design, jobs[k], options.run_time_limit);
+      if (options.progress) {
+        const std::lock_guard<std::mutex> lock(progress_mutex);
+        options.progress(runs[k], k, ++done, jobs.size());
+      }
+    }
   };
   const int threads = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
   std::vector<std::thread> pool;
@@ -130,78 +420,275 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
   for (std::thread& t : pool) t.join();
 
   result.base = runs[0];
-  result.runs.assign(runs.begin() + 1, runs.end());
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t i = 0; i < chosen.size(); ++i) {
-    std::array<double, 3> d{nan, nan, nan};
+  result.runs.assign(runs.begin() + 1, runs.begin() + 1 + static_cast<std::ptrdiff_t>(first_order_count));
+  result.second_order_runs.assign(runs.begin() + 1 + static_cast<std::ptrdiff_t>(first_order_count), runs.end());
+
+  // First order: A_i and A0 (equations 1-3).
+  const std::size_t per_parameter = result.central ? 2 : 1;
+  result.constant = result.base.ok ? responses_of(result.base) : std::array<double, 3>{kNaN, kNaN, kNaN};
+  for (std::size_t i = 0; i < first_order_count / per_parameter; ++i) {
+    std::array<double, 3> d{kNaN, kNaN, kNaN};
     for (int k = 0; k < 3; ++k) {
       if (result.central) {
         const SensitivityRun& plus = result.runs[2 * i];
         const SensitivityRun& minus = result.runs[2 * i + 1];
         if (plus.ok && minus.ok)
-          d[static_cast<std::size_t>(k)] =
-              (response(plus.responses, k) - response(minus.responses, k)) / (2.0 * options.central_step);
+          d[k] = (response(plus.responses, k) - response(minus.responses, k)) / (2.0 * options.central_step);
       } else {
         const SensitivityRun& run = result.runs[i];
         if (run.ok && result.base.ok)
-          d[static_cast<std::size_t>(k)] =
-              (response(run.responses, k) - response(result.base.responses, k)) / (design.factor - 1.0);
+          d[k] = (response(run.responses, k) - response(result.base.responses, k)) / (design.factor - 1.0);
       }
+      result.constant[k] -= d[k];
     }
     result.derivatives.push_back(d);
+  }
+
+  // Second order: every run that varies only parameters of the form.
+  if (!terms.empty()) {
+    std::vector<std::string> term_parameters;
+    for (const SensitivityTerm& t : terms) {
+      term_parameters.push_back(t.first);
+      if (!t.linear()) term_parameters.push_back(t.second);
+    }
+    const auto in_form = [&](const SensitivityPoint& point) {
+      return std::all_of(point.begin(), point.end(), [&](const auto& entry) {
+        return std::find(term_parameters.begin(), term_parameters.end(), entry.first) != term_parameters.end();
+      });
+    };
+    std::vector<SensitivitySample> samples;
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      if (!in_form(runs[k].variation)) continue;
+      const std::string label = "run " + std::to_string(k) + " (" + point_text(runs[k].variation) + ")";
+      if (!runs[k].ok) {
+        result.fit_note += (result.fit_note.empty() ? "" : "; ") + label + " failed and is left out";
+        continue;
+      }
+      samples.push_back(SensitivitySample{label, runs[k].variation, responses_of(runs[k])});
+    }
+    result.fit = fit_quadratic(terms, samples);
   }
   return result;
 }
 
+namespace {
+
+std::string number(double value, const char* format = "%.3f") {
+  if (std::isnan(value)) return "n/a";
+  if (std::isinf(value)) return "inf";
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+std::string csv_number(double value) { return std::isnan(value) ? "" : number(value, "%.10g"); }
+
+std::string csv_text(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// "R1 = 1.980 - 0.005 P5 - 0.180 P6 ..." with terms that round to zero at 3 decimals left out.
+std::string equation(int response_index, double constant, const std::vector<std::pair<std::string, double>>& terms) {
+  std::string text = "R" + std::to_string(response_index + 1) + " = " + number(constant);
+  for (const auto& [label, value] : terms) {
+    if (!std::isnan(value) && std::abs(value) < 0.0005) continue;
+    text += (value < 0.0 ? " - " : " + ") + number(std::abs(value)) + " " + label;
+  }
+  return text;
+}
+
+std::string power_label(const SensitivityTerm& t) {
+  if (t.linear()) return t.first;
+  if (t.square()) return t.first + "^2";
+  return t.first + " " + t.second;
+}
+
+}  // namespace
+
 std::string write_sensitivity(const SensitivityResult& result, const SensitivityDesign& design, const std::string& directory) {
   std::filesystem::create_directories(directory);
   const auto description = [&](const std::string& name) {
-    for (const auto& p : design.parameters)
-      if (p.name == name) return p.description;
-    return std::string();
+    const SensitivityParameter* p = find_parameter(design, name);
+    return p ? p->description : std::string();
   };
-  std::ofstream csv(directory + "/sensitivity.csv");
-  csv << "run,parameter,factor,status,R1,R2,R3,override,message\n";
+  const std::size_t per_parameter = result.central ? 2 : 1;
+  const auto parameter_of = [&](std::size_t i) { return result.runs[per_parameter * i].parameter; };
+  const auto percent = [&](double now, double base) { return base != 0.0 ? 100.0 * (now - base) / base : 0.0; };
   std::ostringstream md;
-  md << "| Run | Parameter varied | Factor | R1 | R2 | R3 | dR1 % | dR2 % | dR3 % |\n|---|---|---|---|---|---|---|---|---|\n";
-  const auto row = [&](std::size_t index, const SensitivityRun& r) {
-    char line[512];
-    std::snprintf(line, sizeof line, "%zu,%s,%.6g,%s,%.6g,%.6g,%.6g,%d,\"%s\"\n", index, r.parameter.c_str(), r.factor,
-                  r.ok ? "ok" : "failed", r.responses.r1, r.responses.r2, r.responses.r3, r.responses.overridden ? 1 : 0,
-                  r.message.c_str());
-    csv << line;
-    if (!r.ok) {
-      md << "| " << index << " | " << (r.parameter.empty() ? "base" : r.parameter) << " | " << r.factor << " | failed: "
-         << r.message << " | | | | | |\n";
-      return;
+
+  // Runs: sensitivity.csv, and Table 11 / Tables 12-13 in the Markdown.
+  {
+    std::ofstream csv(directory + "/sensitivity.csv");
+    csv << "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message\n";
+    std::vector<const SensitivityRun*> all{&result.base};
+    for (const SensitivityRun& r : result.runs) all.push_back(&r);
+    for (const SensitivityRun& r : result.second_order_runs) all.push_back(&r);
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      const SensitivityRun& r = *all[k];
+      std::string names, values;
+      for (const auto& [name, value] : r.variation) {
+        names += (names.empty() ? "" : " ") + name;
+        values += (values.empty() ? "" : " ") + number(value, "%g");
+      }
+      const int order = k == 0 ? 0 : (k <= result.runs.size() ? 1 : 2);
+      csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : "failed") << ','
+          << csv_number(r.responses.r1) << ',' << csv_number(r.responses.r2) << ',' << csv_number(r.responses.r3) << ','
+          << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << '\n';
     }
-    const auto percent = [&](double now, double base) { return base != 0.0 ? 100.0 * (now - base) / base : 0.0; };
-    std::snprintf(line, sizeof line, "| %zu | %s | %.3g | %.3f | %.3f | %.3f | %+.2f | %+.2f | %+.2f |\n", index,
-                  r.parameter.empty() ? "base" : r.parameter.c_str(), r.factor, r.responses.r1, r.responses.r2, r.responses.r3,
-                  percent(r.responses.r1, result.base.responses.r1), percent(r.responses.r2, result.base.responses.r2),
-                  percent(r.responses.r3, result.base.responses.r3));
-    md << line;
+  }
+  md << "## Runs, first order (report Table 11)\n\n"
+     << "| Run | Parameter varied | Factor | R1 | R2 | R3 | dR1 % | dR2 % | dR3 % |\n|---|---|---|---|---|---|---|---|---|\n";
+  const Responses& base = result.base.responses;
+  const auto result_cells = [&](const SensitivityRun& r) {
+    if (!r.ok) return "failed: " + r.message + " | | | | | |";
+    char cells[256];
+    std::snprintf(cells, sizeof cells, "%.3f | %.3f | %.3f | %+.2f | %+.2f | %+.2f |", r.responses.r1, r.responses.r2,
+                  r.responses.r3, percent(r.responses.r1, base.r1), percent(r.responses.r2, base.r2),
+                  percent(r.responses.r3, base.r3));
+    return std::string(cells);
   };
-  row(0, result.base);
-  for (std::size_t k = 0; k < result.runs.size(); ++k) row(k + 1, result.runs[k]);
-  // Derivatives ranked by magnitude for each response (the report's Tables 15-17).
+  md << "| 0 | base | 1 | " << result_cells(result.base) << "\n";
+  for (std::size_t k = 0; k < result.runs.size(); ++k)
+    md << "| " << k + 1 << " | " << result.runs[k].parameter << " | " << number(result.runs[k].factor, "%g") << " | "
+       << result_cells(result.runs[k]) << "\n";
+
+  if (!result.second_order_runs.empty()) {
+    std::vector<std::string> varied;  // design order
+    for (const SensitivityParameter& p : design.parameters)
+      for (const SensitivityRun& r : result.second_order_runs)
+        if (std::any_of(r.variation.begin(), r.variation.end(), [&](const auto& e) { return e.first == p.name; }) &&
+            std::find(varied.begin(), varied.end(), p.name) == varied.end())
+          varied.push_back(p.name);
+    md << "\n## Runs, second order (report Tables 12 and 13; parameters not shown are 1.0)\n\n| Run |";
+    for (const std::string& name : varied) md << ' ' << name << " |";
+    md << " R1 | R2 | R3 | dR1 % | dR2 % | dR3 % |\n|---|";
+    for (std::size_t k = 0; k < varied.size() + 6; ++k) md << "---|";
+    md << '\n';
+    for (std::size_t k = 0; k < result.second_order_runs.size(); ++k) {
+      const SensitivityRun& r = result.second_order_runs[k];
+      md << "| " << k + 1 + result.runs.size() << " |";
+      for (const std::string& name : varied) {
+        double value = 1.0;
+        for (const auto& [n, v] : r.variation)
+          if (n == name) value = v;
+        md << ' ' << number(value, "%.1f") << " |";
+      }
+      md << ' ' << result_cells(r) << '\n';
+    }
+  }
+
+  // First-order coefficients: equations (1)-(3) and sensitivity_first_order.csv.
+  {
+    std::ofstream csv(directory + "/sensitivity_first_order.csv");
+    csv << "term,description,R1,R2,R3\n1,constant A0," << csv_number(result.constant[0]) << ','
+        << csv_number(result.constant[1]) << ',' << csv_number(result.constant[2]) << '\n';
+    for (std::size_t i = 0; i < result.derivatives.size(); ++i)
+      csv << parameter_of(i) << ',' << csv_text(description(parameter_of(i))) << ',' << csv_number(result.derivatives[i][0])
+          << ',' << csv_number(result.derivatives[i][1]) << ',' << csv_number(result.derivatives[i][2]) << '\n';
+    md << "\n## First-order fit (report equations 1-3)\n\n"
+       << (result.central ? "A_i = (R(1+h) - R(1-h)) / 2h" : "A_i = (R(run i) - R(run 0)) / (factor - 1)")
+       << ", A0 = R(run 0) - sum A_i; terms that round to 0.000 are left out, as in the report.\n\n```\n";
+    for (int k = 0; k < 3; ++k) {
+      std::vector<std::pair<std::string, double>> terms;
+      for (std::size_t i = 0; i < result.derivatives.size(); ++i) terms.emplace_back(parameter_of(i), result.derivatives[i][k]);
+      md << equation(k, result.constant[k], terms) << '\n';
+    }
+    md << "```\n";
+  }
+
+  // Second-order fit, its constants and the derivatives at P = 1 (Table 14).
+  const QuadraticFit& fit = result.fit;
+  const auto second_order_derivative = [&](const std::string& name, int k) {
+    for (const SensitivityDerivative& d : fit.derivatives)
+      if (d.second.empty() && d.first == name) return d.value[k];
+    return kNaN;
+  };
+  if (!fit.terms.empty()) {
+    std::ofstream csv(directory + "/sensitivity_second_order.csv");
+    csv << "term,R1,R2,R3\n1," << csv_number(fit.constant[0]) << ',' << csv_number(fit.constant[1]) << ','
+        << csv_number(fit.constant[2]) << '\n';
+    for (std::size_t k = 0; k < fit.terms.size(); ++k)
+      csv << fit.terms[k].label() << ',' << csv_number(fit.coefficients[k][0]) << ',' << csv_number(fit.coefficients[k][1])
+          << ',' << csv_number(fit.coefficients[k][2]) << '\n';
+    md << "\n## Second-order fit (report Section 4.4, reduced second-order form)\n\n";
+    std::string term_list = "1";
+    for (const SensitivityTerm& t : fit.terms) term_list += ", " + t.label();
+    md << fit.unknowns << " constants (terms " << term_list << ") from " << fit.equations << " runs: "
+       << (fit.equations == fit.unknowns ? "square system" : fit.equations > fit.unknowns ? "least squares" : "fewer runs than constants")
+       << ", rank " << fit.rank << ", condition number " << number(fit.condition_number, "%.3g");
+    if (fit.determined() && fit.equations > fit.unknowns) md << ", largest residual " << number(fit.largest_residual, "%.3g");
+    md << ".\nRuns used: ";
+    for (std::size_t k = 0; k < fit.samples.size(); ++k) md << (k ? ", " : "") << fit.samples[k];
+    md << ".\n";
+    if (!result.fit_note.empty()) md << "Left out: " << result.fit_note << ".\n";
+    if (!fit.undetermined.empty()) {
+      md << "**Not determined** (the runs used cannot separate them; they are n/a below): ";
+      for (std::size_t k = 0; k < fit.undetermined.size(); ++k) md << (k ? ", " : "") << fit.undetermined[k];
+      md << ".\n";
+    }
+    md << "\n```\n";
+    for (int k = 0; k < 3; ++k) {
+      std::vector<std::pair<std::string, double>> terms;
+      for (std::size_t i = 0; i < fit.terms.size(); ++i) terms.emplace_back(power_label(fit.terms[i]), fit.coefficients[i][k]);
+      md << equation(k, fit.constant[k], terms) << '\n';
+    }
+    md << "```\n\n## Derivatives at the design point, all P = 1 (report Table 14)\n\n"
+       << "| Derivative | R1 | R2 | R3 | first order: R1 | R2 | R3 |\n|---|---|---|---|---|---|---|\n";
+    std::ofstream derivatives_csv(directory + "/sensitivity_derivatives.csv");
+    derivatives_csv << "derivative,R1,R2,R3,first_order_R1,first_order_R2,first_order_R3\n";
+    for (const SensitivityDerivative& d : fit.derivatives) {
+      std::array<double, 3> first_order{kNaN, kNaN, kNaN};
+      if (d.second.empty())
+        for (std::size_t i = 0; i < result.derivatives.size(); ++i)
+          if (parameter_of(i) == d.first) first_order = result.derivatives[i];
+      md << "| " << d.label() << " | " << number(d.value[0]) << " | " << number(d.value[1]) << " | " << number(d.value[2])
+         << " | " << (d.second.empty() ? number(first_order[0]) : "") << " | " << (d.second.empty() ? number(first_order[1]) : "")
+         << " | " << (d.second.empty() ? number(first_order[2]) : "") << " |\n";
+      derivatives_csv << d.label() << ',' << csv_number(d.value[0]) << ',' << csv_number(d.value[1]) << ','
+                      << csv_number(d.value[2]) << ',' << csv_number(first_order[0]) << ',' << csv_number(first_order[1])
+                      << ',' << csv_number(first_order[2]) << '\n';
+    }
+  }
+
+  // Rankings (Tables 15-17): by |first-order coefficient|, as the report ranks them.
+  std::ofstream ranking_csv(directory + "/sensitivity_ranking.csv");
+  ranking_csv << "response,rank,parameter,description,first_order,second_order_derivative\n";
+  static const char* const kTitles[3] = {"Crush sensitivity (R1, report Table 15)", "Override sensitivity (R2, report Table 16)",
+                                         "Crush with subsequent override sensitivity (R3, report Table 17)"};
   const std::size_t count = result.derivatives.size();
   for (int k = 0; k < 3; ++k) {
     std::vector<std::size_t> order(count);
     for (std::size_t i = 0; i < count; ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      const double da = std::abs(result.derivatives[a][static_cast<std::size_t>(k)]);
-      const double db = std::abs(result.derivatives[b][static_cast<std::size_t>(k)]);
+      const double da = std::abs(result.derivatives[a][k]), db = std::abs(result.derivatives[b][k]);
       return (std::isnan(db) && !std::isnan(da)) || da > db;
     });
-    md << "\n| R" << k + 1 << ": parameter | description | dR" << k + 1 << "/dP" << (result.central ? " (central)" : "")
-       << " |\n|---|---|---|\n";
+    md << "\n## " << kTitles[k] << "\n\nRanked by the first-order coefficient (equation " << k + 1
+       << ")" << (result.central ? ", central differences" : "")
+       << "; the last column is dR/dP at P = 1 from the second-order form where it has the parameter.\n\n"
+       << "| Rank | Parameter | Physical description | Sensitivity | second-order dR/dP |\n|---|---|---|---|---|\n";
+    std::string negligible, failed;
+    int rank = 0;
     for (std::size_t i : order) {
-      const std::string& name = result.runs[result.central ? 2 * i : i].parameter;
-      char value[32];
-      std::snprintf(value, sizeof value, "%+.3f", result.derivatives[i][static_cast<std::size_t>(k)]);
-      md << "| " << name << " | " << description(name) << " | " << value << " |\n";
+      const double value = result.derivatives[i][k];
+      const std::string name = parameter_of(i);
+      ranking_csv << 'R' << k + 1 << ',' << (std::isnan(value) ? 0 : ++rank) << ',' << name << ','
+                  << csv_text(description(name)) << ',' << csv_number(value) << ','
+                  << csv_number(second_order_derivative(name, k)) << '\n';
+      if (std::isnan(value)) {
+        failed += (failed.empty() ? "" : ", ") + name;
+      } else if (std::abs(value) < 0.0005) {
+        negligible += (negligible.empty() ? "" : ", ") + name;
+      } else {
+        const double second = second_order_derivative(name, k);
+        md << "| " << rank << " | " << name << " | " << description(name) << " | " << number(value) << " | "
+           << (std::isnan(second) ? "" : number(second)) << " |\n";
+      }
     }
+    if (!negligible.empty()) md << "\nNo effect at 3 decimals (|dR/dP| < 0.0005): " << negligible << ".\n";
+    if (!failed.empty()) md << "\nNot available (a run failed): " << failed << ".\n";
   }
   std::ofstream(directory + "/sensitivity.md") << md.str();
   return md.str();

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -156,4 +157,42 @@ TEST_CASE("static equilibrium reports a body that nothing holds", "[initial]") {
   std::vector<double> y;
   std::vector<EventRecord> events;
   CHECK_THROWS_WITH(prepare_start(system, y, events), Catch::Contains("no static equilibrium"));
+}
+
+TEST_CASE("static equilibrium settles onto the kink of a stop spring", "[initial]") {
+  // A 100 kg block on a linear spring "adjusted for load": free length 1 + W / k, so the
+  // spring alone carries the weight W = 981 N at length 1.0, exactly where a stop spring
+  // (0 N/m, then 1e7 N/m in compression from length 1.0) begins. The equilibrium is the kink
+  // itself: y = 1.0 with no force in the stop. A horizontal guide spring at its free length
+  // there holds x. Started 0.2 m high, the settle must land on the kink and the run must
+  // then not move.
+  const std::string text =
+      "railcrash: 1\nname: kink\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+      "  - {name: block, mass: 100, inertia: 1, position: [0, 1.2]}\nelements:\n"
+      "  - {name: main, type: linear_spring, stiffness: 1.0e4, free_length: 1.0981, "
+      "points: [{body: ground, at: [0, 0]}, {body: block, at: [0, 0]}]}\n"
+      "  - {name: stop, type: nonlinear_spring, free_length: 1.0, compression_stiffness_1: 0, "
+      "compression_stiffness_2: 1.0e7, compression_breakpoint: 0, extension_stiffness_1: 0, "
+      "points: [{body: ground, at: [0, 0]}, {body: block, at: [0, 0]}]}\n"
+      "  - {name: guide, type: linear_spring, stiffness: 1.0e5, free_length: 1.0, "
+      "points: [{body: ground, at: [-1, 1.0]}, {body: block, at: [0, 0]}]}\n"
+      "simulation: {t_end: 0.1, static_equilibrium: true, rtol: 1e-8}\n";
+  const Model model = testing::model_from_text(text);
+  const DaeSystem system(model);
+  std::vector<double> y;
+  std::vector<EventRecord> events;
+  const StartReport start = prepare_start(system, y, events);
+  CHECK(start.equilibrium.steps > 0);
+  CHECK(start.equilibrium.residual_force < 1e-6);
+  CHECK(y[1] == Approx(1.0).margin(1e-9));
+  CHECK(y[0] == Approx(0.0).margin(1e-9));
+  std::vector<double> out(system.output_names().size());
+  system.outputs(y.data(), y.data() + 2 * system.body_unknowns(), out.data());
+  const auto& names = system.output_names();
+  const auto stop_force = std::find(names.begin(), names.end(), "stop.force");
+  REQUIRE(stop_force != names.end());
+  CHECK(std::abs(out[static_cast<std::size_t>(stop_force - names.begin())]) < 1e-2);  // [N]
+  const RunOutcome o = testing::simulate(model);
+  CHECK(o.y[1] == Approx(1.0).margin(1e-8));
+  CHECK(std::abs(o.y[4]) < 1e-6);
 }

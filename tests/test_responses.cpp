@@ -107,3 +107,87 @@ TEST_CASE("R1 from the anticlimber's crush: a car end into a fixed anticlimber, 
   CHECK_FALSE(report.responses.overridden);
   CHECK(report.responses.r2 == Approx(0.0).margin(1e-9));  // no vertical load
 }
+
+// ---- summary.json extras: peak accelerations and the crush of each car (results.hpp) ----
+
+namespace {
+
+std::string temporary_folder(const std::string& name) {
+  const auto path = std::filesystem::temp_directory_path() / ("railcrash_test_" + name);
+  std::filesystem::remove_all(path);
+  return path.string();
+}
+
+}  // namespace
+
+TEST_CASE("peak deceleration and crush of the crush-impact case match the closed form under both integrators", "[responses]") {
+  // On the structure's plateau the force is F0 = 100 kN on 100 kg: 1000 m/s^2 (101.97 g);
+  // largest crush 0.055 m (crush_impact.yaml). The mass is one car ("car"; no car<N>_ names).
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    Model model = crush_model("");
+    model.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    model.simulation.dt = 2e-6;
+    const RunReport report = run_model(model, temporary_folder(std::string("peaks_") + integrator));
+    REQUIRE(report.outcome.ok);
+    REQUIRE(report.acceleration_peaks.size() == 1);
+    const AccelerationPeaks& p = report.acceleration_peaks[0];
+    CHECK(p.x == Approx(1000.0).epsilon(1e-6));
+    CHECK(p.magnitude == Approx(1000.0).epsilon(1e-6));
+    CHECK(p.y == Approx(0.0).margin(1e-9));
+    CHECK(p.magnitude / standard_gravity(model) == Approx(1000.0 / 9.80665).epsilon(1e-6));
+    REQUIRE(report.car_crush.size() == 1);
+    CHECK(report.car_crush[0].car == "car");
+    CHECK(report.car_crush[0].max_crush == Approx(0.055).epsilon(5e-3));
+  }
+}
+
+TEST_CASE("peak acceleration of a pendulum released from the horizontal includes the joint reaction", "[responses]") {
+  // Rigid pendulum (mass m, inertia I about its centre, centre at L from the pin) released at
+  // rest with its arm horizontal: at the bottom no moment acts and the centre moves on its
+  // circle with omega^2 = 2 m g L / (I + m L^2), so |a| = omega^2 L = 2 g m L^2 / (I + m L^2),
+  // the largest acceleration of the swing (at angle phi below the horizontal
+  // |a|^2 = (a_t cos phi)^2 + (omega^2 L)^2 grows to it). Without the reaction -G^T lambda
+  // the acceleration would be gravity's alone.
+  const double g = 9.81, m = 2.0, inertia = 0.1, length = 1.0;
+  const std::string text =
+      "railcrash: 1\nname: pendulum\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+      "  - {name: bob, mass: 2, inertia: 0.1, position: [1, 0]}\nelements:\n"
+      "  - {name: hinge, type: pin_joint, points: [{body: ground, at: [0, 0]}, {body: bob, at: [-1, 0]}]}\n"
+      "simulation: {t_end: 0.8, rtol: 1e-9, output_interval: 0.0005, dt: 1e-5}\n";
+  const double expected = 2.0 * g * m * length * length / (inertia + m * length * length);
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    Model model = testing::model_from_text(text);
+    model.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    const RunReport report = run_model(model, temporary_folder(std::string("pendulum_") + integrator));
+    REQUIRE(report.outcome.ok);
+    const AccelerationPeaks& p = report.acceleration_peaks.at(0);
+    CHECK(p.magnitude == Approx(expected).epsilon(std::string(integrator) == "ida" ? 1e-4 : 1e-2));
+    // At the bottom the acceleration points up at the pin: |y''| peaks there too.
+    CHECK(p.y == Approx(expected).epsilon(std::string(integrator) == "ida" ? 1e-4 : 1e-2));
+  }
+}
+
+TEST_CASE("cars are the car<N>_ name prefixes and an element between two cars counts half for each", "[responses]") {
+  const std::string bodies =
+      "railcrash: 1\nname: cars\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: car1_end, mass: 10, inertia: 1, position: [0, 0], velocity: [5, 0]}\n"
+      "  - {name: car2_end, mass: 10, inertia: 1, position: [1, 0]}\n"
+      "  - {name: car2_rear, mass: 10, inertia: 1, position: [3, 0]}\nelements:\n"
+      "  - {name: between, type: crush_spring, free_length: 1.0, curve: [[0, 0], [0.01, 1000], [1, 1000]], "
+      "unloading_stiffness: 1.0e5, points: [{body: car1_end, at: [0, 0]}, {body: car2_end, at: [0, 0]}]}\n"
+      "  - {name: inside, type: crush_spring, free_length: 2.0, curve: [[0, 0], [0.01, 1000], [1, 1000]], "
+      "unloading_stiffness: 1.0e5, points: [{body: car2_end, at: [0, 0]}, {body: car2_rear, at: [0, 0]}]}\n"
+      "simulation: {t_end: 0.1}\n";
+  const Model model = testing::model_from_text(bodies);
+  const DaeSystem system(model);
+  const std::vector<CarCrush> cars = cars_of(system);
+  REQUIRE(cars.size() == 2);
+  CHECK(cars[0].car == "car1");
+  CHECK(cars[0].elements == std::vector<std::string>{"between"});
+  CHECK(cars[0].shares == std::vector<double>{0.5});
+  CHECK(cars[1].car == "car2");
+  CHECK(cars[1].elements == std::vector<std::string>{"between", "inside"});
+  CHECK(cars[1].shares == std::vector<double>{0.5, 1.0});
+}

@@ -1,8 +1,12 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include "railcrash/model_io.hpp"
 #include "railcrash/sensitivity.hpp"
@@ -78,11 +82,15 @@ TEST_CASE("first-order study: each run against the closed-form crush, derivative
   const std::string md = write_sensitivity(result, design, files.dir + "/out");
   CHECK_THAT(md, Catch::Contains("| 1 | P7 | 1.2 |"));
   // Ranked: P7 moves R1 the most.
-  CHECK(md.find("| P7 | horizontal yield force") < md.find("| P5 | horizontal elastic slope"));
+  const auto p7_row = md.find("| P7 | horizontal yield force"), p5_row = md.find("| P5 | horizontal elastic slope");
+  REQUIRE(p5_row != std::string::npos);
+  CHECK(p7_row < p5_row);
   std::ifstream csv(files.dir + "/out/sensitivity.csv");
   std::string header;
   std::getline(csv, header);
-  CHECK(header == "run,parameter,factor,status,R1,R2,R3,override,message");
+  CHECK(header == "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message");
+  // A0 of the first-order form: the base response less the sum of the coefficients (report eq. 1-3).
+  CHECK(std::isnan(result.constant[0]));  // a run failed: A0 is not known
 }
 
 TEST_CASE("central differences and a subset of parameters", "[sensitivity]") {
@@ -104,4 +112,253 @@ TEST_CASE("scaling overrides multiply a model number", "[sensitivity]") {
   const Model model = load_model(files.model, {"elements.ac.horizontal_yield_deflection*=1.5", "simulation.t_end*=2"});
   CHECK(model.simulation.t_end == Approx(0.3));
   CHECK_THROWS_WITH(load_model(files.model, {"elements.ac.face_height*=x"}), Catch::Contains("KEY*=FACTOR"));
+}
+
+namespace {
+
+std::string report_design_path() { return std::string(RAILCRASH_SOURCE_DIR) + "/models/report/sensitivity_design.yaml"; }
+
+// The runs the report's reduced second-order form is solved from: the base, the first-order run
+// (at the design's factor) of every parameter of the form, and the design's second-order runs.
+std::vector<SensitivityPoint> report_fit_points(const SensitivityDesign& design) {
+  std::vector<SensitivityPoint> points{{}};
+  for (const char* name : {"P6", "P7", "P16", "P17", "P20", "P21", "P24", "P25"}) points.push_back({{name, design.factor}});
+  for (const SensitivityPoint& p : design.second_order.runs) points.push_back(p);
+  return points;
+}
+
+double value_of(const SensitivityPoint& point, const std::string& name) {
+  for (const auto& [n, v] : point)
+    if (n == name) return v;
+  return 1.0;
+}
+
+// A response that is exactly a polynomial of the reduced form, written out term by term
+// (independently of SensitivityTerm::value).
+struct KnownPolynomial {
+  double a0 = 0.75;
+  std::vector<std::pair<std::string, double>> linear{{"P6", -0.31}, {"P7", 0.47}, {"P16", 0.12}, {"P17", -0.93},
+                                                     {"P20", 0.58}, {"P21", -0.21}, {"P24", 0.36}, {"P25", -0.66}};
+  double b66 = 0.29, b67 = -0.41, b77 = 0.17, b1617 = 0.83, b2020 = -0.52, b2021 = 0.64, b2121 = 0.11, b2425 = -0.37;
+  double operator()(const SensitivityPoint& p) const {
+    double r = a0;
+    for (const auto& [name, a] : linear) r += a * value_of(p, name);
+    const auto v = [&](const char* name) { return value_of(p, name); };
+    return r + b66 * v("P6") * v("P6") + b67 * v("P6") * v("P7") + b77 * v("P7") * v("P7") + b1617 * v("P16") * v("P17") +
+           b2020 * v("P20") * v("P20") + b2021 * v("P20") * v("P21") + b2121 * v("P21") * v("P21") +
+           b2425 * v("P24") * v("P25");
+  }
+  // In the design file's term order (P6 .. P25, P6^2, P6*P7, P7^2, P16*P17, P20^2, P20*P21, P21^2, P24*P25).
+  std::vector<double> coefficients() const {
+    std::vector<double> c;
+    for (const auto& entry : linear) c.push_back(entry.second);
+    for (double b : {b66, b67, b77, b1617, b2020, b2021, b2121, b2425}) c.push_back(b);
+    return c;
+  }
+};
+
+std::vector<SensitivitySample> samples_of(const std::vector<SensitivityPoint>& points, const KnownPolynomial& r1) {
+  std::vector<SensitivitySample> samples;
+  for (const SensitivityPoint& p : points) {
+    const double value = r1(p);
+    samples.push_back({"", p, {value, 2.0 * value, -value}});
+  }
+  return samples;
+}
+
+}  // namespace
+
+TEST_CASE("second-order fit recovers a known polynomial from the report's design points", "[sensitivity]") {
+  const SensitivityDesign design = load_design(report_design_path());
+  REQUIRE(design.second_order.terms.size() == 16);
+  REQUIRE(design.second_order.runs.size() == 8);
+  const KnownPolynomial polynomial;
+  const std::vector<double> expected = polynomial.coefficients();
+  const QuadraticFit fit = fit_quadratic(design.second_order.terms, samples_of(report_fit_points(design), polynomial));
+  REQUIRE(fit.determined());
+  CHECK(fit.equations == 17);
+  CHECK(fit.unknowns == 17);
+  CHECK(fit.condition_number > 1.0);
+  CHECK(fit.condition_number < 1e6);
+  CHECK(fit.constant[0] == Approx(polynomial.a0).margin(1e-10));
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    INFO(fit.terms[k].label());
+    CHECK(fit.coefficients[k][0] == Approx(expected[k]).margin(1e-10));
+    CHECK(fit.coefficients[k][1] == Approx(2.0 * expected[k]).margin(1e-10));
+    CHECK(fit.coefficients[k][2] == Approx(-expected[k]).margin(1e-10));
+  }
+  // First derivatives at P = 1 against a central difference of the polynomial (exact for a
+  // quadratic up to round-off); second derivatives against the second difference.
+  const double h = 1e-3;
+  for (const SensitivityDerivative& d : fit.derivatives) {
+    INFO(d.label());
+    if (d.second.empty()) {
+      const double slope = (polynomial({{d.first, 1.0 + h}}) - polynomial({{d.first, 1.0 - h}})) / (2.0 * h);
+      CHECK(d.value[0] == Approx(slope).margin(1e-8));
+    } else if (d.first == d.second) {
+      const double curvature =
+          (polynomial({{d.first, 1.0 + h}}) - 2.0 * polynomial({}) + polynomial({{d.first, 1.0 - h}})) / (h * h);
+      CHECK(d.value[0] == Approx(curvature).margin(1e-5));
+    } else {
+      const double mixed = (polynomial({{d.first, 1.0 + h}, {d.second, 1.0 + h}}) - polynomial({{d.first, 1.0 + h}}) -
+                            polynomial({{d.second, 1.0 + h}}) + polynomial({})) /
+                           (h * h);
+      CHECK(d.value[0] == Approx(mixed).margin(1e-5));
+    }
+  }
+  CHECK(fit.derivatives.size() == 8 + 8);
+
+  // More runs than constants (central runs added): least squares, still exact for an exact polynomial.
+  std::vector<SensitivityPoint> more = report_fit_points(design);
+  for (const char* name : {"P6", "P20", "P25"}) more.push_back({{name, 0.95}});
+  const QuadraticFit least_squares = fit_quadratic(design.second_order.terms, samples_of(more, polynomial));
+  REQUIRE(least_squares.determined());
+  CHECK(least_squares.equations == 20);
+  CHECK(least_squares.largest_residual < 1e-10);
+  for (std::size_t k = 0; k < expected.size(); ++k) CHECK(least_squares.coefficients[k][0] == Approx(expected[k]).margin(1e-9));
+}
+
+TEST_CASE("second-order fit names the terms a missing run leaves undetermined", "[sensitivity]") {
+  const SensitivityDesign design = load_design(report_design_path());
+  const KnownPolynomial polynomial;
+  std::vector<SensitivityPoint> points = report_fit_points(design);
+  // Without run 32 (P6 = 0.8) P6 takes only the values 1.0 and 1.2, where (P6 - 1)(P6 - 1.2) =
+  // P6^2 - 2.2 P6 + 1.2 vanishes: the constant, P6 and P6^2 cannot be separated; the others can.
+  points.erase(std::find(points.begin(), points.end(), SensitivityPoint{{"P6", 0.8}}));
+  const QuadraticFit fit = fit_quadratic(design.second_order.terms, samples_of(points, polynomial));
+  CHECK_FALSE(fit.determined());
+  CHECK(fit.rank == 16);
+  CHECK(fit.undetermined == std::vector<std::string>{"1", "P6", "P6^2"});
+  CHECK(std::isinf(fit.condition_number));
+  CHECK(std::isnan(fit.constant[0]));
+  const std::vector<double> expected = polynomial.coefficients();
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    const std::string label = fit.terms[k].label();
+    INFO(label);
+    if (label == "P6" || label == "P6^2")
+      CHECK(std::isnan(fit.coefficients[k][0]));
+    else
+      CHECK(fit.coefficients[k][0] == Approx(expected[k]).margin(1e-9));
+  }
+  CHECK(std::isnan(fit.derivatives[0].value[0]));       // d/dP6 needs A6 and B6,6
+  CHECK(fit.derivatives[1].value[0] == Approx(0.47 + 2 * 0.17 - 0.41).margin(1e-9));  // d/dP7
+}
+
+TEST_CASE("second-order fit of the report's own Tables 11 and 13 gives its printed constants and Table 14", "[sensitivity]") {
+  // Report Tables 11 and 13 (models/report/TRANSCRIPTION.md sections 12-13), runs in the order of
+  // report_fit_points: 0, 6, 7, 16, 17, 20, 21, 24, 25, 32-39.
+  const double table[17][3] = {{1.255, 0.610, 1.865}, {1.219, 0.654, 1.873}, {1.210, 0.652, 1.862}, {1.254, 0.628, 1.882},
+                               {1.254, 0.570, 1.824}, {1.236, 0.645, 1.881}, {1.236, 0.626, 1.862}, {1.244, 0.617, 1.861},
+                               {1.243, 0.561, 1.804}, {1.302, 0.547, 1.849}, {1.304, 0.553, 1.857}, {1.181, 0.642, 1.823},
+                               {1.254, 0.609, 1.863}, {1.255, 0.623, 1.878}, {1.255, 0.623, 1.878}, {1.253, 0.601, 1.854},
+                               {1.253, 0.600, 1.853}};
+  const SensitivityDesign design = load_design(report_design_path());
+  const std::vector<SensitivityPoint> points = report_fit_points(design);
+  std::vector<SensitivitySample> samples;
+  for (std::size_t i = 0; i < points.size(); ++i) samples.push_back({"", points[i], {table[i][0], table[i][1], table[i][2]}});
+  const QuadraticFit fit = fit_quadratic(design.second_order.terms, samples);
+  REQUIRE(fit.determined());
+  // The exact solution (TRANSCRIPTION.md section 13; the report prints these rounded half away from zero).
+  const double constant[3] = {3.2550, -0.6350, 2.6200};
+  const double coefficients[16][3] = {
+      {-0.6575, 2.0925, 1.4350}, {-0.5100, 1.9725, 1.4625}, {-0.030, -0.435, -0.465}, {-0.030, -0.725, -0.755},
+      {-0.4725, 0.3550, -0.1175}, {-0.4725, 0.7825, 0.3100}, {-0.580, -0.765, -1.345}, {-0.585, -1.045, -1.630},
+      {0.1375, -0.2375, -0.1000}, {0.175, -1.350, -1.175},   {0.0500, -0.1875, -0.1375}, {0.025, 0.525, 0.550},
+      {-0.2375, 0.6000, 0.3625}, {0.900, -1.500, -0.600},    {-0.2375, 0.3625, 0.1250},  {0.525, 0.800, 1.325}};
+  for (int r = 0; r < 3; ++r) {
+    CHECK(fit.constant[r] == Approx(constant[r]).margin(1e-9));
+    for (std::size_t k = 0; k < 16; ++k) {
+      INFO("R" << r + 1 << " " << fit.terms[k].label());
+      CHECK(fit.coefficients[k][r] == Approx(coefficients[k][r]).margin(1e-9));
+    }
+  }
+  // Table 14 as printed (computed there from the rounded constants: compare at +-0.002, reading
+  // T14-2; dR2/dP25 read -0.245, reading T14-3).
+  const double table14[16][3] = {{-0.207, 0.267, 0.060},  {-0.235, 0.247, 0.012},  {-0.005, 0.090, 0.085},
+                                 {-0.005, -0.200, -0.205}, {-0.049, 0.055, 0.008},  {-0.049, 0.009, -0.040},
+                                 {-0.055, 0.035, -0.020},  {-0.060, -0.245, -0.305}, {0.276, -0.476, -0.200},
+                                 {0.100, -0.376, -0.276},  {-0.476, 1.200, 0.726},  {-0.476, 0.726, 0.250},
+                                 {0.175, -1.350, -1.175},  {0.025, 0.525, 0.550},   {0.900, -1.500, -0.600},
+                                 {0.525, 0.800, 1.325}};
+  const char* const labels[16] = {"d/dP6",      "d/dP7",      "d/dP16",       "d/dP17",        "d/dP20",        "d/dP21",
+                                  "d/dP24",     "d/dP25",     "d2/dP6^2",     "d2/dP7^2",      "d2/dP20^2",     "d2/dP21^2",
+                                  "d2/dP6dP7", "d2/dP16dP17", "d2/dP20dP21", "d2/dP24dP25"};
+  REQUIRE(fit.derivatives.size() == 16);
+  for (std::size_t k = 0; k < 16; ++k) {
+    CHECK(fit.derivatives[k].label() == labels[k]);
+    for (int r = 0; r < 3; ++r) CHECK(fit.derivatives[k].value[r] == Approx(table14[k][r]).margin(0.002));
+  }
+}
+
+TEST_CASE("second-order runs end to end: the parabola through 0.8 1.0 1.2 against the closed-form crush",
+          "[sensitivity]") {
+  Files files;
+  std::ofstream(files.design, std::ios::app) << "second_order:\n  terms: [P7, P7^2]\n  runs:\n    - {P7: 0.8}\n"
+                                                "    - {P9: 1.2}\n";
+  const SensitivityDesign design = load_design(files.design);
+  SensitivityOptions options;
+  options.jobs = 2;
+  options.only = {"P7", "P9"};  // P5 left out: its second-order runs and terms would be too
+  const SensitivityResult result = run_sensitivity(files.model, design, options);
+  REQUIRE(result.second_order_runs.size() == 2);
+  REQUIRE(result.second_order_runs[0].ok);
+  CHECK(result.second_order_runs[0].responses.r1 == Approx(crush_for(0.008) / 0.02).epsilon(1e-5));
+  CHECK_FALSE(result.second_order_runs[1].ok);  // P9's key does not exist: reported, the others go on
+  // Fit from runs 0 (base), 1 (P7 = 1.2) and 3 (P7 = 0.8): 3 constants, 3 runs.
+  const QuadraticFit& fit = result.fit;
+  REQUIRE(fit.determined());
+  CHECK(fit.equations == 3);
+  const double low = crush_for(0.008) / 0.02, mid = crush_for(0.01) / 0.02, high = crush_for(0.012) / 0.02;
+  REQUIRE(fit.derivatives.size() == 2);
+  CHECK(fit.derivatives[0].value[0] == Approx((high - low) / 0.4).epsilon(1e-4));
+  CHECK(fit.derivatives[1].value[0] == Approx((high - 2.0 * mid + low) / 0.04).epsilon(1e-3));
+  const std::string md = write_sensitivity(result, design, files.dir + "/out2");
+  CHECK_THAT(md, Catch::Contains("3 constants (terms 1, P7, P7^2) from 3 runs: square system"));
+  CHECK_THAT(md, Catch::Contains("| d/dP7 |"));
+  for (const char* file : {"sensitivity_second_order.csv", "sensitivity_derivatives.csv", "sensitivity_ranking.csv",
+                           "sensitivity_first_order.csv"})
+    CHECK(std::filesystem::exists(files.dir + "/out2/" + file));
+}
+
+TEST_CASE("design files: unknown parameters in the second-order study are refused with file and line", "[sensitivity]") {
+  Files files;
+  const std::string base = "sensitivity: 1\nparameters:\n  - {name: P6, scale: [{key: a.b, power: 1}]}\n"
+                           "  - {name: P7, scale: [{key: a.c, power: 1}]}\n";
+  const auto refused = [&](const std::string& second_order, const std::string& message) {
+    const std::string path = files.dir + "/bad_design.yaml";
+    std::ofstream(path) << base << second_order;
+    CHECK_THROWS_AS(load_design(path), InputError);
+    CHECK_THROWS_WITH(load_design(path), Catch::Contains(message));
+  };
+  refused("second_order:\n  terms: [P6]\n  runs:\n    - {P6: 0.8}\n    - {P6: 1.2, P99: 1.2}\n",
+          "bad_design.yaml:9: second_order run 2: no parameter 'P99' in 'parameters' (use one of P6, P7)");
+  refused("second_order:\n  terms: [P6, P6*P8]\n  runs: [{P6: 0.8}]\n", "bad_design.yaml:6: second_order term 'P6*P8': no parameter 'P8'");
+  refused("second_order:\n  terms: [P6^3]\n  runs: [{P6: 0.8}]\n", "only squares are allowed");
+  refused("second_order:\n  terms: [P6*P7, P7*P6]\n  runs: [{P6: 0.8}]\n", "'P7*P6' is listed twice");
+  refused("second_order:\n  terms: [P6]\n  runs: [{P6: -0.8}]\n", "the value of P6 must be positive");
+  refused("second_order:\n  - {P6: 0.8}\n", "'second_order' needs 'terms'");
+  // The report's design is the file beside the model.
+  const std::string report_model = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml";
+  CHECK(std::filesystem::equivalent(default_design_path(report_model), report_design_path()));
+  CHECK_THROWS_WITH(default_design_path(files.model), Catch::Contains("pass --design FILE"));
+}
+
+TEST_CASE("a run that exceeds the run time limit is stopped and reported failed", "[sensitivity]") {
+  Files files;
+  // The same car end run for 1e6 s with output every 1e-4 s: far longer than the limit.
+  std::ifstream in(files.model);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find("t_end: 0.15");
+  REQUIRE(at != std::string::npos);
+  text.replace(at, 11, "t_end: 1.0e6");
+  std::ofstream(files.model) << text;
+  const SensitivityDesign design = load_design(files.design);
+  SensitivityOptions options;
+  options.only = {"P7"};
+  options.run_time_limit = 0.2;
+  const SensitivityResult result = run_sensitivity(files.model, design, options);
+  CHECK_FALSE(result.base.ok);
+  CHECK_THAT(result.base.message, Catch::Contains("stopped at the run time limit of 0.2 s"));
+  CHECK(result.base.wall_seconds < 5.0);
+  CHECK(std::isnan(result.derivatives[0][0]));
 }

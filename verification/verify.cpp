@@ -4,6 +4,7 @@
 // comparison is also written as a Markdown table row to
 // <build>/verification/results/<case>.md (collected into verification/README.md).
 #define CATCH_CONFIG_MAIN
+#include <algorithm>
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -292,14 +293,17 @@ TEST_CASE("crush spring impact: contact time, crush, permanent set, rebound and 
 TEST_CASE("report sensitivity: crush falls as the anticlimber horizontal yield force and plastic slope rise",
           "[verification]") {
   // Report Table 15 (first-order, R1): P7 -0.225 and P6 -0.180, the two most important
-  // crush parameters. The side-by-side of all parameters is the issue of a later session;
-  // this case holds the signs the report's conclusions rest on.
+  // crush parameters, and Table 14 (second order) for the same two. The side-by-side of all
+  // parameters is verification/report_comparison.md; this case holds the signs the report's
+  // conclusions rest on.
   start_case("report_sensitivity");
   const std::string models = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/";
   const SensitivityDesign design = load_design(models + "sensitivity_design.yaml");
   SensitivityOptions options;
   options.jobs = 2;
   options.only = {"P6", "P7"};
+  // With P6 and P7 only, the design's second-order runs 32-34 (P6 = 0.8, P7 = 0.8, both 1.2) are
+  // kept and the form 1, P6, P7, P6^2, P6*P7, P7^2 is solved from 6 runs.
   const SensitivityResult result = run_sensitivity(models + "final_two_car.yaml", design, options);
   REQUIRE(result.base.ok);
   REQUIRE(result.derivatives.size() == 2);
@@ -312,5 +316,20 @@ TEST_CASE("report sensitivity: crush falls as the anticlimber horizontal yield f
     check("report_sensitivity", "dR1/d" + name + " sign (ours " + std::to_string(derivative) + ", report " +
                                     std::to_string(report_r1[i]) + ")",
           -1.0, derivative < 0.0 ? -1.0 : 1.0, 0.0, false, "report Table 15");
+  }
+  // Second order (report Table 14): dR1/dP6 -0.207, dR1/dP7 -0.235, d2R1/dP6dP7 +0.175 at P = 1.
+  REQUIRE(result.second_order_runs.size() == 3);
+  REQUIRE(result.fit.determined());
+  const double report_table14[3] = {-0.207, -0.235, 0.175};
+  const char* const labels[3] = {"d/dP6", "d/dP7", "d2/dP6dP7"};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto it = std::find_if(result.fit.derivatives.begin(), result.fit.derivatives.end(),
+                                 [&](const SensitivityDerivative& d) { return d.label() == labels[k]; });
+    REQUIRE(it != result.fit.derivatives.end());
+    const double value = it->value[0];
+    const double sign = report_table14[k] < 0.0 ? -1.0 : 1.0;
+    check("report_sensitivity", std::string(labels[k]) + " R1 sign, second-order form (ours " + std::to_string(value) +
+                                    ", report " + std::to_string(report_table14[k]) + ")",
+          sign, value < 0.0 ? -1.0 : 1.0, 0.0, false, "report Table 14");
   }
 }

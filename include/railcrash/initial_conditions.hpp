@@ -47,9 +47,27 @@ struct EquilibriumReport {
 /// Pseudo-transient continuation: each step solves
 ///   [ M / h^2 + K   G^T ] [ dq ]     [ f(q) - G^T lambda ]
 ///   [ G             0   ] [ dl ] = - [ Phi(q)            ]   (signs as in the DAE residual)
-/// with K = -df/dq + d(G^T lambda)/dq from the DAE Jacobian; h grows while the residual
-/// falls (toward Newton) and shrinks when it does not. M / h^2 keeps free directions (a car
-/// on its rails) regular. Roots that turn negative are committed after each step.
+/// with K = -df/dq + d(G^T lambda)/dq from the DAE Jacobian, in the modes of the current
+/// state; h grows after an accepted step (toward Newton) and shrinks after a rejected one.
+/// M / h^2 keeps free directions (a car on its rails) regular. Each step is limited to a
+/// trust region (0.05 % of the model size, 0.01 rad: the settle follows the state down as a
+/// heavily damped motion would); the trial state is projected onto the joints and every
+/// element is put in the mode of the trial state (all roots that turned negative are
+/// committed, repeatedly) before the step is judged.
+/// Acceptance (why the settle does not stall on kinks): a step is accepted when the
+/// unbalanced forces do positive work along it (trapezoidal rule of the residual forces at
+/// both ends), i.e. when it goes down the model's energy. The energy of piecewise-linear
+/// laws is continuously differentiable across their kinks where the force residual is not,
+/// so a Newton step that jumps over a kink into a stiff segment meets a large opposing force
+/// at its end and is shortened, and a state whose equilibrium lies on (or next to) a kink is
+/// approached from either side without the residual norm having to fall monotonically (the
+/// criterion of the earlier version, which stalled there). When the work is at round-off,
+/// the residual norm must fall instead (Newton's last, quadratic steps). The work of the
+/// residual needs no energy function, so non-conservative laws (hysteresis, plasticity)
+/// take part as they stand. A rejected step puts the elements back in the modes of the
+/// current state; a history change (yield, fracture) committed at a rejected trial state
+/// stays, unlogged (none in the report's models).
+/// A model with several equilibria reaches the one this damped descent leads to.
 /// Throws SolverError when it does not settle.
 EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector<double>& y,
                                             std::vector<EventRecord>& events);

@@ -18,8 +18,8 @@ struct RunStatistics {
   long error_test_failures = 0;
   long nonlinear_convergence_failures = 0;
   long events = 0;
-  long root_returns = 0;       // ida: returns at a located root (one may commit several events)
-  long reinitializations = 0;  // ida: restarts (a mode change that made the state inconsistent)
+  long root_returns = 0;       // ida: mode changes located within a step (summary: located_mode_changes)
+  long reinitializations = 0;  // ida: restarts (a mode change the step could not absorb); euler: mode changes
   double wall_seconds = 0.0;
   double last_step = 0.0;          // [time]
   double stability_limit = 0.0;    // euler: [time] estimated largest stable step

@@ -9,6 +9,7 @@
 #include "railcrash/integrator.hpp"
 #include "railcrash/model.hpp"
 #include "railcrash/responses.hpp"
+#include "railcrash/results.hpp"
 
 namespace railcrash {
 
@@ -33,6 +34,9 @@ struct RunReport {
   std::string integrator;
   bool has_responses = false;  // the model has a responses section
   Responses responses;         // R1-R3 and what they are made of
+  // From the result writer (empty when no output folder): per body, per car (results.hpp).
+  std::vector<AccelerationPeaks> acceleration_peaks;
+  std::vector<CarCrush> car_crush;
 };
 
 /// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files).

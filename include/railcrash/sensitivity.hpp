@@ -1,23 +1,59 @@
-// Parameter studies in the manner of the report's Section 4 (Tables 9-11, equations 1-3):
-// a base run and one run per parameter with that parameter scaled (1.2 in the report), or
-// two runs at 1 +- h (central differences), each giving R1-R3; then the first-order
-// coefficients dR/dP (P nondimensional, 1.0 = the model's value) and the parameters ranked
-// by them, as in Tables 15-17.
+// Parameter studies in the manner of the report's Section 4 (Tables 9-17, equations 1-3;
+// models/report/TRANSCRIPTION.md sections 11-15).
 //
-// A design file says what each nondimensional parameter scales in the model:
+// Runs. A base run (every nondimensional parameter P = 1, i.e. the model's value), one run per
+// parameter at the design's factor (1.2 in the report: Table 11), or two at 1 +- h (central
+// differences), and the design's second-order runs (Table 12: several parameters set at once,
+// e.g. P6 = 0.8, or P6 = P7 = 1.2). Each run gives R1-R3 (responses.hpp). Runs go in parallel;
+// a failed run is reported and the others go on. The model file is read once, at the start, so
+// every run sees the same model even if the file is edited while the study runs.
+//
+// First-order fit (equations 1-3). R = A0 + sum_i A_i P_i with
+//   A_i = (R(run i) - R(base)) / (factor - 1)            (central: (R(1+h) - R(1-h)) / 2h)
+//   A0  = R(base) - sum_i A_i                              (every P_i = 1 in the base run)
+// A_i is the sensitivity the report ranks in Tables 15-17 (by |A_i|).
+//
+// Second-order fit (report Section 4.4, "reduced second-order form"). With the parameters that
+// matter most, R = A0 + sum_i A_i P_i + sum_(i<=j) B_ij P_i P_j, keeping only the quadratic
+// terms the design lists (the report keeps 8 linear and 8 quadratic terms: 17 constants). Each
+// run that varies only term parameters (the base run, their first-order runs and the
+// second-order runs; all other parameters at 1) gives one equation
+//   [1, t_1(P), ..., t_n(P)] c = R(run)
+// in the constants c. With as many runs as constants the square system is solved (LU with full
+// pivoting); with more, in the least-squares sense (column-pivoted QR). The condition number
+// (largest / smallest singular value) is reported. If the matrix is rank deficient, the null
+// space (singular vectors of the zero singular values) says which constants the runs cannot
+// separate: those are reported as not determined (NaN); the others are still unique and are
+// given (minimum-norm solution).
+//
+// Derivatives at the design point (P = 1, Table 14) from the second-order form:
+//   dR/dP_i        = A_i + 2 B_ii + sum_(j != i) B_ij
+//   d2R/dP_i2      = 2 B_ii
+//   d2R/dP_i dP_j  = B_ij
+//
+// A design file says what each nondimensional parameter scales in the model, and the
+// second-order study:
 //   sensitivity: 1
 //   factor: 1.2                         # first-order runs (default 1.2)
 //   parameters:
 //     - name: P7
 //       description: anticlimber horizontal yield force
-//       scale:                          # key *= factor^power for every entry
+//       scale:                          # key *= value^power for every entry
 //         - {key: elements.anticlimber.horizontal_yield_deflection, power: 1}
+//   second_order:                       # optional
+//     terms: [P6, P7, P6^2, P6*P7, P7^2]   # besides the constant A0
+//     runs:                             # each: parameter -> value (the others 1.0)
+//       - {P6: 0.8}
+//       - {P6: 1.2, P7: 1.2}
 // so a derived quantity (a yield force = slope x yield deflection) is varied through the
-// inputs it is made of. Runs go in parallel; a failed run is reported and the others go on.
+// inputs it is made of.
 #pragma once
 
 #include <array>
+#include <cstddef>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "railcrash/responses.hpp"
@@ -30,40 +66,107 @@ struct SensitivityParameter {
   std::vector<std::pair<std::string, double>> scales;  // (model key, power)
 };
 
+/// A term of the second-order form: P_first (linear), P_first^2 (second == first) or
+/// P_first P_second.
+struct SensitivityTerm {
+  std::string first, second;
+  bool linear() const { return second.empty(); }
+  bool square() const { return second == first; }
+  std::string label() const;  // "P6", "P6^2", "P6*P7" (the design file's spelling)
+  /// The term's value at the given parameter values (parameters not listed: 1.0).
+  double value(const std::vector<std::pair<std::string, double>>& values) const;
+};
+
+/// Parameter name -> nondimensional value; parameters not listed are 1.0.
+using SensitivityPoint = std::vector<std::pair<std::string, double>>;
+
+struct SecondOrderDesign {
+  std::vector<SensitivityTerm> terms;   // besides the constant
+  std::vector<SensitivityPoint> runs;   // the second-order runs (Table 12)
+  bool empty() const { return terms.empty() && runs.empty(); }
+};
+
 struct SensitivityDesign {
   double factor = 1.2;
   std::vector<SensitivityParameter> parameters;
+  SecondOrderDesign second_order;
 };
 
 /// Reads a design file (errors name the file and line).
 SensitivityDesign load_design(const std::string& path);
 
+/// The design file `sensitivity_design.yaml` beside the model file ("the report's design" for
+/// models/report/final_two_car.yaml); InputError if there is none.
+std::string default_design_path(const std::string& model_path);
+
 struct SensitivityRun {
-  std::string parameter;  // "" for the base run
-  double factor = 1.0;
+  SensitivityPoint variation;  // parameter -> value; empty for the base run
+  std::string parameter;       // first-order runs: the parameter ("" for the base run); else "P6+P7"
+  double factor = 1.0;         // first-order runs: its value
   bool ok = false;
   std::string message;
   Responses responses;
   double wall_seconds = 0.0;
 };
 
+/// One run's data for a fit.
+struct SensitivitySample {
+  std::string label;
+  SensitivityPoint point;
+  std::array<double, 3> responses{};  // R1, R2, R3
+};
+
+struct SensitivityDerivative {
+  std::string first, second;  // dR/dP_first (second empty), or the second derivative by P_first and P_second
+  std::string label() const;  // "d/dP6", "d2/dP6^2", "d2/dP6dP7"
+  std::array<double, 3> value{};
+};
+
+struct QuadraticFit {
+  std::vector<SensitivityTerm> terms;             // besides the constant
+  std::array<double, 3> constant{};               // A0 for R1-R3 (NaN if not determined)
+  std::vector<std::array<double, 3>> coefficients;  // per term (NaN if not determined)
+  std::vector<std::string> samples;               // labels of the runs used, in row order
+  int equations = 0, unknowns = 0, rank = 0;
+  double condition_number = 0.0;                  // largest / smallest singular value (inf if singular)
+  double largest_residual = 0.0;                  // least squares: max |row . c - R|
+  std::vector<std::string> undetermined;          // term labels ("1" = the constant) the runs cannot separate
+  std::vector<SensitivityDerivative> derivatives; // at P = 1: first derivatives, then second (Table 14 order)
+  bool determined() const { return unknowns > 0 && rank == unknowns; }
+};
+
+/// Fits R = A0 + sum c_k t_k(P) to the samples (see the header comment).
+QuadraticFit fit_quadratic(const std::vector<SensitivityTerm>& terms, const std::vector<SensitivitySample>& samples);
+
 struct SensitivityResult {
   SensitivityRun base;
-  std::vector<SensitivityRun> runs;               // per parameter (central: +h then -h)
-  std::vector<std::array<double, 3>> derivatives; // dR1/dP, dR2/dP, dR3/dP per parameter (NaN if a run failed)
+  std::vector<SensitivityRun> runs;                // first-order, per parameter (central: +h then -h)
+  std::vector<std::array<double, 3>> derivatives;  // A_i = dR1/dP, dR2/dP, dR3/dP per parameter run (NaN if a run failed)
+  std::array<double, 3> constant{};                // A0 of equations (1)-(3)
+  std::vector<SensitivityRun> second_order_runs;   // Table 12/13
+  QuadraticFit fit;                                // empty terms: no second-order study
+  std::string fit_note;                            // runs left out of the fit and why
   bool central = false;
 };
 
 struct SensitivityOptions {
   int jobs = 1;
   double central_step = 0.0;         // > 0: central differences at 1 +- this
-  std::vector<std::string> only;     // parameter names to run (empty: all)
+  std::vector<std::string> only;     // parameter names to run (empty: all); second-order runs and
+                                     // terms are kept when all their parameters are among them
+  bool second_order = true;          // run the design's second-order runs and fit
+  double run_time_limit = 0.0;       // [s] wall time after which a run is stopped and reported failed (0: none)
+  /// Called (one call at a time) as each run finishes: the run, its number (0 = base), runs done, runs in all.
+  std::function<void(const SensitivityRun&, std::size_t, std::size_t, std::size_t)> progress;
 };
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
                                   const SensitivityOptions& options);
 
-/// Writes DIR/sensitivity.csv and DIR/sensitivity.md; returns the Markdown.
+/// Writes DIR/sensitivity.md (all tables, shaped like the report's Tables 11-17) and the CSV files
+/// DIR/sensitivity.csv (runs), sensitivity_first_order.csv (A0, A_i), sensitivity_second_order.csv
+/// (fitted constants), sensitivity_derivatives.csv (Table 14), sensitivity_ranking.csv (Tables
+/// 15-17); returns the Markdown.
 std::string write_sensitivity(const SensitivityResult& result, const SensitivityDesign& design, const std::string& directory);
 
 }  // namespace railcrash

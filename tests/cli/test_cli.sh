@@ -71,5 +71,19 @@ expect_status "forced euler divergence exits 1" 1 "$bin" run "$tmp/stiff.yaml" -
 expect_text "failed summary" "$tmp/stiff/summary.json" '"status": "failed"'
 expect_text "failed summary says why" "$tmp/stiff/summary.json" 'diverged'
 
+# sensitivity: the default design is sensitivity_design.yaml beside the model; none there -> input error.
+expect_status "sensitivity without a design beside the model exits 2" 2 "$bin" sensitivity "$crank" --out "$tmp/sens"
+expect_text "it says to pass --design" "$tmp/stderr" "sensitivity_design.yaml does not exist; pass --design FILE"
+
+# converge: a small study writes its CSV, plot and summary; an unknown quantity is an input error.
+spring=$src/verification/cases/damped_spring_mass.yaml
+expect_status "converge runs" 0 "$bin" converge "$spring" --t-end 0.5 --euler-dt 0.01 --euler-steps 3 --rtols 1e-3,1e-4 --quantities displacement_rms,R1 --out "$tmp/conv"
+expect_text "converge prints the observed orders" "$tmp/stdout" "Observed orders"
+expect_text "converge says what does not apply" "$tmp/stdout" "R1 .*not applicable: the model has no responses section"
+expect_text "converge CSV header" "$tmp/conv/converge.csv" '^method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events,displacement_rms'
+[ -s "$tmp/conv/converge.svg" ] && passes=$((passes + 1)) || { echo "FAIL: converge wrote no plot"; failures=$((failures + 1)); }
+expect_status "converge with an unknown quantity exits 2" 2 "$bin" converge "$spring" --quantities max_crunch
+expect_text "it names the quantity" "$tmp/stderr" "unknown quantity 'max_crunch'"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -1,0 +1,220 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "railcrash/converge.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+std::string case_path(const std::string& name) {
+  return std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/" + name + ".yaml";
+}
+
+/// One run outside the study: body 0's (x, y) at every sample and the largest value of one output column.
+struct Trace {
+  std::vector<double> times, x, y;
+  double peak = -1e300;
+};
+
+class TraceObserver : public RunObserver {
+ public:
+  TraceObserver(const DaeSystem& system, const std::string& column, Trace& trace)
+      : system_(system), outputs_(system.output_names().size()), trace_(trace) {
+    const auto& names = system.output_names();
+    index_ = static_cast<std::size_t>(std::find(names.begin(), names.end(), column) - names.begin());
+  }
+  void sample(double t, const double* y, const double* lambda, const double*) override {
+    trace_.times.push_back(t);
+    trace_.x.push_back(y[0]);
+    trace_.y.push_back(y[1]);
+    system_.outputs(y, lambda, outputs_.data());
+    if (index_ < outputs_.size()) trace_.peak = std::max(trace_.peak, outputs_[index_]);
+  }
+
+ private:
+  const DaeSystem& system_;
+  std::vector<double> outputs_;
+  Trace& trace_;
+  std::size_t index_;
+};
+
+Trace run_by_hand(const std::string& path, const std::string& column, const std::vector<std::string>& settings) {
+  const Model model = load_model(path, settings);
+  const DaeSystem system(model);
+  Trace trace;
+  TraceObserver observer(system, column, trace);
+  const RunOutcome outcome =
+      make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval_of(model.simulation), observer);
+  REQUIRE(outcome.ok);
+  return trace;
+}
+
+}  // namespace
+
+TEST_CASE("convergence study: Euler first order and IDA errors falling with rtol on the damped spring-mass", "[converge]") {
+  ConvergeOptions options;
+  options.quantities = {"displacement_rms", "body.mass.x", "R1"};
+  options.euler_first_step = 0.01;  // the output interval, so every run samples at the same times
+  options.euler_runs = 5;
+  options.rtols = {1e-3, 1e-4, 1e-5, 1e-6};
+  const std::string path = case_path("damped_spring_mass");
+  const ConvergePlan plan = plan_convergence(path, options);
+  REQUIRE(plan.euler_steps.size() == 5);
+  CHECK(plan.euler_steps[4] == Approx(0.01 / 16));
+  CHECK(plan.headline == 0);
+  // R1 does not apply: reported as such, never as a number.
+  REQUIRE_FALSE(plan.quantities[2].applicable);
+  CHECK_THAT(plan.quantities[2].note, Catch::Contains("no responses section"));
+
+  const ConvergeResult result = run_convergence(plan);
+  REQUIRE(result.reference.ok);
+  REQUIRE(result.euler.size() == 5);
+  REQUIRE(result.ida.size() == 4);
+  for (const auto* runs : {&result.euler, &result.ida})
+    for (const ConvergeRun& run : *runs) {
+      REQUIRE(run.ok);
+      CHECK(std::isnan(run.values[2]));
+      CHECK(std::isnan(run.errors[2]));
+    }
+  // The reference against the closed form: x - L0 = A e^(-zeta w t) (cos wd t + zeta w / wd sin wd t).
+  const double omega = 10.0, zeta = 0.1, amplitude = 0.1, t_end = 3.0;
+  const double wd = omega * std::sqrt(1.0 - zeta * zeta);
+  const double exact = amplitude * std::exp(-zeta * omega * t_end) * (std::cos(wd * t_end) + zeta * omega / wd * std::sin(wd * t_end));
+  CHECK(result.reference.values[1] == Approx(exact - amplitude).margin(1e-7));
+
+  // Explicit Euler (velocity first) with damping is first order in the trajectory.
+  CHECK(result.euler_order[0].points == 5);
+  CHECK(result.euler_order[0].slope > 0.8);
+  CHECK(result.euler_order[0].slope < 1.2);
+  // IDA: the trajectory error falls with every tenfold tighter tolerance.
+  for (std::size_t k = 1; k < result.ida.size(); ++k) CHECK(result.ida[k].errors[0] < result.ida[k - 1].errors[0]);
+  CHECK(result.ida_rtol_slope[0].slope > 0.5);
+
+  // One error by hand, from two runs made outside the study (dt = 0.0025 samples at the same times).
+  const Trace reference = run_by_hand(path, "", {"simulation.rtol=1e-9", "simulation.integrator=ida"});
+  const Trace euler = run_by_hand(path, "", {"simulation.integrator=euler", "simulation.dt=0.0025"});
+  REQUIRE(euler.times.size() == reference.times.size());
+  double sum = 0.0, largest = 0.0;
+  for (std::size_t i = 0; i < reference.times.size(); ++i) {
+    REQUIRE(euler.times[i] == Approx(reference.times[i]).margin(1e-12));
+    const double dx = (euler.x[i] - euler.x[0]) - (reference.x[i] - reference.x[0]);
+    const double dy = (euler.y[i] - euler.y[0]) - (reference.y[i] - reference.y[0]);
+    sum += dx * dx + dy * dy;
+    largest = std::max({largest, std::abs(reference.x[i] - reference.x[0]), std::abs(reference.y[i] - reference.y[0])});
+  }
+  const double rms = std::sqrt(sum / (2.0 * static_cast<double>(reference.times.size())));
+  CHECK(result.euler[2].step == Approx(0.0025));
+  CHECK(result.euler[2].values[0] == Approx(rms).epsilon(1e-6));
+  CHECK(result.euler[2].errors[0] == Approx(rms / largest).epsilon(1e-6));
+  // body.mass.x: end displacement, error over the reference's largest x displacement.
+  const double end_error = std::abs((euler.x.back() - euler.x[0]) - (reference.x.back() - reference.x[0])) / largest;
+  CHECK(result.euler[2].errors[1] == Approx(end_error).epsilon(1e-6));
+}
+
+TEST_CASE("convergence study: peak crush against the closed form and an Euler error by hand", "[converge]") {
+  // 100 kg at 10 m/s into an elastic-perfectly-plastic crush structure: largest crush 0.055 m
+  // (closed form in verification/cases/crush_impact.yaml), largest force F0 = 100 kN.
+  ConvergeOptions options;
+  options.quantities = {"max_crush", "element.crush.force", "peak_anticlimber_force"};
+  options.t_end = 0.1;
+  options.output_interval = 1e-4;
+  options.euler_first_step = 1e-4;
+  options.euler_runs = 2;
+  options.rtols = {1e-5};
+  const std::string path = case_path("crush_impact");
+  const ConvergeResult result = run_convergence(plan_convergence(path, options));
+  REQUIRE(result.reference.ok);
+  CHECK(result.reference.values[0] == Approx(0.055).epsilon(1e-4));
+  CHECK(result.reference.values[1] == Approx(1e5).epsilon(1e-6));
+  CHECK_FALSE(result.quantities[2].applicable);
+  CHECK(result.reference.errors[0] == 0.0);
+
+  const Trace reference =
+      run_by_hand(path, "crush.crush", {"simulation.t_end=0.1", "simulation.output_interval=1e-4", "simulation.rtol=1e-9"});
+  const Trace euler = run_by_hand(
+      path, "crush.crush",
+      {"simulation.t_end=0.1", "simulation.output_interval=1e-4", "simulation.integrator=euler", "simulation.dt=5e-5"});
+  REQUIRE(result.euler[1].ok);
+  CHECK(result.euler[1].values[0] == Approx(euler.peak).epsilon(1e-12));
+  CHECK(result.euler[1].errors[0] == Approx(std::abs(euler.peak - reference.peak) / reference.peak).epsilon(1e-6));
+}
+
+TEST_CASE("convergence study: unknown quantities are input errors that say what to write", "[converge]") {
+  const std::string path = case_path("damped_spring_mass");
+  ConvergeOptions options;
+  options.euler_runs = 0;
+  options.quantities = {"max_crunch"};
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("unknown quantity 'max_crunch'") &&
+                                                         Catch::Contains("element.NAME.OUTPUT"));
+  options.quantities = {"element.nope.force"};
+  CHECK_THROWS_AS(plan_convergence(path, options), InputError);
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("no element named 'nope'"));
+  options.quantities = {"element.spring.torque"};
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("has no output 'torque'") && Catch::Contains("force"));
+  options.quantities = {"body.mass.z"};
+  CHECK_THROWS_AS(plan_convergence(path, options), InputError);
+  options.quantities = {"R2", "displacement_rms"};
+  options.headline = "R2";
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("does not apply"));
+  options.headline.clear();
+  options.rtols = {1e-3, 1e-10};
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("not looser than the reference"));
+}
+
+TEST_CASE("convergence study: log-log slope and the files written", "[converge]") {
+  // y = 3 x^1.5 exactly; the zero and NaN points are left out of the fit.
+  const std::vector<double> x{1e-3, 2e-3, 4e-3, 8e-3, 1.0};
+  const std::vector<double> y{3 * std::pow(1e-3, 1.5), 3 * std::pow(2e-3, 1.5), 3 * std::pow(4e-3, 1.5), 0.0, std::nan("")};
+  const ConvergeFit fit = log_log_slope(x, y);
+  CHECK(fit.points == 3);
+  CHECK(fit.slope == Approx(1.5).epsilon(1e-12));
+  CHECK(std::isnan(log_log_slope({1.0}, {2.0}).slope));
+
+  ConvergeOptions options;
+  options.quantities = {"displacement_rms"};
+  options.euler_first_step = 0.01;
+  options.euler_runs = 2;
+  options.rtols = {1e-4};
+  options.t_end = 0.5;
+  options.jobs = 2;
+  const ConvergeResult result = run_convergence(plan_convergence(case_path("damped_spring_mass"), options));
+  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_converge_test").string();
+  std::filesystem::remove_all(dir);
+  const std::string md = write_convergence(result, dir);
+  CHECK_THAT(md, Catch::Contains("Observed orders"));
+  std::ifstream csv(dir + "/converge.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  CHECK(header == "method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events,"
+                  "displacement_rms,displacement_rms_error,message");
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  CHECK(rows == 4);  // reference, two Euler, one IDA
+  CHECK(std::filesystem::file_size(dir + "/converge.svg") > 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("convergence study: a run over its time limit is stopped and reported failed", "[converge]") {
+  ConvergeOptions options;
+  options.quantities = {"displacement_rms"};
+  options.t_end = 1.0;
+  options.euler_first_step = 1e-8;  // a hundred million steps (about a minute): far longer than the limit
+  options.euler_runs = 1;
+  options.rtols = {1e-4};
+  options.run_time_limit = 1.0;     // the IDA runs take milliseconds (a tenth of a second under ASan)
+  const ConvergeResult result = run_convergence(plan_convergence(case_path("damped_spring_mass"), options));
+  REQUIRE(result.euler.size() == 1);
+  CHECK_FALSE(result.euler[0].ok);
+  CHECK_THAT(result.euler[0].message, Catch::Contains("run time limit of 1 s"));
+  CHECK(result.euler[0].wall_seconds < 10.0);
+  CHECK(std::isnan(result.euler[0].errors[0]));
+  CHECK(result.reference.ok);
+  CHECK(result.ida[0].ok);
+}
