@@ -13,10 +13,12 @@ if [ -n "$(git status --porcelain 2>/dev/null | grep -v '^??' || true)" ]; then 
 bench=build/railcrash_bench
 case $what in
   consist|sensitivity) $bench --commit "$commit" "$what" "$@" ;;
-  converge) build/railcrash converge models/report/final_two_car.yaml --out bench/converge_final_two_car "$@" ;;
+  converge) build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
+              --out bench/converge_final_two_car_0.5s "$@" ;;
   all)
-    $bench --commit "$commit" consist
+    $bench --commit "$commit" consist --t-end 0.05
     $bench --commit "$commit" sensitivity
-    build/railcrash converge models/report/final_two_car.yaml --out bench/converge_final_two_car ;;
+    build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
+        --out bench/converge_final_two_car_0.5s ;;
   *) echo "usage: bench/run.sh [consist|sensitivity|converge|all] [options]" >&2; exit 2 ;;
 esac
