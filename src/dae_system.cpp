@@ -619,17 +619,6 @@ bool DaeSystem::commit_element_root(int e, int local, int direction, double t, c
   return true;
 }
 
-std::vector<int> DaeSystem::elements_of_roots(const int* direction) const {
-  std::vector<int> owners;
-  for (std::size_t e = 0; e < model_.elements().size(); ++e)
-    for (int k = 0; k < model_.elements()[e]->root_count(); ++k)
-      if (direction[root_offset_[e] + k] != 0) {
-        owners.push_back(static_cast<int>(e));
-        break;
-      }
-  return owners;
-}
-
 DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y) const {
   const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
   const int nq = body_unknowns();
@@ -646,8 +635,7 @@ DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y)
   return load;
 }
 
-bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                             std::vector<int>* changed_elements) const {
+bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const {
   const int nq = body_unknowns();
   const double* lambda = y + 2 * nq;
   bool changed = false;
@@ -661,7 +649,6 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
       if (el.commit(k, d, t, gather_state(el, y, y + nq), element_lambda, event)) {
         changed = true;
         events.push_back({t, el.name(), event.what, event.value});
-        if (changed_elements) changed_elements->push_back(static_cast<int>(e));
         break;  // the element's other roots belonged to the mode it just left
       }
     }

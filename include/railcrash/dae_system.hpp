@@ -128,10 +128,8 @@ class DaeSystem {
   void roots(double t, const double* y, double* g) const;
   /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
   /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
-  /// any mode changed (the integrator must then re-initialize).
-  /// changed_elements (optional) receives the indices of the elements that changed mode.
-  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                    std::vector<int>* changed_elements = nullptr) const;
+  /// any mode changed (Euler and the static settle; IDA commits element by element).
+  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
   /// Element-level access for integrators that locate events element by element.
   int root_offset(int e) const { return root_offset_[static_cast<std::size_t>(e)]; }
   /// Element owning root k.
@@ -144,8 +142,6 @@ class DaeSystem {
   /// event. Returns true when the element changed mode.
   bool commit_element_root(int e, int local, int direction, double t, const double* y,
                            std::vector<EventRecord>& events) const;
-  /// Indices of the elements owning a root with direction[k] != 0.
-  std::vector<int> elements_of_roots(const int* direction) const;
   /// What element e alone contributes at y: its generalized forces on its two body slots (force
   /// elements, and joint friction from the multipliers in y; not the constraint rows) and the
   /// power delivered to it (its work quadrature's rate). Lets an integrator judge a mode change
