@@ -4,6 +4,9 @@
 //       consists of the report's car (railcrash consist) striking a standing consist: wall and
 //       CPU time per simulated second, steps, residual evaluations, events, root returns,
 //       integrator restarts, peak memory; then the fitted exponent of cost against cars.
+//   railcrash_bench kernels [--cars 2,10,100]
+//       the cost per unknown of one residual, Jacobian and root-function evaluation of the
+//       consists at t = 0: whether the element kernels themselves scale linearly.
 //   railcrash_bench sensitivity [--design FILE]
 //       the report's sensitivity study (base + first-order + second-order runs) with 1 and 2
 //       jobs: wall time and speed-up.
@@ -25,6 +28,7 @@
 #include <thread>
 
 #include "railcrash/consist.hpp"
+#include "railcrash/dae_system.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/sensitivity.hpp"
@@ -135,6 +139,47 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
   return all_ok ? 0 : 1;
 }
 
+int kernels_benchmark(const std::string& template_path, const std::vector<int>& cars, const std::string& results,
+                      const std::string& commit) {
+  std::ostringstream table;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "| cars per consist | unknowns | Jacobian nonzeros | residual ns per unknown | Jacobian ns per unknown | "
+                "roots ns per unknown |\n|---|---|---|---|---|---|\n");
+  table << line;
+  std::fputs(line, stdout);
+  for (const int n : cars) {
+    const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_kernels_" + std::to_string(n) + ".yaml");
+    {
+      std::ofstream out(file);
+      out << make_consist_model(template_path, n);
+    }
+    const Model model = load_model(file.string());
+    std::filesystem::remove(file);
+    const DaeSystem system(model);
+    const std::vector<double> y = system.initial_state();
+    std::vector<double> yp(y.size(), 0.0), r(y.size()), values(static_cast<std::size_t>(system.pattern().nonzeros()));
+    std::vector<double> g(static_cast<std::size_t>(system.root_count()));
+    const auto time_per_unknown = [&](auto&& evaluate) {
+      const int repeats = std::max(5, 200000 / system.size());
+      evaluate();  // warm up
+      const double start = cpu_seconds();
+      for (int k = 0; k < repeats; ++k) evaluate();
+      return 1e9 * (cpu_seconds() - start) / repeats / system.size();
+    };
+    const double residual = time_per_unknown([&] { system.residual(0.0, y.data(), yp.data(), r.data()); });
+    const double jacobian = time_per_unknown([&] { system.jacobian(0.0, 1e4, y.data(), yp.data(), values.data()); });
+    const double roots = time_per_unknown([&] { system.roots(0.0, y.data(), g.data()); });
+    std::snprintf(line, sizeof line, "| %d | %d | %d | %.1f | %.1f | %.1f |\n", n, system.size(), system.pattern().nonzeros(),
+                  residual, jacobian, roots);
+    table << line;
+    std::fputs(line, stdout);
+    std::fflush(stdout);
+  }
+  append_results(results, "Element kernels per unknown", table.str(), commit);
+  return 0;
+}
+
 int sensitivity_benchmark(const std::string& model_path, const std::string& design_path, const std::string& results,
                           const std::string& commit) {
   const SensitivityDesign design = load_design(design_path);
@@ -186,6 +231,11 @@ int main(int argc, char** argv) {
   consist->add_option("--cars", cars_text, "cars per consist, comma-separated")->capture_default_str();
   consist->add_option("--t-end", t_end, "simulated time of each run [s]")->capture_default_str();
 
+  std::string kernel_cars = "2,10,100";
+  CLI::App* kernels = app.add_subcommand("kernels", "cost per unknown of residual, Jacobian and roots against consist length");
+  kernels->add_option("--template", template_path, "two-car model the consists are built from")->capture_default_str();
+  kernels->add_option("--cars", kernel_cars, "cars per consist, comma-separated")->capture_default_str();
+
   std::string design_path = source + "/models/report/sensitivity_design.yaml";
   CLI::App* sensitivity = app.add_subcommand("sensitivity", "the report's sensitivity study with 1 and 2 jobs");
   sensitivity->add_option("--design", design_path, "design file")->capture_default_str();
@@ -193,6 +243,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*consist) return consist_benchmark(template_path, parse_list(cars_text), t_end, results, commit);
+    if (*kernels) return kernels_benchmark(template_path, parse_list(kernel_cars), results, commit);
     if (*sensitivity) return sensitivity_benchmark(template_path, design_path, results, commit);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "railcrash_bench: %s\n", e.what());

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|sensitivity|converge|all] [extra options for railcrash_bench]
+#   bench/run.sh [consist|kernels|sensitivity|converge|all] [extra options for railcrash_bench]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -12,13 +12,14 @@ commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 if [ -n "$(git status --porcelain 2>/dev/null | grep -v '^??' || true)" ]; then commit="$commit+changes"; fi
 bench=build/railcrash_bench
 case $what in
-  consist|sensitivity) $bench --commit "$commit" "$what" "$@" ;;
+  consist|sensitivity|kernels) $bench --commit "$commit" "$what" "$@" ;;
   converge) build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
               --out bench/converge_final_two_car_0.5s "$@" ;;
   all)
     $bench --commit "$commit" consist --t-end 0.05
+    $bench --commit "$commit" kernels --cars 2,10,20,50,100
     $bench --commit "$commit" sensitivity
     build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
         --out bench/converge_final_two_car_0.5s ;;
-  *) echo "usage: bench/run.sh [consist|sensitivity|converge|all] [options]" >&2; exit 2 ;;
+  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|all] [options]" >&2; exit 2 ;;
 esac
