@@ -84,6 +84,18 @@ void append_results(const std::string& path, const std::string& heading, const s
   else std::printf("appended to %s\n", path.c_str());
 }
 
+/// The 2N-car consist built from the template, through a model file (so it is loaded like any other).
+Model load_consist(const std::string& template_path, int cars) {
+  const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_consist_" + std::to_string(cars) + ".yaml");
+  {
+    std::ofstream out(file);
+    out << make_consist_model(template_path, cars);
+  }
+  Model model = load_model(file.string());
+  std::filesystem::remove(file);
+  return model;
+}
+
 int consist_benchmark(const std::string& template_path, const std::vector<int>& cars, double t_end,
                       const std::string& results, const std::string& commit) {
   std::ostringstream table;
@@ -96,12 +108,7 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
   std::vector<double> fit_cars, fit_cost;
   bool all_ok = true;
   for (const int n : cars) {
-    const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_consist_" + std::to_string(n) + ".yaml");
-    {
-      std::ofstream out(file);
-      out << make_consist_model(template_path, n);
-    }
-    Model model = load_model(file.string());
+    Model model = load_consist(template_path, n);
     RunOverrides overrides;
     overrides.t_end = t_end;
     overrides.output_interval = t_end / 100.0;
@@ -124,7 +131,6 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
       fit_cars.push_back(n);
       fit_cost.push_back(cpu / report.outcome.t_reached);
     }
-    std::filesystem::remove(file);
   }
   if (fit_cars.size() >= 2) {
     std::snprintf(line, sizeof line, "\nCPU time per simulated second grows as cars^%.2f (least squares, %g to %g cars per consist; goal <= 1.1)\n",
@@ -149,13 +155,7 @@ int kernels_benchmark(const std::string& template_path, const std::vector<int>& 
   table << line;
   std::fputs(line, stdout);
   for (const int n : cars) {
-    const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_kernels_" + std::to_string(n) + ".yaml");
-    {
-      std::ofstream out(file);
-      out << make_consist_model(template_path, n);
-    }
-    const Model model = load_model(file.string());
-    std::filesystem::remove(file);
+    const Model model = load_consist(template_path, n);
     const DaeSystem system(model);
     const std::vector<double> y = system.initial_state();
     std::vector<double> yp(y.size(), 0.0), r(y.size()), values(static_cast<std::size_t>(system.pattern().nonzeros()));

@@ -26,6 +26,11 @@ double jacobian_error(const DaeSystem& system, double t, double cj, const std::v
 /// output_interval) and requires success.
 RunOutcome simulate(const Model& model, double output_interval = 0.01);
 
+/// The R1 test model (SI): a 1000 kg car end at 2 m/s into an anticlimber fixed to ground
+/// (elastic to 0.01 m at 1e7 N/m, then 1e5 N/m), with a responses section (reference crush
+/// 0.02 m), simulated to t_end.
+std::string anticlimber_r1_model_text(double t_end);
+
 /// Positions and velocities of a DAE state.
 struct BodyState {
   std::vector<double> q, v;

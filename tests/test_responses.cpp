@@ -89,16 +89,7 @@ TEST_CASE("responses input errors", "[responses]") {
 TEST_CASE("R1 from the anticlimber's crush: a car end into a fixed anticlimber, closed form", "[responses]") {
   // 1000 kg at 2 m/s: elastic to 0.01 m (500 J), then 1e5 N + 1e5 N/m beyond: the remaining
   // 1500 J give u^2 + 2u - 0.03 = 0, u = sqrt(1.03) - 1, largest crush 0.01 + u.
-  const std::string text =
-      "railcrash: 1\nname: r1\nunits: SI\ngravity: [0, 0]\nbodies:\n"
-      "  - {name: car, mass: 1000, inertia: 100, position: [0.1, 0], velocity: [-2, 0]}\nelements:\n"
-      "  - name: ac\n    type: anticlimber\n"
-      "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n    horizontal_yield_deflection: 0.01\n"
-      "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
-      "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n    torsional_yield_deflection: 0.01\n"
-      "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
-      "responses:\n  crush: anticlimber\n  reference_crush: 0.02\n  anticlimber: ac\n  reference_velocity: 4.0\n"
-      "simulation: {t_end: 0.2, rtol: 1e-9, output_interval: 0.0001}\n";
+  const std::string text = testing::anticlimber_r1_model_text(0.2);
   const RunReport report = run_model(testing::model_from_text(text), "");
   REQUIRE(report.outcome.ok);
   const double crush = 0.01 + std::sqrt(1.03) - 1.0;

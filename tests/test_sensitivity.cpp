@@ -32,16 +32,7 @@ struct Files {
   Files() {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
-    std::ofstream(model)
-        << "railcrash: 1\nname: r1\nunits: SI\ngravity: [0, 0]\nbodies:\n"
-           "  - {name: car, mass: 1000, inertia: 100, position: [0.1, 0], velocity: [-2, 0]}\nelements:\n"
-           "  - name: ac\n    type: anticlimber\n"
-           "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n    horizontal_yield_deflection: 0.01\n"
-           "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
-           "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n    torsional_yield_deflection: 0.01\n"
-           "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
-           "responses:\n  crush: anticlimber\n  reference_crush: 0.02\n  anticlimber: ac\n  reference_velocity: 4.0\n"
-           "simulation: {t_end: 0.15, rtol: 1e-9, output_interval: 0.0001}\n";
+    std::ofstream(model) << testing::anticlimber_r1_model_text(0.15);
     std::ofstream(design) << "sensitivity: 1\nfactor: 1.2\nparameters:\n"
                              "  - name: P7\n    description: horizontal yield force (slope held)\n"
                              "    scale: [{key: elements.ac.horizontal_yield_deflection, power: 1}]\n"
