@@ -161,6 +161,22 @@ std::string ReadingsPlan::label(const std::vector<int>& combination) const {
   return text;
 }
 
+SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, const SensitivityDesign& design) const {
+  SensitivityDesign changed = design;
+  for (std::size_t r = 0; r < readings.size(); ++r) {
+    const ReadingLevel& level = readings[r].levels[static_cast<std::size_t>(combination[r])];
+    for (const auto& [name, scales] : level.scales) {
+      const auto it = std::find_if(changed.parameters.begin(), changed.parameters.end(),
+                                   [&](const SensitivityParameter& p) { return p.name == name; });
+      if (it == changed.parameters.end())
+        throw InputError(SourceLocation{path, level.line}.prefix() + "reading '" + readings[r].name + "', level '" + level.name +
+                         "': the design has no parameter '" + name + "'");
+      it->scales = scales;
+    }
+  }
+  return changed;
+}
+
 ReadingsPlan load_readings(const std::string& path) {
   YAML::Node root;
   try {
@@ -202,7 +218,7 @@ ReadingsPlan load_readings(const std::string& path) {
     std::set<std::string> level_names;
     for (const YAML::Node& l : levels) {
       if (!l.IsMap()) readings_error(path, l, context + ": each level is a map {name, set}");
-      check_keys(path, l, {"name", "set"}, context + " level");
+      check_keys(path, l, {"name", "set", "scale"}, context + " level");
       ReadingLevel level;
       level.name = scalar_text(path, l["name"], context + ": level name");
       level.line = line_of(l);
@@ -216,6 +232,30 @@ ReadingsPlan load_readings(const std::string& path) {
             readings_error(path, entry.first, context + ", level '" + level.name + "': give a value for '" + key + "'");
           // "elements.x.stiffness*: 1.2" becomes KEY*=FACTOR (a scaling), anything else KEY=VALUE.
           level.settings.push_back(key + "=" + YAML::Dump(entry.second));
+        }
+      }
+      if (const YAML::Node scale = l["scale"]) {
+        const std::string where = context + ", level '" + level.name + "': scale";
+        if (!scale.IsMap()) readings_error(path, scale, where + " must map parameters to lists of {key, power}");
+        for (const auto& entry : scale) {
+          const std::string parameter = scalar_text(path, entry.first, where + ": a parameter name");
+          if (!entry.second.IsSequence() || entry.second.size() == 0)
+            readings_error(path, entry.second, where + ": " + parameter + " needs a list of {key, power}");
+          std::vector<std::pair<std::string, double>> scales;
+          for (const YAML::Node& item : entry.second) {
+            if (!item.IsMap() || !item["key"]) readings_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
+            check_keys(path, item, {"key", "power"}, where);
+            double power = 1.0;
+            if (item["power"]) {
+              try {
+                power = item["power"].as<double>();
+              } catch (const YAML::Exception&) {
+                readings_error(path, item["power"], where + ": power must be a number");
+              }
+            }
+            scales.emplace_back(scalar_text(path, item["key"], where + ": key"), power);
+          }
+          level.scales.emplace_back(parameter, std::move(scales));
         }
       }
       reading.levels.push_back(std::move(level));
@@ -347,7 +387,15 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
                      "models/report/sensitivity_design.yaml does");
   check_readings(plan, model_path);
   const std::vector<std::vector<int>> combinations = plan.combinations();
-  check_design_keys(design, model_path, plan.settings(combinations.front()));
+  std::vector<SensitivityDesign> designs;
+  for (const std::vector<int>& combination : combinations) {
+    designs.push_back(plan.design_for(combination, design));
+    try {
+      check_design_keys(designs.back(), model_path, plan.settings(combination));
+    } catch (const InputError& e) {
+      throw InputError(plan.path + ": the combination " + plan.label(combination) + ": " + e.what());
+    }
+  }
   std::vector<ReadingsCombinationResult> results;
   for (std::size_t c = 0; c < combinations.size(); ++c) {
     const auto start = std::chrono::steady_clock::now();
@@ -355,8 +403,8 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
     study.settings = plan.settings(combinations[c]);
     ReadingsCombinationResult r;
     r.levels = combinations[c];
-    r.study = run_sensitivity(model_path, design, study);
-    r.agreement = score_agreement(r.study, design);
+    r.study = run_sensitivity(model_path, designs[c], study);
+    r.agreement = score_agreement(r.study, designs[c]);
     r.failed_runs = r.study.base.ok ? 0 : 1;
     for (const auto& run : r.study.runs) r.failed_runs += run.ok ? 0 : 1;
     for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok ? 0 : 1;
@@ -445,6 +493,11 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     for (const ReadingLevel& l : r.levels) {
       std::string changes;
       for (const auto& s : l.settings) changes += (changes.empty() ? "" : ", ") + std::string("`") + s.substr(0, s.find_last_not_of("\n") + 1) + "`";
+      for (const auto& [parameter, scales] : l.scales) {
+        std::string how;
+        for (const auto& [key, power] : scales) how += (how.empty() ? "" : " and ") + key + "^" + format(power, "%g");
+        changes += (changes.empty() ? "" : ", ") + parameter + " scales " + how;
+      }
       md << "  - " << l.name << ": " << (changes.empty() ? "the model as it is" : changes) << "\n";
     }
   }
@@ -466,7 +519,8 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
   out << text;
   if (!out) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.md").string());
   for (std::size_t c = 0; c < results.size(); ++c)
-    write_sensitivity(results[c].study, design, (std::filesystem::path(directory) / folder_of(c)).string());
+    write_sensitivity(results[c].study, plan.design_for(results[c].levels, design),
+                      (std::filesystem::path(directory) / folder_of(c)).string());
   return text;
 }
 

@@ -182,3 +182,20 @@ TEST_CASE("a reading study ranks first the reading that reproduces the published
   CHECK(std::filesystem::exists(out + "/readings.csv"));
   CHECK(std::filesystem::exists(out + "/combination_001/sensitivity.csv"));
 }
+
+TEST_CASE("a reading level may change what a design parameter scales", "[readings]") {
+  SensitivityDesign design;
+  design.parameters.push_back({"P5", "elastic slope", {{"elements.a.k", 1.0}}});
+  design.parameters.push_back({"P7", "yield force", {{"elements.a.d", 1.0}}});
+  const ReadingsPlan plan = load_readings(temporary_file(
+      "plan3.yaml", "reading_study: 1\nreadings:\n  - name: slope_holds\n    levels:\n      - {name: deflection}\n"
+                    "      - name: force\n        scale: {P5: [{key: elements.a.k}, {key: elements.a.d, power: -1}]}\n"
+                    "      - name: typo\n        scale: {P55: [{key: elements.a.k}]}\n"));
+  const SensitivityDesign same = plan.design_for({0}, design);
+  CHECK(same.parameters[0].scales == design.parameters[0].scales);
+  const SensitivityDesign force = plan.design_for({1}, design);
+  REQUIRE(force.parameters[0].scales.size() == 2);
+  CHECK(force.parameters[0].scales[1] == std::pair<std::string, double>{"elements.a.d", -1.0});
+  CHECK(force.parameters[1].scales == design.parameters[1].scales);  // P7 untouched
+  CHECK_THAT(error_of([&] { (void)plan.design_for({2}, design); }), Contains("plan3.yaml:8: ") && Contains("no parameter 'P55'"));
+}

@@ -14,6 +14,12 @@
 //       levels:
 //         - {name: on}                               # no changes: the model as it is
 //         - {name: off, set: {gravity: [0, 0]}}
+//     - name: slope_holds
+//       levels:                      # a level may also change what design parameters scale
+//         - {name: deflection}
+//         - name: force
+//           scale: {P5: [{key: elements.a.horizontal_elastic_stiffness, power: 1},
+//                        {key: elements.a.horizontal_yield_deflection, power: -1}]}
 // For every combination the design's whole study runs (base, first-order and second-order
 // runs; sensitivity.hpp) with the combination's changes applied to every run before the
 // parameters' scaling, and the study is scored against the design's published results
@@ -54,6 +60,8 @@ inline constexpr double kSignificantChange = 0.005;
 struct ReadingLevel {
   std::string name;
   std::vector<std::string> settings;  // KEY=VALUE or KEY*=FACTOR
+  /// Design parameters whose scaling this level replaces: parameter -> (model key, power).
+  std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> scales;
   int line = 0;                       // in the readings file
 };
 
@@ -73,6 +81,9 @@ struct ReadingsPlan {
   std::vector<std::string> settings(const std::vector<int>& combination) const;
   /// "gravity=off, inertia=printed"
   std::string label(const std::vector<int>& combination) const;
+  /// The design with the combination's replaced parameter scalings (InputError naming the
+  /// readings file's line for a parameter the design does not have).
+  SensitivityDesign design_for(const std::vector<int>& combination, const SensitivityDesign& design) const;
 };
 
 /// Reads a readings file; errors name the file and line.
