@@ -893,6 +893,34 @@ TEST_CASE("coupler_end restitution: a mass hitting the faces rebounds at e times
   }
 }
 
+TEST_CASE("coupler_end restitution: faces touching at rest, pushed by a load: reversal at 2 P / k, then the unloading line",
+          "[elements][couplers]") {
+  // Loading: delta = (P / k)(1 - cos w t), at rest again at t = pi / w, delta_max = 2 P / k.
+  // Unloading line P_f = k_u (delta - p): harmonic at w / e about delta_eq = p + P / k_u; a
+  // quarter of its period later the mass passes delta_eq at speed (delta_max - delta_eq) w / e.
+  const double m = 10.0, P = 1000.0, e = 0.5, k = kFaceStiffness, ku = k / (e * e), omega = std::sqrt(k / m);
+  const double peak = 2.0 * P / k, set = peak * (1.0 - e * e), equilibrium = set + P / ku;
+  const double t_unloading = kPi / omega, t_end = t_unloading + 0.5 * kPi * e / omega;
+  const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(-P) + ", 0]}\n";
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), m, kContact, 0.0, 0.0, 0.0,
+                                                          t_end, integrator, 1e-6, "SI", load)));
+    std::ostringstream seen;
+    for (const EventRecord& ev : r.outcome.events) seen << ev.t << " " << ev.what << " " << ev.value << "\n";
+    INFO(seen.str());
+    REQUIRE(r.outcome.events.size() == 2);
+    CHECK(r.outcome.events[0].what == "contact");
+    CHECK(r.outcome.events[0].t < 1e-4);
+    CHECK(r.outcome.events[1].what == "unloading");
+    CHECK(r.outcome.events[1].t == Approx(t_unloading).epsilon(0).margin(ida ? 1e-7 : 3e-6));
+    CHECK(r.outcome.events[1].value == Approx(-peak).epsilon(ida ? 1e-8 : 1e-4));
+    CHECK(r.x == Approx(kContact - equilibrium).epsilon(ida ? 1e-7 : 1e-4));
+    CHECK(r.vx == Approx((peak - equilibrium) * omega / e).epsilon(ida ? 1e-6 : 1e-3));
+  }
+}
+
 TEST_CASE("coupler_end restitution: a set face reloads along its unloading line up to delta_max, then on the loading line",
           "[elements][couplers]") {
   const double e = 0.5, k = kFaceStiffness, ku = k / (e * e), peak = 0.02, set = peak * (1.0 - e * e);
