@@ -877,12 +877,15 @@ TEST_CASE("coupler_end restitution: a mass hitting the faces rebounds at e times
       const Run r = run(model);
       check_events(r.outcome, {{"contact", t_contact, 0.0}, {"unloading", t_unloading, -peak}, {"separation", t_separation, -set}},
                    ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
-      // Euler (dt 1e-6) sees each switch up to one step late, omega_u dt <= 1.5e-4 of a radian
-      // of the unloading motion: the rebound speed to well within 1e-3.
-      CHECK(r.vx == Approx(e * v).epsilon(ida ? 1e-8 : 1e-3));
+      // Euler (dt 1e-6) sees each switch up to one step late, but the force is continuous at
+      // both (the lines meet at delta_max; both are zero at the set) and the reversal comes at
+      // near-zero speed, so the rebound speed keeps second-order accuracy: measured 1e-8
+      // relative; asserted to 1e-6.
+      CHECK(r.vx == Approx(e * v).epsilon(ida ? 1e-8 : 1e-6));
       CHECK(r.x == Approx(kContact - set + e * v * (t_end - t_separation)).epsilon(ida ? 1e-8 : 1e-4));
-      CHECK(element_work(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
-      CHECK(dissipated(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
+      // Euler's work quadrature is first order: measured 5e-5 (e = 0.3) and 1.7e-4 (e = 0.8).
+      CHECK(element_work(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 5e-4));
+      CHECK(dissipated(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 5e-4));
       // Euler's energy error oscillates with relative amplitude of order omega dt, largest
       // on the stiffer unloading line (omega / e).
       CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-7 : 3.0 * omega / e * 1e-6) * 0.5 * m * v * v);
