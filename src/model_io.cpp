@@ -206,6 +206,12 @@ class YamlParameterReader : public ParameterReader {
     if (!node) return std::nullopt;
     return reader_.boolean(node, context_ + ": '" + key + "'");
   }
+  std::optional<std::string> word(const std::string& key) override {
+    used_.insert(key);
+    const YAML::Node node = element_[key];
+    if (!node) return std::nullopt;
+    return reader_.text(node, context_ + ": '" + key + "'");
+  }
   [[noreturn]] void fail(const std::string& key, const std::string& what_to_change) const override {
     const YAML::Node node = element_[key];
     reader_.fail(node ? node : element_, context_ + ": " + what_to_change);
@@ -346,6 +352,10 @@ class KeyProbe : public ParameterReader {
   std::optional<bool> flag(const std::string& key) override {
     keys.insert(key);
     return false;
+  }
+  std::optional<std::string> word(const std::string& key) override {
+    keys.insert(key);
+    return std::nullopt;  // the default, which every type accepts
   }
   [[noreturn]] void fail(const std::string&, const std::string&) const override { throw Stop{}; }
   std::set<std::string> keys;
