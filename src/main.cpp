@@ -7,6 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -128,16 +129,24 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
     if (!name.empty()) options.only.push_back(name);
   const auto start = std::chrono::steady_clock::now();
   const SensitivityResult result = run_sensitivity(path, design, options);
-  const std::string table = write_sensitivity(result, design, out_dir);
+  std::string table = write_sensitivity(result, design, out_dir);
+  if (design.reference && !result.central && result.base.ok) {
+    const std::string comparison = comparison_markdown(result, design);
+    std::ofstream file(std::filesystem::path(out_dir) / "comparison.md");
+    file << "# The study against the design's published results\n\n" << comparison;
+    if (!file) throw std::runtime_error("cannot write " + (std::filesystem::path(out_dir) / "comparison.md").string());
+    table += "\n" + comparison;
+  }
   std::fputs(table.c_str(), stdout);
   int failed = result.base.ok ? 0 : 1;
   for (const auto& r : result.runs) failed += r.ok ? 0 : 1;
   for (const auto& r : result.second_order_runs) failed += r.ok ? 0 : 1;
   std::printf("\n%s: %zu runs with %d jobs in %.1f s; %d failed; results in %s/ (sensitivity.md, sensitivity.csv, "
               "sensitivity_first_order.csv, sensitivity_second_order.csv, sensitivity_derivatives.csv, "
-              "sensitivity_ranking.csv)\n",
+              "sensitivity_ranking.csv%s)\n",
               design_path.c_str(), result.runs.size() + result.second_order_runs.size() + 1, options.jobs,
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str());
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str(),
+              design.reference && !result.central && result.base.ok ? ", comparison.md" : "");
   return failed == 0 ? 0 : 1;
 }
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <set>
@@ -288,10 +289,14 @@ void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
 namespace {
 
 // Every key a design parameter scales must be a number of the model (else its run would fail
-// only when it executes).
-void check_design_keys(const SensitivityDesign& design, const std::string& model_path, const std::vector<std::string>& settings) {
+// only when it executes). With `unchanged_from`, parameters that scale as they do there are
+// not checked again (a level's settings cannot remove a key the other combination had).
+void check_design_keys(const SensitivityDesign& design, const std::string& model_path, const std::vector<std::string>& settings,
+                       const SensitivityDesign* unchanged_from = nullptr) {
   const std::string text = model_text_of(model_path);
-  for (const SensitivityParameter& p : design.parameters) {
+  for (std::size_t i = 0; i < design.parameters.size(); ++i) {
+    const SensitivityParameter& p = design.parameters[i];
+    if (unchanged_from && unchanged_from->parameters[i].scales == p.scales) continue;
     std::vector<std::string> all = settings;
     for (const auto& scale : p.scales) all.push_back(scale.first + "*=1");
     try {
@@ -380,6 +385,130 @@ Agreement score_agreement(const SensitivityResult& result, const SensitivityDesi
   return agreement;
 }
 
+std::string comparison_markdown(const SensitivityResult& result, const SensitivityDesign& design) {
+  RAILCRASH_DEMAND(design.reference.has_value());
+  const PublishedResults& published = *design.reference;
+  const Agreement agreement = score_agreement(result, design);
+  std::ostringstream md;
+  md << "## Agreement with the published study\n\n"
+     << (published.source.empty() ? std::string() : "Published: " + published.source + ".\n\n")
+     << "| | R1 | R2 | R3 |\n|---|---|---|---|\n";
+  const auto row = [&](const std::string& label, const std::function<std::string(const ResponseAgreement&)>& cell) {
+    md << "| " << label;
+    for (const ResponseAgreement& a : agreement.responses) md << " | " << cell(a);
+    md << " |\n";
+  };
+  row("run 0, ours", [](const ResponseAgreement& a) { return format(a.value); });
+  row("run 0, published", [](const ResponseAgreement& a) { return format(a.published); });
+  row("run 0, relative error", [](const ResponseAgreement& a) { return format(100.0 * a.relative_error, "%+.1f %%"); });
+  row("first-order runs: published sign kept (change >= 0.005)",
+      [](const ResponseAgreement& a) { return std::to_string(a.sign_agreements) + " of " + std::to_string(a.significant_runs); });
+  row("first-order runs: Spearman rho of the changes", [](const ResponseAgreement& a) { return format(a.spearman, "%.2f"); });
+  row("first-order runs: RMS of the change differences", [](const ResponseAgreement& a) { return format(a.rms, "%.4f"); });
+  row("all runs: published sign kept",
+      [](const ResponseAgreement& a) { return std::to_string(a.sign_agreements_all) + " of " + std::to_string(a.significant_runs_all); });
+  row("all runs: Spearman rho", [](const ResponseAgreement& a) { return format(a.spearman_all, "%.2f"); });
+  row("all runs: RMS", [](const ResponseAgreement& a) { return format(a.rms_all, "%.4f"); });
+  row("our top five (by first-order coefficient)", [](const ResponseAgreement& a) {
+    std::string top;
+    for (const auto& p : a.top_five) top += (top.empty() ? "" : " ") + p;
+    return top;
+  });
+  row("published top five in ours",
+      [](const ResponseAgreement& a) { return a.top_five_shared < 0 ? std::string("-") : std::to_string(a.top_five_shared) + " of 5"; });
+  std::string missed;
+  for (const auto& g : agreement.goals_missed) missed += (missed.empty() ? "" : "; ") + g;
+  md << "\nGoals met: " << agreement.goals_met << " of " << Agreement::kGoals << (missed.empty() ? "" : " (missed: " + missed + ")")
+     << ".\n\n";
+
+  // Every run against the published one.
+  md << "## Runs: ours against the published (changes against run 0)\n\n"
+     << "| run | varied | R1 | published | R2 | published | R3 | published | dR1 | published | dR2 | published |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const auto run_row = [&](const std::string& number, const SensitivityRun& run, const std::array<double, 3>& theirs) {
+    std::string varied;
+    for (const auto& [name, value] : run.variation) varied += (varied.empty() ? "" : ", ") + name + " = " + format(value, "%g");
+    md << "| " << number << " | " << (varied.empty() ? "none" : varied);
+    const std::array<double, 3> ours = {run.responses.r1, run.responses.r2, run.responses.r3};
+    for (std::size_t k = 0; k < 3; ++k) md << " | " << (run.ok ? format(ours[k]) : "failed") << " | " << format(theirs[k]);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const double mine = run.ok && result.base.ok ? ours[k] - agreement.responses[k].value : kNaN;
+      const double their = theirs[k] - published.base[k];
+      const bool significant = std::abs(their) >= kSignificantChange - 1e-9;
+      md << " | " << format(mine, "%+.4f") << " | " << format(their, "%+.3f")
+         << (significant ? (mine * their > 0.0 ? " (sign kept)" : " (**sign differs**)") : "");
+    }
+    md << " |\n";
+  };
+  run_row("0", result.base, published.base);
+  int number = 0;
+  for (const SensitivityRun& run : result.runs) {
+    ++number;
+    for (const auto& [name, values] : published.first_order)
+      if (name == run.parameter && !result.central) run_row(std::to_string(number), run, values);
+  }
+  for (std::size_t j = 0; j < result.second_order_runs.size() && j < published.second_order.size(); ++j)
+    run_row(std::to_string(++number), result.second_order_runs[j], published.second_order[j]);
+
+  // Rankings.
+  if (!result.central) {
+    std::vector<std::array<double, 3>> theirs(result.runs.size(), {kNaN, kNaN, kNaN});
+    for (std::size_t i = 0; i < result.runs.size(); ++i)
+      for (const auto& [name, values] : published.first_order)
+        if (name == result.runs[i].parameter)
+          for (std::size_t k = 0; k < 3; ++k) theirs[i][k] = (values[k] - published.base[k]) / (design.factor - 1.0);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto& ranking = published.ranking[k];
+      if (ranking.empty()) continue;
+      std::vector<std::size_t> order(result.runs.size());
+      std::iota(order.begin(), order.end(), 0);
+      const auto magnitude = [&](std::size_t i) { return std::isnan(result.derivatives[i][k]) ? -1.0 : std::abs(result.derivatives[i][k]); };
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return magnitude(a) > magnitude(b); });
+      md << "\n## R" << k + 1 << ": the published ranking against ours\n\n"
+         << "| published rank | parameter | published dR/dP | ours | our rank | sign |\n|---|---|---|---|---|---|\n";
+      for (std::size_t rank = 0; rank < ranking.size(); ++rank) {
+        std::size_t i = 0;
+        while (i < result.runs.size() && result.runs[i].parameter != ranking[rank]) ++i;
+        if (i == result.runs.size()) continue;
+        const std::size_t our_rank = static_cast<std::size_t>(std::find(order.begin(), order.end(), i) - order.begin()) + 1;
+        const double mine = result.derivatives[i][k], their = theirs[i][k];
+        md << "| " << rank + 1 << " | " << ranking[rank] << " | " << format(their, "%+.3f") << " | " << format(mine, "%+.3f") << " | "
+           << our_rank << " | " << (std::abs(mine) < 0.0005 ? "ours 0.000" : (mine * their > 0.0 ? "same" : "**differs**")) << " |\n";
+      }
+    }
+  }
+
+  // Second-order derivatives: ours and the published runs' through the same fit.
+  if (!result.fit.terms.empty() && published.second_order.size() == design.second_order.runs.size()) {
+    std::vector<SensitivitySample> samples{{"run 0", {}, published.base}};
+    std::vector<std::string> term_parameters;
+    for (const SensitivityTerm& t : result.fit.terms) {
+      term_parameters.push_back(t.first);
+      if (!t.linear()) term_parameters.push_back(t.second);
+    }
+    const auto in_form = [&](const std::string& name) {
+      return std::find(term_parameters.begin(), term_parameters.end(), name) != term_parameters.end();
+    };
+    for (const auto& [name, values] : published.first_order)
+      if (in_form(name)) samples.push_back({name, {{name, design.factor}}, values});
+    for (std::size_t j = 0; j < published.second_order.size(); ++j) {
+      const SensitivityPoint& point = design.second_order.runs[j];
+      if (std::all_of(point.begin(), point.end(), [&](const auto& e) { return in_form(e.first); }))
+        samples.push_back({"second order " + std::to_string(j + 1), point, published.second_order[j]});
+    }
+    const QuadraticFit theirs = fit_quadratic(result.fit.terms, samples);
+    md << "\n## Derivatives at P = 1 of the second-order form: ours and the published runs' (same fit)\n\n"
+       << "| derivative | R1 ours | R1 published | R2 ours | R2 published | R3 ours | R3 published |\n|---|---|---|---|---|---|---|\n";
+    for (std::size_t d = 0; d < result.fit.derivatives.size() && d < theirs.derivatives.size(); ++d) {
+      md << "| " << result.fit.derivatives[d].label();
+      for (std::size_t k = 0; k < 3; ++k)
+        md << " | " << format(result.fit.derivatives[d].value[k], "%+.3f") << " | " << format(theirs.derivatives[d].value[k], "%+.3f");
+      md << " |\n";
+    }
+  }
+  return md.str();
+}
+
 std::vector<ReadingsCombinationResult> run_readings(const std::string& model_path, const SensitivityDesign& design,
                                                     const ReadingsPlan& plan, const ReadingsOptions& options) {
   if (!design.reference)
@@ -391,7 +520,7 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
   for (const std::vector<int>& combination : combinations) {
     designs.push_back(plan.design_for(combination, design));
     try {
-      check_design_keys(designs.back(), model_path, plan.settings(combination));
+      check_design_keys(designs.back(), model_path, plan.settings(combination), designs.size() > 1 ? &designs.front() : nullptr);
     } catch (const InputError& e) {
       throw InputError(plan.path + ": the combination " + plan.label(combination) + ": " + e.what());
     }
@@ -518,9 +647,16 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
   std::ofstream out(std::filesystem::path(directory) / "readings.md");
   out << text;
   if (!out) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.md").string());
-  for (std::size_t c = 0; c < results.size(); ++c)
-    write_sensitivity(results[c].study, plan.design_for(results[c].levels, design),
-                      (std::filesystem::path(directory) / folder_of(c)).string());
+  for (std::size_t c = 0; c < results.size(); ++c) {
+    const SensitivityDesign combination_design = plan.design_for(results[c].levels, design);
+    const std::filesystem::path run_folder = std::filesystem::path(directory) / folder_of(c);
+    write_sensitivity(results[c].study, combination_design, run_folder.string());
+    if (!results[c].study.base.ok || results[c].study.central) continue;
+    std::ofstream comparison(run_folder / "comparison.md");
+    comparison << "# " << plan.label(results[c].levels) << ": the study against the published results\n\n"
+               << comparison_markdown(results[c].study, combination_design);
+    if (!comparison) throw std::runtime_error("cannot write " + (run_folder / "comparison.md").string());
+  }
   return text;
 }
 

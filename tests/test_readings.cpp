@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -181,6 +182,14 @@ TEST_CASE("a reading study ranks first the reading that reproduces the published
   CHECK_THAT(md, Contains("| 1 | 1 | printed |"));  // ranked first: combination 1
   CHECK(std::filesystem::exists(out + "/readings.csv"));
   CHECK(std::filesystem::exists(out + "/combination_001/sensitivity.csv"));
+  CHECK(std::filesystem::exists(out + "/combination_001/comparison.md"));
+  // The side by side of the matching combination: no error, every sign kept, ours = published.
+  const std::string comparison = comparison_markdown(results[1].study, design);
+  CHECK_THAT(comparison, Contains("| run 0, relative error | +0.0 % |"));
+  CHECK_THAT(comparison, Contains("(sign kept)") && !Contains("sign differs"));
+  char r1[16];
+  std::snprintf(r1, sizeof r1, "%.3f", truth.base.responses.r1);
+  CHECK_THAT(comparison, Contains("| run 0, ours | " + std::string(r1)) && Contains("| run 0, published | " + std::string(r1)));
 }
 
 TEST_CASE("a reading level may change what a design parameter scales", "[readings]") {

@@ -117,6 +117,12 @@ struct Agreement {
 /// failed runs are left out of the changes).
 Agreement score_agreement(const SensitivityResult& result, const SensitivityDesign& design);
 
+/// The study side by side with the design's published results (Markdown): the agreement
+/// scores, every run against its published counterpart, the rankings (Tables 15-17 for the
+/// report) and, when the design has a second-order form, its derivatives at P = 1 from our runs
+/// and from the published ones (Table 14), fitted the same way.
+std::string comparison_markdown(const SensitivityResult& result, const SensitivityDesign& design);
+
 /// Spearman's rank correlation (average ranks for ties); NaN if fewer than 3 pairs or either
 /// side is constant.
 double spearman_correlation(const std::vector<double>& a, const std::vector<double>& b);
