@@ -16,6 +16,7 @@
 
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/table_text.hpp"
 
 namespace railcrash {
 
@@ -52,20 +53,8 @@ std::string model_text_of(const std::string& model_path) {
   return buffer.str();
 }
 
-std::string format(double value, const char* spec = "%.3f") {
-  if (std::isnan(value)) return "n/a";
-  char text[48];
-  std::snprintf(text, sizeof text, spec, value);
-  return text;
-}
-
-std::string csv_field(double value) { return std::isnan(value) ? "" : format(value, "%.8g"); }
-
-std::string csv_quoted(const std::string& text) {
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
+std::string format(double value, const char* spec = "%.3f") { return table_number(value, spec); }
+std::string csv_field(double value) { return csv_number(value, "%.8g"); }
 
 std::vector<double> average_ranks(const std::vector<double>& values) {
   std::vector<std::size_t> order(values.size());
@@ -562,7 +551,7 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
 
   std::ofstream csv(std::filesystem::path(directory) / "readings.csv");
   csv << "rank,combination";
-  for (const Reading& r : plan.readings) csv << "," << csv_quoted(r.name);
+  for (const Reading& r : plan.readings) csv << "," << csv_text(r.name);
   for (int k = 1; k <= 3; ++k)
     csv << ",R" << k << ",R" << k << "_error,R" << k << "_sign_runs,R" << k << "_sign_agree,R" << k << "_spearman,R" << k
         << "_rms,R" << k << "_sign_runs_all,R" << k << "_sign_agree_all,R" << k << "_spearman_all,R" << k << "_rms_all,R" << k
@@ -572,13 +561,13 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     const ReadingsCombinationResult& r = results[order[rank]];
     csv << rank + 1 << "," << order[rank];
     for (std::size_t i = 0; i < plan.readings.size(); ++i)
-      csv << "," << csv_quoted(plan.readings[i].levels[static_cast<std::size_t>(r.levels[i])].name);
+      csv << "," << csv_text(plan.readings[i].levels[static_cast<std::size_t>(r.levels[i])].name);
     for (const ResponseAgreement& a : r.agreement.responses) {
       std::string top;
       for (const auto& p : a.top_five) top += (top.empty() ? "" : " ") + p;
       csv << "," << csv_field(a.value) << "," << csv_field(a.relative_error) << "," << a.significant_runs << "," << a.sign_agreements
           << "," << csv_field(a.spearman) << "," << csv_field(a.rms) << "," << a.significant_runs_all << "," << a.sign_agreements_all
-          << "," << csv_field(a.spearman_all) << "," << csv_field(a.rms_all) << "," << a.top_five_shared << "," << csv_quoted(top);
+          << "," << csv_field(a.spearman_all) << "," << csv_field(a.rms_all) << "," << a.top_five_shared << "," << csv_text(top);
     }
     csv << "," << r.agreement.goals_met << "," << csv_field(r.agreement.score) << "," << r.failed_runs << ","
         << format(r.wall_seconds, "%.1f") << "\n";

@@ -19,6 +19,7 @@
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
+#include "railcrash/table_text.hpp"
 
 namespace railcrash {
 
@@ -531,21 +532,7 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
 
 namespace {
 
-std::string number(double value, const char* format = "%.3f") {
-  if (std::isnan(value)) return "n/a";
-  if (std::isinf(value)) return "inf";
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
-std::string csv_number(double value) { return std::isnan(value) ? "" : number(value, "%.10g"); }
-
-std::string csv_text(const std::string& text) {
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
+std::string number(double value, const char* format = "%.3f") { return table_number(value, format); }
 
 // "R1 = 1.980 - 0.005 P5 - 0.180 P6 ..." with terms that round to zero at 3 decimals left out.
 std::string equation(int response_index, double constant, const std::vector<std::pair<std::string, double>>& terms) {
