@@ -605,6 +605,24 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     md << " | " << format(a[2].spearman, "%.2f") << " | " << r.agreement.goals_met << "/" << Agreement::kGoals << " | "
        << format(r.agreement.score, "%.2f") << " | " << r.failed_runs << " |\n";
   }
+  // How much each reading decided: the best combination with each of its levels.
+  if (!results.empty()) {
+    md << "\nHow much each reading decided: the best combination with each level (goals met, score; "
+          "with the R2 and R3 errors of run 0 and the rank correlations of that combination).\n\n"
+       << "| reading | level | best combination | goals | score | R2 | R3 | R1 rho | R2 rho |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (std::size_t r = 0; r < plan.readings.size(); ++r)
+      for (std::size_t l = 0; l < plan.readings[r].levels.size(); ++l) {
+        const auto it = std::find_if(order.begin(), order.end(),
+                                     [&](std::size_t c) { return results[c].levels[r] == static_cast<int>(l); });
+        if (it == order.end()) continue;
+        const ReadingsCombinationResult& best = results[*it];
+        const auto& a = best.agreement.responses;
+        md << "| " << plan.readings[r].name << " | " << plan.readings[r].levels[l].name << " | " << *it << " | "
+           << best.agreement.goals_met << "/" << Agreement::kGoals << " | " << format(best.agreement.score, "%.2f") << " | "
+           << format(100.0 * a[1].relative_error, "%+.1f %%") << " | " << format(100.0 * a[2].relative_error, "%+.1f %%") << " | "
+           << format(a[0].spearman, "%.2f") << " | " << format(a[1].spearman, "%.2f") << " |\n";
+      }
+  }
   md << "\nReadings and levels:\n\n";
   for (const Reading& r : plan.readings) {
     md << "- **" << r.name << "**" << (r.description.empty() ? "" : ": " + r.description) << "\n";
