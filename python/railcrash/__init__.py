@@ -22,6 +22,7 @@ models in parallel.
 import json as _json
 import math as _math
 import numbers as _numbers
+import os as _os
 
 from ._railcrash import InputError, Model, Results, RunSettings, SolverError, __version__
 from . import _railcrash
@@ -100,8 +101,10 @@ def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, outpu
 
     Unset arguments keep the model's simulation section. integrator: "ida" or "euler".
     """
-    if not isinstance(model, Model):
+    if isinstance(model, (str, _os.PathLike)):
         model = load(model, set)
+    elif not isinstance(model, Model):
+        raise TypeError(f"run takes a railcrash.Model or a model file's path, not {type(model).__name__}")
     elif set:
         model = model.with_settings(set)
     settings = RunSettings()
