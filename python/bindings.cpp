@@ -64,10 +64,14 @@ py::dict sensitivity(const std::string& model_path, const std::string& design, i
   for (const auto& r : result.runs) runs.append(sensitivity_run_dict(r));
   for (const auto& r : result.second_order_runs) runs.append(sensitivity_run_dict(r));
   py::list first_order;
-  for (std::size_t i = 0; i < result.derivatives.size() && i < loaded.parameters.size(); ++i) {
+  // derivatives[i] belongs to the i-th parameter run (runs[i], or runs[2i] and runs[2i+1] central).
+  const std::size_t per_parameter = result.central ? 2 : 1;
+  for (std::size_t i = 0; i < result.derivatives.size() && per_parameter * i < result.runs.size(); ++i) {
+    const std::string& name = result.runs[per_parameter * i].parameter;
     py::dict row;
-    row["parameter"] = loaded.parameters[i].name;
-    row["description"] = loaded.parameters[i].description;
+    row["parameter"] = name;
+    for (const railcrash::SensitivityParameter& p : loaded.parameters)
+      if (p.name == name) row["description"] = p.description;
     row["A_R1"] = result.derivatives[i][0];
     row["A_R2"] = result.derivatives[i][1];
     row["A_R3"] = result.derivatives[i][2];

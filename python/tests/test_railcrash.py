@@ -283,6 +283,25 @@ class SensitivityTest(unittest.TestCase):
         self.assertAlmostEqual(p7["A_R1"], expected, delta=1e-3 * abs(expected))
         self.assertLess(p7["A_R1"], 0.0)
 
+    def test_only_and_central(self):
+        """--only and --central: the rows name the parameters that ran."""
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "model.yaml"
+            design = pathlib.Path(folder) / "design.yaml"
+            model.write_text(ANTICLIMBER)
+            design.write_text("sensitivity: 1\nparameters:\n"
+                              "  - name: P5\n    description: elastic slope\n"
+                              "    scale: [{key: elements.ac.horizontal_elastic_stiffness, power: 1}]\n"
+                              "  - name: P7\n    description: horizontal yield force\n"
+                              "    scale: [{key: elements.ac.horizontal_yield_deflection, power: 1}]\n")
+            table = railcrash.sensitivity(model, design=design, jobs=2, only=["P7"], central=0.05)
+        self.assertTrue(table["central"])
+        self.assertEqual([r["parameter"] for r in table["runs"]], ["base", "P7", "P7"])
+        (p7,) = table["first_order"]
+        self.assertEqual((p7["parameter"], p7["description"]), ("P7", "horizontal yield force"))
+        expected = (crush_for(0.0105) - crush_for(0.0095)) / 0.02 / 0.1
+        self.assertAlmostEqual(p7["A_R1"], expected, delta=1e-3 * abs(expected))
+
     def test_design_errors(self):
         with self.assertRaises(railcrash.InputError):
             railcrash.sensitivity("/no/such/model.yaml", design="/no/such/design.yaml")
