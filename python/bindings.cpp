@@ -9,7 +9,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
+#include <map>
 #include <thread>
+#include <tuple>
 
 #include "railcrash/api.hpp"
 #include "railcrash/sensitivity.hpp"
@@ -164,6 +167,33 @@ PYBIND11_MODULE(_railcrash, m) {
       }, "committed mode changes: (t, element, event, value) tuples")
       .def_property_readonly("summary_json", [](const rc::Results& r) { return r.summary_json; })
       .def_property_readonly("message", [](const rc::Results& r) { return r.summary.message; });
+
+  py::class_<rc::ModelBuilder>(m, "ModelBuilder",
+                               "Builds a model in code; build() checks it as a model file is checked.")
+      .def(py::init<std::string, std::string>(), py::arg("name"), py::arg("units") = "SI")
+      .def("gravity", &rc::ModelBuilder::gravity, py::arg("x"), py::arg("y"), py::return_value_policy::reference_internal)
+      .def("body", [](rc::ModelBuilder& b, const std::string& name, double mass, double inertia, std::array<double, 2> position,
+                      double angle, std::array<double, 2> velocity, double angular_velocity) -> rc::ModelBuilder& {
+            return b.body({name, mass, inertia, position[0], position[1], angle, velocity[0], velocity[1], angular_velocity});
+          }, py::arg("name"), py::arg("mass"), py::arg("inertia"), py::arg("position"), py::arg("angle") = 0.0,
+          py::arg("velocity") = std::array<double, 2>{0.0, 0.0}, py::arg("angular_velocity") = 0.0,
+          py::return_value_policy::reference_internal)
+      .def("element", [](rc::ModelBuilder& b, const std::string& name, const std::string& type,
+                         const std::vector<std::tuple<std::string, double, double>>& points,
+                         const std::map<std::string, rc::Parameter>& parameters) -> rc::ModelBuilder& {
+            std::vector<rc::Point> at;
+            for (const auto& [body, x, y] : points) at.push_back({body, x, y});
+            return b.element(name, type, at, parameters);
+          }, py::arg("name"), py::arg("type"), py::arg("points"), py::arg("parameters") = std::map<std::string, rc::Parameter>{},
+          "points: [(body, x, y), ...] (body-frame offsets); parameters: {key: number | bool | [numbers] | [[numbers]]}",
+          py::return_value_policy::reference_internal)
+      .def("force", [](rc::ModelBuilder& b, const std::string& body, std::array<double, 2> at,
+                       std::array<double, 2> value) -> rc::ModelBuilder& { return b.force({body, at[0], at[1]}, value[0], value[1]); },
+           py::arg("body"), py::arg("at"), py::arg("value"), py::return_value_policy::reference_internal)
+      .def("moment", &rc::ModelBuilder::moment, py::arg("body"), py::arg("value"), py::return_value_policy::reference_internal)
+      .def("simulation", &rc::ModelBuilder::simulation, py::arg("settings"), py::return_value_policy::reference_internal)
+      .def("yaml", &rc::ModelBuilder::yaml)
+      .def("build", &rc::ModelBuilder::build);
 
   m.def("_run", [](const rc::Model& model, const rc::RunSettings& settings) {
         return std::make_shared<rc::Results>(rc::run(model, settings));

@@ -9,6 +9,12 @@
     r.events                                   # [(t, element, event, value), ...]
     r.dataframe()                              # every column, when pandas is installed
 
+    b = railcrash.ModelBuilder("spring-mass", "SI")   # a model in code
+    b.gravity(0, 0).body("cart", mass=2.0, inertia=0.1, position=(1.1, 0))
+    b.element("spring", "linear_spring", [("ground", 0, 0), ("cart", 0, 0)],
+              {"stiffness": 800.0, "free_length": 1.0})
+    m = b.build()
+
 Settings (`set=`) are the command line's --set: {"simulation.t_end": 0.5} is
 simulation.t_end=0.5; a key ending in "*" scales the model's number:
 {"elements.k1.stiffness*": 1.2} is elements.k1.stiffness*=1.2.
@@ -24,13 +30,13 @@ import math as _math
 import numbers as _numbers
 import os as _os
 
-from ._railcrash import InputError, Model, Results, RunSettings, SolverError, __version__
+from ._railcrash import InputError, Model, ModelBuilder, Results, RunSettings, SolverError, __version__
 from . import _railcrash
 
-for _name in ("InputError", "SolverError", "Model", "Results", "RunSettings"):
+for _name in ("InputError", "SolverError", "Model", "ModelBuilder", "Results", "RunSettings"):
     getattr(_railcrash, _name).__module__ = "railcrash"
 
-__all__ = ["load", "from_yaml", "run", "sensitivity", "Model", "Results", "InputError", "SolverError", "__version__"]
+__all__ = ["load", "from_yaml", "run", "sensitivity", "Model", "ModelBuilder", "Results", "InputError", "SolverError", "__version__"]
 
 
 def _setting_value(key, value):

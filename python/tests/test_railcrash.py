@@ -109,6 +109,48 @@ class RunTest(unittest.TestCase):
         self.assertAlmostEqual(summary["peaks"]["spring.force"]["abs_max"], STIFFNESS * 0.1, places=3)
         self.assertEqual(result.events, [])
 
+    def test_model_built_in_code(self):
+        builder = railcrash.ModelBuilder("oscillator", "SI")
+        builder.gravity(0.0, 0.0).body("cart", mass=MASS, inertia=0.1, position=(1.1, 0.0))
+        builder.element("spring", "linear_spring", [("ground", 0, 0), ("cart", 0, 0)],
+                        {"stiffness": STIFFNESS, "free_length": 1.0})
+        settings = railcrash.RunSettings()
+        settings.t_end = 1.0
+        settings.output_interval = 1e-4
+        builder.simulation(settings)
+        model = builder.build()
+        self.assertIn("linear_spring", builder.yaml())
+        result = railcrash.run(model, rtol=1e-9)
+        exact = 2.0 * math.pi * math.sqrt(MASS / STIFFNESS)
+        self.assertLess(abs(mean_period(result.t, result.series("cart.x"), 1.0) - exact) / exact, 1e-6)
+        # A constant force F moves the equilibrium by F / k.
+        pushed = railcrash.ModelBuilder("pushed", "SI")
+        pushed.gravity(0, 0).body("cart", mass=MASS, inertia=0.1, position=(1.0, 0.0))
+        pushed.element("spring", "linear_spring", [("ground", 0, 0), ("cart", 0, 0)],
+                       {"stiffness": STIFFNESS, "free_length": 1.0})
+        pushed.element("damper", "linear_dashpot", [("ground", 0, 0), ("cart", 0, 0)], {"damping": 80.0})  # critical: 2 sqrt(k m)
+        pushed.force("cart", at=(0, 0), value=(40.0, 0.0))
+        settled = railcrash.run(pushed.build(), t_end=2.0)
+        self.assertAlmostEqual(settled.series("cart.x")[-1], 1.0 + 40.0 / STIFFNESS, places=6)
+
+    def test_built_model_errors_name_the_element(self):
+        builder = railcrash.ModelBuilder("dangling")
+        builder.body("cart", mass=1.0, inertia=0.1, position=(1, 0))
+        builder.element("spring", "linear_spring", [("ground", 0, 0), ("crat", 0, 0)], {"stiffness": 10.0})
+        with self.assertRaisesRegex(railcrash.InputError, "element 'spring'.*unknown body 'crat' \\(did you mean 'cart'\\?\\)"):
+            builder.build()
+        typo = railcrash.ModelBuilder("typo")
+        typo.body("cart", mass=1.0, inertia=0.1, position=(1, 0))
+        typo.element("spring", "linear_sprung", [("ground", 0, 0), ("cart", 0, 0)], {"stiffness": 10.0})
+        with self.assertRaisesRegex(railcrash.InputError, "did you mean 'linear_spring'"):
+            typo.build()
+        negative = railcrash.ModelBuilder("negative")
+        negative.body("cart", mass=-1.0, inertia=0.1, position=(1, 0))
+        with self.assertRaisesRegex(railcrash.InputError, "body 'cart': mass must be positive"):
+            negative.build()
+        with self.assertRaises(TypeError):
+            negative.element("spring", "linear_spring", [("ground", 0, 0)], {"stiffness": "stiff"})
+
     def test_settings_scale_and_set_values(self):
         model = railcrash.from_yaml(OSCILLATOR)
         base = railcrash.run(model)
