@@ -5,7 +5,7 @@
 //   #include <railcrash/api.hpp>
 //   namespace rc = railcrash::api;
 //   rc::Model model = rc::Model::load("models/report/final_two_car.yaml",
-//                                     {"elements.car1_anticlimber.horizontal_yield_force*=1.2"});
+//                                     {"elements.anticlimber.horizontal_yield_deflection*=1.2"});
 //   rc::RunSettings settings;
 //   settings.integrator = "ida";
 //   settings.rtol = 1e-4;

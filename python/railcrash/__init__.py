@@ -2,7 +2,7 @@
 
     import railcrash
     m = railcrash.load("models/report/final_two_car.yaml",
-                       set={"elements.car1_anticlimber.horizontal_yield_force*": 1.2})
+                       set={"elements.anticlimber.horizontal_yield_deflection*": 1.2})
     r = railcrash.run(m, integrator="ida", rtol=1e-4)
     r.t, r.series("car1_center_body.x")      # numpy arrays (read-only views)
     r.summary["car_crush"]                     # summary.json as a dict
