@@ -1,6 +1,7 @@
 // The public interface (api.hpp): results in memory against the files `railcrash run` writes,
 // models built in code against the closed form, errors, and runs from several threads.
 #include <catch2/catch.hpp>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -62,7 +63,8 @@ TEST_CASE("api: results in memory are the files railcrash run writes", "[api]") 
   railcrash::RunOverrides overrides;
   overrides.rtol = 1e-4;
   railcrash::apply_overrides(loaded, overrides);
-  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_api_test").string();
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("railcrash_api_test_" + std::to_string(::getpid()))).string();
   std::filesystem::remove_all(dir);
   const railcrash::RunReport report = railcrash::run_model(loaded, dir);
   REQUIRE(report.outcome.ok);
