@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|kernels|sensitivity|converge|python|all] [extra options for railcrash_bench]
+#   bench/run.sh [consist|kernels|sensitivity|converge|readings|python|all] [extra options for railcrash_bench]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -16,11 +16,21 @@ case $what in
   python) PYTHONPATH=build/python /usr/bin/python3 bench/python_overhead.py "$@" ;;
   converge) build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
               --out bench/converge_final_two_car_0.5s "$@" ;;
+  readings)
+    # The report's reading study: 64 combinations x 40 runs (issue 10's goal: under 30 min on 2 cores).
+    start=$(date +%s)
+    build/railcrash readings models/report/final_two_car.yaml --readings models/report/readings.yaml --jobs "$(nproc)" \
+        --out out/readings "$@" > /dev/null
+    seconds=$(( $(date +%s) - start ))
+    load=$(cut -d' ' -f1-3 /proc/loadavg)
+    line="readings (models/report/readings.yaml, 64 combinations x 40 runs, --jobs $(nproc)): ${seconds} s wall; load average at the end ${load}; commit $commit, $(nproc) cores"
+    echo "$line"
+    printf -- '- %s: %s\n' "$(date -u +%Y-%m-%d)" "$line" >> bench/results.md ;;
   all)
     $bench --commit "$commit" consist --t-end 0.05
     $bench --commit "$commit" kernels --cars 2,10,20,50,100
     $bench --commit "$commit" sensitivity
     build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
         --out bench/converge_final_two_car_0.5s ;;
-  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|python|all] [options]" >&2; exit 2 ;;
+  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|readings|python|all] [options]" >&2; exit 2 ;;
 esac

@@ -85,5 +85,22 @@ expect_text "converge CSV header" "$tmp/conv/converge.csv" '^method,step,rtol,st
 expect_status "converge with an unknown quantity exits 2" 2 "$bin" converge "$spring" --quantities max_crunch
 expect_text "it names the quantity" "$tmp/stderr" "unknown quantity 'max_crunch'"
 
+# readings: bad readings files exit 2 naming the file and line, before any run starts (the
+# report model's study would take minutes, so an exit within seconds shows nothing ran).
+report_model=$src/models/report/final_two_car.yaml
+printf 'reading_study: 1\nreadings:\n  - name: a\n    levels:\n      - {name: x, set: {elements.nothing.stiffness: 2}}\n' > "$tmp/missing_key.yaml"
+expect_status "readings naming a missing model key exits 2" 2 "$bin" readings "$report_model" --readings "$tmp/missing_key.yaml" --out "$tmp/r1"
+expect_text "it names the readings file's line and the key" "$tmp/stderr" "missing_key.yaml:5: reading 'a', level 'x'.*no element named 'nothing'"
+printf 'reading_study: 1\nreadings: []\n' > "$tmp/empty.yaml"
+expect_status "an empty readings list exits 2" 2 "$bin" readings "$report_model" --readings "$tmp/empty.yaml" --out "$tmp/r2"
+expect_text "it says what to give" "$tmp/stderr" "empty.yaml:2: .*at least one reading"
+printf 'reading_study: 1\nreadings:\n  - {name: a, levelz: []}\n' > "$tmp/unknown_key.yaml"
+expect_status "an unknown reading key exits 2" 2 "$bin" readings "$report_model" --readings "$tmp/unknown_key.yaml" --out "$tmp/r3"
+expect_text "it names the key" "$tmp/stderr" "unknown_key.yaml:3: reading: unknown key 'levelz'"
+[ ! -e "$tmp/r1" ] && [ ! -e "$tmp/r2" ] && [ ! -e "$tmp/r3" ] && passes=$((passes + 1)) || { echo "FAIL: a rejected readings study wrote output"; failures=$((failures + 1)); }
+sed '/^reference:/,$d' "$src/models/report/sensitivity_design.yaml" > "$tmp/no_reference.yaml"
+expect_status "readings with a design without a reference exits 2" 2 "$bin" readings "$report_model" --readings "$src/models/report/readings.yaml" --design "$tmp/no_reference.yaml" --out "$tmp/r4"
+expect_text "it says the reference is missing" "$tmp/stderr" "no 'reference' section"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
