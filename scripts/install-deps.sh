@@ -2,8 +2,12 @@
 # Installs what railcrash needs to build and test, from Debian 12's packages (as root, or
 # through sudo). Does nothing that is already installed.
 set -euo pipefail
-packages=(build-essential cmake ninja-build pkg-config
-          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2)
+# file + dpkg-dev: CPack's Debian packages (their dependencies come from dpkg-shlibdeps).
+# pybind11 + numpy + python3-dev: the Python module; pandas and matplotlib: its dataframe()
+# and the Python example (all from Debian, for /usr/bin/python3; no pip).
+packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
+          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2
+          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# One command: install dependencies, build, run the whole test suite (unit tests and
-# verification cases), then build the unit tests with AddressSanitizer and
-# UndefinedBehaviorSanitizer and run them again.
+# One command: install dependencies, build, run the whole test suite (unit tests,
+# verification cases, the Python module's tests and example, the installed package used from
+# an outside project, the Debian packages), then build the unit tests with AddressSanitizer
+# and UndefinedBehaviorSanitizer and run them again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh

@@ -34,7 +34,8 @@ std::string join(const std::vector<std::string>& words) {
   return out;
 }
 
-/// " (did you mean 'x'?)" when a known word is close to `word`.
+}  // namespace
+
 std::string suggestion(const std::string& word, const std::vector<std::string>& known) {
   std::string best;
   std::size_t best_distance = 3;
@@ -44,6 +45,8 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
   }
   return best.empty() ? "" : " (did you mean '" + best + "'?)";
 }
+
+namespace {
 
 /// Reads one model file, keeping the file name for every message.
 class Reader {

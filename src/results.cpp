@@ -96,20 +96,29 @@ std::string json_number(double value) {
   return buffer;
 }
 
-ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system)
-    : system_(system), directory_(directory), last_flush_(std::chrono::steady_clock::now()) {
-  std::error_code error;
-  std::filesystem::create_directories(directory, error);
-  if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
-  timeseries_ = std::fopen((directory + "/timeseries.csv").c_str(), "w");
-  events_ = std::fopen((directory + "/events.csv").c_str(), "w");
-  if (!timeseries_ || !events_) throw InputError("cannot write into the output folder '" + directory + "'");
-  std::fputs("t", timeseries_);
+std::vector<std::string> timeseries_columns(const DaeSystem& system) {
+  std::vector<std::string> names{"t"};
   for (const Body& b : system.model().bodies())
-    for (const char* q : {"x", "y", "theta", "vx", "vy", "omega"}) std::fprintf(timeseries_, ",%s.%s", b.name.c_str(), q);
-  for (const std::string& name : system.output_names()) std::fprintf(timeseries_, ",%s", name.c_str());
-  std::fputs("\n", timeseries_);
-  std::fputs("t,element,event,value\n", events_);
+    for (const char* q : {"x", "y", "theta", "vx", "vy", "omega"}) names.push_back(b.name + "." + q);
+  for (const std::string& name : system.output_names()) names.push_back(name);
+  return names;
+}
+
+ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory)
+    : system_(system), directory_(directory), last_flush_(std::chrono::steady_clock::now()) {
+  const std::vector<std::string> names = timeseries_columns(system);
+  if (!directory.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(directory, error);
+    if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
+    timeseries_ = std::fopen((directory + "/timeseries.csv").c_str(), "w");
+    events_ = std::fopen((directory + "/events.csv").c_str(), "w");
+    if (!timeseries_ || !events_) throw InputError("cannot write into the output folder '" + directory + "'");
+    for (std::size_t k = 0; k < names.size(); ++k) std::fprintf(timeseries_, "%s%s", k ? "," : "", names[k].c_str());
+    std::fputs("\n", timeseries_);
+    std::fputs("t,element,event,value\n", events_);
+  }
+  if (keep_in_memory) columns_.resize(names.size());
   output_values_.assign(system.output_names().size(), 0.0);
   peak_output_.assign(system.output_names().size(), 0.0);
   peak_time_.assign(system.output_names().size(), 0.0);
@@ -126,19 +135,29 @@ ResultWriter::~ResultWriter() {
 void ResultWriter::sample(double t, const double* y, const double* lambda, const double*) {
   const int n = system_.model().body_count();
   const int nq = 3 * n;
-  std::fprintf(timeseries_, "%.12g", t);
-  for (int i = 0; i < n; ++i)
-    std::fprintf(timeseries_, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", y[3 * i], y[3 * i + 1], y[3 * i + 2], y[nq + 3 * i],
-                 y[nq + 3 * i + 1], y[nq + 3 * i + 2]);
+  if (timeseries_) {
+    std::fprintf(timeseries_, "%.12g", t);
+    for (int i = 0; i < n; ++i)
+      std::fprintf(timeseries_, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", y[3 * i], y[3 * i + 1], y[3 * i + 2], y[nq + 3 * i],
+                   y[nq + 3 * i + 1], y[nq + 3 * i + 2]);
+  }
   system_.outputs(y, lambda, output_values_.data());
   for (std::size_t k = 0; k < output_values_.size(); ++k) {
-    std::fprintf(timeseries_, ",%.12g", output_values_[k]);
+    if (timeseries_) std::fprintf(timeseries_, ",%.12g", output_values_[k]);
     if (std::abs(output_values_[k]) > peak_output_[k]) {
       peak_output_[k] = std::abs(output_values_[k]);
       peak_time_[k] = t;
     }
   }
-  std::fputs("\n", timeseries_);
+  if (timeseries_) std::fputs("\n", timeseries_);
+  if (!columns_.empty()) {  // same order as the CSV columns
+    std::size_t column = 0;
+    columns_[column++].push_back(t);
+    for (int i = 0; i < n; ++i)
+      for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2})
+        columns_[column++].push_back(y[k]);
+    for (const double value : output_values_) columns_[column++].push_back(value);
+  }
   body_accelerations(system_, t, y, lambda, acceleration_.data());
   for (int i = 0; i < n; ++i) {
     AccelerationPeaks& p = acceleration_peaks_[static_cast<std::size_t>(i)];
@@ -155,6 +174,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
   }
   // Keep what is on disk current without flushing every row.
+  if (!timeseries_) return;
   const auto now = std::chrono::steady_clock::now();
   if (now - last_flush_ > std::chrono::milliseconds(500)) {
     std::fflush(timeseries_);
@@ -164,6 +184,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
 }
 
 void ResultWriter::event(const EventRecord& record, const double*) {
+  if (!events_) return;  // in memory, the events are the run outcome's
   std::string element = record.element, what = record.what;
   for (std::string* text : {&element, &what})
     if (text->find_first_of(",\"") != std::string::npos) {
@@ -174,9 +195,9 @@ void ResultWriter::event(const EventRecord& record, const double*) {
   std::fprintf(events_, "%.12g,%s,%s,%.12g\n", record.t, element.c_str(), what.c_str(), record.value);
 }
 
-void ResultWriter::write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json) {
-  std::fflush(timeseries_);
-  std::fflush(events_);
+std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json) {
+  if (timeseries_) std::fflush(timeseries_);
+  if (events_) std::fflush(events_);
   const Model& model = system_.model();
   const bool si = model.units == UnitSystem::SI;
   const EnergyBalance energy = EnergyBalance::between(outcome.initial_energy, outcome.final_energy);
@@ -238,9 +259,11 @@ void ResultWriter::write_summary(const RunOutcome& outcome, const std::string& i
     j << "]}";
   }
   j << "}" << extra_json << "\n}\n";
+  if (directory_.empty()) return j.str();
   std::ofstream out(directory_ + "/summary.json");
   out << j.str();
   if (!out) throw SolverError("could not write " + directory_ + "/summary.json");
+  return j.str();
 }
 
 }  // namespace railcrash

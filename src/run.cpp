@@ -73,13 +73,15 @@ std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const Simul
   return std::make_unique<IdaIntegrator>(system, ida);
 }
 
-RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress) {
+RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
+                    bool keep_in_memory) {
   const DaeSystem system(model);
   std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;
   std::vector<RunObserver*> observers;
-  if (!out_dir.empty()) observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system)).get());
+  if (!out_dir.empty() || keep_in_memory)
+    observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory)).get());
   if (model.responses.defined())
     observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
   const bool terminal = show_progress && isatty(STDERR_FILENO);
@@ -91,10 +93,15 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     report.responses = responses->result();
     report.has_responses = true;
   }
-  if (writer) writer->write_summary(report.outcome, report.integrator, responses ? ",\n  \"responses\": " + responses->json() : "");
   if (writer) {
+    report.summary_json =
+        writer->write_summary(report.outcome, report.integrator, responses ? ",\n  \"responses\": " + responses->json() : "");
     report.acceleration_peaks = writer->acceleration_peaks();
     report.car_crush = writer->car_crush();
+  }
+  if (keep_in_memory) {
+    report.columns = timeseries_columns(system);
+    report.series = std::move(writer->columns());
   }
   return report;
 }

@@ -1,4 +1,5 @@
 #include <catch2/catch.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -27,7 +28,9 @@ double crush_for(double yield_deflection) {
 }
 
 struct Files {
-  std::string dir = (std::filesystem::temp_directory_path() / "railcrash_sensitivity_test").string();
+  // One folder per process: CTest runs test cases in parallel, and other checkouts on the machine too.
+  std::string dir =
+      (std::filesystem::temp_directory_path() / ("railcrash_sensitivity_test_" + std::to_string(::getpid()))).string();
   std::string model = dir + "/model.yaml", design = dir + "/design.yaml";
   Files() {
     std::filesystem::remove_all(dir);

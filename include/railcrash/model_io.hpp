@@ -16,4 +16,7 @@ Model load_model(const std::string& path);
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
 Model load_model(const std::string& path, const std::vector<std::string>& overrides);
 
+/// " (did you mean 'x'?)" when a word of `known` is close to `word` (edit distance < 3), else "".
+std::string suggestion(const std::string& word, const std::vector<std::string>& known);
+
 }  // namespace railcrash

@@ -1,9 +1,11 @@
-// Run results on disk, written as the run goes:
+// Run results, written to disk as the run goes, kept in memory, or both:
 //   DIR/timeseries.csv  t, then <body>.x,<body>.y,<body>.theta,<body>.vx,<body>.vy,<body>.omega for
 //                       every body in file order, then <element>.<quantity> columns
 //   DIR/events.csv      t,element,event,value
 //   DIR/summary.json    status, message, t_reached, integrator, units, stats, energy, peaks,
 //                       peak_accelerations, car_crush (and responses, when the model has them)
+// In memory (the library's runs, api.hpp): the timeseries.csv columns as vectors and the
+// summary.json text; no folder is needed.
 //
 // Peak accelerations: every body's acceleration v' at every output sample, from its
 // equations of motion  M v' = f(t, q, v) - G^T lambda  (lambda: IDA's multipliers, or the
@@ -57,19 +59,26 @@ struct CarCrush {
 /// Cars of a model (see above), with their crush elements.
 std::vector<CarCrush> cars_of(const DaeSystem& system);
 
+/// Column names of timeseries.csv: t, the six body columns per body, the element outputs.
+std::vector<std::string> timeseries_columns(const DaeSystem& system);
+
 class ResultWriter : public RunObserver {
  public:
-  /// Creates DIR and the two CSV files with their headers.
-  ResultWriter(const std::string& directory, const DaeSystem& system);
+  /// Creates DIR and the two CSV files with their headers (DIR empty: no files). With
+  /// keep_in_memory, every sample is also kept as one value per timeseries column.
+  ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory = false);
   ~ResultWriter() override;
   ResultWriter(const ResultWriter&) = delete;
   ResultWriter& operator=(const ResultWriter&) = delete;
 
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
   void event(const EventRecord& record, const double* y) override;
-  /// Writes summary.json (call once, at the end, whatever the outcome).
-  void write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json = "");
+  /// Writes summary.json when there is a folder (call once, at the end, whatever the
+  /// outcome); returns its text.
+  std::string write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json = "");
   const std::string& directory() const { return directory_; }
+  /// The kept samples (keep_in_memory): columns[k] is timeseries column k over the samples.
+  std::vector<std::vector<double>>& columns() { return columns_; }
   /// Peaks so far, per body in model order.
   const std::vector<AccelerationPeaks>& acceleration_peaks() const { return acceleration_peaks_; }
   /// Largest crush of each car so far.
@@ -80,6 +89,7 @@ class ResultWriter : public RunObserver {
   std::string directory_;
   std::FILE* timeseries_ = nullptr;
   std::FILE* events_ = nullptr;
+  std::vector<std::vector<double>> columns_;  // in memory, per timeseries column
   std::vector<double> output_values_;
   std::vector<double> peak_output_;  // largest |value| of each element output
   std::vector<double> peak_time_;

@@ -37,11 +37,16 @@ struct RunReport {
   // From the result writer (empty when no output folder): per body, per car (results.hpp).
   std::vector<AccelerationPeaks> acceleration_peaks;
   std::vector<CarCrush> car_crush;
+  std::string summary_json;  // the text of summary.json (empty when neither a folder nor memory)
+  // keep_in_memory: timeseries.csv in memory, column by column (events: outcome.events).
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> series;
 };
 
-/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files).
+/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files);
+/// with keep_in_memory the same results also come back in the report.
 /// Input errors throw InputError before anything runs; solver failures come back with ok = false.
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
-                    bool show_progress = false);
+                    bool show_progress = false, bool keep_in_memory = false);
 
 }  // namespace railcrash

@@ -1,0 +1,165 @@
+"""railcrash: planar rail-vehicle crash dynamics from Python.
+
+    import railcrash
+    m = railcrash.load("models/report/final_two_car.yaml",
+                       set={"elements.anticlimber.horizontal_yield_deflection*": 1.2})
+    r = railcrash.run(m, integrator="ida", rtol=1e-4)
+    r.t, r.series("car1_center_body.x")      # numpy arrays (read-only views)
+    r.summary["car_crush"]                     # summary.json as a dict
+    r.events                                   # [(t, element, event, value), ...]
+    r.dataframe()                              # every column, when pandas is installed
+
+    b = railcrash.ModelBuilder("spring-mass", "SI")   # a model in code
+    b.gravity(0, 0).body("cart", mass=2.0, inertia=0.1, position=(1.1, 0))
+    b.element("spring", "linear_spring", [("ground", 0, 0), ("cart", 0, 0)],
+              {"stiffness": 800.0, "free_length": 1.0})
+    m = b.build()
+
+Settings (`set=`) are the command line's --set: {"simulation.t_end": 0.5} is
+simulation.t_end=0.5; a key ending in "*" scales the model's number:
+{"elements.k1.stiffness*": 1.2} is elements.k1.stiffness*=1.2.
+
+Errors in a model or a setting raise railcrash.InputError (a ValueError) whose message
+names the file, line, element or key and what to change. A run the solver cannot finish
+does not raise: r.ok is False and r.message says why. Runs release the GIL: threads run
+models in parallel.
+"""
+
+import json as _json
+import math as _math
+import numbers as _numbers
+import os as _os
+
+from ._railcrash import InputError, Model, ModelBuilder, Results, RunSettings, SolverError, __version__
+from . import _railcrash
+
+for _name in ("InputError", "SolverError", "Model", "ModelBuilder", "Results", "RunSettings"):
+    getattr(_railcrash, _name).__module__ = "railcrash"
+
+__all__ = ["load", "from_yaml", "run", "sensitivity", "Model", "ModelBuilder", "Results", "InputError", "SolverError", "__version__"]
+
+
+def _setting_value(key, value):
+    """The YAML text of one setting's value; TypeError names the key for anything else."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, _numbers.Real):
+        number = float(value)
+        if not _math.isfinite(number):
+            raise InputError(f"set: '{key}' must be a finite number, not {value!r}")
+        return repr(number)
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_setting_value(key, item) for item in value) + "]"
+    raise TypeError(f"set: the value of '{key}' must be a number, a bool, a string or a list, "
+                    f"not {type(value).__name__}")
+
+
+def _settings(values):
+    """{"KEY": value, "KEY*": factor} -> ["KEY=value", "KEY*=factor"] (a list of strings passes through)."""
+    if values is None:
+        return []
+    if isinstance(values, (list, tuple)):
+        for item in values:
+            if not isinstance(item, str):
+                raise TypeError(f"set: a list of settings holds 'KEY=VALUE' strings, not {type(item).__name__}")
+        return list(values)
+    if not isinstance(values, dict):
+        raise TypeError(f"set must be a dict {{key: value}} or a list of 'KEY=VALUE' strings, not {type(values).__name__}")
+    out = []
+    for key, value in values.items():
+        if not isinstance(key, str) or not key:
+            raise TypeError(f"set: keys are strings such as 'simulation.t_end', not {key!r}")
+        if key.endswith("*"):
+            if isinstance(value, bool) or not isinstance(value, _numbers.Real):
+                raise TypeError(f"set: '{key}' scales a number; its factor must be a number, not {type(value).__name__}")
+            out.append(f"{key}={_setting_value(key, value)}")
+        else:
+            out.append(f"{key}={_setting_value(key, value)}")
+    return out
+
+
+def load(path, set=None):
+    """Reads and checks a model file; `set` applies settings (see the module help)."""
+    return Model.load(str(path), _settings(set))
+
+
+def from_yaml(text, set=None, source="<string>"):
+    """A model from YAML text; `source` names it in error messages."""
+    return Model.from_yaml(text, source, _settings(set))
+
+
+_with_settings = Model.with_settings
+
+
+def _with(self, set):
+    """A copy of the model with more settings applied (a dict as for load, or 'KEY=VALUE' strings)."""
+    return _with_settings(self, _settings(set))
+
+
+Model.with_settings = _with
+
+
+def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, output_interval=None, force_dt=False,
+        set=None):
+    """Runs a model (a Model, or a model file's path) and returns its Results, in memory.
+
+    Unset arguments keep the model's simulation section. integrator: "ida" or "euler".
+    """
+    if isinstance(model, (str, _os.PathLike)):
+        model = load(model, set)
+    elif not isinstance(model, Model):
+        raise TypeError(f"run takes a railcrash.Model or a model file's path, not {type(model).__name__}")
+    elif set:
+        model = model.with_settings(set)
+    settings = RunSettings()
+    if integrator is not None:
+        if integrator not in ("ida", "euler"):
+            raise InputError(f"integrator must be 'ida' or 'euler', not {integrator!r}")
+        settings.integrator = integrator
+    for name, value in (("t_end", t_end), ("rtol", rtol), ("atol", atol), ("dt", dt),
+                        ("output_interval", output_interval)):
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, _numbers.Real):
+            raise TypeError(f"{name} must be a number, not {type(value).__name__}")
+        setattr(settings, name, float(value))
+    settings.force_dt = bool(force_dt)
+    return _railcrash._run(model, settings)
+
+
+def _summary(self):
+    """summary.json of the run as a dict (status, stats, energy, peaks, peak_accelerations, car_crush, ...)."""
+    return _json.loads(self.summary_json)
+
+
+def _dataframe(self):
+    """Every column as a pandas DataFrame indexed by t (needs pandas)."""
+    try:
+        import pandas
+    except ImportError as error:
+        raise ImportError("Results.dataframe() needs pandas (Debian: apt install python3-pandas); "
+                          "Results.series(name) gives numpy arrays without it") from error
+    columns = self.columns
+    frame = pandas.DataFrame({name: self.series(name) for name in columns[1:]}, index=self.series("t"))
+    frame.index.name = "t"
+    return frame
+
+
+Results.summary = property(_summary)
+Results.dataframe = _dataframe
+
+
+def sensitivity(model_path, design="report", jobs=0, only=None, second_order=True, central=0.0, run_limit=0.0):
+    """The report's parameter study of R1-R3 (`railcrash sensitivity`), returned as tables.
+
+    design: a design file, or "report" for sensitivity_design.yaml beside the model.
+    Returns a dict: "runs" (one row per run: parameter, variation, factor, ok, R1-R3),
+    "first_order" (A_i per parameter), "constant" (A0 for R1-R3) and, with a second-order
+    design, "second_order" (fitted constants per term). Rows are dicts: pandas.DataFrame(rows)
+    makes a table of them.
+    """
+    only = list(only) if only else []
+    return _railcrash._sensitivity(str(model_path), str(design), int(jobs), only, bool(second_order), float(central),
+                                   float(run_limit))

@@ -1,0 +1,353 @@
+"""Tests of the Python module (run by CTest: `ctest -R python`, with PYTHONPATH=build/python).
+
+Values are checked against closed forms: the period of a spring-mass oscillator, the crush of
+a mass stopped by an anticlimber (energy balance), and against the same runs done alone.
+"""
+
+import math
+import os
+import pathlib
+import tempfile
+import threading
+import time
+import unittest
+
+import numpy
+
+import railcrash
+
+SOURCE = pathlib.Path(os.environ.get("RAILCRASH_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+TWO_CAR = SOURCE / "models" / "report" / "final_two_car.yaml"
+
+MASS = 2.0          # [kg]
+STIFFNESS = 800.0   # [N/m]
+OSCILLATOR = f"""railcrash: 1
+name: oscillator
+units: SI
+gravity: [0, 0]
+bodies:
+  - {{name: cart, mass: {MASS}, inertia: 0.1, position: [1.1, 0]}}
+elements:
+  - name: spring
+    type: linear_spring
+    stiffness: {STIFFNESS}
+    free_length: 1.0
+    points: [{{body: ground, at: [0, 0]}}, {{body: cart, at: [0, 0]}}]
+simulation: {{t_end: 1.0, output_interval: 1.0e-4, rtol: 1.0e-9}}
+"""
+
+# A 1000 kg car at 2 m/s into an anticlimber against the ground: elastic 1e7 N/m up to the
+# yield deflection, then 1e5 N/m (tests/support.cpp, the C++ sensitivity test's model).
+ANTICLIMBER = """railcrash: 1
+name: r1
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: car, mass: 1000, inertia: 100, position: [0.1, 0], velocity: [-2, 0]}
+elements:
+  - name: ac
+    type: anticlimber
+    horizontal_elastic_stiffness: 1.0e7
+    horizontal_plastic_stiffness: 1.0e5
+    horizontal_yield_deflection: 0.01
+    vertical_elastic_stiffness: 1.0e6
+    vertical_plastic_stiffness: 1.0e4
+    vertical_yield_deflection: 0.01
+    torsional_elastic_stiffness: 1.0e6
+    torsional_plastic_stiffness: 1.0e4
+    torsional_yield_deflection: 0.01
+    face_height: 0.1
+    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]
+responses:
+  crush: anticlimber
+  reference_crush: 0.02
+  anticlimber: ac
+  reference_velocity: 4.0
+simulation: {t_end: 0.15, rtol: 1.0e-9, output_interval: 0.0001}
+"""
+
+
+def crush_for(yield_deflection, elastic=1e7, plastic=1e5, energy=2000.0):
+    """Largest crush [m] from the energy balance k d_y^2/2 + F_y u + k_p u^2/2 = E."""
+    force = elastic * yield_deflection
+    rest = energy - 0.5 * elastic * yield_deflection ** 2
+    u = (-force + math.sqrt(force ** 2 + 2.0 * plastic * rest)) / plastic
+    return yield_deflection + u
+
+
+def mean_period(t, x, level):
+    """Mean period from the upward crossings of `level` (linear interpolation)."""
+    below = x[:-1] < level
+    k = numpy.nonzero(below & (x[1:] >= level))[0]
+    crossings = t[k] + (level - x[k]) / (x[k + 1] - x[k]) * (t[k + 1] - t[k])
+    return (crossings[-1] - crossings[0]) / (len(crossings) - 1)
+
+
+class RunTest(unittest.TestCase):
+    def test_spring_mass_period_against_the_closed_form(self):
+        model = railcrash.from_yaml(OSCILLATOR)
+        self.assertEqual(model.name, "oscillator")
+        self.assertEqual(model.bodies, ["cart"])
+        self.assertEqual(model.elements, [("spring", "linear_spring")])
+        result = railcrash.run(model, integrator="ida")
+        self.assertTrue(result.ok, result.message)
+        self.assertIsInstance(result.t, numpy.ndarray)
+        self.assertEqual(result.t.shape, (10001,))
+        self.assertAlmostEqual(result.t[-1], 1.0, places=12)
+        x = result.series("cart.x")
+        self.assertEqual(x.shape, result.t.shape)
+        self.assertFalse(x.flags.writeable)
+        exact = 2.0 * math.pi * math.sqrt(MASS / STIFFNESS)
+        self.assertLess(abs(mean_period(result.t, x, 1.0) - exact) / exact, 1e-6)
+        # Amplitude 0.1 m about the free length; energy k A^2 / 2 = 4 J is kept.
+        self.assertAlmostEqual(x.max(), 1.1, places=6)
+        self.assertAlmostEqual(x.min(), 0.9, places=6)
+        summary = result.summary
+        self.assertEqual(summary["status"], "ok")
+        self.assertEqual(summary["integrator"], "ida")
+        self.assertLess(abs(summary["energy"]["balance_error"]), 1e-5)
+        self.assertAlmostEqual(summary["peaks"]["spring.force"]["abs_max"], STIFFNESS * 0.1, places=3)
+        self.assertEqual(result.events, [])
+
+    def test_model_built_in_code(self):
+        builder = railcrash.ModelBuilder("oscillator", "SI")
+        builder.gravity(0.0, 0.0).body("cart", mass=MASS, inertia=0.1, position=(1.1, 0.0))
+        builder.element("spring", "linear_spring", [("ground", 0, 0), ("cart", 0, 0)],
+                        {"stiffness": STIFFNESS, "free_length": 1.0})
+        settings = railcrash.RunSettings()
+        settings.t_end = 1.0
+        settings.output_interval = 1e-4
+        builder.simulation(settings)
+        model = builder.build()
+        self.assertIn("linear_spring", builder.yaml())
+        result = railcrash.run(model, rtol=1e-9)
+        exact = 2.0 * math.pi * math.sqrt(MASS / STIFFNESS)
+        self.assertLess(abs(mean_period(result.t, result.series("cart.x"), 1.0) - exact) / exact, 1e-6)
+        # A constant force F moves the equilibrium by F / k.
+        pushed = railcrash.ModelBuilder("pushed", "SI")
+        pushed.gravity(0, 0).body("cart", mass=MASS, inertia=0.1, position=(1.0, 0.0))
+        pushed.element("spring", "linear_spring", [("ground", 0, 0), ("cart", 0, 0)],
+                       {"stiffness": STIFFNESS, "free_length": 1.0})
+        pushed.element("damper", "linear_dashpot", [("ground", 0, 0), ("cart", 0, 0)], {"damping": 80.0})  # critical: 2 sqrt(k m)
+        pushed.force("cart", at=(0, 0), value=(40.0, 0.0))
+        settled = railcrash.run(pushed.build(), t_end=2.0)
+        self.assertAlmostEqual(settled.series("cart.x")[-1], 1.0 + 40.0 / STIFFNESS, places=6)
+
+    def test_built_model_errors_name_the_element(self):
+        builder = railcrash.ModelBuilder("dangling")
+        builder.body("cart", mass=1.0, inertia=0.1, position=(1, 0))
+        builder.element("spring", "linear_spring", [("ground", 0, 0), ("crat", 0, 0)], {"stiffness": 10.0})
+        with self.assertRaisesRegex(railcrash.InputError, "element 'spring'.*unknown body 'crat' \\(did you mean 'cart'\\?\\)"):
+            builder.build()
+        typo = railcrash.ModelBuilder("typo")
+        typo.body("cart", mass=1.0, inertia=0.1, position=(1, 0))
+        typo.element("spring", "linear_sprung", [("ground", 0, 0), ("cart", 0, 0)], {"stiffness": 10.0})
+        with self.assertRaisesRegex(railcrash.InputError, "did you mean 'linear_spring'"):
+            typo.build()
+        negative = railcrash.ModelBuilder("negative")
+        negative.body("cart", mass=-1.0, inertia=0.1, position=(1, 0))
+        with self.assertRaisesRegex(railcrash.InputError, "body 'cart': mass must be positive"):
+            negative.build()
+        with self.assertRaises(TypeError):
+            negative.element("spring", "linear_spring", [("ground", 0, 0)], {"stiffness": "stiff"})
+
+    def test_settings_scale_and_set_values(self):
+        model = railcrash.from_yaml(OSCILLATOR)
+        base = railcrash.run(model)
+        stiffer = railcrash.run(model, set={"elements.spring.stiffness*": 4})
+        ratio = mean_period(stiffer.t, stiffer.series("cart.x"), 1.0) / mean_period(base.t, base.series("cart.x"), 1.0)
+        self.assertAlmostEqual(ratio, 0.5, places=6)
+        heavier = model.with_settings({"bodies.cart.mass": 4 * MASS, "simulation.t_end": 0.5})
+        self.assertEqual(heavier.settings, ["bodies.cart.mass=8.0", "simulation.t_end=0.5"])
+        self.assertEqual(heavier.t_end, 0.5)
+        result = railcrash.run(heavier, t_end=0.75, output_interval=1e-3)
+        self.assertAlmostEqual(result.t[-1], 0.75, places=12)
+        self.assertEqual(len(result.t), 751)
+        # Euler from Python too, at a fixed step.
+        euler = railcrash.run(model, integrator="euler", dt=1e-5, t_end=0.2)
+        self.assertTrue(euler.ok, euler.message)
+        self.assertEqual(euler.summary["integrator"], "euler")
+
+    def test_events_and_responses_of_an_anticlimber_crush(self):
+        result = railcrash.run(railcrash.from_yaml(ANTICLIMBER))
+        self.assertTrue(result.ok, result.message)
+        crush = crush_for(0.01)
+        self.assertAlmostEqual(result.summary["responses"]["R1"], crush / 0.02, delta=1e-5 * crush / 0.02)
+        self.assertAlmostEqual(result.series("ac.horizontal_deformation").max(), crush, delta=1e-4 * crush)
+        kinds = [event for _, element, event, _ in result.events if element == "ac"]
+        self.assertIn("contact", " ".join(kinds))
+        self.assertIn("yield", " ".join(kinds))
+        for t, element, event, value in result.events:
+            self.assertIsInstance(t, float)
+            self.assertTrue(0.0 <= t <= 0.15)
+
+    @unittest.skipUnless(TWO_CAR.exists(), "the report's two-car model")
+    def test_report_model_from_file(self):
+        model = railcrash.load(TWO_CAR, set={"elements.anticlimber.horizontal_yield_deflection*": 1.2,
+                                            "simulation.t_end": 0.05})
+        self.assertEqual(len(model.bodies), 18)
+        self.assertIn("car1_center_body.x", model.columns)
+        result = railcrash.run(model, integrator="ida", rtol=1e-4)
+        self.assertTrue(result.ok, result.message)
+        self.assertEqual(result.columns, model.columns)
+        x = result.series("car1_center_body.x")
+        # The striking car enters at 616 in/s (35 mph) and slows down.
+        self.assertAlmostEqual((x[1] - x[0]) / (result.t[1] - result.t[0]), 616.0, delta=1.0)
+        self.assertLess(result.series("car1_center_body.vx")[-1], 616.0)
+        self.assertGreater(len(result.events), 0)
+        self.assertEqual(set(result.summary["car_crush"]), {"car1", "car2"})
+
+    @unittest.skipUnless(TWO_CAR.exists(), "the report's two-car model")
+    def test_same_results_as_the_command_line_settings(self):
+        """A KEY*=FACTOR setting from Python and its KEY=VALUE spelling give the same run."""
+        scaled = railcrash.load(TWO_CAR, set={"elements.anticlimber.horizontal_yield_deflection*": 1.5,
+                                             "simulation.t_end": 0.02})
+        valued = railcrash.load(TWO_CAR, set=["elements.anticlimber.horizontal_yield_deflection=0.159",
+                                              "simulation.t_end=0.02"])
+        a = railcrash.run(scaled, rtol=1e-5).series("anticlimber.horizontal_force")
+        b = railcrash.run(valued, rtol=1e-5).series("anticlimber.horizontal_force")
+        numpy.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-6)
+
+    @unittest.skipUnless(__import__("importlib").util.find_spec("pandas"), "pandas is not installed")
+    def test_dataframe(self):
+        result = railcrash.run(railcrash.from_yaml(OSCILLATOR), t_end=0.1)
+        frame = result.dataframe()
+        self.assertEqual(frame.index.name, "t")
+        self.assertEqual(len(frame), len(result.t))
+        self.assertEqual(list(frame.columns), result.columns[1:])
+        numpy.testing.assert_array_equal(frame["cart.x"].to_numpy(), result.series("cart.x"))
+
+
+class ErrorTest(unittest.TestCase):
+    def test_model_file_error_names_file_and_line(self):
+        with tempfile.TemporaryDirectory() as folder:
+            path = pathlib.Path(folder) / "model.yaml"
+            path.write_text(OSCILLATOR.replace("stiffness: 800.0", "stifness: 800.0"))
+            with self.assertRaises(railcrash.InputError) as caught:
+                railcrash.load(path)
+            message = str(caught.exception)
+            self.assertIn(f"{path}:10:", message)  # the stiffness line
+            self.assertIn("stifness", message)
+            self.assertIn("did you mean 'stiffness'", message)
+            self.assertIsInstance(caught.exception, ValueError)
+
+    def test_missing_file(self):
+        with self.assertRaisesRegex(railcrash.InputError, "cannot open the model file"):
+            railcrash.load("/no/such/model.yaml")
+
+    def test_bad_settings(self):
+        with self.assertRaisesRegex(railcrash.InputError, "no element named 'sprung'"):
+            railcrash.from_yaml(OSCILLATOR, set={"elements.sprung.stiffness": 1.0})
+        with self.assertRaisesRegex(railcrash.InputError, "stiffnes"):
+            railcrash.from_yaml(OSCILLATOR, set={"elements.spring.stiffnes": 1.0})
+        with self.assertRaisesRegex(railcrash.InputError, "stiffness"):
+            railcrash.from_yaml(OSCILLATOR, set={"elements.spring.stiffness": "stiff"})
+        with self.assertRaisesRegex(TypeError, "elements.spring.stiffness"):
+            railcrash.from_yaml(OSCILLATOR, set={"elements.spring.stiffness": object()})
+        with self.assertRaisesRegex(TypeError, "factor must be a number"):
+            railcrash.from_yaml(OSCILLATOR, set={"elements.spring.stiffness*": "2"})
+        with self.assertRaisesRegex(railcrash.InputError, "finite"):
+            railcrash.from_yaml(OSCILLATOR, set={"simulation.t_end": float("nan")})
+        with self.assertRaises(TypeError):
+            railcrash.from_yaml(OSCILLATOR, set=42)
+
+    def test_bad_run_arguments(self):
+        model = railcrash.from_yaml(OSCILLATOR)
+        with self.assertRaisesRegex(TypeError, "rtol must be a number"):
+            railcrash.run(model, rtol="tight")
+        with self.assertRaisesRegex(railcrash.InputError, "integrator"):
+            railcrash.run(model, integrator="rk4")
+        with self.assertRaisesRegex(railcrash.InputError, "--rtol must be a positive number"):
+            railcrash.run(model, rtol=-1.0)
+        with self.assertRaises(TypeError):
+            railcrash.run(42)
+        result = railcrash.run(model, t_end=0.01)
+        with self.assertRaisesRegex(railcrash.InputError, "did you mean 'cart.x'"):
+            result.series("cart.xx")
+
+
+class ThreadTest(unittest.TestCase):
+    @unittest.skipUnless(TWO_CAR.exists(), "the report's two-car model")
+    def test_two_threads_run_while_python_goes_on(self):
+        """Two runs in two threads give what they give alone, and the GIL is free meanwhile."""
+        first = railcrash.load(TWO_CAR, set={"simulation.t_end": 0.1})
+        second = first.with_settings({"elements.anticlimber.horizontal_yield_deflection*": 1.2})
+        alone = [railcrash.run(model, rtol=1e-4) for model in (first, second)]
+        together = [None, None]
+        spans = [None, None]  # (start, end) of each threaded run [s]
+
+        def work(index, model):
+            start = time.perf_counter()
+            together[index] = railcrash.run(model, rtol=1e-4)
+            spans[index] = (start, time.perf_counter())
+
+        threads = [threading.Thread(target=work, args=(k, m)) for k, m in enumerate((first, second))]
+        for thread in threads:
+            thread.start()
+        # Heartbeat of the main thread while the runs go. A run that held the GIL would leave
+        # no beat inside its span: Python cannot run any other thread meanwhile.
+        beats = []
+        while any(thread.is_alive() for thread in threads):
+            beats.append(time.perf_counter())
+            time.sleep(0.001)
+        for thread in threads:
+            thread.join()
+        for a, b in zip(alone, together):
+            self.assertTrue(b.ok, b.message)
+            numpy.testing.assert_array_equal(a.series("anticlimber.horizontal_force"),
+                                             b.series("anticlimber.horizontal_force"))
+            self.assertEqual(a.events, b.events)
+        self.assertFalse(numpy.array_equal(together[0].series("anticlimber.horizontal_force"),
+                                           together[1].series("anticlimber.horizontal_force")))
+        for start, end in spans:
+            inside = sum(1 for beat in beats if start < beat < end)
+            self.assertGreaterEqual(inside, 5, f"{inside} heartbeats during a run of {end - start:.3f} s: "
+                                               "the run held the GIL")
+
+
+class SensitivityTest(unittest.TestCase):
+    def test_first_order_study_against_the_closed_form(self):
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "model.yaml"
+            design = pathlib.Path(folder) / "design.yaml"
+            model.write_text(ANTICLIMBER)
+            design.write_text("sensitivity: 1\nfactor: 1.2\nparameters:\n"
+                              "  - name: P7\n    description: horizontal yield force\n"
+                              "    scale: [{key: elements.ac.horizontal_yield_deflection, power: 1}]\n")
+            table = railcrash.sensitivity(model, design=design, jobs=2)
+        runs = table["runs"]
+        self.assertEqual([r["parameter"] for r in runs], ["base", "P7"])
+        self.assertTrue(all(r["ok"] for r in runs))
+        self.assertAlmostEqual(runs[0]["R1"], crush_for(0.01) / 0.02, delta=1e-5 * runs[0]["R1"])
+        self.assertAlmostEqual(runs[1]["R1"], crush_for(0.012) / 0.02, delta=1e-5 * runs[1]["R1"])
+        (p7,) = table["first_order"]
+        expected = (crush_for(0.012) - crush_for(0.01)) / 0.02 / 0.2
+        self.assertAlmostEqual(p7["A_R1"], expected, delta=1e-3 * abs(expected))
+        self.assertLess(p7["A_R1"], 0.0)
+
+    def test_only_and_central(self):
+        """--only and --central: the rows name the parameters that ran."""
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "model.yaml"
+            design = pathlib.Path(folder) / "design.yaml"
+            model.write_text(ANTICLIMBER)
+            design.write_text("sensitivity: 1\nparameters:\n"
+                              "  - name: P5\n    description: elastic slope\n"
+                              "    scale: [{key: elements.ac.horizontal_elastic_stiffness, power: 1}]\n"
+                              "  - name: P7\n    description: horizontal yield force\n"
+                              "    scale: [{key: elements.ac.horizontal_yield_deflection, power: 1}]\n")
+            table = railcrash.sensitivity(model, design=design, jobs=2, only=["P7"], central=0.05)
+        self.assertTrue(table["central"])
+        self.assertEqual([r["parameter"] for r in table["runs"]], ["base", "P7", "P7"])
+        (p7,) = table["first_order"]
+        self.assertEqual((p7["parameter"], p7["description"]), ("P7", "horizontal yield force"))
+        expected = (crush_for(0.0105) - crush_for(0.0095)) / 0.02 / 0.1
+        self.assertAlmostEqual(p7["A_R1"], expected, delta=1e-3 * abs(expected))
+
+    def test_design_errors(self):
+        with self.assertRaises(railcrash.InputError):
+            railcrash.sensitivity("/no/such/model.yaml", design="/no/such/design.yaml")
+
+
+if __name__ == "__main__":
+    unittest.main()

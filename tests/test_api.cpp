@@ -1,0 +1,225 @@
+// The public interface (api.hpp): results in memory against the files `railcrash run` writes,
+// models built in code against the closed form, errors, and runs from several threads.
+#include <catch2/catch.hpp>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "railcrash/api.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+namespace rc = railcrash::api;
+
+namespace {
+
+const std::string kTwoCar = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml";
+
+/// Mean period [s] from the upward crossings of `level` (linear interpolation).
+double mean_period(const std::vector<double>& t, const std::vector<double>& x, double level) {
+  std::vector<double> crossings;
+  for (std::size_t k = 1; k < t.size(); ++k)
+    if (x[k - 1] < level && x[k] >= level)
+      crossings.push_back(t[k - 1] + (level - x[k - 1]) / (x[k] - x[k - 1]) * (t[k] - t[k - 1]));
+  REQUIRE(crossings.size() >= 2);
+  return (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+}
+
+rc::ModelBuilder oscillator(double mass, double stiffness) {
+  rc::ModelBuilder b("oscillator", "SI");
+  b.gravity(0.0, 0.0);
+  b.body({"cart", mass, 0.1, 1.1, 0.0});
+  b.element("spring", "linear_spring", {{"ground", 0.0, 0.0}, {"cart", 0.0, 0.0}}, {{"stiffness", stiffness}, {"free_length", 1.0}});
+  rc::RunSettings s;
+  s.t_end = 1.0;
+  s.output_interval = 1e-4;
+  b.simulation(s);
+  return b;
+}
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+TEST_CASE("api: results in memory are the files railcrash run writes", "[api]") {
+  const rc::Model model = rc::Model::load(kTwoCar, {"simulation.t_end=0.02"});
+  rc::RunSettings settings;
+  settings.rtol = 1e-4;
+  const rc::Results memory = rc::run(model, settings);
+  REQUIRE(memory.ok());
+
+  // The same run through run_model with a folder.
+  railcrash::Model loaded = railcrash::load_model(kTwoCar, {"simulation.t_end=0.02"});
+  railcrash::RunOverrides overrides;
+  overrides.rtol = 1e-4;
+  railcrash::apply_overrides(loaded, overrides);
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("railcrash_api_test_" + std::to_string(::getpid()))).string();
+  std::filesystem::remove_all(dir);
+  const railcrash::RunReport report = railcrash::run_model(loaded, dir);
+  REQUIRE(report.outcome.ok);
+
+  std::ifstream csv(dir + "/timeseries.csv");
+  std::string header;
+  std::getline(csv, header);
+  std::string joined;
+  for (const std::string& c : memory.columns) joined += (joined.empty() ? "" : ",") + c;
+  CHECK(header == joined);
+  CHECK(memory.columns == model.columns());
+  std::size_t row = 0;
+  for (std::string line; std::getline(csv, line); ++row) {
+    std::stringstream cells(line);
+    std::size_t column = 0;
+    for (std::string cell; std::getline(cells, cell, ','); ++column) {
+      REQUIRE(column < memory.values.size());
+      REQUIRE(row < memory.values[column].size());
+      const double value = memory.values[column][row];
+      CHECK(std::stod(cell) == Approx(value).epsilon(1e-11).margin(1e-300));
+    }
+    CHECK(column == memory.columns.size());
+  }
+  CHECK(row == memory.t().size());
+  CHECK(memory.t().back() == Approx(0.02));
+  // Events: one row each, in order.
+  std::ifstream events(dir + "/events.csv");
+  std::string line;
+  std::getline(events, line);
+  std::size_t event_rows = 0;
+  while (std::getline(events, line)) ++event_rows;
+  CHECK(event_rows == memory.events.size());
+  CHECK(memory.events.size() == report.outcome.events.size());
+  // summary.json: the same text, but for the run's own wall times.
+  const std::string file_summary = read(dir + "/summary.json");
+  const auto without_times = [](std::string text) {
+    const auto at = text.find("\"wall_seconds\": ");
+    const auto end = text.find(',', at);
+    return text.erase(at, end - at);
+  };
+  CHECK(without_times(memory.summary_json) == without_times(file_summary));
+  REQUIRE(memory.summary.cars.size() == 2);
+  CHECK(memory.summary.cars[0].car == "car1");
+  CHECK(memory.summary.cars[0].max_crush == Approx(report.car_crush[0].max_crush));
+  CHECK(memory.summary.peak_accelerations.size() == 18);
+  CHECK(memory.summary.integrator == "ida");
+  CHECK(memory.summary.has_responses == report.has_responses);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("api: a model built in code oscillates with period 2 pi sqrt(m / k)", "[api]") {
+  const rc::Model model = oscillator(2.0, 800.0).build();
+  CHECK(model.name() == "oscillator");
+  CHECK(model.path().empty());
+  CHECK(model.units() == "SI");
+  CHECK(model.bodies() == std::vector<std::string>{"cart"});
+  rc::RunSettings settings;
+  settings.rtol = 1e-9;
+  const rc::Results r = rc::run(model, settings);
+  REQUIRE(r.ok());
+  CHECK(r.t().size() == 10001);
+  CHECK(mean_period(r.t(), r.series("cart.x"), 1.0) == Approx(2.0 * M_PI * std::sqrt(2.0 / 800.0)).epsilon(1e-7));
+  // A setting on top: 4x the stiffness halves the period; the settings are kept in order.
+  const rc::Model stiffer = model.with({"elements.spring.stiffness*=2"}).with({"elements.spring.stiffness*=2"});
+  CHECK(stiffer.settings() == std::vector<std::string>{"elements.spring.stiffness*=2", "elements.spring.stiffness*=2"});
+  const rc::Results s = rc::run(stiffer, settings);
+  CHECK(mean_period(s.t(), s.series("cart.x"), 1.0) == Approx(M_PI * std::sqrt(2.0 / 800.0)).epsilon(1e-7));
+  // The builder's YAML is a model file: the same model from text gives the same run.
+  const rc::Results again = rc::run(rc::Model::from_yaml(oscillator(2.0, 800.0).yaml()), settings);
+  CHECK(again.series("cart.x") == r.series("cart.x"));
+}
+
+TEST_CASE("api: a built model with loads, tables and flags", "[api]") {
+  // A constant force F on a critically damped spring-mass settles at F / k; a table force
+  // that is zero after 0.1 s returns it to the free length.
+  rc::ModelBuilder b("loads", "SI");
+  b.gravity(0.0, 0.0);
+  b.body({"cart", 2.0, 0.1, 1.0, 0.0});
+  b.element("spring", "linear_spring", {{"ground", 0, 0}, {"cart", 0, 0}}, {{"stiffness", 800.0}, {"free_length", 1.0}});
+  b.element("damper", "linear_dashpot", {{"ground", 0, 0}, {"cart", 0, 0}}, {{"damping", 80.0}});
+  b.force({"cart", 0.0, 0.0}, 40.0, 0.0);
+  b.moment("cart", 0.0);
+  rc::RunSettings s;
+  s.t_end = 2.0;
+  b.simulation(s);
+  const rc::Results settled = rc::run(b.build());
+  CHECK(settled.series("cart.x").back() == Approx(1.05).epsilon(1e-7));
+
+  rc::ModelBuilder pulse("pulse", "SI");
+  pulse.gravity(0.0, 0.0);
+  pulse.body({"cart", 2.0, 0.1, 1.0, 0.0});
+  pulse.element("spring", "linear_spring", {{"ground", 0, 0}, {"cart", 0, 0}}, {{"stiffness", 800.0}, {"free_length", 1.0}});
+  pulse.element("damper", "linear_dashpot", {{"ground", 0, 0}, {"cart", 0, 0}}, {{"damping", 80.0}});
+  pulse.force({"cart", 0.0, 0.0}, std::vector<std::array<double, 3>>{{0.0, 40.0, 0.0}, {0.1, 40.0, 0.0}, {0.1000001, 0.0, 0.0}});
+  pulse.simulation(s);
+  const rc::Results back = rc::run(pulse.build());
+  const std::vector<double>& x = back.series("cart.x");
+  CHECK(*std::max_element(x.begin(), x.end()) > 1.01);
+  CHECK(x.back() == Approx(1.0).margin(1e-7));
+}
+
+TEST_CASE("api: errors name the file and line, the element or the key", "[api]") {
+  CHECK_THROWS_WITH(rc::Model::load("/no/such/model.yaml"), Catch::Contains("cannot open the model file"));
+  CHECK_THROWS_WITH(rc::Model::load(kTwoCar, {"elements.anticlimbr.horizontal_yield_deflection*=1.2"}),
+                    Catch::Contains("no number at 'elements.anticlimbr.horizontal_yield_deflection'"));
+  CHECK_THROWS_WITH(rc::Model::from_yaml("railcrash: 1\nname: x\nunits: SI\nbodies: []\n", "inline.yaml"),
+                    Catch::Contains("inline.yaml:4:"));
+  // A dangling body name in a built model: the element and the body, no meaningless line.
+  rc::ModelBuilder b("dangling", "SI");
+  b.body({"cart", 1.0, 0.1, 1.0, 0.0});
+  b.element("spring", "linear_spring", {{"ground", 0, 0}, {"crat", 0, 0}}, {{"stiffness", 10.0}});
+  CHECK_THROWS_WITH(b.build(), Catch::StartsWith("element 'spring' (linear_spring): point 2: unknown body 'crat' (did you mean 'cart'?)"));
+  // Non-finite numbers are not numbers.
+  rc::ModelBuilder nan("nan", "SI");
+  nan.body({"cart", std::nan(""), 0.1, 1.0, 0.0});
+  CHECK_THROWS_AS(nan.build(), railcrash::InputError);
+  rc::ModelBuilder wrong_kind("kind", "SI");
+  wrong_kind.body({"cart", 1.0, 0.1, 1.0, 0.0});
+  wrong_kind.element("spring", "linear_spring", {{"ground", 0, 0}, {"cart", 0, 0}}, {{"stiffness", std::vector<double>{1.0, 2.0}}});
+  CHECK_THROWS_WITH(wrong_kind.build(), Catch::Contains("stiffness"));
+  // Run settings.
+  const rc::Model model = oscillator(2.0, 800.0).build();
+  rc::RunSettings bad;
+  bad.integrator = "rk4";
+  CHECK_THROWS_WITH(rc::run(model, bad), Catch::Contains("\"ida\" or \"euler\""));
+  bad = {};
+  bad.rtol = -1.0;
+  CHECK_THROWS_WITH(rc::run(model, bad), Catch::Contains("--rtol must be a positive number"));
+  bad = {};
+  bad.t_end = 0.01;
+  const rc::Results r = rc::run(model, bad);
+  CHECK_THROWS_WITH(r.series("cart.xx"), Catch::Contains("did you mean 'cart.x'"));
+}
+
+TEST_CASE("api: a stop flag ends the run early, reported, not thrown", "[api]") {
+  const rc::Model model = oscillator(2.0, 800.0).build();
+  const std::atomic<bool> stop{true};
+  const rc::Results r = rc::run(model, {}, &stop);
+  CHECK_FALSE(r.ok());
+  CHECK_FALSE(r.summary.message.empty());
+  CHECK(r.summary.t_reached < 1.0);
+}
+
+TEST_CASE("api: one model run from several threads at once gives the runs done alone", "[api]") {
+  const rc::Model model = rc::Model::load(kTwoCar, {"simulation.t_end=0.03"});
+  rc::RunSettings settings;
+  settings.rtol = 1e-4;
+  const rc::Results alone = rc::run(model, settings);
+  std::vector<rc::Results> together(3);
+  std::vector<std::thread> threads;
+  for (auto& slot : together) threads.emplace_back([&, out = &slot] { *out = rc::run(model, settings); });
+  for (auto& t : threads) t.join();
+  for (const rc::Results& r : together) {
+    REQUIRE(r.ok());
+    CHECK(r.values == alone.values);
+    CHECK(r.events.size() == alone.events.size());
+  }
+}
