@@ -17,6 +17,7 @@
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/table_text.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -168,14 +169,7 @@ SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, 
 }
 
 ReadingsPlan load_readings(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path + ": cannot open the readings file (check the path)");
-  } catch (const YAML::ParserException& e) {
-    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path, "readings file");
   if (!root.IsMap() || !root["reading_study"])
     readings_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
   check_keys(path, root, {"reading_study", "description", "combinations", "readings"}, "readings file");

@@ -20,6 +20,7 @@
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/table_text.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -288,14 +289,7 @@ std::string SensitivityDerivative::label() const {
 }
 
 SensitivityDesign load_design(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path + ": cannot open the design file (check the path)");
-  } catch (const YAML::ParserException& e) {
-    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = load_yaml_file(path, "design file");
   if (!root.IsMap() || !root["sensitivity"]) design_error(path, root, "a design file starts with 'sensitivity: 1'");
   SensitivityDesign design;
   if (root["factor"]) {

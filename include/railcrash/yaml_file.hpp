@@ -1,0 +1,24 @@
+// Reading the studies' own YAML files (design, readings) with input errors that name the file
+// and line.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+
+#include "railcrash/error.hpp"
+
+namespace railcrash {
+
+/// Parses the YAML file at `path`; `what` names it in the message ("design file").
+inline YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(path + ": cannot open the " + what + " (check the path)");
+  } catch (const YAML::ParserException& e) {
+    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
+  }
+}
+
+}  // namespace railcrash
