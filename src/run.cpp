@@ -95,6 +95,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   if (writer) {
     report.acceleration_peaks = writer->acceleration_peaks();
     report.car_crush = writer->car_crush();
+    report.filtered_accelerations = writer->filtered_accelerations();
   }
   return report;
 }

@@ -11,6 +11,12 @@
 // old). Peaks of |x''|, |y''| and of the magnitude sqrt(x''^2 + y''^2), in the model's units
 // and in g (standard gravity 9.80665 m/s^2 = 386.088 in/s^2, whatever the model's gravity).
 // Sampled at the output interval: a finer interval sees sharper peaks.
+// The same peaks of the accelerations filtered at a channel frequency class (CFC 60 unless
+// set_filter_class says otherwise; results/cfc_filter.hpp) are given beside them ("x_cfc",
+// "y_cfc", "magnitude_cfc"), and each body's collision pulse (first contact, end of its velocity
+// change, mean deceleration; results/crash_pulse.hpp) as "collision". The filter needs a
+// sample rate of at least 2 x 2.0775 CFC; below 10 CFC the summary says the sampling is too coarse.
+// The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
 //
 // Car crush: a car is the set of bodies whose names start with the same "car<N>_" prefix
 // (car1_coupler, car1_front_end, ... form car1); a model without such names is one car,
@@ -24,10 +30,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "railcrash/integrator.hpp"
+#include "railcrash/results/crash_pulse.hpp"
 
 namespace railcrash {
 
@@ -44,6 +52,13 @@ struct AccelerationPeaks {
   double magnitude = 0.0, t_magnitude = 0.0;
 };
 
+/// Filtered peaks and the collision pulse of one body.
+struct FilteredAccelerations {
+  bool filtered = false;      // false when the samples were too few or too coarse to filter
+  AccelerationPeaks peaks;    // of the CFC-filtered accelerations
+  CollisionPulse collision;   // from the body's x velocity
+};
+
 /// One car's crush elements and its largest crush [length] over the samples.
 struct CarCrush {
   std::string car;
@@ -56,6 +71,8 @@ struct CarCrush {
 
 /// Cars of a model (see above), with their crush elements.
 std::vector<CarCrush> cars_of(const DaeSystem& system);
+
+class EnergyWriter;
 
 class ResultWriter : public RunObserver {
  public:
@@ -74,6 +91,11 @@ class ResultWriter : public RunObserver {
   const std::vector<AccelerationPeaks>& acceleration_peaks() const { return acceleration_peaks_; }
   /// Largest crush of each car so far.
   const std::vector<CarCrush>& car_crush() const { return cars_; }
+  /// Channel frequency class of the summary's filtered accelerations (default 60).
+  void set_filter_class(double cfc) { cfc_ = cfc; }
+  double filter_class() const { return cfc_; }
+  /// CFC-filtered peaks and collision pulses per body over the samples so far.
+  std::vector<FilteredAccelerations> filtered_accelerations() const;
 
  private:
   const DaeSystem& system_;
@@ -86,6 +108,12 @@ class ResultWriter : public RunObserver {
   std::vector<double> acceleration_;  // 3 per body at the last sample
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
+  std::FILE* accelerations_file_ = nullptr;
+  std::FILE* energy_file_ = nullptr;
+  std::unique_ptr<EnergyWriter> energy_;
+  double cfc_ = 60.0;
+  std::vector<double> sample_times_;                  // [time]
+  std::vector<std::vector<double>> vx_, ax_, ay_;     // per body, per sample
   std::chrono::steady_clock::time_point last_flush_;
 };
 

@@ -37,6 +37,7 @@ struct RunReport {
   // From the result writer (empty when no output folder): per body, per car (results.hpp).
   std::vector<AccelerationPeaks> acceleration_peaks;
   std::vector<CarCrush> car_crush;
+  std::vector<FilteredAccelerations> filtered_accelerations;  // CFC 60 peaks, collision pulses
 };
 
 /// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files).
