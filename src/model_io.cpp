@@ -149,6 +149,33 @@ class Reader {
     return node.Scalar();
   }
 
+  /// A body or element name: it becomes CSV column headers, JSON keys and report text, so it may
+  /// not hold a comma, quote, backslash, <, >, &, a control character or invalid UTF-8.
+  std::string name(const YAML::Node& node, const std::string& what) const {
+    const std::string value = text(node, what);
+    if (value.empty()) fail(node, what + " must not be empty");
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      const unsigned char c = static_cast<unsigned char>(value[i]);
+      if (c < 0x20 || c == 0x7F || std::string(",\"'\\<>&").find(static_cast<char>(c)) != std::string::npos)
+        fail(node, what + " '" + printable(value) + "' holds the character " + (c < 0x20 || c == 0x7F ? "code " + std::to_string(c) : "'" + std::string(1, static_cast<char>(c)) + "'") +
+                       ", which would break the CSV, JSON and report files; use letters, digits, _ - . and spaces");
+      if (c >= 0x80) {
+        const std::size_t length = (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+        bool ok = length > 0 && i + length <= value.size();
+        for (std::size_t k = 1; ok && k < length; ++k) ok = (static_cast<unsigned char>(value[i + k]) >> 6) == 0x2;
+        if (!ok) fail(node, what + " '" + printable(value) + "' is not valid UTF-8 text; save the model file as UTF-8");
+        i += length - 1;
+      }
+    }
+    return value;
+  }
+
+  static std::string printable(const std::string& value) {
+    std::string out;
+    for (char c : value) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F) ? '?' : c;
+    return out;
+  }
+
   const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
     const YAML::Node node = map[key];
     if (!node) fail(map, context + ": missing required key '" + key + "'");
@@ -375,7 +402,7 @@ const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol",
 
 Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double gravity_magnitude) {
   r.require_map(node, "each body");
-  const std::string name = r.text(r.required(node, "name", "body"), "body name");
+  const std::string name = r.name(r.required(node, "name", "body"), "body name");
   const std::string context = "body '" + name + "'";
   r.check_keys(node, kBodyKeys, context);
   Body b;
@@ -411,7 +438,7 @@ Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double
 
 std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, const Model& model) {
   r.require_map(node, "each element");
-  const std::string name = r.text(r.required(node, "name", "element"), "element name");
+  const std::string name = r.name(r.required(node, "name", "element"), "element name");
   const YAML::Node type_node = r.required(node, "type", "element '" + name + "'");
   const std::string type = r.text(type_node, "element '" + name + "': type");
   const ElementRegistry& registry = ElementRegistry::instance();

@@ -142,9 +142,7 @@
   if (haveAnimation) {
     frames.bodies.forEach(function (name, k) { bodyIndex[name] = k; });
     model.bodies.forEach(function (b) {
-      var pts = b.points.slice();
-      if (pts.length < 3) pts.push([0, 0]);
-      hulls.push(hull(pts));
+      hulls.push(hull(b.points.concat([[0, 0]])));  // with the centre of mass: no flat outline of collinear points
     });
     elements.forEach(function (e, k) {
       var values = frames.force[k];
