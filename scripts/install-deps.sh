@@ -2,12 +2,17 @@
 # Installs what railcrash needs to build and test, from Debian 12's packages (as root, or
 # through sudo). Does nothing that is already installed.
 set -euo pipefail
+# nodejs + npm: the build fetches the run report's plotting library (uPlot, pinned in
+# src/report/js/package-lock.json) from the npm registry; chromium: the report's browser test.
 packages=(build-essential cmake ninja-build pkg-config
-          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2)
+          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# A node.js from elsewhere (e.g. NodeSource, which bundles npm) is fine too.
+command -v node > /dev/null || missing+=(nodejs)
+command -v npm > /dev/null || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   echo "railcrash: all build dependencies are installed"
   exit 0
