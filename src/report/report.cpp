@@ -252,6 +252,17 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   const std::string summary = read_file(dir / "summary.json", &summary_found);
   if (!summary_found) problems.insert(problems.begin(), "no summary.json: the run did not finish (it was killed, crashed or is still running); "
                                                 "the report shows the rows written so far");
+  {  // A failed run says so first.
+    std::smatch status, message, reached;
+    if (std::regex_search(summary, status, std::regex(R"re("status": "failed")re"))) {
+      std::regex_search(summary, message, std::regex(R"re("message": "((?:[^"\\]|\\.)*)")re"));
+      std::regex_search(summary, reached, std::regex(R"re("t_reached": ([0-9.eE+-]+))re"));
+      std::string text = message.empty() ? std::string() : message[1].str();
+      replace_all(text, "\\\"", "\"");
+      problems.insert(problems.begin(), "The run FAILED" + (reached.empty() ? std::string() : " at t = " + reached[1].str() + " s") +
+                                            ": " + text + "; the report shows the results up to then");
+    }
+  }
   const std::string model_json = read_file(dir / "model.json", &found);
   if (!found) problems.push_back("no model.json (written by `railcrash run` since the report came in): no animation; run the model again");
   const auto types = element_types(model_json);

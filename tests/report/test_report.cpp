@@ -127,6 +127,17 @@ TEST_CASE("railcrash report: a good run, a truncated one, one without summary, a
   CHECK_THAT(page, !Catch::Contains("src=\"http") && !Catch::Contains("<link"));  // nothing fetched
   CHECK((page.find("uPlot") != std::string::npos) == railcrash::report::have_plotting_library());
 
+  // A failed run: the failure comes first.
+  {
+    std::string summary = slurp(dir / "summary.json");
+    summary.replace(summary.find("\"status\": \"ok\""), 14, "\"status\": \"failed\"");
+    summary.replace(summary.find("\"message\": \"\""), 13, "\"message\": \"IDA: error test failed \\\"repeatedly\\\"\"");
+    std::ofstream(dir / "summary.json", std::ios::trunc) << summary;
+    const railcrash::report::ReportResult failed = write_report(dir.string());
+    REQUIRE_FALSE(failed.problems.empty());
+    CHECK(failed.problems[0] == "The run FAILED at t = 0.3 s: IDA: error test failed \"repeatedly\"; the report shows the results up to then");
+  }
+
   // Cut timeseries.csv in the middle of a row and remove the summary: a run killed half-way.
   const std::string series = slurp(dir / "timeseries.csv");
   {

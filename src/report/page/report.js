@@ -38,10 +38,12 @@
   var energyUnit = units.energy || (model && model.units && model.units.energy) || "";
   (function header() {
     var box = document.getElementById("problems");
-    if (summary && summary.status === "failed")
-      box.appendChild(el("div", {"class": "problem failed"}, "The run FAILED at t = " + fmt(summary.t_reached) + " s: " + summary.message));
-    if (!summary) box.appendChild(el("div", {"class": "problem failed"}, "No complete summary: this is what the run wrote before it stopped."));
-    problems.forEach(function (p) { box.appendChild(el("div", {"class": "problem"}, p)); });
+    if (summary && summary.status === "failed" && !problems.some(function (p) { return p.indexOf("The run FAILED") === 0; }))
+      problems.unshift("The run FAILED at t = " + fmt(summary.t_reached) + " s: " + summary.message);
+    problems.forEach(function (p) {
+      var failed = p.indexOf("The run FAILED") === 0 || p.indexOf("no summary.json") === 0;
+      box.appendChild(el("div", {"class": failed ? "problem failed" : "problem"}, p));
+    });
 
     var head = document.getElementById("header");
     head.textContent = "";
