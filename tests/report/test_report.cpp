@@ -9,6 +9,8 @@
 #include <random>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/report/decimate.hpp"
@@ -28,7 +30,7 @@ std::string slurp(const fs::path& path) {
 
 /// A fresh run folder of the small two-car crash (tests/report/two_car.yaml).
 fs::path small_run(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_" + name);
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const railcrash::Model model = railcrash::load_model(std::string(RAILCRASH_SOURCE_DIR) + "/tests/report/two_car.yaml");
   const railcrash::RunReport run = railcrash::run_model(model, dir.string());
@@ -153,7 +155,7 @@ TEST_CASE("railcrash report: a good run, a truncated one, one without summary, a
   CHECK(truncated.rows < 1501);
 
   // A folder without a timeseries, a header only, and a missing folder: errors (exit status 2).
-  const fs::path empty = fs::temp_directory_path() / "railcrash_report_test_empty";
+  const fs::path empty = fs::temp_directory_path() / ("railcrash_report_test_empty_" + std::to_string(::getpid()));
   fs::remove_all(empty);
   fs::create_directories(empty);
   CHECK_THROWS_WITH(write_report(empty.string()), Catch::Contains("no timeseries.csv") && Catch::Contains("not a run folder"));
