@@ -19,6 +19,7 @@
 #include "railcrash/sensitivity.hpp"
 #include "railcrash/converge.hpp"
 #include "railcrash/report/report.hpp"
+#include "railcrash/version.hpp"
 
 #include <sstream>
 #include <thread>
@@ -76,13 +77,13 @@ int report_command(const std::string& run_dir, double cfc) {
 }
 
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
-                const std::string& out_dir, bool with_report) {
+                const std::string& out_dir, bool with_report, bool quiet) {
   using namespace railcrash;
   Model model = load_model(path, settings);
   apply_overrides(model, overrides);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  const RunReport report = run_model(model, out_dir, &g_stop, true);
+  const RunReport report = run_model(model, out_dir, &g_stop, !quiet);
   const RunOutcome& o = report.outcome;
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
   std::printf("%s: %s with %s to t = %g in %.3g s (%ld steps, %ld residual evaluations)\n", model.name.c_str(),
@@ -208,6 +209,7 @@ int consist_command(const std::string& template_path, int cars, const std::strin
 int main(int argc, char** argv) {
   CLI::App app{"railcrash: planar rail-vehicle crash dynamics (IDA + KLU, or explicit Euler)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", railcrash::version_text());
 
   std::string model_path, out_dir = "out", integrator;
   std::vector<std::string> settings;
@@ -227,6 +229,8 @@ int main(int argc, char** argv) {
   run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
   bool with_report = false;
   run->add_flag("--report", with_report, "also write DIR/report.html (as `railcrash report DIR`)");
+  bool quiet = false;
+  run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
 
   std::string report_dir;
   double report_cfc = 60.0;
@@ -319,7 +323,7 @@ int main(int argc, char** argv) {
     if (*atol_option) overrides.atol = atol;
     if (*dt_option) overrides.dt = dt;
     if (*output_option) overrides.output_interval = output_interval;
-    return run_command(model_path, settings, overrides, out_dir, with_report);
+    return run_command(model_path, settings, overrides, out_dir, with_report, quiet);
   } catch (const railcrash::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

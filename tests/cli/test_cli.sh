@@ -105,5 +105,11 @@ expect_status "report of a truncated run folder" 0 "$bin" report "$tmp/two"
 expect_text "it lists the truncated row" "$tmp/stderr" "report: timeseries.csv line [0-9]*: .*the file ends mid-row"
 expect_text "and the missing summary" "$tmp/stderr" "report: no summary.json: the run did not finish"
 
+expect_status "--version" 0 "$bin" --version
+expect_text "it names SUNDIALS" "$tmp/stdout" "^SUNDIALS 6"
+expect_text "and SuiteSparse" "$tmp/stdout" "^SuiteSparse [0-9.]* (KLU"
+expect_status "--quiet run" 0 "$bin" run "$src/tests/report/two_car.yaml" --quiet --out "$tmp/quiet"
+[ ! -s "$tmp/stderr" ] && passes=$((passes + 1)) || { echo "FAIL: --quiet printed to stderr"; failures=$((failures + 1)); }
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
