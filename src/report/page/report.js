@@ -520,6 +520,7 @@
   check.library = haveLibrary;
   check.problems = problems.length;
   check.errors = window.railcrashErrors;
+  check.ms = Math.round(performance.now());  // from navigation start to the page drawn, self-check included
   box.textContent = JSON.stringify(check);
   box.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
 })();
