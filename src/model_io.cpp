@@ -391,7 +391,7 @@ std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementS
   return probe.keys;
 }
 
-const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description",
+const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
                                            "responses"};
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
@@ -576,6 +576,61 @@ PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, co
   return ref;
 }
 
+void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
+  r.require_list(node, "outputs");
+  std::vector<std::string> taken;  // names whose columns exist already
+  for (const Body& b : model.bodies()) taken.push_back(b.name);
+  for (const auto& e : model.elements()) taken.push_back(e->name());
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node item = node[i];
+    const std::string context = "outputs: item " + std::to_string(i + 1);
+    r.require_map(item, context);
+    r.check_keys(item, {"name", "body", "at", "quantities"}, context);
+    OutputPoint output;
+    output.where = r.at(item);
+    const YAML::Node body_node = r.required(item, "body", context);
+    const std::string body = r.text(body_node, context + ": body");
+    const auto index = model.find_body(body);
+    if (!index) {
+      std::vector<std::string> names;
+      for (const Body& b : model.bodies()) names.push_back(b.name);
+      r.fail(body_node, context + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
+    }
+    if (*index == kGround) r.fail(body_node, context + ": the ground does not move; name a body");
+    output.point.body = *index;
+    if (item["at"]) {
+      const auto at = r.numbers(item["at"], 2, context + ": at");
+      output.point.sx = at[0];
+      output.point.sy = at[1];
+    }
+    if (item["name"]) {
+      output.name = r.name(item["name"], context + ": name");
+    } else {
+      int k = 1;
+      for (const OutputPoint& o : model.output_points) k += o.point.body == *index;
+      output.name = body + "_point" + std::to_string(k);
+    }
+    if (std::find(taken.begin(), taken.end(), output.name) != taken.end())
+      r.fail(item["name"] ? item["name"] : item, context + ": the name '" + output.name +
+                                                     "' is already a body, element or output; give the point another name");
+    taken.push_back(output.name);
+    if (item["quantities"]) {
+      const YAML::Node list = item["quantities"];
+      r.require_list(list, context + ": quantities");
+      output.position = output.velocity = output.acceleration = false;
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const std::string q = r.text(list[k], context + ": quantity");
+        if (q == "position") output.position = true;
+        else if (q == "velocity") output.velocity = true;
+        else if (q == "acceleration") output.acceleration = true;
+        else r.fail(list[k], context + ": unknown quantity '" + q + "'; use position, velocity or acceleration");
+      }
+      if (list.size() == 0) r.fail(list, context + ": quantities is empty; list position, velocity and/or acceleration");
+    }
+    model.output_points.push_back(output);
+  }
+}
+
 void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
   r.require_map(node, "responses");
   r.check_keys(node, {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force", "reference_velocity"},
@@ -758,6 +813,7 @@ Model build(const YAML::Node& root, const Reader& r) {
     for (std::size_t i = 0; i < root["loads"].size(); ++i) model.add_load(read_load(r, root["loads"][i], model));
   }
   if (root["responses"]) read_responses(r, root["responses"], model);
+  if (root["outputs"]) read_outputs(r, root["outputs"], model);
   read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
   return model;
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/output_points.hpp"
 #include "railcrash/results/run_files.hpp"
 
 namespace railcrash {
@@ -124,6 +125,7 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
   for (const Body& b : system.model().bodies())
     for (const char* q : {"x", "y", "theta", "vx", "vy", "omega"}) std::fprintf(timeseries_, ",%s.%s", b.name.c_str(), q);
   for (const std::string& name : system.output_names()) std::fprintf(timeseries_, ",%s", name.c_str());
+  for (const std::string& name : output_point_columns(system.model())) std::fprintf(timeseries_, ",%s", name.c_str());
   std::fputs("\n", timeseries_);
   std::fputs("t,element,event,value\n", events_);
   output_values_.assign(system.output_names().size(), 0.0);
@@ -156,8 +158,12 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
       peak_time_[k] = t;
     }
   }
-  std::fputs("\n", timeseries_);
   body_accelerations(system_, t, y, lambda, acceleration_.data());
+  if (!system_.model().output_points.empty()) {
+    output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
+    for (double value : point_values_) std::fprintf(timeseries_, ",%.12g", value);
+  }
+  std::fputs("\n", timeseries_);
   std::fprintf(accelerations_file_, "%.12g", t);
   for (double a : acceleration_) std::fprintf(accelerations_file_, ",%.12g", a);
   std::fputs("\n", accelerations_file_);

@@ -1,6 +1,7 @@
 // Run results on disk, written as the run goes:
 //   DIR/timeseries.csv  t, then <body>.x,<body>.y,<body>.theta,<body>.vx,<body>.vy,<body>.omega for
-//                       every body in file order, then <element>.<quantity> columns
+//                       every body in file order, then <element>.<quantity> columns, then the
+//                       output points' columns (results/output_points.hpp), if the model asks
 //   DIR/events.csv      t,element,event,value
 //   DIR/summary.json    status, message, t_reached, integrator, units, stats, energy, peaks,
 //                       peak_accelerations, car_crush (and responses, when the model has them)
@@ -114,6 +115,7 @@ class ResultWriter : public RunObserver {
   double cfc_ = 60.0;
   std::vector<double> sample_times_;                  // [time]
   std::vector<std::vector<double>> vx_, ax_, ay_;     // per body, per sample
+  std::vector<double> point_values_;                  // output points' columns at the last sample
   std::chrono::steady_clock::time_point last_flush_;
 };
 
