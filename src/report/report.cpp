@@ -112,6 +112,7 @@ std::vector<std::string> csv_fields(const std::string& line) {
 struct NumericTable {
   bool found = false;
   std::vector<std::string> columns;
+  std::map<std::string, int> index;  // column by name
   std::vector<std::vector<double>> data;  // per column
   std::size_t rows = 0;
 };
@@ -124,6 +125,7 @@ NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& pr
   std::string line;
   if (!std::getline(in, line)) return table;
   table.columns = csv_fields(line);
+  for (std::size_t k = 0; k < table.columns.size(); ++k) table.index.emplace(table.columns[k], static_cast<int>(k));
   table.data.assign(table.columns.size(), {});
   std::size_t line_number = 1;
   while (std::getline(in, line)) {
@@ -156,8 +158,8 @@ NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& pr
 }
 
 int column_of(const NumericTable& table, const std::string& name) {
-  const auto it = std::find(table.columns.begin(), table.columns.end(), name);
-  return it == table.columns.end() ? -1 : static_cast<int>(it - table.columns.begin());
+  const auto it = table.index.find(name);
+  return it == table.index.end() ? -1 : it->second;
 }
 
 /// Element names and types from model.json (written one element per line by run_files.cpp).
