@@ -171,9 +171,9 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   sample_times_.push_back(t);
   for (int i = 0; i < n; ++i) {
     const std::size_t b = static_cast<std::size_t>(i);
-    vx_[b].push_back(y[nq + 3 * i]);
-    ax_[b].push_back(acceleration_[3 * b]);
-    ay_[b].push_back(acceleration_[3 * b + 1]);
+    vx_[b].push_back(static_cast<float>(y[nq + 3 * i]));
+    ax_[b].push_back(static_cast<float>(acceleration_[3 * b]));
+    ay_[b].push_back(static_cast<float>(acceleration_[3 * b + 1]));
   }
   for (int i = 0; i < n; ++i) {
     AccelerationPeaks& p = acceleration_peaks_[static_cast<std::size_t>(i)];
@@ -217,11 +217,12 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
   const bool can_filter = sample_times_.size() >= 3 && interval > 0.0 && cfc::design_frequency(cfc_) * interval < 0.5;
   for (std::size_t b = 0; b < vx_.size(); ++b) {
     FilteredAccelerations& f = result[b];
-    f.collision = collision_pulse(sample_times_, vx_[b]);
+    const auto widen = [](const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); };
+    f.collision = collision_pulse(sample_times_, widen(vx_[b]));
     if (!can_filter) continue;
     f.filtered = true;
-    const std::vector<double> ax = cfc::filter(cfc::resample_uniform(sample_times_, ax_[b], interval), interval, cfc_);
-    const std::vector<double> ay = cfc::filter(cfc::resample_uniform(sample_times_, ay_[b], interval), interval, cfc_);
+    const std::vector<double> ax = cfc::filter(cfc::resample_uniform(sample_times_, widen(ax_[b]), interval), interval, cfc_);
+    const std::vector<double> ay = cfc::filter(cfc::resample_uniform(sample_times_, widen(ay_[b]), interval), interval, cfc_);
     for (std::size_t k = 0; k < ax.size(); ++k) {
       const double t = sample_times_.front() + static_cast<double>(k) * interval;
       const double magnitude = std::hypot(ax[k], ay[k]);
