@@ -42,6 +42,9 @@ for (const id of expected) {
   if (!p) problems.push("plot " + id + " missing");
   else if (!(p.points > 0 && p.series > 0 && p.drawn)) problems.push("plot " + id + " has no data: " + JSON.stringify(p));
 }
+const jump = check.event_jump;
+if (!jump || Math.abs(jump.frame_t - jump.event_t) > jump.spacing || jump.current !== "current")
+  problems.push("a click on an event does not move the animation to it: " + JSON.stringify(jump));
 if (check.problems !== 0) problems.push(check.problems + " problems listed at the top of a good run's report");
 // The model name holds markup: it must be shown as text, never run.
 if (!dom.includes("two cars &lt;script&gt;document.title=\"injected\"&lt;/script&gt; &amp; \"quotes\", commas")) problems.push("the model name is not shown as text");

@@ -512,9 +512,14 @@
     var first = canvasDigest();
     setFrame(frames.t.length - 1);
     var last = canvasDigest();
-    var middle = nearestFrame(0.5 * frames.t[frames.t.length - 1]);
-    setFrame(middle);
     check.frames = {count: frames.t.length, first: first, last: last, differ: first !== last};
+    if (eventRows.length) {  // a click on the last event moves the animation to its time
+      var k = eventRows.length - 1;
+      eventRows[k].click();
+      check.event_jump = {event_t: events[k][0], frame_t: frames.t[frameIndex],
+                          spacing: frames.t.length > 1 ? frames.t[1] - frames.t[0] : 0, current: eventRows[k].className};
+    }
+    setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
   }
   var box = document.getElementById("self-check");
   check.library = haveLibrary;
