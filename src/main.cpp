@@ -71,6 +71,10 @@ int report_command(const std::string& run_dir, double cfc) {
   options.cfc = cfc;
   const railcrash::report::ReportResult result = railcrash::report::write_report(run_dir, options);
   for (const std::string& problem : result.problems) std::fprintf(stderr, "report: %s\n", problem.c_str());
+  if (!result.study.empty()) {
+    std::printf("report of the %s study (%zu files) written to %s\n", result.study.c_str(), result.rows, result.path.c_str());
+    return 0;
+  }
   std::printf("report of %zu output rows written to %s%s\n", result.rows, result.path.c_str(),
               railcrash::report::have_plotting_library() ? "" : " (without plots: this build has no plotting library)");
   return 0;

@@ -230,6 +230,90 @@ void fill(std::string& page, std::size_t& cursor, const std::string& key, const 
   cursor = at + value.size();
 }
 
+std::string base64(const std::string& bytes) {
+  static const char* const kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const unsigned a = static_cast<unsigned char>(bytes[i]);
+    const unsigned b = i + 1 < bytes.size() ? static_cast<unsigned char>(bytes[i + 1]) : 0u;
+    const unsigned c = i + 2 < bytes.size() ? static_cast<unsigned char>(bytes[i + 2]) : 0u;
+    const unsigned triple = (a << 16) | (b << 8) | c;
+    out += kDigits[(triple >> 18) & 63];
+    out += kDigits[(triple >> 12) & 63];
+    out += i + 1 < bytes.size() ? kDigits[(triple >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kDigits[triple & 63] : '=';
+  }
+  return out;
+}
+
+std::string html_text(const std::string& text) {
+  std::string out;
+  for (char c : valid_utf8(text)) {
+    if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '&') out += "&amp;";
+    else out += c;
+  }
+  return out;
+}
+
+/// Writes DIR/report.html: the template filled with the title, the JSON blocks (summary.json,
+/// model.json and the report's data, made safe for a script element) and the inlined script,
+/// style and library. Placeholders are filled in page order, each once, so that nothing
+/// inserted is searched again. Returns the path.
+std::string write_page(const fs::path& dir, const std::string& title, const std::string& summary, const std::string& model,
+                       const std::string& data) {
+  std::string page = joined(assets::kTemplate);
+  std::string library = joined(assets::kLibraryScript);
+  replace_all(library, "</script", "<\\/script");
+  std::string script = joined(assets::kScript);
+  replace_all(script, "</script", "<\\/script");
+  std::size_t cursor = 0;
+  fill(page, cursor, "{{TITLE}}", html_text(title));
+  fill(page, cursor, "{{LIBRARY_STYLE}}", joined(assets::kLibraryStyle));
+  fill(page, cursor, "{{STYLE}}", joined(assets::kStyle));
+  fill(page, cursor, "{{SUMMARY}}", script_safe(summary));
+  fill(page, cursor, "{{MODEL}}", script_safe(model));
+  fill(page, cursor, "{{DATA}}", script_safe(data));
+  fill(page, cursor, "{{LIBRARY_SCRIPT}}", library);
+  fill(page, cursor, "{{SCRIPT}}", script);
+  const std::string path = (dir / "report.html").string();
+  std::ofstream out(path, std::ios::binary);
+  out << page;
+  if (!out) throw InputError("cannot write " + path);
+  return path;
+}
+
+/// Files of a `converge` or `sensitivity` folder, in the order shown.
+const char* const kStudyFiles[] = {"converge.md", "converge.csv", "sensitivity.md", "sensitivity.csv", "sensitivity_first_order.csv",
+                                   "sensitivity_second_order.csv", "sensitivity_derivatives.csv", "sensitivity_ranking.csv"};
+
+/// A report of a study folder: its Markdown summary, its tables and its chart.
+ReportResult write_study_report(const fs::path& dir) {
+  ReportResult result;
+  const bool converge = fs::exists(dir / "converge.csv") || fs::exists(dir / "converge.md");
+  result.study = converge ? "converge" : "sensitivity";
+  std::string files = "[";
+  for (const char* name : kStudyFiles) {
+    bool found = false;
+    const std::string text = read_file(dir / name, &found);
+    if (!found) continue;
+    const bool markdown = std::string(name).size() > 3 && std::string(name).substr(std::string(name).size() - 3) == ".md";
+    files += std::string(files.size() > 1 ? ",\n" : "") + "{\"name\": " + js(name) + ", \"kind\": " + js(markdown ? "markdown" : "csv") +
+             ", \"text\": " + js(text) + "}";
+    ++result.rows;
+  }
+  files += "]";
+  bool svg_found = false;
+  const std::string svg = read_file(dir / "converge.svg", &svg_found);
+  const std::string data = "{\"study\": " + js(converge ? "converge" : "sensitivity") + ", \"run_dir\": " +
+                           js(fs::absolute(dir).lexically_normal().string()) + ", \"problems\": [], \"files\": " + files +
+                           ", \"chart\": " + (svg_found ? js("data:image/svg+xml;base64," + base64(svg)) : std::string("null")) + "}";
+  result.path = write_page(dir, std::string(converge ? "railcrash convergence study: " : "railcrash sensitivity study: ") +
+                                    dir.filename().string(), "null", "null", data);
+  return result;
+}
+
 }  // namespace
 
 bool have_plotting_library() { return assets::kHaveLibrary; }
@@ -242,6 +326,8 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   ReportResult result;
   std::vector<std::string>& problems = result.problems;
   const NumericTable series = read_numeric_csv(dir / "timeseries.csv", problems);
+  if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv")))
+    return write_study_report(dir);
   if (!series.found)
     throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (write one with `railcrash run MODEL --out " +
                      run_dir + "`)");
@@ -472,34 +558,8 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
                            ",\n\"frames\": " + frames + ",\n\"plots\": " + plots_json + ",\n\"loops\": " + loops_json +
                            ",\n\"energy\": " + energy_json + ",\n\"events\": " + events + "}";
 
-  std::string page = joined(assets::kTemplate);
-  std::string library = joined(assets::kLibraryScript);
-  replace_all(library, "</script", "<\\/script");
-  std::string script = joined(assets::kScript);
-  replace_all(script, "</script", "<\\/script");
-  std::string title = "railcrash report: " + dir.filename().string();
-  std::string escaped_title;
-  for (char c : valid_utf8(title)) {
-    if (c == '<') escaped_title += "&lt;";
-    else if (c == '>') escaped_title += "&gt;";
-    else if (c == '&') escaped_title += "&amp;";
-    else escaped_title += c;
-  }
-  // Filled in page order, each placeholder once, so nothing inserted is searched again.
-  std::size_t cursor = 0;
-  fill(page, cursor, "{{TITLE}}", escaped_title);
-  fill(page, cursor, "{{LIBRARY_STYLE}}", joined(assets::kLibraryStyle));
-  fill(page, cursor, "{{STYLE}}", joined(assets::kStyle));
-  fill(page, cursor, "{{SUMMARY}}", summary.empty() ? "null" : script_safe(summary));
-  fill(page, cursor, "{{MODEL}}", model_json.empty() ? "null" : script_safe(model_json));
-  fill(page, cursor, "{{DATA}}", script_safe(data));
-  fill(page, cursor, "{{LIBRARY_SCRIPT}}", library);
-  fill(page, cursor, "{{SCRIPT}}", script);
-
-  result.path = (dir / "report.html").string();
-  std::ofstream out(result.path, std::ios::binary);
-  out << page;
-  if (!out) throw InputError("cannot write " + result.path);
+  result.path = write_page(dir, "railcrash report: " + dir.filename().string(), summary.empty() ? "null" : summary,
+                           model_json.empty() ? "null" : model_json, data);
   return result;
 }
 

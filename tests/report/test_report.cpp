@@ -167,6 +167,21 @@ TEST_CASE("railcrash report: a good run, a truncated one, one without summary, a
   fs::remove_all(dir);
 }
 
+TEST_CASE("railcrash report of a sensitivity folder: its summary and tables", "[report]") {
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_study_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "sensitivity.csv") << "run,P1,R1\nbase,1,0.5\n";
+  std::ofstream(dir / "sensitivity.md") << "# Sensitivity <b>study</b>\n\n| P | R1 |\n|---|---|\n| P1 | 0.5 |\n";
+  const railcrash::report::ReportResult result = railcrash::report::write_report(dir.string());
+  CHECK(result.study == "sensitivity");
+  CHECK(result.rows == 2);
+  const std::string page = slurp(dir / "report.html");
+  CHECK_THAT(page, Catch::Contains("run,P1,R1\\nbase,1,0.5") && Catch::Contains("\\u003cb>study"));
+  CHECK_THAT(page, !Catch::Contains("<b>study"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("Body and element names that would break CSV, JSON or HTML are refused with file and line", "[report]") {
   const std::string head = "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: ";
   const std::string tail = ", mass: 1, inertia: 1, position: [0, 0]}\nelements: []\nsimulation: {t_end: 1}\n";

@@ -53,4 +53,15 @@ if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
 console.log("report ok: " + check.plots.length + " plots, " + check.frames.count + " frames");
 JS
 [ -s "$out/report_screenshot.png" ] || fail "no screenshot"
+
+# A convergence study's folder: its tables and chart.
+"$bin" converge "$src/verification/cases/damped_spring_mass.yaml" --t-end 0.5 --euler-dt 0.01 --euler-steps 3 --rtols 1e-3,1e-4 \
+  --quantities displacement_rms --out "$tmp/converge" > /dev/null 2>&1 || fail "converge"
+"$bin" report "$tmp/converge" > /dev/null || fail "report of a converge folder"
+timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=3000 --dump-dom "file://$tmp/converge/report.html" > "$tmp/study.html" 2> "$tmp/chromium.log" ||
+  fail "chromium --dump-dom (study)"
+if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the study report (above)"; fi
+grep -q 'data-status="ran"' "$tmp/study.html" || fail "the study report's script did not run"
+grep -Eq '&quot;tables&quot;:[1-9][0-9]*,&quot;chart&quot;:true' "$tmp/study.html" || grep -Eq '"tables":[1-9][0-9]*,"chart":true' "$tmp/study.html" ||
+  { grep -o '<div id="self-check"[^<]*' "$tmp/study.html"; fail "the study report has no tables or no chart"; }
 echo "PASS: report opens in Chromium without errors; screenshot in $out/report_screenshot.png"

@@ -15,6 +15,10 @@
 // draft_gear, coupler_end, couplings) are shown first and get force-deformation loops. Long
 // series are decimated with decimate_minmax (peaks kept), animation frames uniformly.
 //
+// A folder of `railcrash converge` or `railcrash sensitivity` (converge.csv or sensitivity.csv,
+// no timeseries.csv) gets a page of its Markdown summary and CSV files as tables, and the
+// convergence chart (converge.svg).
+//
 // Bad folders: a missing folder, or one without timeseries.csv or without a single complete
 // row in it, throws InputError (exit 2). Anything else that is missing or broken (no
 // summary.json, a failed run, a truncated CSV row, no model.json from an older railcrash) is
@@ -37,6 +41,7 @@ struct ReportResult {
   std::string path;                   // RUN_DIR/report.html
   std::vector<std::string> problems;  // shown at the top of the page
   std::size_t rows = 0;               // complete rows of timeseries.csv
+  std::string study;                  // "converge" or "sensitivity" for a study folder (rows: its files)
 };
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options = {});

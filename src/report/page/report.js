@@ -30,6 +30,75 @@
   var model = parseBlock("model-json", problems);
   problems = (data.problems || []).concat(problems);
   var check = {errors: window.railcrashErrors, plots: [], frames: null};
+  if (data.study) { studyReport(); return; }
+
+  // ---------------------------------------------------------------- a study folder (converge, sensitivity)
+  function csvRows(text) {  // RFC 4180 fields
+    var rows = [], row = [""], quoted = false;
+    for (var i = 0; i < text.length; ++i) {
+      var c = text[i];
+      if (quoted) {
+        if (c === '"' && text[i + 1] === '"') { row[row.length - 1] += '"'; ++i; }
+        else if (c === '"') quoted = false;
+        else row[row.length - 1] += c;
+      } else if (c === '"') quoted = true;
+      else if (c === ",") row.push("");
+      else if (c === "\n") { rows.push(row); row = [""]; }
+      else if (c !== "\r") row[row.length - 1] += c;
+    }
+    if (row.length > 1 || row[0] !== "") rows.push(row);
+    return rows;
+  }
+  function table(rows) {
+    var t = el("table", {"class": "facts"});
+    rows.forEach(function (cells, k) {
+      var tr = el("tr");
+      cells.forEach(function (cell) { tr.appendChild(el(k === 0 ? "th" : "td", {}, cell)); });
+      t.appendChild(tr);
+    });
+    return t;
+  }
+  function studyReport() {
+    ["animation-section", "plots-section", "loops-section", "energy-section"].forEach(function (id) {
+      document.getElementById(id).hidden = true;
+    });
+    var head = document.getElementById("header");
+    head.textContent = "";
+    head.appendChild(el("h1", {}, (data.study === "converge" ? "railcrash convergence study: " : "railcrash sensitivity study: ") + data.run_dir));
+    var box = el("section");
+    document.body.insertBefore(box, document.getElementById("footer"));
+    var tables = 0;
+    if (data.chart) {
+      box.appendChild(el("h2", {}, "Error against cost"));
+      box.appendChild(el("img", {src: data.chart, alt: "converge.svg"}));
+    }
+    data.files.forEach(function (file) {
+      box.appendChild(el("h2", {}, file.name));
+      if (file.kind === "csv") {
+        box.appendChild(table(csvRows(file.text)));
+        ++tables;
+        return;
+      }
+      // Markdown: its tables as tables, the rest as paragraphs (text, never markup).
+      var lines = file.text.split("\n"), pending = [];
+      function flush() { if (pending.length) { box.appendChild(table(pending)); ++tables; pending = []; } }
+      lines.forEach(function (line) {
+        var trimmed = line.trim();
+        if (trimmed.charAt(0) === "|") {
+          if (/^\|[\s|:-]+\|$/.test(trimmed)) return;  // the separator row
+          pending.push(trimmed.replace(/^\||\|$/g, "").split("|").map(function (c) { return c.trim(); }));
+          return;
+        }
+        flush();
+        if (trimmed) box.appendChild(el("p", {}, trimmed.replace(/^#+\s*/, "")));
+      });
+      flush();
+    });
+    document.getElementById("footer").textContent = "railcrash report of a " + data.study + " folder";
+    var selfCheck = document.getElementById("self-check");
+    selfCheck.textContent = JSON.stringify({errors: window.railcrashErrors, study: data.study, tables: tables, chart: !!data.chart});
+    selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  }
 
   // ---------------------------------------------------------------- header and problems
   var units = (summary && summary.units) || {};
