@@ -7,6 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -16,6 +17,7 @@
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
+#include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
 #include "railcrash/converge.hpp"
 #include "railcrash/report/report.hpp"
@@ -149,19 +151,56 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
     if (!name.empty()) options.only.push_back(name);
   const auto start = std::chrono::steady_clock::now();
   const SensitivityResult result = run_sensitivity(path, design, options);
-  const std::string table = write_sensitivity(result, design, out_dir);
+  std::string table = write_sensitivity(result, design, out_dir);
+  if (design.reference && !result.central && result.base.ok) {
+    const std::string comparison = comparison_markdown(result, design);
+    std::ofstream file(std::filesystem::path(out_dir) / "comparison.md");
+    file << "# The study against the design's published results\n\n" << comparison;
+    if (!file) throw std::runtime_error("cannot write " + (std::filesystem::path(out_dir) / "comparison.md").string());
+    table += "\n" + comparison;
+  }
   std::fputs(table.c_str(), stdout);
   int failed = result.base.ok ? 0 : 1;
   for (const auto& r : result.runs) failed += r.ok ? 0 : 1;
   for (const auto& r : result.second_order_runs) failed += r.ok ? 0 : 1;
   std::printf("\n%s: %zu runs with %d jobs in %.1f s; %d failed; results in %s/ (sensitivity.md, sensitivity.csv, "
               "sensitivity_first_order.csv, sensitivity_second_order.csv, sensitivity_derivatives.csv, "
-              "sensitivity_ranking.csv)\n",
+              "sensitivity_ranking.csv%s)\n",
               design_path.c_str(), result.runs.size() + result.second_order_runs.size() + 1, options.jobs,
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str());
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str(),
+              design.reference && !result.central && result.base.ok ? ", comparison.md" : "");
   return failed == 0 ? 0 : 1;
 }
 
+int readings_command(const std::string& path, const std::string& design_option, const std::string& readings_path, int jobs,
+                     bool first_order_only, double run_limit, const std::string& out_dir) {
+  using namespace railcrash;
+  const std::string design_path = design_option == "report" ? default_design_path(path) : design_option;
+  const SensitivityDesign design = load_design(design_path);
+  const ReadingsPlan plan = load_readings(readings_path);
+  ReadingsOptions options;
+  options.study.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.study.second_order = !first_order_only;
+  options.study.run_time_limit = run_limit;
+  options.progress = [&plan](const ReadingsCombinationResult& r, std::size_t number, std::size_t total) {
+    const auto& a = r.agreement.responses;
+    std::fprintf(stderr, "[%zu/%zu] %s: R1 %.3f R2 %.3f R3 %.3f; rho R1 %.2f R2 %.2f; goals %d/%d; %d failed; %.0f s\n",
+                 number + 1, total, plan.label(r.levels).c_str(), a[0].value, a[1].value, a[2].value, a[0].spearman,
+                 a[1].spearman, r.agreement.goals_met, Agreement::kGoals, r.failed_runs, r.wall_seconds);
+  };
+  const auto start = std::chrono::steady_clock::now();
+  const auto results = run_readings(path, design, plan, options);
+  const std::string table = write_readings(results, plan, design, out_dir);
+  std::fputs(table.c_str(), stdout);
+  int failed = 0;
+  for (const auto& r : results) failed += r.failed_runs;
+  std::printf("\n%zu combinations x %zu runs with %d jobs in %.1f s; %d runs failed; results in %s/ (readings.md, readings.csv, "
+              "combination_NNN/)\n",
+              results.size(), results.empty() ? 0 : 1 + results.front().study.runs.size() + results.front().study.second_order_runs.size(),
+              options.study.jobs, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed,
+              out_dir.c_str());
+  return failed == 0 ? 0 : 1;
+}
 
 int converge_command(const std::string& path, const railcrash::ConvergeOptions& options, const std::string& out_dir) {
   using namespace railcrash;
@@ -262,6 +301,20 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
 
+  std::string readings_path;
+  CLI::App* readings = app.add_subcommand(
+      "readings", "reading study: the design's whole study for every combination of open readings, scored against "
+                  "the published results (report Tables 11-17)");
+  readings->add_option("model", model_path, "model file with a responses section")->required();
+  readings->add_option("--readings", readings_path, "readings file (YAML: reading_study: 1, readings: [{name, levels}])")->required();
+  readings->add_option("--design", design_path, "design file with a 'reference' section; 'report' = sensitivity_design.yaml beside the model")
+      ->capture_default_str();
+  readings->add_option("--jobs", jobs, "runs in parallel (default: all cores)");
+  readings->add_flag("--first-order", first_order_only, "skip the design's second-order runs");
+  readings->add_option("--run-limit", run_limit, "stop a run after this many seconds and report it failed (default: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  readings->add_option("--out", out_dir, "output folder")->capture_default_str();
+
   railcrash::ConvergeOptions converge_options;
   std::string converge_out = "out";
   CLI::App* converge = app.add_subcommand(
@@ -319,6 +372,7 @@ int main(int argc, char** argv) {
       converge_options.settings = settings;
       return converge_command(model_path, converge_options, converge_out);
     }
+    if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, out_dir);
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, out_dir);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -49,8 +50,9 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
-  /// Marks `value` (and everything inside it) as coming from the command-line setting
-  /// `setting`: its line numbers belong to the setting, not to the file.
+  /// Marks `value` (and everything inside it) as coming from a setting: its line numbers
+  /// belong to the setting, not to the file. `setting` is the prefix of the messages about it
+  /// (e.g. "model.yaml: --set 'k=2'" or "variant.yaml:12: set 'k'").
   void add_override(const YAML::Node& value, const std::string& setting) {
     overridden_.emplace_back(value, setting);
     if (value.IsSequence() || value.IsMap())
@@ -86,8 +88,7 @@ class Reader {
     return {file_, node.Mark().line + 1};
   }
   [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
-    if (const std::string* setting = from_override(node))
-      throw InputError(SourceLocation{file_, 0}.prefix() + "--set '" + *setting + "': " + message);
+    if (const std::string* setting = from_override(node)) throw InputError(*setting + ": " + message);
     throw InputError(at(node).prefix() + message);
   }
 
@@ -232,6 +233,12 @@ class YamlParameterReader : public ParameterReader {
     if (!node) return std::nullopt;
     return reader_.boolean(node, context_ + ": '" + key + "'");
   }
+  std::optional<std::string> word(const std::string& key) override {
+    used_.insert(key);
+    const YAML::Node node = element_[key];
+    if (!node) return std::nullopt;
+    return reader_.text(node, context_ + ": '" + key + "'");
+  }
   [[noreturn]] void fail(const std::string& key, const std::string& what_to_change) const override {
     const YAML::Node node = element_[key];
     reader_.fail(node ? node : element_, context_ + ": " + what_to_change);
@@ -296,8 +303,10 @@ bool apply_scaling(YAML::Node& root, const std::string& setting, const std::stri
   return true;
 }
 
-void apply_override(YAML::Node& root, const std::string& setting, Reader& reader) {
-  const std::string where = SourceLocation{reader.file(), 0}.prefix() + "--set '" + setting + "': ";
+/// `label`: how messages name the setting ("file: --set 'KEY=VALUE'" when empty).
+void apply_override(YAML::Node& root, const std::string& setting, Reader& reader, std::string label = {}) {
+  if (label.empty()) label = SourceLocation{reader.file(), 0}.prefix() + "--set '" + setting + "'";
+  const std::string where = label + ": ";
   if (apply_scaling(root, setting, where)) return;
   const auto equals = setting.find('=');
   if (equals == std::string::npos || equals == 0)
@@ -309,7 +318,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
   } catch (const YAML::Exception& e) {
     throw InputError(where + "the value is not valid YAML (" + e.msg + ")");
   }
-  reader.add_override(value, setting);
+  reader.add_override(value, label);
   std::vector<std::string> parts;
   std::stringstream stream(key);
   for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
@@ -331,7 +340,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
     }
     YAML::Node section = root[parts[0]];
     section[parts[1]] = value;
-    mark_override_key(section, value, setting, reader);
+    mark_override_key(section, value, label, reader);
     return;
   }
   if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
@@ -341,7 +350,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
         if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == parts[1]) {
           YAML::Node item = list[i];
           item[parts[2]] = value;
-          mark_override_key(item, value, setting, reader);
+          mark_override_key(item, value, label, reader);
           return;
         }
     throw InputError(where + "the model has no " + (parts[0] == "bodies" ? "body" : "element") + " named '" + parts[1] + "'");
@@ -370,6 +379,10 @@ class KeyProbe : public ParameterReader {
   std::optional<bool> flag(const std::string& key) override {
     keys.insert(key);
     return false;
+  }
+  std::optional<std::string> word(const std::string& key) override {
+    keys.insert(key);
+    return std::nullopt;  // the default, which every type accepts
   }
   [[noreturn]] void fail(const std::string&, const std::string&) const override { throw Stop{}; }
   std::set<std::string> keys;
@@ -633,7 +646,8 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
 
 void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
   r.require_map(node, "responses");
-  r.check_keys(node, {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force", "reference_velocity"},
+  r.check_keys(node, {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force", "reference_velocity",
+                      "vertical_force_window"},
                "responses");
   ResponseSettings& s = model.responses;
   if (node["crush_gauges"]) {
@@ -678,6 +692,16 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     if (it == elements.end() || (*it)->type() != "anticlimber")
       r.fail(node["anticlimber"], "responses: 'anticlimber: " + s.anticlimber + "' must name an element of type anticlimber");
     s.vertical_yield_force = positive("vertical_yield_force");
+    if (node["vertical_force_window"]) {
+      using Window = ResponseSettings::VerticalForceWindow;
+      const std::string window = r.text(node["vertical_force_window"], "responses: vertical_force_window");
+      if (window == "whole_run") s.vertical_force_window = Window::WholeRun;
+      else if (window == "until_largest_crush") s.vertical_force_window = Window::UntilLargestCrush;
+      else if (window == "until_separation") s.vertical_force_window = Window::UntilSeparation;
+      else
+        r.fail(node["vertical_force_window"],
+               "responses: vertical_force_window must be whole_run, until_largest_crush or until_separation");
+    }
     if (!node["reference_velocity"])
       r.fail(node, "responses: an anticlimber needs 'reference_velocity' (the velocity that fails the collision post, for R2 after override)");
     s.reference_velocity = *positive("reference_velocity");
@@ -820,11 +844,11 @@ Model build(const YAML::Node& root, const Reader& r) {
 
 }  // namespace
 
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
-  Reader reader(path);
-  YAML::Node root;
+namespace {
+
+YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
   try {
-    root = YAML::Load(text);
+    return YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
     // A ']' or '}' left out is noticed only where the next thing starts (often the next
@@ -838,15 +862,74 @@ Model load_model_text(const std::string& text, const std::string& path, const st
                        "' (the parser stopped at line " + std::to_string(line) + ": " + e.msg + ")");
     throw InputError(SourceLocation{path, line}.prefix() + "not valid YAML: " + e.msg);
   }
+}
+
+/// A setting taken from a variant file: KEY=VALUE and how messages name it.
+struct VariantSetting {
+  std::string setting, label;
+};
+
+/// A variant file (README "Model variants"): `variant_of: BASE` (relative to the variant's
+/// folder), an optional `name` and `description`, and `set:` a map KEY: VALUE of the same keys
+/// as --set. Returns the base document; `file` becomes the base file (its lines are the
+/// base's), `settings` the variant's changes, to be applied like --set before the user's own.
+YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, std::string& file,
+                           std::vector<VariantSetting>& settings) {
+  const Reader reader(path);
+  reader.check_keys(variant, {"railcrash", "variant_of", "name", "description", "set"}, "model variant");
+  const YAML::Node version = reader.required(variant, "railcrash", "model variant (add 'railcrash: 1')");
+  if (!version.IsScalar() || version.Scalar() != "1") reader.fail(version, "model variant: 'railcrash' must be 1");
+  const YAML::Node base_node = variant["variant_of"];
+  const std::string base_name = reader.text(base_node, "model variant: variant_of");
+  const std::filesystem::path base_path =
+      std::filesystem::path(base_name).is_absolute() ? std::filesystem::path(base_name)
+                                                     : std::filesystem::path(path).parent_path() / base_name;
+  std::ifstream in(base_path);
+  if (!in)
+    reader.fail(base_node, "model variant: cannot open the base model '" + base_path.string() +
+                               "' (variant_of is relative to the variant's folder)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  file = base_path.string();
+  YAML::Node base = parse_model_yaml(buffer.str(), file);
+  if (base.IsMap() && base["variant_of"])
+    reader.fail(base_node, "model variant: '" + file + "' is itself a variant; name the model it is a variant of");
+  const auto add = [&](const YAML::Node& key, const std::string& name, const YAML::Node& value) {
+    const std::string label = reader.at(key).prefix() + "set '" + name + "'";
+    if (!value.IsDefined() || value.IsNull()) throw InputError(label + ": give a value (" + name + ": VALUE)");
+    settings.push_back({name + "=" + YAML::Dump(value), label});
+  };
+  for (const char* key : {"name", "description"})
+    if (variant[key]) add(variant[key], key, variant[key]);
+  if (variant["set"]) {
+    reader.require_map(variant["set"], "model variant: set");
+    for (const auto& entry : variant["set"]) {
+      if (!entry.first.IsScalar()) reader.fail(entry.first, "model variant: set: keys are KEY paths like elements.spring.stiffness");
+      add(entry.first, entry.first.Scalar(), entry.second);
+    }
+  }
+  return base;
+}
+
+}  // namespace
+
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  YAML::Node root = parse_model_yaml(text, path);
+  std::string file = path;
+  std::vector<VariantSetting> variant_settings;
+  if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings);
+  Reader reader(file);
   reader.index_empty_values(root);
-  if (root.IsMap() || root.IsNull())  // otherwise build() says what the file should look like
+  if (root.IsMap() || root.IsNull()) {  // otherwise build() says what the file should look like
+    for (const VariantSetting& v : variant_settings) apply_override(root, v.setting, reader, v.label);
     for (const auto& setting : overrides) apply_override(root, setting, reader);
+  }
   try {
     Model model = build(root, reader);
     model.finalize();
     return model;
   } catch (const YAML::Exception& e) {  // a check above missed a case: still an input error with a line
-    throw InputError(SourceLocation{path, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "cannot read the model: " + e.msg);
+    throw InputError(SourceLocation{file, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "cannot read the model: " + e.msg);
   }
 }
 

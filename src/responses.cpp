@@ -51,15 +51,24 @@ void ResponseTracker::sample(double, const double* y, const double* lambda, cons
     responses_.max_crush[k] = std::max(responses_.max_crush[k], initial_length_[k] - gauge_length(settings_.crush_gauges[k], y));
   if (vertical_force_column_ >= 0) {
     system_.outputs(y, lambda, outputs_.data());
-    responses_.max_vertical_force =
-        std::max(responses_.max_vertical_force, std::abs(outputs_[static_cast<std::size_t>(vertical_force_column_)]));
+    if (!vertical_window_closed_)
+      responses_.max_vertical_force =
+          std::max(responses_.max_vertical_force, std::abs(outputs_[static_cast<std::size_t>(vertical_force_column_)]));
     responses_.max_anticlimber_crush =
         std::max(responses_.max_anticlimber_crush, outputs_[static_cast<std::size_t>(horizontal_deformation_column_)]);
   }
 }
 
 void ResponseTracker::event(const EventRecord& record, const double* y) {
-  if (record.element != settings_.anticlimber || responses_.overridden) return;
+  if (record.element != settings_.anticlimber) return;
+  // The window of R2's largest vertical force closes at the first event that ends it (the
+  // sample at the event time, written before the mode change, is still inside).
+  using Window = ResponseSettings::VerticalForceWindow;
+  if ((settings_.vertical_force_window == Window::UntilLargestCrush &&
+       record.what.find("horizontal unloading") != std::string::npos) ||
+      (settings_.vertical_force_window == Window::UntilSeparation && record.what.find("separation") != std::string::npos))
+    vertical_window_closed_ = true;
+  if (responses_.overridden) return;
   if (record.what.find("override") == std::string::npos) return;
   const Element& e = *system_.model().elements()[static_cast<std::size_t>(anticlimber_element_)];
   const int nq = system_.body_unknowns();
@@ -92,7 +101,12 @@ std::string ResponseTracker::json() const {
     << ", \"override_relative_velocity\": " << json_number(r.override_relative_velocity)
     << ", \"max_vertical_anticlimber_force\": " << json_number(r.max_vertical_force)
     << ", \"max_anticlimber_crush\": " << json_number(r.max_anticlimber_crush)
-    << ", \"vertical_yield_force\": " << json_number(r.vertical_yield_force) << ", \"max_crush\": {";
+    << ", \"vertical_yield_force\": " << json_number(r.vertical_yield_force) << ", \"vertical_force_window\": "
+    << json_string(settings_.vertical_force_window == ResponseSettings::VerticalForceWindow::WholeRun ? "whole_run"
+                   : settings_.vertical_force_window == ResponseSettings::VerticalForceWindow::UntilLargestCrush
+                       ? "until_largest_crush"
+                       : "until_separation")
+    << ", \"max_crush\": {";
   for (std::size_t k = 0; k < settings_.crush_gauges.size(); ++k)
     j << (k ? ", " : "") << json_string(settings_.crush_gauges[k].name) << ": " << json_number(r.max_crush[k]);
   j << "}, \"crush_measure\": "

@@ -119,6 +119,63 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
   }
 }
 
+std::array<double, 3> response_triple(const std::string& path, const YAML::Node& node, const std::string& context) {
+  if (!node.IsSequence() || node.size() != 3) design_error(path, node, context + ": give [R1, R2, R3], e.g. [1.255, 0.610, 1.865]");
+  std::array<double, 3> values{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    try {
+      values[k] = node[k].as<double>();
+    } catch (const YAML::Exception&) {
+      design_error(path, node[k], context + ": R" + std::to_string(k + 1) + " must be a number");
+    }
+  }
+  return values;
+}
+
+void load_reference(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
+  if (!node.IsMap() || !node["base"])
+    design_error(path, node, "'reference' needs at least 'base: [R1, R2, R3]' (the published run 0)");
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    if (key != "source" && key != "base" && key != "first_order" && key != "second_order" && key != "ranking")
+      design_error(path, entry.first, "reference: unknown key '" + key + "' (allowed: source, base, first_order, second_order, ranking)");
+  }
+  PublishedResults reference;
+  if (node["source"]) reference.source = node["source"].as<std::string>();
+  reference.base = response_triple(path, node["base"], "reference: base");
+  if (const YAML::Node first = node["first_order"]) {
+    if (!first.IsMap()) design_error(path, first, "reference: first_order must map parameters to [R1, R2, R3]");
+    for (const auto& entry : first) {
+      const std::string name = entry.first.as<std::string>();
+      require_parameter(path, entry.first, design, name, "reference: first_order");
+      reference.first_order.emplace_back(name, response_triple(path, entry.second, "reference: first_order: " + name));
+    }
+  }
+  if (const YAML::Node second = node["second_order"]) {
+    if (!second.IsSequence() || second.size() != design.second_order.runs.size())
+      design_error(path, second, "reference: second_order must list [R1, R2, R3] for each of the " +
+                                     std::to_string(design.second_order.runs.size()) + " second_order runs, in their order");
+    for (std::size_t i = 0; i < second.size(); ++i)
+      reference.second_order.push_back(response_triple(path, second[i], "reference: second_order " + std::to_string(i + 1)));
+  }
+  if (const YAML::Node ranking = node["ranking"]) {
+    if (!ranking.IsMap()) design_error(path, ranking, "reference: ranking must map R1, R2, R3 to lists of parameters");
+    for (const auto& entry : ranking) {
+      const std::string response = entry.first.as<std::string>();
+      if (response != "R1" && response != "R2" && response != "R3")
+        design_error(path, entry.first, "reference: ranking: keys are R1, R2 and R3");
+      if (!entry.second.IsSequence()) design_error(path, entry.second, "reference: ranking: " + response + " must be a list");
+      auto& list = reference.ranking[static_cast<std::size_t>(response[1] - '1')];
+      for (const YAML::Node& p : entry.second) {
+        const std::string name = p.as<std::string>();
+        require_parameter(path, p, design, name, "reference: ranking: " + response);
+        list.push_back(name);
+      }
+    }
+  }
+  design.reference = std::move(reference);
+}
+
 std::string number_text(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", value);
@@ -134,14 +191,14 @@ struct Job {
 // model_text: the model file as read once at the start of the study, so that every run sees the
 // same model even if the file is edited while the study runs.
 SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
-                       const Job& job, double time_limit) {
+                       const Job& job, const std::vector<std::string>& base_settings, double time_limit) {
   SensitivityRun run;
   run.variation = job.variation;
   run.parameter = job.parameter;
   run.factor = job.factor;
   const auto start = std::chrono::steady_clock::now();
   try {
-    std::vector<std::string> settings;
+    std::vector<std::string> settings = base_settings;
     for (const auto& [name, value] : job.variation) {
       const SensitivityParameter* parameter = find_parameter(design, name);
       RAILCRASH_DEMAND(parameter != nullptr);  // load_design and run_sensitivity checked the names
@@ -263,6 +320,7 @@ SensitivityDesign load_design(const std::string& path) {
     design.parameters.push_back(std::move(parameter));
   }
   if (root["second_order"]) load_second_order(path, root["second_order"], design);
+  if (root["reference"]) load_reference(path, root["reference"], design);
   return design;
 }
 
@@ -406,7 +464,7 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
   std::mutex progress_mutex;
   const auto worker = [&]() {
     for (std::size_t k = next++; k < jobs.size(); k = next++) {
-      runs[k] = run_one(model_path, model_text, design, jobs[k], options.run_time_limit);
+      runs[k] = run_one(model_path, model_text, design, jobs[k], options.settings, options.run_time_limit);
       if (options.progress) {
         const std::lock_guard<std::mutex> lock(progress_mutex);
         options.progress(runs[k], k, ++done, jobs.size());

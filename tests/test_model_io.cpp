@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -387,6 +389,88 @@ TEST_CASE("bad --set overrides are InputErrors naming the setting", "[model_io]"
   CHECK_THAT(m, Contains("force_dt must be true or false"));
   m = error({"a.b.c.d=1"});
   CHECK_THAT(m, Contains("KEY must be"));
+}
+
+namespace {
+
+/// Writes `text` to a file in a fresh temporary folder; returns its path.
+std::string write_file(const std::string& folder, const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / ("railcrash_test_variants_" + folder);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / name) << text;
+  return (dir / name).string();
+}
+
+}  // namespace
+
+TEST_CASE("a model variant is its base model with the keys it sets changed", "[model_io]") {
+  write_file("ok", "base.yaml", kBase);
+  const std::string variant = write_file("ok", "variant.yaml",
+                                         "railcrash: 1\nvariant_of: base.yaml\nname: stiffer\n"
+                                         "set:\n  elements.spring.stiffness: 250   # why\n  gravity: [0, 0]\n"
+                                         "  bodies.bob.mass*: 3\n");
+  const Model model = load_model(variant, {"simulation.t_end=0.25"});
+  CHECK(model.name == "stiffer");
+  const auto* spring = dynamic_cast<const LinearSpring*>(model.elements()[0].get());
+  REQUIRE(spring != nullptr);
+  CHECK(spring->stiffness == 250.0);
+  CHECK(model.gravity_y == 0.0);
+  CHECK(model.bodies()[0].mass == Approx(3.0));   // 1 x 3
+  CHECK(model.bodies()[1].mass == 3.0);            // the base's
+  CHECK(model.simulation.t_end == 0.25);           // --set still applies, after the variant
+  const Model base = load_model(write_file("ok", "base.yaml", kBase));
+  CHECK(base.elements().size() == model.elements().size());
+}
+
+TEST_CASE("model variant errors name the variant's line or the base file", "[model_io]") {
+  write_file("bad", "base.yaml", kBase);
+  const auto error = [](const std::string& path) {
+    try {
+      (void)load_model(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  const std::string missing_key = write_file("bad", "v1.yaml", "railcrash: 1\nvariant_of: base.yaml\nset:\n  elements.nothing.stiffness: 2\n");
+  CHECK_THAT(error(missing_key), StartsWith(missing_key + ":4: set 'elements.nothing.stiffness'") && Contains("no element named 'nothing'"));
+  const std::string bad_value = write_file("bad", "v2.yaml", "railcrash: 1\nvariant_of: base.yaml\nset:\n  simulation.t_end: -1\n");
+  CHECK_THAT(error(bad_value), StartsWith(bad_value + ":4: set 'simulation.t_end'") && Contains("t_end must be positive"));
+  const std::string no_base = write_file("bad", "v3.yaml", "railcrash: 1\nvariant_of: nowhere.yaml\n");
+  CHECK_THAT(error(no_base), StartsWith(no_base + ":2: ") && Contains("cannot open the base model"));
+  const std::string other_key = write_file("bad", "v4.yaml", "railcrash: 1\nvariant_of: base.yaml\nbodies: []\n");
+  CHECK_THAT(error(other_key), StartsWith(other_key + ":3: ") && Contains("unknown key 'bodies'"));
+  const std::string chained = write_file("bad", "v5.yaml", "railcrash: 1\nvariant_of: v1.yaml\n");
+  CHECK_THAT(error(chained), StartsWith(chained + ":2: ") && Contains("is itself a variant"));
+  const std::string self = write_file("bad", "v6.yaml", "railcrash: 1\nvariant_of: v6.yaml\n");
+  CHECK_THAT(error(self), Contains("is itself a variant"));
+  const std::string no_value = write_file("bad", "v7.yaml", "railcrash: 1\nvariant_of: base.yaml\nset:\n  simulation.t_end:\n");
+  CHECK_THAT(error(no_value), StartsWith(no_value + ":4: ") && Contains("give a value"));
+}
+
+TEST_CASE("the report's corrected final model is the printed one with three proposals", "[model_io]") {
+  const std::string folder = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/";
+  const Model printed = load_model(folder + "final_two_car.yaml");
+  const Model corrected = load_model(folder + "final_two_car_corrected.yaml");
+  const auto body = [](const Model& m, const std::string& name) {
+    for (const Body& b : m.bodies())
+      if (b.name == name) return b;
+    FAIL("no body " << name);
+    return Body{};
+  };
+  CHECK(body(printed, "car1_center_body").inertia == 253200.0);  // Table 6 as printed
+  CHECK(body(corrected, "car1_center_body").inertia == 2.7e6);   // the proposal T6-1
+  const auto spring = [](const Model& m, const std::string& name) {
+    for (const auto& e : m.elements())
+      if (e->name() == name) return dynamic_cast<const LinearSpring&>(*e).free_length.value();
+    FAIL("no element " << name);
+    return 0.0;
+  };
+  for (const char* name : {"car1_front_susp_spring", "car1_rear_susp_spring", "car2_front_susp_spring", "car2_rear_susp_spring"})
+    CHECK(spring(printed, name) == 20.04);  // Table 8 as printed, both cars
+  CHECK(spring(corrected, "car1_front_susp_spring") == 24.98);
+  CHECK(spring(corrected, "car1_rear_susp_spring") == 24.98);
+  CHECK(spring(corrected, "car2_front_susp_spring") == 20.04);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -182,3 +182,56 @@ TEST_CASE("cars are the car<N>_ name prefixes and an element between two cars co
   CHECK(cars[1].elements == std::vector<std::string>{"between", "inside"});
   CHECK(cars[1].shares == std::vector<double>{0.5, 1.0});
 }
+
+TEST_CASE("R2's window: the whole run, until the largest crush or until separation, closed form", "[responses]") {
+  // A 1000 kg point mass at (0.002, 0) moving at (-2, 0.2) m/s into an anticlimber face on
+  // ground (no gravity). The faces meet at t_c = 1 ms. Horizontally (closed form, see the R1
+  // case): elastic at 1e7 N/m to 0.01 m (Omega = 100 rad/s, sin(Omega t1) = 0.5: t1 = 5.236 ms,
+  // speed 2 cos 30 deg = 1.732 m/s), then 1e5 N + 1e5 N/m (u'' + 100 u = -100, u = -1 + cos 10t
+  // + 0.1732 sin 10t, largest crush at tan 10t = 0.1732: 17.151 ms later), then elastic
+  // unloading to zero force in a quarter period pi / (2 Omega) = 15.708 ms. Vertically the
+  // interlock is elastic (1e6 N/m, omega = 31.623 rad/s, amplitude 0.2 / omega = 6.32 mm, below
+  // the 0.01 m yield) and independent of the horizontal motion (the mass has no arm):
+  // V(t) = 1e6 (0.2 / omega) sin(omega (t - t_c)) while the faces are engaged.
+  const auto run = [](const std::string& window) {
+    const std::string text = "railcrash: 1\nname: window\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+                                  "  - {name: car, mass: 1000, inertia: 100, position: [0.002, 0], velocity: [-2, 0.2]}\nelements:\n"
+                                  "  - name: ac\n    type: anticlimber\n"
+                                  "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n"
+                                  "    horizontal_yield_deflection: 0.01\n"
+                                  "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n"
+                                  "    vertical_yield_deflection: 0.01\n"
+                                  "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n"
+                                  "    torsional_yield_deflection: 0.01\n"
+                                  "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
+                                  "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n" +
+                                  (window.empty() ? std::string() : "  vertical_force_window: " + window + "\n") +
+                                  "simulation: {t_end: 0.08, rtol: 1e-9, output_interval: 1.0e-5}\n";
+    const RunReport report = run_model(testing::model_from_text(text), "");
+    REQUIRE(report.outcome.ok);
+    REQUIRE_FALSE(report.responses.overridden);
+    return report.responses.max_vertical_force;
+  };
+  const double omega = std::sqrt(1.0e3), amplitude = 1.0e6 * 0.2 / omega;
+  const double t1 = (M_PI / 6.0) / 100.0, t_plastic = std::atan(std::sqrt(3.0) / 10.0) / 10.0, t_unload = M_PI / 200.0;
+  const double at_largest_crush = amplitude * std::sin(omega * (t1 + t_plastic));
+  const double at_separation = amplitude * std::sin(omega * (t1 + t_plastic + t_unload));
+  CHECK(at_largest_crush == Approx(4113).epsilon(1e-3));  // the numbers in the comment
+  CHECK(at_separation == Approx(5905).epsilon(1e-3));
+  // The peaks are taken at the output rows (every 1e-5 s), so each lies at most one interval
+  // before its event: below the closed form by at most the force's rate x 1e-5 s.
+  const auto within_one_row = [&](double peak, double exact, double phase) {
+    const double rate = amplitude * omega * std::cos(phase);  // [N/s]
+    INFO("peak " << peak << ", closed form " << exact << ", one row " << rate * 1e-5);
+    CHECK(peak <= exact * (1.0 + 1e-7));
+    CHECK(peak >= exact - rate * 1.0e-5 * (1.0 + 1e-3));
+  };
+  const double phase_crush = omega * (t1 + t_plastic), phase_separation = omega * (t1 + t_plastic + t_unload);
+  within_one_row(run("until_largest_crush"), at_largest_crush, phase_crush);
+  within_one_row(run("until_separation"), at_separation, phase_separation);
+  // After the separation the faces carry nothing: the whole run's peak is the separation's.
+  within_one_row(run(""), at_separation, phase_separation);
+  within_one_row(run("whole_run"), at_separation, phase_separation);
+  CHECK_THROWS_WITH(load_model_text(testing::anticlimber_r1_model_text(0.1), "r1.yaml", {"responses.vertical_force_window=later"}),
+                    Catch::Contains("vertical_force_window must be whole_run, until_largest_crush or until_separation"));
+}

@@ -26,6 +26,8 @@ class ParameterReader {
   /// A table of rows of exactly `width` finite numbers ([[a, b], ...]), or nullopt.
   virtual std::optional<std::vector<std::vector<double>>> table(const std::string& key, std::size_t width) = 0;
   virtual std::optional<bool> flag(const std::string& key) = 0;
+  /// A word (a YAML scalar, e.g. `release`), or nullopt when the key is absent.
+  virtual std::optional<std::string> word(const std::string& key) = 0;
   /// Throws an InputError located at `key` (or at the element when the key is absent).
   [[noreturn]] virtual void fail(const std::string& key, const std::string& what_to_change) const = 0;
 

@@ -65,6 +65,14 @@ struct ResponseSettings {
   std::string anticlimber;                    // element whose vertical force and override make R2
   std::optional<double> vertical_yield_force; // [force] default: the anticlimber's own
   double reference_velocity = 0.0;            // [length/time] velocity that fails the collision post
+  /// Over which part of the run R2's largest vertical force is taken (a reading; the report
+  /// says only "maximum vertical force at anticlimbers"):
+  ///   WholeRun          every output sample of the run;
+  ///   UntilLargestCrush until the anticlimber's horizontal law first unloads (the cars have
+  ///                     reached their common speed and begin to move apart);
+  ///   UntilSeparation   until the anticlimber faces first separate.
+  enum class VerticalForceWindow { WholeRun, UntilLargestCrush, UntilSeparation };
+  VerticalForceWindow vertical_force_window = VerticalForceWindow::WholeRun;
   bool defined() const { return !crush_gauges.empty() || !anticlimber.empty(); }
 };
 

@@ -14,6 +14,9 @@
 //        which the planar model has no mass for: an approximation, stated in summary.json)
 //   R3 = max(R1, R2) when both are below 1, else R1 + R2 (reading R-1)
 // The largest force and crush are taken over the output samples (finer output, finer peaks).
+// R2's largest vertical force is taken over the whole run or, as `vertical_force_window`
+// says, only until the anticlimber first unloads horizontally (largest crush) or first
+// separates (a reading: models/report/README.md).
 #pragma once
 
 #include <optional>
@@ -57,6 +60,7 @@ class ResponseTracker : public RunObserver {
   std::vector<double> outputs_;
   Responses responses_;
   bool started_ = false;
+  bool vertical_window_closed_ = false;  // R2's window (ResponseSettings::vertical_force_window) has ended
 };
 
 }  // namespace railcrash

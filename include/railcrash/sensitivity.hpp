@@ -52,6 +52,7 @@
 #include <array>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -86,10 +87,27 @@ struct SecondOrderDesign {
   bool empty() const { return terms.empty() && runs.empty(); }
 };
 
+/// A study's published results, to compare a model's study with (the report's Tables 11, 13
+/// and 15-17 for its design). In the design file:
+///   reference:
+///     source: text saying where the numbers come from
+///     base: [R1, R2, R3]                   # run 0
+///     first_order: {P1: [R1, R2, R3], ...} # each parameter's run at the design's factor
+///     second_order: [[R1, R2, R3], ...]    # in the order of second_order.runs
+///     ranking: {R1: [P7, P6, ...], R2: [...], R3: [...]}   # the printed rankings, best first
+struct PublishedResults {
+  std::string source;
+  std::array<double, 3> base{};
+  std::vector<std::pair<std::string, std::array<double, 3>>> first_order;  // parameter -> R1-R3
+  std::vector<std::array<double, 3>> second_order;                         // per second-order run
+  std::array<std::vector<std::string>, 3> ranking;                         // R1-R3, most important first
+};
+
 struct SensitivityDesign {
   double factor = 1.2;
   std::vector<SensitivityParameter> parameters;
   SecondOrderDesign second_order;
+  std::optional<PublishedResults> reference;
 };
 
 /// Reads a design file (errors name the file and line).
@@ -151,6 +169,7 @@ struct SensitivityResult {
 
 struct SensitivityOptions {
   int jobs = 1;
+  std::vector<std::string> settings;  // KEY=VALUE / KEY*=FACTOR applied to every run before the parameters' scaling
   double central_step = 0.0;         // > 0: central differences at 1 +- this
   std::vector<std::string> only;     // parameter names to run (empty: all); second-order runs and
                                      // terms are kept when all their parameters are among them

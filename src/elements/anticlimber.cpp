@@ -132,7 +132,14 @@ Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type,
   length = p.number("length");
   const std::optional<double> misalignment = p.number("initial_misalignment");
   facing = p.number("facing");
+  const std::optional<std::string> interlock = p.word("interlock_while_unloading");
   spec.require_points(2);
+  if (interlock && *interlock != "hold" && *interlock != "release")
+    p.fail("interlock_while_unloading",
+           "'interlock_while_unloading' must be hold (the faces keep their vertical and torsional interlock while the "
+           "horizontal law unloads) or release (the interlock lets go at the horizontal unloading and re-seats at "
+           "reloading), not '" + *interlock + "'");
+  release_while_unloading = interlock && *interlock == "release";
 
   if (length && !(*length > 0.0)) p.fail("length", "'length' must be positive");
   if (!inputs[0].rupture && length) inputs[0].rupture = length;  // crushed through over its whole length
@@ -185,8 +192,10 @@ void Anticlimber::roots_of(const Deformations& k, double* g) const {
       break;
     case Contact::Engaged:
       horizontal.roots(state_.horizontal, k.d[0], k.rate[0], g + kHorizontalRoots);
-      vertical.roots(state_.vertical, k.d[1], k.rate[1], g + kVerticalRoots);
-      torsional.roots(state_.torsional, k.d[2], k.rate[2], g + kTorsionalRoots);
+      if (!state_.interlock_released) {
+        vertical.roots(state_.vertical, k.d[1], k.rate[1], g + kVerticalRoots);
+        torsional.roots(state_.torsional, k.d[2], k.rate[2], g + kTorsionalRoots);
+      }
       g[kOverrideRoot] = face_height - std::abs(k.offset);
       break;
     case Contact::Overridden:
@@ -203,6 +212,7 @@ bool Anticlimber::active(int index) const {
       if (index == kOverrideRoot) return true;
       if (index == kContactRoot) return false;
       if (index < kVerticalRoots) return horizontal.active(state_.horizontal, index - kHorizontalRoots);
+      if (state_.interlock_released) return false;
       if (index < kTorsionalRoots) return vertical.active(state_.vertical, index - kVerticalRoots);
       return torsional.active(state_.torsional, index - kTorsionalRoots);
     case Contact::Overridden:
@@ -210,6 +220,14 @@ bool Anticlimber::active(int index) const {
       break;
   }
   return false;
+}
+
+void Anticlimber::seat_interlock(const Deformations& k) {
+  state_.interlock_released = false;
+  state_.vertical_reference = k.offset;
+  state_.torsional_reference = k.rotation;
+  if (state_.vertical.mode != ElasticPlasticLaw::Mode::Failed) state_.vertical = vertical.fresh();
+  if (state_.torsional.mode != ElasticPlasticLaw::Mode::Failed) state_.torsional = torsional.fresh();
 }
 
 void Anticlimber::transition(int index, double t, const Deformations& k, std::string& what) {
@@ -222,10 +240,7 @@ void Anticlimber::transition(int index, double t, const Deformations& k, std::st
       return;
     }
     state_.contact = Contact::Engaged;
-    state_.vertical_reference = k.offset;
-    state_.torsional_reference = k.rotation;
-    if (state_.vertical.mode != ElasticPlasticLaw::Mode::Failed) state_.vertical = vertical.fresh();
-    if (state_.torsional.mode != ElasticPlasticLaw::Mode::Failed) state_.torsional = torsional.fresh();
+    seat_interlock(k);
     add("contact");
     return;
   }
@@ -241,14 +256,27 @@ void Anticlimber::transition(int index, double t, const Deformations& k, std::st
   const std::string name = kDirections[direction];
   switch (law.leave(st, index % 3, k.d[direction])) {
     case ElasticPlasticLaw::Outcome::Yield: add(name + " yield"); break;
-    case ElasticPlasticLaw::Outcome::Reloading: add(name + " reloading"); break;
-    case ElasticPlasticLaw::Outcome::Unloading: add(name + " unloading"); break;
+    case ElasticPlasticLaw::Outcome::Reloading:
+      add(name + " reloading");
+      if (direction == 0 && state_.interlock_released) {
+        seat_interlock(k);
+        add("interlock re-seated");
+      }
+      break;
+    case ElasticPlasticLaw::Outcome::Unloading:
+      add(name + " unloading");
+      if (direction == 0 && release_while_unloading) {
+        state_.interlock_released = true;
+        add("interlock released");
+      }
+      break;
     case ElasticPlasticLaw::Outcome::Rupture:
       if (direction == 0) state_.contact = Contact::Crushed;
       add(direction == 0 ? "crushing failure" : (direction == 1 ? "shear failure" : "bending failure"));
       break;
     case ElasticPlasticLaw::Outcome::Release:
       state_.contact = Contact::Open;
+      state_.interlock_released = false;  // the next contact seats it afresh
       add("separation");
       break;
   }
@@ -325,19 +353,20 @@ bool Anticlimber::commit(int index, int direction, double t, const ElementState<
 double Anticlimber::potential_energy(const ElementState<double>& s) const {
   if (state_.contact != Contact::Engaged) return 0.0;
   const Deformations k = deformations(s);
-  return horizontal.elastic_energy(state_.horizontal, k.d[0]) + vertical.elastic_energy(state_.vertical, k.d[1]) +
-         torsional.elastic_energy(state_.torsional, k.d[2]);
+  const double h = horizontal.elastic_energy(state_.horizontal, k.d[0]);
+  if (state_.interlock_released) return h;
+  return h + vertical.elastic_energy(state_.vertical, k.d[1]) + torsional.elastic_energy(state_.torsional, k.d[2]);
 }
 
 void Anticlimber::outputs(const ElementState<double>& s, const double*, double* out) const {
   const Deformations k = deformations(s);
-  const bool engaged = state_.contact == Contact::Engaged;
+  const bool engaged = state_.contact == Contact::Engaged, held = interlocked();
   out[0] = engaged ? horizontal.force(state_.horizontal, k.d[0]) : 0.0;
-  out[1] = engaged ? vertical.force(state_.vertical, k.d[1]) : 0.0;
-  out[2] = engaged ? torsional.force(state_.torsional, k.d[2]) : 0.0;
+  out[1] = held ? vertical.force(state_.vertical, k.d[1]) : 0.0;
+  out[2] = held ? torsional.force(state_.torsional, k.d[2]) : 0.0;
   out[3] = k.d[0];
-  out[4] = engaged ? k.d[1] : 0.0;
-  out[5] = engaged ? k.d[2] : 0.0;
+  out[4] = held ? k.d[1] : 0.0;
+  out[5] = held ? k.d[2] : 0.0;
   out[6] = k.offset;
   out[7] = overridden() ? 1.0 : 0.0;
 }

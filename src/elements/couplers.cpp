@@ -530,7 +530,22 @@ CouplerEnd::CouplerEnd(ElementSpec& spec) : ForceElement(spec.name, spec.type, s
   friction = p.optional_nonnegative("friction").value_or(0.0);
   friction_velocity = p.optional_positive("friction_velocity").value_or(0.01);
   coupled = p.flag("coupled").value_or(false);
+  const std::optional<double> e = p.number("restitution");
+  shear_load = p.number("shear_load");
   spec.require_points(2);
+  if (shear_load && !(*shear_load > 0.0))
+    p.fail("shear_load",
+           "'shear_load' is the buff face force at which the coupler faces shear off: give a positive force, or leave it "
+           "out for faces that never shear");
+  if (e && !(*e > 0.0 && *e <= 1.0))
+    p.fail("restitution",
+           "'restitution' is the coefficient of restitution of the faces' buff contact: give a value above 0 and at most 1 "
+           "(1: elastic faces, the default)");
+  restitution = e.value_or(1.0);
+  if (restitution < 1.0 && coupled)
+    p.fail("restitution",
+           "'restitution' below 1 gives the faces a permanent set in buff, which the coupled knuckles' draft law does not "
+           "follow: use it with uncoupled faces ('coupled: false') or leave it out");
   const auto per_end = [&](const std::optional<std::vector<double>>& values, const char* key, bool zero_allowed) {
     if (!values) p.fail(key, std::string("missing required parameter '") + key + "': [end K, end L]");
     for (double v : *values)
@@ -562,34 +577,84 @@ void CouplerEnd::initialize(const ElementState<double>& initial) {
   const Kinematics k = kinematics(initial);
   state_ = State{};
   state_.overlapping = std::abs(k.dy) <= half_overlap();
-  state_.band = faces_.initial(k.h, k.h_rate);
+  if (lossy()) {
+    state_.band = lossy_band(k);
+    if (state_.band == DeadBand::Mode::Below && !(k.h_rate < 0.0)) {  // deflected, not closing: loaded to here
+      state_.unloading = true;
+      state_.peak = faces_.lo - k.h;
+    }
+  } else {
+    state_.band = faces_.initial(k.h, k.h_rate);
+  }
+  if (shear_load && active() && state_.band == DeadBand::Mode::Below && -face_tension(k.h) >= *shear_load) {
+    std::ostringstream msg;
+    msg << where_.prefix() << "coupler_end '" << name_ << "' starts with a face force " << -face_tension(k.h)
+        << " at or above its shear_load " << *shear_load << "; start the faces closer to touching";
+    throw InputError(msg.str());
+  }
   initial_state_ = state_;
 }
 
-void CouplerEnd::roots_at(const Kinematics& k, double* g) const {
-  g[0] = g[1] = 1.0;
-  if (state_.overlapping) {
-    faces_.roots(state_.band, k.h, g);
-    g[2] = half_overlap() - std::abs(k.dy) + faces_.tolerance;
-  } else {
-    g[2] = std::abs(k.dy) - half_overlap() + faces_.tolerance;
+DeadBand::Mode CouplerEnd::lossy_band(const Kinematics& k) const {
+  const double touch = faces_.lo - permanent_set(state_);  // spacing at which the faces touch
+  return (k.h < touch || (k.h == touch && k.h_rate < 0.0)) ? DeadBand::Mode::Below : DeadBand::Mode::Inside;
+}
+
+void CouplerEnd::lossy_roots(const Kinematics& k, double* g) const {
+  const double touch = faces_.lo - permanent_set(state_), tol = faces_.tolerance;
+  if (state_.blocked) {
+    g[0] = touch - k.h + tol;  // clear once apart beyond the set
+    return;
   }
+  if (state_.band == DeadBand::Mode::Inside) {
+    g[0] = k.h - touch + tol;  // contact
+  } else if (!state_.unloading) {
+    g[0] = -k.h_rate;  // loading while the penetration grows
+  } else {
+    g[0] = touch - k.h + tol;                           // separation at the set
+    g[1] = k.h - (faces_.lo - state_.peak) + tol;       // back on the loading line at delta_max
+  }
+}
+
+void CouplerEnd::roots_at(const Kinematics& k, double* g) const {
+  std::fill(g, g + kRoots, 1.0);
+  if (state_.sheared) return;
+  if (state_.overlapping) {
+    if (lossy()) lossy_roots(k, g);
+    else faces_.roots(state_.band, k.h, g);
+    g[kOverlapRoot] = half_overlap() - std::abs(k.dy) + faces_.tolerance;
+  } else {
+    g[kOverlapRoot] = std::abs(k.dy) - half_overlap() + faces_.tolerance;
+  }
+  if (shear_load && active() && state_.band == DeadBand::Mode::Below) g[kShearRoot] = *shear_load + face_tension(k.h);
 }
 
 void CouplerEnd::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
 
 void CouplerEnd::apply(int index, const Kinematics& k, Event& event) {
   State& st = state_;
-  if (index == 2) {
+  if (index == kShearRoot) {
+    event = {"face shear failure", -face_tension(k.h)};
+    st.sheared = true;
+    return;
+  }
+  if (index == kOverlapRoot) {
     if (st.overlapping) {
+      if (lossy() && st.band == DeadBand::Mode::Below && !st.unloading && !st.blocked)
+        st.peak = std::max(st.peak, faces_.lo - k.h);  // the set of the loading that ends here
       st.overlapping = false;
       event = {"vertical overlap lost", k.dy};
     } else {
       st.overlapping = true;
-      st.band = faces_.initial(k.h, k.h_rate);
+      st.unloading = false;
+      st.band = lossy() ? lossy_band(k) : faces_.initial(k.h, k.h_rate);
       st.blocked = st.band != DeadBand::Mode::Inside;
       event = {st.blocked ? "vertical overlap regained, faces past each other" : "vertical overlap regained", k.dy};
     }
+    return;
+  }
+  if (lossy()) {
+    apply_lossy(index, k, event);
     return;
   }
   using M = DeadBand::Mode;
@@ -608,6 +673,31 @@ void CouplerEnd::apply(int index, const Kinematics& k, Event& event) {
   event = {what, gap};
 }
 
+void CouplerEnd::apply_lossy(int index, const Kinematics& k, Event& event) {
+  State& st = state_;
+  const double gap = k.h - faces_.lo;  // -delta
+  if (st.blocked) {
+    st.blocked = false;
+    st.band = DeadBand::Mode::Inside;
+    event = {"faces clear", gap};
+  } else if (st.band == DeadBand::Mode::Inside) {
+    st.band = DeadBand::Mode::Below;
+    st.unloading = st.peak > 0.0;  // a set face is reloaded along its unloading line
+    event = {"contact", gap};
+  } else if (!st.unloading) {
+    st.peak = std::max(st.peak, -gap);
+    st.unloading = true;
+    event = {"unloading", gap};
+  } else if (index == 0) {
+    st.band = DeadBand::Mode::Inside;
+    st.unloading = false;
+    event = {"separation", gap};
+  } else {
+    st.unloading = false;
+    event = {"reloading", gap};
+  }
+}
+
 bool CouplerEnd::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
   const Kinematics k = kinematics(s);
   return commit_crossing<kRoots>(
@@ -616,22 +706,27 @@ bool CouplerEnd::commit(int index, int direction, double, const ElementState<dou
 
 void CouplerEnd::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
   const State saved = state_;
-  state_ = {DeadBand::Mode::Below, true, false};
+  state_ = {DeadBand::Mode::Below, true, false, lossy(), saved.peak, false};  // the steeper unloading line if any
   std::array<Pose<double>, 2> f{};
   add_force_jacobian(t, s, f, df_dq, df_dv);
   state_ = saved;
 }
 
 double CouplerEnd::potential_energy(const ElementState<double>& s) const {
-  return active() ? faces_.energy(state_.band, kinematics(s).h) : 0.0;
+  if (!active()) return 0.0;
+  const double h = kinematics(s).h;
+  if (state_.band != DeadBand::Mode::Below) return faces_.energy(state_.band, h);
+  const double push = -face_tension(h);
+  return 0.5 * push * push / unloading_stiffness();  // what unloading gives back (k_u = k when elastic)
 }
 
 void CouplerEnd::outputs(const ElementState<double>& s, const double*, double* out) const {
   const Kinematics k = kinematics(s);
   const bool on = active();
-  out[0] = on ? -faces_.force(state_.band, k.h) : 0.0;
+  const double tension = on ? face_tension(k.h) : 0.0;
+  out[0] = -tension;
   out[1] = on && friction > 0.0
-               ? -friction * faces_.magnitude(state_.band, k.h) * std::tanh(k.dy_rate / friction_velocity)
+               ? -friction * std::abs(tension) * std::tanh(k.dy_rate / friction_velocity)
                : 0.0;
   out[2] = k.h - faces_.lo;
 }

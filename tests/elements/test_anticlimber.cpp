@@ -40,6 +40,7 @@ struct Parameters {
   double misalignment = 0.0;
   std::optional<double> facing;
   std::optional<double> length;
+  std::string interlock;  // interlock_while_unloading; empty: not given (hold)
 };
 
 std::string number(double x) {
@@ -62,6 +63,7 @@ std::string parameters_yaml(const Parameters& p) {
   if (p.misalignment != 0.0) s += "    initial_misalignment: " + number(p.misalignment) + "\n";
   if (p.facing) s += "    facing: " + number(*p.facing) + "\n";
   if (p.length) s += "    length: " + number(*p.length) + "\n";
+  if (!p.interlock.empty()) s += "    interlock_while_unloading: " + p.interlock + "\n";
   return s;
 }
 
@@ -234,6 +236,18 @@ ElasticPlasticLaw::State law_state(const ElasticPlasticLaw& law, Mode mode, doub
   st.upper = law.yield_deflection + shift;
   st.lower = law.one_sided ? offset : -law.yield_deflection + shift;
   return st;
+}
+
+/// Jacobian against finite differences at random states near the start, in the element's
+/// current mode.
+void check_jacobian_near_start(const DaeSystem& system, std::mt19937& rng) {
+  for (int trial = 0; trial < 3; ++trial) {
+    const std::vector<double> y = testing::random_state(system, rng, 0.05);
+    const std::vector<double> yp = testing::random_state(system, rng, 0.05);
+    double outside = -1.0;
+    CHECK(testing::jacobian_error(system, 0.1, 30.0 * (trial + 1), y, yp, &outside) < 1e-6);
+    CHECK(outside == 0.0);
+  }
 }
 
 // Two cars: body 1 turned by 0.15 rad, body 2 by -0.1 rad; face points away from the centres.
@@ -605,13 +619,7 @@ TEST_CASE("anticlimber Jacobian matches finite differences in every mode", "[ele
     std::mt19937 rng(3);
     int checked = 0;
     const auto check_here = [&]() {
-      for (int trial = 0; trial < 3; ++trial) {
-        const std::vector<double> y = testing::random_state(system, rng, 0.05);
-        const std::vector<double> yp = testing::random_state(system, rng, 0.05);
-        double outside = -1.0;
-        CHECK(testing::jacobian_error(system, 0.1, 30.0 * (trial + 1), y, yp, &outside) < 1e-6);
-        CHECK(outside == 0.0);
-      }
+      check_jacobian_near_start(system, rng);
       ++checked;
     };
     for (const Mode h : {Mode::Elastic, Mode::PlasticUp})
@@ -973,4 +981,165 @@ TEST_CASE("anticlimber crush under Euler converges to the closed form as the ste
   CHECK(e3 < 0.5 * e2);
   CHECK(e3 < 1e-3 * c.rebound_speed);
   CHECK(ida < 1e-7 * c.rebound_speed);
+}
+
+// ---- interlock while unloading: hold | release ------------------------------------------------
+
+namespace {
+
+/// A mass sliding up at 0.1 m/s hits the anticlimber at 2 m/s while a load (8 kN growing by
+/// 20 kN/s) presses it on: the faces crush, unload elastically from the largest crush and,
+/// pressed on by the growing load, reload onto the yield line without separating.
+Model pressed_sliding_mass(const std::string& interlock, const std::string& integrator, double t_end) {
+  Parameters p;
+  p.interlock = interlock;
+  const std::vector<BodySpec> bodies{{"b", 100.0, 1.0, 0.001, 0.0, 0.0, -1.5, 0.1, 0.0}};
+  const std::string load = "  - {type: force, body: b, value: [[0, -6000, 0], [1, -26000, 0]]}\n";
+  const std::string sim = "t_end: " + number(t_end) + ", integrator: " + integrator + ", rtol: 1e-10, dt: 1e-6, output_interval: 1e-4";
+  return testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim, "", load));
+}
+
+}  // namespace
+
+TEST_CASE("anticlimber interlock_while_unloading: hold keeps the vertical force while the faces unload, release lets go "
+          "until reloading",
+          "[elements][anticlimber]") {
+  // Horizontal and vertical motion are independent here (the point is the mass's centre, the
+  // faces stay square), so both readings have the same horizontal events. Vertically the
+  // interlock is elastic (|V| stays below the 4 kN yield): V = k_v (y - v_e).
+  const Parameters p;
+  const double kv = p.vertical.elastic, omega_v = std::sqrt(kv / 100.0), t_end = 0.114;
+  for (const char* integrator : {"ida", "euler"}) {
+    const bool ida = std::string(integrator) == "ida";
+    const Model hold_model = pressed_sliding_mass("hold", integrator, t_end);
+    const Model release_model = pressed_sliding_mass("release", integrator, t_end);
+    const Run hold = simulate(hold_model), release = simulate(release_model);
+    INFO(integrator << "\nhold:\n" << event_list(hold.outcome) << "release:\n" << event_list(release.outcome));
+    const char* const hold_events[] = {"contact", "horizontal yield", "horizontal unloading", "horizontal reloading"};
+    const char* const release_events[] = {"contact", "horizontal yield", "horizontal unloading, interlock released",
+                                          "horizontal reloading, interlock re-seated"};
+    REQUIRE(hold.outcome.events.size() == 4);
+    REQUIRE(release.outcome.events.size() == 4);
+    for (std::size_t k = 0; k < 4; ++k) {
+      CHECK(hold.outcome.events[k].what == hold_events[k]);
+      CHECK(release.outcome.events[k].what == release_events[k]);
+      CHECK(release.outcome.events[k].t == Approx(hold.outcome.events[k].t).epsilon(0).margin(ida ? 1e-9 : 1e-6));
+      CHECK(release.outcome.events[k].value == Approx(hold.outcome.events[k].value).epsilon(0).margin(1e-9));
+    }
+    const double t_unloading = hold.outcome.events[2].t, t_reloading = hold.outcome.events[3].t;
+    REQUIRE(t_reloading - t_unloading > 0.05);
+    // hold: the vertical force of the interlock (reference: the offset at contact) builds up
+    // while the faces unload: it reaches a good part of the amplitude m w_v 0.1 = 447 N.
+    const double reference = anticlimber_of(hold_model).state().vertical_reference;
+    double hold_peak = 0.0;
+    int inside = 0;
+    for (std::size_t k = 0; k < hold.samples.t.size(); ++k) {
+      const double t = hold.samples.t[k];
+      if (t <= t_unloading + 1e-5 || t >= t_reloading - 1e-5) continue;
+      hold_peak = std::max(hold_peak, std::abs(kv * (hold.samples.y[k][1] - reference)));
+      ++inside;
+    }
+    CHECK(inside > 100);
+    CHECK(hold_peak > 200.0);
+    // release: no vertical force from the unloading event to the reloading event: the mass
+    // slides up at the vertical speed it had at the unloading event.
+    std::optional<std::size_t> first;
+    double release_drift = 0.0;
+    for (std::size_t k = 0; k < release.samples.t.size(); ++k) {
+      const double t = release.samples.t[k];
+      if (t <= t_unloading + 1e-5 || t >= t_reloading - 1e-5) continue;
+      if (!first) first = k;
+      release_drift = std::max(release_drift, std::abs(release.samples.y[k][4] - release.samples.y[*first][4]));
+      const double expected_y = release.samples.y[*first][1] + release.samples.y[*first][4] * (t - release.samples.t[*first]);
+      CHECK(release.samples.y[k][1] == Approx(expected_y).epsilon(0).margin(ida ? 1e-10 : 1e-9));
+    }
+    REQUIRE(first);
+    CHECK(release_drift < (ida ? 1e-10 : 1e-12));
+    // ... and the force comes back at reloading: the interlock re-seats at the offset of that
+    // moment, y_r = y_u + w_u (t_r - t_u), and the mass oscillates about it from there:
+    // y = y_r + (w_u / w_v) sin(w_v (t - t_r)).
+    const Anticlimber& ac = anticlimber_of(release_model);
+    const double y_u = release.samples.y[*first][1] - release.samples.y[*first][4] * (release.samples.t[*first] - t_unloading);
+    const double w_u = release.samples.y[*first][4];
+    const double y_r = y_u + w_u * (t_reloading - t_unloading);
+    CHECK(ac.interlocked());
+    CHECK(ac.state().vertical_reference == Approx(y_r).epsilon(0).margin(ida ? 1e-9 : 1e-7));
+    CHECK(std::abs(w_u) > 0.02);  // a real slide, so the re-seated interlock is loaded again
+    const double y_end = y_r + w_u / omega_v * std::sin(omega_v * (t_end - t_reloading));
+    CHECK(release.outcome.y[1] == Approx(y_end).epsilon(0).margin(ida ? 1e-8 : 1e-6));
+    const DaeSystem system(release_model);
+    const std::vector<double> out = element_outputs(system, release.outcome.y);
+    CHECK(out[1] == Approx(kv * (release.outcome.y[1] - ac.state().vertical_reference)).epsilon(1e-12));
+    CHECK(std::abs(out[1]) > 50.0);
+    // Energy: the release dissipates the vertical elastic energy of that moment; the balance
+    // closes for both readings (Euler-Cromer: O(omega dt) of the energy exchanged).
+    for (const Run* r : {&hold, &release}) {
+      const EnergyBalance balance = EnergyBalance::between(r->outcome.initial_energy, r->outcome.final_energy);
+      CHECK(std::abs(balance.error()) < (ida ? 1e-7 : 1e-4) * (balance.initial_total + balance.external_work));
+    }
+    const EnergyBalance held = EnergyBalance::between(hold.outcome.initial_energy, hold.outcome.final_energy);
+    const EnergyBalance released = EnergyBalance::between(release.outcome.initial_energy, release.outcome.final_energy);
+    // Same horizontal history, same external work; the vertical energy at the release went.
+    CHECK(released.external_work == Approx(held.external_work).epsilon(ida ? 1e-9 : 1e-5));
+    // The vertical law stays elastic in both, so the difference is the energy released:
+    // V_u^2 / 2 k_v with V_u = k_v (y_u - v_e), about 0.31 J here.
+    const double released_energy = 0.5 * kv * (y_u - reference) * (y_u - reference);
+    CHECK(released_energy > 0.1);
+    CHECK(released.dissipated - held.dissipated == Approx(released_energy).epsilon(ida ? 1e-5 : 2e-2));
+  }
+}
+
+TEST_CASE("anticlimber Jacobian matches finite differences with the interlock released", "[elements][anticlimber]") {
+  Parameters p;
+  p.interlock = "release";
+  const Model model = testing::model_from_text(model_yaml(two_cars(), p, kCar1Face, kCar2Face, "t_end: 1"));
+  const DaeSystem system(model);
+  Anticlimber& ac = anticlimber_of(model);
+  CHECK(ac.release_while_unloading);
+  std::mt19937 rng(5);
+  for (const Mode v : {Mode::Elastic, Mode::PlasticUp, Mode::Failed}) {
+    INFO("vertical mode " << static_cast<int>(v));
+    Anticlimber::State st = ac.state();
+    st.contact = Anticlimber::Contact::Engaged;
+    st.interlock_released = true;
+    st.vertical_reference = 0.2;
+    st.torsional_reference = -0.1;
+    st.horizontal = law_state(ac.horizontal, Mode::Elastic, 0.003);
+    st.vertical = law_state(ac.vertical, v, -0.005);
+    st.torsional = law_state(ac.torsional, Mode::Elastic, 0.002);
+    ac.set_state(st);
+    check_jacobian_near_start(system, rng);
+    // Released: only the horizontal law acts, along body 1's axis at face 2 (no moment M).
+    const std::vector<double> y = system.initial_state();
+    const std::vector<double> q = positions(system, y);
+    const std::vector<double> f = element_forces(model, q);
+    const double e1x = std::cos(0.15), e1y = std::sin(0.15);
+    CHECK(std::abs(f[3] * e1y - f[4] * e1x) < 1e-9 * (std::abs(f[3]) + std::abs(f[4]) + 1.0));  // along e1
+    const std::vector<double> out = element_outputs(system, y);
+    CHECK(out[1] == 0.0);
+    CHECK(out[2] == 0.0);
+    CHECK(out[4] == 0.0);
+    CHECK(out[5] == 0.0);
+    CHECK(energy_at(model, q) == Approx(ac.horizontal.elastic_energy(st.horizontal, out[3])).epsilon(1e-12));
+    double g[Anticlimber::kRootCount];
+    ac.roots(0.0, gather_state(ac, y.data(), y.data() + system.body_unknowns()), nullptr, g);
+    for (int i = Anticlimber::kVerticalRoots; i < Anticlimber::kContactRoot; ++i) CHECK(g[i] == 1.0);
+  }
+}
+
+TEST_CASE("anticlimber interlock_while_unloading must be hold or release", "[elements][anticlimber]") {
+  const auto load = [](const std::string& interlock) {
+    Parameters p;
+    p.interlock = interlock;
+    return testing::model_from_text(model_yaml(two_cars(), p, kCar1Face, kCar2Face, "t_end: 1"));
+  };
+  for (const char* bad : {"keep", "1"})
+    CHECK_THROWS_WITH(load(bad), Catch::Contains("test.yaml:") && Catch::Contains("'interlock_while_unloading' must be hold") &&
+                                     Catch::Contains(std::string("not '") + bad + "'"));
+  CHECK_THROWS_WITH(load("[hold]"), Catch::Contains("'interlock_while_unloading' must be a word"));
+  CHECK_FALSE(anticlimber_of(load("hold")).release_while_unloading);
+  CHECK(anticlimber_of(load("release")).release_while_unloading);
+  Parameters p;  // not given: hold
+  CHECK_FALSE(anticlimber_of(testing::model_from_text(model_yaml(two_cars(), p, kCar1Face, kCar2Face, "t_end: 1")))
+                  .release_while_unloading);
 }

@@ -856,6 +856,246 @@ TEST_CASE("coupler_end Jacobian matches central differences in every mode", "[el
   }
 }
 
+// ---- coupler_end: restitution (permanent set) and face shear ------------------------------------
+
+TEST_CASE("coupler_end restitution: a mass hitting the faces rebounds at e times its speed, closed form under both integrators",
+          "[elements][couplers]") {
+  // Loading P = k delta: a quarter period of omega = sqrt(k / m) to delta_max = v / omega;
+  // unloading P = k_u (delta - p), k_u = k / e^2, p = delta_max (1 - e^2): a quarter period of
+  // omega / e back to the set, leaving at omega_u (delta_max - p) = (omega / e) e^2 v / omega = e v.
+  const double m = 100.0, v = 2.0, gap = 0.03, omega = std::sqrt(kFaceStiffness / m);
+  for (const double e : {0.3, 0.8}) {
+    const double peak = v / omega, set = peak * (1.0 - e * e);
+    const double t_contact = gap / v, t_unloading = t_contact + 0.5 * kPi / omega;
+    const double t_separation = t_unloading + 0.5 * kPi * e / omega, t_end = t_separation + 0.02;
+    const double lost = 0.5 * m * v * v * (1.0 - e * e);
+    for (const char* integrator : {"ida", "euler"}) {
+      INFO("e = " << e << ", " << integrator);
+      const bool ida = std::string(integrator) == "ida";
+      const Model model = testing::model_from_text(one_mass(coupler_end_yaml("    restitution: " + num(e) + "\n"), m,
+                                                            kContact + gap, 0.0, -v, 0.0, t_end, integrator));
+      const Run r = run(model);
+      check_events(r.outcome, {{"contact", t_contact, 0.0}, {"unloading", t_unloading, -peak}, {"separation", t_separation, -set}},
+                   ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
+      // Euler (dt 1e-6) sees each switch up to one step late, but the force is continuous at
+      // both (the lines meet at delta_max; both are zero at the set) and the reversal comes at
+      // near-zero speed, so the rebound speed keeps second-order accuracy: measured 1e-8
+      // relative; asserted to 1e-6.
+      CHECK(r.vx == Approx(e * v).epsilon(ida ? 1e-8 : 1e-6));
+      CHECK(r.x == Approx(kContact - set + e * v * (t_end - t_separation)).epsilon(ida ? 1e-8 : 1e-4));
+      // Euler's work quadrature is first order: measured 5e-5 (e = 0.3) and 1.7e-4 (e = 0.8).
+      CHECK(element_work(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 5e-4));
+      CHECK(dissipated(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 5e-4));
+      // Euler's energy error oscillates with relative amplitude of order omega dt, largest
+      // on the stiffer unloading line (omega / e).
+      CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-7 : 3.0 * omega / e * 1e-6) * 0.5 * m * v * v);
+      const CouplerEnd& end = dynamic_cast<const CouplerEnd&>(*model.elements()[0]);
+      CHECK(end.state().peak == Approx(peak).epsilon(ida ? 1e-8 : 1e-4));
+      CHECK(end.permanent_set(end.state()) == Approx(set).epsilon(ida ? 1e-8 : 1e-4));
+    }
+  }
+}
+
+TEST_CASE("coupler_end restitution: faces touching at rest, pushed by a load: reversal at 2 P / k, then the unloading line",
+          "[elements][couplers]") {
+  // Loading: delta = (P / k)(1 - cos w t), at rest again at t = pi / w, delta_max = 2 P / k.
+  // Unloading line P_f = k_u (delta - p): harmonic at w / e about delta_eq = p + P / k_u; a
+  // quarter of its period later the mass passes delta_eq at speed (delta_max - delta_eq) w / e.
+  const double m = 10.0, P = 1000.0, e = 0.5, k = kFaceStiffness, ku = k / (e * e), omega = std::sqrt(k / m);
+  const double peak = 2.0 * P / k, set = peak * (1.0 - e * e), equilibrium = set + P / ku;
+  const double t_unloading = kPi / omega, t_end = t_unloading + 0.5 * kPi * e / omega;
+  const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(-P) + ", 0]}\n";
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const bool ida = std::string(integrator) == "ida";
+    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), m, kContact, 0.0, 0.0, 0.0,
+                                                          t_end, integrator, 1e-6, "SI", load)));
+    std::ostringstream seen;
+    for (const EventRecord& ev : r.outcome.events) seen << ev.t << " " << ev.what << " " << ev.value << "\n";
+    INFO(seen.str());
+    REQUIRE(r.outcome.events.size() == 2);
+    CHECK(r.outcome.events[0].what == "contact");
+    CHECK(r.outcome.events[0].t < 1e-4);
+    CHECK(r.outcome.events[1].what == "unloading");
+    CHECK(r.outcome.events[1].t == Approx(t_unloading).epsilon(0).margin(ida ? 1e-7 : 3e-6));
+    CHECK(r.outcome.events[1].value == Approx(-peak).epsilon(ida ? 1e-8 : 1e-4));
+    CHECK(r.x == Approx(kContact - equilibrium).epsilon(ida ? 1e-7 : 1e-4));
+    CHECK(r.vx == Approx((peak - equilibrium) * omega / e).epsilon(ida ? 1e-6 : 1e-3));
+  }
+}
+
+TEST_CASE("coupler_end restitution: a set face reloads along its unloading line up to delta_max, then on the loading line",
+          "[elements][couplers]") {
+  const double e = 0.5, k = kFaceStiffness, ku = k / (e * e), peak = 0.02, set = peak * (1.0 - e * e);
+  const Model model =
+      testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
+  CouplerEnd& end = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
+  CHECK(end.unloading_stiffness() == Approx(ku));
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const auto state_at = [&](double delta, double delta_rate) {
+    y[0] = kContact - delta;
+    y[3] = -delta_rate;
+    return gather_state(end, y.data(), y.data() + 3);
+  };
+  const auto push = [&](double delta) {  // force on the mass along +x, the faces' push
+    std::array<Pose<double>, 2> f{};
+    end.add_force(0.0, state_at(delta, 0.0), f);
+    return f[1].x;
+  };
+  Element::Event event;
+  const auto crossing = [&](int index, double delta, double delta_rate) {
+    return end.commit(index, -1, 0.0, state_at(delta, delta_rate), nullptr, event);
+  };
+  CHECK(push(0.01) == 0.0);
+  REQUIRE(crossing(0, 1e-9, 1.0));
+  CHECK(event.what == "contact");
+  CHECK(push(0.01) == Approx(k * 0.01));
+  CHECK_FALSE(crossing(0, 0.015, 0.5));  // still closing: no reversal
+  REQUIRE(crossing(0, peak, -0.5));
+  CHECK(event.what == "unloading");
+  CHECK(event.value == Approx(-peak));
+  CHECK(end.state().peak == Approx(peak));
+  CHECK(push(peak) == Approx(k * peak));  // the lines meet at delta_max
+  CHECK(push(0.018) == Approx(ku * (0.018 - set)));
+  CHECK(end.potential_energy(state_at(0.018, 0.0)) == Approx(0.5 * std::pow(ku * (0.018 - set), 2) / ku));
+  CHECK_FALSE(crossing(0, set + 1e-6, -0.5));  // not yet at the set
+  REQUIRE(crossing(0, set - 1e-9, -0.5));
+  CHECK(event.what == "separation");
+  CHECK(event.value == Approx(-set));
+  CHECK(push(0.01) == 0.0);  // below the set: open
+  // A new contact starts at the set, on the unloading line.
+  CHECK_FALSE(crossing(0, set - 1e-6, 0.5));
+  REQUIRE(crossing(0, set + 1e-9, 0.5));
+  CHECK(event.what == "contact");
+  CHECK(end.state().unloading);
+  CHECK(push(0.018) == Approx(ku * (0.018 - set)));
+  CHECK_FALSE(crossing(1, peak - 1e-6, 0.5));
+  REQUIRE(crossing(1, peak + 1e-9, 0.5));
+  CHECK(event.what == "reloading");
+  CHECK(push(0.025) == Approx(k * 0.025));
+  CHECK(end.potential_energy(state_at(0.025, 0.0)) == Approx(0.5 * std::pow(k * 0.025, 2) / ku));
+  // A reversal further in moves the set: delta_max 0.03, p = 0.0225.
+  REQUIRE(crossing(0, 0.03, -0.1));
+  CHECK(end.permanent_set(end.state()) == Approx(0.03 * (1.0 - e * e)));
+  CHECK(push(0.025) == Approx(ku * (0.025 - 0.0225)));
+  end.reset_modes();
+  CHECK(end.state().peak == 0.0);
+  CHECK(push(0.01) == 0.0);
+}
+
+TEST_CASE("coupler_end restitution: loss of overlap while loading keeps the set; overlap regained past the set is blocked",
+          "[elements][couplers]") {
+  const double e = 0.5, peak = 0.02, set = peak * (1.0 - e * e);
+  const Model model =
+      testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
+  CouplerEnd& end = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
+  const DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  const auto state_at = [&](double delta, double dy, double delta_rate) {
+    y[0] = kContact - delta;
+    y[1] = dy;
+    y[3] = -delta_rate;
+    return gather_state(end, y.data(), y.data() + 3);
+  };
+  Element::Event event;
+  REQUIRE(end.commit(0, -1, 0.0, state_at(1e-9, 0.0, 1.0), nullptr, event));
+  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(peak, 0.3 + 1e-9, 1.0), nullptr, event));
+  CHECK(event.what == "vertical overlap lost");
+  CHECK(end.permanent_set(end.state()) == Approx(set));
+  // Back into overlap with the faces deeper than the set: blocked, no force, clear at the set.
+  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(0.018, 0.1, -1.0), nullptr, event));
+  CHECK(event.what == "vertical overlap regained, faces past each other");
+  std::array<Pose<double>, 2> f{};
+  end.add_force(0.0, state_at(0.018, 0.1, 0.0), f);
+  CHECK(f[1].x == 0.0);
+  CHECK_FALSE(end.commit(0, -1, 0.0, state_at(set + 1e-6, 0.1, -1.0), nullptr, event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(set - 1e-9, 0.1, -1.0), nullptr, event));
+  CHECK(event.what == "faces clear");
+  REQUIRE(end.commit(0, -1, 0.0, state_at(set + 1e-9, 0.1, 1.0), nullptr, event));
+  CHECK(event.what == "contact");
+  CHECK(end.state().unloading);
+}
+
+TEST_CASE("coupler_end shear_load: the faces shear off at the stated force and carry nothing afterwards",
+          "[elements][couplers]") {
+  // Loading P = k delta reaches S at delta_s = S / k, at omega t = asin(omega delta_s / v)
+  // after contact; then the mass flies on at sqrt(v^2 - (omega delta_s)^2). Lost: S^2 / 2k,
+  // with either restitution (the energy the faces held is dissipated by the failure).
+  const double m = 100.0, v = 2.0, gap = 0.03, omega = std::sqrt(kFaceStiffness / m);
+  const double S = 0.6 * kFaceStiffness * v / omega, delta_s = S / kFaceStiffness;
+  const double t_contact = gap / v, t_shear = t_contact + std::asin(omega * delta_s / v) / omega;
+  const double v_after = std::sqrt(v * v - omega * omega * delta_s * delta_s), t_end = t_shear + 0.05;
+  for (const char* e : {"1", "0.5"}) {
+    for (const char* integrator : {"ida", "euler"}) {
+      INFO("restitution " << e << ", " << integrator);
+      const bool ida = std::string(integrator) == "ida";
+      const Model model = testing::model_from_text(
+          one_mass(coupler_end_yaml("    friction: 0.3\n    restitution: " + std::string(e) + "\n    shear_load: " + num(S) + "\n"),
+                   m, kContact + gap, 0.0, -v, 0.0, t_end, integrator));
+      const Run r = run(model);
+      // Euler sees the shear one step late: the force overshoots S by at most k v dt (0.36 here).
+      check_events(r.outcome, {{"contact", t_contact, 0.0}, {"face shear failure", t_shear, S}}, ida ? 1e-8 : 3e-6,
+                   ida ? 1e-9 : 1e-4);
+      CHECK(r.vx == Approx(-v_after).epsilon(ida ? 1e-8 : 1e-4));
+      CHECK(r.x == Approx(kContact - delta_s - v_after * (t_end - t_shear)).margin(ida ? 1e-9 : 1e-5));
+      const double lost = 0.5 * S * S / kFaceStiffness;
+      CHECK(dissipated(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
+      CHECK(element_work(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
+      // Sheared: no force in any direction, whatever the faces do.
+      CouplerEnd& end = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
+      CHECK(end.state().sheared);
+      const DaeSystem system(model);
+      std::vector<double> y = system.initial_state();
+      y[0] = kContact - 0.05;
+      y[4] = 0.5;
+      std::array<Pose<double>, 2> f{};
+      end.add_force(0.0, gather_state(end, y.data(), y.data() + 3), f);
+      CHECK(f[1].x == 0.0);
+      CHECK(f[1].y == 0.0);
+      double g[CouplerEnd::kRoots];
+      end.roots(0.0, gather_state(end, y.data(), y.data() + 3), nullptr, g);
+      for (double value : g) CHECK(value > 0.0);
+    }
+  }
+}
+
+TEST_CASE("coupler_end restitution: Euler's stability estimate sees the unloading slope k / e^2", "[elements][couplers]") {
+  const Model model =
+      testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
+  Element& e = *model.elements()[0];
+  const DaeSystem system(model);
+  const std::vector<double> y = system.initial_state();
+  ForceBlock stiffest{}, stiffest_v{};
+  e.stiffest_force_jacobian(0.0, gather_state(e, y.data(), y.data() + 3), stiffest, stiffest_v);
+  const auto x = static_cast<std::size_t>(3 * e.point_slot(1));
+  CHECK(stiffest[x][x] == Approx(-4.0 * kFaceStiffness));
+}
+
+TEST_CASE("coupler_end with restitution and shear_load: Jacobian matches central differences in every mode",
+          "[elements][couplers]") {
+  using B = DeadBand::Mode;
+  const std::vector<CouplerEnd::State> modes = {
+      {B::Inside, true, false, false, 0.02, false},  // open, with a set
+      {B::Below, true, false, false, 0.0, false},    // loading
+      {B::Below, true, false, true, 0.02, false},    // unloading / reloading along k / e^2
+      {B::Below, true, true, false, 0.02, false},    // blocked
+      {B::Below, false, false, true, 0.02, false},   // overlap lost
+      {B::Below, true, false, true, 0.02, true}};    // sheared
+  for (const bool ground_first : {true, false}) {
+    Model model = testing::model_from_text(
+        two_bodies(coupler_end_yaml("    friction: 0.3\n    restitution: 0.6\n    shear_load: 1e9\n"), ground_first));
+    CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
+    const DaeSystem system(model);
+    std::mt19937 rng(11);
+    for (std::size_t k = 0; k < modes.size(); ++k) {
+      INFO((ground_first ? "ground-body" : "body-body") << ", mode " << k);
+      e.set_state(modes[k]);
+      check_jacobian_here(system, rng);
+    }
+  }
+}
+
 // =================================================================================================
 // coupling
 // =================================================================================================
@@ -1034,6 +1274,16 @@ TEST_CASE("coupler elements: input errors name the parameter and what to change"
   CHECK_THAT(error_of(with(gear_yaml(kGear, "    fracture_load: 1e4\n    free_length: 1.01\n"))),
              Catch::Contains("fracture_load"));  // starts compressed beyond it
   CHECK_THAT(error_of(with(coupler_end_yaml("    total_horizontal_slack: 0.1\n"))), Catch::Contains("coupled: true"));
+  for (const char* e : {"0", "-0.2", "1.5"})
+    CHECK_THAT(error_of(with(coupler_end_yaml("    restitution: " + std::string(e) + "\n"))),
+               Catch::Contains("'restitution'") && Catch::Contains("at most 1") && Catch::Contains("test.yaml:"));
+  CHECK_THAT(error_of(with(coupler_end_yaml("    restitution: 0.5\n    coupled: true\n"))),
+             Catch::Contains("'restitution'") && Catch::Contains("coupled: false"));
+  for (const char* load : {"0", "-5"})
+    CHECK_THAT(error_of(with(coupler_end_yaml("    shear_load: " + std::string(load) + "\n"))), Catch::Contains("shear_load"));
+  // Starts pressed 0.01 into the faces: 1800 > 1000.
+  CHECK_THAT(error_of(one_mass(coupler_end_yaml("    shear_load: 1000\n"), 10.0, 0.09, 0.0, 0.0, 0.0, 1.0, "ida")),
+             Catch::Contains("shear_load 1000") && Catch::Contains("coupler_end 'e'"));
   CHECK_THAT(error_of(with("    type: coupler_end\n    horizontal_stiffness: 3e5\n    free_length: [1, 1]\n"
                            "    coupler_height: [1, 1]\n")),
              Catch::Contains("horizontal_stiffness"));

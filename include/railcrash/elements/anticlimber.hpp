@@ -22,6 +22,15 @@
 //   relative rotation        phi = theta2 - theta1.
 // Once the faces engage (below) the ribbed faces interlock at the offset and rotation of that
 // moment: vertical deformation d_v = v - v_e and torsional deformation d_t = phi - phi_e.
+// interlock_while_unloading (hold | release, default hold): whether the ribbed faces keep
+// holding each other vertically and in rotation while the horizontal law unloads from its
+// largest crush. The report does not settle it; it is a reading.
+//   hold     the interlock acts whenever the faces are engaged (up to separation).
+//   release  when the horizontal law leaves plastic loading ("horizontal unloading": d_h' = 0
+//            at the largest crush) the interlock lets go: no vertical force, no moment, the
+//            faces slide freely; it re-seats when the horizontal law reloads onto its yield
+//            line ("horizontal reloading"), taking the offset and rotation of that moment
+//            as the new reference (elastic, no offset), exactly as on first contact.
 //
 // ---- Force laws (each direction on its own, "independent" as the report says) ------------
 // Each direction follows a bilinear elastic-plastic law with kinematic hardening: elastic
@@ -52,7 +61,8 @@
 // vertical_force V (positive when it pushes face 2 down, i.e. resists d_v > 0), moment M
 // (positive when it turns body 2 back, i.e. resists d_t > 0), horizontal_deformation d_h
 // (= -gap, also while open), vertical_deformation d_v and torsional_deformation d_t (0 when
-// not engaged), vertical_offset v, override (0 / 1). All three forces are 0 unless engaged.
+// not engaged or while the interlock is released), vertical_offset v, override (0 / 1). All
+// three forces are 0 unless engaged; V and M are 0 while the interlock is released.
 //
 // ---- Modes (history changes only at events) ----------------------------------------------
 // contact:
@@ -72,6 +82,19 @@
 //                   law normally stops it; after a shear failure nothing does; a large
 //                   initial misalignment leaves less room).
 //                 - horizontal rupture: "crushing failure".
+//               With interlock_while_unloading: release the engaged state has two phases:
+//                 interlocked  the three laws act (from contact, and from each re-seating);
+//                 released     from a "horizontal unloading" to the next "horizontal
+//                              reloading" (or to separation): only the horizontal law acts;
+//                              the vertical and torsional laws give no force and have no
+//                              roots (their yield, unloading and rupture cannot happen);
+//                              the event is named "horizontal unloading, interlock
+//                              released". At "horizontal reloading" the interlock re-seats
+//                              ("horizontal reloading, interlock re-seated"): references
+//                              v_e, phi_e := v, phi; laws fresh (a failed law stays failed).
+//                              An unloading from below the yield line (the law never left
+//                              its elastic range) releases nothing. Override detection
+//                              stays active in both phases.
 //   overridden  terminal: the car ends pass over each other; no force in any direction.
 //               override_time() and the output `override` (0/1) tell when / whether.
 //   crushed     terminal: the anticlimber / end structure is crushed through; no force.
@@ -97,9 +120,10 @@
 // only at the end of a step, possibly past several boundaries), listing them all in one event.
 // A start with the faces just touching (gap 0) is engaged if they are closing, open otherwise.
 //
-// Energy: the elastic energy above (zero when not engaged); the rest of the work done on the
-// element is dissipated (plastic flow, and the elastic energy lost at a rupture, a separation
-// or an override).
+// Energy: the elastic energy above (zero when not engaged; only the horizontal term while the
+// interlock is released); the rest of the work done on the element is dissipated (plastic
+// flow, and the elastic energy lost at a rupture, a separation, an override or a release of
+// the interlock).
 //
 // Response R2 (report Section 4.1): R2 = max |vertical_force| / vertical yield force, the
 // latter vertical_elastic_stiffness * vertical_yield_deflection (vertical_yield_force()).
@@ -191,6 +215,7 @@ class Anticlimber : public ForceElement<Anticlimber> {
   std::optional<double> length;  // [length] of the crushable structure (bounds the crush)
   double initial_misalignment;   // [length] vertical offset of face 2 above face 1 added to the geometry
   std::optional<double> facing;  // +1 / -1: body 1's face looks along +e1 / -e1 (default: from the start)
+  bool release_while_unloading = false;  // interlock_while_unloading: release (true) or hold (false)
 
   enum class Contact { Open, Engaged, Overridden, Crushed };
   struct State {
@@ -199,6 +224,7 @@ class Anticlimber : public ForceElement<Anticlimber> {
     double vertical_reference = 0.0;   // [length] v at engagement
     double torsional_reference = 0.0;  // [rad] phi at engagement
     double override_time = -1.0;       // [time] of the override; < 0: none
+    bool interlock_released = false;   // release: between horizontal unloading and reloading
   };
   const State& state() const { return state_; }
   /// Puts the element in a given mode (tests and tools; a run changes modes only by commit).
@@ -208,6 +234,8 @@ class Anticlimber : public ForceElement<Anticlimber> {
   double override_time() const { return state_.override_time; }
   /// Denominator of the report's response R2 [force].
   double vertical_yield_force() const { return vertical.yield_force(); }
+  /// True while the vertical and torsional laws act (engaged and not released).
+  bool interlocked() const { return state_.contact == Contact::Engaged && !state_.interlock_released; }
 
   /// Geometry of the faces (see the header comment).
   template <class T>
@@ -241,8 +269,11 @@ class Anticlimber : public ForceElement<Anticlimber> {
     if (state_.contact != Contact::Engaged) return;
     const Kinematics<T> k = kinematics(s);
     const T h = horizontal.force(state_.horizontal, k.horizontal);
-    const T v = vertical.force(state_.vertical, k.vertical - state_.vertical_reference);
-    const T m = torsional.force(state_.torsional, k.rotation - state_.torsional_reference);
+    T v(0.0), m(0.0);
+    if (!state_.interlock_released) {
+      v = vertical.force(state_.vertical, k.vertical - state_.vertical_reference);
+      m = torsional.force(state_.torsional, k.rotation - state_.torsional_reference);
+    }
     const T push = h * (*facing);
     const Vec2<T> force{push * k.e1.x - v * k.n1.x, push * k.e1.y - v * k.n1.y};
     const PointRef& p2 = point(1);
@@ -290,6 +321,8 @@ class Anticlimber : public ForceElement<Anticlimber> {
   Deformations deformations(const ElementState<double>& s) const;
   void roots_of(const Deformations& k, double* g) const;
   bool active(int index) const;
+  /// Takes the current offset and rotation as the interlock's reference (fresh laws).
+  void seat_interlock(const Deformations& k);
   /// Leaves the current mode through root `index`; appends what happened to `what`.
   void transition(int index, double t, const Deformations& k, std::string& what);
   /// Applies every transition whose root is already negative.

@@ -105,11 +105,42 @@
 //   friction between the faces: F_t = -mu |T| tanh(Dy' / v_f) on P2 (vertical), Coulomb
 //     regularized below friction_velocity v_f; |F_t| <= mu |T|.
 //   force on P2 = (-sigma T, F_t), on P1 the opposite. Energy T^2 / (2 k) in contact.
-//   The report's "shear" between the faces is this vertical (friction) force; the faces
-//   have no failure load of their own.
-// Events: "contact", "separation", "slack taken up (draft)", "draft released", "buff to
-// draft" / "draft to buff" (coupled, no slack), value h - c; "vertical overlap lost",
-// "vertical overlap regained[, faces past each other]", value Dy; "faces clear".
+//   restitution e (0 < e <= 1, default 1: the elastic faces above). The report: "The
+//     impacting coupler ends were modeled to yield high forces at low deflections. They also
+//     included a low coefficient of repercussion to allow for a low force recovery". Read
+//     as the coefficient of restitution of the faces' buff contact. With penetration
+//     delta = c - h, largest penetration so far delta_max and permanent set
+//     p = delta_max (1 - e^2), the buff force P = -T >= 0 is
+//       loading     P = k delta                     (the line above; delta grows)
+//       unloading   P = k_u (delta - p),  k_u = k / e^2, through (delta_max, k delta_max)
+//     so unloading from force P gives back P^2 / (2 k_u) = e^2 P^2 / (2 k): a mass hitting
+//     the faces rebounds with e times its speed. The faces keep the set p: contact reopens
+//     at delta = p, a later contact starts there on the unloading line, which it follows up
+//     to delta_max, then the loading line again. Modes (e < 1; roots positive inside):
+//       open        delta < p                       leaves at delta = p: "contact" (onto the
+//                                                   loading line if delta_max = 0, else onto
+//                                                   the unloading line)
+//       loading     P = k delta                     delta' = 0: "unloading" (delta_max = delta)
+//       unloading   P = k_u (delta - p)             delta = p: "separation"; delta = delta_max:
+//                                                   "reloading" (back on the loading line)
+//     delta_max (and so p) changes only at these events (and at "vertical overlap lost"
+//     while loading). Energy in contact: P^2 / (2 k_u), what unloading would give back; the
+//     rest of the work done on the faces is dissipated. With e = 1 there is no unloading
+//     mode (k_u = k, p = 0: the faces are elastic and log only "contact" / "separation").
+//     Blocked faces (overlap regained past each other) clear at delta = p. Only buff
+//     contact has a set: restitution < 1 with coupled: true is an input error (the knuckles'
+//     draft law is elastic and a set would shift their slack; the report's coupler ends
+//     are uncoupled).
+//   shear_load S (force, default none: never): the faces shear off when the buff face force
+//     P reaches S: "face shear failure" (value: the force), terminal: no force afterwards in
+//     any direction (normal, friction, draft), the stored energy is dissipated. This is the
+//     reading of the report's statement that the coupler-end element "accounts for free
+//     play, elastic deformation, shear and friction"; the vertical friction force between
+//     intact faces is unchanged by it. A start with P >= S is an input error.
+// Events: "contact", "separation", "unloading", "reloading" (restitution < 1), "slack taken
+// up (draft)", "draft released", "buff to draft" / "draft to buff" (coupled, no slack),
+// value h - c; "vertical overlap lost", "vertical overlap regained[, faces past each
+// other]", value Dy; "faces clear"; "face shear failure", value P.
 // Report values (Tables 5 and 8): horizontal stiffness 360,000 lb/in, free length 1 in and
 // coupler height 12 in at each end, total horizontal slack 0.0 in. The "Friction parameter
 // (muR) = 0.3" printed under them in Table 8 is the pin joint's (Table 5 lists it under
@@ -371,11 +402,16 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   double friction = 0.0;                       // [-] mu between the faces
   double friction_velocity = 0.01;             // [length/time] v_f
   bool coupled = false;                        // knuckles carry draft
+  double restitution = 1.0;                    // [-] e of the buff contact, 0 < e <= 1
+  std::optional<double> shear_load;            // [force] buff face force at which the faces shear off; none: never
 
   struct State {
     DeadBand::Mode band = DeadBand::Mode::Inside;  // below: buff contact, above: draft contact
     bool overlapping = true;  // the faces overlap vertically
     bool blocked = false;     // overlap regained with the faces past each other: no force
+    bool unloading = false;   // buff contact on the unloading line (restitution < 1)
+    double peak = 0.0;        // [length] delta_max, largest buff penetration so far (restitution < 1)
+    bool sheared = false;     // the faces have sheared off (terminal)
   };
   const State& state() const { return state_; }
   void set_state(const State& st) { state_ = st; }
@@ -383,21 +419,38 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   /// +1 when P2 lies in +x of P1 (faces meet along +x), -1 otherwise.
   double side() const { return side_; }
   double series_stiffness() const { return faces_.stiffness; }
+  /// k_u = k / e^2 [force/length], the slope of unloading and reloading.
+  double unloading_stiffness() const { return faces_.stiffness / (restitution * restitution); }
+  /// p = delta_max (1 - e^2) [length], the faces' permanent set in state st.
+  double permanent_set(const State& st) const { return st.peak * (1.0 - restitution * restitution); }
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
     if (!active()) return;
     const PointOffset<T> o = point_offset(*this, s);
-    const T tension = faces_.force(state_.band, side_ * o.d.x);
+    const T tension = face_tension(side_ * o.d.x);
     Vec2<T> on_p2{-side_ * tension, T(0.0)};
-    if (friction > 0.0)
-      on_p2.y = -friction * faces_.magnitude(state_.band, side_ * o.d.x) * tanh(o.d_rate.y / friction_velocity);
+    if (friction > 0.0) {
+      const T normal = state_.band == DeadBand::Mode::Below ? -tension : tension;
+      on_p2.y = -friction * normal * tanh(o.d_rate.y / friction_velocity);
+    }
     apply_line_force(*this, s, on_p2, f);
   }
-  bool active() const { return state_.overlapping && !state_.blocked && state_.band != DeadBand::Mode::Inside; }
+  /// Tension T at spacing h in the current mode, if the faces are active (< 0: buff).
+  template <class T>
+  T face_tension(const T& h) const {
+    if (state_.band == DeadBand::Mode::Below && state_.unloading)
+      return unloading_stiffness() * (h - (faces_.lo - permanent_set(state_)));
+    return faces_.force(state_.band, h);
+  }
+  bool active() const {
+    return state_.overlapping && !state_.blocked && !state_.sheared && state_.band != DeadBand::Mode::Inside;
+  }
 
   void initialize(const ElementState<double>& initial) override;
-  static constexpr int kRoots = DeadBand::kRoots + 1;  // + vertical overlap
+  static constexpr int kOverlapRoot = DeadBand::kRoots;
+  static constexpr int kShearRoot = DeadBand::kRoots + 1;
+  static constexpr int kRoots = DeadBand::kRoots + 2;  // + vertical overlap, face shear
   int root_count() const override { return kRoots; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
   bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
@@ -414,8 +467,14 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   };
   Kinematics kinematics(const ElementState<double>& s) const;
   void roots_at(const Kinematics& k, double* g) const;
+  /// Roots 0, 1 of the faces with restitution < 1 (buff only, with the permanent set).
+  void lossy_roots(const Kinematics& k, double* g) const;
   void apply(int index, const Kinematics& k, Event& event);
+  void apply_lossy(int index, const Kinematics& k, Event& event);
+  /// Buff mode at the start or when the overlap is regained (restitution < 1).
+  DeadBand::Mode lossy_band(const Kinematics& k) const;
   double half_overlap() const { return 0.5 * (coupler_height[0] + coupler_height[1]); }
+  bool lossy() const { return restitution < 1.0; }
 
   DeadBand faces_;
   double side_ = 1.0;

@@ -1,0 +1,663 @@
+#include "railcrash/readings.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <numeric>
+#include <set>
+#include <sstream>
+
+#include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
+
+namespace railcrash {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+[[noreturn]] void readings_error(const std::string& path, const YAML::Node& node, const std::string& message) {
+  const int line = node && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
+  throw InputError(SourceLocation{path, line}.prefix() + message);
+}
+
+int line_of(const YAML::Node& node) { return node && !node.Mark().is_null() ? node.Mark().line + 1 : 0; }
+
+void check_keys(const std::string& path, const YAML::Node& map, const std::set<std::string>& allowed, const std::string& context) {
+  std::string list;
+  for (const std::string& k : allowed) list += (list.empty() ? "" : ", ") + k;
+  for (const auto& entry : map) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
+    if (!allowed.count(key)) readings_error(path, entry.first, context + ": unknown key '" + key + "' (allowed: " + list + ")");
+  }
+}
+
+std::string scalar_text(const std::string& path, const YAML::Node& node, const std::string& context) {
+  if (!node || !node.IsScalar() || node.Scalar().empty()) readings_error(path, node, context + " must be a word");
+  return node.Scalar();
+}
+
+std::string model_text_of(const std::string& model_path) {
+  std::ifstream in(model_path);
+  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+std::string format(double value, const char* spec = "%.3f") {
+  if (std::isnan(value)) return "n/a";
+  char text[48];
+  std::snprintf(text, sizeof text, spec, value);
+  return text;
+}
+
+std::string csv_field(double value) { return std::isnan(value) ? "" : format(value, "%.8g"); }
+
+std::string csv_quoted(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::vector<double> average_ranks(const std::vector<double>& values) {
+  std::vector<std::size_t> order(values.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return values[a] < values[b]; });
+  std::vector<double> ranks(values.size());
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i;
+    while (j + 1 < order.size() && values[order[j + 1]] == values[order[i]]) ++j;
+    const double rank = 0.5 * static_cast<double>(i + j) + 1.0;
+    for (std::size_t k = i; k <= j; ++k) ranks[order[k]] = rank;
+    i = j + 1;
+  }
+  return ranks;
+}
+
+struct ChangeScores {
+  int significant = 0, agree = 0;
+  double spearman = kNaN, rms = kNaN;
+};
+
+ChangeScores score_changes(const std::vector<double>& ours, const std::vector<double>& published) {
+  ChangeScores s;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    sum += (ours[i] - published[i]) * (ours[i] - published[i]);
+    // The published changes are rounded to 3 decimals: compare with a hair of slack.
+    if (std::abs(published[i]) < kSignificantChange - 1e-9) continue;
+    ++s.significant;
+    if (ours[i] * published[i] > 0.0) ++s.agree;
+  }
+  if (!ours.empty()) s.rms = std::sqrt(sum / static_cast<double>(ours.size()));
+  s.spearman = spearman_correlation(ours, published);
+  return s;
+}
+
+}  // namespace
+
+double spearman_correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size() || a.size() < 3) return kNaN;
+  const std::vector<double> ra = average_ranks(a), rb = average_ranks(b);
+  const double n = static_cast<double>(a.size());
+  const double mean = (n + 1.0) / 2.0;  // the mean of average ranks is always (n + 1) / 2
+  double sab = 0.0, saa = 0.0, sbb = 0.0;
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    sab += (ra[i] - mean) * (rb[i] - mean);
+    saa += (ra[i] - mean) * (ra[i] - mean);
+    sbb += (rb[i] - mean) * (rb[i] - mean);
+  }
+  if (saa <= 0.0 || sbb <= 0.0) return kNaN;
+  return sab / std::sqrt(saa * sbb);
+}
+
+std::vector<std::vector<int>> ReadingsPlan::combinations() const {
+  std::vector<std::vector<int>> list;
+  const std::vector<int> first(readings.size(), 0);
+  if (one_at_a_time) {
+    list.push_back(first);
+    for (std::size_t r = 0; r < readings.size(); ++r)
+      for (std::size_t l = 1; l < readings[r].levels.size(); ++l) {
+        std::vector<int> c = first;
+        c[r] = static_cast<int>(l);
+        list.push_back(c);
+      }
+    return list;
+  }
+  std::vector<int> c = first;
+  while (true) {
+    list.push_back(c);
+    std::size_t r = readings.size();
+    while (r > 0) {  // odometer, last reading fastest
+      --r;
+      if (++c[r] < static_cast<int>(readings[r].levels.size())) break;
+      c[r] = 0;
+      if (r == 0) return list;
+    }
+    if (readings.empty()) return list;
+  }
+}
+
+std::vector<std::string> ReadingsPlan::settings(const std::vector<int>& combination) const {
+  std::vector<std::string> all;
+  for (std::size_t r = 0; r < readings.size(); ++r) {
+    const auto& level = readings[r].levels[static_cast<std::size_t>(combination[r])];
+    all.insert(all.end(), level.settings.begin(), level.settings.end());
+  }
+  return all;
+}
+
+std::string ReadingsPlan::label(const std::vector<int>& combination) const {
+  std::string text;
+  for (std::size_t r = 0; r < readings.size(); ++r)
+    text += (text.empty() ? "" : ", ") + readings[r].name + "=" + readings[r].levels[static_cast<std::size_t>(combination[r])].name;
+  return text;
+}
+
+SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, const SensitivityDesign& design) const {
+  SensitivityDesign changed = design;
+  for (std::size_t r = 0; r < readings.size(); ++r) {
+    const ReadingLevel& level = readings[r].levels[static_cast<std::size_t>(combination[r])];
+    for (const auto& [name, scales] : level.scales) {
+      const auto it = std::find_if(changed.parameters.begin(), changed.parameters.end(),
+                                   [&](const SensitivityParameter& p) { return p.name == name; });
+      if (it == changed.parameters.end())
+        throw InputError(SourceLocation{path, level.line}.prefix() + "reading '" + readings[r].name + "', level '" + level.name +
+                         "': the design has no parameter '" + name + "'");
+      it->scales = scales;
+    }
+  }
+  return changed;
+}
+
+ReadingsPlan load_readings(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(path + ": cannot open the readings file (check the path)");
+  } catch (const YAML::ParserException& e) {
+    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
+  }
+  if (!root.IsMap() || !root["reading_study"])
+    readings_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
+  check_keys(path, root, {"reading_study", "description", "combinations", "readings"}, "readings file");
+  if (!root["reading_study"].IsScalar() || root["reading_study"].Scalar() != "1")
+    readings_error(path, root["reading_study"], "reading_study must be 1");
+  ReadingsPlan plan;
+  plan.path = path;
+  if (root["combinations"]) {
+    const std::string how = scalar_text(path, root["combinations"], "combinations");
+    if (how != "factorial" && how != "one_at_a_time")
+      readings_error(path, root["combinations"], "combinations must be factorial or one_at_a_time");
+    plan.one_at_a_time = how == "one_at_a_time";
+  }
+  const YAML::Node list = root["readings"];
+  if (!list || !list.IsSequence() || list.size() == 0)
+    readings_error(path, list ? list : root, "'readings' must list at least one reading: - {name, levels: [{name, set: {KEY: VALUE}}]}");
+  std::set<std::string> names;
+  for (const YAML::Node& node : list) {
+    if (!node.IsMap()) readings_error(path, node, "each reading is a map with name, description and levels");
+    check_keys(path, node, {"name", "description", "levels"}, "reading");
+    Reading reading;
+    reading.name = scalar_text(path, node["name"], "reading: name");
+    reading.line = line_of(node);
+    if (!names.insert(reading.name).second) readings_error(path, node["name"], "reading '" + reading.name + "' is listed twice");
+    if (node["description"]) reading.description = node["description"].as<std::string>();
+    const std::string context = "reading '" + reading.name + "'";
+    const YAML::Node levels = node["levels"];
+    if (!levels || !levels.IsSequence() || levels.size() == 0)
+      readings_error(path, levels ? levels : node, context + ": 'levels' must list at least one level {name, set: {KEY: VALUE}}");
+    std::set<std::string> level_names;
+    for (const YAML::Node& l : levels) {
+      if (!l.IsMap()) readings_error(path, l, context + ": each level is a map {name, set}");
+      check_keys(path, l, {"name", "set", "scale"}, context + " level");
+      ReadingLevel level;
+      level.name = scalar_text(path, l["name"], context + ": level name");
+      level.line = line_of(l);
+      if (!level_names.insert(level.name).second) readings_error(path, l["name"], context + ": level '" + level.name + "' is listed twice");
+      if (const YAML::Node set = l["set"]) {
+        if (!set.IsMap()) readings_error(path, set, context + ", level '" + level.name + "': 'set' must map model keys to values");
+        for (const auto& entry : set) {
+          const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
+          if (key.empty()) readings_error(path, entry.first, context + ": a key must be a model key such as elements.x.stiffness");
+          if (!entry.second.IsDefined() || entry.second.IsNull())
+            readings_error(path, entry.first, context + ", level '" + level.name + "': give a value for '" + key + "'");
+          // "elements.x.stiffness*: 1.2" becomes KEY*=FACTOR (a scaling), anything else KEY=VALUE.
+          level.settings.push_back(key + "=" + YAML::Dump(entry.second));
+        }
+      }
+      if (const YAML::Node scale = l["scale"]) {
+        const std::string where = context + ", level '" + level.name + "': scale";
+        if (!scale.IsMap()) readings_error(path, scale, where + " must map parameters to lists of {key, power}");
+        for (const auto& entry : scale) {
+          const std::string parameter = scalar_text(path, entry.first, where + ": a parameter name");
+          if (!entry.second.IsSequence() || entry.second.size() == 0)
+            readings_error(path, entry.second, where + ": " + parameter + " needs a list of {key, power}");
+          std::vector<std::pair<std::string, double>> scales;
+          for (const YAML::Node& item : entry.second) {
+            if (!item.IsMap() || !item["key"]) readings_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
+            check_keys(path, item, {"key", "power"}, where);
+            double power = 1.0;
+            if (item["power"]) {
+              try {
+                power = item["power"].as<double>();
+              } catch (const YAML::Exception&) {
+                readings_error(path, item["power"], where + ": power must be a number");
+              }
+            }
+            scales.emplace_back(scalar_text(path, item["key"], where + ": key"), power);
+          }
+          level.scales.emplace_back(parameter, std::move(scales));
+        }
+      }
+      reading.levels.push_back(std::move(level));
+    }
+    plan.readings.push_back(std::move(reading));
+  }
+  return plan;
+}
+
+void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
+  const std::string text = model_text_of(model_path);
+  for (const Reading& reading : plan.readings)
+    for (const ReadingLevel& level : reading.levels) {
+      try {
+        (void)load_model_text(text, model_path, level.settings);
+      } catch (const InputError& e) {
+        throw InputError(SourceLocation{plan.path, level.line}.prefix() + "reading '" + reading.name + "', level '" + level.name +
+                         "' does not fit the model: " + e.what());
+      }
+    }
+  for (const std::vector<int>& combination : plan.combinations()) {
+    try {
+      (void)load_model_text(text, model_path, plan.settings(combination));
+    } catch (const InputError& e) {
+      throw InputError(plan.path + ": the combination " + plan.label(combination) + " does not fit the model: " + e.what());
+    }
+  }
+}
+
+namespace {
+
+// Every key a design parameter scales must be a number of the model (else its run would fail
+// only when it executes). With `unchanged_from`, parameters that scale as they do there are
+// not checked again (a level's settings cannot remove a key the other combination had).
+void check_design_keys(const SensitivityDesign& design, const std::string& model_path, const std::vector<std::string>& settings,
+                       const SensitivityDesign* unchanged_from = nullptr) {
+  const std::string text = model_text_of(model_path);
+  for (std::size_t i = 0; i < design.parameters.size(); ++i) {
+    const SensitivityParameter& p = design.parameters[i];
+    if (unchanged_from && unchanged_from->parameters[i].scales == p.scales) continue;
+    std::vector<std::string> all = settings;
+    for (const auto& scale : p.scales) all.push_back(scale.first + "*=1");
+    try {
+      (void)load_model_text(text, model_path, all);
+    } catch (const InputError& e) {
+      throw InputError("design parameter " + p.name + " does not fit the model: " + e.what());
+    }
+  }
+}
+
+double response_of(const Responses& r, int k) { return k == 0 ? r.r1 : (k == 1 ? r.r2 : r.r3); }
+
+}  // namespace
+
+Agreement score_agreement(const SensitivityResult& result, const SensitivityDesign& design) {
+  RAILCRASH_DEMAND(design.reference.has_value());
+  const PublishedResults& published = *design.reference;
+  Agreement agreement;
+  for (int k = 0; k < 3; ++k) {
+    ResponseAgreement& a = agreement.responses[static_cast<std::size_t>(k)];
+    a.published = published.base[static_cast<std::size_t>(k)];
+    a.value = result.base.ok ? response_of(result.base.responses, k) : kNaN;
+    a.relative_error = (a.value - a.published) / a.published;
+    std::vector<double> ours, theirs;
+    const auto add = [&](const SensitivityRun& run, double published_value) {
+      if (!run.ok || !result.base.ok) return;
+      ours.push_back(response_of(run.responses, k) - a.value);
+      theirs.push_back(published_value - a.published);
+    };
+    if (!result.central)
+      for (const SensitivityRun& run : result.runs)
+        for (const auto& [name, values] : published.first_order)
+          if (name == run.parameter) add(run, values[static_cast<std::size_t>(k)]);
+    const ChangeScores first = score_changes(ours, theirs);
+    a.significant_runs = first.significant;
+    a.sign_agreements = first.agree;
+    a.spearman = first.spearman;
+    a.rms = first.rms;
+    for (std::size_t j = 0; j < result.second_order_runs.size() && j < published.second_order.size(); ++j)
+      add(result.second_order_runs[j], published.second_order[j][static_cast<std::size_t>(k)]);
+    const ChangeScores all = score_changes(ours, theirs);
+    a.significant_runs_all = all.significant;
+    a.sign_agreements_all = all.agree;
+    a.spearman_all = all.spearman;
+    a.rms_all = all.rms;
+    // Our top five by |first-order coefficient| (ties: design order).
+    std::vector<std::size_t> order(result.derivatives.size());
+    std::iota(order.begin(), order.end(), 0);
+    const auto magnitude = [&](std::size_t i) {
+      const double d = result.derivatives[i][static_cast<std::size_t>(k)];
+      return std::isnan(d) ? -1.0 : std::abs(d);
+    };
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return magnitude(x) > magnitude(y); });
+    const std::size_t per_parameter = result.central ? 2 : 1;
+    for (std::size_t i = 0; i < order.size() && a.top_five.size() < 5; ++i)
+      a.top_five.push_back(result.runs[per_parameter * order[i]].parameter);
+    const auto& ranking = published.ranking[static_cast<std::size_t>(k)];
+    if (!ranking.empty()) {
+      a.top_five_shared = 0;
+      for (std::size_t i = 0; i < ranking.size() && i < 5; ++i)
+        a.top_five_shared += std::count(a.top_five.begin(), a.top_five.end(), ranking[i]) > 0 ? 1 : 0;
+    }
+  }
+  const auto goal = [&](bool met, const std::string& what) {
+    if (met) ++agreement.goals_met;
+    else agreement.goals_missed.push_back(what);
+  };
+  const auto& r = agreement.responses;
+  goal(std::abs(r[1].relative_error) <= 0.10, "R2 run 0 within 10 %");
+  goal(std::abs(r[2].relative_error) <= 0.05, "R3 run 0 within 5 %");
+  for (int k = 0; k < 2; ++k) {
+    const std::string name = "R" + std::to_string(k + 1);
+    goal(r[static_cast<std::size_t>(k)].significant_runs > 0 && r[static_cast<std::size_t>(k)].sign_share() >= 0.8,
+         name + " signs >= 80 %");
+    goal(r[static_cast<std::size_t>(k)].spearman >= 0.7, name + " Spearman >= 0.7");
+    goal(r[static_cast<std::size_t>(k)].top_five_shared >= 4, name + " top five >= 4 of 5");
+  }
+  double score = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    const ResponseAgreement& a = r[static_cast<std::size_t>(k)];
+    score += a.sign_share() + (std::isnan(a.spearman) ? 0.0 : a.spearman) + std::max(0, a.top_five_shared) / 5.0;
+  }
+  const double e2 = std::isnan(r[1].relative_error) ? 10.0 : std::abs(r[1].relative_error);
+  const double e3 = std::isnan(r[2].relative_error) ? 10.0 : std::abs(r[2].relative_error);
+  agreement.score = score - e2 / 0.10 - e3 / 0.05;
+  return agreement;
+}
+
+std::string comparison_markdown(const SensitivityResult& result, const SensitivityDesign& design) {
+  RAILCRASH_DEMAND(design.reference.has_value());
+  const PublishedResults& published = *design.reference;
+  const Agreement agreement = score_agreement(result, design);
+  std::ostringstream md;
+  md << "## Agreement with the published study\n\n"
+     << (published.source.empty() ? std::string() : "Published: " + published.source + ".\n\n")
+     << "| | R1 | R2 | R3 |\n|---|---|---|---|\n";
+  const auto row = [&](const std::string& label, const std::function<std::string(const ResponseAgreement&)>& cell) {
+    md << "| " << label;
+    for (const ResponseAgreement& a : agreement.responses) md << " | " << cell(a);
+    md << " |\n";
+  };
+  row("run 0, ours", [](const ResponseAgreement& a) { return format(a.value); });
+  row("run 0, published", [](const ResponseAgreement& a) { return format(a.published); });
+  row("run 0, relative error", [](const ResponseAgreement& a) { return format(100.0 * a.relative_error, "%+.1f %%"); });
+  row("first-order runs: published sign kept (change >= 0.005)",
+      [](const ResponseAgreement& a) { return std::to_string(a.sign_agreements) + " of " + std::to_string(a.significant_runs); });
+  row("first-order runs: Spearman rho of the changes", [](const ResponseAgreement& a) { return format(a.spearman, "%.2f"); });
+  row("first-order runs: RMS of the change differences", [](const ResponseAgreement& a) { return format(a.rms, "%.4f"); });
+  row("all runs: published sign kept",
+      [](const ResponseAgreement& a) { return std::to_string(a.sign_agreements_all) + " of " + std::to_string(a.significant_runs_all); });
+  row("all runs: Spearman rho", [](const ResponseAgreement& a) { return format(a.spearman_all, "%.2f"); });
+  row("all runs: RMS", [](const ResponseAgreement& a) { return format(a.rms_all, "%.4f"); });
+  row("our top five (by first-order coefficient)", [](const ResponseAgreement& a) {
+    std::string top;
+    for (const auto& p : a.top_five) top += (top.empty() ? "" : " ") + p;
+    return top;
+  });
+  row("published top five in ours",
+      [](const ResponseAgreement& a) { return a.top_five_shared < 0 ? std::string("-") : std::to_string(a.top_five_shared) + " of 5"; });
+  std::string missed;
+  for (const auto& g : agreement.goals_missed) missed += (missed.empty() ? "" : "; ") + g;
+  md << "\nGoals met: " << agreement.goals_met << " of " << Agreement::kGoals << (missed.empty() ? "" : " (missed: " + missed + ")")
+     << ".\n\n";
+
+  // Every run against the published one.
+  md << "## Runs: ours against the published (changes against run 0)\n\n"
+     << "| run | varied | R1 | published | R2 | published | R3 | published | dR1 | published | dR2 | published |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const auto run_row = [&](const std::string& number, const SensitivityRun& run, const std::array<double, 3>& theirs) {
+    std::string varied;
+    for (const auto& [name, value] : run.variation) varied += (varied.empty() ? "" : ", ") + name + " = " + format(value, "%g");
+    md << "| " << number << " | " << (varied.empty() ? "none" : varied);
+    const std::array<double, 3> ours = {run.responses.r1, run.responses.r2, run.responses.r3};
+    for (std::size_t k = 0; k < 3; ++k) md << " | " << (run.ok ? format(ours[k]) : "failed") << " | " << format(theirs[k]);
+    for (std::size_t k = 0; k < 2; ++k) {
+      const double mine = run.ok && result.base.ok ? ours[k] - agreement.responses[k].value : kNaN;
+      const double their = theirs[k] - published.base[k];
+      const bool significant = std::abs(their) >= kSignificantChange - 1e-9;
+      md << " | " << format(mine, "%+.4f") << " | " << format(their, "%+.3f")
+         << (significant ? (mine * their > 0.0 ? " (sign kept)" : " (**sign differs**)") : "");
+    }
+    md << " |\n";
+  };
+  run_row("0", result.base, published.base);
+  int number = 0;
+  for (const SensitivityRun& run : result.runs) {
+    ++number;
+    for (const auto& [name, values] : published.first_order)
+      if (name == run.parameter && !result.central) run_row(std::to_string(number), run, values);
+  }
+  for (std::size_t j = 0; j < result.second_order_runs.size() && j < published.second_order.size(); ++j)
+    run_row(std::to_string(++number), result.second_order_runs[j], published.second_order[j]);
+
+  // Rankings.
+  if (!result.central) {
+    std::vector<std::array<double, 3>> theirs(result.runs.size(), {kNaN, kNaN, kNaN});
+    for (std::size_t i = 0; i < result.runs.size(); ++i)
+      for (const auto& [name, values] : published.first_order)
+        if (name == result.runs[i].parameter)
+          for (std::size_t k = 0; k < 3; ++k) theirs[i][k] = (values[k] - published.base[k]) / (design.factor - 1.0);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto& ranking = published.ranking[k];
+      if (ranking.empty()) continue;
+      std::vector<std::size_t> order(result.runs.size());
+      std::iota(order.begin(), order.end(), 0);
+      const auto magnitude = [&](std::size_t i) { return std::isnan(result.derivatives[i][k]) ? -1.0 : std::abs(result.derivatives[i][k]); };
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return magnitude(a) > magnitude(b); });
+      md << "\n## R" << k + 1 << ": the published ranking against ours\n\n"
+         << "| published rank | parameter | published dR/dP | ours | our rank | sign |\n|---|---|---|---|---|---|\n";
+      for (std::size_t rank = 0; rank < ranking.size(); ++rank) {
+        std::size_t i = 0;
+        while (i < result.runs.size() && result.runs[i].parameter != ranking[rank]) ++i;
+        if (i == result.runs.size()) continue;
+        const std::size_t our_rank = static_cast<std::size_t>(std::find(order.begin(), order.end(), i) - order.begin()) + 1;
+        const double mine = result.derivatives[i][k], their = theirs[i][k];
+        md << "| " << rank + 1 << " | " << ranking[rank] << " | " << format(their, "%+.3f") << " | " << format(mine, "%+.3f") << " | "
+           << our_rank << " | " << (std::abs(mine) < 0.0005 ? "ours 0.000" : (mine * their > 0.0 ? "same" : "**differs**")) << " |\n";
+      }
+    }
+  }
+
+  // Second-order derivatives: ours and the published runs' through the same fit.
+  if (!result.fit.terms.empty() && published.second_order.size() == design.second_order.runs.size()) {
+    std::vector<SensitivitySample> samples{{"run 0", {}, published.base}};
+    std::vector<std::string> term_parameters;
+    for (const SensitivityTerm& t : result.fit.terms) {
+      term_parameters.push_back(t.first);
+      if (!t.linear()) term_parameters.push_back(t.second);
+    }
+    const auto in_form = [&](const std::string& name) {
+      return std::find(term_parameters.begin(), term_parameters.end(), name) != term_parameters.end();
+    };
+    for (const auto& [name, values] : published.first_order)
+      if (in_form(name)) samples.push_back({name, {{name, design.factor}}, values});
+    for (std::size_t j = 0; j < published.second_order.size(); ++j) {
+      const SensitivityPoint& point = design.second_order.runs[j];
+      if (std::all_of(point.begin(), point.end(), [&](const auto& e) { return in_form(e.first); }))
+        samples.push_back({"second order " + std::to_string(j + 1), point, published.second_order[j]});
+    }
+    const QuadraticFit theirs = fit_quadratic(result.fit.terms, samples);
+    md << "\n## Derivatives at P = 1 of the second-order form: ours and the published runs' (same fit)\n\n"
+       << "| derivative | R1 ours | R1 published | R2 ours | R2 published | R3 ours | R3 published |\n|---|---|---|---|---|---|---|\n";
+    for (std::size_t d = 0; d < result.fit.derivatives.size() && d < theirs.derivatives.size(); ++d) {
+      md << "| " << result.fit.derivatives[d].label();
+      for (std::size_t k = 0; k < 3; ++k)
+        md << " | " << format(result.fit.derivatives[d].value[k], "%+.3f") << " | " << format(theirs.derivatives[d].value[k], "%+.3f");
+      md << " |\n";
+    }
+  }
+  return md.str();
+}
+
+std::vector<ReadingsCombinationResult> run_readings(const std::string& model_path, const SensitivityDesign& design,
+                                                    const ReadingsPlan& plan, const ReadingsOptions& options) {
+  if (!design.reference)
+    throw InputError("the design has no 'reference' section (the published results to score against); add one, as "
+                     "models/report/sensitivity_design.yaml does");
+  check_readings(plan, model_path);
+  const std::vector<std::vector<int>> combinations = plan.combinations();
+  std::vector<SensitivityDesign> designs;
+  for (const std::vector<int>& combination : combinations) {
+    designs.push_back(plan.design_for(combination, design));
+    try {
+      check_design_keys(designs.back(), model_path, plan.settings(combination), designs.size() > 1 ? &designs.front() : nullptr);
+    } catch (const InputError& e) {
+      throw InputError(plan.path + ": the combination " + plan.label(combination) + ": " + e.what());
+    }
+  }
+  std::vector<ReadingsCombinationResult> results;
+  for (std::size_t c = 0; c < combinations.size(); ++c) {
+    const auto start = std::chrono::steady_clock::now();
+    SensitivityOptions study = options.study;
+    study.settings = plan.settings(combinations[c]);
+    ReadingsCombinationResult r;
+    r.levels = combinations[c];
+    r.study = run_sensitivity(model_path, designs[c], study);
+    r.agreement = score_agreement(r.study, designs[c]);
+    r.failed_runs = r.study.base.ok ? 0 : 1;
+    for (const auto& run : r.study.runs) r.failed_runs += run.ok ? 0 : 1;
+    for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok ? 0 : 1;
+    r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (options.progress) options.progress(r, c, combinations.size());
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
+std::string write_readings(const std::vector<ReadingsCombinationResult>& results, const ReadingsPlan& plan,
+                           const SensitivityDesign& design, const std::string& directory) {
+  std::filesystem::create_directories(directory);
+  std::vector<std::size_t> order(results.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const Agreement& x = results[a].agreement;
+    const Agreement& y = results[b].agreement;
+    return x.goals_met != y.goals_met ? x.goals_met > y.goals_met : x.score > y.score;
+  });
+  char folder[48];
+  const auto folder_of = [&](std::size_t c) {
+    std::snprintf(folder, sizeof folder, "combination_%03zu", c);
+    return std::string(folder);
+  };
+
+  std::ofstream csv(std::filesystem::path(directory) / "readings.csv");
+  csv << "rank,combination";
+  for (const Reading& r : plan.readings) csv << "," << csv_quoted(r.name);
+  for (int k = 1; k <= 3; ++k)
+    csv << ",R" << k << ",R" << k << "_error,R" << k << "_sign_runs,R" << k << "_sign_agree,R" << k << "_spearman,R" << k
+        << "_rms,R" << k << "_sign_runs_all,R" << k << "_sign_agree_all,R" << k << "_spearman_all,R" << k << "_rms_all,R" << k
+        << "_top5_shared,R" << k << "_top5";
+  csv << ",goals_met,score,failed_runs,wall_seconds\n";
+  for (std::size_t rank = 0; rank < order.size(); ++rank) {
+    const ReadingsCombinationResult& r = results[order[rank]];
+    csv << rank + 1 << "," << order[rank];
+    for (std::size_t i = 0; i < plan.readings.size(); ++i)
+      csv << "," << csv_quoted(plan.readings[i].levels[static_cast<std::size_t>(r.levels[i])].name);
+    for (const ResponseAgreement& a : r.agreement.responses) {
+      std::string top;
+      for (const auto& p : a.top_five) top += (top.empty() ? "" : " ") + p;
+      csv << "," << csv_field(a.value) << "," << csv_field(a.relative_error) << "," << a.significant_runs << "," << a.sign_agreements
+          << "," << csv_field(a.spearman) << "," << csv_field(a.rms) << "," << a.significant_runs_all << "," << a.sign_agreements_all
+          << "," << csv_field(a.spearman_all) << "," << csv_field(a.rms_all) << "," << a.top_five_shared << "," << csv_quoted(top);
+    }
+    csv << "," << r.agreement.goals_met << "," << csv_field(r.agreement.score) << "," << r.failed_runs << ","
+        << format(r.wall_seconds, "%.1f") << "\n";
+  }
+  if (!csv) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.csv").string());
+
+  std::ostringstream md;
+  md << "# Reading study\n\n"
+     << "Readings file `" << plan.path << "`, " << results.size() << " combinations ("
+     << (plan.one_at_a_time ? "one at a time" : "factorial") << "), each scored against the design's published results"
+     << (design.reference && !design.reference->source.empty() ? " (" + design.reference->source + ")" : std::string()) << ".\n\n"
+     << "Columns: run 0's R1-R3 (relative error against the published run 0); for R1 and R2 over the first-order runs: "
+        "sign agreement among the runs whose published change is at least 0.005, Spearman's rho of the changes, and how many of "
+        "the published top five (Tables 15-17) are in ours; goals met of "
+     << Agreement::kGoals << " (R2 within 10 %, R3 within 5 %, signs >= 80 %, rho >= 0.7, top five >= 4). Ranked by goals met, "
+        "then by the score (include/railcrash/readings.hpp).\n\n";
+  md << "| rank | #";
+  for (const Reading& r : plan.readings) md << " | " << r.name;
+  md << " | R1 | R2 | R3 | R1 signs | R1 rho | R1 top 5 | R2 signs | R2 rho | R2 top 5 | R3 rho | goals | score | failed |\n|";
+  for (std::size_t i = 0; i < plan.readings.size() + 17; ++i) md << "---|";
+  md << "\n";
+  for (std::size_t rank = 0; rank < order.size(); ++rank) {
+    const ReadingsCombinationResult& r = results[order[rank]];
+    const auto& a = r.agreement.responses;
+    md << "| " << rank + 1 << " | " << order[rank];
+    for (std::size_t i = 0; i < plan.readings.size(); ++i) md << " | " << plan.readings[i].levels[static_cast<std::size_t>(r.levels[i])].name;
+    for (int k = 0; k < 3; ++k)
+      md << " | " << format(a[static_cast<std::size_t>(k)].value) << " (" << format(100.0 * a[static_cast<std::size_t>(k)].relative_error, "%+.1f")
+         << " %)";
+    for (int k = 0; k < 2; ++k) {
+      const ResponseAgreement& x = a[static_cast<std::size_t>(k)];
+      md << " | " << x.sign_agreements << "/" << x.significant_runs << " | " << format(x.spearman, "%.2f") << " | "
+         << x.top_five_shared << "/5";
+    }
+    md << " | " << format(a[2].spearman, "%.2f") << " | " << r.agreement.goals_met << "/" << Agreement::kGoals << " | "
+       << format(r.agreement.score, "%.2f") << " | " << r.failed_runs << " |\n";
+  }
+  md << "\nReadings and levels:\n\n";
+  for (const Reading& r : plan.readings) {
+    md << "- **" << r.name << "**" << (r.description.empty() ? "" : ": " + r.description) << "\n";
+    for (const ReadingLevel& l : r.levels) {
+      std::string changes;
+      for (const auto& s : l.settings) changes += (changes.empty() ? "" : ", ") + std::string("`") + s.substr(0, s.find_last_not_of("\n") + 1) + "`";
+      for (const auto& [parameter, scales] : l.scales) {
+        std::string how;
+        for (const auto& [key, power] : scales) how += (how.empty() ? "" : " and ") + key + "^" + format(power, "%g");
+        changes += (changes.empty() ? "" : ", ") + parameter + " scales " + how;
+      }
+      md << "  - " << l.name << ": " << (changes.empty() ? "the model as it is" : changes) << "\n";
+    }
+  }
+  if (!results.empty()) {
+    const ReadingsCombinationResult& best = results[order.front()];
+    md << "\nBest combination (" << order.front() << "): " << plan.label(best.levels) << "; top five R1 ";
+    for (const auto& p : best.agreement.responses[0].top_five) md << p << " ";
+    md << "/ R2 ";
+    for (const auto& p : best.agreement.responses[1].top_five) md << p << " ";
+    md << "/ R3 ";
+    for (const auto& p : best.agreement.responses[2].top_five) md << p << " ";
+    md << "; goals missed: ";
+    std::string missed;
+    for (const auto& g : best.agreement.goals_missed) missed += (missed.empty() ? "" : "; ") + g;
+    md << (missed.empty() ? "none" : missed) << ".\n";
+  }
+  const std::string text = md.str();
+  std::ofstream out(std::filesystem::path(directory) / "readings.md");
+  out << text;
+  if (!out) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.md").string());
+  for (std::size_t c = 0; c < results.size(); ++c) {
+    const SensitivityDesign combination_design = plan.design_for(results[c].levels, design);
+    const std::filesystem::path run_folder = std::filesystem::path(directory) / folder_of(c);
+    write_sensitivity(results[c].study, combination_design, run_folder.string());
+    if (!results[c].study.base.ok || results[c].study.central) continue;
+    std::ofstream comparison(run_folder / "comparison.md");
+    comparison << "# " << plan.label(results[c].levels) << ": the study against the published results\n\n"
+               << comparison_markdown(results[c].study, combination_design);
+    if (!comparison) throw std::runtime_error("cannot write " + (run_folder / "comparison.md").string());
+  }
+  return text;
+}
+
+}  // namespace railcrash
