@@ -285,14 +285,15 @@ std::string write_page(const fs::path& dir, const std::string& title, const std:
 }
 
 /// Files of a `converge` or `sensitivity` folder, in the order shown.
-const char* const kStudyFiles[] = {"converge.md", "converge.csv", "sensitivity.md", "sensitivity.csv", "sensitivity_first_order.csv",
-                                   "sensitivity_second_order.csv", "sensitivity_derivatives.csv", "sensitivity_ranking.csv"};
+const char* const kStudyFiles[] = {"converge.md", "converge.csv", "readings.md", "readings.csv", "sensitivity.md", "comparison.md",
+                                   "sensitivity.csv", "sensitivity_first_order.csv", "sensitivity_second_order.csv",
+                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv"};
 
 /// A report of a study folder: its Markdown summary, its tables and its chart.
 ReportResult write_study_report(const fs::path& dir) {
   ReportResult result;
   const bool converge = fs::exists(dir / "converge.csv") || fs::exists(dir / "converge.md");
-  result.study = converge ? "converge" : "sensitivity";
+  result.study = converge ? "converge" : fs::exists(dir / "readings.csv") ? "readings" : "sensitivity";
   std::string files = "[";
   for (const char* name : kStudyFiles) {
     bool found = false;
@@ -306,11 +307,10 @@ ReportResult write_study_report(const fs::path& dir) {
   files += "]";
   bool svg_found = false;
   const std::string svg = read_file(dir / "converge.svg", &svg_found);
-  const std::string data = "{\"study\": " + js(converge ? "converge" : "sensitivity") + ", \"run_dir\": " +
+  const std::string data = "{\"study\": " + js(result.study) + ", \"run_dir\": " +
                            js(fs::absolute(dir).lexically_normal().string()) + ", \"problems\": [], \"files\": " + files +
                            ", \"chart\": " + (svg_found ? js("data:image/svg+xml;base64," + base64(svg)) : std::string("null")) + "}";
-  result.path = write_page(dir, std::string(converge ? "railcrash convergence study: " : "railcrash sensitivity study: ") +
-                                    dir.filename().string(), "null", "null", data);
+  result.path = write_page(dir, "railcrash " + result.study + " study: " + dir.filename().string(), "null", "null", data);
   return result;
 }
 
@@ -326,7 +326,7 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   ReportResult result;
   std::vector<std::string>& problems = result.problems;
   const NumericTable series = read_numeric_csv(dir / "timeseries.csv", problems);
-  if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv")))
+  if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv") || fs::exists(dir / "readings.csv")))
     return write_study_report(dir);
   if (!series.found)
     throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (write one with `railcrash run MODEL --out " +

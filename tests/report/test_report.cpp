@@ -179,6 +179,8 @@ TEST_CASE("railcrash report of a sensitivity folder: its summary and tables", "[
   const std::string page = slurp(dir / "report.html");
   CHECK_THAT(page, Catch::Contains("run,P1,R1\\nbase,1,0.5") && Catch::Contains("\\u003cb>study"));
   CHECK_THAT(page, !Catch::Contains("<b>study"));
+  std::ofstream(dir / "readings.csv") << "combination,score\nA,3\n";  // a readings folder holds its combinations' studies
+  CHECK(railcrash::report::write_report(dir.string()).study == "readings");
   fs::remove_all(dir);
 }
 

@@ -15,9 +15,9 @@
 // draft_gear, coupler_end, couplings) are shown first and get force-deformation loops. Long
 // series are decimated with decimate_minmax (peaks kept), animation frames uniformly.
 //
-// A folder of `railcrash converge` or `railcrash sensitivity` (converge.csv or sensitivity.csv,
-// no timeseries.csv) gets a page of its Markdown summary and CSV files as tables, and the
-// convergence chart (converge.svg).
+// A folder of `railcrash converge`, `sensitivity` or `readings` (converge.csv, sensitivity.csv or
+// readings.csv, no timeseries.csv) gets a page of its Markdown summaries and CSV files as
+// tables, and the convergence chart (converge.svg).
 //
 // Bad folders: a missing folder, or one without timeseries.csv or without a single complete
 // row in it, throws InputError (exit 2). Anything else that is missing or broken (no
@@ -41,7 +41,7 @@ struct ReportResult {
   std::string path;                   // RUN_DIR/report.html
   std::vector<std::string> problems;  // shown at the top of the page
   std::size_t rows = 0;               // complete rows of timeseries.csv
-  std::string study;                  // "converge" or "sensitivity" for a study folder (rows: its files)
+  std::string study;                  // "converge", "sensitivity" or "readings" for a study folder (rows: its files)
 };
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options = {});

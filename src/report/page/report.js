@@ -64,7 +64,8 @@
     });
     var head = document.getElementById("header");
     head.textContent = "";
-    head.appendChild(el("h1", {}, (data.study === "converge" ? "railcrash convergence study: " : "railcrash sensitivity study: ") + data.run_dir));
+    head.appendChild(el("h1", {}, "railcrash " + ({converge: "convergence", readings: "reading", sensitivity: "sensitivity"}[data.study] || data.study) +
+                                  " study: " + data.run_dir));
     var box = el("section");
     document.body.insertBefore(box, document.getElementById("footer"));
     var tables = 0;
