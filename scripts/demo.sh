@@ -8,5 +8,5 @@ scripts/build.sh
 model=models/report/final_two_car.yaml
 echo "== railcrash check $model"
 build/railcrash check "$model"
-echo "== railcrash run $model --out results/final_two_car"
-build/railcrash run "$model" --out results/final_two_car
+echo "== railcrash run $model --out results/final_two_car --report"
+build/railcrash run "$model" --out results/final_two_car --report

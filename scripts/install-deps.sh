@@ -5,13 +5,18 @@ set -euo pipefail
 # file + dpkg-dev: CPack's Debian packages (their dependencies come from dpkg-shlibdeps).
 # pybind11 + numpy + python3-dev: the Python module; pandas and matplotlib: its dataframe()
 # and the Python example (all from Debian, for /usr/bin/python3; no pip).
+# nodejs + npm: the build fetches the run report's plotting library (uPlot, pinned in
+# src/report/js/package-lock.json) from the npm registry; chromium: the report's browser test.
 packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
-          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2
+          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# A node.js from elsewhere (e.g. NodeSource, which bundles npm) is fine too.
+command -v node > /dev/null || missing+=(nodejs)
+command -v npm > /dev/null || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   echo "railcrash: all build dependencies are installed"
   exit 0

@@ -20,6 +20,8 @@
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
 #include "railcrash/converge.hpp"
+#include "railcrash/report/report.hpp"
+#include "railcrash/version.hpp"
 
 #include <sstream>
 #include <thread>
@@ -66,14 +68,28 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
   return 0;
 }
 
+int report_command(const std::string& run_dir, double cfc) {
+  railcrash::report::ReportOptions options;
+  options.cfc = cfc;
+  const railcrash::report::ReportResult result = railcrash::report::write_report(run_dir, options);
+  for (const std::string& problem : result.problems) std::fprintf(stderr, "report: %s\n", problem.c_str());
+  if (!result.study.empty()) {
+    std::printf("report of the %s study (%zu files) written to %s\n", result.study.c_str(), result.rows, result.path.c_str());
+    return 0;
+  }
+  std::printf("report of %zu output rows written to %s%s\n", result.rows, result.path.c_str(),
+              railcrash::report::have_plotting_library() ? "" : " (without plots: this build has no plotting library)");
+  return 0;
+}
+
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
-                const std::string& out_dir) {
+                const std::string& out_dir, bool with_report, bool quiet) {
   using namespace railcrash;
   Model model = load_model(path, settings);
   apply_overrides(model, overrides);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  const RunReport report = run_model(model, out_dir, &g_stop, true);
+  const RunReport report = run_model(model, out_dir, &g_stop, !quiet);
   const RunOutcome& o = report.outcome;
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
   std::printf("%s: %s with %s to t = %g in %.3g s (%ld steps, %ld residual evaluations)\n", model.name.c_str(),
@@ -90,19 +106,25 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
     std::printf("responses  R1 %.3f (crush)  R2 %.3f (override)  R3 %.3f  override: %s\n", r.r1, r.r2, r.r3,
                 r.overridden ? ("yes, at t = " + std::to_string(r.override_time)).c_str() : "no");
   }
-  // Each car's largest crush and the peak accelerations of its car-body masses (bodies whose
-  // names contain "body" or "end"; every body's are in summary.json).
+  // Each car's largest crush and the CFC 60 peak accelerations of its car-body masses (bodies
+  // whose names contain "body" or "end"; every body's are in summary.json).
   for (const CarCrush& car : report.car_crush) {
-    std::printf("%-10s max crush %.4g at t = %.4g; peak acceleration [g]:", car.car.c_str(), car.max_crush, car.t);
+    std::printf("%-10s max crush %.4g at t = %.4g; peak acceleration (CFC 60, unfiltered) [g]:", car.car.c_str(), car.max_crush, car.t);
     for (std::size_t i = 0; i < report.acceleration_peaks.size(); ++i) {
       const std::string& name = model.bodies()[i].name;
       const bool in_car = report.car_crush.size() == 1 || name.rfind(car.car + "_", 0) == 0;
       if (!in_car || (name.find("body") == std::string::npos && name.find("end") == std::string::npos)) continue;
-      std::printf(" %s %.3g", name.c_str(), report.acceleration_peaks[i].magnitude / standard_gravity(model));
+      const double g = standard_gravity(model);
+      if (i < report.filtered_accelerations.size() && report.filtered_accelerations[i].filtered)
+        std::printf(" %s %.3g (%.3g)", name.c_str(), report.filtered_accelerations[i].peaks.magnitude / g,
+                    report.acceleration_peaks[i].magnitude / g);
+      else
+        std::printf(" %s %.3g (unfiltered)", name.c_str(), report.acceleration_peaks[i].magnitude / g);
     }
     std::printf("\n");
   }
-  std::printf("results in %s/ (timeseries.csv, events.csv, summary.json)\n", out_dir.c_str());
+  std::printf("results in %s/ (timeseries.csv, events.csv, summary.json, accelerations.csv, energy.csv, model.json)\n", out_dir.c_str());
+  if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;
 }
 
@@ -230,6 +252,7 @@ int consist_command(const std::string& template_path, int cars, const std::strin
 int main(int argc, char** argv) {
   CLI::App app{"railcrash: planar rail-vehicle crash dynamics (IDA + KLU, or explicit Euler)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", railcrash::version_text());
 
   std::string model_path, out_dir = "out", integrator;
   std::vector<std::string> settings;
@@ -247,6 +270,17 @@ int main(int argc, char** argv) {
   run->add_flag("--force-dt", overrides.force_dt, "euler: run even above the stability limit");
   run->add_option("--out", out_dir, "output folder")->capture_default_str();
   run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
+  bool with_report = false;
+  run->add_flag("--report", with_report, "also write DIR/report.html (as `railcrash report DIR`)");
+  bool quiet = false;
+  run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
+
+  std::string report_dir;
+  double report_cfc = 60.0;
+  CLI::App* report = app.add_subcommand("report", "write RUN_DIR/report.html: header, animation, event log, plots (one self-contained file)");
+  report->add_option("run_dir", report_dir, "run folder (the --out of `railcrash run`)")->required();
+  report->add_option("--cfc", report_cfc, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
 
   std::string design_path = "report", only;
   int jobs = 0;
@@ -330,6 +364,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*check) return check_command(model_path, settings);
+    if (*report) return report_command(report_dir, report_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out);
     if (*converge) {
       if (*converge_t_end) converge_options.t_end = t_end;
@@ -346,7 +381,7 @@ int main(int argc, char** argv) {
     if (*atol_option) overrides.atol = atol;
     if (*dt_option) overrides.dt = dt;
     if (*output_option) overrides.output_interval = output_interval;
-    return run_command(model_path, settings, overrides, out_dir);
+    return run_command(model_path, settings, overrides, out_dir, with_report, quiet);
   } catch (const railcrash::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

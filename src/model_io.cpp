@@ -153,6 +153,33 @@ class Reader {
     return node.Scalar();
   }
 
+  /// A body or element name: it becomes CSV column headers, JSON keys and report text, so it may
+  /// not hold a comma, quote, backslash, <, >, &, a control character or invalid UTF-8.
+  std::string name(const YAML::Node& node, const std::string& what) const {
+    const std::string value = text(node, what);
+    if (value.empty()) fail(node, what + " must not be empty");
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      const unsigned char c = static_cast<unsigned char>(value[i]);
+      if (c < 0x20 || c == 0x7F || std::string(",\"'\\<>&").find(static_cast<char>(c)) != std::string::npos)
+        fail(node, what + " '" + printable(value) + "' holds the character " + (c < 0x20 || c == 0x7F ? "code " + std::to_string(c) : "'" + std::string(1, static_cast<char>(c)) + "'") +
+                       ", which would break the CSV, JSON and report files; use letters, digits, _ - . and spaces");
+      if (c >= 0x80) {
+        const std::size_t length = (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+        bool ok = length > 0 && i + length <= value.size();
+        for (std::size_t k = 1; ok && k < length; ++k) ok = (static_cast<unsigned char>(value[i + k]) >> 6) == 0x2;
+        if (!ok) fail(node, what + " '" + printable(value) + "' is not valid UTF-8 text; save the model file as UTF-8");
+        i += length - 1;
+      }
+    }
+    return value;
+  }
+
+  static std::string printable(const std::string& value) {
+    std::string out;
+    for (char c : value) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F) ? '?' : c;
+    return out;
+  }
+
   const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
     const YAML::Node node = map[key];
     if (!node) fail(map, context + ": missing required key '" + key + "'");
@@ -380,7 +407,7 @@ std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementS
   return probe.keys;
 }
 
-const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description",
+const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
                                            "responses"};
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
@@ -391,7 +418,7 @@ const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol",
 
 Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double gravity_magnitude) {
   r.require_map(node, "each body");
-  const std::string name = r.text(r.required(node, "name", "body"), "body name");
+  const std::string name = r.name(r.required(node, "name", "body"), "body name");
   const std::string context = "body '" + name + "'";
   r.check_keys(node, kBodyKeys, context);
   Body b;
@@ -427,7 +454,7 @@ Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double
 
 std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, const Model& model) {
   r.require_map(node, "each element");
-  const std::string name = r.text(r.required(node, "name", "element"), "element name");
+  const std::string name = r.name(r.required(node, "name", "element"), "element name");
   const YAML::Node type_node = r.required(node, "type", "element '" + name + "'");
   const std::string type = r.text(type_node, "element '" + name + "': type");
   const ElementRegistry& registry = ElementRegistry::instance();
@@ -563,6 +590,61 @@ PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, co
     ref.sy = at[1];
   }
   return ref;
+}
+
+void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
+  r.require_list(node, "outputs");
+  std::vector<std::string> taken;  // names whose columns exist already
+  for (const Body& b : model.bodies()) taken.push_back(b.name);
+  for (const auto& e : model.elements()) taken.push_back(e->name());
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node item = node[i];
+    const std::string context = "outputs: item " + std::to_string(i + 1);
+    r.require_map(item, context);
+    r.check_keys(item, {"name", "body", "at", "quantities"}, context);
+    OutputPoint output;
+    output.where = r.at(item);
+    const YAML::Node body_node = r.required(item, "body", context);
+    const std::string body = r.text(body_node, context + ": body");
+    const auto index = model.find_body(body);
+    if (!index) {
+      std::vector<std::string> names;
+      for (const Body& b : model.bodies()) names.push_back(b.name);
+      r.fail(body_node, context + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
+    }
+    if (*index == kGround) r.fail(body_node, context + ": the ground does not move; name a body");
+    output.point.body = *index;
+    if (item["at"]) {
+      const auto at = r.numbers(item["at"], 2, context + ": at");
+      output.point.sx = at[0];
+      output.point.sy = at[1];
+    }
+    if (item["name"]) {
+      output.name = r.name(item["name"], context + ": name");
+    } else {
+      int k = 1;
+      for (const OutputPoint& o : model.output_points) k += o.point.body == *index;
+      output.name = body + "_point" + std::to_string(k);
+    }
+    if (std::find(taken.begin(), taken.end(), output.name) != taken.end())
+      r.fail(item["name"] ? item["name"] : item, context + ": the name '" + output.name +
+                                                     "' is already a body, element or output; give the point another name");
+    taken.push_back(output.name);
+    if (item["quantities"]) {
+      const YAML::Node list = item["quantities"];
+      r.require_list(list, context + ": quantities");
+      output.position = output.velocity = output.acceleration = false;
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const std::string q = r.text(list[k], context + ": quantity");
+        if (q == "position") output.position = true;
+        else if (q == "velocity") output.velocity = true;
+        else if (q == "acceleration") output.acceleration = true;
+        else r.fail(list[k], context + ": unknown quantity '" + q + "'; use position, velocity or acceleration");
+      }
+      if (list.size() == 0) r.fail(list, context + ": quantities is empty; list position, velocity and/or acceleration");
+    }
+    model.output_points.push_back(output);
+  }
 }
 
 void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
@@ -758,6 +840,7 @@ Model build(const YAML::Node& root, const Reader& r) {
     for (std::size_t i = 0; i < root["loads"].size(); ++i) model.add_load(read_load(r, root["loads"][i], model));
   }
   if (root["responses"]) read_responses(r, root["responses"], model);
+  if (root["outputs"]) read_outputs(r, root["outputs"], model);
   read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
   return model;
 }

@@ -8,6 +8,10 @@
 #include <regex>
 #include <sstream>
 
+#include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/output_points.hpp"
+#include "railcrash/results/run_files.hpp"
+
 namespace railcrash {
 
 void body_accelerations(const DaeSystem& system, double t, const double* y, const double* lambda, double* acceleration) {
@@ -101,6 +105,7 @@ std::vector<std::string> timeseries_columns(const DaeSystem& system) {
   for (const Body& b : system.model().bodies())
     for (const char* q : {"x", "y", "theta", "vx", "vy", "omega"}) names.push_back(b.name + "." + q);
   for (const std::string& name : system.output_names()) names.push_back(name);
+  for (const std::string& name : output_point_columns(system.model())) names.push_back(name);
   return names;
 }
 
@@ -113,12 +118,25 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
     timeseries_ = std::fopen((directory + "/timeseries.csv").c_str(), "w");
     events_ = std::fopen((directory + "/events.csv").c_str(), "w");
-    if (!timeseries_ || !events_) throw InputError("cannot write into the output folder '" + directory + "'");
+    accelerations_file_ = std::fopen((directory + "/accelerations.csv").c_str(), "w");
+    energy_file_ = std::fopen((directory + "/energy.csv").c_str(), "w");
+    if (!timeseries_ || !events_ || !accelerations_file_ || !energy_file_)
+      throw InputError("cannot write into the output folder '" + directory + "'");
+    write_model_geometry(system, directory + "/model.json");
+    energy_ = std::make_unique<EnergyWriter>(system, energy_file_);
+    std::fputs("t", accelerations_file_);
+    for (const Body& b : system.model().bodies())
+      for (const char* q : {"ax", "ay", "alpha"}) std::fprintf(accelerations_file_, ",%s.%s", b.name.c_str(), q);
+    std::fputs("\n", accelerations_file_);
     for (std::size_t k = 0; k < names.size(); ++k) std::fprintf(timeseries_, "%s%s", k ? "," : "", names[k].c_str());
     std::fputs("\n", timeseries_);
     std::fputs("t,element,event,value\n", events_);
   }
   if (keep_in_memory) columns_.resize(names.size());
+  const std::size_t body_count = static_cast<std::size_t>(system.model().body_count());
+  vx_.assign(body_count, {});
+  ax_.assign(body_count, {});
+  ay_.assign(body_count, {});
   output_values_.assign(system.output_names().size(), 0.0);
   peak_output_.assign(system.output_names().size(), 0.0);
   peak_time_.assign(system.output_names().size(), 0.0);
@@ -130,9 +148,11 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
 ResultWriter::~ResultWriter() {
   if (timeseries_) std::fclose(timeseries_);
   if (events_) std::fclose(events_);
+  if (accelerations_file_) std::fclose(accelerations_file_);
+  if (energy_file_) std::fclose(energy_file_);
 }
 
-void ResultWriter::sample(double t, const double* y, const double* lambda, const double*) {
+void ResultWriter::sample(double t, const double* y, const double* lambda, const double* quadratures) {
   const int n = system_.model().body_count();
   const int nq = 3 * n;
   if (timeseries_) {
@@ -149,6 +169,12 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
       peak_time_[k] = t;
     }
   }
+  body_accelerations(system_, t, y, lambda, acceleration_.data());
+  if (!system_.model().output_points.empty()) {
+    output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
+    if (timeseries_)
+      for (double value : point_values_) std::fprintf(timeseries_, ",%.12g", value);
+  }
   if (timeseries_) std::fputs("\n", timeseries_);
   if (!columns_.empty()) {  // same order as the CSV columns
     std::size_t column = 0;
@@ -157,8 +183,22 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
       for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2})
         columns_[column++].push_back(y[k]);
     for (const double value : output_values_) columns_[column++].push_back(value);
+    if (!system_.model().output_points.empty())
+      for (const double value : point_values_) columns_[column++].push_back(value);
   }
-  body_accelerations(system_, t, y, lambda, acceleration_.data());
+  if (accelerations_file_) {
+    std::fprintf(accelerations_file_, "%.12g", t);
+    for (double a : acceleration_) std::fprintf(accelerations_file_, ",%.12g", a);
+    std::fputs("\n", accelerations_file_);
+  }
+  if (energy_) energy_->sample(t, y, quadratures);
+  sample_times_.push_back(t);
+  for (int i = 0; i < n; ++i) {
+    const std::size_t b = static_cast<std::size_t>(i);
+    vx_[b].push_back(static_cast<float>(y[nq + 3 * i]));
+    ax_[b].push_back(static_cast<float>(acceleration_[3 * b]));
+    ay_[b].push_back(static_cast<float>(acceleration_[3 * b + 1]));
+  }
   for (int i = 0; i < n; ++i) {
     AccelerationPeaks& p = acceleration_peaks_[static_cast<std::size_t>(i)];
     const double ax = acceleration_[static_cast<std::size_t>(3 * i)], ay = acceleration_[static_cast<std::size_t>(3 * i + 1)];
@@ -179,6 +219,8 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   if (now - last_flush_ > std::chrono::milliseconds(500)) {
     std::fflush(timeseries_);
     std::fflush(events_);
+    std::fflush(accelerations_file_);
+    std::fflush(energy_file_);
     last_flush_ = now;
   }
 }
@@ -195,9 +237,32 @@ void ResultWriter::event(const EventRecord& record, const double*) {
   std::fprintf(events_, "%.12g,%s,%s,%.12g\n", record.t, element.c_str(), what.c_str(), record.value);
 }
 
+std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const {
+  std::vector<FilteredAccelerations> result(vx_.size());
+  const double interval = cfc::typical_interval(sample_times_);
+  const bool can_filter = sample_times_.size() >= 3 && interval > 0.0 && cfc::design_frequency(cfc_) * interval < 0.5;
+  for (std::size_t b = 0; b < vx_.size(); ++b) {
+    FilteredAccelerations& f = result[b];
+    const auto widen = [](const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); };
+    f.collision = collision_pulse(sample_times_, widen(vx_[b]));
+    if (!can_filter) continue;
+    f.filtered = true;
+    const std::vector<double> ax = cfc::filter(cfc::resample_uniform(sample_times_, widen(ax_[b]), interval), interval, cfc_);
+    const std::vector<double> ay = cfc::filter(cfc::resample_uniform(sample_times_, widen(ay_[b]), interval), interval, cfc_);
+    for (std::size_t k = 0; k < ax.size(); ++k) {
+      const double t = sample_times_.front() + static_cast<double>(k) * interval;
+      const double magnitude = std::hypot(ax[k], ay[k]);
+      if (std::abs(ax[k]) > f.peaks.x) { f.peaks.x = std::abs(ax[k]); f.peaks.t_x = t; }
+      if (std::abs(ay[k]) > f.peaks.y) { f.peaks.y = std::abs(ay[k]); f.peaks.t_y = t; }
+      if (magnitude > f.peaks.magnitude) { f.peaks.magnitude = magnitude; f.peaks.t_magnitude = t; }
+    }
+  }
+  return result;
+}
+
 std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json) {
-  if (timeseries_) std::fflush(timeseries_);
-  if (events_) std::fflush(events_);
+  for (std::FILE* file : {timeseries_, events_, accelerations_file_, energy_file_})
+    if (file) std::fflush(file);
   const Model& model = system_.model();
   const bool si = model.units == UnitSystem::SI;
   const EnergyBalance energy = EnergyBalance::between(outcome.initial_energy, outcome.final_energy);
@@ -239,14 +304,39 @@ std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::st
       << ", \"t\": " << json_number(peak_time_[k]) << "}";
   j << "},\n";
   const double g = standard_gravity(model);
-  j << "  \"peak_accelerations\": {\"standard_gravity\": " << json_number(g) << ", \"bodies\": {";
+  const std::vector<FilteredAccelerations> filtered = filtered_accelerations();
+  const double interval = cfc::typical_interval(sample_times_);
+  const bool filtered_any = !filtered.empty() && filtered.front().filtered;
+  const bool adequate = cfc::adequately_sampled(cfc_, interval);
+  j << "  \"peak_accelerations\": {\"standard_gravity\": " << json_number(g) << ", \"filter\": {\"cfc\": " << json_number(cfc_)
+    << ", \"standard\": \"SAE J211-1 / ISO 6487, two-pass Butterworth\", \"sample_interval\": " << json_number(interval)
+    << ", \"adequately_sampled\": " << (adequate ? "true" : "false") << ", \"note\": "
+    << json_string(!filtered_any ? "too few or too coarse samples to filter: lower the output interval below " +
+                                       json_number(0.5 / cfc::design_frequency(cfc_)) + " s"
+                   : adequate ? "x_cfc, y_cfc, magnitude_cfc: peaks of the filtered accelerations; unfiltered beside them"
+                              : "sample rate below 10 x CFC: filtered peaks are rough, lower the output interval")
+    << "}, \"bodies\": {";
+  const auto peak_json = [&](double value, double t) {
+    return "{\"abs_max\": " + json_number(value) + ", \"g\": " + json_number(value / g) + ", \"t\": " + json_number(t) + "}";
+  };
   for (std::size_t i = 0; i < acceleration_peaks_.size(); ++i) {
     const AccelerationPeaks& p = acceleration_peaks_[i];
+    const FilteredAccelerations& f = filtered[i];
     j << (i ? ", " : "") << json_string(model.bodies()[i].name) << ": {\"x\": {\"abs_max\": " << json_number(p.x)
       << ", \"g\": " << json_number(p.x / g) << ", \"t\": " << json_number(p.t_x) << "}, \"y\": {\"abs_max\": "
       << json_number(p.y) << ", \"g\": " << json_number(p.y / g) << ", \"t\": " << json_number(p.t_y)
       << "}, \"magnitude\": {\"max\": " << json_number(p.magnitude) << ", \"g\": " << json_number(p.magnitude / g)
-      << ", \"t\": " << json_number(p.t_magnitude) << "}}";
+      << ", \"t\": " << json_number(p.t_magnitude) << "}";
+    if (f.filtered)
+      j << ", \"x_cfc\": " << peak_json(f.peaks.x, f.peaks.t_x) << ", \"y_cfc\": " << peak_json(f.peaks.y, f.peaks.t_y)
+        << ", \"magnitude_cfc\": " << peak_json(f.peaks.magnitude, f.peaks.t_magnitude);
+    const CollisionPulse& c = f.collision;
+    if (c.found)
+      j << ", \"collision\": {\"t_start\": " << json_number(c.t_start) << ", \"t_end\": " << json_number(c.t_end)
+        << ", \"complete\": " << (c.complete ? "true" : "false") << ", \"velocity_change\": " << json_number(c.velocity_change)
+        << ", \"mean_deceleration\": " << json_number(c.mean_deceleration) << ", \"mean_deceleration_g\": "
+        << json_number(c.mean_deceleration / g) << "}";
+    j << "}";
   }
   j << "}},\n";
   j << "  \"car_crush\": {";

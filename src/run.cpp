@@ -1,13 +1,11 @@
 #include "railcrash/run.hpp"
 
-#include <unistd.h>
-
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/ida_integrator.hpp"
+#include "railcrash/progress.hpp"
 #include "railcrash/responses.hpp"
 #include "railcrash/results.hpp"
 
@@ -21,30 +19,28 @@ double checked_positive(double value, const char* option) {
   return value;
 }
 
-/// Forwards samples to the writer and the response tracker (if any) and shows progress on a terminal.
+/// Forwards samples to the writer and the response tracker (if any) and shows progress
+/// (progress.hpp: a bar on a terminal, a line every few seconds otherwise).
 class ProgressObserver : public RunObserver {
  public:
-  ProgressObserver(std::vector<RunObserver*> next, double t_end, bool show) : next_(std::move(next)), t_end_(t_end), show_(show) {}
+  ProgressObserver(std::vector<RunObserver*> next, double t_end, bool show)
+      : next_(std::move(next)), meter_(t_end, ProgressMeter::style_for(show, stderr)) {}
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
     for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures);
-    if (!show_) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_ < std::chrono::milliseconds(200) && t < t_end_) return;
-    last_ = now;
-    std::fprintf(stderr, "\r  t = %-12.6g of %g  (%3.0f%%)", t, t_end_, 100.0 * t / t_end_);
-    if (t >= t_end_) std::fputs("\n", stderr);
-    std::fflush(stderr);
+    meter_.update(t);
+    t_last_ = t;
   }
 
   void event(const EventRecord& record, const double* y) override {
     for (RunObserver* o : next_) o->event(record, y);
   }
 
+  void finish() { meter_.finish(t_last_); }
+
  private:
   std::vector<RunObserver*> next_;
-  double t_end_;
-  bool show_;
-  std::chrono::steady_clock::time_point last_{};
+  ProgressMeter meter_;
+  double t_last_ = 0.0;
 };
 
 }  // namespace
@@ -84,11 +80,11 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory)).get());
   if (model.responses.defined())
     observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
-  const bool terminal = show_progress && isatty(STDERR_FILENO);
-  ProgressObserver observer(observers, model.simulation.t_end, terminal);
+  ProgressObserver observer(observers, model.simulation.t_end, show_progress);
   RunReport report;
   report.integrator = integrator->name();
   report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+  observer.finish();
   if (responses) {
     report.responses = responses->result();
     report.has_responses = true;
@@ -98,6 +94,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
         writer->write_summary(report.outcome, report.integrator, responses ? ",\n  \"responses\": " + responses->json() : "");
     report.acceleration_peaks = writer->acceleration_peaks();
     report.car_crush = writer->car_crush();
+    report.filtered_accelerations = writer->filtered_accelerations();
   }
   if (keep_in_memory) {
     report.columns = timeseries_columns(system);

@@ -76,6 +76,16 @@ struct ResponseSettings {
   bool defined() const { return !crush_gauges.empty() || !anticlimber.empty(); }
 };
 
+/// An output request (the model file's `outputs:`): the motion of a point on a body, written
+/// to timeseries.csv as <name>.x,<name>.y (position), <name>.vx,<name>.vy (velocity),
+/// <name>.ax,<name>.ay (acceleration) after the element columns (results/output_points.hpp).
+struct OutputPoint {
+  std::string name;          // column prefix; default <body>_point<k>
+  PointRef point;            // a body (not ground) and the offset from its centre of mass [length]
+  bool position = true, velocity = true, acceleration = true;
+  SourceLocation where;
+};
+
 enum class IntegratorKind { Ida, Euler };
 
 struct SimulationSettings {
@@ -102,6 +112,7 @@ class Model {
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
   SimulationSettings simulation;
   ResponseSettings responses;
+  std::vector<OutputPoint> output_points;
 
   int add_body(Body body);
   Element& add_element(std::unique_ptr<Element> element);

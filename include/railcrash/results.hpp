@@ -1,6 +1,7 @@
 // Run results, written to disk as the run goes, kept in memory, or both:
 //   DIR/timeseries.csv  t, then <body>.x,<body>.y,<body>.theta,<body>.vx,<body>.vy,<body>.omega for
-//                       every body in file order, then <element>.<quantity> columns
+//                       every body in file order, then <element>.<quantity> columns, then the
+//                       output points' columns (results/output_points.hpp), if the model asks
 //   DIR/events.csv      t,element,event,value
 //   DIR/summary.json    status, message, t_reached, integrator, units, stats, energy, peaks,
 //                       peak_accelerations, car_crush (and responses, when the model has them)
@@ -13,6 +14,12 @@
 // old). Peaks of |x''|, |y''| and of the magnitude sqrt(x''^2 + y''^2), in the model's units
 // and in g (standard gravity 9.80665 m/s^2 = 386.088 in/s^2, whatever the model's gravity).
 // Sampled at the output interval: a finer interval sees sharper peaks.
+// The same peaks of the accelerations filtered at a channel frequency class (CFC 60 unless
+// set_filter_class says otherwise; results/cfc_filter.hpp) are given beside them ("x_cfc",
+// "y_cfc", "magnitude_cfc"), and each body's collision pulse (first contact, end of its velocity
+// change, mean deceleration; results/crash_pulse.hpp) as "collision". The filter needs a
+// sample rate of at least 2 x 2.0775 CFC; below 10 CFC the summary says the sampling is too coarse.
+// The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
 //
 // Car crush: a car is the set of bodies whose names start with the same "car<N>_" prefix
 // (car1_coupler, car1_front_end, ... form car1); a model without such names is one car,
@@ -26,10 +33,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "railcrash/integrator.hpp"
+#include "railcrash/results/crash_pulse.hpp"
 
 namespace railcrash {
 
@@ -44,6 +53,13 @@ struct AccelerationPeaks {
   double x = 0.0, t_x = 0.0;
   double y = 0.0, t_y = 0.0;
   double magnitude = 0.0, t_magnitude = 0.0;
+};
+
+/// Filtered peaks and the collision pulse of one body.
+struct FilteredAccelerations {
+  bool filtered = false;      // false when the samples were too few or too coarse to filter
+  AccelerationPeaks peaks;    // of the CFC-filtered accelerations
+  CollisionPulse collision;   // from the body's x velocity
 };
 
 /// One car's crush elements and its largest crush [length] over the samples.
@@ -61,6 +77,7 @@ std::vector<CarCrush> cars_of(const DaeSystem& system);
 
 /// Column names of timeseries.csv: t, the six body columns per body, the element outputs.
 std::vector<std::string> timeseries_columns(const DaeSystem& system);
+class EnergyWriter;
 
 class ResultWriter : public RunObserver {
  public:
@@ -83,6 +100,11 @@ class ResultWriter : public RunObserver {
   const std::vector<AccelerationPeaks>& acceleration_peaks() const { return acceleration_peaks_; }
   /// Largest crush of each car so far.
   const std::vector<CarCrush>& car_crush() const { return cars_; }
+  /// Channel frequency class of the summary's filtered accelerations (default 60).
+  void set_filter_class(double cfc) { cfc_ = cfc; }
+  double filter_class() const { return cfc_; }
+  /// CFC-filtered peaks and collision pulses per body over the samples so far.
+  std::vector<FilteredAccelerations> filtered_accelerations() const;
 
  private:
   const DaeSystem& system_;
@@ -96,6 +118,15 @@ class ResultWriter : public RunObserver {
   std::vector<double> acceleration_;  // 3 per body at the last sample
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
+  std::FILE* accelerations_file_ = nullptr;
+  std::FILE* energy_file_ = nullptr;
+  std::unique_ptr<EnergyWriter> energy_;
+  double cfc_ = 60.0;
+  std::vector<double> sample_times_;                  // [time]
+  // Per body, per sample, for the filtered peaks and collision pulses at the end; in single
+  // precision (7 digits are plenty for peaks) to halve the memory of long, large runs.
+  std::vector<std::vector<float>> vx_, ax_, ay_;
+  std::vector<double> point_values_;                  // output points' columns at the last sample
   std::chrono::steady_clock::time_point last_flush_;
 };
 

@@ -41,6 +41,7 @@ struct RunReport {
   // keep_in_memory: timeseries.csv in memory, column by column (events: outcome.events).
   std::vector<std::string> columns;
   std::vector<std::vector<double>> series;
+  std::vector<FilteredAccelerations> filtered_accelerations;  // CFC 60 peaks, collision pulses
 };
 
 /// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files);

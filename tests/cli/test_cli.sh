@@ -102,5 +102,31 @@ sed '/^reference:/,$d' "$src/models/report/sensitivity_design.yaml" > "$tmp/no_r
 expect_status "readings with a design without a reference exits 2" 2 "$bin" readings "$report_model" --readings "$src/models/report/readings.yaml" --design "$tmp/no_reference.yaml" --out "$tmp/r4"
 expect_text "it says the reference is missing" "$tmp/stderr" "no 'reference' section"
 
+# report: a run folder gives report.html (exit 0); a missing folder or one without a timeseries exits 2.
+expect_status "run a small crash" 0 "$bin" run "$src/tests/report/two_car.yaml" --out "$tmp/two"
+expect_status "report of a run folder" 0 "$bin" report "$tmp/two"
+[ -s "$tmp/two/report.html" ] && passes=$((passes + 1)) || { echo "FAIL: report wrote no report.html"; failures=$((failures + 1)); }
+expect_text "report says where" "$tmp/stdout" "report of 1501 output rows written to $tmp/two/report.html"
+expect_text "the summary has CFC 60 peaks" "$tmp/two/summary.json" '"x_cfc": {"abs_max"'
+expect_text "and mean decelerations" "$tmp/two/summary.json" '"mean_deceleration": '
+expect_text "run writes the model geometry" "$tmp/crank/model.json" '"name": "crank", "mass"'
+expect_text "run writes the accelerations" "$tmp/crank/accelerations.csv" '^t,crank.ax,crank.ay,crank.alpha,rod.ax'
+expect_status "report of a missing folder exits 2" 2 "$bin" report "$tmp/nowhere"
+expect_text "it says the folder does not exist" "$tmp/stderr" "run folder '$tmp/nowhere' does not exist"
+mkdir -p "$tmp/not_a_run"
+expect_status "report of a folder without timeseries exits 2" 2 "$bin" report "$tmp/not_a_run"
+expect_text "it says it is not a run folder" "$tmp/stderr" "has no timeseries.csv: it is not a run folder"
+head -c 200000 "$tmp/two/timeseries.csv" > "$tmp/two/cut.csv" && mv "$tmp/two/cut.csv" "$tmp/two/timeseries.csv"
+rm "$tmp/two/summary.json"
+expect_status "report of a truncated run folder" 0 "$bin" report "$tmp/two"
+expect_text "it lists the truncated row" "$tmp/stderr" "report: timeseries.csv line [0-9]*: .*the file ends mid-row"
+expect_text "and the missing summary" "$tmp/stderr" "report: no summary.json: the run did not finish"
+
+expect_status "--version" 0 "$bin" --version
+expect_text "it names SUNDIALS" "$tmp/stdout" "^SUNDIALS 6"
+expect_text "and SuiteSparse" "$tmp/stdout" "^SuiteSparse [0-9.]* (KLU"
+expect_status "--quiet run" 0 "$bin" run "$src/tests/report/two_car.yaml" --quiet --out "$tmp/quiet"
+[ ! -s "$tmp/stderr" ] && passes=$((passes + 1)) || { echo "FAIL: --quiet printed to stderr"; failures=$((failures + 1)); }
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -1,0 +1,52 @@
+// `railcrash report RUN_DIR`: one self-contained HTML page (RUN_DIR/report.html) of a run folder.
+//
+// It reads what the folder holds (results.hpp, results/run_files.hpp): summary.json (header:
+// model, integrator, status, t reached, wall time, steps, events, energy balance, R1-R3,
+// override, each car's crush and CFC-filtered peak accelerations), model.json and
+// timeseries.csv (the animation of the planar model: bodies as the polygons of their
+// connection points, elements as lines coloured by force or by mode), events.csv (the event
+// log, synchronised with the animation), accelerations.csv (filtered here at the class asked,
+// CFC 60 by default) and energy.csv (the energy partition). The page inlines its script and
+// style and the plotting library the build fetched from npm (assets.hpp), so it opens
+// without network access.
+//
+// Plotted bodies: the car bodies (names containing "body"), else every body. Element forces:
+// every element output named force, *_force; the crash elements (anticlimber, crush_spring,
+// draft_gear, coupler_end, couplings) are shown first and get force-deformation loops. Long
+// series are decimated with decimate_minmax (peaks kept), animation frames uniformly.
+//
+// A folder of `railcrash converge`, `sensitivity` or `readings` (converge.csv, sensitivity.csv or
+// readings.csv, no timeseries.csv) gets a page of its Markdown summaries and CSV files as
+// tables, and the convergence chart (converge.svg).
+//
+// Bad folders: a missing folder, or one without timeseries.csv or without a single complete
+// row in it, throws InputError (exit 2). Anything else that is missing or broken (no
+// summary.json, a failed run, a truncated CSV row, no model.json from an older railcrash) is
+// listed as a problem at the top of the page, and the page shows what there is.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace railcrash::report {
+
+struct ReportOptions {
+  double cfc = 60.0;                   // channel frequency class of the accelerations
+  std::size_t max_plot_points = 4000;  // per series
+  std::size_t max_frames = 1000;       // animation frames (fewer for very large models)
+};
+
+struct ReportResult {
+  std::string path;                   // RUN_DIR/report.html
+  std::vector<std::string> problems;  // shown at the top of the page
+  std::size_t rows = 0;               // complete rows of timeseries.csv
+  std::string study;                  // "converge", "sensitivity" or "readings" for a study folder (rows: its files)
+};
+
+ReportResult write_report(const std::string& run_dir, const ReportOptions& options = {});
+
+/// Whether this build inlines a plotting library (npm was available at build time).
+bool have_plotting_library();
+
+}  // namespace railcrash::report

@@ -1,0 +1,45 @@
+// The run folder's files beside timeseries.csv, events.csv and summary.json, written for the
+// report (`railcrash report`) and for users' own post-processing:
+//   DIR/model.json         geometry: units, every body (name, mass, inertia, its connection
+//                          points in its own frame) and every element (name, type, its points
+//                          as {body index or -1 for ground, offset}, its output columns). With the
+//                          body poses of timeseries.csv this places every point at every row.
+//   DIR/accelerations.csv  t, then <body>.ax,<body>.ay,<body>.alpha for every body: the
+//                          accelerations v' of results.hpp, unfiltered, at every output row.
+//   DIR/energy.csv         t, kinetic, elastic, gravity (change from t = 0), external_work,
+//                          dissipated, then dissipated.<element type> for each type present,
+//                          then balance_error = kinetic + elastic + gravity + dissipated -
+//                          (initial kinetic + elastic) - external_work [energy]. The dissipation of
+//                          an element is the work done on it less the change of its stored
+//                          energy; under Euler the penalty joints are one more class, `penalty`.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "railcrash/dae_system.hpp"
+
+namespace railcrash {
+
+/// Writes DIR/model.json (see above). Throws InputError if it cannot be written.
+void write_model_geometry(const DaeSystem& system, const std::string& path);
+
+/// Writes energy.csv one row per sample.
+class EnergyWriter {
+ public:
+  EnergyWriter(const DaeSystem& system, std::FILE* file);
+  void sample(double t, const double* y, const double* quadratures);
+
+ private:
+  const DaeSystem& system_;
+  std::FILE* file_;
+  std::vector<std::string> types_;       // element types, in first-appearance order
+  std::vector<int> type_of_element_;     // index into types_
+  std::vector<double> initial_elastic_;  // per element [energy]
+  double initial_gravity_ = 0.0, initial_total_ = 0.0;
+  bool first_ = true;
+  std::vector<double> dissipated_;       // per type, scratch
+};
+
+}  // namespace railcrash

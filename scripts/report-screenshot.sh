@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Runs the flagship (models/report/final_two_car.yaml) with --report and saves a screenshot of
+# its report, docs/report.png, shown in the README. Needs build/railcrash and chromium.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+build/railcrash run models/report/final_two_car.yaml --out "$out/final_two_car" --report > /dev/null
+chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
+  --window-size=1280,1500 --screenshot="$PWD/docs/report.png" "file://$out/final_two_car/report.html" > /dev/null 2>&1
+echo "docs/report.png: $(stat -c %s docs/report.png) bytes"

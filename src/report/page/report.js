@@ -1,0 +1,601 @@
+// railcrash run report: header, animation of the planar model, event log, plots (uPlot, inlined
+// from npm by the build), force-deformation loops and the energy partition. The data come
+// from the JSON blocks of the page (written by src/report/report.cpp). Every text from the
+// run (names, messages, events) is put in with textContent, never parsed as HTML.
+"use strict";
+(function () {
+  function parseBlock(id, problems) {
+    var text = document.getElementById(id).textContent;
+    try {
+      return JSON.parse(text);
+    } catch (e) {
+      problems.push(id.replace("-json", ".json") + " cannot be read (" + e.message + "): the file is broken or was cut off");
+      return null;
+    }
+  }
+  function el(tag, attributes, text) {
+    var node = document.createElement(tag);
+    for (var k in attributes || {}) node.setAttribute(k, attributes[k]);
+    if (text !== undefined && text !== null) node.textContent = String(text);
+    return node;
+  }
+  function fmt(value, digits) {
+    if (value === null || value === undefined || typeof value !== "number" || !isFinite(value)) return "-";
+    return Number(value.toPrecision(digits || 4)).toString();
+  }
+
+  var problems = [];
+  var data = parseBlock("report-data", problems) || {problems: [], plots: [], loops: [], events: [], frames: null};
+  var summary = parseBlock("summary-json", problems);
+  var model = parseBlock("model-json", problems);
+  problems = (data.problems || []).concat(problems);
+  var check = {errors: window.railcrashErrors, plots: [], frames: null};
+  if (data.study) { studyReport(); return; }
+
+  // ---------------------------------------------------------------- a study folder (converge, sensitivity)
+  function csvRows(text) {  // RFC 4180 fields
+    var rows = [], row = [""], quoted = false;
+    for (var i = 0; i < text.length; ++i) {
+      var c = text[i];
+      if (quoted) {
+        if (c === '"' && text[i + 1] === '"') { row[row.length - 1] += '"'; ++i; }
+        else if (c === '"') quoted = false;
+        else row[row.length - 1] += c;
+      } else if (c === '"') quoted = true;
+      else if (c === ",") row.push("");
+      else if (c === "\n") { rows.push(row); row = [""]; }
+      else if (c !== "\r") row[row.length - 1] += c;
+    }
+    if (row.length > 1 || row[0] !== "") rows.push(row);
+    return rows;
+  }
+  function table(rows) {
+    var t = el("table", {"class": "facts"});
+    rows.forEach(function (cells, k) {
+      var tr = el("tr");
+      cells.forEach(function (cell) { tr.appendChild(el(k === 0 ? "th" : "td", {}, cell)); });
+      t.appendChild(tr);
+    });
+    return t;
+  }
+  function studyReport() {
+    ["animation-section", "plots-section", "loops-section", "energy-section"].forEach(function (id) {
+      document.getElementById(id).hidden = true;
+    });
+    var head = document.getElementById("header");
+    head.textContent = "";
+    head.appendChild(el("h1", {}, "railcrash " + ({converge: "convergence", readings: "reading", sensitivity: "sensitivity"}[data.study] || data.study) +
+                                  " study: " + data.run_dir));
+    var box = el("section");
+    document.body.insertBefore(box, document.getElementById("footer"));
+    var tables = 0;
+    if (data.chart) {
+      box.appendChild(el("h2", {}, "Error against cost"));
+      box.appendChild(el("img", {src: data.chart, alt: "converge.svg"}));
+    }
+    data.files.forEach(function (file) {
+      box.appendChild(el("h2", {}, file.name));
+      if (file.kind === "csv") {
+        box.appendChild(table(csvRows(file.text)));
+        ++tables;
+        return;
+      }
+      // Markdown: its tables as tables, the rest as paragraphs (text, never markup).
+      var lines = file.text.split("\n"), pending = [];
+      function flush() { if (pending.length) { box.appendChild(table(pending)); ++tables; pending = []; } }
+      lines.forEach(function (line) {
+        var trimmed = line.trim();
+        if (trimmed.charAt(0) === "|") {
+          if (/^\|[\s|:-]+\|$/.test(trimmed)) return;  // the separator row
+          pending.push(trimmed.replace(/^\||\|$/g, "").split("|").map(function (c) { return c.trim(); }));
+          return;
+        }
+        flush();
+        if (trimmed) box.appendChild(el("p", {}, trimmed.replace(/^#+\s*/, "")));
+      });
+      flush();
+    });
+    document.getElementById("footer").textContent = "railcrash report of a " + data.study + " folder";
+    var selfCheck = document.getElementById("self-check");
+    selfCheck.textContent = JSON.stringify({errors: window.railcrashErrors, study: data.study, tables: tables, chart: !!data.chart});
+    selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  }
+
+  // ---------------------------------------------------------------- header and problems
+  var units = (summary && summary.units) || {};
+  var lengthUnit = units.length || (model && model.units && model.units.length) || "";
+  var forceUnit = units.force || (model && model.units && model.units.force) || "";
+  var energyUnit = units.energy || (model && model.units && model.units.energy) || "";
+  (function header() {
+    var box = document.getElementById("problems");
+    if (summary && summary.status === "failed" && !problems.some(function (p) { return p.indexOf("The run FAILED") === 0; }))
+      problems.unshift("The run FAILED at t = " + fmt(summary.t_reached) + " s: " + summary.message);
+    problems.forEach(function (p) {
+      var failed = p.indexOf("The run FAILED") === 0 || p.indexOf("no summary.json") === 0;
+      box.appendChild(el("div", {"class": failed ? "problem failed" : "problem"}, p));
+    });
+
+    var head = document.getElementById("header");
+    head.textContent = "";
+    head.appendChild(el("h1", {}, "railcrash run report: " + ((summary && summary.model) || (model && model.name) || data.run_dir || "")));
+    var table = el("table", {"class": "facts"});
+    function row(name, value, cls) {
+      var tr = el("tr");
+      tr.appendChild(el("th", {}, name));
+      var td = el("td", cls ? {"class": cls} : {}, value);
+      tr.appendChild(td);
+      table.appendChild(tr);
+    }
+    row("run folder", data.run_dir);
+    if (summary) {
+      var s = summary.stats || {};
+      row("status", summary.status + (summary.message ? ": " + summary.message : ""), summary.status === "ok" ? "status-ok" : "status-failed");
+      row("integrator", summary.integrator);
+      row("t reached", fmt(summary.t_reached) + " s");
+      row("wall time, steps, events", fmt(s.wall_seconds, 3) + " s, " + s.steps + " steps, " + s.events + " events");
+      var e = summary.energy || {};
+      row("energy balance error", fmt(e.balance_error, 3) + " " + energyUnit + " (" + fmt(100 * (e.relative_balance_error || 0), 3) + " % of the energy turned over)");
+      var r = summary.responses;
+      if (r) {
+        row("R1 (crush), R2 (override), R3", fmt(r.R1) + ", " + fmt(r.R2) + ", " + fmt(r.R3));
+        row("override", r.override ? "YES, at t = " + fmt(r.override_time) + " s" : "no");
+      } else {
+        row("R1-R3", "not computed (the model has no responses section)");
+      }
+      var pa = summary.peak_accelerations || {};
+      var filter = pa.filter || {};
+      var crush = summary.car_crush || {};
+      Object.keys(crush).forEach(function (car) {
+        var parts = ["crush " + fmt(crush[car].max_crush) + " " + lengthUnit + " at t = " + fmt(crush[car].t) + " s"];
+        var bodies = pa.bodies || {};
+        Object.keys(bodies).forEach(function (b) {
+          var inCar = Object.keys(crush).length === 1 || b.indexOf(car + "_") === 0;
+          if (!inCar || b.indexOf("body") < 0) return;
+          var p = bodies[b];
+          var filtered = p.x_cfc ? fmt(p.x_cfc.g, 3) + " g" : "-";
+          var mean = p.collision ? fmt(p.collision.mean_deceleration_g, 3) + " g" : "-";
+          parts.push(b + ": peak x'' " + filtered + " (CFC " + fmt(filter.cfc) + "), mean deceleration " + mean);
+        });
+        row(car, parts.join("; "));
+      });
+    }
+    head.appendChild(table);
+  })();
+
+  // ---------------------------------------------------------------- animation
+  var frames = data.frames;
+  var canvas = document.getElementById("canvas");
+  var ctx = canvas.getContext("2d");
+  var slider = document.getElementById("slider");
+  var timeLabel = document.getElementById("time-label");
+  var frameIndex = 0;
+  var view = null;  // {scale [px/length], x0, y0 (world at canvas centre)}
+  var bodyIndex = {};
+  var hulls = [];
+  var elements = (model && model.elements) || [];
+  var forcePeak = [];
+  var events = data.events || [];
+  var eventsByElement = {};
+  events.forEach(function (ev, k) {
+    (eventsByElement[ev[1]] = eventsByElement[ev[1]] || []).push(k);
+  });
+
+  function hull(points) {  // convex hull (monotone chain) of [[x, y], ...]
+    var p = points.slice().sort(function (a, b) { return a[0] - b[0] || a[1] - b[1]; });
+    if (p.length < 3) return p;
+    function cross(o, a, b) { return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]); }
+    var lower = [], upper = [];
+    p.forEach(function (q) {
+      while (lower.length >= 2 && cross(lower[lower.length - 2], lower[lower.length - 1], q) <= 0) lower.pop();
+      lower.push(q);
+    });
+    for (var i = p.length - 1; i >= 0; --i) {
+      while (upper.length >= 2 && cross(upper[upper.length - 2], upper[upper.length - 1], p[i]) <= 0) upper.pop();
+      upper.push(p[i]);
+    }
+    return lower.slice(0, -1).concat(upper.slice(0, -1));
+  }
+
+  function pose(frame, body) {
+    var k = bodyIndex[body];
+    if (k === undefined) return null;
+    var q = frames.pose[frame];
+    return [q[3 * k], q[3 * k + 1], q[3 * k + 2]];
+  }
+  function place(frame, body, at) {  // global position of a body-fixed point (ground: at is global)
+    if (body < 0) return at;
+    var q = pose(frame, model.bodies[body].name);
+    if (!q) return null;
+    var c = Math.cos(q[2]), s = Math.sin(q[2]);
+    return [q[0] + c * at[0] - s * at[1], q[1] + s * at[0] + c * at[1]];
+  }
+
+  var haveAnimation = frames && frames.t && frames.t.length > 0 && model && model.bodies;
+  if (haveAnimation) {
+    frames.bodies.forEach(function (name, k) { bodyIndex[name] = k; });
+    model.bodies.forEach(function (b) {
+      hulls.push(hull(b.points.concat([[0, 0]])));  // with the centre of mass: no flat outline of collinear points
+    });
+    elements.forEach(function (e, k) {
+      var values = frames.force[k];
+      var peak = 0;
+      if (values) values.forEach(function (v) { if (v !== null && Math.abs(v) > peak) peak = Math.abs(v); });
+      forcePeak.push(peak);
+    });
+    slider.max = String(frames.t.length - 1);
+  } else {
+    ctx.font = "16px sans-serif";
+    ctx.fillText("No animation: the run folder has no model.json (or no rows).", 20, 40);
+  }
+
+  function fitView() {
+    var xmin = Infinity, xmax = -Infinity, ymin = Infinity, ymax = -Infinity;
+    [0, frames.t.length - 1].forEach(function (f) {
+      model.bodies.forEach(function (b, i) {
+        hulls[i].forEach(function (p) {
+          var g = place(f, i, p);
+          if (!g) return;
+          xmin = Math.min(xmin, g[0]); xmax = Math.max(xmax, g[0]);
+          ymin = Math.min(ymin, g[1]); ymax = Math.max(ymax, g[1]);
+        });
+      });
+    });
+    if (!isFinite(xmin)) { xmin = -1; xmax = 1; ymin = -1; ymax = 1; }
+    var w = Math.max(xmax - xmin, 1e-9), h = Math.max(ymax - ymin, 1e-9);
+    var scale = 0.92 * Math.min(canvas.width / w, canvas.height / h);
+    view = {scale: scale, x0: 0.5 * (xmin + xmax), y0: 0.5 * (ymin + ymax)};
+  }
+  function toScreen(p) {
+    return [canvas.width / 2 + (p[0] - view.x0) * view.scale, canvas.height / 2 - (p[1] - view.y0) * view.scale];
+  }
+
+  function modeOf(elementName, t) {  // category from the element's last event up to t
+    var list = eventsByElement[elementName];
+    if (!list) return "none";
+    var text = null;
+    for (var i = 0; i < list.length && events[list[i]][0] <= t + 1e-12; ++i) text = events[list[i]][2].toLowerCase();
+    if (text === null) return "none";
+    if (/fail|ruptur|fractur|shear|broke|overrid/.test(text)) return "failed";
+    if (/plastic|yield|bottom|crush|lock/.test(text)) return "plastic";
+    if (/open|separat|lost|lift|release/.test(text)) return "open";
+    return "elastic";
+  }
+  var modeColours = {none: "#8a8a8a", elastic: "#1f77b4", plastic: "#ff7f0e", failed: "#d62728", open: "#bbbbbb"};
+  function forceColour(fraction) {  // light grey (no force) to dark red (the element's peak)
+    var f = Math.max(0, Math.min(1, fraction));
+    var r = Math.round(200 + 55 * f), g = Math.round(200 * (1 - f)), b = Math.round(200 * (1 - f));
+    return "rgb(" + r + "," + g + "," + b + ")";
+  }
+
+  function draw(f) {
+    if (!haveAnimation) return;
+    if (!view) fitView();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.clearRect(0, 0, canvas.width, canvas.height);
+    // Ground line y = 0.
+    ctx.strokeStyle = "#999";
+    ctx.setLineDash([6, 4]);
+    ctx.beginPath();
+    var g0 = toScreen([view.x0 - 1e12, 0]), g1 = toScreen([view.x0 + 1e12, 0]);
+    ctx.moveTo(0, g0[1]); ctx.lineTo(canvas.width, g1[1]);
+    ctx.stroke();
+    ctx.setLineDash([]);
+    model.bodies.forEach(function (b, i) {
+      var pts = hulls[i].map(function (p) { return place(f, i, p); });
+      if (pts.some(function (p) { return !p; })) return;
+      ctx.beginPath();
+      pts.forEach(function (p, k) { var s = toScreen(p); if (k) ctx.lineTo(s[0], s[1]); else ctx.moveTo(s[0], s[1]); });
+      ctx.closePath();
+      ctx.fillStyle = b.name.indexOf("car2") === 0 ? "rgba(120,160,220,0.35)" : "rgba(150,200,150,0.35)";
+      ctx.fill();
+      ctx.strokeStyle = "#555";
+      ctx.lineWidth = 1;
+      ctx.stroke();
+      var c = toScreen(place(f, i, [0, 0]));
+      ctx.fillStyle = "#333";
+      ctx.fillRect(c[0] - 1.5, c[1] - 1.5, 3, 3);
+    });
+    var byMode = document.getElementById("colour-by").value === "mode";
+    var t = frames.t[f];
+    elements.forEach(function (e, k) {
+      var pts = e.points.map(function (p) { return place(f, p.body, p.at); });
+      if (pts.some(function (p) { return !p; })) return;
+      var colour;
+      if (byMode) {
+        colour = modeColours[modeOf(e.name, t)];
+      } else {
+        var v = frames.force[k] ? frames.force[k][f] : null;
+        colour = v === null || forcePeak[k] === 0 ? "#8a8a8a" : forceColour(Math.abs(v) / forcePeak[k]);
+      }
+      ctx.strokeStyle = colour;
+      ctx.fillStyle = colour;
+      ctx.lineWidth = e.constraint ? 1.5 : 2.5;
+      if (pts.length === 1) {
+        var s = toScreen(pts[0]);
+        ctx.beginPath(); ctx.arc(s[0], s[1], 3, 0, 2 * Math.PI); ctx.fill();
+        return;
+      }
+      ctx.beginPath();
+      pts.forEach(function (p, j) { var s = toScreen(p); if (j) ctx.lineTo(s[0], s[1]); else ctx.moveTo(s[0], s[1]); });
+      ctx.stroke();
+    });
+    ctx.fillStyle = "#222";
+    ctx.font = "14px sans-serif";
+    ctx.fillText("t = " + fmt(t, 5) + " s", 10, 20);
+  }
+
+  var eventRows = [];
+  (function eventLog() {
+    var log = document.getElementById("event-log");
+    events.forEach(function (ev) {
+      var row = el("div", {}, fmt(ev[0], 5) + " s  " + ev[1] + ": " + ev[2]);
+      row.title = ev[1] + ": " + ev[2] + " (value " + fmt(ev[3]) + ")";
+      row.addEventListener("click", function () { setFrame(nearestFrame(ev[0])); });
+      log.appendChild(row);
+      eventRows.push(row);
+    });
+    if (!events.length) log.appendChild(el("div", {}, "no events"));
+  })();
+  function nearestFrame(t) {
+    if (!haveAnimation) return 0;
+    var best = 0;
+    for (var i = 0; i < frames.t.length; ++i) if (Math.abs(frames.t[i] - t) < Math.abs(frames.t[best] - t)) best = i;
+    return best;
+  }
+  var lastCurrent = null;
+  function syncEvents(t) {
+    var current = null;
+    eventRows.forEach(function (row, k) {
+      var past = events[k][0] <= t + 1e-12;
+      row.className = past ? "past" : "future";
+      if (past) current = row;
+    });
+    if (current) {
+      current.className = "current";
+      if (current !== lastCurrent) {
+        var log = document.getElementById("event-log");
+        log.scrollTop = Math.max(0, current.offsetTop - log.offsetTop - 150);
+      }
+    }
+    lastCurrent = current;
+  }
+  var plotsToMark = [];
+  function setFrame(f) {
+    if (!haveAnimation) return;
+    frameIndex = Math.max(0, Math.min(frames.t.length - 1, f));
+    slider.value = String(frameIndex);
+    timeLabel.textContent = "t = " + fmt(frames.t[frameIndex], 5) + " s (" + (frameIndex + 1) + "/" + frames.t.length + ")";
+    draw(frameIndex);
+    syncEvents(frames.t[frameIndex]);
+    plotsToMark.forEach(function (u) { u.redraw(false, false); });
+  }
+
+  var playing = false, lastTime = null, simTime = 0;
+  function step(now) {
+    if (!playing) return;
+    if (lastTime !== null) {
+      simTime += (now - lastTime) / 1000 * Number(document.getElementById("speed").value);
+      var f = frameIndex;
+      while (f + 1 < frames.t.length && frames.t[f + 1] <= simTime) ++f;
+      if (f >= frames.t.length - 1) { setFrame(frames.t.length - 1); togglePlay(); return; }
+      if (f !== frameIndex) setFrame(f);
+    }
+    lastTime = now;
+    requestAnimationFrame(step);
+  }
+  function togglePlay() {
+    playing = !playing && haveAnimation;
+    document.getElementById("play").textContent = playing ? "Pause" : "Play";
+    if (playing) {
+      if (frameIndex >= frames.t.length - 1) frameIndex = 0;
+      simTime = frames.t[frameIndex];
+      lastTime = null;
+      requestAnimationFrame(step);
+    }
+  }
+  document.getElementById("play").addEventListener("click", togglePlay);
+  slider.addEventListener("input", function () { setFrame(Number(slider.value)); });
+  document.getElementById("colour-by").addEventListener("change", function () { draw(frameIndex); legend(); });
+  document.getElementById("reset-view").addEventListener("click", function () { view = null; draw(frameIndex); });
+  canvas.addEventListener("wheel", function (e) {
+    if (!view) return;
+    e.preventDefault();
+    var rect = canvas.getBoundingClientRect();
+    var sx = (e.clientX - rect.left) * canvas.width / rect.width, sy = (e.clientY - rect.top) * canvas.height / rect.height;
+    var wx = view.x0 + (sx - canvas.width / 2) / view.scale, wy = view.y0 - (sy - canvas.height / 2) / view.scale;
+    var factor = e.deltaY < 0 ? 1.2 : 1 / 1.2;
+    view.scale *= factor;
+    view.x0 = wx - (sx - canvas.width / 2) / view.scale;
+    view.y0 = wy + (sy - canvas.height / 2) / view.scale;
+    draw(frameIndex);
+  }, {passive: false});
+  var drag = null;
+  canvas.addEventListener("mousedown", function (e) { drag = [e.clientX, e.clientY]; });
+  window.addEventListener("mouseup", function () { drag = null; });
+  window.addEventListener("mousemove", function (e) {
+    if (!drag || !view) return;
+    view.x0 -= (e.clientX - drag[0]) / view.scale;
+    view.y0 += (e.clientY - drag[1]) / view.scale;
+    drag = [e.clientX, e.clientY];
+    draw(frameIndex);
+  });
+  function legend() {
+    var box = document.getElementById("legend");
+    box.textContent = "";
+    if (document.getElementById("colour-by").value === "mode") {
+      box.appendChild(document.createTextNode("Element colour: mode after its last event:"));
+      Object.keys(modeColours).forEach(function (m) {
+        var sw = el("span", {"class": "swatch"});
+        sw.style.background = modeColours[m];
+        box.appendChild(sw);
+        box.appendChild(document.createTextNode(m === "none" ? "no event yet" : m));
+      });
+    } else {
+      box.appendChild(document.createTextNode("Element colour: |force| / its peak over the run, grey (0) to red (peak); " +
+                                              "thin lines: joints. Bodies: polygons of their connection points. Length unit: " + lengthUnit));
+    }
+  }
+  legend();
+
+  // ---------------------------------------------------------------- plots
+  var haveLibrary = typeof window.uPlot === "function";
+  var palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+  function timeMarker(u) {  // the animation's time as a vertical line
+    if (!haveAnimation) return;
+    var x = u.valToPos(frames.t[frameIndex], "x", true);
+    var c = u.ctx;
+    c.save();
+    c.strokeStyle = "rgba(0,0,0,0.45)";
+    c.setLineDash([4, 3]);
+    c.beginPath();
+    c.moveTo(x, u.bbox.top);
+    c.lineTo(x, u.bbox.top + u.bbox.height);
+    c.stroke();
+    c.restore();
+  }
+  function unitOf(label) {
+    return {length: lengthUnit, "length/time": lengthUnit ? lengthUnit + "/s" : "", force: forceUnit, energy: energyUnit, g: "g"}[label] || label;
+  }
+  function addTimePlot(container, spec, extra) {
+    var box = el("div", {"class": "plot"});
+    container.appendChild(box);
+    var series = [{label: "t [s]"}];
+    var columns = [spec.t];
+    spec.series.forEach(function (s, k) {
+      series.push({label: s.name, show: s.show, stroke: palette[k % palette.length], width: 1.25, spanGaps: false});
+      columns.push(s.values);
+    });
+    var options = {
+      title: spec.title, width: 560, height: 320,
+      scales: {x: {time: false}},
+      axes: [{label: "t [s]"}, {label: unitOf(spec.y_label), size: 70}],
+      series: series,
+      legend: {live: true},
+      cursor: {sync: {key: "railcrash-time"}},
+      hooks: {draw: [timeMarker]}
+    };
+    if (extra) extra(options, columns);
+    var u = new uPlot(options, columns, box);
+    plotsToMark.push(u);
+    var notes = [];
+    if (spec.note) notes.push(spec.note);
+    if (spec.decimated) notes.push("decimated for drawing: every peak kept (min/max per bucket)");
+    if (notes.length) box.appendChild(el("div", {"class": "note"}, notes.join("; ")));
+    var points = 0;
+    columns.slice(1).forEach(function (c) { c.forEach(function (v) { if (v !== null) ++points; }); });
+    check.plots.push({id: spec.id, series: columns.length - 1, points: points, drawn: !!u.ctx});
+    return u;
+  }
+  function noLibrary(container) {
+    container.appendChild(el("p", {"class": "no-library"},
+      "This railcrash was built without its plotting library (npm was not available when it was built), so the plots are " +
+      "left out. Install nodejs and npm (scripts/install-deps.sh), build again and run `railcrash report` on this folder."));
+  }
+
+  var plotsBox = document.getElementById("plots");
+  if (!haveLibrary) noLibrary(plotsBox);
+  else (data.plots || []).forEach(function (spec) {
+    if (!spec.series.length) { plotsBox.appendChild(el("p", {}, spec.title + ": nothing to plot")); return; }
+    addTimePlot(plotsBox, spec);
+  });
+
+  var loopsBox = document.getElementById("loops");
+  if (!haveLibrary) noLibrary(loopsBox);
+  else if (!(data.loops || []).length) loopsBox.appendChild(el("p", {}, "No crush elements, draft gears or anticlimbers in this model."));
+  else data.loops.forEach(function (loop) {
+    var box = el("div", {"class": "plot"});
+    loopsBox.appendChild(box);
+    var u = new uPlot({
+      mode: 2, title: loop.name + " (" + loop.type + ")", width: 420, height: 320,
+      scales: {x: {time: false}},
+      axes: [{label: loop.x_label + " [" + lengthUnit + "]"}, {label: loop.y_label + " [" + forceUnit + "]", size: 70}],
+      series: [{}, {label: loop.name, stroke: "#d62728", width: 1.25, paths: uPlot.paths.linear(), points: {show: false}}],
+      legend: {show: false}
+    }, [null, [loop.x, loop.y]], box);
+    check.plots.push({id: "loop:" + loop.name, series: 1, points: loop.x.length, drawn: !!u.ctx});
+  });
+
+  var energyBox = document.getElementById("energy");
+  if (!haveLibrary) noLibrary(energyBox);
+  else if (!data.energy) energyBox.appendChild(el("p", {}, "No energy.csv in this run folder."));
+  else (function energyPlot() {
+    // Stacked areas: kinetic, elastic, gravity change, dissipated by element type; lines:
+    // initial energy + external work (the top of the stack when the balance closes) and the
+    // balance error on its own axis.
+    var spec = data.energy;
+    var byName = {};
+    spec.series.forEach(function (s) { byName[s.name] = s.values; });
+    var layers = ["kinetic", "elastic", "gravity"];
+    spec.series.forEach(function (s) { if (s.name.indexOf("dissipated.") === 0) layers.push(s.name); });
+    var n = spec.t.length;
+    var total0 = byName.kinetic && byName.elastic ? byName.kinetic[0] + byName.elastic[0] : 0;
+    var stacked = [], sum = new Array(n).fill(0);
+    var available = layers.filter(function (name) {
+      var v = byName[name];
+      return v && v.some(function (x) { return x !== null && Math.abs(x) > 0; });
+    });
+    available.forEach(function (name) {
+      var v = byName[name];
+      sum = sum.map(function (s, k) { return s + (v[k] || 0); });
+      stacked.push(sum.slice());
+    });
+    var supply = byName.external_work ? byName.external_work.map(function (w) { return total0 + (w || 0); }) : null;
+    var columns = [spec.t].concat(stacked);
+    var series = [{label: "t [s]"}];
+    var fills = ["rgba(31,119,180,0.45)", "rgba(44,160,44,0.45)", "rgba(140,86,75,0.35)", "rgba(255,127,14,0.45)",
+                 "rgba(214,39,40,0.4)", "rgba(148,103,189,0.4)", "rgba(227,119,194,0.4)", "rgba(188,189,34,0.4)", "rgba(23,190,207,0.4)"];
+    var bands = [];
+    available.forEach(function (name, k) {
+      series.push({label: name + " (stacked)", stroke: fills[k % fills.length].replace(/0\.\d+\)$/, "1)"), width: 1,
+                   fill: k === 0 ? fills[0] : undefined});
+      if (k > 0) bands.push({series: [k + 1, k], fill: fills[k % fills.length]});
+    });
+    if (supply) { columns.push(supply); series.push({label: "initial + external work", stroke: "#555", width: 1.5, dash: [8, 4]}); }
+    if (byName.balance_error) { columns.push(byName.balance_error); series.push({label: "balance error (right axis)", stroke: "#000", width: 1, dash: [2, 2], scale: "error"}); }
+    var box = el("div", {"class": "plot"});
+    energyBox.appendChild(box);
+    var u = new uPlot({
+      title: "Energy partition [" + energyUnit + "] (stacked areas)", width: 900, height: 380,
+      scales: {x: {time: false}, y: {range: function (u, min, max) { return [Math.min(0, min), max + 0.02 * Math.abs(max - Math.min(0, min))]; }}, error: {}},
+      axes: [{label: "t [s]"}, {label: energyUnit, size: 80}, {scale: "error", side: 1, label: "balance error", size: 80, grid: {show: false}}],
+      series: series, bands: bands, legend: {live: true},
+      cursor: {sync: {key: "railcrash-time"}}, hooks: {draw: [timeMarker]}
+    }, columns, box);
+    plotsToMark.push(u);
+    var points = 0;
+    columns.slice(1).forEach(function (c) { c.forEach(function (v) { if (v !== null) ++points; }); });
+    check.plots.push({id: "energy", series: columns.length - 1, points: points, drawn: !!u.ctx});
+  })();
+
+  document.getElementById("footer").textContent = "railcrash report; plots by " + (data.library || "no plotting library") +
+    " (inlined); accelerations filtered at CFC " + fmt(data.cfc) + " (SAE J211-1 / ISO 6487); " + (data.rows || 0) + " output rows.";
+
+  // ---------------------------------------------------------------- self-check (for the browser test)
+  function canvasDigest() {
+    var pixels = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
+    var hash = 0;
+    for (var i = 0; i < pixels.length; i += 7) hash = (hash * 31 + pixels[i]) % 1000000007;
+    return hash;
+  }
+  if (haveAnimation) {
+    setFrame(0);
+    var first = canvasDigest();
+    setFrame(frames.t.length - 1);
+    var last = canvasDigest();
+    check.frames = {count: frames.t.length, first: first, last: last, differ: first !== last};
+    if (eventRows.length) {  // a click on the last event moves the animation to its time
+      var k = eventRows.length - 1;
+      eventRows[k].click();
+      check.event_jump = {event_t: events[k][0], frame_t: frames.t[frameIndex],
+                          spacing: frames.t.length > 1 ? frames.t[1] - frames.t[0] : 0, current: eventRows[k].className};
+    }
+    setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
+  }
+  var box = document.getElementById("self-check");
+  check.library = haveLibrary;
+  check.problems = problems.length;
+  check.errors = window.railcrashErrors;
+  check.ms = Math.round(performance.now());  // from navigation start to the page drawn, self-check included
+  box.textContent = JSON.stringify(check);
+  box.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+})();

@@ -1,0 +1,566 @@
+// The HTML run report (see the header): reads the run folder, filters and decimates the
+// series, and fills the page template with the data as JSON.
+#include "railcrash/report/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "railcrash/error.hpp"
+#include "railcrash/report/assets.hpp"
+#include "railcrash/report/decimate.hpp"
+#include "railcrash/results.hpp"
+#include "railcrash/results/cfc_filter.hpp"
+
+namespace railcrash::report {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Text with invalid UTF-8 bytes replaced by U+FFFD, so that the page stays valid UTF-8.
+std::string valid_utf8(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    std::size_t length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool ok = length > 0 && i + length <= text.size();
+    for (std::size_t k = 1; ok && k < length; ++k) ok = (static_cast<unsigned char>(text[i + k]) >> 6) == 0x2;
+    if (ok) {
+      out.append(text, i, length);
+      i += length;
+    } else {
+      out += "\xEF\xBF\xBD";
+      ++i;
+    }
+  }
+  return out;
+}
+
+/// Text safe inside <script type="application/json">: no "<" (so no "</script>"), valid UTF-8.
+std::string script_safe(const std::string& json) {
+  std::string out;
+  for (const char c : valid_utf8(json)) {
+    if (c == '<') out += "\\u003c";
+    else out += c;
+  }
+  return out;
+}
+
+std::string js(const std::string& text) { return json_string(valid_utf8(text)); }
+
+std::string number(double value) {
+  if (!std::isfinite(value)) return "null";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+
+std::string numbers(const std::vector<double>& values) {
+  std::string out = "[";
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (k) out += ',';
+    out += number(values[k]);
+  }
+  return out + "]";
+}
+
+std::string read_file(const fs::path& path, bool* found) {
+  std::ifstream in(path, std::ios::binary);
+  *found = static_cast<bool>(in);
+  std::stringstream text;
+  if (in) text << in.rdbuf();
+  return text.str();
+}
+
+/// Fields of one CSV line (RFC 4180 quoting).
+std::vector<std::string> csv_fields(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        fields.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+    } else if (c != '\r') {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+/// A numeric CSV file: header and complete rows; stops at the first broken row.
+struct NumericTable {
+  bool found = false;
+  std::vector<std::string> columns;
+  std::map<std::string, int> index;  // column by name
+  std::vector<std::vector<double>> data;  // per column
+  std::size_t rows = 0;
+};
+
+NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& problems) {
+  NumericTable table;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return table;
+  table.found = true;
+  std::string line;
+  if (!std::getline(in, line)) return table;
+  table.columns = csv_fields(line);
+  for (std::size_t k = 0; k < table.columns.size(); ++k) table.index.emplace(table.columns[k], static_cast<int>(k));
+  table.data.assign(table.columns.size(), {});
+  std::size_t line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    const bool ends_with_newline = !in.eof();  // getline stopped at a newline, not at the end
+    const bool last_line = !ends_with_newline || in.peek() == std::char_traits<char>::eof();
+    std::vector<double> row;
+    std::string reason;
+    const std::vector<std::string> fields = csv_fields(line);
+    if (fields.size() != table.columns.size())
+      reason = std::to_string(fields.size()) + " fields, the header has " + std::to_string(table.columns.size());
+    for (std::size_t k = 0; reason.empty() && k < fields.size(); ++k) {
+      char* end = nullptr;
+      const double value = std::strtod(fields[k].c_str(), &end);
+      if (fields[k].empty() || end == fields[k].c_str() || *end != '\0') reason = "'" + fields[k].substr(0, 20) + "' is not a number";
+      row.push_back(value);
+    }
+    if (reason.empty() && last_line && !ends_with_newline && !line.empty()) reason = "the row has no end of line";
+    if (!reason.empty()) {
+      if (line.empty() && last_line) break;
+      problems.push_back(path.filename().string() + " line " + std::to_string(line_number) + ": " + reason +
+                         (last_line ? " (the file ends mid-row: the run was stopped or is still writing)" : "") +
+                         "; the report uses the " + std::to_string(table.rows) + " complete rows before it");
+      break;
+    }
+    for (std::size_t k = 0; k < row.size(); ++k) table.data[k].push_back(row[k]);
+    ++table.rows;
+  }
+  return table;
+}
+
+int column_of(const NumericTable& table, const std::string& name) {
+  const auto it = table.index.find(name);
+  return it == table.index.end() ? -1 : it->second;
+}
+
+/// Element names and types from model.json (written one element per line by run_files.cpp).
+std::vector<std::pair<std::string, std::string>> element_types(const std::string& model_json) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const std::regex pattern(R"re(\{"name": "((?:[^"\\]|\\.)*)", "type": "([A-Za-z0-9_]+)", "constraint")re");
+  std::stringstream lines(model_json);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch match;
+    if (!std::regex_search(line, match, pattern)) continue;
+    std::string name;  // undo json_string's escapes (names are plain text: model_io checks them)
+    const std::string raw = match[1].str();
+    for (std::size_t i = 0; i < raw.size(); ++i) name += (raw[i] == '\\' && i + 1 < raw.size()) ? raw[++i] : raw[i];
+    out.emplace_back(name, match[2].str());
+  }
+  return out;
+}
+
+double standard_gravity_of(const std::string& model_json, const std::string& summary_json) {
+  const std::regex pattern(R"re("standard_gravity": ([0-9.eE+-]+))re");
+  std::smatch match;
+  if (std::regex_search(model_json, match, pattern) || std::regex_search(summary_json, match, pattern))
+    return std::strtod(match[1].str().c_str(), nullptr);
+  return 0.0;
+}
+
+bool is_crash_type(const std::string& type) {
+  return type == "anticlimber" || type == "crush_spring" || type == "draft_gear" || type == "coupler_end" ||
+         type.find("coupling") != std::string::npos;
+}
+
+struct PlotSeries {
+  std::string name;
+  std::vector<double> values;
+  bool show = true;
+};
+
+std::string plot_json(const std::string& id, const std::string& title, const std::string& y_label, const std::vector<double>& t,
+                      const std::vector<PlotSeries>& series, std::size_t max_points, const std::string& note = "") {
+  std::vector<std::vector<double>> values;
+  for (const PlotSeries& s : series) values.push_back(s.values);
+  const Decimated d = decimate_minmax(t, values, max_points);
+  std::string out = "{\"id\": " + js(id) + ", \"title\": " + js(title) + ", \"y_label\": " + js(y_label) +
+                    ", \"note\": " + js(note) + ", \"decimated\": " + (d.x.size() < t.size() ? "true" : "false") +
+                    ", \"t\": " + numbers(d.x) + ", \"series\": [";
+  for (std::size_t k = 0; k < series.size(); ++k)
+    out += std::string(k ? ", " : "") + "{\"name\": " + js(series[k].name) + ", \"show\": " + (series[k].show ? "true" : "false") +
+           ", \"values\": " + numbers(d.series[k]) + "}";
+  return out + "]}";
+}
+
+std::string joined(const char* const* chunks) {
+  std::string out;
+  for (const char* const* c = chunks; *c; ++c) out += *c;
+  return out;
+}
+
+void replace_all(std::string& text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) text.replace(at, from.size(), to);
+}
+
+/// Replaces the next placeholder `key` after `cursor` by `value` and moves the cursor past it,
+/// so that text inserted earlier is never searched for placeholders.
+void fill(std::string& page, std::size_t& cursor, const std::string& key, const std::string& value) {
+  const std::size_t at = page.find(key, cursor);
+  if (at == std::string::npos) throw std::logic_error("report template lacks " + key);
+  page.replace(at, key.size(), value);
+  cursor = at + value.size();
+}
+
+std::string base64(const std::string& bytes) {
+  static const char* const kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const unsigned a = static_cast<unsigned char>(bytes[i]);
+    const unsigned b = i + 1 < bytes.size() ? static_cast<unsigned char>(bytes[i + 1]) : 0u;
+    const unsigned c = i + 2 < bytes.size() ? static_cast<unsigned char>(bytes[i + 2]) : 0u;
+    const unsigned triple = (a << 16) | (b << 8) | c;
+    out += kDigits[(triple >> 18) & 63];
+    out += kDigits[(triple >> 12) & 63];
+    out += i + 1 < bytes.size() ? kDigits[(triple >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kDigits[triple & 63] : '=';
+  }
+  return out;
+}
+
+std::string html_text(const std::string& text) {
+  std::string out;
+  for (char c : valid_utf8(text)) {
+    if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '&') out += "&amp;";
+    else out += c;
+  }
+  return out;
+}
+
+/// Writes DIR/report.html: the template filled with the title, the JSON blocks (summary.json,
+/// model.json and the report's data, made safe for a script element) and the inlined script,
+/// style and library. Placeholders are filled in page order, each once, so that nothing
+/// inserted is searched again. Returns the path.
+std::string write_page(const fs::path& dir, const std::string& title, const std::string& summary, const std::string& model,
+                       const std::string& data) {
+  std::string page = joined(assets::kTemplate);
+  std::string library = joined(assets::kLibraryScript);
+  replace_all(library, "</script", "<\\/script");
+  std::string script = joined(assets::kScript);
+  replace_all(script, "</script", "<\\/script");
+  std::size_t cursor = 0;
+  fill(page, cursor, "{{TITLE}}", html_text(title));
+  fill(page, cursor, "{{LIBRARY_STYLE}}", joined(assets::kLibraryStyle));
+  fill(page, cursor, "{{STYLE}}", joined(assets::kStyle));
+  fill(page, cursor, "{{SUMMARY}}", script_safe(summary));
+  fill(page, cursor, "{{MODEL}}", script_safe(model));
+  fill(page, cursor, "{{DATA}}", script_safe(data));
+  fill(page, cursor, "{{LIBRARY_SCRIPT}}", library);
+  fill(page, cursor, "{{SCRIPT}}", script);
+  const std::string path = (dir / "report.html").string();
+  std::ofstream out(path, std::ios::binary);
+  out << page;
+  if (!out) throw InputError("cannot write " + path);
+  return path;
+}
+
+/// Files of a `converge` or `sensitivity` folder, in the order shown.
+const char* const kStudyFiles[] = {"converge.md", "converge.csv", "readings.md", "readings.csv", "sensitivity.md", "comparison.md",
+                                   "sensitivity.csv", "sensitivity_first_order.csv", "sensitivity_second_order.csv",
+                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv"};
+
+/// A report of a study folder: its Markdown summary, its tables and its chart.
+ReportResult write_study_report(const fs::path& dir) {
+  ReportResult result;
+  const bool converge = fs::exists(dir / "converge.csv") || fs::exists(dir / "converge.md");
+  result.study = converge ? "converge" : fs::exists(dir / "readings.csv") ? "readings" : "sensitivity";
+  std::string files = "[";
+  for (const char* name : kStudyFiles) {
+    bool found = false;
+    const std::string text = read_file(dir / name, &found);
+    if (!found) continue;
+    const bool markdown = std::string(name).size() > 3 && std::string(name).substr(std::string(name).size() - 3) == ".md";
+    files += std::string(files.size() > 1 ? ",\n" : "") + "{\"name\": " + js(name) + ", \"kind\": " + js(markdown ? "markdown" : "csv") +
+             ", \"text\": " + js(text) + "}";
+    ++result.rows;
+  }
+  files += "]";
+  bool svg_found = false;
+  const std::string svg = read_file(dir / "converge.svg", &svg_found);
+  const std::string data = "{\"study\": " + js(result.study) + ", \"run_dir\": " +
+                           js(fs::absolute(dir).lexically_normal().string()) + ", \"problems\": [], \"files\": " + files +
+                           ", \"chart\": " + (svg_found ? js("data:image/svg+xml;base64," + base64(svg)) : std::string("null")) + "}";
+  result.path = write_page(dir, "railcrash " + result.study + " study: " + dir.filename().string(), "null", "null", data);
+  return result;
+}
+
+}  // namespace
+
+bool have_plotting_library() { return assets::kHaveLibrary; }
+
+ReportResult write_report(const std::string& run_dir, const ReportOptions& options) {
+  const fs::path dir(run_dir);
+  std::error_code error;
+  if (!fs::is_directory(dir, error))
+    throw InputError("run folder '" + run_dir + "' does not exist; give the --out folder of a `railcrash run`");
+  ReportResult result;
+  std::vector<std::string>& problems = result.problems;
+  const NumericTable series = read_numeric_csv(dir / "timeseries.csv", problems);
+  if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv") || fs::exists(dir / "readings.csv")))
+    return write_study_report(dir);
+  if (!series.found)
+    throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (write one with `railcrash run MODEL --out " +
+                     run_dir + "`)");
+  if (series.rows == 0 || series.columns.empty() || series.columns[0] != "t")
+    throw InputError("'" + run_dir + "/timeseries.csv' has no complete row of results" +
+                     (problems.empty() ? std::string() : " (" + problems.front() + ")") + ": nothing to report");
+  result.rows = series.rows;
+
+  bool found = false, summary_found = false;
+  const std::string summary = read_file(dir / "summary.json", &summary_found);
+  if (!summary_found) problems.insert(problems.begin(), "no summary.json: the run did not finish (it was killed, crashed or is still running); "
+                                                "the report shows the rows written so far");
+  {  // A failed run says so first.
+    std::smatch status, message, reached;
+    if (std::regex_search(summary, status, std::regex(R"re("status": "failed")re"))) {
+      std::regex_search(summary, message, std::regex(R"re("message": "((?:[^"\\]|\\.)*)")re"));
+      std::regex_search(summary, reached, std::regex(R"re("t_reached": ([0-9.eE+-]+))re"));
+      std::string text = message.empty() ? std::string() : message[1].str();
+      replace_all(text, "\\\"", "\"");
+      problems.insert(problems.begin(), "The run FAILED" + (reached.empty() ? std::string() : " at t = " + reached[1].str() + " s") +
+                                            ": " + text + "; the report shows the results up to then");
+    }
+  }
+  const std::string model_json = read_file(dir / "model.json", &found);
+  if (!found) problems.push_back("no model.json (written by `railcrash run` since the report came in): no animation; run the model again");
+  const auto types = element_types(model_json);
+  const double g = standard_gravity_of(model_json, summary);
+
+  // Bodies: groups of six columns <body>.x ... <body>.omega after t.
+  std::vector<std::string> bodies;
+  std::size_t column = 1;
+  static const char* const kBodyQuantities[] = {".x", ".y", ".theta", ".vx", ".vy", ".omega"};
+  const auto ends_with = [](const std::string& text, const std::string& tail) {
+    return text.size() > tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  while (column + 5 < series.columns.size() && ends_with(series.columns[column], ".x")) {
+    const std::string name = series.columns[column].substr(0, series.columns[column].size() - 2);
+    bool all = true;
+    for (int k = 0; k < 6; ++k) all = all && series.columns[column + static_cast<std::size_t>(k)] == name + kBodyQuantities[k];
+    if (!all) break;
+    bodies.push_back(name);
+    column += 6;
+  }
+  const std::size_t first_output_column = column;
+  const std::vector<double>& t = series.data[0];
+
+  // Plotted bodies: car bodies, else all.
+  std::vector<std::size_t> plotted;
+  for (std::size_t b = 0; b < bodies.size(); ++b)
+    if (bodies[b].find("body") != std::string::npos) plotted.push_back(b);
+  if (plotted.empty())
+    for (std::size_t b = 0; b < bodies.size(); ++b) plotted.push_back(b);
+  std::string body_note;
+  if (plotted.size() > 60) {
+    body_note = "the first 60 of " + std::to_string(plotted.size()) + " bodies";
+    plotted.resize(60);
+  }
+
+  std::vector<std::string> plots;
+  {
+    std::vector<PlotSeries> x, v;
+    for (std::size_t b : plotted) {
+      const std::vector<double>& position = series.data[1 + 6 * b];
+      std::vector<double> displacement(position.size());
+      for (std::size_t k = 0; k < position.size(); ++k) displacement[k] = position[k] - position[0];
+      x.push_back({bodies[b], displacement, true});
+      v.push_back({bodies[b], series.data[1 + 6 * b + 3], true});
+    }
+    plots.push_back(plot_json("displacement", "Longitudinal displacement x(t) - x(0)", "length", t, x, options.max_plot_points, body_note));
+    plots.push_back(plot_json("velocity", "Longitudinal velocity", "length/time", t, v, options.max_plot_points, body_note));
+  }
+
+  // Accelerations, filtered.
+  const NumericTable accelerations = read_numeric_csv(dir / "accelerations.csv", problems);
+  if (!accelerations.found) problems.push_back("no accelerations.csv (older run folder): no acceleration plots");
+  if (accelerations.found && accelerations.rows >= 3) {
+    const std::vector<double>& ta = accelerations.data[0];
+    const double interval = cfc::typical_interval(ta);
+    const bool can_filter = interval > 0.0 && cfc::design_frequency(options.cfc) * interval < 0.5;
+    if (!can_filter)
+      problems.push_back("the output interval " + number(interval) + " s is too long for CFC " + number(options.cfc) +
+                         ": the acceleration plots are unfiltered (run with --output-interval below " +
+                         number(0.1 / options.cfc) + " s)");
+    else if (!cfc::adequately_sampled(options.cfc, interval))
+      problems.push_back("the sample rate " + number(1.0 / interval) + " Hz is below 10 x CFC: filtered accelerations are rough");
+    std::vector<double> uniform_t;
+    if (can_filter) {
+      const std::vector<double> index(ta.begin(), ta.end());
+      uniform_t = cfc::resample_uniform(ta, index, interval);
+    } else {
+      uniform_t = ta;
+    }
+    const double scale = g > 0.0 ? 1.0 / g : 1.0;
+    for (const char* axis : {"ax", "ay"}) {
+      std::vector<PlotSeries> list;
+      for (std::size_t b : plotted) {
+        const int c = column_of(accelerations, bodies[b] + "." + axis);
+        if (c < 0) continue;
+        std::vector<double> a = accelerations.data[static_cast<std::size_t>(c)];
+        if (can_filter) a = cfc::filter(cfc::resample_uniform(ta, a, interval), interval, options.cfc);
+        for (double& value : a) value *= scale;
+        list.push_back({bodies[b], a, true});
+      }
+      const std::string what = std::string(axis) == "ax" ? "Longitudinal" : "Vertical";
+      const std::string filter_name = can_filter ? "CFC " + number(options.cfc) : "unfiltered";
+      plots.push_back(plot_json(std::string("acceleration_") + axis, what + " acceleration (" + filter_name + ")",
+                                g > 0.0 ? "g" : "length/time^2", uniform_t, list, options.max_plot_points, body_note));
+    }
+  }
+
+  // Element forces and force-deformation loops.
+  std::map<std::string, std::string> type_of(types.begin(), types.end());
+  std::vector<PlotSeries> forces;
+  std::vector<std::string> loops;
+  std::vector<std::string> element_force_column;  // per element of model.json: its force column
+  static const char* const kForceNames[] = {"horizontal_force", "force", "normal_force"};
+  static const char* const kDeformationNames[] = {"horizontal_deformation", "compression", "deformation", "deflection", "crush", "stretch"};
+  std::vector<std::string> crash_first, others;
+  for (const auto& [name, type] : types) (is_crash_type(type) ? crash_first : others).push_back(name);
+  for (const auto* group : {&crash_first, &others})
+    for (const std::string& name : *group) {
+      int force = -1, deformation = -1;
+      for (const char* f : kForceNames)
+        if (force < 0) force = column_of(series, name + "." + f);
+      for (const char* d : kDeformationNames)
+        if (deformation < 0) deformation = column_of(series, name + "." + d);
+      if (force < 0) continue;
+      const bool crash = group == &crash_first;
+      forces.push_back({name, series.data[static_cast<std::size_t>(force)], crash});
+      if (crash && deformation >= 0 && loops.size() < 40) {
+        const std::vector<double>& a = series.data[static_cast<std::size_t>(deformation)];
+        const std::vector<double>& b = series.data[static_cast<std::size_t>(force)];
+        std::vector<double> da, db;
+        for (std::size_t k : decimate_path(a, b, options.max_plot_points)) {
+          da.push_back(a[k]);
+          db.push_back(b[k]);
+        }
+        loops.push_back("{\"name\": " + js(name) + ", \"type\": " + js(type_of[name]) + ", \"x_label\": " +
+                        js(series.columns[static_cast<std::size_t>(deformation)]) + ", \"y_label\": " +
+                        js(series.columns[static_cast<std::size_t>(force)]) + ", \"x\": " + numbers(da) + ", \"y\": " + numbers(db) + "}");
+      }
+    }
+  if (types.empty())  // no model.json: every force column, shown
+    for (std::size_t c = first_output_column; c < series.columns.size(); ++c)
+      if (ends_with(series.columns[c], ".force") || ends_with(series.columns[c], "_force"))
+        forces.push_back({series.columns[c], series.data[c], true});
+  if (forces.size() > 200) forces.resize(200);
+  plots.push_back(plot_json("forces", "Element forces (crash elements shown; click a name to show others)", "force", t, forces,
+                            options.max_plot_points));
+
+  // Energy partition.
+  const NumericTable energy = read_numeric_csv(dir / "energy.csv", problems);
+  std::string energy_json = "null";
+  if (energy.found && energy.rows > 0) {
+    std::vector<PlotSeries> list;
+    for (std::size_t c = 1; c < energy.columns.size(); ++c) list.push_back({energy.columns[c], energy.data[c], true});
+    energy_json = plot_json("energy", "Energy partition", "energy", energy.data[0], list, options.max_plot_points);
+  } else if (!energy.found) {
+    problems.push_back("no energy.csv (older run folder): no energy plot");
+  }
+
+  // Animation frames: uniform stride, bounded total size.
+  const std::size_t per_frame = 3 * bodies.size() + types.size() + 1;
+  const std::size_t frame_budget = std::max<std::size_t>(50, 3000000 / std::max<std::size_t>(per_frame, 1));
+  const std::size_t frame_count = std::min({series.rows, options.max_frames, frame_budget});
+  std::vector<std::size_t> frame_rows;
+  for (std::size_t f = 0; f < frame_count; ++f)
+    frame_rows.push_back(frame_count > 1 ? f * (series.rows - 1) / (frame_count - 1) : 0);
+  std::string frames = "{\"t\": [";
+  for (std::size_t f = 0; f < frame_rows.size(); ++f) frames += (f ? "," : "") + number(t[frame_rows[f]]);
+  frames += "], \"bodies\": " + [&] {
+    std::string out = "[";
+    for (std::size_t b = 0; b < bodies.size(); ++b) out += (b ? ", " : "") + js(bodies[b]);
+    return out + "]";
+  }() + ", \"pose\": [";
+  for (std::size_t f = 0; f < frame_rows.size(); ++f) {
+    frames += f ? ",[" : "[";
+    for (std::size_t b = 0; b < bodies.size(); ++b)
+      for (int k = 0; k < 3; ++k)
+        frames += (b || k ? "," : "") + number(series.data[1 + 6 * b + static_cast<std::size_t>(k)][frame_rows[f]]);
+    frames += "]";
+  }
+  frames += "], \"force\": [";
+  for (std::size_t e = 0; e < types.size(); ++e) {
+    int force = -1;
+    for (const char* f : kForceNames)
+      if (force < 0) force = column_of(series, types[e].first + "." + f);
+    if (force < 0) {
+      frames += e ? ",null" : "null";
+      continue;
+    }
+    std::vector<double> values;
+    for (std::size_t row : frame_rows) values.push_back(series.data[static_cast<std::size_t>(force)][row]);
+    frames += (e ? "," : "") + numbers(values);
+  }
+  frames += "]}";
+
+  // Events.
+  std::string events = "[";
+  {
+    std::ifstream in(dir / "events.csv", std::ios::binary);
+    if (!in) problems.push_back("no events.csv");
+    std::string line;
+    std::getline(in, line);
+    std::size_t count = 0;
+    while (std::getline(in, line) && count < 20000) {
+      const std::vector<std::string> f = csv_fields(line);
+      if (f.size() != 4) continue;
+      events += std::string(count++ ? ",\n" : "") + "[" + number(std::strtod(f[0].c_str(), nullptr)) + "," + js(f[1]) + "," +
+                js(f[2]) + "," + number(std::strtod(f[3].c_str(), nullptr)) + "]";
+    }
+  }
+  events += "]";
+
+  std::string problems_json = "[";
+  for (std::size_t k = 0; k < problems.size(); ++k) problems_json += (k ? ", " : "") + js(problems[k]);
+  problems_json += "]";
+  std::string plots_json = "[";
+  for (std::size_t k = 0; k < plots.size(); ++k) plots_json += (k ? ",\n" : "") + plots[k];
+  plots_json += "]";
+  std::string loops_json = "[";
+  for (std::size_t k = 0; k < loops.size(); ++k) loops_json += (k ? ",\n" : "") + loops[k];
+  loops_json += "]";
+
+  const std::string data = "{\"run_dir\": " + js(fs::absolute(dir).lexically_normal().string()) + ", \"problems\": " + problems_json +
+                           ", \"cfc\": " + number(options.cfc) + ", \"standard_gravity\": " + number(g) +
+                           ", \"rows\": " + std::to_string(series.rows) + ", \"library\": " + js(assets::kLibraryName) +
+                           ",\n\"frames\": " + frames + ",\n\"plots\": " + plots_json + ",\n\"loops\": " + loops_json +
+                           ",\n\"energy\": " + energy_json + ",\n\"events\": " + events + "}";
+
+  result.path = write_page(dir, "railcrash report: " + dir.filename().string(), summary.empty() ? "null" : summary,
+                           model_json.empty() ? "null" : model_json, data);
+  return result;
+}
+
+}  // namespace railcrash::report

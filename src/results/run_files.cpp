@@ -1,0 +1,103 @@
+// model.json and energy.csv of a run folder (see the header).
+#include "railcrash/results/run_files.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "railcrash/results.hpp"
+
+namespace railcrash {
+
+void write_model_geometry(const DaeSystem& system, const std::string& path) {
+  const Model& model = system.model();
+  const bool si = model.units == UnitSystem::SI;
+  // Connection points of each body, without repeats.
+  std::vector<std::vector<std::array<double, 2>>> points(static_cast<std::size_t>(model.body_count()));
+  for (const auto& e : model.elements())
+    for (const PointRef& p : e->points()) {
+      if (p.body == kGround) continue;
+      auto& list = points[static_cast<std::size_t>(p.body)];
+      const std::array<double, 2> at{p.sx, p.sy};
+      if (std::find(list.begin(), list.end(), at) == list.end()) list.push_back(at);
+    }
+  std::ostringstream j;
+  j << "{\n  \"format\": 1,\n  \"name\": " << json_string(model.name) << ",\n  \"units\": {\"length\": "
+    << json_string(si ? "m" : "in") << ", \"force\": " << json_string(si ? "N" : "lbf") << ", \"mass\": "
+    << json_string(si ? "kg" : "lbf*s^2/in") << ", \"energy\": " << json_string(si ? "J" : "in*lbf")
+    << ", \"standard_gravity\": " << json_number(standard_gravity(model)) << "},\n  \"bodies\": [";
+  for (int i = 0; i < model.body_count(); ++i) {
+    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
+    j << (i ? "," : "") << "\n    {\"name\": " << json_string(b.name) << ", \"mass\": " << json_number(b.mass)
+      << ", \"inertia\": " << json_number(b.inertia) << ", \"points\": [";
+    const auto& list = points[static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < list.size(); ++k)
+      j << (k ? ", " : "") << "[" << json_number(list[k][0]) << ", " << json_number(list[k][1]) << "]";
+    j << "]}";
+  }
+  j << "\n  ],\n  \"elements\": [";
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const Element& el = *model.elements()[e];
+    j << (e ? "," : "") << "\n    {\"name\": " << json_string(el.name()) << ", \"type\": " << json_string(el.type())
+      << ", \"constraint\": " << (el.constraint_count() > 0 ? "true" : "false") << ", \"points\": [";
+    for (std::size_t k = 0; k < el.points().size(); ++k) {
+      const PointRef& p = el.points()[k];
+      j << (k ? ", " : "") << "{\"body\": " << p.body << ", \"at\": [" << json_number(p.sx) << ", " << json_number(p.sy) << "]}";
+    }
+    j << "], \"outputs\": [";
+    const auto names = el.output_names();
+    for (std::size_t k = 0; k < names.size(); ++k) j << (k ? ", " : "") << json_string(names[k]);
+    j << "]}";
+  }
+  j << "\n  ]\n}\n";
+  std::ofstream out(path);
+  out << j.str();
+  if (!out) throw InputError("cannot write " + path);
+}
+
+EnergyWriter::EnergyWriter(const DaeSystem& system, std::FILE* file) : system_(system), file_(file) {
+  const Model& model = system.model();
+  for (const auto& e : model.elements()) {
+    auto it = std::find(types_.begin(), types_.end(), e->type());
+    if (it == types_.end()) it = types_.insert(types_.end(), e->type());
+    type_of_element_.push_back(static_cast<int>(it - types_.begin()));
+  }
+  if (model.constraint_rows() > 0) types_.push_back("penalty");  // Euler's penalty joints (zero under IDA)
+  dissipated_.assign(types_.size(), 0.0);
+  std::fputs("t,kinetic,elastic,gravity,external_work,dissipated", file_);
+  for (const std::string& type : types_) std::fprintf(file_, ",dissipated.%s", type.c_str());
+  std::fputs(",balance_error\n", file_);
+}
+
+void EnergyWriter::sample(double t, const double* y, const double* quadratures) {
+  const Model& model = system_.model();
+  const int nq = system_.body_unknowns();
+  const EnergyState state = system_.energy(y, quadratures);
+  std::fill(dissipated_.begin(), dissipated_.end(), 0.0);
+  if (first_) initial_elastic_.assign(model.elements().size(), 0.0);
+  double elastic = 0.0;
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const Element& el = *model.elements()[e];
+    const double stored = el.potential_energy(gather_state(el, y, y + nq));
+    if (first_) initial_elastic_[e] = stored;
+    elastic += stored;
+    const double work = quadratures ? quadratures[DaeSystem::kFirstElementWork + static_cast<int>(e)] : 0.0;
+    dissipated_[static_cast<std::size_t>(type_of_element_[e])] += work - (stored - initial_elastic_[e]);
+  }
+  if (model.constraint_rows() > 0 && quadratures) dissipated_.back() += quadratures[DaeSystem::kPenaltyWork];
+  if (first_) {
+    initial_gravity_ = state.gravity;
+    initial_total_ = state.kinetic + elastic;
+    first_ = false;
+  }
+  double dissipated = 0.0;
+  for (double d : dissipated_) dissipated += d;
+  const double gravity = state.gravity - initial_gravity_;
+  const double balance = state.kinetic + elastic + gravity + dissipated - initial_total_ - state.load_work;
+  std::fprintf(file_, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", t, state.kinetic, elastic, gravity, state.load_work, dissipated);
+  for (double d : dissipated_) std::fprintf(file_, ",%.12g", d);
+  std::fprintf(file_, ",%.12g\n", balance);
+}
+
+}  // namespace railcrash

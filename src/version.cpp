@@ -1,0 +1,29 @@
+// Versions from the libraries' own headers at build time.
+#include "railcrash/version.hpp"
+
+#include <klu.h>
+#include <sundials/sundials_config.h>
+
+#include <Eigen/Core>
+
+#include "railcrash/report/assets.hpp"
+
+#ifndef RAILCRASH_VERSION
+#define RAILCRASH_VERSION "unknown"
+#endif
+
+namespace railcrash {
+
+std::string version_text() {
+  const auto number = [](int value) { return std::to_string(value); };
+  std::string text = "railcrash " RAILCRASH_VERSION "\n";
+  text += "SUNDIALS " SUNDIALS_VERSION " (IDAS)\n";
+  text += "SuiteSparse " + number(SUITESPARSE_MAIN_VERSION) + "." + number(SUITESPARSE_SUB_VERSION) + "." +
+          number(SUITESPARSE_SUBSUB_VERSION) + " (KLU " + number(KLU_MAIN_VERSION) + "." + number(KLU_SUB_VERSION) + "." +
+          number(KLU_SUBSUB_VERSION) + ")\n";
+  text += "Eigen " + number(EIGEN_WORLD_VERSION) + "." + number(EIGEN_MAJOR_VERSION) + "." + number(EIGEN_MINOR_VERSION) + "\n";
+  text += std::string("report plots: ") + (report::assets::kHaveLibrary ? report::assets::kLibraryName : "none (built without npm)");
+  return text;
+}
+
+}  // namespace railcrash

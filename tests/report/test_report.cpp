@@ -1,0 +1,196 @@
+// The run report: min/max decimation, and what `railcrash report` does with good and bad run
+// folders (the page itself is checked in a browser by test_report_browser.sh).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/report/decimate.hpp"
+#include "railcrash/report/report.hpp"
+#include "railcrash/run.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// A fresh run folder of the small two-car crash (tests/report/two_car.yaml).
+fs::path small_run(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const railcrash::Model model = railcrash::load_model(std::string(RAILCRASH_SOURCE_DIR) + "/tests/report/two_car.yaml");
+  const railcrash::RunReport run = railcrash::run_model(model, dir.string());
+  REQUIRE(run.outcome.ok);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("Min/max decimation keeps every peak and at most the points asked for", "[report]") {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const std::size_t n = 100003;
+  std::vector<double> t(n), a(n), b(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    t[k] = 1e-5 * static_cast<double>(k);
+    a[k] = std::sin(40.0 * t[k]) + 0.1 * noise(rng);
+    b[k] = 0.0;
+  }
+  a[12345] = 50.0;   // one-sample spikes
+  a[99999] = -70.0;
+  b[500] = 3.0;
+  const railcrash::report::Decimated d = railcrash::report::decimate_minmax(t, {a, b}, 4000);
+  REQUIRE(d.x.size() <= 4000);
+  REQUIRE(d.series.size() == 2);
+  REQUIRE(d.series[0].size() == d.x.size());
+  CHECK(*std::max_element(d.series[0].begin(), d.series[0].end()) == 50.0);
+  CHECK(*std::min_element(d.series[0].begin(), d.series[0].end()) == -70.0);
+  CHECK(*std::max_element(d.series[1].begin(), d.series[1].end()) == 3.0);
+  CHECK(std::is_sorted(d.x.begin(), d.x.end()));
+  // The spike's time moves by at most one bucket.
+  const auto spike = std::max_element(d.series[0].begin(), d.series[0].end()) - d.series[0].begin();
+  CHECK(std::abs(d.x[static_cast<std::size_t>(spike)] - t[12345]) <= 2.0 * (t.back() - t.front()) / 2000.0);
+  // Short series are unchanged.
+  const railcrash::report::Decimated same = railcrash::report::decimate_minmax({0, 1, 2}, {{5, -1, 4}}, 4000);
+  CHECK(same.x == std::vector<double>{0, 1, 2});
+  CHECK(same.series[0] == std::vector<double>{5, -1, 4});
+  // Loops: the extremes of both coordinates are kept.
+  const std::vector<std::size_t> keep = railcrash::report::decimate_path(a, t, 1000);
+  CHECK(keep.size() <= 1001);
+  CHECK(std::find(keep.begin(), keep.end(), 12345u) != keep.end());
+  CHECK(std::find(keep.begin(), keep.end(), 99999u) != keep.end());
+  CHECK(std::is_sorted(keep.begin(), keep.end()));
+}
+
+TEST_CASE("Run folders hold model geometry, accelerations, energy and filtered peaks", "[report]") {
+  const fs::path dir = small_run("files");
+  const std::string model = slurp(dir / "model.json"), summary = slurp(dir / "summary.json");
+  CHECK_THAT(model, Catch::Contains("\"name\": \"car1_body\", \"mass\": 5000") && Catch::Contains("\"type\": \"anticlimber\""));
+  // The model name's markup and quotes are escaped as JSON, not left raw.
+  CHECK_THAT(summary, Catch::Contains(R"(two cars <script>document.title=\"injected\"</script> & \"quotes\", commas)"));
+  CHECK_THAT(summary, Catch::Contains("\"x_cfc\"") && Catch::Contains("\"collision\"") && Catch::Contains("\"cfc\": 60"));
+  std::ifstream energy(dir / "energy.csv");
+  std::string header, row, last;
+  std::getline(energy, header);
+  CHECK(header.rfind("t,kinetic,elastic,gravity,external_work,dissipated,dissipated.anticlimber", 0) == 0);
+  while (std::getline(energy, row)) last = row;
+  // The balance closes: the last column, relative to the initial kinetic energy (0.5 (500 + 5000) 25).
+  const double balance = std::stod(last.substr(last.rfind(',') + 1));
+  CHECK(std::abs(balance) < 1e-5 * 0.5 * 5500.0 * 25.0);
+  std::ifstream accelerations(dir / "accelerations.csv");
+  std::getline(accelerations, header);
+  CHECK(header == "t,car1_end.ax,car1_end.ay,car1_end.alpha,car1_body.ax,car1_body.ay,car1_body.alpha,car2_end.ax,car2_end.ay,"
+                  "car2_end.alpha,car2_body.ax,car2_body.ay,car2_body.alpha");
+}
+
+TEST_CASE("The mean deceleration of a car body equals its momentum change over the collision", "[report]") {
+  // Car 2 (5500 kg) gains what car 1 loses; its car body's mean deceleration is its velocity
+  // change over the collision's duration, both from the velocity samples.
+  const fs::path dir = small_run("pulse");
+  const std::string summary = slurp(dir / "summary.json");
+  const auto number_after = [&](const std::string& body, const std::string& key) {
+    const std::size_t at = summary.find(key, summary.find("\"" + body + "\": {\"x\""));
+    return std::stod(summary.substr(at + key.size()));
+  };
+  const double dv = number_after("car2_body", "\"velocity_change\": ");
+  const double t0 = number_after("car2_body", "\"t_start\": "), t1 = number_after("car2_body", "\"t_end\": ");
+  const double mean = number_after("car2_body", "\"mean_deceleration\": ");
+  CHECK(mean == Approx(std::abs(dv) / (t1 - t0)).epsilon(1e-9));
+  // Elastic-plastic crush: car 2 ends faster than the 2.5 m/s common speed, below 5 m/s.
+  CHECK(dv > 2.5);
+  CHECK(dv < 5.0);
+  CHECK(t0 < 0.02);  // contact at 8 ms (gap 0.04 m at 5 m/s); the car body follows through its springs
+}
+
+TEST_CASE("railcrash report: a good run, a truncated one, one without summary, and folders that are not runs", "[report]") {
+  using railcrash::report::write_report;
+  const fs::path dir = small_run("bad");
+  railcrash::report::ReportResult good = write_report(dir.string());
+  CHECK(good.problems.empty());
+  CHECK(good.rows == 1501);
+  const std::string page = slurp(good.path);
+  CHECK(page.size() > 20000);
+  CHECK_THAT(page, !Catch::Contains("<script>document.title"));  // the model's name never appears as markup
+  CHECK_THAT(page, Catch::Contains("\\u003cscript>document.title"));
+  CHECK_THAT(page, !Catch::Contains("src=\"http") && !Catch::Contains("<link"));  // nothing fetched
+  CHECK((page.find("uPlot") != std::string::npos) == railcrash::report::have_plotting_library());
+
+  // A failed run: the failure comes first.
+  {
+    std::string summary = slurp(dir / "summary.json");
+    summary.replace(summary.find("\"status\": \"ok\""), 14, "\"status\": \"failed\"");
+    summary.replace(summary.find("\"message\": \"\""), 13, "\"message\": \"IDA: error test failed \\\"repeatedly\\\"\"");
+    std::ofstream(dir / "summary.json", std::ios::trunc) << summary;
+    const railcrash::report::ReportResult failed = write_report(dir.string());
+    REQUIRE_FALSE(failed.problems.empty());
+    CHECK(failed.problems[0] == "The run FAILED at t = 0.3 s: IDA: error test failed \"repeatedly\"; the report shows the results up to then");
+  }
+
+  // Cut timeseries.csv in the middle of a row and remove the summary: a run killed half-way.
+  const std::string series = slurp(dir / "timeseries.csv");
+  {
+    std::ofstream cut(dir / "timeseries.csv", std::ios::binary | std::ios::trunc);
+    cut << series.substr(0, series.size() / 2);
+  }
+  fs::remove(dir / "summary.json");
+  const railcrash::report::ReportResult truncated = write_report(dir.string());
+  REQUIRE(truncated.problems.size() >= 2);
+  CHECK_THAT(truncated.problems[0], Catch::Contains("no summary.json"));
+  CHECK_THAT(truncated.problems[1], Catch::Contains("timeseries.csv line") && Catch::Contains("complete rows before it"));
+  CHECK(truncated.rows > 100);
+  CHECK(truncated.rows < 1501);
+
+  // A folder without a timeseries, a header only, and a missing folder: errors (exit status 2).
+  const fs::path empty = fs::temp_directory_path() / ("railcrash_report_test_empty_" + std::to_string(::getpid()));
+  fs::remove_all(empty);
+  fs::create_directories(empty);
+  CHECK_THROWS_WITH(write_report(empty.string()), Catch::Contains("no timeseries.csv") && Catch::Contains("not a run folder"));
+  { std::ofstream header_only(empty / "timeseries.csv"); header_only << "t,a.x\n"; }
+  CHECK_THROWS_AS(write_report(empty.string()), railcrash::InputError);
+  CHECK_THROWS_WITH(write_report(empty.string()), Catch::Contains("no complete row"));
+  CHECK_THROWS_WITH(write_report((empty / "missing").string()), Catch::Contains("does not exist"));
+  fs::remove_all(empty);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("railcrash report of a sensitivity folder: its summary and tables", "[report]") {
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_study_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "sensitivity.csv") << "run,P1,R1\nbase,1,0.5\n";
+  std::ofstream(dir / "sensitivity.md") << "# Sensitivity <b>study</b>\n\n| P | R1 |\n|---|---|\n| P1 | 0.5 |\n";
+  const railcrash::report::ReportResult result = railcrash::report::write_report(dir.string());
+  CHECK(result.study == "sensitivity");
+  CHECK(result.rows == 2);
+  const std::string page = slurp(dir / "report.html");
+  CHECK_THAT(page, Catch::Contains("run,P1,R1\\nbase,1,0.5") && Catch::Contains("\\u003cb>study"));
+  CHECK_THAT(page, !Catch::Contains("<b>study"));
+  std::ofstream(dir / "readings.csv") << "combination,score\nA,3\n";  // a readings folder holds its combinations' studies
+  CHECK(railcrash::report::write_report(dir.string()).study == "readings");
+  fs::remove_all(dir);
+}
+
+TEST_CASE("Body and element names that would break CSV, JSON or HTML are refused with file and line", "[report]") {
+  const std::string head = "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: ";
+  const std::string tail = ", mass: 1, inertia: 1, position: [0, 0]}\nelements: []\nsimulation: {t_end: 1}\n";
+  for (const std::string& bad : {std::string("'a,b'"), std::string("'<script>'"), std::string("'say \"hi\"'"), std::string("\"a\\nb\""),
+                                 std::string("'a") + '\xFF' + "'"}) {  // a raw byte that is not UTF-8
+    INFO(bad);
+    CHECK_THROWS_WITH(railcrash::load_model_text(head + bad + tail, "names.yaml"), Catch::Contains("names.yaml:5") && Catch::Contains("body name"));
+  }
+  CHECK_NOTHROW(railcrash::load_model_text(head + "'front end (car 1)'" + tail, "names.yaml"));
+}
