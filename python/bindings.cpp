@@ -173,10 +173,10 @@ PYBIND11_MODULE(_railcrash, m) {
       .def(py::init<std::string, std::string>(), py::arg("name"), py::arg("units") = "SI")
       .def("gravity", &rc::ModelBuilder::gravity, py::arg("x"), py::arg("y"), py::return_value_policy::reference_internal)
       .def("body", [](rc::ModelBuilder& b, const std::string& name, double mass, double inertia, std::array<double, 2> position,
-                      double angle, std::array<double, 2> velocity, double angular_velocity) -> rc::ModelBuilder& {
-            return b.body({name, mass, inertia, position[0], position[1], angle, velocity[0], velocity[1], angular_velocity});
+                      double angle, std::array<double, 2> velocity, double angular_velocity, const std::string& car) -> rc::ModelBuilder& {
+            return b.body({name, mass, inertia, position[0], position[1], angle, velocity[0], velocity[1], angular_velocity, car});
           }, py::arg("name"), py::arg("mass"), py::arg("inertia"), py::arg("position"), py::arg("angle") = 0.0,
-          py::arg("velocity") = std::array<double, 2>{0.0, 0.0}, py::arg("angular_velocity") = 0.0,
+          py::arg("velocity") = std::array<double, 2>{0.0, 0.0}, py::arg("angular_velocity") = 0.0, py::arg("car") = "",
           py::return_value_policy::reference_internal)
       .def("element", [](rc::ModelBuilder& b, const std::string& name, const std::string& type,
                          const std::vector<std::tuple<std::string, double, double>>& points,

@@ -181,7 +181,8 @@ ModelBuilder& ModelBuilder::gravity(double x, double y) {
 ModelBuilder& ModelBuilder::body(const BodySpec& b) {
   bodies_.push_back("{name: " + json_string(b.name) + ", mass: " + yaml_number(b.mass) + ", inertia: " + yaml_number(b.inertia) +
                     ", position: " + yaml_list({b.x, b.y}) + ", angle: " + yaml_number(b.angle) +
-                    ", velocity: " + yaml_list({b.vx, b.vy}) + ", angular_velocity: " + yaml_number(b.angular_velocity) + "}");
+                    ", velocity: " + yaml_list({b.vx, b.vy}) + ", angular_velocity: " + yaml_number(b.angular_velocity) +
+                    (b.car.empty() ? std::string() : ", car: " + json_string(b.car)) + "}");
   return *this;
 }
 

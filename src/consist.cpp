@@ -156,6 +156,7 @@ std::string make_consist_model(const std::string& template_path, int cars_per_co
       YAML::Node copy = renamed(b, striking ? names_s[static_cast<std::size_t>(k - 1)] : names_t[static_cast<std::size_t>(k - 1)]);
       const double shift = (k - 1) * (striking ? -length_s : length_t);
       copy["position"] = pair(b["position"][0].as<double>() + shift, b["position"][1].as<double>());
+      copy["car"] = (striking ? "s" : "t") + std::to_string(k);  // each generated car is summarised on its own
       copy.SetStyle(YAML::EmitterStyle::Flow);
       bodies.push_back(copy);
     }

@@ -39,15 +39,9 @@ const char* const kQuantityHelp =
     "max_crush, peak_anticlimber_force, peak_coupler_force, R1, R2, displacement_rms, "
     "element.NAME.OUTPUT (peak |value| of an element output) or body.NAME.x|y|theta (displacement at the end)";
 
-std::vector<int> columns_of_type(const DaeSystem& system, const std::vector<std::string>& types, const std::string& output) {
+std::vector<int> role_columns(const DaeSystem& system, OutputRole role) {
   std::vector<int> columns;
-  const auto& names = system.output_names();
-  for (const auto& element : system.model().elements()) {
-    if (std::find(types.begin(), types.end(), element->type()) == types.end()) continue;
-    const auto it = std::find(names.begin(), names.end(), element->name() + "." + output);
-    RAILCRASH_DEMAND(it != names.end());
-    columns.push_back(static_cast<int>(it - names.begin()));
-  }
+  for (const RoleColumn& c : columns_with_role(system, role)) columns.push_back(c.column);
   return columns;
 }
 
@@ -73,24 +67,22 @@ ConvergeQuantity resolve_quantity(const std::string& requested, const DaeSystem&
                         : responses.total_crush      ? " (R1's measure: total shortening of the crush gauges)"
                                                      : " (R1's measure: largest shortening of a crush gauge)";
     } else {
-      q.columns = columns_of_type(system, {"crush_spring"}, "crush");
-      const std::vector<int> anticlimbers = columns_of_type(system, {"anticlimber"}, "horizontal_deformation");
-      q.columns.insert(q.columns.end(), anticlimbers.begin(), anticlimbers.end());
-      q.description += " (crush_spring crush, anticlimber horizontal deformation)";
-      if (q.columns.empty()) not_applicable("the model has no crush gauges, crush_spring or anticlimber elements");
+      q.columns = role_columns(system, OutputRole::Crush);
+      q.description += " (outputs with the crush role: crush_spring crush, anticlimber horizontal deformation)";
+      if (q.columns.empty()) not_applicable("the model has no crush gauges and no element output with the crush role "
+                                            "(crush_spring, anticlimber)");
     }
   } else if (key == "peak_anticlimber_force") {
     q.kind = Kind::PeakAnticlimberForce;
     q.description = "largest absolute horizontal force of the anticlimbers [" + force_unit + "]";
-    q.columns = columns_of_type(system, {"anticlimber"}, "horizontal_force");
-    if (q.columns.empty()) not_applicable("the model has no anticlimber elements");
+    q.columns = role_columns(system, OutputRole::ContactForce);
+    if (q.columns.empty()) not_applicable("the model has no element output with the contact force role (anticlimber)");
   } else if (key == "peak_coupler_force") {
     q.kind = Kind::PeakCouplerForce;
     q.description = "largest absolute coupler face / coupling horizontal force [" + force_unit + "]";
-    q.columns = columns_of_type(system, {"coupler_end"}, "normal_force");
-    const std::vector<int> couplings = columns_of_type(system, {"coupling"}, "horizontal_force");
-    q.columns.insert(q.columns.end(), couplings.begin(), couplings.end());
-    if (q.columns.empty()) not_applicable("the model has no coupler_end or coupling elements");
+    q.columns = role_columns(system, OutputRole::CouplerForce);
+    if (q.columns.empty())
+      not_applicable("the model has no element output with the coupler force role (coupler_end, coupling)");
   } else if (key == "r1") {
     q.kind = Kind::R1;
     q.name = "R1";

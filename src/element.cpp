@@ -10,6 +10,24 @@ void demand_failed(const char* condition, const char* file, int line) {
   std::abort();
 }
 
+const char* output_role_name(OutputRole role) {
+  switch (role) {
+    case OutputRole::Crush: return "crush";
+    case OutputRole::ContactForce: return "contact_force";
+    case OutputRole::CouplerForce: return "coupler_force";
+    case OutputRole::VerticalInterlockForce: return "vertical_interlock_force";
+    case OutputRole::CrashForce: return "crash_force";
+    case OutputRole::CrashDeformation: return "crash_deformation";
+  }
+  return "";
+}
+
+std::string Element::output_with_role(OutputRole role) const {
+  for (const RoleOfOutput& r : output_roles())
+    if (r.role == role) return r.output;
+  return "";
+}
+
 Element::Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where)
     : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {}
 

@@ -106,14 +106,15 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
     std::printf("responses  R1 %.3f (crush)  R2 %.3f (override)  R3 %.3f  override: %s\n", r.r1, r.r2, r.r3,
                 r.overridden ? ("yes, at t = " + std::to_string(r.override_time)).c_str() : "no");
   }
-  // Each car's largest crush and the CFC 60 peak accelerations of its car-body masses (bodies
-  // whose names contain "body" or "end"; every body's are in summary.json).
+  // Each declared car's largest crush and the CFC 60 peak accelerations of its car-body masses
+  // (its bodies whose names contain "body" or "end"; every body's are in summary.json).
+  if (report.car_crush.empty()) std::printf("no per-car crush: no body declares a car (car: in the model file)\n");
   for (const CarCrush& car : report.car_crush) {
     std::printf("%-10s max crush %.4g at t = %.4g; peak acceleration (CFC 60, unfiltered) [g]:", car.car.c_str(), car.max_crush, car.t);
-    for (std::size_t i = 0; i < report.acceleration_peaks.size(); ++i) {
+    for (const int body : car.bodies) {
+      const auto i = static_cast<std::size_t>(body);
       const std::string& name = model.bodies()[i].name;
-      const bool in_car = report.car_crush.size() == 1 || name.rfind(car.car + "_", 0) == 0;
-      if (!in_car || (name.find("body") == std::string::npos && name.find("end") == std::string::npos)) continue;
+      if (name.find("body") == std::string::npos && name.find("end") == std::string::npos) continue;
       const double g = standard_gravity(model);
       if (i < report.filtered_accelerations.size() && report.filtered_accelerations[i].filtered)
         std::printf(" %s %.3g (%.3g)", name.c_str(), report.filtered_accelerations[i].peaks.magnitude / g,

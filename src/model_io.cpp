@@ -409,7 +409,8 @@ std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementS
 
 const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
                                            "responses"};
-const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity"};
+const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity",
+                                            "car"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
 const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt",
                                                   "static_equilibrium",
@@ -449,6 +450,11 @@ Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double
     b.vy = v[1];
   }
   if (node["angular_velocity"]) b.angular_velocity = r.number(node["angular_velocity"], context + ": angular_velocity");
+  if (node["car"]) {  // the car's name heads its rows in summary.json, the run output and the report
+    b.car = r.name(node["car"], context + ": car");
+    if (b.car.front() == ' ' || b.car.back() == ' ')
+      r.fail(node["car"], context + ": car '" + b.car + "' starts or ends with a space; write the car's name without them");
+  }
   return b;
 }
 

@@ -22,13 +22,13 @@ ResponseTracker::ResponseTracker(const DaeSystem& system, const ResponseSettings
     throw InputError(SourceLocation{system.model().file, 0}.prefix() + "responses: 'anticlimber: " + settings.anticlimber +
                      "' must name an element of type anticlimber");
   const auto& names = system.output_names();
-  const auto column_of = [&](const std::string& quantity) {
-    const auto it = std::find(names.begin(), names.end(), settings.anticlimber + "." + quantity);
+  const auto column_of = [&](OutputRole role) {
+    const auto it = std::find(names.begin(), names.end(), settings.anticlimber + "." + anticlimber->output_with_role(role));
     RAILCRASH_DEMAND(it != names.end());
     return static_cast<int>(it - names.begin());
   };
-  vertical_force_column_ = column_of("vertical_force");
-  horizontal_deformation_column_ = column_of("horizontal_deformation");
+  vertical_force_column_ = column_of(OutputRole::VerticalInterlockForce);
+  horizontal_deformation_column_ = column_of(OutputRole::Crush);
   responses_.vertical_yield_force = settings.vertical_yield_force.value_or(anticlimber->vertical_yield_force());
 }
 

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 #include "railcrash/results/cfc_filter.hpp"
@@ -29,45 +28,43 @@ void body_accelerations(const DaeSystem& system, double t, const double* y, cons
 
 double standard_gravity(const Model& model) { return model.units == UnitSystem::SI ? 9.80665 : 386.088; }
 
+std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole role) {
+  std::vector<RoleColumn> columns;
+  const auto& names = system.output_names();
+  for (const auto& e : system.model().elements()) {
+    const std::string output = e->output_with_role(role);
+    if (output.empty()) continue;
+    const auto it = std::find(names.begin(), names.end(), e->name() + "." + output);
+    RAILCRASH_DEMAND(it != names.end());  // a role names one of the element's outputs
+    columns.push_back(RoleColumn{e.get(), static_cast<int>(it - names.begin())});
+  }
+  return columns;
+}
+
 std::vector<CarCrush> cars_of(const DaeSystem& system) {
   const Model& model = system.model();
-  const std::regex prefix("^(car[0-9]+)_.*");
-  std::vector<std::string> car_of_body;
   std::vector<CarCrush> cars;
-  bool named = false;
-  for (const Body& b : model.bodies()) {
-    std::smatch match;
-    const bool is_car = std::regex_match(b.name, match, prefix);
-    named = named || is_car;
-    car_of_body.push_back(is_car ? match[1].str() : std::string());
+  std::vector<int> car_of_body;  // index into cars, -1 for a body of no car
+  for (int i = 0; i < model.body_count(); ++i) {
+    const std::string& name = model.bodies()[static_cast<std::size_t>(i)].car;
+    auto car = std::find_if(cars.begin(), cars.end(), [&](const CarCrush& c) { return c.car == name; });
+    if (!name.empty() && car == cars.end()) car = cars.insert(cars.end(), CarCrush{name, {}, {}, {}, {}, 0.0, 0.0});
+    if (car != cars.end()) car->bodies.push_back(i);
+    car_of_body.push_back(name.empty() ? -1 : static_cast<int>(car - cars.begin()));
   }
-  for (std::string& c : car_of_body)
-    if (!named) c = "car";
-  for (const std::string& c : car_of_body)
-    if (!c.empty() && std::none_of(cars.begin(), cars.end(), [&](const CarCrush& k) { return k.car == c; }))
-      cars.push_back(CarCrush{c, {}, {}, {}, 0.0, 0.0});
-  const auto& names = system.output_names();
-  for (const auto& e : model.elements()) {
-    std::string quantity;
-    if (e->type() == "anticlimber") quantity = "horizontal_deformation";
-    else if (e->type() == "crush_spring") quantity = "crush";
-    else continue;
-    const auto it = std::find(names.begin(), names.end(), e->name() + "." + quantity);
-    if (it == names.end()) continue;
-    std::vector<std::string> touched;
+  for (const RoleColumn& crush : columns_with_role(system, OutputRole::Crush)) {
+    std::vector<int> touched;
     for (int slot = 0; slot < 2; ++slot) {
-      const int body = e->slot_body(slot);
-      if (body == kGround) continue;
-      const std::string& c = car_of_body[static_cast<std::size_t>(body)];
-      if (!c.empty() && std::find(touched.begin(), touched.end(), c) == touched.end()) touched.push_back(c);
+      const int body = crush.element->slot_body(slot);
+      const int car = body == kGround ? -1 : car_of_body[static_cast<std::size_t>(body)];
+      if (car >= 0 && std::find(touched.begin(), touched.end(), car) == touched.end()) touched.push_back(car);
     }
-    for (const std::string& c : touched)
-      for (CarCrush& car : cars)
-        if (car.car == c) {
-          car.elements.push_back(e->name());
-          car.columns.push_back(static_cast<int>(it - names.begin()));
-          car.shares.push_back(1.0 / static_cast<double>(touched.size()));
-        }
+    for (const int c : touched) {
+      CarCrush& car = cars[static_cast<std::size_t>(c)];
+      car.elements.push_back(crush.element->name());
+      car.columns.push_back(crush.column);
+      car.shares.push_back(1.0 / static_cast<double>(touched.size()));
+    }
   }
   return cars;
 }
@@ -339,11 +336,16 @@ std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::st
     j << "}";
   }
   j << "}},\n";
+  if (cars_.empty())
+    j << "  \"cars_note\": \"no body declares a car (the bodies' car: key in the model file): no per-car crush\",\n";
   j << "  \"car_crush\": {";
   for (std::size_t c = 0; c < cars_.size(); ++c) {
     const CarCrush& car = cars_[c];
     j << (c ? ", " : "") << json_string(car.car) << ": {\"max_crush\": " << json_number(car.max_crush)
-      << ", \"t\": " << json_number(car.t) << ", \"elements\": [";
+      << ", \"t\": " << json_number(car.t) << ", \"bodies\": [";
+    for (std::size_t k = 0; k < car.bodies.size(); ++k)
+      j << (k ? ", " : "") << json_string(model.bodies()[static_cast<std::size_t>(car.bodies[k])].name);
+    j << "], \"elements\": [";
     for (std::size_t k = 0; k < car.elements.size(); ++k)
       j << (k ? ", " : "") << "{\"element\": " << json_string(car.elements[k]) << ", \"share\": " << json_number(car.shares[k]) << "}";
     j << "]}";

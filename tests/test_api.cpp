@@ -137,6 +137,32 @@ TEST_CASE("api: a model built in code oscillates with period 2 pi sqrt(m / k)", 
   CHECK(again.series("cart.x") == r.series("cart.x"));
 }
 
+TEST_CASE("api: a built body may declare its car, and the summary then has that car's crush", "[api]") {
+  // A 2 kg cart at 1 m/s into a crush spring on the ground with a 1 N plateau after 1 mm:
+  // the crush grows until the plateau has taken the kinetic energy, 1 J = 1 N x (d - 0.0005 m).
+  rc::ModelBuilder b("crusher", "SI");
+  b.gravity(0.0, 0.0);
+  rc::BodySpec cart{"cart", 2.0, 0.1, 1.0, 0.0};
+  cart.vx = -1.0;
+  cart.car = "train";
+  b.body(cart);
+  b.element("crush", "crush_spring", {{"ground", 0.0, 0.0}, {"cart", 0.0, 0.0}},
+            {{"free_length", 1.0}, {"curve", std::vector<std::vector<double>>{{0.0, 0.0}, {0.001, 1.0}, {2.0, 1.0}}},
+             {"unloading_stiffness", 1.0e4}});
+  rc::RunSettings s;
+  s.t_end = 2.5;
+  s.output_interval = 1e-4;
+  b.simulation(s);
+  CHECK_THAT(b.yaml(), Catch::Contains("car: \"train\""));
+  rc::RunSettings settings;
+  settings.rtol = 1e-8;
+  const rc::Results r = rc::run(b.build(), settings);
+  REQUIRE(r.ok());
+  REQUIRE(r.summary.cars.size() == 1);
+  CHECK(r.summary.cars[0].car == "train");
+  CHECK(r.summary.cars[0].max_crush == Approx(1.0005).epsilon(1e-3));
+}
+
 TEST_CASE("api: a built model with loads, tables and flags", "[api]") {
   // A constant force F on a critically damped spring-mass settles at F / k; a table force
   // that is zero after 0.1 s returns it to the free length.

@@ -10,6 +10,7 @@
 #include "railcrash/dae_system.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/results.hpp"
 #include "support.hpp"
 
 using namespace railcrash;
@@ -55,6 +56,15 @@ TEST_CASE("consist: three cars per side keep the template's cars, shifted by the
   CHECK(body_named(train, "s2_center_body").vx == body_named(pair, "car1_center_body").vx);
   CHECK(body_named(train, "t3_front_truck").vx == 0.0);
   CHECK(body_named(train, "s1_coupler").x == body_named(pair, "car1_coupler").x);
+  // Each generated car declares itself: the bodies renamed s<k>_ / t<k>_ form car s<k> / t<k>,
+  // so the summary has six cars, each with the template car's bodies.
+  for (const Body& b : train.bodies()) {
+    INFO(b.name);
+    CHECK(b.car == b.name.substr(0, b.name.find('_')));
+  }
+  const std::vector<CarCrush> cars = cars_of(DaeSystem(train));
+  REQUIRE(cars.size() == 6);
+  for (const CarCrush& car : cars) CHECK(car.bodies.size() * 2 == static_cast<std::size_t>(pair.body_count()));
 }
 
 TEST_CASE("consist: couplings start with the faces touching and carry no force", "[consist]") {

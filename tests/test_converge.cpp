@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "railcrash/converge.hpp"
 #include "railcrash/model_io.hpp"
@@ -217,4 +218,40 @@ TEST_CASE("convergence study: a run over its time limit is stopped and reported 
   CHECK(std::isnan(result.euler[0].errors[0]));
   CHECK(result.reference.ok);
   CHECK(result.ida[0].ok);
+}
+
+TEST_CASE("convergence study: max_crush and the peak forces take the same columns by role as by element type before", "[converge]") {
+  // Before the output roles, converge picked the columns by element type: max_crush from
+  // crush_spring crush and anticlimber horizontal_deformation, peak_anticlimber_force from
+  // anticlimber horizontal_force, peak_coupler_force from coupler_end normal_force and
+  // coupling horizontal_force. The report model (its max_crush is R1's measure, from the
+  // responses section) and the barrier model (crush springs, a coupler_end) must keep them.
+  ConvergeOptions options;
+  options.euler_runs = 0;
+  options.quantities = {"max_crush", "peak_anticlimber_force", "peak_coupler_force"};
+  for (const char* file : {"/models/report/final_two_car.yaml", "/models/barrier/two_car_barrier.yaml"}) {
+    const std::string path = std::string(RAILCRASH_SOURCE_DIR) + file;
+    INFO(path);
+    const ConvergePlan plan = plan_convergence(path, options);
+    const Model model = load_model(path);
+    const DaeSystem system(model);
+    const auto by_type = [&](const std::vector<std::pair<std::string, std::string>>& type_outputs) {
+      std::set<int> columns;
+      const auto& names = system.output_names();
+      for (const auto& e : model.elements())
+        for (const auto& [type, output] : type_outputs)
+          if (e->type() == type)
+            columns.insert(static_cast<int>(std::find(names.begin(), names.end(), e->name() + "." + output) - names.begin()));
+      return columns;
+    };
+    const auto columns = [&](std::size_t q) { return std::set<int>(plan.quantities[q].columns.begin(), plan.quantities[q].columns.end()); };
+    const bool from_responses = model.responses.crush_from_anticlimber || !model.responses.crush_gauges.empty();
+    CHECK(plan.quantities[0].from_responses == from_responses);
+    CHECK(columns(0) == (from_responses ? std::set<int>{}
+                                        : by_type({{"crush_spring", "crush"}, {"anticlimber", "horizontal_deformation"}})));
+    CHECK(columns(1) == by_type({{"anticlimber", "horizontal_force"}}));
+    CHECK(columns(2) == by_type({{"coupler_end", "normal_force"}, {"coupling", "horizontal_force"}}));
+    CHECK(plan.quantities[0].applicable);
+    CHECK(plan.quantities[2].applicable);
+  }
 }

@@ -658,6 +658,20 @@ TEST_CASE("NaN, infinite and non-numeric values are rejected", "[model_io]") {
   expect_error("list name", text, line_of(text, "[bob]"), {"body name must be a word"});
 }
 
+TEST_CASE("a body's car: is a name; bodies without one belong to no car", "[model_io]") {
+  const Model model = testing::model_from_text(edit(kBase, "    angular_velocity: 0.2\n", "    angular_velocity: 0.2\n    car: lead car\n"));
+  CHECK(model.bodies()[0].car.empty());
+  CHECK(model.bodies()[1].car == "lead car");
+  const auto with_car = [](const std::string& value) {
+    return edit(kBase, "    angular_velocity: 0.2\n", "    angular_velocity: 0.2\n    car: " + value + "\n");
+  };
+  const int line = line_of(with_car("x"), "    car: x");
+  expect_error("empty car", with_car("\"\""), line, {"body 'cart': car must not be empty"});
+  expect_error("list car", with_car("[lead]"), line, {"body 'cart': car must be a word"});
+  expect_error("car with a comma", with_car("\"lead, front\""), line, {"body 'cart': car 'lead, front' holds the character ','"});
+  expect_error("car with spaces around", with_car("\" lead\""), line, {"body 'cart': car ' lead' starts or ends with a space"});
+}
+
 TEST_CASE("names must be unique and 'ground' is reserved", "[model_io]") {
   std::string text = edit(kBase, "- name: cart", "- name: bob");
   expect_error("duplicate body", text, line_of(kBase, "- name: cart"), {"body 'bob' is defined twice", "unique"});

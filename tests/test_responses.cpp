@@ -113,7 +113,7 @@ std::string temporary_folder(const std::string& name) {
 
 TEST_CASE("peak deceleration and crush of the crush-impact case match the closed form under both integrators", "[responses]") {
   // On the structure's plateau the force is F0 = 100 kN on 100 kg: 1000 m/s^2 (101.97 g);
-  // largest crush 0.055 m (crush_impact.yaml). The mass is one car ("car"; no car<N>_ names).
+  // largest crush 0.055 m (crush_impact.yaml). The mass is one car: its body declares `car: car`.
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     Model model = crush_model("");
@@ -158,29 +158,6 @@ TEST_CASE("peak acceleration of a pendulum released from the horizontal includes
     // At the bottom the acceleration points up at the pin: |y''| peaks there too.
     CHECK(p.y == Approx(expected).epsilon(std::string(integrator) == "ida" ? 1e-4 : 1e-2));
   }
-}
-
-TEST_CASE("cars are the car<N>_ name prefixes and an element between two cars counts half for each", "[responses]") {
-  const std::string bodies =
-      "railcrash: 1\nname: cars\nunits: SI\ngravity: [0, 0]\nbodies:\n"
-      "  - {name: car1_end, mass: 10, inertia: 1, position: [0, 0], velocity: [5, 0]}\n"
-      "  - {name: car2_end, mass: 10, inertia: 1, position: [1, 0]}\n"
-      "  - {name: car2_rear, mass: 10, inertia: 1, position: [3, 0]}\nelements:\n"
-      "  - {name: between, type: crush_spring, free_length: 1.0, curve: [[0, 0], [0.01, 1000], [1, 1000]], "
-      "unloading_stiffness: 1.0e5, points: [{body: car1_end, at: [0, 0]}, {body: car2_end, at: [0, 0]}]}\n"
-      "  - {name: inside, type: crush_spring, free_length: 2.0, curve: [[0, 0], [0.01, 1000], [1, 1000]], "
-      "unloading_stiffness: 1.0e5, points: [{body: car2_end, at: [0, 0]}, {body: car2_rear, at: [0, 0]}]}\n"
-      "simulation: {t_end: 0.1}\n";
-  const Model model = testing::model_from_text(bodies);
-  const DaeSystem system(model);
-  const std::vector<CarCrush> cars = cars_of(system);
-  REQUIRE(cars.size() == 2);
-  CHECK(cars[0].car == "car1");
-  CHECK(cars[0].elements == std::vector<std::string>{"between"});
-  CHECK(cars[0].shares == std::vector<double>{0.5});
-  CHECK(cars[1].car == "car2");
-  CHECK(cars[1].elements == std::vector<std::string>{"between", "inside"});
-  CHECK(cars[1].shares == std::vector<double>{0.5, 1.0});
 }
 
 TEST_CASE("R2's window: the whole run, until the largest crush or until separation, closed form", "[responses]") {

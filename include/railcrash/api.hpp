@@ -98,7 +98,7 @@ struct Event {
   double value = 0.0;     // the quantity that crossed its threshold, in model units
 };
 
-/// One car's largest crush (cars are the "car<N>_" prefixes of the body names; README).
+/// One car's largest crush (cars are declared by the bodies' `car:` key; README).
 struct CarCrush {
   std::string car;
   double max_crush = 0.0;  // [length]
@@ -160,6 +160,7 @@ struct BodySpec {
   double angle = 0.0;              // [rad]
   double vx = 0.0, vy = 0.0;       // [length/s]
   double angular_velocity = 0.0;   // [rad/s]
+  std::string car{};               // the car the body belongs to; "" = none (track, barrier, ...)
 };
 
 /// A connection point: a body ("ground" for the fixed one) and an offset from its centre of

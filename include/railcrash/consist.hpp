@@ -7,8 +7,8 @@
 // other, moving at the striking car's velocity, and N standing cars coupled behind the
 // struck car:
 //   striking car k (k = 1..N): the car1_* bodies and elements renamed s<k>_*, shifted by
-//                              -(k-1) L in x;
-//   standing car k:            the car2_* ones renamed t<k>_*, shifted by +(k-1) L;
+//                              -(k-1) L in x, its bodies declaring `car: s<k>`;
+//   standing car k:            the car2_* ones renamed t<k>_*, shifted by +(k-1) L, `car: t<k>`;
 //   interface elements:        once, between s1 and t1 (car1_ -> s1_, car2_ -> t1_);
 //   couplings:                 s<k>_coupling joins car k's coupler face (the template's
 //                              coupler_faces point on its coupler) to car k-1's rear body, at

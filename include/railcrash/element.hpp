@@ -47,6 +47,29 @@ struct ElementState {
   std::array<Pose<T>, 2> v{};
 };
 
+/// What an element output means to the run summary, `converge`, the responses and the report,
+/// so that none of them has to know element types. Each element type declares, next to its
+/// output_names(), which of its outputs plays which role (at most one output per role).
+enum class OutputRole {
+  Crush,                   // [length] crush deformation counted in the crush of its cars (positive part)
+  ContactForce,            // [force] horizontal force where two interlocking car ends bear on each other
+  CouplerForce,            // [force] horizontal force through a coupler (coupler faces, coupling)
+  VerticalInterlockForce,  // [force] vertical force holding two interlocked car ends together
+  CrashForce,              // [force] force of an element in the crash load path: y of its force-deformation loop
+  CrashDeformation,        // [length] the deformation that force works through: x of the loop
+};
+constexpr OutputRole kAllOutputRoles[] = {OutputRole::Crush,       OutputRole::ContactForce,
+                                          OutputRole::CouplerForce, OutputRole::VerticalInterlockForce,
+                                          OutputRole::CrashForce,  OutputRole::CrashDeformation};
+/// snake_case name of a role (model.json, summaries): "crush", "contact_force", ...
+const char* output_role_name(OutputRole role);
+
+/// One output of an element and the role it plays.
+struct RoleOfOutput {
+  OutputRole role;
+  const char* output;  // one of the element's output_names()
+};
+
 using ForceBlock = std::array<std::array<double, 6>, 6>;  // d f(slot, comp) / d (slot, comp)
 constexpr int kMaxConstraintRows = 3;
 
@@ -137,6 +160,10 @@ class Element {
   virtual double potential_energy(const ElementState<double>& /*s*/) const { return 0.0; }
   /// Names of the quantities this element adds to timeseries.csv (without the element prefix).
   virtual std::vector<std::string> output_names() const { return {}; }
+  /// Which of those outputs play which role (OutputRole); most elements have none.
+  virtual std::vector<RoleOfOutput> output_roles() const { return {}; }
+  /// The output playing `role`, or "" when the element has none.
+  std::string output_with_role(OutputRole role) const;
   /// Values of those quantities; lambda are the element's constraint multipliers (if any).
   virtual void outputs(const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*out*/) const {}
 

@@ -32,6 +32,7 @@ struct Body {
   double angle = 0.0;             // [rad]
   double vx = 0.0, vy = 0.0;      // [length/time]
   double angular_velocity = 0.0;  // [rad/time]
+  std::string car;                // the car the body belongs to (the model file's `car:`); "" = none
   SourceLocation where;
 };
 

@@ -21,14 +21,15 @@
 // sample rate of at least 2 x 2.0775 CFC; below 10 CFC the summary says the sampling is too coarse.
 // The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
 //
-// Car crush: a car is the set of bodies whose names start with the same "car<N>_" prefix
-// (car1_coupler, car1_front_end, ... form car1); a model without such names is one car,
-// "car". The crush of a car is the sum of the crush deformations of the crush elements that
-// act on its bodies: an anticlimber's horizontal_deformation (positive part) and a
-// crush_spring's crush. An element between two cars gives half of its deformation to each
-// (the report's anticlimber carries the two identical ends in series); one between a car
-// and ground or within a car, all of it. The summary gives each car's largest crush over
-// the output samples and when.
+// Car crush: a car is the set of bodies that declare it with `car: NAME` in the model file
+// (bodies without the key, such as a barrier or a track, belong to no car). A model where no
+// body declares a car has no per-car crush: summary.json then says so under "cars_note". The
+// crush of a car is the sum of the outputs with the role OutputRole::Crush (positive part; an
+// anticlimber's horizontal_deformation, a crush_spring's crush) of the elements that act on
+// its bodies. An element between two cars gives half of its deformation to each (the
+// report's anticlimber carries the two identical ends in series); one between a car and
+// ground, a body of no car or within a car, all of it. The summary gives each car's bodies
+// and its largest crush over the output samples and when.
 #pragma once
 
 #include <chrono>
@@ -65,6 +66,7 @@ struct FilteredAccelerations {
 /// One car's crush elements and its largest crush [length] over the samples.
 struct CarCrush {
   std::string car;
+  std::vector<int> bodies;        // body indices, in model order
   std::vector<std::string> elements;
   std::vector<int> columns;       // output columns of their crush deformations
   std::vector<double> shares;     // 1, or 0.5 for an element between two cars
@@ -72,8 +74,16 @@ struct CarCrush {
   double t = 0.0;                 // [time]
 };
 
-/// Cars of a model (see above), with their crush elements.
+/// Cars of a model (see above) in the order they are first declared, with their crush elements.
 std::vector<CarCrush> cars_of(const DaeSystem& system);
+
+/// An element output column (index into DaeSystem::output_names()) that plays a role.
+struct RoleColumn {
+  const Element* element;
+  int column;
+};
+/// Every output playing `role`, in element order.
+std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole role);
 
 /// Column names of timeseries.csv: t, the six body columns per body, the element outputs.
 std::vector<std::string> timeseries_columns(const DaeSystem& system);

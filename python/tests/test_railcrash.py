@@ -133,6 +133,17 @@ class RunTest(unittest.TestCase):
         settled = railcrash.run(pushed.build(), t_end=2.0)
         self.assertAlmostEqual(settled.series("cart.x")[-1], 1.0 + 40.0 / STIFFNESS, places=6)
 
+    def test_built_body_declares_its_car(self):
+        builder = railcrash.ModelBuilder("cars")
+        builder.gravity(0, 0).body("cart", mass=1.0, inertia=0.1, position=(1, 0), car="train")
+        builder.body("post", mass=1.0, inertia=0.1, position=(3, 0))
+        self.assertIn('car: "train"', builder.yaml())
+        self.assertEqual(builder.yaml().count("car:"), 1)
+        empty = railcrash.ModelBuilder("empty car")
+        empty.body("cart", mass=1.0, inertia=0.1, position=(1, 0), car=" train")
+        with self.assertRaisesRegex(railcrash.InputError, "body 'cart': car ' train' starts or ends with a space"):
+            empty.build()
+
     def test_built_model_errors_name_the_element(self):
         builder = railcrash.ModelBuilder("dangling")
         builder.body("cart", mass=1.0, inertia=0.1, position=(1, 0))

@@ -186,9 +186,22 @@ double standard_gravity_of(const std::string& model_json, const std::string& sum
   return 0.0;
 }
 
-bool is_crash_type(const std::string& type) {
-  return type == "anticlimber" || type == "crush_spring" || type == "draft_gear" || type == "coupler_end" ||
-         type.find("coupling") != std::string::npos;
+/// Roles of the element outputs from model.json: element name -> role name -> output
+/// (element.hpp OutputRole; one element per line, its "roles" object last).
+std::map<std::string, std::map<std::string, std::string>> element_roles(const std::string& model_json) {
+  std::map<std::string, std::map<std::string, std::string>> out;
+  const std::regex roles_pattern(R"re("roles": \{([^}]*)\}\})re");
+  const std::regex pair_pattern(R"re("([a-z_]+)": "([A-Za-z0-9_]+)")re");
+  std::stringstream lines(model_json);
+  for (std::string line; std::getline(lines, line);) {
+    const std::vector<std::pair<std::string, std::string>> element = element_types(line);
+    std::smatch roles;
+    if (element.size() != 1 || !std::regex_search(line, roles, roles_pattern)) continue;
+    const std::string text = roles[1].str();
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), pair_pattern); it != std::sregex_iterator(); ++it)
+      out[element.front().first][(*it)[1].str()] = (*it)[2].str();
+  }
+  return out;
 }
 
 struct PlotSeries {
@@ -444,18 +457,27 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   std::vector<std::string> loops;
   std::vector<std::string> element_force_column;  // per element of model.json: its force column
   static const char* const kForceNames[] = {"horizontal_force", "force", "normal_force"};
-  static const char* const kDeformationNames[] = {"horizontal_deformation", "compression", "deformation", "deflection", "crush", "stretch"};
+  // Crash elements (an output with the crash_force role) come first and are shown, with a
+  // force-deformation loop when they also have a crash_deformation; others are listed hidden.
+  const auto roles = element_roles(model_json);
+  const auto role_column = [&](const std::string& name, const char* role) {
+    const auto element = roles.find(name);
+    if (element == roles.end()) return -1;
+    const auto output = element->second.find(role);
+    return output == element->second.end() ? -1 : column_of(series, name + "." + output->second);
+  };
+  if (!types.empty() && model_json.find("\"roles\": ") == std::string::npos)
+    problems.push_back("model.json gives no output roles (older run folder): no element is shown as a crash element");
   std::vector<std::string> crash_first, others;
-  for (const auto& [name, type] : types) (is_crash_type(type) ? crash_first : others).push_back(name);
+  for (const auto& [name, type] : types) (role_column(name, "crash_force") >= 0 ? crash_first : others).push_back(name);
   for (const auto* group : {&crash_first, &others})
     for (const std::string& name : *group) {
-      int force = -1, deformation = -1;
+      const bool crash = group == &crash_first;
+      int force = crash ? role_column(name, "crash_force") : -1;
+      const int deformation = crash ? role_column(name, "crash_deformation") : -1;
       for (const char* f : kForceNames)
         if (force < 0) force = column_of(series, name + "." + f);
-      for (const char* d : kDeformationNames)
-        if (deformation < 0) deformation = column_of(series, name + "." + d);
       if (force < 0) continue;
-      const bool crash = group == &crash_first;
       forces.push_back({name, series.data[static_cast<std::size_t>(force)], crash});
       if (crash && deformation >= 0 && loops.size() < 40) {
         const std::vector<double>& a = series.data[static_cast<std::size_t>(deformation)];

@@ -30,7 +30,9 @@ void write_model_geometry(const DaeSystem& system, const std::string& path) {
   for (int i = 0; i < model.body_count(); ++i) {
     const Body& b = model.bodies()[static_cast<std::size_t>(i)];
     j << (i ? "," : "") << "\n    {\"name\": " << json_string(b.name) << ", \"mass\": " << json_number(b.mass)
-      << ", \"inertia\": " << json_number(b.inertia) << ", \"points\": [";
+      << ", \"inertia\": " << json_number(b.inertia);
+    if (!b.car.empty()) j << ", \"car\": " << json_string(b.car);
+    j << ", \"points\": [";
     const auto& list = points[static_cast<std::size_t>(i)];
     for (std::size_t k = 0; k < list.size(); ++k)
       j << (k ? ", " : "") << "[" << json_number(list[k][0]) << ", " << json_number(list[k][1]) << "]";
@@ -48,7 +50,11 @@ void write_model_geometry(const DaeSystem& system, const std::string& path) {
     j << "], \"outputs\": [";
     const auto names = el.output_names();
     for (std::size_t k = 0; k < names.size(); ++k) j << (k ? ", " : "") << json_string(names[k]);
-    j << "]}";
+    j << "], \"roles\": {";
+    const auto roles = el.output_roles();
+    for (std::size_t k = 0; k < roles.size(); ++k)
+      j << (k ? ", " : "") << json_string(output_role_name(roles[k].role)) << ": " << json_string(roles[k].output);
+    j << "}}";
   }
   j << "\n  ]\n}\n";
   std::ofstream out(path);

@@ -167,6 +167,32 @@ TEST_CASE("railcrash report: a good run, a truncated one, one without summary, a
   fs::remove_all(dir);
 }
 
+TEST_CASE("railcrash report: crash elements and their loops come from the output roles, cars from car:", "[report]") {
+  using railcrash::report::write_report;
+  const fs::path dir = small_run("roles");
+  const std::string model = slurp(dir / "model.json"), summary = slurp(dir / "summary.json");
+  CHECK_THAT(model, Catch::Contains("\"roles\": {\"crush\": \"horizontal_deformation\", \"contact_force\": \"horizontal_force\""));
+  CHECK_THAT(model, Catch::Contains("\"name\": \"car1_body\", \"mass\": 5000, \"inertia\": 5000, \"car\": \"car1\""));
+  CHECK_THAT(summary, Catch::Contains("\"car2\": {\"max_crush\": ") && Catch::Contains("\"bodies\": [\"car2_end\", \"car2_body\"]"));
+  // The anticlimber (crash_force, crash_deformation) has the only loop; the sills and dampers
+  // are listed but not crash elements.
+  const railcrash::report::ReportResult good = write_report(dir.string());
+  CHECK(good.problems.empty());
+  const std::string page = slurp(good.path);
+  CHECK_THAT(page, Catch::Contains("\"x_label\": \"anticlimber.horizontal_deformation\", \"y_label\": \"anticlimber.horizontal_force\""));
+  CHECK(page.find("\"x_label\": ") == page.rfind("\"x_label\": "));
+  // A model.json without roles (an older run folder) shows no crash element and says why.
+  std::string old = model;
+  for (std::size_t at = old.find(", \"roles\": {"); at != std::string::npos; at = old.find(", \"roles\": {"))
+    old.erase(at, old.find('}', at) + 1 - at);
+  std::ofstream(dir / "model.json", std::ios::trunc) << old;
+  const railcrash::report::ReportResult older = write_report(dir.string());
+  REQUIRE(older.problems.size() == 1);
+  CHECK_THAT(older.problems[0], Catch::Contains("no output roles"));
+  CHECK(slurp(older.path).find("\"x_label\": ") == std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("railcrash report of a sensitivity folder: its summary and tables", "[report]") {
   const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_study_" + std::to_string(::getpid()));
   fs::remove_all(dir);

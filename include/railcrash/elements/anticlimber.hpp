@@ -305,6 +305,14 @@ class Anticlimber : public ForceElement<Anticlimber> {
     return {"horizontal_force",      "vertical_force",         "moment",          "horizontal_deformation",
             "vertical_deformation", "torsional_deformation", "vertical_offset", "override"};
   }
+  /// The horizontal law is the car ends' crush and contact; the vertical one, the interlock.
+  std::vector<RoleOfOutput> output_roles() const override {
+    return {{OutputRole::Crush, "horizontal_deformation"},
+            {OutputRole::ContactForce, "horizontal_force"},
+            {OutputRole::VerticalInterlockForce, "vertical_force"},
+            {OutputRole::CrashForce, "horizontal_force"},
+            {OutputRole::CrashDeformation, "horizontal_deformation"}};
+  }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  private:

@@ -376,6 +376,10 @@ class DraftGear : public ForceElement<DraftGear> {
   void reset_modes() override { state_ = initial_state_; }
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "compression"}; }
+  /// In the crash load path, but not a coupler force: the force between coupler and car body.
+  std::vector<RoleOfOutput> output_roles() const override {
+    return {{OutputRole::CrashForce, "force"}, {OutputRole::CrashDeformation, "compression"}};
+  }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  private:
@@ -459,6 +463,10 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   void reset_modes() override { state_ = initial_state_; }
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"normal_force", "friction_force", "gap"}; }
+  /// The gap is no deformation: the report shows the force without a loop.
+  std::vector<RoleOfOutput> output_roles() const override {
+    return {{OutputRole::CouplerForce, "normal_force"}, {OutputRole::CrashForce, "normal_force"}};
+  }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  private:
@@ -527,6 +535,11 @@ class Coupling : public ForceElement<Coupling> {
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override {
     return {"horizontal_force", "deflection", "vertical_force", "vertical_offset", "friction_force"};
+  }
+  std::vector<RoleOfOutput> output_roles() const override {
+    return {{OutputRole::CouplerForce, "horizontal_force"},
+            {OutputRole::CrashForce, "horizontal_force"},
+            {OutputRole::CrashDeformation, "deflection"}};
   }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 

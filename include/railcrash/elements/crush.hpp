@@ -90,6 +90,9 @@ class CrushSpring : public ForceElement<CrushSpring> {
   void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "crush", "permanent_crush"}; }
+  std::vector<RoleOfOutput> output_roles() const override {
+    return {{OutputRole::Crush, "crush"}, {OutputRole::CrashForce, "force"}, {OutputRole::CrashDeformation, "crush"}};
+  }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  private:

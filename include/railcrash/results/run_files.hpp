@@ -1,9 +1,11 @@
 // The run folder's files beside timeseries.csv, events.csv and summary.json, written for the
 // report (`railcrash report`) and for users' own post-processing:
-//   DIR/model.json         geometry: units, every body (name, mass, inertia, its connection
-//                          points in its own frame) and every element (name, type, its points
-//                          as {body index or -1 for ground, offset}, its output columns). With the
-//                          body poses of timeseries.csv this places every point at every row.
+//   DIR/model.json         geometry: units, every body (name, mass, inertia, its car if it
+//                          declares one, its connection points in its own frame) and every
+//                          element (name, type, its points as {body index or -1 for ground,
+//                          offset}, its output columns, the roles of its outputs as
+//                          {"crush": "horizontal_deformation", ...}; element.hpp OutputRole). With
+//                          the body poses of timeseries.csv this places every point at every row.
 //   DIR/accelerations.csv  t, then <body>.ax,<body>.ay,<body>.alpha for every body: the
 //                          accelerations v' of results.hpp, unfiltered, at every output row.
 //   DIR/energy.csv         t, kinetic, elastic, gravity (change from t = 0), external_work,

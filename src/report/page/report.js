@@ -145,12 +145,12 @@
       var pa = summary.peak_accelerations || {};
       var filter = pa.filter || {};
       var crush = summary.car_crush || {};
+      if (summary.cars_note) row("cars", summary.cars_note);
       Object.keys(crush).forEach(function (car) {
         var parts = ["crush " + fmt(crush[car].max_crush) + " " + lengthUnit + " at t = " + fmt(crush[car].t) + " s"];
         var bodies = pa.bodies || {};
-        Object.keys(bodies).forEach(function (b) {
-          var inCar = Object.keys(crush).length === 1 || b.indexOf(car + "_") === 0;
-          if (!inCar || b.indexOf("body") < 0) return;
+        (crush[car].bodies || []).forEach(function (b) {  // the bodies that declare this car
+          if (!bodies[b] || b.indexOf("body") < 0) return;
           var p = bodies[b];
           var filtered = p.x_cfc ? fmt(p.x_cfc.g, 3) + " g" : "-";
           var mean = p.collision ? fmt(p.collision.mean_deceleration_g, 3) + " g" : "-";
@@ -501,7 +501,7 @@
 
   var loopsBox = document.getElementById("loops");
   if (!haveLibrary) noLibrary(loopsBox);
-  else if (!(data.loops || []).length) loopsBox.appendChild(el("p", {}, "No crush elements, draft gears or anticlimbers in this model."));
+  else if (!(data.loops || []).length) loopsBox.appendChild(el("p", {}, "No element with a crash force and deformation (crush springs, draft gears, anticlimbers, couplings) in this model."));
   else data.loops.forEach(function (loop) {
     var box = el("div", {"class": "plot"});
     loopsBox.appendChild(box);

@@ -1,0 +1,80 @@
+// Output roles (element.hpp OutputRole): every element type declares its roles on real outputs.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <set>
+#include <string>
+
+#include "railcrash/element_registry.hpp"
+#include "railcrash/model_io.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+std::string source_path(const std::string& relative) { return std::string(RAILCRASH_SOURCE_DIR) + "/" + relative; }
+
+// The element types no shipped model uses, one element each.
+const char* const kOtherTypes =
+    "railcrash: 1\nname: other types\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    "  - {name: a, mass: 1, inertia: 1, position: [0, 0]}\n"
+    "  - {name: b, mass: 1, inertia: 1, position: [1, 0]}\nelements:\n"
+    "  - {name: coupling, type: coupling, kind: 1, curve: [[0, 0], [0.01, 1.0e5], [0.05, 3.0e5]], unloading_factor: 0.5,\n"
+    "     points: [{body: a}, {body: b}]}\n"
+    "  - {name: torsion, type: torsional_spring, stiffness: 10, points: [{body: ground}, {body: a}]}\n"
+    "  - {name: torsion_damper, type: torsional_dashpot, damping: 0.5, points: [{body: ground}, {body: a}]}\n"
+    "  - {name: double_slider, type: double_slider_joint, points: [{body: a}, {body: b}]}\n"
+    "  - {name: rigid, type: rigid_joint, points: [{body: a, at: [0.5, 0]}, {body: b, at: [-0.5, 0]}]}\n"
+    "simulation: {t_end: 0.1}\n";
+
+}  // namespace
+
+TEST_CASE("every element type's output roles name one of its outputs, each role at most once", "[roles]") {
+  std::vector<Model> models;
+  for (const char* file : {"models/report/final_two_car.yaml", "models/report/preliminary_car.yaml",
+                           "models/barrier/two_car_barrier.yaml", "models/examples/coupled_cars.yaml"})
+    models.push_back(load_model(source_path(file)));
+  models.push_back(testing::model_from_text(kOtherTypes));
+  std::set<std::string> checked;
+  for (const Model& model : models)
+    for (const auto& element : model.elements()) {
+      INFO(element->type() << " '" << element->name() << "'");
+      const std::vector<std::string> outputs = element->output_names();
+      std::set<OutputRole> seen;
+      for (const RoleOfOutput& r : element->output_roles()) {
+        INFO("role " << output_role_name(r.role) << " -> " << r.output);
+        CHECK(std::find(outputs.begin(), outputs.end(), std::string(r.output)) != outputs.end());
+        CHECK(seen.insert(r.role).second);
+        CHECK(element->output_with_role(r.role) == r.output);
+      }
+      checked.insert(element->type());
+    }
+  // Every registered type was among them, so none escapes the check.
+  for (const std::string& type : ElementRegistry::instance().types()) {
+    INFO(type);
+    CHECK(checked.count(type) == 1);
+  }
+}
+
+TEST_CASE("the roles say which outputs are crush, contact, coupler and interlock forces", "[roles]") {
+  // What the run summary, converge, the responses and the report selected by type before.
+  const Model model = load_model(source_path("models/report/final_two_car.yaml"));
+  const auto role_of = [&](const std::string& type, OutputRole role) {
+    for (const auto& e : model.elements())
+      if (e->type() == type) return e->output_with_role(role);
+    FAIL("no " << type << " in the report model");
+    return std::string();
+  };
+  CHECK(role_of("anticlimber", OutputRole::Crush) == "horizontal_deformation");
+  CHECK(role_of("anticlimber", OutputRole::ContactForce) == "horizontal_force");
+  CHECK(role_of("anticlimber", OutputRole::VerticalInterlockForce) == "vertical_force");
+  CHECK(role_of("coupler_end", OutputRole::CouplerForce) == "normal_force");
+  CHECK(role_of("coupler_end", OutputRole::CrashDeformation).empty());  // a gap is no deformation
+  CHECK(role_of("draft_gear", OutputRole::CrashForce) == "force");
+  CHECK(role_of("draft_gear", OutputRole::CrashDeformation) == "compression");
+  CHECK(role_of("draft_gear", OutputRole::CouplerForce).empty());
+  CHECK(role_of("elastic_plastic_beam", OutputRole::Crush).empty());
+  CHECK(role_of("wheel_rail", OutputRole::ContactForce).empty());
+  CHECK(std::string(output_role_name(OutputRole::VerticalInterlockForce)) == "vertical_interlock_force");
+}

@@ -1,0 +1,110 @@
+// Cars in the run summary (results.hpp): declared by the bodies' `car:` key, never guessed.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <string>
+
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+std::string temporary_folder(const std::string& name) {
+  const auto path = std::filesystem::temp_directory_path() / ("railcrash_test_" + name);
+  std::filesystem::remove_all(path);
+  return path.string();
+}
+
+// Two cars of two bodies each and a crush spring in each car and one between them; the
+// bodies' car keys (CAR_A, CAR_B) are filled in by the test.
+std::string two_car_text(const std::string& car_a, const std::string& car_b) {
+  return "railcrash: 1\nname: cars\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+         "  - {name: striker_rear, " + car_a + "mass: 10, inertia: 1, position: [-2, 0], velocity: [5, 0]}\n"
+         "  - {name: striker_end, " + car_a + "mass: 10, inertia: 1, position: [0, 0], velocity: [5, 0]}\n"
+         "  - {name: struck_end, " + car_b + "mass: 10, inertia: 1, position: [1, 0]}\n"
+         "  - {name: struck_rear, " + car_b + "mass: 10, inertia: 1, position: [3, 0]}\nelements:\n"
+         "  - {name: between, type: crush_spring, free_length: 1.0, curve: [[0, 0], [0.01, 1000], [1, 1000]], "
+         "unloading_stiffness: 1.0e5, points: [{body: striker_end, at: [0, 0]}, {body: struck_end, at: [0, 0]}]}\n"
+         "  - {name: inside, type: crush_spring, free_length: 2.0, curve: [[0, 0], [0.01, 1000], [1, 1000]], "
+         "unloading_stiffness: 1.0e5, points: [{body: struck_end, at: [0, 0]}, {body: struck_rear, at: [0, 0]}]}\n"
+         "  - {name: striker_spring, type: linear_spring, stiffness: 1.0e4, "
+         "points: [{body: striker_rear, at: [0, 0]}, {body: striker_end, at: [0, 0]}]}\n"
+         "simulation: {t_end: 0.05, output_interval: 0.001}\n";
+}
+
+}  // namespace
+
+TEST_CASE("cars are the bodies' car: keys and an element between two cars counts half for each", "[results]") {
+  const Model model = testing::model_from_text(two_car_text("car: striking, ", "car: struck, "));
+  const DaeSystem system(model);
+  const std::vector<CarCrush> cars = cars_of(system);
+  REQUIRE(cars.size() == 2);
+  CHECK(cars[0].car == "striking");
+  CHECK(cars[0].bodies == std::vector<int>{0, 1});
+  CHECK(cars[0].elements == std::vector<std::string>{"between"});
+  CHECK(cars[0].shares == std::vector<double>{0.5});
+  CHECK(cars[1].car == "struck");
+  CHECK(cars[1].bodies == std::vector<int>{2, 3});
+  CHECK(cars[1].elements == std::vector<std::string>{"between", "inside"});
+  CHECK(cars[1].shares == std::vector<double>{0.5, 1.0});
+}
+
+TEST_CASE("a model whose bodies declare no car has no per-car crush, and its summary says why", "[results]") {
+  // Names that once made cars (car1_, car2_) make none now: only the car: key does.
+  const std::string text = two_car_text("", "");
+  std::string named = text;
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"striker_", "car1_"}, {"struck_", "car2_"}})
+    for (std::size_t at = named.find(from); at != std::string::npos; at = named.find(from, at)) named.replace(at, from.size(), to);
+  for (const std::string& yaml : {text, named}) {
+    const Model model = testing::model_from_text(yaml);
+    CHECK(cars_of(DaeSystem(model)).empty());
+    const RunReport report = run_model(model, temporary_folder("no_cars"));
+    REQUIRE(report.outcome.ok);
+    CHECK(report.car_crush.empty());
+    CHECK_THAT(report.summary_json, Catch::Contains("\"car_crush\": {}") && Catch::Contains("\"cars_note\": \"no body declares a car"));
+  }
+  // With cars declared the note is gone and each car has its row.
+  const RunReport report =
+      run_model(testing::model_from_text(two_car_text("car: striking, ", "car: struck, ")), temporary_folder("cars"));
+  REQUIRE(report.outcome.ok);
+  CHECK_THAT(report.summary_json, !Catch::Contains("cars_note") &&
+                                      Catch::Contains("\"striking\": {\"max_crush\": ") &&
+                                      Catch::Contains("\"bodies\": [\"striker_rear\", \"striker_end\"]"));
+}
+
+TEST_CASE("the barrier model's two cars are summarised separately", "[results]") {
+  // models/barrier/two_car_barrier.yaml: the leading car's bodies are lead_*, the trailing
+  // car's trail_*; the shared coupler belongs to neither. Its crush elements are crush
+  // springs: lead_crush and lead_draft_sill within the leading car, trail_draft_sill within
+  // the trailing one.
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml");
+  const DaeSystem system(model);
+  const std::vector<CarCrush> cars = cars_of(system);
+  REQUIRE(cars.size() == 2);
+  const auto prefixed = [&](const std::string& prefix) {
+    std::vector<int> bodies;
+    for (int i = 0; i < model.body_count(); ++i)
+      if (model.bodies()[static_cast<std::size_t>(i)].name.rfind(prefix, 0) == 0) bodies.push_back(i);
+    return bodies;
+  };
+  const auto crush_springs_within = [&](const std::vector<int>& bodies) {
+    std::vector<std::string> names;
+    for (const auto& e : model.elements()) {
+      const auto in = [&](int slot) { return std::find(bodies.begin(), bodies.end(), e->slot_body(slot)) != bodies.end(); };
+      if (e->type() == "crush_spring" && in(0) && in(1)) names.push_back(e->name());
+    }
+    return names;
+  };
+  CHECK(cars[0].car == "lead");
+  CHECK(cars[0].bodies == prefixed("lead_"));
+  CHECK(cars[0].elements == crush_springs_within(prefixed("lead_")));
+  CHECK(cars[0].elements == std::vector<std::string>{"lead_crush", "lead_draft_sill"});
+  CHECK(cars[0].shares == std::vector<double>{1.0, 1.0});
+  CHECK(cars[1].car == "trail");
+  CHECK(cars[1].bodies == prefixed("trail_"));
+  CHECK(cars[1].elements == std::vector<std::string>{"trail_draft_sill"});
+  CHECK(cars[0].bodies.size() + cars[1].bodies.size() + 1 == static_cast<std::size_t>(model.body_count()));  // + coupler
+}
