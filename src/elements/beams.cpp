@@ -276,7 +276,7 @@ std::vector<ParameterSpec> with_material(const std::vector<ParameterSpec>& secti
 
 const char* const kBeamPoints = "P1 on body 1, P2 on body 2: the beam's ends, rigidly attached to their bodies";
 const char* const kBeamLaw =
-    "Co-rotational planar beam rigidly attached to both bodies: axial force N = k_a (e - e_p), end moments "
+    "co-rotational planar beam rigidly attached to both bodies, axial force N = k_a (e - e_p), end moments "
     "[M1; M2] = K_b (phi - phi_p); axial yield at yield_stress times the area, end hinges at yield_stress times "
     "the plastic section modulus, kinematic hardening with plastic_modulus, elastic unloading; fracture when "
     "|N| / A or |M| / Z reaches ultimate_stress.";
@@ -288,7 +288,8 @@ const char* const kBeamMaterialExample =
 void register_beams_elements(ElementRegistry& registry) {
   registry.add(
       {"elastic_plastic_beam", "5", 2, kBeamPoints,
-       std::string(kBeamLaw) + " Uniform section: k_a = E A / L0, K_b = E I / L0 [4 2; 2 4].",
+       "Elastic-plastic beam of uniform section: " + std::string(kBeamLaw) +
+           " For the uniform section k_a = E A / L0, K_b = E I / L0 [4 2; 2 4].",
        with_material(
            {{"height", Unit::Length, optional("give area and second_moment instead"), Range::Positive,
              "height of a rectangular section (in the plane of bending), with width"},
@@ -304,9 +305,9 @@ void register_beams_elements(ElementRegistry& registry) {
        std::string(kBeamMaterialExample) + "height: 0.1\nwidth: 0.05",
        [](ElementSpec& s) { return std::make_unique<ElasticPlasticBeam>(s); }});
   registry.add({"tapered_beam", "22", 2, kBeamPoints,
-                std::string(kBeamLaw) +
-                    " Rectangular section whose height and width vary linearly from end 1 to end 2: stiffness "
-                    "from the flexibility integrals of the taper.",
+                "Elastic-plastic beam of tapered section: " + std::string(kBeamLaw) +
+                    " The rectangular section's height and width vary linearly from end 1 to end 2; the stiffness "
+                    "comes from the flexibility integrals of the taper.",
                 with_material({{"height_1", Unit::Length, required, Range::Positive, "section height at end 1"},
                                {"height_2", Unit::Length, required, Range::Positive, "section height at end 2"},
                                {"width_1", Unit::Length, required, Range::Positive, "section width at end 1"},

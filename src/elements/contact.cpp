@@ -187,7 +187,7 @@ void register_contact_elements(ElementRegistry& registry) {
        [](ElementSpec& s) { return std::make_unique<SurfaceContact>(s, false); }});
   registry.add(
       {"wheel_rail", "18", 1, "P1: the wheel centre",
-       "The wheel centre against the rail line y = rail_height + wheel_radius (normal +y), as `contact` with two "
+       "Wheel on a rail: the wheel centre against the rail line y = rail_height + wheel_radius (normal +y), as `contact` with two "
        "slopes: stiffness below the penetration `breakpoint`, stiffness_above beyond it; friction is the "
        "braking / rolling resistance.",
        contact_law_specs({{"wheel_radius", Unit::Length, required, Range::Positive, "wheel radius"},

@@ -887,7 +887,7 @@ ParameterSpec friction_velocity_spec() {
 void register_couplers_elements(ElementRegistry& registry) {
   registry.add(
       {"draft_gear", "13", 2, "P1 on body 1, P2 on body 2: the ends of the gear (yoke and draft pocket)",
-       "Friction draft gear along P1-P2, compression d = free_length - L, mirror-symmetric in draft: stuck by "
+       "Friction draft gear along P1-P2: compression d = free_length - L, mirror-symmetric in draft: stuck by "
        "friction until breakaway, loads on initial_stiffness d + hysteresis_load, bottoms at `travel` "
        "(stiffness_after_bottoming beyond), unloads elastically (transition_stiffness) down to "
        "initial_stiffness d - hysteresis_load, released at zero force. Buff overload shears the pin: free "
@@ -913,7 +913,7 @@ void register_couplers_elements(ElementRegistry& registry) {
        [](ElementSpec& s) { return std::make_unique<DraftGear>(s); }});
   registry.add(
       {"coupler_end", "14", 2, "P1 on coupler K, P2 on coupler L, each free_length behind its face",
-       "Contact of two vertical coupler faces along global x, the two horizontal stiffnesses in series: the faces "
+       "Two coupler faces in contact: vertical faces along global x, the two horizontal stiffnesses in series; the faces "
        "push when closer than their contact spacing, and pull only when coupled and past the total horizontal "
        "slack; only while the faces overlap vertically (coupler_height). Friction mu |T| tanh(Dy' / "
        "friction_velocity) between the faces. With restitution e < 1 (uncoupled only) the faces unload and reload "

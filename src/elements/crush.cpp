@@ -166,7 +166,7 @@ void CrushSpring::outputs(const ElementState<double>& s, const double*, double* 
 
 void register_crush_elements(ElementRegistry& registry) {
   registry.add({"crush_spring", "", 2, "P1 on body 1, P2 on body 2: the ends of the structure",
-                "Crushable structure between P1 and P2, crush d = free_length - L (positive when shortened), "
+                "Crushable structure along P1-P2: crush d = free_length - L (positive when shortened), "
                 "force P >= 0 pushing the points apart. While crushing P follows the loading `curve` (its last "
                 "slope continues beyond it); it unloads and reloads elastically with unloading_stiffness, "
                 "remembering the permanent crush; in tension no force (or tension_stiffness when given).",

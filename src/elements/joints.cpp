@@ -151,7 +151,8 @@ void register_joint_elements(ElementRegistry& registry) {
       "friction_radius: 0.01", make_joint<PinJoint>));
   registry.add(joint_type(
       "slider_joint", "7",
-      "P2 on the line through P1 along the axis (fixed in body 1) and theta2 - theta1 locked (2 equations). "
+      "P2 slides along the axis, theta2 - theta1 locked (2 equations): P2 stays on the line through P1 along the axis "
+      "(fixed in body 1). "
       "Optional friction mu sqrt(R_n^2 + (2M/slider_length)^2) tanh(v / friction_velocity) along the axis.",
       {axis_spec(), relative_angle_spec(),
        {"friction", Unit::Dimensionless, default_value(0.0), Range::NonNegative, "friction coefficient mu; 0: none"},
@@ -160,7 +161,8 @@ void register_joint_elements(ElementRegistry& registry) {
        friction_velocity_spec(Unit::Velocity)},
       "axis: [1, 0]\nfriction: 0.1\nslider_length: 0.5", make_joint<SliderJoint>));
   registry.add(joint_type("sliding_pin_joint", "8",
-                          "P2 on the line through P1 along the axis (fixed in body 1); rotation free (1 equation).",
+                          "P2 slides along the axis, rotation free (1 equation): P2 stays on the line through P1 along the axis (fixed "
+                          "in body 1).",
                           {axis_spec()}, "axis: [0, 1]", make_joint<SlidingPinJoint>));
   registry.add(joint_type("double_slider_joint", "9", "theta2 - theta1 locked; translation free (1 equation).",
                           {relative_angle_spec()}, "relative_angle: 0", make_joint<DoubleSliderJoint>));

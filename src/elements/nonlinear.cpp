@@ -343,7 +343,7 @@ void register_nonlinear_elements(ElementRegistry& registry) {
   const std::string ends = "P1 on body 1, P2 on body 2: the ends";
   registry.add(
       {"nonlinear_spring", "19", 2, ends,
-       "Spring along P1-P2 with two slopes on each side of e = L - free_length: tension T = -preload + "
+       "Piecewise-linear spring along P1-P2: two slopes on each side of e = L - free_length: tension T = -preload + "
        "compression_stiffness_1 e (e < 0) or extension_stiffness_1 e (e > 0), continuing with the second slope beyond "
        "the breakpoint; continuous in e, elastic; breaks when |T| reaches fracture_load.",
        joined(joined(branch_specs("compression_stiffness_1", "compression_stiffness_2", "compression_breakpoint",
@@ -360,7 +360,7 @@ void register_nonlinear_elements(ElementRegistry& registry) {
        [](ElementSpec& s) { return std::make_unique<NonlinearSpring>(s); }});
   registry.add(
       {"nonlinear_dashpot", "20", 2, ends,
-       "Dashpot along P1-P2, tension continuous and piecewise linear in the rate L': damping_compression_1 L' "
+       "Piecewise-linear dashpot along P1-P2: tension continuous and piecewise linear in the rate L': damping_compression_1 L' "
        "(L' < 0) or damping_extension_1 L' (L' > 0), continuing with the second coefficient beyond the switch "
        "velocity.",
        joined(branch_specs("damping_compression_1", "damping_compression_2", "compression_switch_velocity",
