@@ -439,6 +439,10 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
     }
     spec.points.push_back(ref);
   }
+  if (spec.points.size() != element_type->points)
+    throw InputError(spec.where.prefix() + context + " needs exactly " + std::to_string(element_type->points) +
+                     (element_type->points == 1 ? " point" : " points") + ", found " +
+                     std::to_string(spec.points.size()) + " (" + element_type->points_meaning + ")");
   // Keys first: a misspelt key would otherwise show up as a missing one.
   std::vector<std::string> allowed{"name", "type", "points"};
   for (const std::string& key : element_type->keys()) allowed.push_back(key);

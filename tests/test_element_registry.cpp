@@ -221,6 +221,20 @@ TEST_CASE("a misspelt key is rejected with the declared key it is closest to", "
   }
 }
 
+TEST_CASE("a wrong number of points is refused with the declared count and what the points are", "[registry]") {
+  for (const std::string& name : ElementRegistry::instance().types()) {
+    INFO("element type " << name);
+    const ElementType& type = *ElementRegistry::instance().find(name);
+    std::string text = model_text(type, example_parameters(type));
+    const std::string one_more = type.points == 1 ? ", {body: car2, at: [0, 0]}]" : ", {body: car2, at: [1, 0]}]";
+    text.replace(text.find("]\n    ", text.find("points:")), 1, one_more);
+    CHECK_THAT(load_error(text), Catch::Contains("test.yaml:9: element 'e' (" + name + ") needs exactly " +
+                                                 std::to_string(type.points) + (type.points == 1 ? " point" : " points") +
+                                                 ", found " + std::to_string(type.points + 1) + " (" +
+                                                 type.points_meaning + ")"));
+  }
+}
+
 TEST_CASE("the reader refuses undeclared keys and wrong shapes, and hands out declared defaults", "[registry]") {
   const ElementType& spring = *ElementRegistry::instance().find("linear_spring");
   const ElementType& pin = *ElementRegistry::instance().find("pin_joint");
