@@ -196,12 +196,6 @@ std::optional<std::string> ParameterReader::word(const std::string& key) {
   return given;
 }
 
-void ElementSpec::require_points(std::size_t count) const {
-  if (points.size() != count)
-    throw InputError(where.prefix() + "element '" + name + "' (" + type + ") needs exactly " + std::to_string(count) +
-                     " points, found " + std::to_string(points.size()));
-}
-
 // ---- ElementRegistry ------------------------------------------------------------------------
 
 const ElementRegistry& ElementRegistry::instance() {

@@ -136,15 +136,14 @@ class ParameterReader {
   const ElementType& type_;
 };
 
+/// What a factory gets: the element's name, type, points (as many as the type declares: the
+/// loader checks the count) and its parameters.
 struct ElementSpec {
   std::string name;
   std::string type;
   std::vector<PointRef> points;
   SourceLocation where;
   ParameterReader* parameters = nullptr;
-
-  /// Throws unless the element has exactly `count` points.
-  void require_points(std::size_t count) const;
 };
 
 class ElementRegistry {

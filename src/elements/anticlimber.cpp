@@ -104,7 +104,6 @@ ElasticPlasticLaw make_law(ParameterReader& p, const std::string& direction, std
 
 Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
-  spec.require_points(2);
   length = p.number("length");
   facing = p.number("facing");
   const std::optional<std::string> interlock = p.word("interlock_while_unloading");

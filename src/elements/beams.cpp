@@ -122,9 +122,7 @@ TaperedBeam::TaperedBeam(ElementSpec& spec)
 // ---- the common law ----------------------------------------------------------------------
 
 BeamElement::BeamElement(ElementSpec& spec, BeamMaterial beam_material)
-    : ForceElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {
-  spec.require_points(2);
-}
+    : ForceElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {}
 
 void BeamElement::initialize(const ElementState<double>& initial) {
   if (point_slot(0) == point_slot(1))

@@ -7,7 +7,6 @@ namespace railcrash {
 
 SurfaceContact::SurfaceContact(ElementSpec& spec, bool wheel_rail)
     : ForceElement(spec.name, spec.type, spec.points, spec.where), wheel_rail_(wheel_rail) {
-  spec.require_points(1);
   ParameterReader& p = *spec.parameters;
   stiffness = p.value("stiffness");
   damping = p.value("damping");

@@ -388,7 +388,6 @@ DraftGear::DraftGear(ElementSpec& spec) : ForceElement(spec.name, spec.type, spe
   fracture_load = p.number("fracture_load");
   const auto transition = p.number("transition_stiffness");
   free_length = p.number("free_length");
-  spec.require_points(2);
   if (post_shear && !pin_shear_load)
     p.fail("post_shear_travel", "'post_shear_travel' is the travel after the shear pin fails: give 'pin_shear_load' too");
   post_shear_travel = post_shear.value_or(0.0);
@@ -532,7 +531,6 @@ CouplerEnd::CouplerEnd(ElementSpec& spec) : ForceElement(spec.name, spec.type, s
   coupled = *p.flag("coupled");
   restitution = p.value("restitution");
   shear_load = p.number("shear_load");
-  spec.require_points(2);
   if (restitution < 1.0 && coupled)
     p.fail("restitution",
            "'restitution' below 1 gives the faces a permanent set in buff, which the coupled knuckles' draft law does not "
@@ -736,7 +734,6 @@ Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.
   friction_velocity = p.value("friction_velocity");
   const auto transition = p.number("transition_stiffness");
   free_length = p.number("free_length");
-  spec.require_points(2);
 
   if (kind_value != 1.0 && kind_value != 2.0)
     p.fail("kind", "'kind' must be 1 (curve + unloading_factor, report type 11) or 2 (loading_curve + unloading_curve, "

@@ -11,7 +11,6 @@ CrushSpring::CrushSpring(ElementSpec& spec)
       unloading_stiffness(spec.parameters->value("unloading_stiffness")),
       tension_stiffness(spec.parameters->number("tension_stiffness")),
       free_length(spec.parameters->number("free_length")) {
-  spec.require_points(2);
   const auto table = spec.parameters->table("curve", 2);  // required: the reader fails when it is absent
   if (table->size() < 2) spec.parameters->fail("curve", "'curve' needs at least two points [[crush, force], ...]");
   for (std::size_t k = 0; k < table->size(); ++k) {

@@ -34,7 +34,6 @@ std::unique_ptr<Element> make_joint(ElementSpec& spec) {
 }  // namespace
 
 PinJoint::PinJoint(ElementSpec& spec) : ConstraintElement(spec.name, spec.type, spec.points, spec.where) {
-  spec.require_points(2);
   friction_radius = spec.parameters->value("friction_radius");
   friction_velocity = spec.parameters->value("friction_velocity");
 }
@@ -48,7 +47,6 @@ void PinJoint::outputs(const ElementState<double>&, const double* lambda, double
 SliderJoint::SliderJoint(ElementSpec& spec)
     : ConstraintElement(spec.name, spec.type, spec.points, spec.where),
       AngleLockingJoint(spec.parameters->number("relative_angle")) {
-  spec.require_points(2);
   const auto axis = read_axis(spec);
   axis_x = axis[0];
   axis_y = axis[1];
@@ -70,7 +68,6 @@ void SliderJoint::outputs(const ElementState<double>& s, const double* lambda, d
 }
 
 SlidingPinJoint::SlidingPinJoint(ElementSpec& spec) : ConstraintElement(spec.name, spec.type, spec.points, spec.where) {
-  spec.require_points(2);
   const auto axis = read_axis(spec);
   axis_x = axis[0];
   axis_y = axis[1];
@@ -85,9 +82,7 @@ void SlidingPinJoint::outputs(const ElementState<double>& s, const double* lambd
 
 DoubleSliderJoint::DoubleSliderJoint(ElementSpec& spec)
     : ConstraintElement(spec.name, spec.type, spec.points, spec.where),
-      AngleLockingJoint(spec.parameters->number("relative_angle")) {
-  spec.require_points(2);
-}
+      AngleLockingJoint(spec.parameters->number("relative_angle")) {}
 
 void DoubleSliderJoint::outputs(const ElementState<double>&, const double* lambda, double* out) const {
   out[0] = -lambda[0];
@@ -95,9 +90,7 @@ void DoubleSliderJoint::outputs(const ElementState<double>&, const double* lambd
 
 RigidJoint::RigidJoint(ElementSpec& spec)
     : ConstraintElement(spec.name, spec.type, spec.points, spec.where),
-      AngleLockingJoint(spec.parameters->number("relative_angle")) {
-  spec.require_points(2);
-}
+      AngleLockingJoint(spec.parameters->number("relative_angle")) {}
 
 void RigidJoint::outputs(const ElementState<double>&, const double* lambda, double* out) const {
   out[0] = -lambda[0];

@@ -91,9 +91,7 @@ int PiecewiseLinearLaw::segment_at(double x, int direction) const {
 
 template <class Derived>
 PiecewiseLineElement<Derived>::PiecewiseLineElement(ElementSpec& spec, int fracture_sides)
-    : ForceElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {
-  spec.require_points(2);
-}
+    : ForceElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {}
 
 template <class Derived>
 void PiecewiseLineElement<Derived>::set_law(PiecewiseLinearLaw law) {

@@ -10,9 +10,7 @@ namespace railcrash {
 LinearSpring::LinearSpring(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
       stiffness(spec.parameters->value("stiffness")),
-      free_length(spec.parameters->number("free_length")) {
-  spec.require_points(2);
-}
+      free_length(spec.parameters->number("free_length")) {}
 
 void LinearSpring::initialize(const ElementState<double>& initial) {
   const double length = line_geometry(*this, initial).length;
@@ -36,9 +34,7 @@ void LinearSpring::outputs(const ElementState<double>& s, const double*, double*
 
 LinearDashpot::LinearDashpot(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      damping(spec.parameters->value("damping")) {
-  spec.require_points(2);
-}
+      damping(spec.parameters->value("damping")) {}
 
 void LinearDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
   const LineGeometry<double> g = line_geometry(*this, s);
@@ -50,9 +46,7 @@ void LinearDashpot::outputs(const ElementState<double>& s, const double*, double
 TorsionalSpring::TorsionalSpring(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
       stiffness(spec.parameters->value("stiffness")),
-      free_angle(spec.parameters->number("free_angle")) {
-  spec.require_points(2);
-}
+      free_angle(spec.parameters->number("free_angle")) {}
 
 void TorsionalSpring::initialize(const ElementState<double>& initial) {
   if (!free_angle) free_angle = relative_angle(initial);
@@ -71,9 +65,7 @@ void TorsionalSpring::outputs(const ElementState<double>& s, const double*, doub
 
 TorsionalDashpot::TorsionalDashpot(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      damping(spec.parameters->value("damping")) {
-  spec.require_points(2);
-}
+      damping(spec.parameters->value("damping")) {}
 
 void TorsionalDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
   const double rate = s.v[static_cast<std::size_t>(point_slot(1))].theta - s.v[static_cast<std::size_t>(point_slot(0))].theta;
