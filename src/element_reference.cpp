@@ -135,7 +135,7 @@ std::string element_reference_markdown(const ElementRegistry& registry) {
       out += "| parameter | unit | default | range | meaning |\n|---|---|---|---|---|\n";
       for (const ParameterSpec& spec : type.parameters)
         out += "| `" + spec.name + "` | " + cell(unit_text(spec.unit, "`")) + " | " + cell(presence_text(spec.presence, "`")) +
-               " | " + cell(range_text(spec.range)) + " | " + cell(spec.meaning) + " |\n";
+               " | " + (spec.range == Range::Any ? "—" : cell(range_text(spec.range))) + " | " + cell(spec.meaning) + " |\n";
       out += "\n";
     }
     out += "```yaml\n" + example_element(type, "") + "```\n";
