@@ -108,11 +108,6 @@ const char* shape_name(Shape shape) {
   return "";
 }
 
-/// " (force/length: the spring rate)": the kind and meaning of a key, for messages.
-std::string described(const ParameterSpec& spec) {
-  return " (" + std::string(unit_kind_name(spec.unit)) + ": " + spec.meaning + ")";
-}
-
 }  // namespace
 
 const ParameterSpec& ParameterReader::declared(const std::string& key, Shape shape) const {
@@ -122,6 +117,12 @@ const ParameterSpec& ParameterReader::declared(const std::string& key, Shape sha
     throw std::logic_error("element type '" + type_.name + "' reads parameter '" + key + "' as a " + shape_name(shape) +
                            " but declares it as a " + shape_name(spec->shape));
   return *spec;
+}
+
+std::string ParameterReader::described(const ParameterSpec& spec) const {
+  const std::string symbol = unit_symbol(spec.unit, units_);
+  return " (" + std::string(unit_kind_name(spec.unit)) + (symbol.empty() ? "" : " [" + symbol + "]") + ": " +
+         spec.meaning + ")";
 }
 
 void ParameterReader::check_range(const ParameterSpec& spec, double value) const {

@@ -204,8 +204,9 @@ class Reader {
 
 class YamlParameterReader : public ParameterReader {
  public:
-  YamlParameterReader(const ElementType& type, const Reader& reader, const YAML::Node& element, std::string context)
-      : ParameterReader(type), reader_(reader), element_(element), context_(std::move(context)) {}
+  YamlParameterReader(const ElementType& type, UnitSystem units, const Reader& reader, const YAML::Node& element,
+                      std::string context)
+      : ParameterReader(type, units), reader_(reader), element_(element), context_(std::move(context)) {}
 
   std::optional<double> given_number(const std::string& key) override {
     const YAML::Node node = element_[key];
@@ -447,7 +448,7 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
   std::vector<std::string> allowed{"name", "type", "points"};
   for (const std::string& key : element_type->keys()) allowed.push_back(key);
   r.check_keys(node, allowed, context);
-  YamlParameterReader parameters(*element_type, r, node, context);
+  YamlParameterReader parameters(*element_type, model.units, r, node, context);
   spec.parameters = &parameters;
   return element_type->factory(spec);
 }

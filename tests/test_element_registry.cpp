@@ -79,7 +79,8 @@ std::string location_of(const std::string& text, const std::string& key) {
 /// Serves an element's parameters from a YAML map and records every key the factory asks for.
 class RecordingReader : public ParameterReader {
  public:
-  RecordingReader(const ElementType& type, YAML::Node parameters) : ParameterReader(type), parameters_(parameters) {}
+  RecordingReader(const ElementType& type, YAML::Node parameters)
+      : ParameterReader(type, UnitSystem::SI), parameters_(parameters) {}
   std::set<std::string> asked;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what_to_change) const override {
@@ -112,6 +113,13 @@ class RecordingReader : public ParameterReader {
  private:
   YAML::Node parameters_;
 };
+
+/// " (force/length [N/m]: spring rate)": how messages describe a key of an SI model.
+std::string described(const ParameterSpec& spec) {
+  const std::string symbol = unit_symbol(spec.unit, UnitSystem::SI);
+  return " (" + std::string(unit_kind_name(spec.unit)) + (symbol.empty() ? "" : " [" + symbol + "]") + ": " +
+         spec.meaning + ")";
+}
 
 /// A value `range` rejects, written for `shape`.
 std::string out_of_range_value(const ParameterSpec& spec) {
@@ -180,7 +188,7 @@ TEST_CASE("every required key, left out, is reported missing by name with its un
       INFO("element type " << name << ", key " << spec.name);
       const std::string message = load_error(model_text(type, without(example, spec.name)));
       CHECK_THAT(message, Catch::Contains("test.yaml:9: element 'e' (" + name + "): missing required parameter '" +
-                                          spec.name + "' (" + unit_kind_name(spec.unit) + ": " + spec.meaning + ")"));
+                                          spec.name + "'" + described(spec)));
       ++checked;
     }
   }
@@ -198,8 +206,7 @@ TEST_CASE("a value outside a key's declared range gives the range message at the
       INFO("element type " << name << ", key " << spec.name);
       const std::string text = model_text(type, with(example, spec.name, out_of_range_value(spec)));
       CHECK_THAT(load_error(text), Catch::Contains(location_of(text, spec.name) + "element 'e' (" + name + "): " +
-                                                   range_message(spec) + " (" + unit_kind_name(spec.unit) + ": " +
-                                                   spec.meaning + ")"));
+                                                   range_message(spec) + described(spec)));
       ++checked;
     }
   }
@@ -233,6 +240,21 @@ TEST_CASE("a wrong number of points is refused with the declared count and what 
                                                  ", found " + std::to_string(type.points + 1) + " (" +
                                                  type.points_meaning + ")"));
   }
+}
+
+TEST_CASE("messages name a key's unit in the model's unit system", "[registry]") {
+  const std::string in_lbf_s =
+      "railcrash: 1\nname: t\nunits: in-lbf-s\nbodies:\n  - {name: a, weight: 100, inertia: 1, position: [0, 0]}\n"
+      "elements:\n  - name: k\n    type: linear_spring\n    points: [{body: ground}, {body: a}]\n    stiffness: -3\n"
+      "simulation: {t_end: 1}\n";
+  CHECK_THAT(load_error(in_lbf_s), Catch::Contains("test.yaml:10: element 'k' (linear_spring): 'stiffness' must not be "
+                                                   "negative, not -3 (force/length [lbf/in]: spring rate)"));
+  std::string si = in_lbf_s;
+  si.replace(si.find("in-lbf-s"), 8, "SI");
+  si.replace(si.find("weight: 100"), 11, "mass: 1");
+  si.replace(si.find("    stiffness: -3\n"), 18, "");
+  CHECK_THAT(load_error(si), Catch::Contains("test.yaml:7: element 'k' (linear_spring): missing required parameter "
+                                             "'stiffness' (force/length [N/m]: spring rate)"));
 }
 
 TEST_CASE("the reader refuses undeclared keys and wrong shapes, and hands out declared defaults", "[registry]") {

@@ -101,7 +101,8 @@ struct ElementType {
 /// give the default; `value` of an absent required key fails with the standard message.
 class ParameterReader {
  public:
-  explicit ParameterReader(const ElementType& type) : type_(type) {}
+  /// `units`: the model's unit system, for the units named in messages.
+  ParameterReader(const ElementType& type, UnitSystem units) : type_(type), units_(units) {}
   virtual ~ParameterReader() = default;
 
   /// The number (the default when absent), or nullopt when absent without a default.
@@ -132,8 +133,11 @@ class ParameterReader {
  private:
   const ParameterSpec& declared(const std::string& key, Shape shape) const;
   void check_range(const ParameterSpec& spec, double value) const;
+  /// " (force/length [lbf/in]: spring rate)": the kind, unit and meaning of a key, for messages.
+  std::string described(const ParameterSpec& spec) const;
 
   const ElementType& type_;
+  UnitSystem units_;
 };
 
 /// What a factory gets: the element's name, type, points (as many as the type declares: the
