@@ -13,6 +13,7 @@
 
 #include "railcrash/consist.hpp"
 #include "railcrash/dae_system.hpp"
+#include "railcrash/element_reference.hpp"
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
@@ -65,6 +66,30 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
   }
   std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end,
               model.simulation.integrator == IntegratorKind::Ida ? "ida" : "euler");
+  return 0;
+}
+
+/// `railcrash elements [TYPE] [--markdown]`: the element reference from the declarations.
+int elements_command(const std::string& type_name, bool markdown) {
+  using namespace railcrash;
+  const ElementRegistry& registry = ElementRegistry::instance();
+  if (markdown) {
+    if (!type_name.empty()) throw InputError("elements: --markdown prints the whole reference; leave out '" + type_name + "'");
+    std::fputs(element_reference_markdown(registry).c_str(), stdout);
+    return 0;
+  }
+  if (type_name.empty()) {
+    std::fputs(element_type_list(registry).c_str(), stdout);
+    return 0;
+  }
+  const ElementType* type = registry.find(type_name);
+  if (!type) {
+    std::string known;
+    for (const std::string& name : registry.types()) known += (known.empty() ? "" : ", ") + name;
+    throw InputError("elements: unknown element type '" + type_name + "'" + suggestion(type_name, registry.types()) +
+                     "; known types: " + known);
+  }
+  std::fputs(element_type_reference(*type).c_str(), stdout);
   return 0;
 }
 
@@ -358,6 +383,12 @@ int main(int argc, char** argv) {
   check->add_option("model", model_path, "model file (YAML)")->required();
   check->add_option("--set", settings, "override a model key");
 
+  std::string element_type_name;
+  bool elements_markdown = false;
+  CLI::App* elements = app.add_subcommand("elements", "element reference: the types, or one type's points and parameters");
+  elements->add_option("type", element_type_name, "element type (default: list all types)");
+  elements->add_flag("--markdown", elements_markdown, "print the whole reference as Markdown (docs/elements.md)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -365,6 +396,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*check) return check_command(model_path, settings);
+    if (*elements) return elements_command(element_type_name, elements_markdown);
     if (*report) return report_command(report_dir, report_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out);
     if (*converge) {

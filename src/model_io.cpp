@@ -204,23 +204,21 @@ class Reader {
 
 class YamlParameterReader : public ParameterReader {
  public:
-  YamlParameterReader(const Reader& reader, const YAML::Node& element, std::string context)
-      : reader_(reader), element_(element), context_(std::move(context)) {}
+  YamlParameterReader(const ElementType& type, UnitSystem units, const Reader& reader, const YAML::Node& element,
+                      std::string context)
+      : ParameterReader(type, units), reader_(reader), element_(element), context_(std::move(context)) {}
 
-  std::optional<double> number(const std::string& key) override {
-    used_.insert(key);
+  std::optional<double> given_number(const std::string& key) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
     return reader_.number(node, context_ + ": '" + key + "'");
   }
-  std::optional<std::vector<double>> vector(const std::string& key, std::size_t size) override {
-    used_.insert(key);
+  std::optional<std::vector<double>> given_vector(const std::string& key, std::size_t size) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
     return reader_.numbers(node, size, context_ + ": '" + key + "'");
   }
-  std::optional<std::vector<std::vector<double>>> table(const std::string& key, std::size_t width) override {
-    used_.insert(key);
+  std::optional<std::vector<std::vector<double>>> given_table(const std::string& key, std::size_t width) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
     if (!node.IsSequence() || node.size() == 0)
@@ -230,14 +228,12 @@ class YamlParameterReader : public ParameterReader {
       rows.push_back(reader_.numbers(node[i], width, context_ + ": '" + key + "' row " + std::to_string(i + 1)));
     return rows;
   }
-  std::optional<bool> flag(const std::string& key) override {
-    used_.insert(key);
+  std::optional<bool> given_flag(const std::string& key) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
     return reader_.boolean(node, context_ + ": '" + key + "'");
   }
-  std::optional<std::string> word(const std::string& key) override {
-    used_.insert(key);
+  std::optional<std::string> given_word(const std::string& key) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
     return reader_.text(node, context_ + ": '" + key + "'");
@@ -246,13 +242,11 @@ class YamlParameterReader : public ParameterReader {
     const YAML::Node node = element_[key];
     reader_.fail(node ? node : element_, context_ + ": " + what_to_change);
   }
-  const std::set<std::string>& used() const { return used_; }
 
  private:
   const Reader& reader_;
   YAML::Node element_;
   std::string context_;
-  std::set<std::string> used_;
 };
 
 /// Marks the key that now holds `value` in `map` as coming from `setting` too (so an
@@ -362,51 +356,6 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
                    "bodies.<name>.<key> or elements.<name>.<key>");
 }
 
-/// Runs an element factory on stand-in values to learn every key its type reads (the
-/// real reader stops at the first problem, so it may not have seen them all).
-class KeyProbe : public ParameterReader {
- public:
-  struct Stop {};
-  std::optional<double> number(const std::string& key) override {
-    keys.insert(key);
-    return 1.0;
-  }
-  std::optional<std::vector<double>> vector(const std::string& key, std::size_t size) override {
-    keys.insert(key);
-    return std::vector<double>(size > 0 ? size : 2, 1.0);
-  }
-  std::optional<std::vector<std::vector<double>>> table(const std::string& key, std::size_t width) override {
-    keys.insert(key);
-    return std::vector<std::vector<double>>{std::vector<double>(width, 0.0), std::vector<double>(width, 1.0)};
-  }
-  std::optional<bool> flag(const std::string& key) override {
-    keys.insert(key);
-    return false;
-  }
-  std::optional<std::string> word(const std::string& key) override {
-    keys.insert(key);
-    return std::nullopt;  // the default, which every type accepts
-  }
-  [[noreturn]] void fail(const std::string&, const std::string&) const override { throw Stop{}; }
-  std::set<std::string> keys;
-};
-
-std::set<std::string> keys_read_by(const ElementFactory& factory, const ElementSpec& spec) {
-  KeyProbe probe;
-  ElementSpec copy = spec;
-  copy.parameters = &probe;
-  // A wrong point count stops the factory part-way, so also try the usual point counts.
-  for (std::size_t count : {spec.points.size(), std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{4}}) {
-    copy.points.assign(count, PointRef{});
-    try {
-      (void)factory(copy);
-    } catch (const KeyProbe::Stop&) {
-    } catch (const InputError&) {
-    }
-  }
-  return probe.keys;
-}
-
 const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
                                            "responses"};
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity",
@@ -464,8 +413,8 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
   const YAML::Node type_node = r.required(node, "type", "element '" + name + "'");
   const std::string type = r.text(type_node, "element '" + name + "': type");
   const ElementRegistry& registry = ElementRegistry::instance();
-  const ElementFactory* factory = registry.find(type);
-  if (!factory)
+  const ElementType* element_type = registry.find(type);
+  if (!element_type)
     r.fail(type_node, "element '" + name + "': unknown element type '" + type + "'" + suggestion(type, registry.types()) +
                           "; known types: " + join(registry.types()));
   const std::string context = "element '" + name + "' (" + type + ")";
@@ -497,24 +446,17 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
     }
     spec.points.push_back(ref);
   }
-  YamlParameterReader parameters(r, node, context);
-  spec.parameters = &parameters;
+  if (spec.points.size() != element_type->points)
+    throw InputError(spec.where.prefix() + context + " needs exactly " + std::to_string(element_type->points) +
+                     (element_type->points == 1 ? " point" : " points") + ", found " +
+                     std::to_string(spec.points.size()) + " (" + element_type->points_meaning + ")");
+  // Keys first: a misspelt key would otherwise show up as a missing one.
   std::vector<std::string> allowed{"name", "type", "points"};
-  std::unique_ptr<Element> element;
-  try {
-    element = (*factory)(spec);
-  } catch (const InputError&) {
-    // A misspelt key first shows up as a missing one ("stifness" -> stiffness missing):
-    // report unknown keys first, against everything the type accepts.
-    std::set<std::string> keys = keys_read_by(*factory, spec);
-    keys.insert(parameters.used().begin(), parameters.used().end());
-    allowed.insert(allowed.end(), keys.begin(), keys.end());
-    r.check_keys(node, allowed, context);
-    throw;
-  }
-  for (const auto& key : parameters.used()) allowed.push_back(key);
+  for (const std::string& key : element_type->keys()) allowed.push_back(key);
   r.check_keys(node, allowed, context);
-  return element;
+  YamlParameterReader parameters(*element_type, model.units, r, node, context);
+  spec.parameters = &parameters;
+  return element_type->factory(spec);
 }
 
 TimeTable read_load_value(const Reader& r, const YAML::Node& node, std::size_t width, const std::string& context) {

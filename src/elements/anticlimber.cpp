@@ -81,43 +81,21 @@ namespace {
 
 const char* const kDirections[3] = {"horizontal", "vertical", "torsional"};
 
-struct LawInput {
-  std::optional<double> elastic, plastic, yield, rupture;
-};
-
-LawInput read_law_input(ParameterReader& p, const std::string& direction) {
-  // Every key is read before any is checked, so that the loader learns all the keys the type
-  // accepts (it reports misspelt keys against them).
-  LawInput in;
-  in.elastic = p.number(direction + "_elastic_stiffness");
-  in.plastic = p.number(direction + "_plastic_stiffness");
-  in.yield = p.number(direction + "_yield_deflection");
-  in.rupture = p.number(direction + "_rupture_deflection");
-  return in;
-}
-
-ElasticPlasticLaw make_law(ParameterReader& p, const std::string& direction, const LawInput& in, bool one_sided) {
-  const bool rotation = direction == "torsional";
-  const std::string slope_unit = rotation ? " [moment/rad]" : " [force/length]";
-  const std::string deflection_unit = rotation ? " [rad]" : " [length]";
+/// One direction's law; `default_rupture` applies when its rupture deflection is not given.
+ElasticPlasticLaw make_law(ParameterReader& p, const std::string& direction, std::optional<double> default_rupture,
+                           bool one_sided) {
   const std::string elastic = direction + "_elastic_stiffness", plastic = direction + "_plastic_stiffness";
   const std::string yield = direction + "_yield_deflection", rupture = direction + "_rupture_deflection";
-  if (!in.elastic) p.fail(elastic, "missing required parameter '" + elastic + "'" + slope_unit + ": the elastic slope");
-  if (!(*in.elastic > 0.0)) p.fail(elastic, "'" + elastic + "' must be positive");
-  if (!in.plastic)
-    p.fail(plastic, "missing required parameter '" + plastic + "'" + slope_unit + ": the slope after yield (0: perfectly plastic)");
-  if (*in.plastic < 0.0) p.fail(plastic, "'" + plastic + "' must not be negative");
-  if (!(*in.plastic < *in.elastic))
-    p.fail(plastic, "'" + plastic + "' must be below '" + elastic + "' (the law must soften at yield)");
-  if (!in.yield) p.fail(yield, "missing required parameter '" + yield + "'" + deflection_unit);
-  if (!(*in.yield > 0.0)) p.fail(yield, "'" + yield + "' must be positive");
-  if (in.rupture && !(*in.rupture > *in.yield))
-    p.fail(rupture, "'" + rupture + "' must exceed '" + yield + "' (rupture happens in plastic flow); leave it out for no rupture");
   ElasticPlasticLaw law;
-  law.elastic_stiffness = *in.elastic;
-  law.plastic_stiffness = *in.plastic;
-  law.yield_deflection = *in.yield;
-  law.rupture_deflection = in.rupture;
+  law.elastic_stiffness = p.value(elastic);
+  law.plastic_stiffness = p.value(plastic);
+  if (!(law.plastic_stiffness < law.elastic_stiffness))
+    p.fail(plastic, "'" + plastic + "' must be below '" + elastic + "' (the law must soften at yield)");
+  law.yield_deflection = p.value(yield);
+  const std::optional<double> given_rupture = p.number(rupture);
+  if (given_rupture && !(*given_rupture > law.yield_deflection))
+    p.fail(rupture, "'" + rupture + "' must exceed '" + yield + "' (rupture happens in plastic flow); leave it out for no rupture");
+  law.rupture_deflection = given_rupture ? given_rupture : default_rupture;
   law.one_sided = one_sided;
   return law;
 }
@@ -126,33 +104,24 @@ ElasticPlasticLaw make_law(ParameterReader& p, const std::string& direction, con
 
 Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
-  LawInput inputs[3];
-  for (int k = 0; k < 3; ++k) inputs[k] = read_law_input(p, kDirections[k]);
-  const std::optional<double> height = p.number("face_height");
   length = p.number("length");
-  const std::optional<double> misalignment = p.number("initial_misalignment");
   facing = p.number("facing");
   const std::optional<std::string> interlock = p.word("interlock_while_unloading");
-  spec.require_points(2);
-  if (interlock && *interlock != "hold" && *interlock != "release")
+  if (*interlock != "hold" && *interlock != "release")
     p.fail("interlock_while_unloading",
            "'interlock_while_unloading' must be hold (the faces keep their vertical and torsional interlock while the "
            "horizontal law unloads) or release (the interlock lets go at the horizontal unloading and re-seats at "
            "reloading), not '" + *interlock + "'");
-  release_while_unloading = interlock && *interlock == "release";
+  release_while_unloading = *interlock == "release";
 
-  if (length && !(*length > 0.0)) p.fail("length", "'length' must be positive");
-  if (!inputs[0].rupture && length) inputs[0].rupture = length;  // crushed through over its whole length
-  horizontal = make_law(p, kDirections[0], inputs[0], true);
-  vertical = make_law(p, kDirections[1], inputs[1], false);
-  torsional = make_law(p, kDirections[2], inputs[2], false);
+  horizontal = make_law(p, kDirections[0], length, true);  // default: crushed through over its whole length
+  vertical = make_law(p, kDirections[1], std::nullopt, false);
+  torsional = make_law(p, kDirections[2], std::nullopt, false);
   if (length && *horizontal.rupture_deflection > *length)
     p.fail("horizontal_rupture_deflection",
            "'horizontal_rupture_deflection' must not exceed 'length' (the structure cannot crush further than its length)");
-  if (!height) p.fail("face_height", "missing required parameter 'face_height' [length]: the height of each anticlimber face");
-  if (!(*height > 0.0)) p.fail("face_height", "'face_height' must be positive");
-  face_height = *height;
-  initial_misalignment = misalignment.value_or(0.0);
+  face_height = p.value("face_height");
+  initial_misalignment = p.value("initial_misalignment");
   if (facing && *facing != 1.0 && *facing != -1.0)
     p.fail("facing", "'facing' must be 1 (body 1's face looks along its +x axis) or -1 (along -x)");
 }
@@ -372,7 +341,48 @@ void Anticlimber::outputs(const ElementState<double>& s, const double*, double* 
 }
 
 void register_anticlimber_elements(ElementRegistry& registry) {
-  registry.add("anticlimber", [](ElementSpec& s) { return std::make_unique<Anticlimber>(s); });
+  std::vector<ParameterSpec> parameters;
+  for (const char* direction : kDirections) {
+    const bool rotation = std::string(direction) == "torsional";
+    const Unit slope = rotation ? Unit::MomentPerAngle : Unit::ForcePerLength;
+    const Unit deflection = rotation ? Unit::Angle : Unit::Length;
+    const std::string d = direction;
+    parameters.push_back({d + "_elastic_stiffness", slope, required, Range::Positive, d + " elastic slope"});
+    parameters.push_back({d + "_plastic_stiffness", slope, required, Range::NonNegative,
+                          d + " slope after yield, below the elastic slope (0: perfectly plastic)"});
+    parameters.push_back({d + "_yield_deflection", deflection, required, Range::Positive, d + " deflection at yield"});
+    parameters.push_back({d + "_rupture_deflection", deflection,
+                          optional(rotation || d == "vertical" ? "no rupture" : "length, else no rupture"),
+                          Range::Positive,
+                          d + " deflection at rupture (" +
+                              (d == "horizontal" ? "crushing" : d == "vertical" ? "shear" : "bending") +
+                              " failure), above the yield deflection"});
+  }
+  parameters.push_back({"face_height", Unit::Length, required, Range::Positive,
+                        "height of each face; the faces override when their vertical offset reaches it"});
+  parameters.push_back({"length", Unit::Length, optional("no bound on the crush"), Range::Positive,
+                        "length of the anticlimber / end structure: bounds the horizontal rupture deflection"});
+  parameters.push_back({"initial_misalignment", Unit::Length, default_value(0.0), Range::Any,
+                        "vertical offset of the faces added to that of the points (face 2 above face 1 > 0)"});
+  parameters.push_back({"facing", Unit::Choice, optional("the side of P2 at the start"), Range::Any,
+                        "1: body 1's face looks along its +x axis, -1: along -x"});
+  parameters.push_back({"interlock_while_unloading", Unit::Choice, default_word("hold"), Range::Any,
+                        "hold: the vertical and torsional interlock holds while the horizontal law unloads; release: "
+                        "it lets go then and re-seats at reloading",
+                        Shape::Word});
+  registry.add({"anticlimber", "15", 2, "P1 on body 1, P2 on body 2: the centres of the two anticlimber faces",
+                "Two impacting anticlimber faces: measured in body 1's frame, open until the faces touch, then "
+                "interlocked, with three independent bilinear elastic-plastic laws with kinematic hardening "
+                "(horizontal in compression only, vertical and torsional both ways). Events for yield, unloading, "
+                "reloading, separation, shear / crushing / bending failure (rupture deflections), and override "
+                "when the vertical offset reaches the face height.",
+                parameters,
+                "horizontal_elastic_stiffness: 4.45e6\nhorizontal_plastic_stiffness: 20620\n"
+                "horizontal_yield_deflection: 0.053\nvertical_elastic_stiffness: 175000\n"
+                "vertical_plastic_stiffness: 1633\nvertical_yield_deflection: 0.2\nvertical_rupture_deflection: 5\n"
+                "torsional_elastic_stiffness: 110800\ntorsional_plastic_stiffness: 25500\n"
+                "torsional_yield_deflection: 0.001\nface_height: 6\nlength: 58.125\ninterlock_while_unloading: hold",
+                [](ElementSpec& s) { return std::make_unique<Anticlimber>(s); }});
 }
 
 }  // namespace railcrash

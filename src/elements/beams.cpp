@@ -11,10 +11,10 @@ namespace {
 BeamMaterial read_material(ElementSpec& spec) {
   ParameterReader& p = *spec.parameters;
   BeamMaterial m{};
-  m.elastic_modulus = p.required_positive("elastic_modulus");
-  m.plastic_modulus = p.required_nonnegative("plastic_modulus");
-  m.yield_stress = p.required_positive("yield_stress");
-  m.ultimate_stress = p.required_positive("ultimate_stress");
+  m.elastic_modulus = p.value("elastic_modulus");
+  m.plastic_modulus = p.value("plastic_modulus");
+  m.yield_stress = p.value("yield_stress");
+  m.ultimate_stress = p.value("ultimate_stress");
   if (!(m.plastic_modulus < m.elastic_modulus))
     p.fail("plastic_modulus", "'plastic_modulus' (the tangent modulus after yield) must be less than 'elastic_modulus'");
   if (!(m.ultimate_stress > m.yield_stress))
@@ -79,11 +79,11 @@ constexpr double kYieldMargin = 1e-9;
 
 ElasticPlasticBeam::ElasticPlasticBeam(ElementSpec& spec) : BeamElement(spec, read_material(spec)) {
   ParameterReader& p = *spec.parameters;
-  height = p.optional_positive("height");
-  width = p.optional_positive("width");
-  const std::optional<double> given_area = p.optional_positive("area");
-  const std::optional<double> given_second_moment = p.optional_positive("second_moment");
-  const std::optional<double> given_modulus = p.optional_positive("plastic_section_modulus");
+  height = p.number("height");
+  width = p.number("width");
+  const std::optional<double> given_area = p.number("area");
+  const std::optional<double> given_second_moment = p.number("second_moment");
+  const std::optional<double> given_modulus = p.number("plastic_section_modulus");
   const bool rectangle = height || width;
   const bool properties = given_area || given_second_moment;
   if (rectangle && properties)
@@ -112,19 +112,17 @@ ElasticPlasticBeam::ElasticPlasticBeam(ElementSpec& spec) : BeamElement(spec, re
 
 TaperedBeam::TaperedBeam(ElementSpec& spec)
     : BeamElement(spec, read_material(spec)),
-      height_1(spec.parameters->required_positive("height_1")),
-      height_2(spec.parameters->required_positive("height_2")),
-      width_1(spec.parameters->required_positive("width_1")),
-      width_2(spec.parameters->required_positive("width_2")) {
+      height_1(spec.parameters->value("height_1")),
+      height_2(spec.parameters->value("height_2")),
+      width_1(spec.parameters->value("width_1")),
+      width_2(spec.parameters->value("width_2")) {
   section_ = tapered_section(height_1, height_2, width_1, width_2);
 }
 
 // ---- the common law ----------------------------------------------------------------------
 
 BeamElement::BeamElement(ElementSpec& spec, BeamMaterial beam_material)
-    : ForceElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {
-  spec.require_points(2);
-}
+    : ForceElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {}
 
 void BeamElement::initialize(const ElementState<double>& initial) {
   if (point_slot(0) == point_slot(1))
@@ -258,9 +256,62 @@ void BeamElement::outputs(const ElementState<double>& s, const double*, double* 
   out[10] = state_.failed ? 1.0 : 0.0;
 }
 
+namespace {
+
+std::vector<ParameterSpec> material_specs() {
+  return {{"elastic_modulus", Unit::Stress, required, Range::Positive, "Young's modulus E"},
+          {"plastic_modulus", Unit::Stress, required, Range::NonNegative, "tangent modulus after yield, below E"},
+          {"yield_stress", Unit::Stress, required, Range::Positive, "stress at which the section yields"},
+          {"ultimate_stress", Unit::Stress, required, Range::Positive,
+           "stress at which the beam fractures, above yield_stress"}};
+}
+
+std::vector<ParameterSpec> with_material(const std::vector<ParameterSpec>& section) {
+  std::vector<ParameterSpec> all = material_specs();
+  all.insert(all.end(), section.begin(), section.end());
+  return all;
+}
+
+const char* const kBeamPoints = "P1 on body 1, P2 on body 2: the beam's ends, rigidly attached to their bodies";
+const char* const kBeamLaw =
+    "co-rotational planar beam rigidly attached to both bodies, axial force N = k_a (e - e_p), end moments "
+    "[M1; M2] = K_b (phi - phi_p); axial yield at yield_stress times the area, end hinges at yield_stress times "
+    "the plastic section modulus, kinematic hardening with plastic_modulus, elastic unloading; fracture when "
+    "|N| / A or |M| / Z reaches ultimate_stress.";
+const char* const kBeamMaterialExample =
+    "elastic_modulus: 2.0e11\nplastic_modulus: 2.0e9\nyield_stress: 2.5e8\nultimate_stress: 4.0e8\n";
+
+}  // namespace
+
 void register_beams_elements(ElementRegistry& registry) {
-  registry.add("elastic_plastic_beam", [](ElementSpec& s) { return std::make_unique<ElasticPlasticBeam>(s); });
-  registry.add("tapered_beam", [](ElementSpec& s) { return std::make_unique<TaperedBeam>(s); });
+  registry.add(
+      {"elastic_plastic_beam", "5", 2, kBeamPoints,
+       "Elastic-plastic beam of uniform section: " + std::string(kBeamLaw) +
+           " For the uniform section k_a = E A / L0, K_b = E I / L0 [4 2; 2 4].",
+       with_material(
+           {{"height", Unit::Length, optional("give area and second_moment instead"), Range::Positive,
+             "height of a rectangular section (in the plane of bending), with width"},
+            {"width", Unit::Length, optional("give area and second_moment instead"), Range::Positive,
+             "width of a rectangular section, with height"},
+            {"area", Unit::Area, optional("from height and width"), Range::Positive,
+             "section area, with second_moment"},
+            {"second_moment", Unit::SecondMoment, optional("from height and width"), Range::Positive,
+             "second moment of area, with area"},
+            {"plastic_section_modulus", Unit::SectionModulus,
+             optional("width height^2 / 4, or that of the rectangle with the same area and second moment"),
+             Range::Positive, "plastic section modulus Z (end hinges yield at yield_stress Z)"}}),
+       std::string(kBeamMaterialExample) + "height: 0.1\nwidth: 0.05",
+       [](ElementSpec& s) { return std::make_unique<ElasticPlasticBeam>(s); }});
+  registry.add({"tapered_beam", "22", 2, kBeamPoints,
+                "Elastic-plastic beam of tapered section: " + std::string(kBeamLaw) +
+                    " The rectangular section's height and width vary linearly from end 1 to end 2; the stiffness "
+                    "comes from the flexibility integrals of the taper.",
+                with_material({{"height_1", Unit::Length, required, Range::Positive, "section height at end 1"},
+                               {"height_2", Unit::Length, required, Range::Positive, "section height at end 2"},
+                               {"width_1", Unit::Length, required, Range::Positive, "section width at end 1"},
+                               {"width_2", Unit::Length, required, Range::Positive, "section width at end 2"}}),
+                std::string(kBeamMaterialExample) + "height_1: 0.1\nheight_2: 0.05\nwidth_1: 0.05\nwidth_2: 0.05",
+                [](ElementSpec& s) { return std::make_unique<TaperedBeam>(s); }});
 }
 
 }  // namespace railcrash

@@ -7,18 +7,17 @@ namespace railcrash {
 
 SurfaceContact::SurfaceContact(ElementSpec& spec, bool wheel_rail)
     : ForceElement(spec.name, spec.type, spec.points, spec.where), wheel_rail_(wheel_rail) {
-  spec.require_points(1);
   ParameterReader& p = *spec.parameters;
-  stiffness = p.required_positive("stiffness");
-  damping = p.optional_nonnegative("damping").value_or(0.0);
-  friction = p.optional_nonnegative("friction").value_or(0.0);
-  friction_velocity = p.optional_positive("friction_velocity").value_or(0.01);
+  stiffness = p.value("stiffness");
+  damping = p.value("damping");
+  friction = p.value("friction");
+  friction_velocity = p.value("friction_velocity");
   if (wheel_rail) {
     // Report type 18: the wheel centre against the rail head line.
-    const double wheel_radius = p.required_positive("wheel_radius");
-    const double rail_height = p.number("rail_height").value_or(0.0);
-    stiffness_above = p.optional_positive("stiffness_above").value_or(stiffness);
-    breakpoint = p.optional_positive("breakpoint").value_or(std::numeric_limits<double>::infinity());
+    const double wheel_radius = p.value("wheel_radius");
+    const double rail_height = p.value("rail_height");
+    stiffness_above = p.number("stiffness_above").value_or(stiffness);
+    breakpoint = p.number("breakpoint").value_or(std::numeric_limits<double>::infinity());
     surface = Surface::Line;
     px = 0.0;
     py = rail_height + wheel_radius;
@@ -31,8 +30,8 @@ SurfaceContact::SurfaceContact(ElementSpec& spec, bool wheel_rail)
   const auto line_point = p.vector("line_point", 2);
   const auto line_normal = p.vector("line_normal", 2);
   const auto center = p.vector("circle_center", 2);
-  const auto circle_radius = p.optional_positive("circle_radius");
-  inside = p.flag("inside").value_or(false);
+  const auto circle_radius = p.number("circle_radius");
+  inside = *p.flag("inside");
   if (line_point && !center) {
     if (!line_normal) p.fail("line_normal", "a line surface needs 'line_normal' [nx, ny] (pointing to the free side)");
     const double norm = std::hypot((*line_normal)[0], (*line_normal)[1]);
@@ -149,9 +148,55 @@ void SurfaceContact::outputs(const ElementState<double>& s, const double*, doubl
   out[2] = k.penetration;
 }
 
+namespace {
+
+/// The normal law and friction both contact types take.
+std::vector<ParameterSpec> contact_law_specs(std::vector<ParameterSpec> surface) {
+  std::vector<ParameterSpec> all{
+      {"stiffness", Unit::ForcePerLength, required, Range::Positive, "normal stiffness k1 (wheel_rail: below breakpoint)"},
+      {"damping", Unit::ForceTimePerLength, default_value(0.0), Range::NonNegative,
+       "normal damping c (the force never pulls)"},
+      {"friction", Unit::Dimensionless, default_value(0.0), Range::NonNegative, "friction coefficient mu"},
+      {"friction_velocity", Unit::Velocity, default_value(0.01), Range::Positive,
+       "slip speed over which the friction builds up (tanh(v_t / friction_velocity))"}};
+  all.insert(all.end(), surface.begin(), surface.end());
+  return all;
+}
+
+}  // namespace
+
 void register_contact_elements(ElementRegistry& registry) {
-  registry.add("contact", [](ElementSpec& s) { return std::make_unique<SurfaceContact>(s, false); });
-  registry.add("wheel_rail", [](ElementSpec& s) { return std::make_unique<SurfaceContact>(s, true); });
+  registry.add(
+      {"contact", "", 1, "P1: the body point that touches the fixed surface",
+       "Unilateral contact of a body point with a fixed line or circle: normal force N = k d + c d' while "
+       "N >= 0 (d the penetration), friction -mu N tanh(v_t / friction_velocity); contact, lift-off and "
+       "release are events.",
+       contact_law_specs(
+           {{"line_point", Unit::Position, optional("give circle_center instead"), Range::Any,
+             "a point of the line surface", Shape::Pair},
+            {"line_normal", Unit::Direction, optional("none; a line needs it"), Range::Any,
+             "normal of the line, pointing to the free side", Shape::Pair},
+            {"circle_center", Unit::Position, optional("give line_point instead"), Range::Any,
+             "centre of the circle surface", Shape::Pair},
+            {"circle_radius", Unit::Length, optional("none; a circle needs it"), Range::Positive,
+             "radius of the circle surface"},
+            {"inside", Unit::Choice, default_flag(false), Range::Any,
+             "true: the point moves inside the circle (a concave surface)", Shape::Flag}}),
+       "stiffness: 1.0e6\ndamping: 100\nfriction: 0.3\nline_point: [0, -1]\nline_normal: [0, 1]",
+       [](ElementSpec& s) { return std::make_unique<SurfaceContact>(s, false); }});
+  registry.add(
+      {"wheel_rail", "18", 1, "P1: the wheel centre",
+       "Wheel on a rail: the wheel centre against the rail line y = rail_height + wheel_radius (normal +y), as `contact` with two "
+       "slopes: stiffness below the penetration `breakpoint`, stiffness_above beyond it; friction is the "
+       "braking / rolling resistance.",
+       contact_law_specs({{"wheel_radius", Unit::Length, required, Range::Positive, "wheel radius"},
+                          {"rail_height", Unit::Length, default_value(0.0), Range::Any, "height of the rail head"},
+                          {"stiffness_above", Unit::ForcePerLength, optional("stiffness"), Range::Positive,
+                           "normal stiffness beyond the breakpoint"},
+                          {"breakpoint", Unit::Length, optional("none: one slope"), Range::Positive,
+                           "penetration at which stiffness_above takes over"}}),
+       "stiffness: 1.0e7\nwheel_radius: 0.45\nrail_height: -1.5\nstiffness_above: 2.0e7\nbreakpoint: 0.001",
+       [](ElementSpec& s) { return std::make_unique<SurfaceContact>(s, true); }});
 }
 
 }  // namespace railcrash

@@ -379,16 +379,15 @@ const char* const kGearSegments[] = {"bottomed", "off bottom"};
 
 DraftGear::DraftGear(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
-  initial_stiffness = p.required_positive("initial_stiffness");
-  travel = p.required_positive("travel");
-  stiffness_after_bottoming = p.required_positive("stiffness_after_bottoming");
-  hysteresis_load = p.required_positive("hysteresis_load");
-  pin_shear_load = p.optional_positive("pin_shear_load");
-  const auto post_shear = p.optional_nonnegative("post_shear_travel");
-  fracture_load = p.optional_positive("fracture_load");
-  const auto transition = p.optional_positive("transition_stiffness");
-  free_length = p.optional_positive("free_length");
-  spec.require_points(2);
+  initial_stiffness = p.value("initial_stiffness");
+  travel = p.value("travel");
+  stiffness_after_bottoming = p.value("stiffness_after_bottoming");
+  hysteresis_load = p.value("hysteresis_load");
+  pin_shear_load = p.number("pin_shear_load");
+  const auto post_shear = p.number("post_shear_travel");
+  fracture_load = p.number("fracture_load");
+  const auto transition = p.number("transition_stiffness");
+  free_length = p.number("free_length");
   if (post_shear && !pin_shear_load)
     p.fail("post_shear_travel", "'post_shear_travel' is the travel after the shear pin fails: give 'pin_shear_load' too");
   post_shear_travel = post_shear.value_or(0.0);
@@ -526,36 +525,23 @@ CouplerEnd::CouplerEnd(ElementSpec& spec) : ForceElement(spec.name, spec.type, s
   const auto stiffness = p.vector("horizontal_stiffness", 2);
   const auto lengths = p.vector("free_length", 2);
   const auto heights = p.vector("coupler_height", 2);
-  total_horizontal_slack = p.optional_nonnegative("total_horizontal_slack").value_or(0.0);
-  friction = p.optional_nonnegative("friction").value_or(0.0);
-  friction_velocity = p.optional_positive("friction_velocity").value_or(0.01);
-  coupled = p.flag("coupled").value_or(false);
-  const std::optional<double> e = p.number("restitution");
+  total_horizontal_slack = p.value("total_horizontal_slack");
+  friction = p.value("friction");
+  friction_velocity = p.value("friction_velocity");
+  coupled = *p.flag("coupled");
+  restitution = p.value("restitution");
   shear_load = p.number("shear_load");
-  spec.require_points(2);
-  if (shear_load && !(*shear_load > 0.0))
-    p.fail("shear_load",
-           "'shear_load' is the buff face force at which the coupler faces shear off: give a positive force, or leave it "
-           "out for faces that never shear");
-  if (e && !(*e > 0.0 && *e <= 1.0))
-    p.fail("restitution",
-           "'restitution' is the coefficient of restitution of the faces' buff contact: give a value above 0 and at most 1 "
-           "(1: elastic faces, the default)");
-  restitution = e.value_or(1.0);
   if (restitution < 1.0 && coupled)
     p.fail("restitution",
            "'restitution' below 1 gives the faces a permanent set in buff, which the coupled knuckles' draft law does not "
            "follow: use it with uncoupled faces ('coupled: false') or leave it out");
-  const auto per_end = [&](const std::optional<std::vector<double>>& values, const char* key, bool zero_allowed) {
-    if (!values) p.fail(key, std::string("missing required parameter '") + key + "': [end K, end L]");
-    for (double v : *values)
-      if (v < 0.0 || (!zero_allowed && v == 0.0))
-        p.fail(key, std::string("'") + key + "' values must be " + (zero_allowed ? "non-negative" : "positive"));
+  // Required and range-checked by the reader: [end K, end L].
+  const auto per_end = [](const std::optional<std::vector<double>>& values) {
     return std::array<double, 2>{(*values)[0], (*values)[1]};
   };
-  horizontal_stiffness = per_end(stiffness, "horizontal_stiffness", false);
-  free_length = per_end(lengths, "free_length", true);
-  coupler_height = per_end(heights, "coupler_height", false);
+  horizontal_stiffness = per_end(stiffness);
+  free_length = per_end(lengths);
+  coupler_height = per_end(heights);
   if (total_horizontal_slack > 0.0 && !coupled)
     p.fail("total_horizontal_slack",
            "'total_horizontal_slack' is the free play of coupled knuckles between buff and draft contact; uncoupled "
@@ -735,20 +721,19 @@ void CouplerEnd::outputs(const ElementState<double>& s, const double*, double* o
 
 Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
-  const double kind_value = p.number("kind").value_or(1.0);
+  const double kind_value = p.value("kind");
   const auto curve = p.table("curve", 2);
-  const auto factor = p.optional_nonnegative("unloading_factor");
+  const auto factor = p.number("unloading_factor");
   const auto loading = p.table("loading_curve", 2);
   const auto unloading = p.table("unloading_curve", 2);
-  horizontal_slack = p.optional_nonnegative("horizontal_slack").value_or(0.0);
-  vertical_slack = p.optional_nonnegative("vertical_slack").value_or(0.0);
-  vertical_stiffness = p.optional_nonnegative("vertical_stiffness").value_or(0.0);
-  misalignment = p.number("misalignment").value_or(0.0);
-  friction = p.optional_nonnegative("friction").value_or(0.0);
-  friction_velocity = p.optional_positive("friction_velocity").value_or(0.01);
-  const auto transition = p.optional_positive("transition_stiffness");
-  free_length = p.optional_nonnegative("free_length");
-  spec.require_points(2);
+  horizontal_slack = p.value("horizontal_slack");
+  vertical_slack = p.value("vertical_slack");
+  vertical_stiffness = p.value("vertical_stiffness");
+  misalignment = p.value("misalignment");
+  friction = p.value("friction");
+  friction_velocity = p.value("friction_velocity");
+  const auto transition = p.number("transition_stiffness");
+  free_length = p.number("free_length");
 
   if (kind_value != 1.0 && kind_value != 2.0)
     p.fail("kind", "'kind' must be 1 (curve + unloading_factor, report type 11) or 2 (loading_curve + unloading_curve, "
@@ -761,7 +746,6 @@ Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.
              "kind 1 takes one 'curve' and an 'unloading_factor'; 'loading_curve' / 'unloading_curve' are for kind: 2");
     if (!curve) p.fail("curve", "missing required parameter 'curve': the loading curve [[deflection, force], ...]");
     if (!factor) p.fail("unloading_factor", "missing required parameter 'unloading_factor' (unloading force / loading force, 0 to 1)");
-    if (*factor > 1.0) p.fail("unloading_factor", "'unloading_factor' must not exceed 1 (unloading below loading)");
     std::vector<double> x, y;
     read_curve(p, "curve", *curve, x, y);
     extent = x.back();
@@ -888,10 +872,100 @@ void Coupling::outputs(const ElementState<double>& s, const double*, double* out
                : 0.0;
 }
 
+namespace {
+
+ParameterSpec friction_velocity_spec() {
+  return {"friction_velocity", Unit::Velocity, default_value(0.01), Range::Positive,
+          "vertical sliding speed over which the friction builds up (tanh(v / friction_velocity))"};
+}
+
+}  // namespace
+
 void register_couplers_elements(ElementRegistry& registry) {
-  registry.add("draft_gear", [](ElementSpec& s) { return std::make_unique<DraftGear>(s); });
-  registry.add("coupler_end", [](ElementSpec& s) { return std::make_unique<CouplerEnd>(s); });
-  registry.add("coupling", [](ElementSpec& s) { return std::make_unique<Coupling>(s); });
+  registry.add(
+      {"draft_gear", "13", 2, "P1 on body 1, P2 on body 2: the ends of the gear (yoke and draft pocket)",
+       "Friction draft gear along P1-P2: compression d = free_length - L, mirror-symmetric in draft: stuck by "
+       "friction until breakaway, loads on initial_stiffness d + hysteresis_load, bottoms at `travel` "
+       "(stiffness_after_bottoming beyond), unloads elastically (transition_stiffness) down to "
+       "initial_stiffness d - hysteresis_load, released at zero force. Buff overload shears the pin: free "
+       "travel for post_shear_travel, then solid. Fracture at |F| = fracture_load.",
+       {{"initial_stiffness", Unit::ForcePerLength, required, Range::Positive, "slope of the gear before bottoming"},
+        {"travel", Unit::Length, required, Range::Positive, "compression at which the gear bottoms"},
+        {"stiffness_after_bottoming", Unit::ForcePerLength, required, Range::Positive, "slope beyond `travel`"},
+        {"hysteresis_load", Unit::Force, required, Range::Positive,
+         "friction force: loading lies this far above, unloading this far below the spring line"},
+        {"pin_shear_load", Unit::Force, optional("no pin shear"), Range::Positive,
+         "buff force at which the shear pin fails"},
+        {"post_shear_travel", Unit::Length, optional("0 (needs pin_shear_load)"), Range::NonNegative,
+         "free travel after the pin shears, before the gear is solid"},
+        {"fracture_load", Unit::Force, optional("no fracture"), Range::Positive,
+         "force (buff or draft) at which the gear breaks"},
+        {"transition_stiffness", Unit::ForcePerLength, optional("stiffness_after_bottoming"), Range::Positive,
+         "slope of the elastic line between loading and unloading; above initial_stiffness, at least "
+         "stiffness_after_bottoming"},
+        {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::Positive,
+         "length of the gear at rest"}},
+       "initial_stiffness: 24000\ntravel: 1.25\nstiffness_after_bottoming: 320000\nhysteresis_load: 10000\n"
+       "pin_shear_load: 150000\npost_shear_travel: 1.375\nfracture_load: 250000",
+       [](ElementSpec& s) { return std::make_unique<DraftGear>(s); }});
+  registry.add(
+      {"coupler_end", "14", 2, "P1 on coupler K, P2 on coupler L, each free_length behind its face",
+       "Two coupler faces in contact: vertical faces along global x, the two horizontal stiffnesses in series; the faces "
+       "push when closer than their contact spacing, and pull only when coupled and past the total horizontal "
+       "slack; only while the faces overlap vertically (coupler_height). Friction mu |T| tanh(Dy' / "
+       "friction_velocity) between the faces. With restitution e < 1 (uncoupled only) the faces unload and reload "
+       "along slope k / e^2 and keep a permanent set. The faces shear off at shear_load (buff).",
+       {{"horizontal_stiffness", Unit::ForcePerLength, required, Range::Positive, "face stiffness [end K, end L]",
+         Shape::Pair},
+        {"free_length", Unit::Length, required, Range::NonNegative,
+         "distance from each point to its face [end K, end L]", Shape::Pair},
+        {"coupler_height", Unit::Length, required, Range::Positive, "height of each face [end K, end L]", Shape::Pair},
+        {"coupled", Unit::Choice, default_flag(false), Range::Any, "true: the knuckles also carry draft",
+         Shape::Flag},
+        {"total_horizontal_slack", Unit::Length, default_value(0.0), Range::NonNegative,
+         "free play of coupled knuckles between buff and draft contact (coupled only)"},
+        {"friction", Unit::Dimensionless, default_value(0.0), Range::NonNegative,
+         "friction coefficient mu between the faces"},
+        friction_velocity_spec(),
+        {"restitution", Unit::Dimensionless, default_value(1.0), Range::Fraction,
+         "coefficient of restitution of the buff contact (below 1: uncoupled faces only)"},
+        {"shear_load", Unit::Force, optional("the faces never shear"), Range::Positive,
+         "buff face force at which the faces shear off"}},
+       "horizontal_stiffness: [1.0e6, 1.0e6]\nfree_length: [0.5, 0.5]\ncoupler_height: [0.1, 0.1]\n"
+       "restitution: 0.8\nshear_load: 1.0e6",
+       [](ElementSpec& s) { return std::make_unique<CouplerEnd>(s); }});
+  registry.add(
+      {"coupling", "11 (kind: 1), 12 (kind: 2)", 2, "P1 on car 1, P2 on car 2",
+       "Freight coupler: a hysteretic nonlinear horizontal spring with slack, mirror-symmetric in draft (kind 1: "
+       "one loading `curve`, unloading at unloading_factor times it; kind 2: separate loading and unloading "
+       "curves), a vertical dead-band spring between the heads, and sliding friction proportional to the "
+       "horizontal force.",
+       {{"kind", Unit::Choice, default_value(1), Range::Any,
+         "1: curve + unloading_factor (report type 11), 2: loading_curve + unloading_curve (type 12)"},
+        {"curve", Unit::LengthForceCurve, optional("none; kind 1 needs it"), Range::Any,
+         "kind 1: loading curve [[deflection, force], ...] from [0, 0], deflection increasing", Shape::Table},
+        {"unloading_factor", Unit::Dimensionless, optional("none; kind 1 needs it"), Range::UnitInterval,
+         "kind 1: unloading force over loading force"},
+        {"loading_curve", Unit::LengthForceCurve, optional("none; kind 2 needs it"), Range::Any,
+         "kind 2: loading curve [[deflection, force], ...] from [0, 0]", Shape::Table},
+        {"unloading_curve", Unit::LengthForceCurve, optional("none; kind 2 needs it"), Range::Any,
+         "kind 2: unloading curve, nowhere above the loading curve", Shape::Table},
+        {"horizontal_slack", Unit::Length, default_value(0.0), Range::NonNegative, "total horizontal free play"},
+        {"vertical_slack", Unit::Length, default_value(0.0), Range::NonNegative, "total vertical free play of the heads"},
+        {"vertical_stiffness", Unit::ForcePerLength, default_value(0.0), Range::NonNegative,
+         "vertical spring outside the slack (0: none)"},
+        {"misalignment", Unit::Length, default_value(0.0), Range::Any,
+         "initial vertical offset of the heads when the points are level"},
+        {"friction", Unit::Dimensionless, default_value(0.0), Range::NonNegative,
+         "friction coefficient mu between the heads"},
+        friction_velocity_spec(),
+        {"transition_stiffness", Unit::ForcePerLength, optional("the steepest slope of the curves"), Range::Positive,
+         "slope of the elastic line between loading and unloading"},
+        {"free_length", Unit::Length, optional("the initial spacing"), Range::NonNegative,
+         "spacing of the points at the centre of the horizontal slack"}},
+       "kind: 1\ncurve: [[0, 0], [0.5, 1.0e5], [1.0, 3.0e5]]\nunloading_factor: 0.5\nhorizontal_slack: 0.1\n"
+       "vertical_slack: 0.05\nvertical_stiffness: 1.0e5",
+       [](ElementSpec& s) { return std::make_unique<Coupling>(s); }});
 }
 
 }  // namespace railcrash

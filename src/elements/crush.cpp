@@ -8,17 +8,13 @@ namespace railcrash {
 
 CrushSpring::CrushSpring(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      unloading_stiffness(spec.parameters->required_positive("unloading_stiffness")),
-      tension_stiffness(spec.parameters->optional_positive("tension_stiffness")),
-      free_length(spec.parameters->optional_positive("free_length")) {
-  spec.require_points(2);
-  const auto table = spec.parameters->table("curve", 2);
-  if (!table) spec.parameters->fail("curve", "missing required parameter 'curve': the loading curve [[crush, force], ...]");
+      unloading_stiffness(spec.parameters->value("unloading_stiffness")),
+      tension_stiffness(spec.parameters->number("tension_stiffness")),
+      free_length(spec.parameters->number("free_length")) {
+  const auto table = spec.parameters->table("curve", 2);  // required: the reader fails when it is absent
   if (table->size() < 2) spec.parameters->fail("curve", "'curve' needs at least two points [[crush, force], ...]");
   for (std::size_t k = 0; k < table->size(); ++k) {
     const double crush = (*table)[k][0], force = (*table)[k][1];
-    if (crush < 0.0 || force < 0.0)
-      spec.parameters->fail("curve", "'curve' point " + std::to_string(k + 1) + ": crush and force must not be negative");
     if (k > 0 && !(crush > curve_crush.back()))
       spec.parameters->fail("curve", "'curve' point " + std::to_string(k + 1) + ": crush values must increase strictly");
     curve_crush.push_back(crush);
@@ -168,7 +164,21 @@ void CrushSpring::outputs(const ElementState<double>& s, const double*, double* 
 }
 
 void register_crush_elements(ElementRegistry& registry) {
-  registry.add("crush_spring", [](ElementSpec& s) { return std::make_unique<CrushSpring>(s); });
+  registry.add({"crush_spring", "", 2, "P1 on body 1, P2 on body 2: the ends of the structure",
+                "Crushable structure along P1-P2: crush d = free_length - L (positive when shortened), "
+                "force P >= 0 pushing the points apart. While crushing P follows the loading `curve` (its last "
+                "slope continues beyond it); it unloads and reloads elastically with unloading_stiffness, "
+                "remembering the permanent crush; in tension no force (or tension_stiffness when given).",
+                {{"curve", Unit::LengthForceCurve, required, Range::NonNegative,
+                  "loading curve [[crush, force], ...], crush strictly increasing, at least two points", Shape::Table},
+                 {"unloading_stiffness", Unit::ForcePerLength, required, Range::Positive,
+                  "slope of elastic unloading and reloading"},
+                 {"tension_stiffness", Unit::ForcePerLength, optional("no force in tension"), Range::Positive,
+                  "slope in tension beyond the permanent crush"},
+                 {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::Positive,
+                  "length at zero crush"}},
+                "curve: [[0, 0], [0.1, 2.0e5], [0.5, 2.5e5]]\nunloading_stiffness: 5.0e6",
+                [](ElementSpec& s) { return std::make_unique<CrushSpring>(s); }});
 }
 
 }  // namespace railcrash

@@ -91,9 +91,7 @@ int PiecewiseLinearLaw::segment_at(double x, int direction) const {
 
 template <class Derived>
 PiecewiseLineElement<Derived>::PiecewiseLineElement(ElementSpec& spec, int fracture_sides)
-    : ForceElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {
-  spec.require_points(2);
-}
+    : ForceElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {}
 
 template <class Derived>
 void PiecewiseLineElement<Derived>::set_law(PiecewiseLinearLaw law) {
@@ -194,9 +192,9 @@ void require_direction(const Element& e, const ElementState<double>& initial) {
 PiecewiseLinearLaw::Branch read_branch(ParameterReader& p, const std::string& slope_1, const std::string& slope_2,
                                        const std::string& breakpoint) {
   PiecewiseLinearLaw::Branch branch;
-  branch.slope_1 = p.required_nonnegative(slope_1);
-  branch.slope_2 = p.optional_nonnegative(slope_2);
-  branch.breakpoint = p.optional_nonnegative(breakpoint);
+  branch.slope_1 = p.value(slope_1);
+  branch.slope_2 = p.number(slope_2);
+  branch.breakpoint = p.number(breakpoint);
   if (branch.slope_2 && !branch.breakpoint)
     p.fail(slope_2, "'" + slope_2 + "' needs '" + breakpoint + "' (where it takes over from '" + slope_1 +
                         "'): give both or neither");
@@ -214,9 +212,9 @@ NonlinearSpring::NonlinearSpring(ElementSpec& spec)
       compression(read_branch(*spec.parameters, "compression_stiffness_1", "compression_stiffness_2",
                               "compression_breakpoint")),
       extension(read_branch(*spec.parameters, "extension_stiffness_1", "extension_stiffness_2", "extension_breakpoint")),
-      preload(spec.parameters->number("preload").value_or(0.0)),
-      free_length(spec.parameters->optional_positive("free_length")) {
-  fracture_load = spec.parameters->optional_positive("fracture_load");
+      preload(spec.parameters->value("preload")),
+      free_length(spec.parameters->number("free_length")) {
+  fracture_load = spec.parameters->number("fracture_load");
   if (fracture_load && std::abs(preload) >= *fracture_load)
     spec.parameters->fail("preload", "'preload' must be smaller in size than 'fracture_load' (the spring would break at once)");
   set_law(PiecewiseLinearLaw::two_branch(-preload, compression, "compression", extension, "extension"));
@@ -251,20 +249,22 @@ Element::Event NonlinearDashpot::segment_event(int, int to, double x) const { re
 
 SpecialSpring::SpecialSpring(ElementSpec& spec) : PiecewiseLineElement<SpecialSpring>(spec, 1) {
   ParameterReader& p = *spec.parameters;
-  const double kind_value = p.number("kind").value_or(1.0);
+  const double kind_value = p.value("kind");
   if (kind_value != 1.0 && kind_value != 2.0)
     p.fail("kind", "'kind' must be 1 (acts in compression, pushes the points apart) or 2 (acts in tension, pulls them together)");
   kind = static_cast<int>(kind_value);
   closed = read_branch(p, "stiffness_1", "stiffness_2", "breakpoint");
-  preload = p.optional_nonnegative("preload").value_or(0.0);
+  preload = p.value("preload");
   if (const auto a = p.vector("axis", 2)) {
     const double size = std::hypot((*a)[0], (*a)[1]);
     if (!(size > 0.0)) p.fail("axis", "'axis' must be a nonzero direction [ax, ay]");
     axis = Vec2<double>{(*a)[0] / size, (*a)[1] / size};
   }
   // Along an axis the separation s has a sign, so any free length will do.
-  free_length = axis ? p.number("free_length") : p.optional_positive("free_length");
-  fracture_load = p.optional_positive("fracture_load");
+  free_length = p.number("free_length");
+  if (!axis && free_length && !(*free_length > 0.0))
+    p.fail("free_length", "'free_length' must be positive without an 'axis' (it is a distance between the points)");
+  fracture_load = p.number("fracture_load");
   if (fracture_load && preload >= *fracture_load)
     p.fail("preload", "'preload' must be below 'fracture_load' (the spring would break as soon as it closes)");
 
@@ -312,10 +312,80 @@ template class PiecewiseLineElement<NonlinearSpring>;
 template class PiecewiseLineElement<NonlinearDashpot>;
 template class PiecewiseLineElement<SpecialSpring>;
 
+namespace {
+
+/// slope_1 (required), slope_2 and breakpoint of one branch of a piecewise-linear law.
+std::vector<ParameterSpec> branch_specs(const std::string& slope_1, const std::string& slope_2,
+                                        const std::string& breakpoint, const std::string& branch, Unit slope_unit,
+                                        Unit breakpoint_unit) {
+  return {{slope_1, slope_unit, required, Range::NonNegative, "first slope of the " + branch},
+          {slope_2, slope_unit, optional("the first slope throughout"), Range::NonNegative,
+           "slope of the " + branch + " beyond " + breakpoint + " (give both or neither)"},
+          {breakpoint, breakpoint_unit, optional("none"), Range::NonNegative,
+           "where the " + branch + " changes from " + slope_1 + " to " + slope_2}};
+}
+
+std::vector<ParameterSpec> joined(std::vector<ParameterSpec> first, const std::vector<ParameterSpec>& second) {
+  first.insert(first.end(), second.begin(), second.end());
+  return first;
+}
+
+ParameterSpec fracture_spec() {
+  return {"fracture_load", Unit::Force, optional("no fracture"), Range::Positive,
+          "force at which the element breaks (no force afterwards)"};
+}
+
+}  // namespace
+
 void register_nonlinear_elements(ElementRegistry& registry) {
-  registry.add("nonlinear_spring", [](ElementSpec& s) { return std::make_unique<NonlinearSpring>(s); });
-  registry.add("nonlinear_dashpot", [](ElementSpec& s) { return std::make_unique<NonlinearDashpot>(s); });
-  registry.add("special_spring", [](ElementSpec& s) { return std::make_unique<SpecialSpring>(s); });
+  const std::string ends = "P1 on body 1, P2 on body 2: the ends";
+  registry.add(
+      {"nonlinear_spring", "19", 2, ends,
+       "Piecewise-linear spring along P1-P2: two slopes on each side of e = L - free_length: tension T = -preload + "
+       "compression_stiffness_1 e (e < 0) or extension_stiffness_1 e (e > 0), continuing with the second slope beyond "
+       "the breakpoint; continuous in e, elastic; breaks when |T| reaches fracture_load.",
+       joined(joined(branch_specs("compression_stiffness_1", "compression_stiffness_2", "compression_breakpoint",
+                                  "compression branch", Unit::ForcePerLength, Unit::Length),
+                     branch_specs("extension_stiffness_1", "extension_stiffness_2", "extension_breakpoint",
+                                  "extension branch", Unit::ForcePerLength, Unit::Length)),
+              {{"preload", Unit::Force, default_value(0.0), Range::Any,
+                "compressive force at the free length (positive pushes the points apart)"},
+               fracture_spec(),
+               {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::Positive,
+                "length at which the tension is -preload"}}),
+       "compression_stiffness_1: 1000\ncompression_stiffness_2: 5000\ncompression_breakpoint: 0.1\n"
+       "extension_stiffness_1: 500\nfracture_load: 1.0e4",
+       [](ElementSpec& s) { return std::make_unique<NonlinearSpring>(s); }});
+  registry.add(
+      {"nonlinear_dashpot", "20", 2, ends,
+       "Piecewise-linear dashpot along P1-P2: tension continuous and piecewise linear in the rate L': damping_compression_1 L' "
+       "(L' < 0) or damping_extension_1 L' (L' > 0), continuing with the second coefficient beyond the switch "
+       "velocity.",
+       joined(branch_specs("damping_compression_1", "damping_compression_2", "compression_switch_velocity",
+                           "compression branch", Unit::ForceTimePerLength, Unit::Velocity),
+              branch_specs("damping_extension_1", "damping_extension_2", "extension_switch_velocity", "extension branch",
+                           Unit::ForceTimePerLength, Unit::Velocity)),
+       "damping_compression_1: 100\ndamping_extension_1: 50\ndamping_extension_2: 10\nextension_switch_velocity: 1",
+       [](ElementSpec& s) { return std::make_unique<NonlinearDashpot>(s); }});
+  registry.add(
+      {"special_spring", "21", 2, ends + " (with an axis: P2 against a stop plane of body 1)",
+       "One-sided contact spring: kind 1 acts in compression (d = free_length - L, pushes the points apart), kind 2 "
+       "in tension (d = L - free_length, pulls them together). No force while d < 0; P = preload + stiffness_1 d, "
+       "then stiffness_2 beyond the breakpoint. With an axis the length is measured along it and the force acts "
+       "along it. Breaks when P reaches fracture_load.",
+       joined({{"kind", Unit::Choice, default_value(1), Range::Any, "1: acts in compression, 2: acts in tension"}},
+              joined(branch_specs("stiffness_1", "stiffness_2", "breakpoint", "closed law", Unit::ForcePerLength,
+                                  Unit::Length),
+                     {{"preload", Unit::Force, default_value(0.0), Range::NonNegative,
+                       "force as soon as the spring closes (an installed, caged spring)"},
+                      fracture_spec(),
+                      {"free_length", Unit::Length, optional("the initial distance (or separation along the axis)"),
+                       Range::Any, "length (or separation along the axis) at which it closes; > 0 without an axis"},
+                      {"axis", Unit::Direction, optional("along P1-P2"), Range::Any,
+                       "direction in body 1's frame along which the separation is measured", Shape::Pair}})),
+       "kind: 1\nstiffness_1: 5000\nstiffness_2: 3.0e6\nbreakpoint: 1.25\npreload: 1250\nfracture_load: 4.0e5\n"
+       "free_length: 1.25\naxis: [1, 0]",
+       [](ElementSpec& s) { return std::make_unique<SpecialSpring>(s); }});
 }
 
 }  // namespace railcrash

@@ -9,10 +9,8 @@ namespace railcrash {
 
 LinearSpring::LinearSpring(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      stiffness(spec.parameters->required_nonnegative("stiffness")),
-      free_length(spec.parameters->optional_nonnegative("free_length")) {
-  spec.require_points(2);
-}
+      stiffness(spec.parameters->value("stiffness")),
+      free_length(spec.parameters->number("free_length")) {}
 
 void LinearSpring::initialize(const ElementState<double>& initial) {
   const double length = line_geometry(*this, initial).length;
@@ -36,9 +34,7 @@ void LinearSpring::outputs(const ElementState<double>& s, const double*, double*
 
 LinearDashpot::LinearDashpot(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      damping(spec.parameters->required_nonnegative("damping")) {
-  spec.require_points(2);
-}
+      damping(spec.parameters->value("damping")) {}
 
 void LinearDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
   const LineGeometry<double> g = line_geometry(*this, s);
@@ -49,10 +45,8 @@ void LinearDashpot::outputs(const ElementState<double>& s, const double*, double
 
 TorsionalSpring::TorsionalSpring(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      stiffness(spec.parameters->required_nonnegative("stiffness")),
-      free_angle(spec.parameters->number("free_angle")) {
-  spec.require_points(2);
-}
+      stiffness(spec.parameters->value("stiffness")),
+      free_angle(spec.parameters->number("free_angle")) {}
 
 void TorsionalSpring::initialize(const ElementState<double>& initial) {
   if (!free_angle) free_angle = relative_angle(initial);
@@ -71,9 +65,7 @@ void TorsionalSpring::outputs(const ElementState<double>& s, const double*, doub
 
 TorsionalDashpot::TorsionalDashpot(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),
-      damping(spec.parameters->required_nonnegative("damping")) {
-  spec.require_points(2);
-}
+      damping(spec.parameters->value("damping")) {}
 
 void TorsionalDashpot::outputs(const ElementState<double>& s, const double*, double* out) const {
   const double rate = s.v[static_cast<std::size_t>(point_slot(1))].theta - s.v[static_cast<std::size_t>(point_slot(0))].theta;
@@ -82,10 +74,31 @@ void TorsionalDashpot::outputs(const ElementState<double>& s, const double*, dou
 }
 
 void register_spring_elements(ElementRegistry& registry) {
-  registry.add("linear_spring", [](ElementSpec& s) { return std::make_unique<LinearSpring>(s); });
-  registry.add("linear_dashpot", [](ElementSpec& s) { return std::make_unique<LinearDashpot>(s); });
-  registry.add("torsional_spring", [](ElementSpec& s) { return std::make_unique<TorsionalSpring>(s); });
-  registry.add("torsional_dashpot", [](ElementSpec& s) { return std::make_unique<TorsionalDashpot>(s); });
+  const std::string two_points = "P1 on body 1, P2 on body 2: the ends";
+  registry.add({"linear_spring", "1", 2, two_points,
+                "Linear spring along P1-P2: tension T = stiffness (L - free_length), L the distance between the points.",
+                {{"stiffness", Unit::ForcePerLength, required, Range::NonNegative, "spring rate"},
+                 {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::NonNegative,
+                  "length at zero force"}},
+                "stiffness: 1000\nfree_length: 0.5",
+                [](ElementSpec& s) { return std::make_unique<LinearSpring>(s); }});
+  registry.add({"linear_dashpot", "2", 2, two_points,
+                "Linear dashpot along P1-P2: tension T = damping L', L' the rate of change of the distance P1-P2.",
+                {{"damping", Unit::ForceTimePerLength, required, Range::NonNegative, "damping coefficient"}},
+                "damping: 50",
+                [](ElementSpec& s) { return std::make_unique<LinearDashpot>(s); }});
+  registry.add({"torsional_spring", "3", 2, "P1 on body 1, P2 on body 2 (only their bodies matter)",
+                "Rotational spring between the two bodies: moment M = stiffness (theta2 - theta1 - free_angle).",
+                {{"stiffness", Unit::MomentPerAngle, required, Range::NonNegative, "rotational spring rate"},
+                 {"free_angle", Unit::Angle, optional("the initial theta2 - theta1"), Range::Any,
+                  "relative angle theta2 - theta1 at zero moment"}},
+                "stiffness: 2000\nfree_angle: 0.1",
+                [](ElementSpec& s) { return std::make_unique<TorsionalSpring>(s); }});
+  registry.add({"torsional_dashpot", "4", 2, "P1 on body 1, P2 on body 2 (only their bodies matter)",
+                "Rotational dashpot between the two bodies: moment M = damping (omega2 - omega1).",
+                {{"damping", Unit::MomentTimePerAngle, required, Range::NonNegative, "rotational damping coefficient"}},
+                "damping: 20",
+                [](ElementSpec& s) { return std::make_unique<TorsionalDashpot>(s); }});
 }
 
 }  // namespace railcrash

@@ -128,5 +128,14 @@ expect_text "and SuiteSparse" "$tmp/stdout" "^SuiteSparse [0-9.]* (KLU"
 expect_status "--quiet run" 0 "$bin" run "$src/tests/report/two_car.yaml" --quiet --out "$tmp/quiet"
 [ ! -s "$tmp/stderr" ] && passes=$((passes + 1)) || { echo "FAIL: --quiet printed to stderr"; failures=$((failures + 1)); }
 
+# elements: the reference written from the element declarations.
+expect_status "elements lists the types" 0 "$bin" elements
+expect_text "one line per type" "$tmp/stdout" "^linear_spring  *(IITRAIN report type 1)  *Linear spring along P1-P2"
+expect_status "elements TYPE prints one type" 0 "$bin" elements linear_spring
+expect_text "its parameters with unit kind, both unit systems, presence and range" "$tmp/stdout" \
+  "stiffness  *force/length (in-lbf-s: lbf/in, SI: N/m); required; >= 0"
+expect_status "an unknown element type exits 2" 2 "$bin" elements linear_sprign
+expect_text "with the nearest type" "$tmp/stderr" "unknown element type 'linear_sprign' (did you mean 'linear_spring'?)"
+
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
