@@ -18,6 +18,7 @@ constexpr double kInch = 0.0254;              // [m]
 constexpr double kPoundForce = 4.4482216152605;  // [N]
 constexpr double kPoundMass = 0.45359237;     // [kg]
 constexpr double kStandardGravitySI = 9.80665;  // [m/s^2]
+constexpr double kStandardGravityInch = 386.088;  // [in/s^2] the value results.hpp's g in in-lbf-s models uses
 
 /// Conversions from the command's units (km/h, mm, kN, t) to the model's.
 struct Units {
@@ -25,7 +26,7 @@ struct Units {
   double length(double mm) const { return inch_pound ? mm / 25.4 : mm * 1e-3; }
   double speed(double kmh) const { return inch_pound ? kmh / 3.6 / kInch : kmh / 3.6; }
   double force(double kn) const { return inch_pound ? kn * 1e3 / kPoundForce : kn * 1e3; }
-  double acceleration(double g) const { return inch_pound ? g * kStandardGravitySI / kInch : g * kStandardGravitySI; }
+  double acceleration(double g) const { return g * (inch_pound ? kStandardGravityInch : kStandardGravitySI); }
   const char* length_name() const { return inch_pound ? "in" : "m"; }
   const char* speed_name() const { return inch_pound ? "in/s" : "m/s"; }
 };
@@ -36,6 +37,12 @@ double required(const std::optional<double>& value, const std::string& option, c
   if (!value) refuse("missing " + option + ": " + what);
   if (!(*value > 0.0)) refuse(option + " must be positive");
   return *value;
+}
+
+std::string number_text(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
 }
 
 bool starts_with(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
@@ -179,7 +186,7 @@ YAML::Node criteria_section(const ScenarioRequest& q, const Template& t, const U
   YAML::Node deceleration(YAML::NodeType::Map);
   deceleration["limit"] = u.acceleration(*q.deceleration_limit);
   deceleration["cfc"] = 60;
-  deceleration["source"] = "--deceleration-limit " + std::to_string(*q.deceleration_limit) + " g: " + input;
+  deceleration["source"] = "--deceleration-limit " + number_text(*q.deceleration_limit) + " g: " + input;
   YAML::Node bodies(YAML::NodeType::Sequence), gauges(YAML::NodeType::Sequence), wheels(YAML::NodeType::Sequence);
   for (const std::string& train : trains)
     for (int k = 1; k <= q.cars; ++k) {
@@ -197,16 +204,16 @@ YAML::Node criteria_section(const ScenarioRequest& q, const Template& t, const U
   s["mean_deceleration"] = deceleration;
   YAML::Node survival(YAML::NodeType::Map);
   survival["limit"] = u.length(*q.survival_limit);
-  survival["source"] = "--survival-space-limit " + std::to_string(*q.survival_limit) + " mm: " + input;
+  survival["source"] = "--survival-space-limit " + number_text(*q.survival_limit) + " mm: " + input;
   survival["gauges"] = gauges;
   s["survival_space"] = survival;
   YAML::Node override_node(YAML::NodeType::Map);
   if (override_bodies.IsSequence()) override_node["bodies"] = override_bodies;
   else override_node["interface"] = t.anticlimber;
   override_node["limit"] = u.length(*q.override_limit);
-  override_node["source"] = "--override-limit " + std::to_string(*q.override_limit) + " mm: " + input;
+  override_node["source"] = "--override-limit " + number_text(*q.override_limit) + " mm: " + input;
   override_node["wheel_lift_limit"] = u.length(*q.wheel_lift_limit);
-  override_node["wheel_lift_source"] = "--wheel-lift-limit " + std::to_string(*q.wheel_lift_limit) + " mm: " + input;
+  override_node["wheel_lift_source"] = "--wheel-lift-limit " + number_text(*q.wheel_lift_limit) + " mm: " + input;
   for (const std::string& train : trains)
     for (const std::string& w : t.leading_wheels) wheels.push_back(train + "1_" + w.substr(5));
   wheels.SetStyle(YAML::EmitterStyle::Flow);
@@ -321,7 +328,10 @@ std::string make_scenario_model(const ScenarioRequest& q) {
     const YAML::Node front = t.body(face["body"].as<std::string>());
     const double face_x = front["position"][0].as<double>() + face["at"][0].as<double>();  // [length]
     const double height = u.length(*q.buffer_height);                                       // [length]
-    const double anchor = u.length(1000.0);  // [length] the wagon point 1 m ahead of its buffer faces
+    // [length] the buffer force acts between the train's face and a wagon point 100 m ahead: the
+    // buffer heads slide on each other, so the force stays within 1/100 rad of horizontal for
+    // each metre of vertical relative displacement.
+    const double anchor = u.length(100000.0);
     const double wagon_mass_kg = q.wagon_mass * 1e3;
     YAML::Node wagon(YAML::NodeType::Map);
     wagon["name"] = "wagon";
@@ -329,16 +339,17 @@ std::string make_scenario_model(const ScenarioRequest& q) {
     else wagon["mass"] = wagon_mass_kg;
     // Its rotation is locked by the slider, so the inertia only has to be positive (Euler's
     // penalty joints need one): that of the mass at 1 m.
-    const double wagon_mass_model = u.inch_pound ? wagon_mass_kg / kPoundMass / (kStandardGravitySI / kInch) : wagon_mass_kg;
-    wagon["inertia"] = wagon_mass_model * anchor * anchor;
-    wagon["position"] = flow_pair(face_x + anchor, height);
+    const double wagon_mass_model = u.inch_pound ? wagon_mass_kg / kPoundMass / kStandardGravityInch : wagon_mass_kg;
+    const double radius = u.length(1000.0);  // [length] the wagon's c.g. 1 m ahead of its buffer faces
+    wagon["inertia"] = wagon_mass_model * radius * radius;
+    wagon["position"] = flow_pair(face_x + radius, height);
     wagon.SetStyle(YAML::EmitterStyle::Flow);
     kept_bodies.push_back(wagon);
     YAML::Node slider(YAML::NodeType::Map);
     slider["name"] = "wagon_on_track";
     slider["type"] = "slider_joint";
     slider["axis"] = flow_pair(1, 0);
-    slider["points"] = two_points("ground", flow_pair(face_x + anchor, height), "wagon", flow_pair(0, 0));
+    slider["points"] = two_points("ground", flow_pair(face_x + radius, height), "wagon", flow_pair(0, 0));
     kept_elements.push_back(slider);
     YAML::Node buffers(YAML::NodeType::Map);
     buffers["name"] = "wagon_buffers";
@@ -349,7 +360,7 @@ std::string make_scenario_model(const ScenarioRequest& q) {
     buffers["unloading_stiffness"] = 2.0 * u.force(*q.buffer_unloading_stiffness) / u.length(1.0);
     buffers["free_length"] = anchor;
     buffers["points"] = two_points(front_body, flow_pair(face_x - front["position"][0].as<double>(), height - front["position"][1].as<double>()),
-                                   "wagon", flow_pair(0, 0));
+                                   "wagon", flow_pair(anchor - radius, 0));
     kept_elements.push_back(buffers);
     model["bodies"] = kept_bodies;
     model["elements"] = kept_elements;

@@ -150,6 +150,21 @@ expect_text "it names the train file" "$tmp/stderr" "coupled_cars.yaml"
 expect_status "a bad buffer curve" 2 "$bin" scenario 2 --train "$train" "${limits[@]}" --buffer-curve 0:0,105 \
   --buffer-unloading-stiffness 50 --buffer-height 1060
 expect_text "it names the point" "$tmp/stderr" "--buffer-curve: '105' is not a point stroke:force"
+# The shipped scenario models are what models/scenarios/make.sh generates, and they run
+# (10 ms, both integrators) with their criteria in summary.json.
+mkdir -p "$tmp/scenarios"
+cd "$src"
+expect_status "make.sh regenerates the scenario models" 0 models/scenarios/make.sh "$bin" "$tmp/scenarios"
+cd - > /dev/null
+for name in scenario1_report_car scenario2_report_car; do
+  if cmp -s "$tmp/scenarios/$name.yaml" "$src/models/scenarios/$name.yaml"; then passes=$((passes + 1));
+  else echo "FAIL: models/scenarios/$name.yaml differs from what make.sh writes now"; failures=$((failures + 1)); fi
+  for integrator in ida euler; do
+    expect_status "$name runs with $integrator" 0 "$bin" run "$src/models/scenarios/$name.yaml" --integrator "$integrator" \
+      --t-end 0.01 --quiet --out "$tmp/$name.$integrator"
+    expect_text "$name has its criteria" "$tmp/$name.$integrator/summary.json" '"criterion": "override"'
+  done
+done
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]
