@@ -3,6 +3,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -235,11 +236,13 @@ YAML::Node two_points(const std::string& body_1, const YAML::Node& at_1, const s
   return points;
 }
 
-bool is_body_of(const YAML::Node& node, const std::string& prefix) {
-  if (node.IsScalar()) return starts_with(node.Scalar(), prefix);
-  if (node.IsSequence() || node.IsMap())
-    for (const auto& item : node)
-      if (is_body_of(node.IsMap() ? item.second : item, prefix)) return true;
+/// True for the standing train's names, t<k>_* (the consist generator's).
+bool is_standing(const std::string& name) { return name.size() > 1 && name[0] == 't' && std::isdigit(static_cast<unsigned char>(name[1])); }
+
+/// True when an element's points list names a body of the standing train.
+bool touches_standing_train(const YAML::Node& points) {
+  for (const YAML::Node& point : points)
+    if (point["body"] && is_standing(point["body"].as<std::string>())) return true;
   return false;
 }
 
@@ -250,8 +253,9 @@ std::string make_scenario_model(const ScenarioRequest& q) {
     refuse("--category " + q.category + " is not an EN 15227 crashworthiness design category; use C-I, C-II, C-III or C-IV");
   if (q.number == 3)
     refuse("scenario 3 (a large deformable obstacle at a level crossing) is not generated: the standard's reference obstacle "
-           "(its mass distribution, geometry and force-deformation characteristic) could not be confirmed from a public source, "
-           "and its impact on the cab front is above the frame, a height profile the cars' lumped front ends do not have");
+           "(its mass distribution, geometry, height and force-deformation characteristic) could not be confirmed from a public "
+           "source, and it would have to be invented");
+  // "the obstacle is pushed aside rather than causing derailment" (railwaynews.net, scenario 4).
   if (q.number == 4)
     refuse("scenario 4 (a low obstacle) cannot be represented: the obstacle deflector's job is to push the obstacle "
            "sideways, out of the longitudinal-vertical plane this planar solver models");
@@ -305,23 +309,23 @@ std::string make_scenario_model(const ScenarioRequest& q) {
            << "# Centre-of-mass frame: the striking train (s*) at +" << closing_speed / 2 << ", the standing one (t*) at -"
            << closing_speed / 2 << " " << u.speed_name() << ".\n";
     for (YAML::Node b : bodies) {
-      const bool striking = starts_with(b["name"].as<std::string>(), "s");
+      const bool striking = !is_standing(b["name"].as<std::string>());
       b["velocity"] = flow_pair(striking ? closing_speed / 2 : -closing_speed / 2, 0.0);
       if (!striking) b["position"] = flow_pair(b["position"][0].as<double>(), b["position"][1].as<double>() + offset);
     }
     for (YAML::Node e : model["elements"])
-      if (e["type"].as<std::string>() == "wheel_rail" && starts_with(e["name"].as<std::string>(), "t"))
+      if (e["type"].as<std::string>() == "wheel_rail" && is_standing(e["name"].as<std::string>()))
         e["rail_height"] = (e["rail_height"] ? e["rail_height"].as<double>() : 0.0) + offset;
   } else {
     // Scenario 2: the striking train alone, at the closing speed, against the wagon at rest.
     YAML::Node kept_bodies(YAML::NodeType::Sequence), kept_elements(YAML::NodeType::Sequence);
     for (YAML::Node b : bodies)
-      if (starts_with(b["name"].as<std::string>(), "s")) {
+      if (!is_standing(b["name"].as<std::string>())) {
         b["velocity"] = flow_pair(closing_speed, 0.0);
         kept_bodies.push_back(b);
       }
     for (const YAML::Node& e : model["elements"])
-      if (!is_body_of(e["points"], "t")) kept_elements.push_back(e);
+      if (!touches_standing_train(e["points"])) kept_elements.push_back(e);
     // The anticlimber's face on the train: the buffers strike there.
     const YAML::Node face = t.anticlimber_node["points"][0];
     const std::string front_body = "s1_" + face["body"].as<std::string>().substr(5);

@@ -31,7 +31,8 @@
 // wheels are not modelled) and the two side buffers as one crush_spring (the buffer curve with
 // twice the force: two buffers in parallel) at the buffer height between the train's front end
 // (at its anticlimber face) and the wagon.
-// Scenarios 3 and 4 are refused with the reason (scenario_refusal).
+// Scenarios 3 and 4 are refused with the reason: 3's reference obstacle could not be confirmed
+// from a public source; 4's obstacle is pushed sideways, out of the plane.
 #pragma once
 
 #include <optional>
