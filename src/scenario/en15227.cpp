@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -285,6 +286,18 @@ std::string make_scenario_model(const ScenarioRequest& q) {
     required(q.buffer_unloading_stiffness, "--buffer-unloading-stiffness", "one side buffer's unloading stiffness [kN/mm]");
     required(q.buffer_height, "--buffer-height", "the wagon's buffer centre height above the rail [mm]");
     if (!(q.wagon_mass > 0.0)) refuse("--wagon-mass must be positive");
+    // The crush_spring unloads at the unloading stiffness from wherever it is on the curve, and
+    // stores P^2 / (2 unloading stiffness): below the curve's steepest slope it would give back
+    // more energy than the buffer took.
+    double steepest = 0.0;  // [kN/mm]
+    for (std::size_t k = 1; k < q.buffer_curve.size(); ++k) {
+      const double stroke = q.buffer_curve[k].first - q.buffer_curve[k - 1].first;
+      if (!(stroke > 0.0)) refuse("--buffer-curve: the strokes must increase (point " + std::to_string(k + 1) + ")");
+      steepest = std::max(steepest, (q.buffer_curve[k].second - q.buffer_curve[k - 1].second) / stroke);
+    }
+    if (*q.buffer_unloading_stiffness < steepest * (1.0 - 1e-9))
+      refuse("--buffer-unloading-stiffness " + number_text(*q.buffer_unloading_stiffness) + " kN/mm is below the curve's steepest slope " +
+             number_text(steepest) + " kN/mm: unloading would give back more energy than the buffer took; give at least that");
   }
   if (q.offset && *q.offset < 0.0) refuse("--offset must not be negative (the standing train is raised by it)");
 

@@ -120,6 +120,9 @@ TEST_CASE("scenario: bad requests name what is missing", "[scenario]") {
   q = report_car(2);
   q.buffer_curve.clear();
   CHECK_THAT(error_of(q), Catch::Contains("missing --buffer-curve"));
+  q = report_car(2);
+  q.buffer_unloading_stiffness = 20.0;  // the curve's second segment rises at 1000 / 45 = 22.2 kN/mm
+  CHECK_THAT(error_of(q), Catch::Contains("below the curve's steepest slope 22.2222 kN/mm"));
   q = report_car(1);
   q.train_path = std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/coupled_cars.yaml";
   CHECK_THAT(error_of(q), Catch::Contains("coupled_cars.yaml"));
