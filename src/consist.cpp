@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "railcrash/error.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 namespace {
@@ -77,18 +78,10 @@ YAML::Node renamed(const YAML::Node& node, const std::map<std::string, std::stri
 
 bool starts_with(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
 
-YAML::Node pair(double a, double b) {
-  YAML::Node n(YAML::NodeType::Sequence);
-  n.push_back(a);
-  n.push_back(b);
-  n.SetStyle(YAML::EmitterStyle::Flow);
-  return n;
-}
-
 YAML::Node point_on(const std::string& body, double x, double y) {
   YAML::Node p(YAML::NodeType::Map);
   p["body"] = body;
-  p["at"] = pair(x, y);
+  p["at"] = flow_pair(x, y);
   p.SetStyle(YAML::EmitterStyle::Flow);
   return p;
 }
@@ -96,13 +89,17 @@ YAML::Node point_on(const std::string& body, double x, double y) {
 }  // namespace
 
 std::string make_consist_model(const std::string& template_path, int cars_per_consist) {
-  if (cars_per_consist < 1) throw InputError("consist: the number of cars per consist must be at least 1");
   YAML::Node root;
   try {
     root = YAML::LoadFile(template_path);
   } catch (const YAML::Exception& e) {
     throw InputError(template_path + ": cannot read the consist template: " + e.what());
   }
+  return make_consist_model(root, template_path, cars_per_consist);
+}
+
+std::string make_consist_model(const YAML::Node& root, const std::string& template_path, int cars_per_consist) {
+  if (cars_per_consist < 1) throw InputError("consist: the number of cars per consist must be at least 1");
   const TemplateReader t(template_path, root);
   if (!root["bodies"] || !root["bodies"].IsSequence() || !root["elements"] || !root["elements"].IsSequence())
     t.fail(root, "needs 'bodies' and 'elements' lists");
@@ -155,7 +152,7 @@ std::string make_consist_model(const std::string& template_path, int cars_per_co
       const bool striking = starts_with(name, "car1_");
       YAML::Node copy = renamed(b, striking ? names_s[static_cast<std::size_t>(k - 1)] : names_t[static_cast<std::size_t>(k - 1)]);
       const double shift = (k - 1) * (striking ? -length_s : length_t);
-      copy["position"] = pair(b["position"][0].as<double>() + shift, b["position"][1].as<double>());
+      copy["position"] = flow_pair(b["position"][0].as<double>() + shift, b["position"][1].as<double>());
       copy["car"] = (striking ? "s" : "t") + std::to_string(k);  // each generated car is summarised on its own
       copy.SetStyle(YAML::EmitterStyle::Flow);
       bodies.push_back(copy);

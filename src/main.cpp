@@ -10,8 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
+#include <optional>
 
 #include "railcrash/consist.hpp"
+#include "railcrash/scenario/en15227.hpp"
 #include "railcrash/dae_system.hpp"
 #include "railcrash/element_reference.hpp"
 #include "railcrash/euler_integrator.hpp"
@@ -260,8 +263,8 @@ int converge_command(const std::string& path, const railcrash::ConvergeOptions& 
   return result.reference.ok && !g_stop.load() ? 0 : 1;
 }
 
-int consist_command(const std::string& template_path, int cars, const std::string& out_path) {
-  const std::string text = railcrash::make_consist_model(template_path, cars);
+/// Writes a generated model to out_path (standard output when empty); `what` names it on stderr.
+int write_generated_model(const std::string& text, const std::string& out_path, const std::string& what) {
   if (out_path.empty()) {
     std::fputs(text.c_str(), stdout);
     return 0;
@@ -269,8 +272,30 @@ int consist_command(const std::string& template_path, int cars, const std::strin
   std::ofstream file(out_path);
   file << text;
   if (!file) throw railcrash::InputError("cannot write " + out_path + "; check that its folder exists");
-  std::fprintf(stderr, "%d + %d cars written to %s\n", cars, cars, out_path.c_str());
+  std::fprintf(stderr, "%s written to %s\n", what.c_str(), out_path.c_str());
   return 0;
+}
+
+int consist_command(const std::string& template_path, int cars, const std::string& out_path) {
+  return write_generated_model(railcrash::make_consist_model(template_path, cars), out_path,
+                               std::to_string(cars) + " + " + std::to_string(cars) + " cars");
+}
+
+/// "mm:kN,mm:kN,..." -> pairs; InputError naming the option otherwise.
+std::vector<std::pair<double, double>> parse_curve(const std::string& text, const std::string& option) {
+  std::vector<std::pair<double, double>> points;
+  std::stringstream items(text);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    const auto colon = item.find(':');
+    try {
+      if (colon == std::string::npos) throw std::invalid_argument(item);
+      points.emplace_back(std::stod(item.substr(0, colon)), std::stod(item.substr(colon + 1)));
+    } catch (const std::exception&) {
+      throw railcrash::InputError(option + ": '" + item + "' is not a point stroke:force (mm:kN), e.g. 0:0,75:600,105:1500");
+    }
+  }
+  return points;
 }
 
 }  // namespace
@@ -379,6 +404,35 @@ int main(int argc, char** argv) {
   consist->add_option("--cars", consist_cars, "cars per consist")->capture_default_str()->check(CLI::Range(1, 100000));
   consist->add_option("--out", consist_out, "model file to write (default: standard output)");
 
+  railcrash::ScenarioRequest scenario_request;
+  std::string scenario_out, buffer_curve;
+  std::map<std::string, double> scenario_values;
+  CLI::App* scenario = app.add_subcommand("scenario", "write a model of an EN 15227 design collision scenario (1 or 2) "
+                                                      "built from a two-car model, with the criteria evaluated after the run");
+  scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon)")->required();
+  scenario->add_option("--train", scenario_request.train_path, "two-car model (car1_* striking), e.g. models/report/final_two_car.yaml")
+      ->required();
+  scenario->add_option("--cars", scenario_request.cars, "cars per train")->capture_default_str()->check(CLI::Range(1, 1000));
+  scenario->add_option("--category", scenario_request.category, "C-I, C-II, C-III or C-IV")->capture_default_str();
+  scenario->add_option("--passenger-bodies", scenario_request.passenger_bodies,
+                       "comma list of the passenger-area bodies (template names without car1_), e.g. center_body")->delimiter(',');
+  scenario->add_option("--survival-gauge", scenario_request.survival_gauge,
+                       "FRONT,REAR: template bodies (without car1_) at the ends of the survival space")->delimiter(',');
+  scenario->add_option("--buffer-curve", buffer_curve, "scenario 2: one side buffer's force-stroke curve mm:kN,mm:kN,...");
+  scenario->add_option("--wagon-mass", scenario_request.wagon_mass, "scenario 2: wagon mass [t]")->capture_default_str();
+  for (const auto& [option, help] : std::vector<std::pair<std::string, std::string>>{
+           {"--speed", "closing speed [km/h] (default 36 for C-I)"},
+           {"--offset", "scenario 1: vertical offset of the standing train [mm] (required)"},
+           {"--deceleration-limit", "mean longitudinal deceleration limit [g] (required)"},
+           {"--survival-space-limit", "largest allowed shortening of the survival space [mm] (required)"},
+           {"--override-limit", "largest allowed vertical relative displacement at the interface [mm] (required)"},
+           {"--wheel-lift-limit", "largest allowed wheel lift of the leading bogies [mm] (required)"},
+           {"--buffer-unloading-stiffness", "scenario 2: one buffer's unloading stiffness [kN/mm] (required)"},
+           {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)"},
+           {"--t-end", "end time of the run [s] (default: the train model's)"}})
+    scenario->add_option(option, scenario_values[option], help);
+  scenario->add_option("--out", scenario_out, "model file to write (default: standard output)");
+
   CLI::App* check = app.add_subcommand("check", "validate a model and print a summary");
   check->add_option("model", model_path, "model file (YAML)")->required();
   check->add_option("--set", settings, "override a model key");
@@ -399,6 +453,24 @@ int main(int argc, char** argv) {
     if (*elements) return elements_command(element_type_name, elements_markdown);
     if (*report) return report_command(report_dir, report_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out);
+    if (*scenario) {
+      const auto given = [&](const std::string& option) -> std::optional<double> {
+        if (scenario->count(option) == 0) return std::nullopt;
+        return scenario_values[option];
+      };
+      scenario_request.speed = given("--speed");
+      scenario_request.offset = given("--offset");
+      scenario_request.deceleration_limit = given("--deceleration-limit");
+      scenario_request.survival_limit = given("--survival-space-limit");
+      scenario_request.override_limit = given("--override-limit");
+      scenario_request.wheel_lift_limit = given("--wheel-lift-limit");
+      scenario_request.buffer_unloading_stiffness = given("--buffer-unloading-stiffness");
+      scenario_request.buffer_height = given("--buffer-height");
+      scenario_request.t_end = given("--t-end");
+      if (!buffer_curve.empty()) scenario_request.buffer_curve = parse_curve(buffer_curve, "--buffer-curve");
+      return write_generated_model(railcrash::make_scenario_model(scenario_request), scenario_out,
+                                   "EN 15227 scenario " + std::to_string(scenario_request.number));
+    }
     if (*converge) {
       if (*converge_t_end) converge_options.t_end = t_end;
       if (*converge_output) converge_options.output_interval = output_interval;

@@ -1,4 +1,5 @@
 #include "railcrash/model_io.hpp"
+#include "railcrash/scenario/criteria.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -357,7 +358,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
 }
 
 const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
-                                           "responses"};
+                                           "responses", "scenario"};
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity",
                                             "car"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
@@ -789,6 +790,8 @@ Model build(const YAML::Node& root, const Reader& r) {
   }
   if (root["responses"]) read_responses(r, root["responses"], model);
   if (root["outputs"]) read_outputs(r, root["outputs"], model);
+  if (root["scenario"])
+    model.scenario = read_scenario_section(root["scenario"], model, [&r](const YAML::Node& node, const std::string& message) { r.fail(node, message); });
   read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
   return model;
 }

@@ -7,6 +7,7 @@
 #include "railcrash/ida_integrator.hpp"
 #include "railcrash/progress.hpp"
 #include "railcrash/responses.hpp"
+#include "railcrash/scenario/criteria.hpp"
 #include "railcrash/results.hpp"
 
 namespace railcrash {
@@ -80,6 +81,8 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory)).get());
   if (model.responses.defined())
     observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
+  std::unique_ptr<ScenarioTracker> scenario;
+  if (model.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *model.scenario)).get());
   ProgressObserver observer(observers, model.simulation.t_end, show_progress);
   RunReport report;
   report.integrator = integrator->name();
@@ -91,7 +94,9 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   }
   if (writer) {
     report.summary_json =
-        writer->write_summary(report.outcome, report.integrator, responses ? ",\n  \"responses\": " + responses->json() : "");
+        writer->write_summary(report.outcome, report.integrator,
+                              (responses ? ",\n  \"responses\": " + responses->json() : "") +
+                                  (scenario ? ",\n  \"scenario\": " + scenario->json() : ""));
     report.acceleration_peaks = writer->acceleration_peaks();
     report.car_crush = writer->car_crush();
     report.filtered_accelerations = writer->filtered_accelerations();

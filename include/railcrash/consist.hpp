@@ -25,10 +25,16 @@
 
 #include <string>
 
+namespace YAML {
+class Node;
+}
+
 namespace railcrash {
 
 /// YAML text of the 2N-car model (N >= 1) built from a two-car template file. Throws
 /// InputError naming the template and what is missing when it is not of the expected shape.
 std::string make_consist_model(const std::string& template_path, int cars_per_consist);
+/// Same, from a template already read (`template_path` names it in messages and comments).
+std::string make_consist_model(const YAML::Node& root, const std::string& template_path, int cars_per_consist);
 
 }  // namespace railcrash

@@ -101,6 +101,8 @@ struct SimulationSettings {
   Element::PenaltyOverrides penalty;  // euler: model-wide penalty settings
 };
 
+struct ScenarioCriteria;  // scenario/criteria.hpp
+
 class Model {
  public:
   Model() = default;
@@ -114,6 +116,7 @@ class Model {
   SimulationSettings simulation;
   ResponseSettings responses;
   std::vector<OutputPoint> output_points;
+  std::shared_ptr<const ScenarioCriteria> scenario;  // the `scenario:` section, if any
 
   int add_body(Body body);
   Element& add_element(std::unique_ptr<Element> element);

@@ -1,5 +1,5 @@
 // Reading the studies' own YAML files (design, readings) with input errors that name the file
-// and line.
+// and line; a helper for the YAML that generated models are written with.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -19,6 +19,15 @@ inline YAML::Node load_yaml_file(const std::string& path, const std::string& wha
   } catch (const YAML::ParserException& e) {
     throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
   }
+}
+
+/// The flow-style sequence [a, b] (positions, points and velocities of generated models).
+inline YAML::Node flow_pair(double a, double b) {
+  YAML::Node n(YAML::NodeType::Sequence);
+  n.push_back(a);
+  n.push_back(b);
+  n.SetStyle(YAML::EmitterStyle::Flow);
+  return n;
 }
 
 }  // namespace railcrash

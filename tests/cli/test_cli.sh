@@ -136,6 +136,43 @@ expect_text "its parameters with unit kind, both unit systems, presence and rang
   "stiffness  *force/length (in-lbf-s: lbf/in, SI: N/m); required; >= 0"
 expect_status "an unknown element type exits 2" 2 "$bin" elements linear_sprign
 expect_text "with the nearest type" "$tmp/stderr" "unknown element type 'linear_sprign' (did you mean 'linear_spring'?)"
+# EN 15227 scenarios: the model is written, runs, and summary.json carries the criteria;
+# a missing required value, a category or scenario the standard does not define, or a train
+# model without the interface the scenario needs exits 2 naming what is missing.
+train=$src/models/report/final_two_car.yaml
+limits=(--deceleration-limit 5 --survival-space-limit 50 --override-limit 100 --wheel-lift-limit 20
+        --passenger-bodies center_body --survival-gauge bolster_body,rear_body)
+expect_status "scenario 2 model" 0 "$bin" scenario 2 --train "$train" "${limits[@]}" --buffer-curve 0:0,105:1000,150:2000 \
+  --buffer-unloading-stiffness 50 --buffer-height 1060 --t-end 0.005 --out "$tmp/scenario2.yaml"
+expect_text "the wagon's weight is 80 t in lbf" "$tmp/scenario2.yaml" "weight: 176369"
+expect_status "scenario 2 runs" 0 "$bin" run "$tmp/scenario2.yaml" --quiet --out "$tmp/scenario2"
+expect_text "summary.json has the criteria" "$tmp/scenario2/summary.json" '"criterion": "wheel_lift", "subject": "s1_front_truck_wheel_1"'
+expect_status "scenario 1 without --offset" 2 "$bin" scenario 1 --train "$train" "${limits[@]}"
+expect_text "it names the option" "$tmp/stderr" "missing --offset: the vertical offset between the two units"
+expect_status "category C-V" 2 "$bin" scenario 1 --train "$train" "${limits[@]}" --offset 40 --category C-V
+expect_text "it names the categories" "$tmp/stderr" "use C-I, C-II, C-III or C-IV"
+expect_status "scenario 4" 2 "$bin" scenario 4 --train "$train" "${limits[@]}"
+expect_text "it says why" "$tmp/stderr" "out of the longitudinal-vertical plane"
+expect_status "a train without the interface" 2 "$bin" scenario 1 --train "$src/models/examples/coupled_cars.yaml" "${limits[@]}" --offset 40
+expect_text "it names the train file" "$tmp/stderr" "coupled_cars.yaml"
+expect_status "a bad buffer curve" 2 "$bin" scenario 2 --train "$train" "${limits[@]}" --buffer-curve 0:0,105 \
+  --buffer-unloading-stiffness 50 --buffer-height 1060
+expect_text "it names the point" "$tmp/stderr" "--buffer-curve: '105' is not a point stroke:force"
+# The shipped scenario models are what models/scenarios/make.sh generates, and they run
+# (10 ms, both integrators) with their criteria in summary.json.
+mkdir -p "$tmp/scenarios"
+cd "$src"
+expect_status "make.sh regenerates the scenario models" 0 models/scenarios/make.sh "$bin" "$tmp/scenarios"
+cd - > /dev/null
+for name in scenario1_report_car scenario2_report_car; do
+  if cmp -s "$tmp/scenarios/$name.yaml" "$src/models/scenarios/$name.yaml"; then passes=$((passes + 1));
+  else echo "FAIL: models/scenarios/$name.yaml differs from what make.sh writes now"; failures=$((failures + 1)); fi
+  for integrator in ida euler; do
+    expect_status "$name runs with $integrator" 0 "$bin" run "$src/models/scenarios/$name.yaml" --integrator "$integrator" \
+      --t-end 0.01 --quiet --out "$tmp/$name.$integrator"
+    expect_text "$name has its criteria" "$tmp/$name.$integrator/summary.json" '"criterion": "override"'
+  done
+done
 
 echo "$passes passed, $failures failed"
 [ "$failures" -eq 0 ]

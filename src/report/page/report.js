@@ -158,6 +158,22 @@
         });
         row(car, parts.join("; "));
       });
+      var sc = summary.scenario;
+      if (sc) {  // EN 15227 criteria (scenario/criteria.hpp): one row per criterion and subject
+        row(sc.standard + " scenario " + sc.number + " (" + sc.category + ")",
+            (sc.pass ? "PASS" : "FAIL") + ": every criterion below" +
+            ((sc.criteria || []).some(function (c) { return c.note; }) ? " (see the notes: the run may not cover the whole collision)" : "") +
+            "; closing speed " + fmt(sc.closing_speed) + " " + lengthUnit + "/s",
+            sc.pass ? "status-ok" : "status-failed");
+        (sc.criteria || []).forEach(function (c) {
+          var g = c.criterion === "mean_deceleration";
+          var unit = g ? " g" : " " + lengthUnit;
+          var value = g ? c.value_g : c.value, limit = g ? c.limit_g : c.limit;
+          row(c.criterion.replace("_", " ") + ": " + c.subject,
+              (c.pass ? "pass" : "FAIL") + ": " + fmt(value, 4) + unit + " (limit " + fmt(limit, 4) + unit + ", margin " + fmt(limit - value, 4) + unit + ")" +
+              (c.note ? "; " + c.note : ""), c.pass ? "status-ok" : "status-failed");
+        });
+      }
     }
     head.appendChild(table);
   })();

@@ -1,0 +1,126 @@
+// The crashworthiness criteria of a design collision scenario (the model file's `scenario:`
+// section, written by `railcrash scenario`; scenario/en15227.hpp) and their evaluation after
+// a run, for summary.json ("scenario") and the run report.
+//
+// The section names everything the criteria are measured on explicitly (it does not rely on
+// body or element names):
+//   scenario:
+//     standard: EN 15227        number: 1        category: C-I
+//     closing_speed: 393.7      # [length/time] what the scenario was built with
+//     mean_deceleration: {limit: 1930.4, cfc: 60, source: "...", bodies: [s1_center_body, ...]}
+//     survival_space: {limit: 1.97, source: "...",
+//                      gauges: [{name: s1, front: s1_bolster_body, rear: s1_rear_body}, ...]}
+//     override: {limit: 3.94, source: "...", interface: anticlimber,
+//                wheel_lift_limit: 0.83, wheel_lift_source: "...", wheels: [s1_front_truck_wheel_1, ...]}
+// Limits are in the model's units ([length/time^2] for the deceleration, [length] otherwise);
+// `source` says where each value comes from (the standard's clause, or "required input").
+//
+// Criteria (each with value, limit, margin = limit - value and pass = value <= limit):
+//   mean deceleration  per body: its longitudinal velocity vx(t), low-pass filtered at the
+//                      channel class `cfc` (results/cfc_filter.hpp), then the collision pulse
+//                      of results/crash_pulse.hpp: |velocity change| / duration of the collision.
+//   survival space     per gauge: the largest shortening of the distance between the two
+//                      bodies' centres of gravity, L(0) - L(t), over the run.
+//   override           the interface anticlimber's vertical_offset: largest |v(t) - v(0)| (the
+//                      vertical relative displacement of the faces), and its `override` output
+//                      (the faces have slid past each other: fails whatever the limit); or,
+//                      with `bodies: [A, B]` instead of `interface`, the largest change of
+//                      y_B - y_A (scenario 2: the train's front end and the wagon);
+//                      wheel lift: the largest lift max(0, -penetration) of the listed wheel_rail
+//                      elements (the leading bogies' wheels).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "railcrash/integrator.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace railcrash {
+
+class Model;
+
+struct ScenarioCriteria {
+  std::string standard;           // e.g. "EN 15227"
+  int number = 0;                 // scenario number
+  std::string category;           // C-I .. C-IV
+  double closing_speed = 0.0;     // [length/time]
+
+  std::vector<std::string> passenger_bodies;
+  double deceleration_limit = 0.0;  // [length/time^2]
+  double cfc = 60.0;                // channel frequency class of the velocity filter
+  std::string deceleration_source;
+
+  struct Gauge {
+    std::string name, front_body, rear_body;
+  };
+  std::vector<Gauge> survival_gauges;
+  double survival_limit = 0.0;  // [length] largest allowed shortening
+  std::string survival_source;
+
+  std::string interface_element;   // anticlimber, or "" when interface_bodies is used
+  std::vector<std::string> interface_bodies;  // two bodies: vertical relative displacement of their c.g.s
+  double override_limit = 0.0;     // [length] largest vertical relative displacement
+  std::string override_source;
+  std::vector<std::string> wheels; // wheel_rail elements of the leading bogies
+  double wheel_lift_limit = 0.0;   // [length]
+  std::string wheel_lift_source;
+};
+
+/// Reads and checks a `scenario:` section against the model's bodies and elements. `fail`
+/// throws an InputError naming the file and line of the node (model_io's reader).
+using SectionFail = std::function<void(const YAML::Node& where, const std::string& message)>;
+std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, const SectionFail& fail);
+
+/// One criterion's outcome.
+struct CriterionResult {
+  std::string criterion;  // "mean_deceleration", "survival_space", "override", "wheel_lift"
+  std::string subject;    // body, gauge, interface element or wheel
+  double value = 0.0;
+  double limit = 0.0;
+  bool pass = false;
+  std::string note;       // e.g. "collision not complete at the end of the run"
+  double margin() const { return limit - value; }
+};
+
+// ---- the criteria on histories (times increasing, one value per time) ----
+
+/// Mean deceleration [length/time^2] of a body over its collision, from vx(t) filtered at `cfc`
+/// (unfiltered when the samples are too few or too coarse for the filter); `complete` tells
+/// whether the velocity change ended before the record.
+double filtered_mean_deceleration(const std::vector<double>& times, const std::vector<double>& vx, double cfc, bool* complete);
+/// Largest shortening L(0) - L(t) [length] (0 if the length never falls below L(0)).
+double largest_shortening(const std::vector<double>& lengths);
+/// Largest |v(t) - v(0)|.
+double largest_change(const std::vector<double>& values);
+/// Largest lift max(0, -penetration) of a wheel [length].
+double largest_lift(const std::vector<double>& penetration);
+
+/// Collects the histories during a run and evaluates the criteria at the end.
+class ScenarioTracker : public RunObserver {
+ public:
+  ScenarioTracker(const DaeSystem& system, const ScenarioCriteria& criteria);
+  void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
+  std::vector<CriterionResult> results() const;
+  /// The scenario and its criteria as a JSON object (summary.json's "scenario").
+  std::string json() const;
+
+ private:
+  const DaeSystem& system_;
+  const ScenarioCriteria& criteria_;
+  std::vector<int> passenger_index_, front_index_, rear_index_;
+  int vertical_offset_column_ = -1, override_column_ = -1;
+  int interface_lower_ = -1, interface_upper_ = -1;  // bodies of interface_bodies
+  std::vector<int> wheel_columns_;
+  std::vector<double> outputs_, times_;
+  std::vector<std::vector<double>> vx_, lengths_, penetration_;
+  std::vector<double> vertical_offset_;
+  bool overridden_ = false;
+};
+
+}  // namespace railcrash

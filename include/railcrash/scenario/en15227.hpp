@@ -1,0 +1,69 @@
+// EN 15227 design collision scenarios built from a two-car crash model (`railcrash scenario`).
+//
+// Values from the standard. EN 15227 (Railway applications - Crashworthiness requirements for
+// rail vehicles) is not freely published; only what a named public source states is used as a
+// default, everything else is a REQUIRED input of the command (README.md, "Collision scenarios"):
+//   - scenario 1 is a front-end collision between two identical train units, "typically at
+//     36 km/h"; scenario 2 a collision with an 80 t freight wagon with side buffers; scenario 3
+//     a heavy (15 t) obstacle at a level crossing; scenario 4 a low obstacle.
+//     Source: railwaynews.net, "Designed to Deform: EN 15227 and the Art of Railway
+//     Crashworthiness" (its section "The Four Design Collision Scenarios").
+//   - scenario 2 at the same 10 m/s (36 km/h) as scenario 1: the open-source
+//     railway-impact-simulator (github.com/sflabbe/railway-impact-simulator,
+//     configs/en15227/README_EN15227_GENERATED.md: "C1/C2: 10.0 m/s", C1 reference mass
+//     80,000 kg wagon).
+//   These two defaults apply to category C-I only (the sources do not give the other
+//   categories' speeds): for C-II..C-IV, --speed is required.
+//   Required, because no public source confirmed them: the vertical offset of scenario 1, the
+//   mean-deceleration limit, the survival-space limit, the override and wheel-lift limits, the
+//   side buffers' force-stroke characteristic and their height.
+//
+// Scenario 1 (make_scenario_model, number 1): the template's STRIKING car (car1_*) is the unit's
+// car; the standing train is its mirror image about the coupler faces (x -> -x of every
+// position, point and axis), so that the two trains are identical. The consist generator
+// (consist.hpp) builds N cars per train. Both trains move towards each other at half the
+// closing speed (the centre-of-mass frame: with identical trains the interface stays at x = 0
+// when there is no offset). The standing train is raised by the vertical offset (its bodies and
+// its rails), and the interface anticlimber's initial_misalignment is 0 (the geometry carries
+// the offset).
+// Scenario 2: the same striking train at the full speed against a wagon at rest: one rigid body
+// (80 t) held by a frictionless slider on the track (it moves only along x; its pitch and its
+// wheels are not modelled) and the two side buffers as one crush_spring (the buffer curve with
+// twice the force: two buffers in parallel) at the buffer height between the train's front end
+// (at its anticlimber face) and the wagon.
+// Scenarios 3 and 4 are refused with the reason: 3's reference obstacle could not be confirmed
+// from a public source; 4's obstacle is pushed sideways, out of the plane.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace railcrash {
+
+struct ScenarioRequest {
+  int number = 0;                    // 1..4
+  std::string train_path;            // two-car template (car1_* striking, car2_* standing)
+  int cars = 1;                      // cars per train
+  std::string category = "C-I";
+  std::optional<double> speed;                  // [km/h] closing speed
+  std::optional<double> offset;                 // [mm] scenario 1: standing train raised by this
+  std::optional<double> deceleration_limit;     // [g]
+  std::optional<double> survival_limit;         // [mm] largest shortening of a survival-space gauge
+  std::optional<double> override_limit;         // [mm] largest vertical relative displacement
+  std::optional<double> wheel_lift_limit;       // [mm]
+  std::vector<std::string> passenger_bodies;    // template bodies without the car1_ prefix
+  std::vector<std::string> survival_gauge;      // two template bodies (front, rear) without car1_
+  double wagon_mass = 80.0;                     // [t] scenario 2
+  std::vector<std::pair<double, double>> buffer_curve;  // [mm, kN] one buffer's force-stroke curve
+  std::optional<double> buffer_unloading_stiffness;     // [kN/mm] one buffer
+  std::optional<double> buffer_height;                  // [mm] above the rail
+  std::optional<double> t_end;                          // [s] default: the template's
+};
+
+/// YAML text of the scenario's model. Throws InputError naming the missing option, or what
+/// the template lacks (file and element), or why the scenario cannot be built.
+std::string make_scenario_model(const ScenarioRequest& request);
+
+}  // namespace railcrash

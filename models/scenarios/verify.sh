@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Prints the two physical checks of the scenario models over longer runs than the unit tests
+# (README.md, "Collision scenarios"). Run from the repository root:
+#   models/scenarios/verify.sh build/railcrash [OUT_DIR]
+#  1. zero-offset scenario 1 (report car, 20 ms, IDA): largest |vx(s body) + vx(mirrored t body)|
+#     over the closing speed up to each millisecond, and how far apart in time IDA located the
+#     mirrored pairs of mode changes (events.csv);
+#  2. scenario 2 (models/scenarios/scenario2_report_car.yaml, whole run, IDA and Euler): the
+#     change of the total longitudinal momentum over its initial value, and the energy balance.
+set -eu
+bin=$1
+out=${2:-out/scenario_checks}
+mkdir -p "$out"
+"$bin" scenario 1 --train models/report/final_two_car.yaml --offset 0 --deceleration-limit 5 --survival-space-limit 50 \
+  --override-limit 100 --wheel-lift-limit 20 --passenger-bodies center_body --survival-gauge bolster_body,rear_body \
+  --t-end 0.02 --out "$out/symmetric.yaml" 2> /dev/null
+"$bin" run "$out/symmetric.yaml" --output-interval 0.0005 --quiet --out "$out/symmetric" > /dev/null
+for integrator in ida euler; do
+  "$bin" run models/scenarios/scenario2_report_car.yaml --integrator "$integrator" --quiet --out "$out/momentum_$integrator" > /dev/null
+done
+/usr/bin/python3 - "$out" <<'PY'
+import csv, json, pathlib, sys
+out = pathlib.Path(sys.argv[1])
+rows = list(csv.DictReader(open(out / "symmetric/timeseries.csv")))
+closing = json.loads((out / "symmetric/summary.json").read_text())["scenario"]["closing_speed"]
+print("scenario 1, zero offset: largest |vx_s + vx_t| / closing speed up to t")
+largest = 0.0
+for r in rows:
+    largest = max([largest] + [abs(float(r[k]) + float(r["t" + k[1:]])) / closing for k in r if k.startswith("s") and k.endswith(".vx")])
+    if round(float(r["t"]) * 1e4) % 10 == 0:
+        print("  t = %5.1f ms  %.3g" % (1e3 * float(r["t"]), largest))
+events = {}
+for e in csv.DictReader(open(out / "symmetric/events.csv")):
+    name = e["element"]
+    key = (name[0], name[1:], e["event"]) if name[0] in "st" and name[1:2].isdigit() else None
+    if key: events.setdefault(key[1:], {}).setdefault(key[0], []).append(float(e["t"]))
+print("mirrored mode changes located apart (first of each pair):")
+for (element, event), times in sorted(events.items(), key=lambda kv: min(min(v) for v in kv[1].values())):
+    if "s" in times and "t" in times:
+        print("  %-28s %-40s t = %.5f s, apart %.2g s" % ("*" + element, event, times["s"][0], abs(times["s"][0] - times["t"][0])))
+for integrator in ("ida", "euler"):
+    run = out / ("momentum_" + integrator)
+    masses = {b["name"]: b["mass"] for b in json.loads((run / "model.json").read_text())["bodies"]}
+    rows = list(csv.DictReader(open(run / "timeseries.csv")))
+    momentum = [sum(m * float(r[b + ".vx"]) for b, m in masses.items()) for r in rows]
+    change = max(abs(p - momentum[0]) for p in momentum) / abs(momentum[0])
+    energy = json.loads((run / "summary.json").read_text())["energy"]["relative_balance_error"]
+    print("scenario 2, %s: largest momentum change %.3g of the initial, relative energy balance error %.3g" % (integrator, change, energy))
+PY

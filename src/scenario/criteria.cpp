@@ -1,0 +1,292 @@
+// Scenario criteria: the model's `scenario:` section and the evaluation (scenario/criteria.hpp).
+#include "railcrash/scenario/criteria.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "railcrash/dae_system.hpp"
+#include "railcrash/error.hpp"
+#include "railcrash/model.hpp"
+#include "railcrash/results.hpp"
+#include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/crash_pulse.hpp"
+
+namespace railcrash {
+namespace {
+
+class SectionReader {
+ public:
+  SectionReader(const Model& model, const SectionFail& fail) : model_(model), fail_(fail) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
+    fail_(node, "scenario: " + message);
+    throw InputError("scenario: " + message);  // fail_ throws; this keeps the promise of [[noreturn]]
+  }
+
+  void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
+    if (!map.IsMap()) fail(map, context + " must be a map of keys (key: value)");
+    for (const auto& entry : map) {
+      const std::string key = entry.first.Scalar();
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(entry.first, context + ": unknown key '" + key + "'; allowed keys: " + list);
+      }
+    }
+  }
+
+  YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
+    const YAML::Node node = map[key];
+    if (!node) fail(map, context + ": missing '" + key + "'");
+    return node;
+  }
+
+  std::string text(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsScalar() || node.Scalar().empty()) fail(node, what + " must be a word or a quoted text");
+    return node.Scalar();
+  }
+
+  double positive(const YAML::Node& node, const std::string& what) const {
+    double value = 0.0;
+    try {
+      value = node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(node, what + " must be a number");
+    }
+    if (!(value > 0.0) || !std::isfinite(value)) fail(node, what + " must be a positive number");
+    return value;
+  }
+
+  std::string body(const YAML::Node& node, const std::string& what) const {
+    const std::string name = text(node, what);
+    if (!model_.find_body(name)) fail(node, what + ": no body named '" + name + "' in the model");
+    return name;
+  }
+
+  std::string element(const YAML::Node& node, const std::string& what, const std::string& type) const {
+    const std::string name = text(node, what);
+    for (const auto& e : model_.elements())
+      if (e->name() == name) {
+        if (e->type() != type) fail(node, what + ": element '" + name + "' is of type " + e->type() + "; it must be of type " + type);
+        return name;
+      }
+    fail(node, what + ": no element named '" + name + "' in the model (it must be a " + type + ")");
+  }
+
+  std::vector<YAML::Node> list(const YAML::Node& node, const std::string& what) const {
+    if (!node.IsSequence() || node.size() == 0) fail(node, what + " must be a non-empty list");
+    return std::vector<YAML::Node>(node.begin(), node.end());
+  }
+
+ private:
+  const Model& model_;
+  const SectionFail& fail_;
+};
+
+int column_of(const DaeSystem& system, const std::string& name) {
+  const auto& names = system.output_names();
+  const auto it = std::find(names.begin(), names.end(), name);
+  RAILCRASH_DEMAND(it != names.end());
+  return static_cast<int>(it - names.begin());
+}
+
+double distance(const double* y, int a, int b) {
+  return std::hypot(y[3 * a] - y[3 * b], y[3 * a + 1] - y[3 * b + 1]);
+}
+
+}  // namespace
+
+std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, const SectionFail& fail) {
+  const SectionReader r(model, fail);
+  r.only_keys(section, {"standard", "number", "category", "closing_speed", "mean_deceleration", "survival_space", "override"},
+              "the section");
+  auto c = std::make_shared<ScenarioCriteria>();
+  c->standard = r.text(r.required(section, "standard", "the section"), "standard");
+  const YAML::Node number = r.required(section, "number", "the section");
+  c->number = static_cast<int>(r.positive(number, "number"));
+  c->category = r.text(r.required(section, "category", "the section"), "category");
+  if (c->category != "C-I" && c->category != "C-II" && c->category != "C-III" && c->category != "C-IV")
+    r.fail(section["category"], "category must be C-I, C-II, C-III or C-IV (EN 15227's crashworthiness design categories)");
+  c->closing_speed = r.positive(r.required(section, "closing_speed", "the section"), "closing_speed");
+
+  const YAML::Node deceleration = r.required(section, "mean_deceleration", "the section");
+  r.only_keys(deceleration, {"limit", "cfc", "source", "bodies"}, "mean_deceleration");
+  c->deceleration_limit = r.positive(r.required(deceleration, "limit", "mean_deceleration"), "mean_deceleration: limit");
+  if (deceleration["cfc"]) c->cfc = r.positive(deceleration["cfc"], "mean_deceleration: cfc");
+  c->deceleration_source = r.text(r.required(deceleration, "source", "mean_deceleration"), "mean_deceleration: source");
+  for (const YAML::Node& b : r.list(r.required(deceleration, "bodies", "mean_deceleration"), "mean_deceleration: bodies"))
+    c->passenger_bodies.push_back(r.body(b, "mean_deceleration: bodies"));
+
+  const YAML::Node survival = r.required(section, "survival_space", "the section");
+  r.only_keys(survival, {"limit", "source", "gauges"}, "survival_space");
+  c->survival_limit = r.positive(r.required(survival, "limit", "survival_space"), "survival_space: limit");
+  c->survival_source = r.text(r.required(survival, "source", "survival_space"), "survival_space: source");
+  for (const YAML::Node& g : r.list(r.required(survival, "gauges", "survival_space"), "survival_space: gauges")) {
+    r.only_keys(g, {"name", "front", "rear"}, "survival_space: gauge");
+    ScenarioCriteria::Gauge gauge;
+    gauge.name = r.text(r.required(g, "name", "survival_space: gauge"), "survival_space: gauge name");
+    gauge.front_body = r.body(r.required(g, "front", "survival_space: gauge " + gauge.name), "survival_space: gauge front");
+    gauge.rear_body = r.body(r.required(g, "rear", "survival_space: gauge " + gauge.name), "survival_space: gauge rear");
+    if (gauge.front_body == gauge.rear_body) r.fail(g, "survival_space: gauge " + gauge.name + ": front and rear must be two bodies");
+    c->survival_gauges.push_back(gauge);
+  }
+
+  const YAML::Node override_node = r.required(section, "override", "the section");
+  r.only_keys(override_node, {"limit", "source", "interface", "bodies", "wheel_lift_limit", "wheel_lift_source", "wheels"}, "override");
+  if (override_node["interface"].IsDefined() == override_node["bodies"].IsDefined())
+    r.fail(override_node, "override: give either 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface)");
+  if (override_node["interface"]) {
+    c->interface_element = r.element(override_node["interface"], "override: interface", "anticlimber");
+  } else {
+    const auto bodies = r.list(override_node["bodies"], "override: bodies");
+    if (bodies.size() != 2) r.fail(override_node["bodies"], "override: bodies must name two bodies [A, B]");
+    for (const YAML::Node& b : bodies) c->interface_bodies.push_back(r.body(b, "override: bodies"));
+  }
+  c->override_limit = r.positive(r.required(override_node, "limit", "override"), "override: limit");
+  c->override_source = r.text(r.required(override_node, "source", "override"), "override: source");
+  c->wheel_lift_limit = r.positive(r.required(override_node, "wheel_lift_limit", "override"), "override: wheel_lift_limit");
+  c->wheel_lift_source = r.text(r.required(override_node, "wheel_lift_source", "override"), "override: wheel_lift_source");
+  for (const YAML::Node& w : r.list(r.required(override_node, "wheels", "override"), "override: wheels"))
+    c->wheels.push_back(r.element(w, "override: wheels", "wheel_rail"));
+  return c;
+}
+
+double filtered_mean_deceleration(const std::vector<double>& times, const std::vector<double>& vx, double cfc, bool* complete) {
+  const double interval = cfc::typical_interval(times);
+  std::vector<double> t = times, v = vx;
+  if (times.size() >= 3 && interval > 0.0 && cfc::design_frequency(cfc) * interval < 0.5) {
+    v = cfc::filter(cfc::resample_uniform(times, vx, interval), interval, cfc);
+    t.resize(v.size());
+    for (std::size_t k = 0; k < t.size(); ++k) t[k] = times.front() + static_cast<double>(k) * interval;
+  }
+  const CollisionPulse pulse = collision_pulse(t, v);
+  if (complete) *complete = pulse.complete;
+  return pulse.mean_deceleration;
+}
+
+double largest_shortening(const std::vector<double>& lengths) {
+  double largest = 0.0;
+  for (const double length : lengths) largest = std::max(largest, lengths.front() - length);
+  return largest;
+}
+
+double largest_change(const std::vector<double>& values) {
+  double largest = 0.0;
+  for (const double value : values) largest = std::max(largest, std::abs(value - values.front()));
+  return largest;
+}
+
+double largest_lift(const std::vector<double>& penetration) {
+  double largest = 0.0;
+  for (const double p : penetration) largest = std::max(largest, -p);
+  return largest;
+}
+
+ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria& criteria)
+    : system_(system), criteria_(criteria), outputs_(system.output_names().size()) {
+  const Model& model = system.model();
+  for (const std::string& b : criteria.passenger_bodies) passenger_index_.push_back(*model.find_body(b));
+  for (const auto& g : criteria.survival_gauges) {
+    front_index_.push_back(*model.find_body(g.front_body));
+    rear_index_.push_back(*model.find_body(g.rear_body));
+  }
+  if (!criteria.interface_element.empty()) {
+    vertical_offset_column_ = column_of(system, criteria.interface_element + ".vertical_offset");
+    override_column_ = column_of(system, criteria.interface_element + ".override");
+  } else {
+    interface_lower_ = *model.find_body(criteria.interface_bodies[0]);
+    interface_upper_ = *model.find_body(criteria.interface_bodies[1]);
+  }
+  for (const std::string& w : criteria.wheels) wheel_columns_.push_back(column_of(system, w + ".penetration"));
+  vx_.resize(passenger_index_.size());
+  lengths_.resize(front_index_.size());
+  penetration_.resize(wheel_columns_.size());
+}
+
+void ScenarioTracker::sample(double t, const double* y, const double* lambda, const double*) {
+  times_.push_back(t);
+  const double* velocities = y + system_.body_unknowns();
+  for (std::size_t k = 0; k < passenger_index_.size(); ++k) vx_[k].push_back(velocities[3 * passenger_index_[k]]);
+  for (std::size_t k = 0; k < front_index_.size(); ++k) lengths_[k].push_back(distance(y, front_index_[k], rear_index_[k]));
+  system_.outputs(y, lambda, outputs_.data());
+  if (vertical_offset_column_ >= 0) {
+    vertical_offset_.push_back(outputs_[static_cast<std::size_t>(vertical_offset_column_)]);
+    overridden_ = overridden_ || outputs_[static_cast<std::size_t>(override_column_)] > 0.0;
+  } else {
+    vertical_offset_.push_back(y[3 * interface_upper_ + 1] - y[3 * interface_lower_ + 1]);
+  }
+  for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
+    penetration_[k].push_back(outputs_[static_cast<std::size_t>(wheel_columns_[k])]);
+}
+
+std::vector<CriterionResult> ScenarioTracker::results() const {
+  std::vector<CriterionResult> out;
+  if (times_.empty()) return out;
+  for (std::size_t k = 0; k < passenger_index_.size(); ++k) {
+    CriterionResult r;
+    r.criterion = "mean_deceleration";
+    r.subject = criteria_.passenger_bodies[k];
+    bool complete = false;
+    r.value = filtered_mean_deceleration(times_, vx_[k], criteria_.cfc, &complete);
+    r.limit = criteria_.deceleration_limit;
+    r.pass = r.value <= r.limit;
+    if (!complete) r.note = "the velocity change had not ended at the end of the run";
+    out.push_back(r);
+  }
+  for (std::size_t k = 0; k < front_index_.size(); ++k) {
+    CriterionResult r;
+    r.criterion = "survival_space";
+    r.subject = criteria_.survival_gauges[k].name;
+    r.value = largest_shortening(lengths_[k]);
+    r.limit = criteria_.survival_limit;
+    r.pass = r.value <= r.limit;
+    out.push_back(r);
+  }
+  CriterionResult interface;
+  interface.criterion = "override";
+  interface.subject = criteria_.interface_element.empty() ? criteria_.interface_bodies[0] + " / " + criteria_.interface_bodies[1]
+                                                          : criteria_.interface_element;
+  interface.value = largest_change(vertical_offset_);
+  interface.limit = criteria_.override_limit;
+  interface.pass = interface.value <= interface.limit && !overridden_;
+  if (overridden_) interface.note = "the anticlimber faces overrode each other";
+  out.push_back(interface);
+  for (std::size_t k = 0; k < wheel_columns_.size(); ++k) {
+    CriterionResult r;
+    r.criterion = "wheel_lift";
+    r.subject = criteria_.wheels[k];
+    r.value = largest_lift(penetration_[k]);
+    r.limit = criteria_.wheel_lift_limit;
+    r.pass = r.value <= r.limit;
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::string ScenarioTracker::json() const {
+  const std::vector<CriterionResult> all = results();
+  const double g = standard_gravity(system_.model());
+  std::ostringstream j;
+  bool pass = !all.empty();
+  for (const auto& r : all) pass = pass && r.pass;
+  j << "{\"standard\": " << json_string(criteria_.standard) << ", \"number\": " << criteria_.number
+    << ", \"category\": " << json_string(criteria_.category) << ", \"closing_speed\": " << json_number(criteria_.closing_speed)
+    << ", \"pass\": " << (pass ? "true" : "false") << ", \"sources\": {\"mean_deceleration\": " << json_string(criteria_.deceleration_source)
+    << ", \"survival_space\": " << json_string(criteria_.survival_source) << ", \"override\": " << json_string(criteria_.override_source)
+    << ", \"wheel_lift\": " << json_string(criteria_.wheel_lift_source) << "}, \"criteria\": [";
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const CriterionResult& r = all[k];
+    j << (k ? ", " : "") << "{\"criterion\": " << json_string(r.criterion) << ", \"subject\": " << json_string(r.subject)
+      << ", \"value\": " << json_number(r.value) << ", \"limit\": " << json_number(r.limit) << ", \"margin\": " << json_number(r.margin());
+    if (r.criterion == "mean_deceleration")
+      j << ", \"value_g\": " << json_number(r.value / g) << ", \"limit_g\": " << json_number(r.limit / g);
+    j << ", \"pass\": " << (r.pass ? "true" : "false") << ", \"note\": " << json_string(r.note) << "}";
+  }
+  j << "]}";
+  return j.str();
+}
+
+}  // namespace railcrash

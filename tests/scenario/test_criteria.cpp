@@ -1,0 +1,122 @@
+// Scenario criteria against hand-computed histories, and the `scenario:` section's checks.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/scenario/criteria.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+/// vx(t): v0 until t0, then falling at `deceleration` until t1, then constant; sampled every dt.
+void ramp(double v0, double deceleration, double t0, double t1, double t_end, double dt, std::vector<double>& t, std::vector<double>& v) {
+  for (int k = 0; k * dt <= t_end + 1e-12; ++k) {
+    const double time = k * dt;
+    t.push_back(time);
+    v.push_back(v0 - deceleration * std::clamp(time - t0, 0.0, t1 - t0));
+  }
+}
+
+const char* kTwoCarts = R"(railcrash: 1
+name: two carts
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: a, mass: 1000, inertia: 100, position: [0, 1]}
+  - {name: b, mass: 1000, inertia: 100, position: [3, 1]}
+elements:
+  - name: faces
+    type: anticlimber
+    horizontal_elastic_stiffness: 1.0e7
+    horizontal_plastic_stiffness: 1.0e5
+    horizontal_yield_deflection: 0.01
+    horizontal_rupture_deflection: 1
+    vertical_elastic_stiffness: 1.0e6
+    vertical_plastic_stiffness: 1.0e4
+    vertical_yield_deflection: 0.01
+    vertical_rupture_deflection: 1
+    torsional_elastic_stiffness: 1.0e6
+    torsional_plastic_stiffness: 1.0e4
+    torsional_yield_deflection: 0.01
+    torsional_rupture_deflection: 1
+    face_height: 0.2
+    length: 2
+    points:
+      - {body: a, at: [1.5, 0]}
+      - {body: b, at: [-1.5, 0]}
+simulation: {t_end: 0.1}
+scenario:
+  standard: EN 15227
+  number: 1
+  category: C-I
+  closing_speed: 10
+  mean_deceleration: {limit: 49.0, source: test, bodies: [a, b]}
+  survival_space: {limit: 0.05, source: test, gauges: [{name: ab, front: a, rear: b}]}
+  override: {limit: 0.1, source: test, interface: faces, wheel_lift_limit: 0.02, wheel_lift_source: test, wheels: [WHEELS]}
+)";
+
+std::string with(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("scenario criteria: mean deceleration of a constant-deceleration pulse", "[scenario]") {
+  std::vector<double> t, v;
+  // 10 m/s falling at 50 m/s^2 from 0.1 s to 0.3 s: mean deceleration 50 m/s^2 (hand: 10 / 0.2).
+  ramp(10.0, 50.0, 0.1, 0.3, 0.5, 0.005, t, v);  // 5 ms samples: too coarse for CFC 60, unfiltered
+  bool complete = false;
+  CHECK(filtered_mean_deceleration(t, v, 60.0, &complete) == Approx(50.0).epsilon(1e-12));
+  CHECK(complete);
+  t.clear();
+  v.clear();
+  // Filtered at CFC 60 (1e-4 s samples): the filter rounds each corner over about one period of
+  // its design frequency fd = 2.0775 x 60 Hz, so the collision found starts and ends at most
+  // 1 / fd = 8.0 ms beyond the ramp's corners: 50 x 0.2 / (0.2 + 2 / fd) < mean < 50.
+  ramp(10.0, 50.0, 0.1, 0.3, 0.5, 1e-4, t, v);
+  const double filtered = filtered_mean_deceleration(t, v, 60.0, &complete);
+  const double design_frequency = 2.0775 * 60.0;  // [Hz]
+  CHECK(filtered < 50.0);
+  CHECK(filtered > 50.0 * 0.2 / (0.2 + 2.0 / design_frequency));
+  // A pulse still going at the end of the record is flagged.
+  t.clear();
+  v.clear();
+  ramp(10.0, 50.0, 0.1, 0.3, 0.2, 0.005, t, v);
+  filtered_mean_deceleration(t, v, 60.0, &complete);
+  CHECK_FALSE(complete);
+}
+
+TEST_CASE("scenario criteria: shortening, vertical change and wheel lift of hand histories", "[scenario]") {
+  CHECK(largest_shortening({10.0, 9.9, 9.5, 9.7, 10.2}) == Approx(0.5));
+  CHECK(largest_shortening({10.0, 10.1, 10.3}) == 0.0);
+  CHECK(largest_change({0.04, 0.05, -0.02, 0.01}) == Approx(0.06));
+  CHECK(largest_lift({0.001, 0.0, -0.004, -0.002}) == Approx(0.004));
+  CHECK(largest_lift({0.001, 0.002}) == 0.0);
+}
+
+TEST_CASE("scenario criteria: the section is checked with file:line messages", "[scenario]") {
+  const std::string no_wheels = with(kTwoCarts, "wheels: [WHEELS]", "wheels: [faces]");
+  try {
+    load_model_text(no_wheels, "cases.yaml");
+    FAIL("a wheel list naming an anticlimber was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("cases.yaml:36") && Catch::Contains("'faces' is of type anticlimber; it must be of type wheel_rail"));
+  }
+  try {
+    load_model_text(with(no_wheels, "category: C-I", "category: C-V"), "cases.yaml");
+    FAIL("category C-V was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("cases.yaml:32") && Catch::Contains("C-I, C-II, C-III or C-IV"));
+  }
+  try {
+    load_model_text(with(no_wheels, "rear: b", "rear: c"), "cases.yaml");
+    FAIL("an unknown gauge body was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("cases.yaml:35") && Catch::Contains("no body named 'c'"));
+  }
+}
