@@ -19,6 +19,7 @@
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/table_text.hpp"
 
 namespace railcrash::report {
 
@@ -82,31 +83,6 @@ std::string read_file(const fs::path& path, bool* found) {
   return text.str();
 }
 
-/// Fields of one CSV line (RFC 4180 quoting).
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> fields(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        fields.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        fields.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.emplace_back();
-    } else if (c != '\r') {
-      fields.back() += c;
-    }
-  }
-  return fields;
-}
 
 /// A numeric CSV file: header and complete rows; stops at the first broken row.
 struct NumericTable {
