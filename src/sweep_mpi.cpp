@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -48,43 +49,74 @@ std::string broadcast(std::string text) {
   return text;
 }
 
-/// Rank 0: hands out the runs not done yet and writes the files.
-int coordinate(const SweepPlan& plan, const std::string& model_text, const std::string& directory, const SweepOptions& options,
-               int ranks) {
+/// One run on this rank (at most one per rank at a time): its runs.csv line, or nothing when
+/// the caller's stop flag interrupted it.
+std::string run_here(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+                     const std::string& directory, const SweepOptions& options, const SweepRunSpec& spec, std::size_t k) {
+  BatchOptions batch;
+  batch.run_time_limit = options.run_time_limit;
+  batch.stop = options.stop;
+  SweepRow row;
+  char folder[32];
+  std::snprintf(folder, sizeof folder, "/runs/%04zu", k);
+  const std::vector<BatchRunState> state = run_batch(
+      1, [&](std::size_t, const RunControl& control) {
+        row = run_sweep_spec(plan, model_path, model_text, spec, control, options.keep_runs ? directory + folder : "");
+      },
+      batch);
+  return state[0] == BatchRunState::finished ? sweep_csv_line(plan, k, spec, row) : std::string();
+}
+
+/// Rank 0: hands out the runs not done yet, one at a time, to the ranks that ask and to a
+/// thread of its own (rank 0 runs too), and writes the files.
+int coordinate(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+               const std::string& directory, const SweepOptions& options, int ranks) {
   SweepResult result = start_sweep(plan, model_text, directory, options.resume);
   std::vector<long> todo;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
     if (!result.lines[k]) todo.push_back(static_cast<long>(k));
+  std::mutex mutex;  // guards next, done and result.lines, shared with rank 0's own worker thread
   std::size_t next = 0, done = result.done();
-  int working = ranks - 1;  // workers not yet told to stop
+  const auto take = [&]() -> long {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if ((options.stop && options.stop->load()) || next >= todo.size()) return -1;
+    return todo[next++];
+  };
+  const auto record = [&](long number, const std::string& line) {
+    if (line.empty()) return;  // interrupted: run again on --resume
+    const std::lock_guard<std::mutex> lock(mutex);
+    result.lines[static_cast<std::size_t>(number)] = line;
+    append_sweep_line(directory, line);
+    ++done;
+    if (options.progress) {
+      const std::vector<std::string> fields = csv_fields(line);
+      SweepRow row;
+      row.status = fields[2 + plan.factors.size()];
+      row.wall_seconds = std::atof(fields[fields.size() - 2].c_str());
+      row.message = fields.back();
+      options.progress(static_cast<std::size_t>(number), row, done, result.specs.size());
+    }
+  };
+  std::thread own([&] {
+    for (long k = take(); k >= 0; k = take())
+      record(k, run_here(plan, model_path, model_text, directory, options, result.specs[static_cast<std::size_t>(k)],
+                         static_cast<std::size_t>(k)));
+  });
+  int working = ranks - 1;  // other ranks not yet told to stop
   while (working > 0) {
     int source = 0;
     const std::string text = receive_text(source);
     const std::size_t newline = text.find('\n');
     const long number = std::atol(text.substr(0, newline).c_str());
-    if (number >= 0 && newline + 1 < text.size()) {
-      const std::string line = text.substr(newline + 1);
-      result.lines[static_cast<std::size_t>(number)] = line;
-      append_sweep_line(directory, line);
-      ++done;
-      if (options.progress) {
-        const std::vector<std::string> fields = csv_fields(line);
-        SweepRow row;
-        row.status = fields[2 + plan.factors.size()];
-        row.wall_seconds = std::atof(fields[fields.size() - 2].c_str());
-        row.message = fields.back();
-        options.progress(static_cast<std::size_t>(number), row, done, result.specs.size());
-      }
-    }
-    const bool stopping = options.stop && options.stop->load();
-    long work = -1;
-    if (!stopping && next < todo.size()) work = todo[next++];
+    if (number >= 0) record(number, text.substr(newline + 1));
+    const long work = take();
     if (work < 0) --working;
     MPI_Send(&work, 1, MPI_LONG, source, kWorkTag, MPI_COMM_WORLD);
   }
+  own.join();
   write_sweep(plan, result, directory);
-  std::printf("%zu of %zu runs done (%zu resumed) on %d MPI ranks (%d running runs); results in %s/ (runs.csv, summary.md)\n",
-              result.done(), result.specs.size(), result.resumed, ranks, ranks - 1, directory.c_str());
+  std::printf("%zu of %zu runs done (%zu resumed) on %d MPI ranks; results in %s/ (runs.csv, summary.md)\n", result.done(),
+              result.specs.size(), result.resumed, ranks, directory.c_str());
   if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
   return result.done() == result.specs.size() ? 0 : 1;
 }
@@ -100,19 +132,7 @@ void work(const SweepPlan& plan, const std::string& model_path, const std::strin
     MPI_Recv(&number, 1, MPI_LONG, 0, kWorkTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (number < 0) return;
     const std::size_t k = static_cast<std::size_t>(number);
-    BatchOptions batch;
-    batch.run_time_limit = options.run_time_limit;
-    batch.stop = options.stop;
-    SweepRow row;
-    char folder[32];
-    std::snprintf(folder, sizeof folder, "/runs/%04zu", k);
-    const std::vector<BatchRunState> state = run_batch(
-        1, [&](std::size_t, const RunControl& control) {
-          row = run_sweep_spec(plan, model_path, model_text, specs[k], control, options.keep_runs ? directory + folder : "");
-        },
-        batch);
-    message = std::to_string(number) + "\n" +
-              (state[0] == BatchRunState::finished ? sweep_csv_line(plan, k, specs[k], row) : std::string());
+    message = std::to_string(number) + "\n" + run_here(plan, model_path, model_text, directory, options, specs[k], k);
   }
 }
 
@@ -156,7 +176,7 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
       const SweepResult result = run_sweep(model_path, plan, directory, options);
       status = result.done() == result.specs.size() ? 0 : 1;
     } else if (rank == 0) {
-      status = coordinate(plan, model_text, directory, options, ranks);
+      status = coordinate(plan, model_path, model_text, directory, options, ranks);
     } else {
       work(plan, model_path, model_text, directory, options);
     }

@@ -1,7 +1,8 @@
 // `railcrash sweep` under mpirun/srun (built with RAILCRASH_MPI): rank 0 hands out run numbers
-// one at a time to the ranks that ask (dynamic: a long run does not hold up the others),
-// gathers their runs.csv lines and writes every file; with one rank it runs the sweep itself
-// on --jobs threads.
+// one at a time to the ranks that ask and to a thread of its own (dynamic: a long run does not
+// hold up the others; each rank does one run at a time, so start one rank per core), gathers
+// the runs.csv lines and writes every file; with one rank it runs the sweep itself on --jobs
+// threads.
 #pragma once
 
 #include <atomic>

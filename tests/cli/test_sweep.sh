@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `railcrash sweep` from the command line: plan errors exit 2 before any run; 1 job, 2 jobs
 # and (given MPIRUN) `mpirun -np 3` write the same runs.csv (wall_seconds aside); --resume
-# after a SIGTERM mid-sweep writes the same file as an uninterrupted sweep.
+# after a SIGTERM mid-sweep (threads, and mpirun -np 2) writes the same file as an uninterrupted sweep.
 # Usage: test_sweep.sh RAILCRASH_BINARY [MPIRUN]
 set -u
 bin=$1
@@ -86,25 +86,32 @@ if grep -q "Main effects" "$tmp/one/summary.md"; then pass; else fail "summary.m
 sed -e 's/^samples: 12/samples: 40/' -e 's/^seed: 3/seed: 3\nset: [simulation.output_interval=0.00001, simulation.rtol=1e-10]/' \
   "$tmp/plan.yaml" > "$tmp/slow.yaml"
 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --out "$tmp/whole" > /dev/null 2>&1
-"$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 1 --out "$tmp/cut" > "$tmp/cut.out" 2>&1 &
-pid=$!
-for _ in $(seq 1 200); do  # until 3 rows are written (header + 3)
-  [ -f "$tmp/cut/runs.csv" ] && [ "$(wc -l < "$tmp/cut/runs.csv")" -ge 4 ] && break
-  sleep 0.05
-done
-kill -TERM $pid
-wait $pid
-status=$?
-rows=$(($(wc -l < "$tmp/cut/runs.csv") - 1))
-if [ $status -eq 1 ] && [ $rows -ge 3 ] && [ $rows -lt 40 ]; then pass; else fail "SIGTERM: status $status with $rows rows (expected 1 with 3-39)"; fi
-"$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --resume --out "$tmp/cut" > "$tmp/resume.out" 2>&1
-if grep -q "($rows resumed)" "$tmp/resume.out"; then pass; else fail "resume keeps the $rows rows: $(cat "$tmp/resume.out")"; fi
-same_rows "--resume after SIGTERM gives the uninterrupted file" "$tmp/cut/runs.csv" "$tmp/whole/runs.csv"
+interrupt_and_resume() {  # description folder command-prefix...: SIGTERM once 3 rows are written, then --resume
+  local description=$1 folder=$2
+  shift 2
+  "$@" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 1 --out "$folder" > "$folder.out" 2>&1 &
+  local pid=$!
+  for _ in $(seq 1 400); do  # until 3 rows are written (header + 3)
+    [ -f "$folder/runs.csv" ] && [ "$(wc -l < "$folder/runs.csv")" -ge 4 ] && break
+    sleep 0.05
+  done
+  kill -TERM $pid
+  wait $pid
+  local status=$?
+  local rows=$(($(wc -l < "$folder/runs.csv") - 1))
+  if [ $status -ne 0 ] && [ $rows -ge 3 ] && [ $rows -lt 40 ]; then pass
+  else fail "$description: SIGTERM: status $status with $rows rows (expected failure with 3-39)"; fi
+  "$@" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --resume --out "$folder" > "$folder.resume" 2>&1
+  if grep -q "($rows resumed)" "$folder.resume"; then pass; else fail "$description: resume keeps the $rows rows: $(cat "$folder.resume")"; fi
+  same_rows "$description: --resume after SIGTERM gives the uninterrupted file" "$folder/runs.csv" "$tmp/whole/runs.csv"
+}
+interrupt_and_resume "threads" "$tmp/cut"
 
 if [ -n "$mpirun" ]; then
   # CI runs as root on 2 cores: allow root, oversubscribe, and yield when idle.
   # OpenMPI keeps some allocations to the end of the process: no leak report in a sanitizer build.
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1 ASAN_OPTIONS=detect_leaks=0
+  interrupt_and_resume "mpirun -np 2" "$tmp/mpi_cut" "$mpirun" --oversubscribe -np 2
   if "$mpirun" --oversubscribe -np 3 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --out "$tmp/mpi" > "$tmp/mpi.out" 2>&1; then pass
   else fail "mpirun -np 3: $(tail -5 "$tmp/mpi.out")"; fi
   same_rows "mpirun -np 3 gives the rows of 1 job" "$tmp/mpi/runs.csv" "$tmp/one/runs.csv"
