@@ -95,12 +95,15 @@ std::vector<std::string> split(const std::string& text, char separator) {
   return parts;
 }
 
-/// The list a key "bodies.b.velocity" names in the model's YAML (an undefined node if none).
+/// The list a key ("gravity", "bodies.b.velocity") names in the model's YAML (an undefined node if none).
 YAML::Node model_list(const YAML::Node& root, const std::string& key) {
   const std::vector<std::string> parts = split(key, '.');
   YAML::Node holder;
   std::string name;
-  if (parts.size() == 2 && root[parts[0]] && root[parts[0]].IsMap()) {
+  if (parts.size() == 1) {
+    holder = root;
+    name = parts[0];
+  } else if (parts.size() == 2 && root[parts[0]] && root[parts[0]].IsMap()) {
     holder = root[parts[0]];
     name = parts[1];
   } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements") && root[parts[0]].IsSequence()) {
@@ -128,7 +131,7 @@ std::string factor_setting(const SweepFactor& factor, const std::string& level, 
     throw InputError(where + ": write an entry of a list as KEY[INDEX], e.g. bodies.car1_center_body.velocity[0]");
   }
   const YAML::Node list = model_list(model_root, list_key);
-  if (!list) throw InputError(where + ": the model has no list at '" + list_key + "' (bodies.<name>.<key>, elements.<name>.<key> or section.key)");
+  if (!list) throw InputError(where + ": the model has no list at '" + list_key + "' (a top-level key, section.key, bodies.<name>.<key> or elements.<name>.<key>)");
   if (index >= list.size())
     throw InputError(where + ": the list at '" + list_key + "' has " + std::to_string(list.size()) + " entries (index from 0)");
   std::string text = list_key + "=[";

@@ -152,6 +152,7 @@ TEST_CASE("sweep plans: an unknown key, a level of the wrong type and an empty d
              Catch::StartsWith(files.plan + ":2:") && Catch::Contains("full_factorial"));
   CHECK_THAT(files.error_of_plan(head + "  - {key: 'bodies.car.velocity[2]', levels: [-1]}\n"),
              Catch::StartsWith(files.plan + ":4:") && Catch::Contains("has 2 entries"));
+  CHECK(files.error_of_plan(head + "  - {key: 'gravity[1]', levels: [-9.81]}\n") == "no error");  // a top-level list
 }
 
 TEST_CASE("sweep: R1 of each run against the closed-form crush; 1 and 2 jobs and a resume give the same rows", "[sweep]") {
