@@ -98,6 +98,8 @@ def main():
     print(f"batch runner overhead per run: {1e3 * batch_overhead:.2f} ms = {100 * batch_overhead / mean_run:.2f} % of a run "
           f"(goal < 1 %); outside the integration (model set-up, responses, runner): {1e3 * outside:.1f} ms "
           f"= {100 * outside / mean_run:.1f} %")
+    print(f"CPU per run (all processes): " + ", ".join(f"{label} {cpu / args.runs:.3f} s" for label, _, cpu, _ in results)
+          + " (wall times on a loaded machine wait for the other work; CPU does not)")
     for label, wall, cpu, workers in results[1:]:
         efficiency = wall_1 / (workers * wall)
         print(f"scaling efficiency, {label}: {100 * efficiency:.0f} % (runs/s against {workers} x the 1-job rate)")
@@ -108,6 +110,9 @@ def main():
     print(f"\npaper estimate, {total} runs on {ranks} ranks: ceil({total}/{ranks}) x {mean_run:.2f} s + the longest run "
           f"{longest:.2f} s (the dynamic distribution's tail) = {estimate / 60:.1f} min at full efficiency; "
           f"{estimate / best_efficiency / 60:.1f} min at the {100 * best_efficiency:.0f} % measured here.")
+    cpu_run = results[0][2] / args.runs
+    cpu_estimate = math.ceil(total / ranks) * cpu_run + longest * cpu_run / mean_run
+    print(f"from the CPU per run instead ({cpu_run:.3f} s, the cost on an idle core): {cpu_estimate / 60:.1f} min")
     print("assumptions: 64 cores as fast per core as this machine, one rank per core, every run costing what this "
           "sweep's runs cost (same model, same tolerances), rank 0's coordination negligible (one 300-byte message per "
           "run), runs.csv on a shared file system written by rank 0 only.")
