@@ -188,8 +188,9 @@ double normal_quantile(double probability) {
 }
 
 double unit_uniform(std::mt19937_64& generator) {
-  const std::uint64_t top = generator() >> 11;  // 53 bits
-  return (static_cast<double>(top) + 0.5) / 9007199254740992.0;  // 2^53
+  // 52 bits, so that k + 0.5 and the quotient are exact: u lies in [2^-53, 1 - 2^-53].
+  const std::uint64_t top = generator() >> 12;
+  return (static_cast<double>(top) + 0.5) / 4503599627370496.0;  // 2^52
 }
 
 std::vector<std::vector<std::size_t>> full_factorial(const std::vector<std::size_t>& level_counts) {
@@ -228,8 +229,10 @@ std::vector<std::vector<double>> latin_hypercube(std::size_t samples, std::size_
       const auto j = static_cast<std::size_t>(unit_uniform(generator) * static_cast<double>(i));
       std::swap(strata[i - 1], strata[std::min(j, i - 1)]);
     }
+    // (k + u) / N can round up to 1 in the last stratum: keep it below.
     for (std::size_t s = 0; s < samples; ++s)
-      rows[s][f] = (static_cast<double>(strata[s]) + unit_uniform(generator)) / static_cast<double>(samples);
+      rows[s][f] = std::min((static_cast<double>(strata[s]) + unit_uniform(generator)) / static_cast<double>(samples),
+                            std::nextafter(1.0, 0.0));
   }
   return rows;
 }

@@ -30,8 +30,8 @@
 //                    1979), the strata matched at random between factors.
 //   monte_carlo      N independent samples.
 // Sampled designs draw from std::mt19937_64 (its output is fixed by the C++ standard) with this
-// file's own transforms, so a seed gives the same runs on every platform: u = (k + 0.5) / 2^53
-// from the top 53 bits k, x = a + (b - a) u (uniform), x = mean + sd * Phi^-1(u) (normal, by
+// file's own transforms, so a seed gives the same runs on every platform: u = (k + 0.5) / 2^52
+// from the top 52 bits k (exact, in (0, 1)), x = a + (b - a) u (uniform), x = mean + sd * Phi^-1(u) (normal, by
 // bisection on Phi to 2^-60 of the range).
 #pragma once
 
@@ -88,7 +88,7 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
 std::vector<std::vector<std::size_t>> full_factorial(const std::vector<std::size_t>& level_counts);
 /// Row 0: every factor at the model's value (-1); then factor i at each level j (others -1).
 std::vector<std::vector<long>> one_at_a_time(const std::vector<std::size_t>& level_counts);
-/// A uniform number in (0, 1) from the top 53 bits of one draw.
+/// A uniform number in (0, 1) from the top 52 bits of one draw.
 double unit_uniform(std::mt19937_64& generator);
 /// samples x factors probabilities in (0, 1), one per stratum [k/N, (k+1)/N) in every column.
 std::vector<std::vector<double>> latin_hypercube(std::size_t samples, std::size_t factors, std::uint64_t seed);

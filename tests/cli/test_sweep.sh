@@ -81,9 +81,9 @@ if [ "$(wc -l < "$tmp/one/runs.csv")" -eq 13 ] && ! grep -q ',failed,' "$tmp/one
 same_rows "2 jobs give the rows of 1 job" "$tmp/two/runs.csv" "$tmp/one/runs.csv"
 if grep -q "Main effects" "$tmp/one/summary.md"; then pass; else fail "summary.md has main effects"; fi
 
-# SIGTERM mid-sweep keeps the finished rows; --resume runs the rest. Longer runs (about 0.06 s
+# SIGTERM mid-sweep keeps the finished rows; --resume runs the rest. Longer runs (about 0.2 s
 # each, 40 of them) so that the signal comes mid-sweep.
-sed -e 's/^samples: 12/samples: 40/' -e 's/^seed: 3/seed: 3\nset: [simulation.output_interval=0.00001, simulation.rtol=1e-10]/' \
+sed -e 's/^samples: 12/samples: 40/' -e 's/^seed: 3/seed: 3\nset: [simulation.output_interval=0.000003, simulation.rtol=1e-10]/' \
   "$tmp/plan.yaml" > "$tmp/slow.yaml"
 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --out "$tmp/whole" > /dev/null 2>&1
 interrupt_and_resume() {  # description folder command-prefix...: SIGTERM once 3 rows are written, then --resume
