@@ -284,7 +284,10 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
   }
   if (const YAML::Node set = root["set"]) {
     if (!set.IsSequence()) yaml_error(path, set, "set is a list of KEY=VALUE or KEY*=FACTOR settings");
-    for (const YAML::Node& s : set) plan.settings.push_back(s.as<std::string>());
+    for (const YAML::Node& setting : set) {
+      if (!setting.IsScalar()) yaml_error(path, setting, "set: write each setting as KEY=VALUE or KEY*=FACTOR");
+      plan.settings.push_back(setting.Scalar());
+    }
   }
   const YAML::Node factors = root["factors"];
   if (!factors || !factors.IsSequence() || factors.size() == 0)
@@ -343,7 +346,8 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
     if (!responses.IsSequence() || responses.size() == 0)
       yaml_error(path, responses, "responses is a list, e.g. [R1, car_crush.car1.max_crush, anticlimber.force@0.05]");
     for (const YAML::Node& r : responses) {
-      const std::string name = r.as<std::string>();
+      if (!r.IsScalar()) yaml_error(path, r, "a response is a name such as R1, car_crush.car1.max_crush or anticlimber.force@0.05");
+      const std::string name = r.Scalar();
       if (name == "status") continue;  // always a column
       if (name.empty()) yaml_error(path, r, "an empty response name");
       plan.responses.push_back(name);

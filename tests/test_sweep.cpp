@@ -153,6 +153,8 @@ TEST_CASE("sweep plans: an unknown key, a level of the wrong type and an empty d
   CHECK_THAT(files.error_of_plan(head + "  - {key: 'bodies.car.velocity[2]', levels: [-1]}\n"),
              Catch::StartsWith(files.plan + ":4:") && Catch::Contains("has 2 entries"));
   CHECK(files.error_of_plan(head + "  - {key: 'gravity[1]', levels: [-9.81]}\n") == "no error");  // a top-level list
+  CHECK_THAT(files.error_of_plan(head + "  - {key: simulation.t_end, levels: [0.1]}\nresponses: [R1, {R2: 1}]\n"),
+             Catch::StartsWith(files.plan + ":5:") && Catch::Contains("a response is a name"));
 }
 
 TEST_CASE("sweep: R1 of each run against the closed-form crush; 1 and 2 jobs and a resume give the same rows", "[sweep]") {
