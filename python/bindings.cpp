@@ -16,6 +16,8 @@
 
 #include "railcrash/api.hpp"
 #include "railcrash/sensitivity.hpp"
+#include "railcrash/sweep.hpp"
+#include "railcrash/table_text.hpp"
 
 namespace py = pybind11;
 namespace rc = railcrash::api;
@@ -43,6 +45,24 @@ py::dict sensitivity_run_dict(const railcrash::SensitivityRun& run) {
   row["R3"] = run.responses.r3;
   row["wall_seconds"] = run.wall_seconds;
   return row;
+}
+
+/// `railcrash sweep`: (columns of runs.csv, each run's fields as text; runs not done left out).
+std::pair<std::vector<std::string>, std::vector<std::vector<std::string>>> sweep(const std::string& model_path,
+                                                                                 const std::string& plan_path, int jobs,
+                                                                                 const std::string& out_dir, bool resume,
+                                                                                 double run_limit) {
+  py::gil_scoped_release release;
+  const railcrash::SweepPlan plan = railcrash::load_sweep_plan(plan_path, model_path);
+  railcrash::SweepOptions options;
+  options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.resume = resume;
+  options.run_time_limit = run_limit;
+  const railcrash::SweepResult result = railcrash::run_sweep(model_path, plan, out_dir, options);
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& line : result.lines)
+    if (line) rows.push_back(railcrash::csv_fields(*line));
+  return {railcrash::csv_fields(railcrash::sweep_csv_header(plan)), rows};
 }
 
 /// The first-order study of `railcrash sensitivity`: rows of runs and of fitted A_i.
@@ -199,6 +219,8 @@ PYBIND11_MODULE(_railcrash, m) {
         return std::make_shared<rc::Results>(rc::run(model, settings));
       }, py::arg("model"), py::arg("settings"), py::call_guard<py::gil_scoped_release>());
 
+  m.def("_sweep", &sweep, py::arg("model_path"), py::arg("plan_path"), py::arg("jobs"), py::arg("out_dir"), py::arg("resume"),
+        py::arg("run_limit"));
   m.def("_sensitivity", &sensitivity, py::arg("model_path"), py::arg("design"), py::arg("jobs"), py::arg("only"),
         py::arg("second_order"), py::arg("central"), py::arg("run_limit"));
 }

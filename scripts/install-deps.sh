@@ -7,9 +7,11 @@ set -euo pipefail
 # and the Python example (all from Debian, for /usr/bin/python3; no pip).
 # nodejs + npm: the build fetches the run report's plotting library (uPlot, pinned in
 # src/report/js/package-lock.json) from the npm registry; chromium: the report's browser test.
+# libopenmpi-dev + openmpi-bin: `railcrash sweep` across ranks (mpirun/srun) and its test.
 packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
           libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium
-          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib)
+          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib
+          libopenmpi-dev openmpi-bin)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -8,10 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <mutex>
 #include <sstream>
-#include <thread>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
@@ -212,37 +211,8 @@ Model load_for_run(const ConvergePlan& plan, const std::string& method, double s
   return model;
 }
 
-/// Raises `flag` when the caller's stop flag rises or after `limit` seconds (0: no limit),
-/// until destroyed.
-class Watchdog {
- public:
-  Watchdog(const std::atomic<bool>* stop, double limit, std::atomic<bool>& flag) {
-    thread_ = std::thread([this, stop, limit, &flag]() {
-      const auto start = Clock::now();
-      while (!done_.load()) {
-        if ((stop && stop->load()) || (limit > 0.0 && seconds_since(start) > limit)) {
-          timed_out_ = !(stop && stop->load());
-          flag.store(true);
-          return;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-    });
-  }
-  ~Watchdog() {
-    done_.store(true);
-    thread_.join();
-  }
-  bool timed_out() const { return timed_out_.load(); }
-
- private:
-  std::atomic<bool> done_{false};
-  std::atomic<bool> timed_out_{false};
-  std::thread thread_;
-};
-
 ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double step, double rtol,
-                    const std::atomic<bool>* stop) {
+                    const RunControl& control) {
   ConvergeRun run;
   run.method = method;
   run.step = step;
@@ -255,14 +225,9 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
     Recorder recorder(system, run, responses.get());
     const auto start = Clock::now();
     std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
-    std::atomic<bool> run_stop{false};
-    RunOutcome outcome;
-    bool timed_out = false;
-    {
-      const Watchdog watchdog(stop, plan.options.run_time_limit, run_stop);
-      outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), recorder, &run_stop);
-      timed_out = watchdog.timed_out();
-    }
+    const RunOutcome outcome =
+        integrator->run(model.simulation.t_end, output_interval_of(model.simulation), recorder, control.stop_flag());
+    const bool timed_out = control.timed_out();
     run.wall_seconds = seconds_since(start);
     run.ok = outcome.ok;
     run.message = outcome.message;
@@ -622,29 +587,25 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
   for (double dt : plan.euler_steps) jobs.push_back({"euler", dt, 0.0});
   for (double rtol : plan.options.rtols) jobs.push_back({"ida", 0.0, rtol});
   std::vector<ConvergeRun> runs(jobs.size());
-  std::atomic<std::size_t> next{0};
-  std::mutex report;
-  const auto worker = [&]() {
-    for (std::size_t k = next++; k < jobs.size(); k = next++) {
-      if (stop && stop->load()) {
-        runs[k].method = jobs[k].method;
-        runs[k].step = jobs[k].step;
-        runs[k].rtol = jobs[k].rtol;
-        runs[k].message = "not run (interrupted)";
-        continue;
-      }
-      runs[k] = run_one(plan, jobs[k].method, jobs[k].step, jobs[k].rtol, stop);
-      if (on_run) {
-        const std::lock_guard<std::mutex> lock(report);
-        on_run(runs[k]);
-      }
+  BatchOptions batch;
+  batch.jobs = plan.options.jobs;
+  batch.run_time_limit = plan.options.run_time_limit;
+  batch.stop = stop;
+  const std::vector<BatchRunState> states = run_batch(
+      jobs.size(), [&](std::size_t k, const RunControl& control) {
+        runs[k] = run_one(plan, jobs[k].method, jobs[k].step, jobs[k].rtol, control);
+      },
+      batch, [&](std::size_t k, BatchRunState) {
+        if (on_run) on_run(runs[k]);
+      });
+  for (std::size_t k = 0; k < jobs.size(); ++k)
+    if (states[k] == BatchRunState::not_started) {
+      runs[k].method = jobs[k].method;
+      runs[k].step = jobs[k].step;
+      runs[k].rtol = jobs[k].rtol;
+      runs[k].message = "not run (interrupted)";
     }
-  };
   result.jobs = std::max(1, std::min<int>(plan.options.jobs, static_cast<int>(jobs.size())));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < result.jobs; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
 
   result.reference = runs[0];
   // A reference that fails (tight tolerances can stall IDA at an event) is retried ten times
@@ -654,7 +615,11 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
   while (!result.reference.ok && !(stop && stop->load()) && 10.0 * result.reference.rtol <= loosest_allowed * (1.0 + 1e-9)) {
     result.reference_note += "reference at rtol " + fmt("%.0e", result.reference.rtol) + " failed (" + result.reference.message +
                              "); ";
-    result.reference = run_one(plan, "reference", 0.0, 10.0 * result.reference.rtol, stop);
+    const double looser = 10.0 * result.reference.rtol;
+    BatchOptions single = batch;
+    single.jobs = 1;
+    run_batch(1, [&](std::size_t, const RunControl& control) { result.reference = run_one(plan, "reference", 0.0, looser, control); },
+              single);
     if (on_run) on_run(result.reference);
   }
   if (!result.reference_note.empty())

@@ -23,6 +23,10 @@
 #include "railcrash/run.hpp"
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
+#include "railcrash/sweep.hpp"
+#ifdef RAILCRASH_MPI
+#include "railcrash/sweep_mpi.hpp"
+#endif
 #include "railcrash/converge.hpp"
 #include "railcrash/report/report.hpp"
 #include "railcrash/version.hpp"
@@ -263,6 +267,34 @@ int converge_command(const std::string& path, const railcrash::ConvergeOptions& 
   return result.reference.ok && !g_stop.load() ? 0 : 1;
 }
 
+int sweep_command(const std::string& path, const std::string& plan_path, int jobs, double run_limit, bool resume,
+                  bool keep_runs, const std::string& out_dir) {
+  using namespace railcrash;
+  SweepOptions options;
+  options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.run_time_limit = run_limit;
+  options.resume = resume;
+  options.keep_runs = keep_runs;
+  options.stop = &g_stop;
+  options.progress = [](std::size_t number, const SweepRow& row, std::size_t done, std::size_t total) {
+    std::fprintf(stderr, "[%zu/%zu] run %zu %s %.2f s%s%s\n", done, total, number, row.status.c_str(), row.wall_seconds,
+                 row.message.empty() ? "" : ": ", row.message.c_str());
+  };
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+#ifdef RAILCRASH_MPI
+  if (launched_by_mpi()) return sweep_with_mpi(path, plan_path, out_dir, options);
+#endif
+  const SweepPlan plan = load_sweep_plan(plan_path, path);  // every key and level checked before any run
+  const auto start = std::chrono::steady_clock::now();
+  const SweepResult result = run_sweep(path, plan, out_dir, options);
+  std::printf("%zu of %zu runs done (%zu resumed) with %d jobs in %.1f s; results in %s/ (runs.csv, summary.md)\n",
+              result.done(), result.specs.size(), result.resumed, options.jobs,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), out_dir.c_str());
+  if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
+  return result.done() == result.specs.size() && !g_stop.load() ? 0 : 1;
+}
+
 /// Writes a generated model to out_path (standard output when empty); `what` names it on stderr.
 int write_generated_model(const std::string& text, const std::string& out_path, const std::string& what) {
   if (out_path.empty()) {
@@ -396,6 +428,19 @@ int main(int argc, char** argv) {
   converge->add_option("--out", converge_out, "output folder")->capture_default_str();
   converge->add_option("--set", settings, "override a model key (KEY=VALUE or KEY*=FACTOR)");
 
+  std::string plan_path;
+  bool resume = false, keep_runs = false;
+  CLI::App* sweep = app.add_subcommand("sweep", "study over model keys (factorial, one at a time, Latin hypercube, Monte Carlo, "
+                                                "run lists): DIR/runs.csv and summary.md; under mpirun the runs go to all ranks");
+  sweep->add_option("model", model_path, "model file (YAML)")->required();
+  sweep->add_option("--plan", plan_path, "plan file (YAML: sweep: 1, design, factors, responses; README \"Sweeps\")")->required();
+  sweep->add_option("--jobs", jobs, "runs in parallel on this machine (default: all cores)");
+  sweep->add_option("--run-limit", run_limit, "stop a run after this many seconds and record it failed (default: no limit)")
+      ->check(CLI::NonNegativeNumber);
+  sweep->add_flag("--resume", resume, "keep the rows of DIR/runs.csv whose run is in the plan (by hash) and run the rest");
+  sweep->add_flag("--keep-runs", keep_runs, "also write each run's files to DIR/runs/NNNN/");
+  sweep->add_option("--out", out_dir, "output folder")->capture_default_str();
+
   std::string consist_out;
   int consist_cars = 2;
   CLI::App* consist = app.add_subcommand("consist", "write a model of N coupled striking cars into N standing cars, "
@@ -477,6 +522,7 @@ int main(int argc, char** argv) {
       converge_options.settings = settings;
       return converge_command(model_path, converge_options, converge_out);
     }
+    if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, out_dir);
     if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, out_dir);
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, out_dir);
     if (!integrator.empty())

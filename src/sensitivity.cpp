@@ -4,18 +4,15 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <mutex>
 #include <sstream>
-#include <thread>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
@@ -193,7 +190,8 @@ struct Job {
 // model_text: the model file as read once at the start of the study, so that every run sees the
 // same model even if the file is edited while the study runs.
 SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
-                       const Job& job, const std::vector<std::string>& base_settings, double time_limit) {
+                       const Job& job, const std::vector<std::string>& base_settings, double time_limit,
+                       const RunControl& control) {
   SensitivityRun run;
   run.variation = job.variation;
   run.parameter = job.parameter;
@@ -213,31 +211,9 @@ SensitivityRun run_one(const std::string& model_path, const std::string& model_t
     const Model model = load_model_text(model_text, model_path, settings);
     if (!model.responses.defined())
       throw InputError(model_path + ": a parameter study needs a 'responses' section (R1-R3) in the model");
-    // A watchdog raises the stop flag once the run has had its time limit.
-    std::atomic<bool> stop{false};
-    std::mutex mutex;
-    std::condition_variable finished;
-    bool done = false;
-    std::thread watchdog;
-    if (time_limit > 0.0)
-      watchdog = std::thread([&]() {
-        std::unique_lock<std::mutex> lock(mutex);
-        if (!finished.wait_for(lock, std::chrono::duration<double>(time_limit), [&] { return done; })) stop = true;
-      });
-    RunReport report;
-    try {
-      report = run_model(model, "", &stop);
-    } catch (...) {
-      { const std::lock_guard<std::mutex> lock(mutex); done = true; }
-      finished.notify_all();
-      if (watchdog.joinable()) watchdog.join();
-      throw;
-    }
-    { const std::lock_guard<std::mutex> lock(mutex); done = true; }
-    finished.notify_all();
-    if (watchdog.joinable()) watchdog.join();
+    const RunReport report = run_model(model, "", control.stop_flag());
     run.ok = report.outcome.ok;  // a run that finished just as the limit passed still counts
-    run.message = !run.ok && stop ? "stopped at the run time limit of " + number_text(time_limit) + " s (t = " +
+    run.message = !run.ok && control.timed_out() ? "stopped at the run time limit of " + number_text(time_limit) + " s (t = " +
                                         number_text(report.outcome.t_reached) + ")"
                                   : report.outcome.message;
     run.responses = report.responses;
@@ -454,23 +430,19 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
   }
 
   std::vector<SensitivityRun> runs(jobs.size());
-  std::atomic<std::size_t> next{0};
   std::size_t done = 0;
-  std::mutex progress_mutex;
-  const auto worker = [&]() {
-    for (std::size_t k = next++; k < jobs.size(); k = next++) {
-      runs[k] = run_one(model_path, model_text, design, jobs[k], options.settings, options.run_time_limit);
-      if (options.progress) {
-        const std::lock_guard<std::mutex> lock(progress_mutex);
-        options.progress(runs[k], k, ++done, jobs.size());
-      }
-    }
-  };
-  const int threads = std::max(1, std::min<int>(options.jobs, static_cast<int>(jobs.size())));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
+  BatchOptions batch;
+  batch.jobs = options.jobs;
+  batch.run_time_limit = options.run_time_limit;
+  run_batch(
+      jobs.size(),
+      [&](std::size_t k, const RunControl& control) {
+        runs[k] = run_one(model_path, model_text, design, jobs[k], options.settings, options.run_time_limit, control);
+      },
+      batch,
+      [&](std::size_t k, BatchRunState) {
+        if (options.progress) options.progress(runs[k], k, ++done, jobs.size());
+      });
 
   result.base = runs[0];
   result.runs.assign(runs.begin() + 1, runs.begin() + 1 + static_cast<std::ptrdiff_t>(first_order_count));

@@ -30,4 +30,12 @@ inline YAML::Node flow_pair(double a, double b) {
   return n;
 }
 
+/// The 1-based line of a node (0: unknown).
+inline int yaml_line(const YAML::Node& node) { return node && !node.Mark().is_null() ? node.Mark().line + 1 : 0; }
+
+/// Throws InputError "path:line: message" at the node.
+[[noreturn]] inline void yaml_error(const std::string& path, const YAML::Node& node, const std::string& message) {
+  throw InputError(SourceLocation{path, yaml_line(node)}.prefix() + message);
+}
+
 }  // namespace railcrash

@@ -15,6 +15,8 @@
               {"stiffness": 800.0, "free_length": 1.0})
     m = b.build()
 
+    t = railcrash.sweep("model.yaml", "plan.yaml", jobs=2)   # `railcrash sweep`: runs.csv as a table
+
 Settings (`set=`) are the command line's --set: {"simulation.t_end": 0.5} is
 simulation.t_end=0.5; a key ending in "*" scales the model's number:
 {"elements.k1.stiffness*": 1.2} is elements.k1.stiffness*=1.2.
@@ -30,13 +32,15 @@ import math as _math
 import numbers as _numbers
 import os as _os
 
+import numpy as _numpy
+
 from ._railcrash import InputError, Model, ModelBuilder, Results, RunSettings, SolverError, __version__
 from . import _railcrash
 
 for _name in ("InputError", "SolverError", "Model", "ModelBuilder", "Results", "RunSettings"):
     getattr(_railcrash, _name).__module__ = "railcrash"
 
-__all__ = ["load", "from_yaml", "run", "sensitivity", "Model", "ModelBuilder", "Results", "InputError", "SolverError", "__version__"]
+__all__ = ["load", "from_yaml", "run", "sensitivity", "sweep", "Model", "ModelBuilder", "Results", "InputError", "SolverError", "__version__"]
 
 
 def _setting_value(key, value):
@@ -163,3 +167,42 @@ def sensitivity(model_path, design="report", jobs=0, only=None, second_order=Tru
     only = list(only) if only else []
     return _railcrash._sensitivity(str(model_path), str(design), int(jobs), only, bool(second_order), float(central),
                                    float(run_limit))
+
+
+def _sweep_column(name, values):
+    """A runs.csv column: integers for "run", floats (NaN where empty) where every value is a
+    number, else the texts."""
+    if name == "run":
+        return _numpy.array([int(v) for v in values], dtype=int)
+    try:
+        return _numpy.array([float(v) if v != "" else _math.nan for v in values], dtype=float)
+    except ValueError:
+        return list(values)
+
+
+def sweep(model_path, plan, jobs=0, out=None, resume=False, run_limit=0.0):
+    """A study over model keys (`railcrash sweep`; README "Sweeps"), returned as a table.
+
+    plan: a plan file, or a dict of the same content (written to a JSON file for the run,
+    so error messages name that file and its line). out: the folder for runs.csv and
+    summary.md (default: a temporary folder, removed afterwards). Returns a
+    pandas.DataFrame when pandas is installed, else a dict of columns (numpy arrays for
+    numbers, lists of text): run, hash, one column per factor, status, one per response,
+    wall_seconds, message. Runs not done (interrupted) are left out.
+    """
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="railcrash_sweep_") as scratch:
+        plan_path = plan
+        if isinstance(plan, dict):
+            plan_path = _os.path.join(scratch, "plan.json")
+            with open(plan_path, "w") as f:
+                _json.dump(plan, f, indent=1)
+        directory = str(out) if out is not None else _os.path.join(scratch, "out")
+        columns, rows = _railcrash._sweep(str(model_path), str(plan_path), int(jobs), directory, bool(resume),
+                                          float(run_limit))
+    table = {name: _sweep_column(name, [row[k] for row in rows]) for k, name in enumerate(columns)}
+    try:
+        import pandas
+    except ImportError:
+        return table
+    return pandas.DataFrame(table, columns=columns)

@@ -8,9 +8,11 @@ import math
 import os
 import pathlib
 import tempfile
+import sys
 import threading
 import time
 import unittest
+from unittest import mock
 
 import numpy
 
@@ -314,6 +316,55 @@ class ThreadTest(unittest.TestCase):
             inside = sum(1 for beat in beats if start < beat < end)
             self.assertGreaterEqual(inside, 5, f"{inside} heartbeats during a run of {end - start:.3f} s: "
                                                "the run held the GIL")
+
+
+class SweepTest(unittest.TestCase):
+    PLAN = {"sweep": 1, "design": "full_factorial",
+            "factors": [{"key": "elements.ac.horizontal_yield_deflection", "levels": [0.008, 0.012]},
+                        {"key": "simulation.t_end", "levels": [0.15]}],
+            "responses": ["R1", "responses.max_anticlimber_crush"]}
+
+    def test_rows_against_the_closed_form_and_the_same_with_two_jobs(self):
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "model.yaml"
+            model.write_text(ANTICLIMBER)
+            table = railcrash.sweep(model, self.PLAN, jobs=1)
+            plan_file = pathlib.Path(folder) / "plan.yaml"
+            plan_file.write_text("sweep: 1\ndesign: runs\nfactors:\n"
+                                 "  - {key: elements.ac.horizontal_yield_deflection}\n"
+                                 "runs:\n  - {elements.ac.horizontal_yield_deflection: 0.012}\n  - {elements.ac.horizontal_yield_deflection: 0.008}\n"
+                                 "responses: [R1, responses.max_anticlimber_crush]\n")
+            explicit = railcrash.sweep(model, plan_file, jobs=2, out=pathlib.Path(folder) / "out")
+            self.assertTrue((pathlib.Path(folder) / "out" / "runs.csv").exists())
+        column = lambda t, name: numpy.asarray(t[name])
+        self.assertEqual(list(column(table, "run")), [0, 1])
+        self.assertEqual(list(column(table, "status")), ["ok", "ok"])
+        yields = column(table, "elements.ac.horizontal_yield_deflection")
+        self.assertEqual(list(yields), [0.008, 0.012])
+        for d_y, r1, crush in zip(yields, column(table, "R1"), column(table, "responses.max_anticlimber_crush")):
+            self.assertAlmostEqual(crush, crush_for(d_y), delta=1e-5 * crush)
+            self.assertAlmostEqual(r1, crush_for(d_y) / 0.02, delta=1e-5 * r1)
+        # The same runs in another order and with two jobs: bit for bit the same responses.
+        self.assertEqual(list(column(explicit, "R1")), list(column(table, "R1"))[::-1])
+
+    def test_without_pandas_a_dict_of_columns(self):
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "model.yaml"
+            model.write_text(ANTICLIMBER)
+            with mock.patch.dict(sys.modules, {"pandas": None}):  # import pandas raises ImportError
+                table = railcrash.sweep(model, self.PLAN)
+        self.assertIsInstance(table, dict)
+        self.assertIsInstance(table["R1"], numpy.ndarray)
+        self.assertEqual(table["status"], ["ok", "ok"])
+        self.assertAlmostEqual(table["R1"][1], crush_for(0.012) / 0.02, delta=1e-5)
+
+    def test_a_plan_error_names_the_line(self):
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "model.yaml"
+            model.write_text(ANTICLIMBER)
+            plan = dict(self.PLAN, factors=[{"key": "elements.ac.no_such_key", "levels": [1.0]}])
+            with self.assertRaisesRegex(railcrash.InputError, r"plan\.json:\d+: factor 'elements\.ac\.no_such_key'"):
+                railcrash.sweep(model, plan)
 
 
 class SensitivityTest(unittest.TestCase):

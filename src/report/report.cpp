@@ -19,6 +19,7 @@
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/table_text.hpp"
 
 namespace railcrash::report {
 
@@ -82,31 +83,6 @@ std::string read_file(const fs::path& path, bool* found) {
   return text.str();
 }
 
-/// Fields of one CSV line (RFC 4180 quoting).
-std::vector<std::string> csv_fields(const std::string& line) {
-  std::vector<std::string> fields(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        fields.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        fields.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.emplace_back();
-    } else if (c != '\r') {
-      fields.back() += c;
-    }
-  }
-  return fields;
-}
 
 /// A numeric CSV file: header and complete rows; stops at the first broken row.
 struct NumericTable {
@@ -297,16 +273,19 @@ std::string write_page(const fs::path& dir, const std::string& title, const std:
   return path;
 }
 
-/// Files of a `converge` or `sensitivity` folder, in the order shown.
+/// Files of a `converge`, `readings`, `sensitivity` or `sweep` folder, in the order shown.
 const char* const kStudyFiles[] = {"converge.md", "converge.csv", "readings.md", "readings.csv", "sensitivity.md", "comparison.md",
                                    "sensitivity.csv", "sensitivity_first_order.csv", "sensitivity_second_order.csv",
-                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv"};
+                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv", "summary.md", "runs.csv"};
 
 /// A report of a study folder: its Markdown summary, its tables and its chart.
 ReportResult write_study_report(const fs::path& dir) {
   ReportResult result;
   const bool converge = fs::exists(dir / "converge.csv") || fs::exists(dir / "converge.md");
-  result.study = converge ? "converge" : fs::exists(dir / "readings.csv") ? "readings" : "sensitivity";
+  result.study = converge                              ? "converge"
+                 : fs::exists(dir / "readings.csv")    ? "readings"
+                 : fs::exists(dir / "sensitivity.csv") ? "sensitivity"
+                                                       : "sweep";
   std::string files = "[";
   for (const char* name : kStudyFiles) {
     bool found = false;
@@ -339,7 +318,8 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   ReportResult result;
   std::vector<std::string>& problems = result.problems;
   const NumericTable series = read_numeric_csv(dir / "timeseries.csv", problems);
-  if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv") || fs::exists(dir / "readings.csv")))
+  if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv") || fs::exists(dir / "readings.csv") ||
+                        fs::exists(dir / "runs.csv")))
     return write_study_report(dir);
   if (!series.found)
     throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (write one with `railcrash run MODEL --out " +

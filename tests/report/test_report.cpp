@@ -210,6 +210,19 @@ TEST_CASE("railcrash report of a sensitivity folder: its summary and tables", "[
   fs::remove_all(dir);
 }
 
+TEST_CASE("railcrash report of a sweep folder: its summary and runs", "[report]") {
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_sweep_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "runs.csv") << "run,hash,k,status,R1,wall_seconds,message\n0,00000000000000aa,1.5,ok,0.25,0.1,\"\"\n";
+  std::ofstream(dir / "summary.md") << "# Sweep plan.yaml\n\n## Main effects\n";
+  const railcrash::report::ReportResult result = railcrash::report::write_report(dir.string());
+  CHECK(result.study == "sweep");
+  CHECK(result.rows == 2);
+  CHECK_THAT(slurp(dir / "report.html"), Catch::Contains("0,00000000000000aa,1.5,ok,0.25") && Catch::Contains("Main effects"));
+  fs::remove_all(dir);
+}
+
 TEST_CASE("Body and element names that would break CSV, JSON or HTML are refused with file and line", "[report]") {
   const std::string head = "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: ";
   const std::string tail = ", mass: 1, inertia: 1, position: [0, 0]}\nelements: []\nsimulation: {t_end: 1}\n";

@@ -32,7 +32,7 @@
   var check = {errors: window.railcrashErrors, plots: [], frames: null};
   if (data.study) { studyReport(); return; }
 
-  // ---------------------------------------------------------------- a study folder (converge, sensitivity)
+  // ---------------------------------------------------------------- a study folder (converge, readings, sensitivity, sweep)
   function csvRows(text) {  // RFC 4180 fields
     var rows = [], row = [""], quoted = false;
     for (var i = 0; i < text.length; ++i) {
@@ -64,7 +64,7 @@
     });
     var head = document.getElementById("header");
     head.textContent = "";
-    head.appendChild(el("h1", {}, "railcrash " + ({converge: "convergence", readings: "reading", sensitivity: "sensitivity"}[data.study] || data.study) +
+    head.appendChild(el("h1", {}, "railcrash " + ({converge: "convergence", readings: "reading", sensitivity: "sensitivity", sweep: "sweep"}[data.study] || data.study) +
                                   " study: " + data.run_dir));
     var box = el("section");
     document.body.insertBefore(box, document.getElementById("footer"));

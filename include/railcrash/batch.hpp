@@ -1,0 +1,59 @@
+// The batch runner every study uses (sensitivity, readings, converge, sweep): runs numbered
+// 0..count-1 over a pool of threads, each with a stop flag that a supervisor raises at the
+// per-run wall limit or when the caller's stop flag rises (SIGINT/SIGTERM in the command
+// line). A run writes its result into the caller's slot for its number, so the results come
+// back in run order and are the same whatever the number of jobs: the pool only decides when
+// a run starts, never what it computes.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <mutex>
+#include <vector>
+
+namespace railcrash {
+
+struct BatchOptions {
+  int jobs = 1;                              // threads (at most one per run)
+  double run_time_limit = 0.0;               // [s] wall time after which a run's stop flag rises (0: none)
+  const std::atomic<bool>* stop = nullptr;   // raised by the caller: runs in progress are stopped, no new run starts
+};
+
+/// What a run sees of the batch: its stop flag, and why it rose.
+class RunControl {
+ public:
+  /// The flag to hand to the integrator (run_model, Integrator::run).
+  const std::atomic<bool>* stop_flag() const { return &stop_; }
+  /// The run limit raised the flag (the run went on too long).
+  bool timed_out() const { return timed_out_.load(); }
+  /// The caller's stop flag raised it (the study was interrupted).
+  bool interrupted() const { return interrupted_.load(); }
+
+ private:
+  friend class BatchSupervisor;
+  friend struct BatchAccess;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> timed_out_{false};
+  std::atomic<bool> interrupted_{false};
+  bool active_ = false;                        // guarded by mutex_, as start_
+  std::chrono::steady_clock::time_point start_{};
+  std::mutex mutex_;                           // the supervisor's checks against a run starting or ending
+};
+
+/// What became of each run.
+enum class BatchRunState {
+  not_started,  // the study was interrupted before the run's turn
+  finished,     // the task returned (its own result says whether the run succeeded)
+  interrupted,  // the task returned after the caller's stop flag stopped it: its result is partial
+};
+
+/// Runs task(number, control) for every number in [0, count), up to options.jobs at a time,
+/// starting them in increasing order. on_finished(number, state) is called one call at a time
+/// (under a lock) as each run returns. A task must not throw (it records its own failure).
+std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void(std::size_t, const RunControl&)>& task,
+                                     const BatchOptions& options,
+                                     const std::function<void(std::size_t, BatchRunState)>& on_finished = {});
+
+}  // namespace railcrash

@@ -1,0 +1,159 @@
+// `railcrash sweep`: a study over model keys (design of experiments, Monte Carlo, explicit run
+// lists) run by the batch runner (batch.hpp), one row per run in runs.csv.
+//
+// Plan file (YAML; README "Sweeps"):
+//   sweep: 1
+//   design: full_factorial      # one_at_a_time | latin_hypercube | monte_carlo | runs
+//   samples: 20                 # latin_hypercube, monte_carlo
+//   seed: 7                     # latin_hypercube, monte_carlo (default 1)
+//   set: [simulation.t_end=0.2] # settings applied to every run (optional)
+//   factors:
+//     - key: elements.anticlimber.horizontal_yield_deflection
+//       scale: true             # the levels multiply the model's value (KEY*=LEVEL)
+//       levels: [0.8, 1.0, 1.2] # full_factorial, one_at_a_time, runs
+//     - key: bodies.car1_center_body.velocity[0]     # one entry of a list
+//       distribution: {uniform: [-500, -400]}        # or {normal: [mean, standard deviation]}
+//   runs:                       # design: runs; each run lists levels by key (others: the model's value)
+//     - {elements.anticlimber.horizontal_yield_deflection: 1.1}
+//   responses: [responses.R1, car_crush.car1.max_crush, anticlimber.force@0.05]
+//
+// Responses are paths into summary.json (keys joined by dots, e.g.
+// peak_accelerations.bodies.car1_center_body.magnitude_cfc.g) or COLUMN@TIME, a column of
+// timeseries.csv interpolated linearly at TIME [s]; R1, R2, R3 are short for responses.R1...
+//
+// Designs. Levels are the listed values; "the model's value" is the run without a setting.
+//   full_factorial   every combination of levels; the first factor changes slowest.
+//   one_at_a_time    run 0 with every factor at the model's value, then each factor at each of
+//                    its levels with the others at the model's value.
+//   latin_hypercube  N samples; each factor's range of probability is cut into N equal strata
+//                    and every stratum holds exactly one sample (McKay, Beckman and Conover
+//                    1979), the strata matched at random between factors.
+//   monte_carlo      N independent samples.
+// Sampled designs draw from std::mt19937_64 (its output is fixed by the C++ standard) with this
+// file's own transforms, so a seed gives the same runs on every platform: u = (k + 0.5) / 2^52
+// from the top 52 bits k (exact, in (0, 1)), x = a + (b - a) u (uniform), x = mean + sd * Phi^-1(u) (normal, by
+// bisection on Phi to 2^-60 of the range).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "railcrash/batch.hpp"
+
+namespace railcrash {
+
+struct SweepDistribution {
+  enum class Kind { uniform, normal };
+  Kind kind = Kind::uniform;
+  double first = 0.0, second = 0.0;  // uniform: lower, upper bound; normal: mean, standard deviation
+  double value_at(double probability) const;  // the quantile
+};
+
+struct SweepFactor {
+  std::string key;                     // model key; "bodies.b.velocity[0]" sets one entry of a list
+  bool scale = false;                  // values multiply the model's number (KEY*=VALUE)
+  std::vector<std::string> levels;     // YAML text of each level
+  std::optional<SweepDistribution> distribution;
+  int line = 0;                        // in the plan file
+  std::string column() const { return scale ? key + "*" : key; }
+};
+
+enum class SweepDesignKind { full_factorial, one_at_a_time, latin_hypercube, monte_carlo, runs };
+
+struct SweepPlan {
+  std::string path;
+  SweepDesignKind design = SweepDesignKind::full_factorial;
+  int design_line = 0;
+  std::size_t samples = 0;
+  std::uint64_t seed = 1;
+  std::vector<std::string> settings;             // every run, before the factors
+  std::vector<SweepFactor> factors;
+  std::vector<std::vector<std::string>> runs;    // design runs: per run, per factor ("" = the model's value)
+  std::vector<int> run_lines;
+  std::vector<std::string> responses;
+};
+
+/// Reads a plan and checks it against the model (every key and level is applied to the model
+/// once): InputError with the plan's file:line before any run.
+SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path);
+
+// ---- design generators (tested against their definitions)
+
+/// Level numbers of every combination; the first factor changes slowest.
+std::vector<std::vector<std::size_t>> full_factorial(const std::vector<std::size_t>& level_counts);
+/// Row 0: every factor at the model's value (-1); then factor i at each level j (others -1).
+std::vector<std::vector<long>> one_at_a_time(const std::vector<std::size_t>& level_counts);
+/// A uniform number in (0, 1) from the top 52 bits of one draw.
+double unit_uniform(std::mt19937_64& generator);
+/// samples x factors probabilities in (0, 1), one per stratum [k/N, (k+1)/N) in every column.
+std::vector<std::vector<double>> latin_hypercube(std::size_t samples, std::size_t factors, std::uint64_t seed);
+/// samples x factors independent probabilities in (0, 1).
+std::vector<std::vector<double>> monte_carlo(std::size_t samples, std::size_t factors, std::uint64_t seed);
+/// Phi^-1(p), the standard normal quantile.
+double normal_quantile(double probability);
+
+// ---- runs
+
+struct SweepRunSpec {
+  std::vector<std::string> levels;     // per factor, YAML text ("" = the model's value)
+  std::vector<std::string> settings;   // what is applied to the model: the plan's, then the factors'
+  std::string hash;                    // 16 hex digits of FNV-1a over the model text and the settings
+};
+
+/// The plan's runs, in order.
+std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_text);
+
+struct SweepRow {
+  std::string status;                  // "ok", "failed"
+  std::vector<double> responses;       // NaN where the run has no such value
+  double wall_seconds = 0.0;
+  std::string message;
+};
+
+/// Runs one specification (used by the thread pool and by MPI ranks).
+SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+                        const SweepRunSpec& spec, const RunControl& control, const std::string& run_folder = "");
+
+/// runs.csv: header and one line per row (run number, hash, factors, status, responses, wall, message).
+std::string sweep_csv_header(const SweepPlan& plan);
+std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const SweepRunSpec& spec, const SweepRow& row);
+
+struct SweepOptions {
+  int jobs = 1;
+  double run_time_limit = 0.0;              // [s]
+  const std::atomic<bool>* stop = nullptr;
+  bool resume = false;
+  bool keep_runs = false;                   // per-run folders DIR/runs/NNNN
+  std::function<void(std::size_t number, const SweepRow&, std::size_t done, std::size_t total)> progress;
+};
+
+struct SweepResult {
+  std::vector<SweepRunSpec> specs;
+  std::vector<std::optional<std::string>> lines;  // runs.csv line per run; empty: not run (interrupted)
+  std::size_t resumed = 0;                        // rows taken from an earlier runs.csv
+  std::size_t done() const;
+};
+
+/// Starts DIR/runs.csv (or, resuming, reads the rows it has whose hash matches a run): the
+/// result with the resumed lines set. InputError if a resumed file has other columns.
+SweepResult start_sweep(const SweepPlan& plan, const std::string& model_text, const std::string& directory, bool resume);
+/// Appends one finished line to DIR/runs.csv (flushed: a killed sweep keeps it).
+void append_sweep_line(const std::string& directory, const std::string& line);
+/// The model file's text, read once so every run sees the same model.
+std::string read_model_text(const std::string& model_path);
+
+/// Runs the plan with threads, writing DIR/runs.csv as runs finish and again in run order at
+/// the end, and DIR/summary.md.
+SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, const std::string& directory,
+                      const SweepOptions& options);
+
+/// Writes DIR/runs.csv (run order; runs not done are left out) and DIR/summary.md (main
+/// effects); returns the Markdown.
+std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const std::string& directory);
+
+}  // namespace railcrash

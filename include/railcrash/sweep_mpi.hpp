@@ -1,0 +1,23 @@
+// `railcrash sweep` under mpirun/srun (built with RAILCRASH_MPI): rank 0 hands out run numbers
+// one at a time to the ranks that ask and to a thread of its own (dynamic: a long run does not
+// hold up the others; each rank does one run at a time, so start one rank per core), gathers
+// the runs.csv lines and writes every file; with one rank it runs the sweep itself on --jobs
+// threads.
+#pragma once
+
+#include <atomic>
+#include <string>
+
+#include "railcrash/sweep.hpp"
+
+namespace railcrash {
+
+/// The process was started by an MPI launcher (OpenMPI's mpirun, or a PMI/PMIx one as srun).
+bool launched_by_mpi();
+
+/// Runs the sweep over the MPI ranks; returns the command's exit status (2: bad input, printed
+/// by rank 0 only). Calls MPI_Init and MPI_Finalize.
+int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, const std::string& directory,
+                   const SweepOptions& options);
+
+}  // namespace railcrash

@@ -1,0 +1,730 @@
+#include "railcrash/sweep.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "railcrash/table_text.hpp"
+#include "railcrash/yaml_file.hpp"
+
+namespace railcrash {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+
+/// The shortest of %.15g, %.16g, %.17g that reads back as the same double.
+std::string exact(double value) {
+  char text[40];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  return text;
+}
+
+/// A level as the YAML text of a --set value: a scalar as written, a list in flow style.
+std::string level_text(const std::string& path, const YAML::Node& node, const std::string& context) {
+  if (node.IsScalar()) return node.Scalar();
+  if (node.IsSequence()) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < node.size(); ++i) text += (i ? ", " : "") + level_text(path, node[i], context);
+    return text + "]";
+  }
+  yaml_error(path, node, context + ": a level is a number, a word or a list of them, not a map");
+}
+
+double plan_number(const std::string& path, const YAML::Node& node, const std::string& context) {
+  try {
+    return node.as<double>();
+  } catch (const YAML::Exception&) {
+    yaml_error(path, node, context + " must be a number");
+  }
+}
+
+SweepDesignKind design_kind(const std::string& path, const YAML::Node& node) {
+  const std::string name = node.IsScalar() ? node.Scalar() : "";
+  if (name == "full_factorial") return SweepDesignKind::full_factorial;
+  if (name == "one_at_a_time") return SweepDesignKind::one_at_a_time;
+  if (name == "latin_hypercube") return SweepDesignKind::latin_hypercube;
+  if (name == "monte_carlo") return SweepDesignKind::monte_carlo;
+  if (name == "runs") return SweepDesignKind::runs;
+  yaml_error(path, node, "design '" + name + "': use full_factorial, one_at_a_time, latin_hypercube, monte_carlo or runs");
+}
+
+bool sampled(SweepDesignKind kind) {
+  return kind == SweepDesignKind::latin_hypercube || kind == SweepDesignKind::monte_carlo;
+}
+
+SweepDistribution load_distribution(const std::string& path, const YAML::Node& node, const std::string& context) {
+  if (!node.IsMap() || node.size() != 1)
+    yaml_error(path, node, context + ": write the distribution as {uniform: [lower, upper]} or {normal: [mean, sd]}");
+  const std::string kind = node.begin()->first.as<std::string>();
+  const YAML::Node values = node.begin()->second;
+  if ((kind != "uniform" && kind != "normal") || !values.IsSequence() || values.size() != 2)
+    yaml_error(path, node, context + ": write the distribution as {uniform: [lower, upper]} or {normal: [mean, sd]}");
+  SweepDistribution d;
+  d.kind = kind == "uniform" ? SweepDistribution::Kind::uniform : SweepDistribution::Kind::normal;
+  d.first = plan_number(path, values[0], context + ": " + kind + "'s first value");
+  d.second = plan_number(path, values[1], context + ": " + kind + "'s second value");
+  if (d.kind == SweepDistribution::Kind::uniform && !(d.second > d.first))
+    yaml_error(path, values, context + ": uniform needs lower < upper");
+  if (d.kind == SweepDistribution::Kind::normal && !(d.second > 0.0))
+    yaml_error(path, values, context + ": normal needs a positive standard deviation");
+  return d;
+}
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  for (std::string part; std::getline(stream, part, separator);) parts.push_back(part);
+  return parts;
+}
+
+/// The list a key ("gravity", "bodies.b.velocity") names in the model's YAML (an undefined node if none).
+YAML::Node model_list(const YAML::Node& root, const std::string& key) {
+  const std::vector<std::string> parts = split(key, '.');
+  YAML::Node holder;
+  std::string name;
+  if (parts.size() == 1) {
+    holder = root;
+    name = parts[0];
+  } else if (parts.size() == 2 && root[parts[0]] && root[parts[0]].IsMap()) {
+    holder = root[parts[0]];
+    name = parts[1];
+  } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements") && root[parts[0]].IsSequence()) {
+    for (const YAML::Node& item : root[parts[0]])
+      if (item.IsMap() && item["name"] && item["name"].IsScalar() && item["name"].Scalar() == parts[1]) holder = item;
+    name = parts[2];
+  }
+  if (!holder || !holder.IsMap() || !holder[name] || !holder[name].IsSequence()) return YAML::Node(YAML::NodeType::Undefined);
+  return holder[name];
+}
+
+/// The setting a factor at one level makes: KEY=LEVEL, KEY*=LEVEL, or for KEY[i] the whole
+/// list with entry i replaced (or scaled).
+std::string factor_setting(const SweepFactor& factor, const std::string& level, const YAML::Node& model_root) {
+  const auto bracket = factor.key.find('[');
+  if (bracket == std::string::npos) return factor.key + (factor.scale ? "*=" : "=") + level;
+  const std::string list_key = factor.key.substr(0, bracket);
+  const std::string where = "'" + factor.key + "'";
+  std::size_t index = 0;
+  try {
+    std::size_t used = 0;
+    index = std::stoul(factor.key.substr(bracket + 1), &used);
+    if (factor.key.substr(bracket + 1 + used) != "]") throw std::invalid_argument("trailing text");
+  } catch (const std::exception&) {
+    throw InputError(where + ": write an entry of a list as KEY[INDEX], e.g. bodies.car1_center_body.velocity[0]");
+  }
+  const YAML::Node list = model_list(model_root, list_key);
+  if (!list) throw InputError(where + ": the model has no list at '" + list_key + "' (a top-level key, section.key, bodies.<name>.<key> or elements.<name>.<key>)");
+  if (index >= list.size())
+    throw InputError(where + ": the list at '" + list_key + "' has " + std::to_string(list.size()) + " entries (index from 0)");
+  std::string text = list_key + "=[";
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    std::string entry = list[i].IsScalar() ? list[i].Scalar() : "";
+    if (i == index) {
+      if (!factor.scale) {
+        entry = level;
+      } else {
+        try {
+          entry = exact(list[i].as<double>() * std::stod(level));
+        } catch (const std::exception&) {
+          throw InputError(where + ": scaling needs a number in the model and a number as the level, not '" + level + "'");
+        }
+      }
+    }
+    text += (i ? ", " : "") + entry;
+  }
+  return text + "]";
+}
+
+std::uint64_t fnv1a(const std::string& text, std::uint64_t hash = 14695981039346656037ull) {
+  for (unsigned char c : text) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+/// A CSV field: as is, or quoted when it holds a comma, a quote or a line break.
+std::string csv_field(const std::string& text) {
+  return text.find_first_of(",\"\n") == std::string::npos ? text : csv_text(text);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- generators
+
+double SweepDistribution::value_at(double probability) const {
+  if (kind == Kind::uniform) return first + (second - first) * probability;
+  return first + second * normal_quantile(probability);
+}
+
+double normal_quantile(double probability) {
+  RAILCRASH_DEMAND(probability > 0.0 && probability < 1.0);
+  // Phi(x) = erfc(-x / sqrt 2) / 2 rises monotonically; bisection on [-40, 40] to 2^-60 of it.
+  double low = -40.0, high = 40.0;
+  for (int k = 0; k < 67; ++k) {
+    const double middle = 0.5 * (low + high);
+    if (0.5 * std::erfc(-middle / std::sqrt(2.0)) < probability) low = middle;
+    else high = middle;
+  }
+  return 0.5 * (low + high);
+}
+
+double unit_uniform(std::mt19937_64& generator) {
+  // 52 bits, so that k + 0.5 and the quotient are exact: u lies in [2^-53, 1 - 2^-53].
+  const std::uint64_t top = generator() >> 12;
+  return (static_cast<double>(top) + 0.5) / 4503599627370496.0;  // 2^52
+}
+
+std::vector<std::vector<std::size_t>> full_factorial(const std::vector<std::size_t>& level_counts) {
+  std::size_t total = level_counts.empty() ? 0 : 1;
+  for (std::size_t n : level_counts) total *= n;
+  std::vector<std::vector<std::size_t>> rows(total, std::vector<std::size_t>(level_counts.size()));
+  for (std::size_t r = 0; r < total; ++r) {
+    std::size_t rest = r;
+    for (std::size_t f = level_counts.size(); f-- > 0;) {  // the last factor changes fastest
+      rows[r][f] = rest % level_counts[f];
+      rest /= level_counts[f];
+    }
+  }
+  return rows;
+}
+
+std::vector<std::vector<long>> one_at_a_time(const std::vector<std::size_t>& level_counts) {
+  const std::vector<long> base(level_counts.size(), -1);
+  std::vector<std::vector<long>> rows{base};
+  for (std::size_t f = 0; f < level_counts.size(); ++f)
+    for (std::size_t j = 0; j < level_counts[f]; ++j) {
+      rows.push_back(base);
+      rows.back()[f] = static_cast<long>(j);
+    }
+  return rows;
+}
+
+std::vector<std::vector<double>> latin_hypercube(std::size_t samples, std::size_t factors, std::uint64_t seed) {
+  std::mt19937_64 generator(seed);
+  std::vector<std::vector<double>> rows(samples, std::vector<double>(factors));
+  std::vector<std::size_t> strata(samples);
+  for (std::size_t f = 0; f < factors; ++f) {
+    std::iota(strata.begin(), strata.end(), std::size_t{0});
+    // Fisher-Yates with this file's own draws (std::shuffle's use of the generator is not specified).
+    for (std::size_t i = samples; i > 1; --i) {
+      const auto j = static_cast<std::size_t>(unit_uniform(generator) * static_cast<double>(i));
+      std::swap(strata[i - 1], strata[std::min(j, i - 1)]);
+    }
+    // (k + u) / N can round up to 1 in the last stratum: keep it below.
+    for (std::size_t s = 0; s < samples; ++s)
+      rows[s][f] = std::min((static_cast<double>(strata[s]) + unit_uniform(generator)) / static_cast<double>(samples),
+                            std::nextafter(1.0, 0.0));
+  }
+  return rows;
+}
+
+std::vector<std::vector<double>> monte_carlo(std::size_t samples, std::size_t factors, std::uint64_t seed) {
+  std::mt19937_64 generator(seed);
+  std::vector<std::vector<double>> rows(samples, std::vector<double>(factors));
+  for (auto& row : rows)
+    for (double& u : row) u = unit_uniform(generator);
+  return rows;
+}
+
+// ---------------------------------------------------------------- plan
+
+std::string read_model_text(const std::string& model_path) {
+  std::ifstream in(model_path);
+  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path) {
+  const YAML::Node root = load_yaml_file(path, "plan file");
+  if (!root.IsMap() || !root["sweep"]) yaml_error(path, root, "a plan file starts with 'sweep: 1'");
+  static const std::vector<std::string> kKeys{"sweep", "design", "samples", "seed", "set", "factors", "runs", "responses"};
+  for (const auto& entry : root) {
+    const std::string key = entry.first.as<std::string>();
+    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end())
+      yaml_error(path, entry.first, "unknown key '" + key + "'" + suggestion(key, kKeys) +
+                                        " (a plan has sweep, design, samples, seed, set, factors, runs, responses)");
+  }
+  SweepPlan plan;
+  plan.path = path;
+  if (!root["design"]) yaml_error(path, root, "give a design: full_factorial, one_at_a_time, latin_hypercube, monte_carlo or runs");
+  plan.design = design_kind(path, root["design"]);
+  plan.design_line = yaml_line(root["design"]);
+  if (sampled(plan.design)) {
+    if (!root["samples"]) yaml_error(path, root["design"], "a sampled design needs 'samples: N' (N > 0)");
+    const double samples = plan_number(path, root["samples"], "samples");
+    if (!(samples >= 1.0) || samples != std::floor(samples))
+      yaml_error(path, root["samples"], "samples must be a whole number of runs, at least 1 (the design is empty)");
+    plan.samples = static_cast<std::size_t>(samples);
+    if (root["seed"]) {
+      const double seed = plan_number(path, root["seed"], "seed");
+      if (!(seed >= 0.0) || seed != std::floor(seed) || seed > 9.0e15) yaml_error(path, root["seed"], "seed must be a whole number >= 0");
+      plan.seed = static_cast<std::uint64_t>(seed);
+    }
+  }
+  if (const YAML::Node set = root["set"]) {
+    if (!set.IsSequence()) yaml_error(path, set, "set is a list of KEY=VALUE or KEY*=FACTOR settings");
+    for (const YAML::Node& setting : set) {
+      if (!setting.IsScalar()) yaml_error(path, setting, "set: write each setting as KEY=VALUE or KEY*=FACTOR");
+      plan.settings.push_back(setting.Scalar());
+    }
+  }
+  const YAML::Node factors = root["factors"];
+  if (!factors || !factors.IsSequence() || factors.size() == 0)
+    yaml_error(path, factors ? factors : root, "'factors' must list at least one factor: - {key: elements.NAME.KEY, levels: [...]}");
+  for (const YAML::Node& f : factors) {
+    if (!f.IsMap() || !f["key"] || !f["key"].IsScalar()) yaml_error(path, f, "each factor needs 'key' (a model key)");
+    SweepFactor factor;
+    factor.key = f["key"].Scalar();
+    factor.line = yaml_line(f);
+    const std::string context = "factor '" + factor.key + "'";
+    for (const auto& entry : f) {
+      const std::string key = entry.first.as<std::string>();
+      if (key != "key" && key != "scale" && key != "levels" && key != "distribution")
+        yaml_error(path, entry.first, context + ": unknown key '" + key + "' (a factor has key, scale, levels, distribution)");
+    }
+    for (const SweepFactor& other : plan.factors)
+      if (other.key == factor.key) yaml_error(path, f["key"], context + " is listed twice");
+    if (f["scale"]) {
+      try {
+        factor.scale = f["scale"].as<bool>();
+      } catch (const YAML::Exception&) {
+        yaml_error(path, f["scale"], context + ": scale is true or false");
+      }
+    }
+    if (sampled(plan.design)) {
+      if (!f["distribution"]) yaml_error(path, f, context + ": a " + root["design"].Scalar() + " design needs a distribution per factor");
+      factor.distribution = load_distribution(path, f["distribution"], context);
+    } else if (plan.design != SweepDesignKind::runs || f["levels"]) {
+      const YAML::Node levels = f["levels"];
+      if (!levels || !levels.IsSequence() || levels.size() == 0)
+        yaml_error(path, levels ? levels : f, context + ": 'levels' must list at least one value (the design is empty)");
+      for (const YAML::Node& level : levels) factor.levels.push_back(level_text(path, level, context));
+    }
+    plan.factors.push_back(std::move(factor));
+  }
+  if (plan.design == SweepDesignKind::runs) {
+    const YAML::Node runs = root["runs"];
+    if (!runs || !runs.IsSequence() || runs.size() == 0)
+      yaml_error(path, runs ? runs : root["design"], "design 'runs' needs 'runs': a list of {key: level} maps (the design is empty)");
+    for (const YAML::Node& r : runs) {
+      if (!r.IsMap()) yaml_error(path, r, "each run is a map {factor key: level}");
+      std::vector<std::string> levels(plan.factors.size());
+      for (const auto& entry : r) {
+        const std::string key = entry.first.as<std::string>();
+        const auto it = std::find_if(plan.factors.begin(), plan.factors.end(), [&](const SweepFactor& x) { return x.key == key; });
+        if (it == plan.factors.end()) yaml_error(path, entry.first, "run: '" + key + "' is not one of the factors (list it under 'factors')");
+        levels[static_cast<std::size_t>(it - plan.factors.begin())] = level_text(path, entry.second, "run: " + key);
+      }
+      plan.runs.push_back(std::move(levels));
+      plan.run_lines.push_back(yaml_line(r));
+    }
+  } else if (root["runs"]) {
+    yaml_error(path, root["runs"], "'runs' is only read with design: runs");
+  }
+  if (const YAML::Node responses = root["responses"]) {
+    if (!responses.IsSequence() || responses.size() == 0)
+      yaml_error(path, responses, "responses is a list, e.g. [R1, car_crush.car1.max_crush, anticlimber.force@0.05]");
+    for (const YAML::Node& r : responses) {
+      if (!r.IsScalar()) yaml_error(path, r, "a response is a name such as R1, car_crush.car1.max_crush or anticlimber.force@0.05");
+      const std::string name = r.Scalar();
+      if (name == "status") continue;  // always a column
+      if (name.empty()) yaml_error(path, r, "an empty response name");
+      plan.responses.push_back(name);
+    }
+  }
+
+  // Every key and level against the model, before any run.
+  const std::string model_text = read_model_text(model_path);
+  const YAML::Node model_root = YAML::Load(model_text);
+  const auto check = [&](const SweepFactor& factor, const std::string& level, int line) {
+    std::vector<std::string> settings = plan.settings;
+    try {
+      settings.push_back(factor_setting(factor, level, model_root));
+      const Model model = load_model_text(model_text, model_path, settings);
+      (void)model;
+    } catch (const InputError& e) {
+      throw InputError(SourceLocation{path, line}.prefix() + "factor '" + factor.key + "' at level '" + level + "': " + e.what());
+    }
+  };
+  try {
+    (void)load_model_text(model_text, model_path, plan.settings);
+  } catch (const InputError& e) {
+    yaml_error(path, root["set"], std::string("set: ") + e.what());
+  }
+  for (const SweepFactor& factor : plan.factors) {
+    for (const std::string& level : factor.levels) check(factor, level, factor.line);
+    if (factor.distribution) check(factor, exact(factor.distribution->value_at(0.5)), factor.line);
+  }
+  for (std::size_t r = 0; r < plan.runs.size(); ++r)
+    for (std::size_t f = 0; f < plan.factors.size(); ++f)
+      if (!plan.runs[r][f].empty()) check(plan.factors[f], plan.runs[r][f], plan.run_lines[r]);
+  if (plan.responses.empty()) {
+    const Model model = load_model_text(model_text, model_path, plan.settings);
+    if (model.responses.defined()) plan.responses = {"R1", "R2", "R3"};
+    plan.responses.push_back("energy.relative_balance_error");
+  }
+  return plan;
+}
+
+// ---------------------------------------------------------------- runs
+
+std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_text) {
+  const std::size_t n = plan.factors.size();
+  std::vector<std::vector<std::string>> levels;
+  std::vector<std::size_t> counts;
+  for (const SweepFactor& f : plan.factors) counts.push_back(f.levels.size());
+  switch (plan.design) {
+    case SweepDesignKind::full_factorial:
+      for (const auto& row : full_factorial(counts)) {
+        levels.emplace_back(n);
+        for (std::size_t f = 0; f < n; ++f) levels.back()[f] = plan.factors[f].levels[row[f]];
+      }
+      break;
+    case SweepDesignKind::one_at_a_time:
+      for (const auto& row : one_at_a_time(counts)) {
+        levels.emplace_back(n);
+        for (std::size_t f = 0; f < n; ++f)
+          if (row[f] >= 0) levels.back()[f] = plan.factors[f].levels[static_cast<std::size_t>(row[f])];
+      }
+      break;
+    case SweepDesignKind::latin_hypercube:
+    case SweepDesignKind::monte_carlo: {
+      const auto probabilities = plan.design == SweepDesignKind::latin_hypercube ? latin_hypercube(plan.samples, n, plan.seed)
+                                                                                 : monte_carlo(plan.samples, n, plan.seed);
+      for (const auto& row : probabilities) {
+        levels.emplace_back(n);
+        for (std::size_t f = 0; f < n; ++f) levels.back()[f] = exact(plan.factors[f].distribution->value_at(row[f]));
+      }
+      break;
+    }
+    case SweepDesignKind::runs:
+      levels = plan.runs;
+      break;
+  }
+  const YAML::Node model_root = YAML::Load(model_text);
+  std::vector<SweepRunSpec> specs;
+  for (auto& row : levels) {
+    SweepRunSpec spec;
+    spec.settings = plan.settings;
+    for (std::size_t f = 0; f < n; ++f)
+      if (!row[f].empty()) spec.settings.push_back(factor_setting(plan.factors[f], row[f], model_root));
+    std::uint64_t hash = fnv1a(model_text);
+    for (const std::string& s : spec.settings) hash = fnv1a(s, fnv1a(std::string(1, '\0'), hash));
+    char text[17];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+    spec.hash = text;
+    spec.levels = std::move(row);
+    specs.push_back(std::move(spec));
+  }
+  return specs;
+}
+
+namespace {
+
+/// A value in summary.json by its dotted path; keys may hold dots themselves
+/// ("anticlimber.force"), so the longest key that matches is taken at each level.
+double summary_value(const YAML::Node& node, const std::string& path) {
+  if (path.empty()) {
+    if (!node.IsScalar()) return kNaN;
+    if (node.Scalar() == "true") return 1.0;
+    if (node.Scalar() == "false") return 0.0;
+    try {
+      return node.as<double>();
+    } catch (const YAML::Exception&) {
+      return kNaN;
+    }
+  }
+  if (!node.IsMap()) return kNaN;
+  std::string best;
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    if ((path == key || path.rfind(key + ".", 0) == 0) && key.size() > best.size()) best = key;
+  }
+  if (best.empty()) return kNaN;
+  return summary_value(node[best], path.size() == best.size() ? "" : path.substr(best.size() + 1));
+}
+
+/// COLUMN@TIME: the column interpolated linearly at TIME (NaN outside the samples).
+double column_at(const RunReport& report, const std::string& column, double t) {
+  const auto it = std::find(report.columns.begin(), report.columns.end(), column);
+  if (it == report.columns.end() || report.columns.empty() || report.columns[0] != "t") return kNaN;
+  const std::vector<double>& times = report.series[0];
+  const std::vector<double>& values = report.series[static_cast<std::size_t>(it - report.columns.begin())];
+  const auto upper = std::lower_bound(times.begin(), times.end(), t);
+  if (upper == times.end()) return kNaN;
+  const std::size_t k = static_cast<std::size_t>(upper - times.begin());
+  if (times[k] == t || k == 0) return times[k] == t ? values[k] : kNaN;
+  const double w = (t - times[k - 1]) / (times[k] - times[k - 1]);
+  return values[k - 1] + w * (values[k] - values[k - 1]);
+}
+
+}  // namespace
+
+SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+                        const SweepRunSpec& spec, const RunControl& control, const std::string& run_folder) {
+  SweepRow row;
+  row.responses.assign(plan.responses.size(), kNaN);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const Model model = load_model_text(model_text, model_path, spec.settings);
+    const RunReport report = run_model(model, run_folder, control.stop_flag(), false, true);
+    row.status = report.outcome.ok ? "ok" : "failed";
+    row.message = report.outcome.message;
+    if (!report.outcome.ok && control.timed_out()) row.message = "stopped at the run time limit (t = " + exact(report.outcome.t_reached) + ")";
+    if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
+    const YAML::Node summary = YAML::Load(report.summary_json);
+    for (std::size_t k = 0; k < plan.responses.size(); ++k) {
+      const std::string& name = plan.responses[k];
+      if (const auto at = name.rfind('@'); at != std::string::npos) {
+        try {
+          row.responses[k] = column_at(report, name.substr(0, at), std::stod(name.substr(at + 1)));
+        } catch (const std::exception&) {
+          row.responses[k] = kNaN;
+        }
+      } else {
+        const bool short_name = name == "R1" || name == "R2" || name == "R3";
+        row.responses[k] = summary_value(summary, short_name ? "responses." + name : name);
+      }
+    }
+  } catch (const std::exception& e) {
+    row.status = "failed";
+    row.message = e.what();
+  }
+  row.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return row;
+}
+
+std::string sweep_csv_header(const SweepPlan& plan) {
+  std::string header = "run,hash";
+  for (const SweepFactor& f : plan.factors) header += "," + csv_field(f.column());
+  header += ",status";
+  for (const std::string& r : plan.responses) header += "," + csv_field(r);
+  return header + ",wall_seconds,message";
+}
+
+std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const SweepRunSpec& spec, const SweepRow& row) {
+  std::string line = std::to_string(number) + "," + spec.hash;
+  for (const std::string& level : spec.levels) line += "," + csv_field(level);
+  line += "," + row.status;
+  for (double value : row.responses) line += "," + (std::isnan(value) ? std::string() : exact(value));
+  (void)plan;
+  char wall[32];
+  std::snprintf(wall, sizeof wall, "%.3f", row.wall_seconds);
+  return line + "," + wall + "," + csv_text(row.message);
+}
+
+std::size_t SweepResult::done() const {
+  return static_cast<std::size_t>(std::count_if(lines.begin(), lines.end(), [](const auto& l) { return l.has_value(); }));
+}
+
+SweepResult start_sweep(const SweepPlan& plan, const std::string& model_text, const std::string& directory, bool resume) {
+  SweepResult result;
+  result.specs = sweep_runs(plan, model_text);
+  result.lines.resize(result.specs.size());
+  std::filesystem::create_directories(directory);
+  const std::string csv_path = directory + "/runs.csv";
+  const std::string header = sweep_csv_header(plan);
+  if (resume && std::filesystem::exists(csv_path)) {
+    std::ifstream in(csv_path);
+    std::string line;
+    std::getline(in, line);
+    if (line != header)
+      throw InputError(csv_path + ": its columns are not this plan's (" + line.substr(0, 80) +
+                       "...); resume with the same plan, or write to another --out");
+    std::map<std::string, std::string> by_hash;  // hash -> the fields after the run's levels
+    for (; std::getline(in, line);) {
+      const std::vector<std::string> fields = csv_fields(line);
+      // run, hash, factors..., status, ...: a line cut short by a kill is not a row.
+      if (fields.size() != 2 + plan.factors.size() + 1 + plan.responses.size() + 2) continue;
+      const std::size_t first = line.find(',');
+      by_hash[fields[1]] = line.substr(line.find(',', first + 1) + 1);
+    }
+    for (std::size_t k = 0; k < result.specs.size(); ++k)
+      if (const auto it = by_hash.find(result.specs[k].hash); it != by_hash.end()) {
+        result.lines[k] = std::to_string(k) + "," + result.specs[k].hash + "," + it->second;
+        ++result.resumed;
+      }
+  }
+  std::ofstream out(csv_path);
+  out << header << '\n';
+  for (const auto& line : result.lines)
+    if (line) out << *line << '\n';
+  if (!out) throw InputError(csv_path + ": cannot write (check the --out folder)");
+  return result;
+}
+
+void append_sweep_line(const std::string& directory, const std::string& line) {
+  std::ofstream out(directory + "/runs.csv", std::ios::app);
+  out << line << '\n';
+  out.flush();
+}
+
+SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, const std::string& directory,
+                      const SweepOptions& options) {
+  const std::string model_text = read_model_text(model_path);
+  SweepResult result = start_sweep(plan, model_text, directory, options.resume);
+  std::vector<std::size_t> todo;
+  for (std::size_t k = 0; k < result.specs.size(); ++k)
+    if (!result.lines[k]) todo.push_back(k);
+  std::vector<SweepRow> rows(todo.size());
+  BatchOptions batch;
+  batch.jobs = options.jobs;
+  batch.run_time_limit = options.run_time_limit;
+  batch.stop = options.stop;
+  std::size_t done = result.done();
+  run_batch(
+      todo.size(),
+      [&](std::size_t i, const RunControl& control) {
+        char folder[32];
+        std::snprintf(folder, sizeof folder, "/runs/%04zu", todo[i]);
+        rows[i] = run_sweep_spec(plan, model_path, model_text, result.specs[todo[i]], control,
+                                 options.keep_runs ? directory + folder : "");
+      },
+      batch,
+      [&](std::size_t i, BatchRunState state) {
+        if (state != BatchRunState::finished) return;  // an interrupted run is run again on --resume
+        const std::size_t k = todo[i];
+        result.lines[k] = sweep_csv_line(plan, k, result.specs[k], rows[i]);
+        append_sweep_line(directory, *result.lines[k]);
+        if (options.progress) options.progress(k, rows[i], ++done, result.specs.size());
+      });
+  write_sweep(plan, result, directory);
+  return result;
+}
+
+// ---------------------------------------------------------------- summary
+
+namespace {
+
+double mean(const std::vector<double>& values) {
+  return values.empty() ? kNaN : std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+}
+
+/// Least-squares slope of y on x and the correlation coefficient (NaN with fewer than 2 points
+/// or no spread).
+std::pair<double, double> linear_trend(const std::vector<double>& x, const std::vector<double>& y) {
+  const double mx = mean(x), my = mean(y);
+  double sxx = 0.0, syy = 0.0, sxy = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxx += (x[i] - mx) * (x[i] - mx);
+    syy += (y[i] - my) * (y[i] - my);
+    sxy += (x[i] - mx) * (y[i] - my);
+  }
+  if (x.size() < 2 || sxx == 0.0) return {kNaN, kNaN};
+  return {sxy / sxx, syy > 0.0 ? sxy / std::sqrt(sxx * syy) : kNaN};
+}
+
+const char* design_name(SweepDesignKind kind) {
+  switch (kind) {
+    case SweepDesignKind::full_factorial: return "full factorial";
+    case SweepDesignKind::one_at_a_time: return "one at a time";
+    case SweepDesignKind::latin_hypercube: return "Latin hypercube";
+    case SweepDesignKind::monte_carlo: return "Monte Carlo";
+    case SweepDesignKind::runs: return "explicit runs";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const std::string& directory) {
+  std::filesystem::create_directories(directory);
+  {
+    std::ofstream csv(directory + "/runs.csv");
+    csv << sweep_csv_header(plan) << '\n';
+    for (const auto& line : result.lines)
+      if (line) csv << *line << '\n';
+  }
+  const std::size_t factor_count = plan.factors.size();
+  // Per finished run: the levels and the responses of ok runs.
+  std::vector<std::vector<std::string>> levels;
+  std::vector<std::vector<double>> values;
+  std::size_t failed = 0;
+  for (const auto& line : result.lines) {
+    if (!line) continue;
+    const std::vector<std::string> fields = csv_fields(*line);
+    if (fields[2 + factor_count] != "ok") {
+      ++failed;
+      continue;
+    }
+    levels.emplace_back(fields.begin() + 2, fields.begin() + 2 + static_cast<std::ptrdiff_t>(factor_count));
+    values.emplace_back();
+    for (std::size_t r = 0; r < plan.responses.size(); ++r) {
+      const std::string& text = fields[3 + factor_count + r];
+      values.back().push_back(text.empty() ? kNaN : std::stod(text));
+    }
+  }
+  std::ostringstream md;
+  md << "# Sweep " << plan.path << "\n\n" << design_name(plan.design) << " design, " << result.specs.size() << " runs: "
+     << result.done() << " done (" << result.resumed << " from an earlier runs.csv), " << failed << " failed, "
+     << result.specs.size() - result.done() << " not run. Rows: runs.csv.\n";
+  const bool trend = sampled(plan.design);
+  md << "\n## Main effects\n\n"
+     << (trend ? "Each response's least-squares slope on each factor over the ok runs, the slope times the factor's "
+                 "sampled range (the effect), and the correlation coefficient r.\n"
+               : "Each response's mean over the ok runs at each level of a factor (all other factors as the design "
+                 "sets them); the effect is the largest mean minus the smallest. \"model\" is the model's own value.\n");
+  for (std::size_t r = 0; r < plan.responses.size(); ++r) {
+    md << "\n### " << plan.responses[r] << "\n\n";
+    if (trend) md << "| Factor | slope | effect | r |\n|---|---|---|---|\n";
+    else md << "| Factor | level: mean (runs) | effect |\n|---|---|---|\n";
+    for (std::size_t f = 0; f < factor_count; ++f) {
+      if (trend) {
+        std::vector<double> x, y;
+        for (std::size_t i = 0; i < values.size(); ++i)
+          if (!std::isnan(values[i][r])) {
+            x.push_back(std::stod(levels[i][f]));
+            y.push_back(values[i][r]);
+          }
+        const auto [slope, correlation] = linear_trend(x, y);
+        const double range = x.empty() ? kNaN : *std::max_element(x.begin(), x.end()) - *std::min_element(x.begin(), x.end());
+        md << "| " << plan.factors[f].column() << " | " << table_number(slope, "%.4g") << " | "
+           << table_number(slope * range, "%.4g") << " | " << table_number(correlation, "%.3f") << " |\n";
+        continue;
+      }
+      std::vector<std::string> order;  // levels in the order the runs first use them
+      std::map<std::string, std::vector<double>> by_level;
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        if (std::isnan(values[i][r])) continue;
+        const std::string level = levels[i][f].empty() ? "model" : levels[i][f];
+        if (!by_level.count(level)) order.push_back(level);
+        by_level[level].push_back(values[i][r]);
+      }
+      std::string cells;
+      double low = kNaN, high = kNaN;
+      for (const std::string& level : order) {
+        const double m = mean(by_level[level]);
+        cells += (cells.empty() ? "" : "; ") + level + ": " + table_number(m, "%.4g") + " (" +
+                 std::to_string(by_level[level].size()) + ")";
+        low = std::isnan(low) ? m : std::min(low, m);
+        high = std::isnan(high) ? m : std::max(high, m);
+      }
+      md << "| " << plan.factors[f].column() << " | " << cells << " | " << table_number(high - low, "%.4g") << " |\n";
+    }
+  }
+  std::ofstream(directory + "/summary.md") << md.str();
+  return md.str();
+}
+
+}  // namespace railcrash

@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# `railcrash sweep` from the command line: plan errors exit 2 before any run; 1 job, 2 jobs
+# and (given MPIRUN) `mpirun -np 3` write the same runs.csv (wall_seconds aside); --resume
+# after a SIGTERM mid-sweep (threads, and mpirun -np 2) writes the same file as an uninterrupted sweep.
+# Usage: test_sweep.sh RAILCRASH_BINARY [MPIRUN]
+set -u
+bin=$1
+mpirun=${2:-}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+passes=0
+
+pass() { passes=$((passes + 1)); }
+fail() { echo "FAIL: $1"; failures=$((failures + 1)); }
+# runs.csv without the wall_seconds column (the last but one; the message is quoted, no commas inside here).
+untimed() { awk -F, 'BEGIN { OFS = "," } { $(NF - 1) = ""; print }' "$1"; }
+same_rows() {  # description file expected-file
+  if [ -f "$2" ] && diff <(untimed "$2") <(untimed "$3") > "$tmp/diff"; then pass; else fail "$1"; sed 's/^/  | /' "$tmp/diff" | head; fi
+}
+
+# A 1000 kg car at 2 m/s into an anticlimber against the ground (tests/support.cpp's R1 model).
+cat > "$tmp/model.yaml" <<'YAML'
+railcrash: 1
+name: r1
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: car, mass: 1000, inertia: 100, position: [0.1, 0], velocity: [-2, 0]}
+elements:
+  - name: ac
+    type: anticlimber
+    horizontal_elastic_stiffness: 1.0e7
+    horizontal_plastic_stiffness: 1.0e5
+    horizontal_yield_deflection: 0.01
+    vertical_elastic_stiffness: 1.0e6
+    vertical_plastic_stiffness: 1.0e4
+    vertical_yield_deflection: 0.01
+    torsional_elastic_stiffness: 1.0e6
+    torsional_plastic_stiffness: 1.0e4
+    torsional_yield_deflection: 0.01
+    face_height: 0.1
+    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]
+responses: {crush: anticlimber, reference_crush: 0.02, anticlimber: ac, reference_velocity: 4.0}
+simulation: {t_end: 0.15, rtol: 1e-8, output_interval: 0.0005}
+YAML
+cat > "$tmp/plan.yaml" <<'YAML'
+sweep: 1
+design: latin_hypercube
+samples: 12
+seed: 3
+factors:
+  - key: elements.ac.horizontal_yield_deflection
+    distribution: {uniform: [0.006, 0.014]}
+  - key: bodies.car.velocity[0]
+    distribution: {normal: [-2, 0.2]}
+responses: [R1, responses.max_anticlimber_crush, car.x@0.01]
+YAML
+
+# Plan errors: exit 2, file:line, before any run (no runs.csv).
+printf 'sweep: 1\ndesign: full_factorial\nfactors:\n  - {key: elements.ac.stiffnes, levels: [1]}\n' > "$tmp/bad_key.yaml"
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/bad_key.yaml" --out "$tmp/bad" > /dev/null 2> "$tmp/stderr"
+status=$?
+if [ $status -eq 2 ] && grep -q "bad_key.yaml:4: factor 'elements.ac.stiffnes'" "$tmp/stderr" && [ ! -e "$tmp/bad/runs.csv" ]; then pass
+else fail "unknown key: status $status, $(cat "$tmp/stderr")"; fi
+printf 'sweep: 1\ndesign: one_at_a_time\nfactors:\n  - key: simulation.t_end\n    levels: [0.1, fast]\n' > "$tmp/bad_level.yaml"
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/bad_level.yaml" --out "$tmp/bad" > /dev/null 2> "$tmp/stderr"
+status=$?
+if [ $status -eq 2 ] && grep -q "bad_level.yaml:4: factor 'simulation.t_end' at level 'fast'" "$tmp/stderr"; then pass
+else fail "wrong level type: status $status, $(cat "$tmp/stderr")"; fi
+printf 'sweep: 1\ndesign: latin_hypercube\nsamples: 0\nfactors:\n  - {key: simulation.t_end, distribution: {uniform: [0.1, 0.2]}}\n' > "$tmp/empty.yaml"
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/empty.yaml" --out "$tmp/bad" > /dev/null 2> "$tmp/stderr"
+status=$?
+if [ $status -eq 2 ] && grep -q "empty.yaml:3: .*the design is empty" "$tmp/stderr"; then pass
+else fail "empty design: status $status, $(cat "$tmp/stderr")"; fi
+
+# 1 job (the reference), 2 jobs.
+if "$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --jobs 1 --out "$tmp/one" > /dev/null 2>&1; then pass; else fail "sweep with 1 job"; fi
+if [ "$(wc -l < "$tmp/one/runs.csv")" -eq 13 ] && ! grep -q ',failed,' "$tmp/one/runs.csv"; then pass; else fail "12 ok rows"; cat "$tmp/one/runs.csv"; fi
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --jobs 2 --out "$tmp/two" > /dev/null 2>&1
+same_rows "2 jobs give the rows of 1 job" "$tmp/two/runs.csv" "$tmp/one/runs.csv"
+if grep -q "Main effects" "$tmp/one/summary.md"; then pass; else fail "summary.md has main effects"; fi
+
+# SIGTERM mid-sweep keeps the finished rows; --resume runs the rest. Longer runs (about 0.2 s
+# each, 40 of them) so that the signal comes mid-sweep.
+sed -e 's/^samples: 12/samples: 40/' -e 's/^seed: 3/seed: 3\nset: [simulation.output_interval=0.000003, simulation.rtol=1e-10]/' \
+  "$tmp/plan.yaml" > "$tmp/slow.yaml"
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --out "$tmp/whole" > /dev/null 2>&1
+interrupt_and_resume() {  # description folder command-prefix...: SIGTERM once 3 rows are written, then --resume
+  local description=$1 folder=$2
+  shift 2
+  "$@" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 1 --out "$folder" > "$folder.out" 2>&1 &
+  local pid=$!
+  for _ in $(seq 1 400); do  # until 3 rows are written (header + 3)
+    [ -f "$folder/runs.csv" ] && [ "$(wc -l < "$folder/runs.csv")" -ge 4 ] && break
+    sleep 0.05
+  done
+  kill -TERM $pid
+  wait $pid
+  local status=$?
+  local rows=$(($(wc -l < "$folder/runs.csv") - 1))
+  if [ $status -ne 0 ] && [ $rows -ge 3 ] && [ $rows -lt 40 ]; then pass
+  else fail "$description: SIGTERM: status $status with $rows rows (expected failure with 3-39)"; fi
+  "$@" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --resume --out "$folder" > "$folder.resume" 2>&1
+  if grep -q "($rows resumed)" "$folder.resume"; then pass; else fail "$description: resume keeps the $rows rows: $(cat "$folder.resume")"; fi
+  same_rows "$description: --resume after SIGTERM gives the uninterrupted file" "$folder/runs.csv" "$tmp/whole/runs.csv"
+}
+interrupt_and_resume "threads" "$tmp/cut"
+
+if [ -n "$mpirun" ]; then
+  # CI runs as root on 2 cores: allow root, oversubscribe, and yield when idle.
+  # OpenMPI keeps some allocations to the end of the process: no leak report in a sanitizer build.
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1 ASAN_OPTIONS=detect_leaks=0
+  interrupt_and_resume "mpirun -np 2" "$tmp/mpi_cut" "$mpirun" --oversubscribe -np 2
+  if "$mpirun" --oversubscribe -np 3 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --out "$tmp/mpi" > "$tmp/mpi.out" 2>&1; then pass
+  else fail "mpirun -np 3: $(tail -5 "$tmp/mpi.out")"; fi
+  same_rows "mpirun -np 3 gives the rows of 1 job" "$tmp/mpi/runs.csv" "$tmp/one/runs.csv"
+  "$mpirun" --oversubscribe -np 2 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/bad_key.yaml" --out "$tmp/bad" > /dev/null 2> "$tmp/stderr"
+  status=$?
+  if [ $status -eq 2 ] && [ "$(grep -c "bad_key.yaml:4:" "$tmp/stderr")" -eq 1 ]; then pass
+  else fail "mpirun with a bad plan: status $status, $(cat "$tmp/stderr")"; fi
+fi
+
+echo "$passes passed, $failures failed"
+[ $failures -eq 0 ]
