@@ -91,7 +91,7 @@ YAML::Node point_on(const std::string& body, double x, double y) {
 std::string make_consist_model(const std::string& template_path, int cars_per_consist) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(template_path);
+    root = load_yaml_file(template_path, "consist template");
   } catch (const YAML::Exception& e) {
     throw InputError(template_path + ": cannot read the consist template: " + e.what());
   }

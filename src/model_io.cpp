@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "railcrash/element_registry.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -312,7 +313,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
   const std::string key = setting.substr(0, equals);
   YAML::Node value;
   try {
-    value = YAML::Load(setting.substr(equals + 1));
+    value = load_yaml_text(setting.substr(equals + 1), label);
   } catch (const YAML::Exception& e) {
     throw InputError(where + "the value is not valid YAML (" + e.msg + ")");
   }
@@ -802,7 +803,7 @@ namespace {
 
 YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
   try {
-    return YAML::Load(text);
+    return load_yaml_text(text, path);
   } catch (const YAML::ParserException& e) {
     const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
     // A ']' or '}' left out is noticed only where the next thing starts (often the next

@@ -714,6 +714,16 @@ TEST_CASE("elements need the right points and a usable axis", "[model_io]") {
   expect_error("coincident spring points", text, line_of(text, "- name: spring"), {"linear_spring 'spring'", "coincide"});
 }
 
+TEST_CASE("a joint with all its points on one body or on ground is refused at load", "[model_io]") {
+  const std::string slide_points = "points: [{body: ground, at: [0, 0]}, {body: cart, at: [0, 0]}]";
+  std::string text = edit(kBase, slide_points, "points: [{body: cart, at: [0, 0]}, {body: cart, at: [1, 0]}]");
+  expect_error("joint from a body to itself", text, line_of(text, "- name: slide"),
+               {"joint 'slide' (slider_joint) has all its points on one body", "constrains nothing"});
+  text = edit(kBase, slide_points, "points: [{body: ground, at: [0, 0]}, {body: ground, at: [1, 0]}]");
+  expect_error("joint from ground to ground", text, line_of(text, "- name: slide"),
+               {"joint 'slide' (slider_joint) has all its points on ground", "two different bodies"});
+}
+
 TEST_CASE("tabulated loads need strictly increasing times", "[model_io]") {
   std::string text = edit(kBase, "      - [3.0, -10.0]\n", "      - [1.0, -10.0]\n");
   expect_error("repeated time", text, line_of(text, "- [1.0, -10.0]"),
