@@ -14,11 +14,11 @@ namespace railcrash {
 /// Limits on what a YAML input may expand to: aliases (*name) are counted as the values they
 /// stand for, so an alias "billion laughs" or an alias inside its own anchor is refused before
 /// anything walks the nodes.
-constexpr std::size_t kYamlMaxExpandedNodes = 2000000;  // [values] after alias expansion
-constexpr std::size_t kYamlMaxDepth = 64;               // [levels] of nested lists and maps
+constexpr std::size_t kYamlMaxAliasedNodes = 2000000;  // [values] that aliases may add beyond the text's size
+constexpr std::size_t kYamlMaxDepth = 64;              // [levels] of nested lists and maps
 
 /// Throws InputError "path:line: ..." if `text` nests deeper than kYamlMaxDepth, expands to more
-/// than kYamlMaxExpandedNodes values, or has an alias inside the node it refers to. Parse
+/// than kYamlMaxAliasedNodes + (its size in bytes) values, or has an alias inside the node it refers to. Parse
 /// errors are thrown as YAML::ParserException (with their mark), as YAML::Load does.
 void check_yaml_structure(const std::string& text, const std::string& path);
 
