@@ -55,6 +55,10 @@ void apply_overrides(Model& model, const RunOverrides& o) {
   if (o.dt) s.dt = checked_positive(*o.dt, "--dt");
   if (o.output_interval) s.output_interval = checked_positive(*o.output_interval, "--output-interval");
   if (o.force_dt) s.force_dt = true;
+  if (o.max_steps) {
+    if (*o.max_steps < 1) throw InputError("--max-steps must be at least 1, not " + std::to_string(*o.max_steps));
+    s.max_steps = *o.max_steps;
+  }
 }
 
 double output_interval_of(const SimulationSettings& settings) {
@@ -63,10 +67,12 @@ double output_interval_of(const SimulationSettings& settings) {
 
 std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const SimulationSettings& settings) {
   if (settings.integrator == IntegratorKind::Euler)
-    return std::make_unique<EulerIntegrator>(system, EulerSettings{settings.dt, settings.force_dt, settings.penalty});
+    return std::make_unique<EulerIntegrator>(system,
+                                             EulerSettings{settings.dt, settings.force_dt, settings.penalty, settings.max_steps});
   IdaSettings ida;
   ida.rtol = settings.rtol;
   ida.atol = settings.atol;
+  ida.max_steps = settings.max_steps;
   return std::make_unique<IdaIntegrator>(system, ida);
 }
 

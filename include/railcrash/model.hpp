@@ -99,6 +99,7 @@ struct SimulationSettings {
   bool force_dt = false;            // euler: accept a step above the stability limit
   bool static_equilibrium = false;  // settle the bodies under gravity and loads at t = 0 first
   Element::PenaltyOverrides penalty;  // euler: model-wide penalty settings
+  long max_steps = 10000000;        // [steps] either integrator may take; the run fails beyond (run --max-steps)
 };
 
 struct ScenarioCriteria;  // scenario/criteria.hpp
