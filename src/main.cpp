@@ -117,6 +117,7 @@ int report_command(const std::string& run_dir, double cfc) {
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
                 const std::string& out_dir, bool with_report, bool quiet) {
   using namespace railcrash;
+  if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   Model model = load_model(path, settings);
   apply_overrides(model, overrides);
   std::signal(SIGINT, on_interrupt);

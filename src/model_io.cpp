@@ -683,6 +683,8 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   s.atol = positive("atol");
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
+  const std::string rows_problem = output_rows_problem(s);
+  if (!rows_problem.empty()) r.fail(node["output_interval"], "simulation: " + rows_problem);
   if (node["force_dt"]) s.force_dt = r.boolean(node["force_dt"], "simulation: force_dt");
   if (node["static_equilibrium"])
     s.static_equilibrium = r.boolean(node["static_equilibrium"], "simulation: static_equilibrium");

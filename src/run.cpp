@@ -55,6 +55,9 @@ void apply_overrides(Model& model, const RunOverrides& o) {
   if (o.dt) s.dt = checked_positive(*o.dt, "--dt");
   if (o.output_interval) s.output_interval = checked_positive(*o.output_interval, "--output-interval");
   if (o.force_dt) s.force_dt = true;
+  const std::string rows_problem = output_rows_problem(s);
+  if (!rows_problem.empty())
+    throw InputError(SourceLocation{model.file, 0}.prefix() + "--output-interval / --t-end: " + rows_problem);
   if (o.max_steps) {
     if (*o.max_steps < 1) throw InputError("--max-steps must be at least 1, not " + std::to_string(*o.max_steps));
     s.max_steps = *o.max_steps;

@@ -102,6 +102,13 @@ struct SimulationSettings {
   long max_steps = 10000000;        // [steps] either integrator may take; the run fails beyond (run --max-steps)
 };
 
+/// The most output rows a run may write: t_end / output_interval above it is refused.
+constexpr double kMaxOutputRows = 1e6;  // [rows]
+
+/// Why the settings' output rows exceed kMaxOutputRows ("" when they do not), with the figure
+/// and the smallest output_interval that fits.
+std::string output_rows_problem(const SimulationSettings& settings);
+
 struct ScenarioCriteria;  // scenario/criteria.hpp
 
 class Model {
