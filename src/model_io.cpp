@@ -296,6 +296,9 @@ bool apply_scaling(YAML::Node& root, const std::string& setting, const std::stri
   } catch (const YAML::Exception&) {
     throw InputError(where + "'" + holder[key].Scalar() + "' is not a number");
   }
+  if (value == 0.0 && factor != 1.0)
+    throw ZeroScaledError(where + "'" + setting.substr(0, star) + "' is 0 in the model, so a factor changes nothing; "
+                     "set a value with KEY=VALUE instead (or leave this parameter out)");
   char text[40];
   std::snprintf(text, sizeof text, "%.17g", value * factor);
   holder[key] = std::string(text);
