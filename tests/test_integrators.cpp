@@ -169,6 +169,19 @@ TEST_CASE("IDA stops at max_steps as a failed run that says so", "[integrators]"
   CHECK(outcome.stats.steps <= 20);
 }
 
+TEST_CASE("a run whose element output is not finite fails naming the element", "[integrators]") {
+  // The point at 1e308 is 2.7e308 from the circle's centre: the penetration overflows to -inf
+  // while the contact stays open (no force, so the motion itself stays finite).
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: far\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: ball, mass: 2, inertia: 0.1, position: [1.0e308, 0], velocity: [1, 0]}\nelements:\n"
+      "  - {name: bump, type: contact, circle_center: [-1.7e308, 0], circle_radius: 1, stiffness: 1.0e6, "
+      "points: [{body: ball, at: [0, 0]}]}\nsimulation: {t_end: 0.1, output_interval: 0.01}\n");
+  const RunReport report = run_model(model, "", nullptr, false);
+  CHECK_FALSE(report.outcome.ok);
+  CHECK_THAT(report.outcome.message, Catch::Contains("element 'bump' (contact): its output 'penetration' is -inf at t = 0"));
+}
+
 TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
   const Model model = testing::model_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
   const DaeSystem system(model);
