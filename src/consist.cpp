@@ -3,7 +3,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -88,10 +91,34 @@ YAML::Node point_on(const std::string& body, double x, double y) {
 
 }  // namespace
 
+double available_memory_bytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kilobytes = 0.0;
+  while (meminfo >> key >> kilobytes) {
+    if (key == "MemAvailable:") return kilobytes * 1024.0;
+    meminfo.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+void check_consist_memory(const std::string& template_path, int cars_per_consist, double available_bytes) {
+  const double needed = 2.0 * cars_per_consist * kConsistBytesPerCar;  // [bytes]
+  if (needed <= available_bytes) return;
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << template_path << ": consist: " << cars_per_consist << " + " << cars_per_consist << " cars would need about "
+      << needed / 1e9 << " GB of memory (" << kConsistBytesPerCar / 1e6 << " MB per car) and " << available_bytes / 1e9
+      << " GB are available; use --cars " << std::max(1, static_cast<int>(available_bytes / (2.0 * kConsistBytesPerCar)))
+      << " or fewer";
+  throw InputError(msg.str());
+}
+
 std::string make_consist_model(const std::string& template_path, int cars_per_consist) {
+  if (cars_per_consist >= 1) check_consist_memory(template_path, cars_per_consist, available_memory_bytes());
   YAML::Node root;
   try {
-    root = YAML::LoadFile(template_path);
+    root = load_yaml_file(template_path, "consist template");
   } catch (const YAML::Exception& e) {
     throw InputError(template_path + ": cannot read the consist template: " + e.what());
   }

@@ -51,6 +51,13 @@ void Element::bind_bodies() {
     }
     point_slot_[p] = slot;
   }
+  // A joint whose points all lie on one body (or all on ground) constrains nothing: its
+  // constraint rows are identically zero and the system would be singular.
+  if (constraint_count() > 0 && used < 2) {
+    const std::string body = slot_body_[0] == kGround ? std::string("ground") : "one body";
+    throw InputError(where_.prefix() + "joint '" + name_ + "' (" + type_ + ") has all its points on " + body +
+                     ", so it constrains nothing; give its points on two different bodies (or one body and ground)");
+  }
 }
 
 void Element::constraint_gradient(const std::array<Pose<double>, 2>&, double*, double[kMaxConstraintRows][6]) const {

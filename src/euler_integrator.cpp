@@ -110,6 +110,23 @@ PenaltyRows EulerIntegrator::make_penalty(double dt) const {
   return rows;
 }
 
+namespace {
+
+/// Refuses a step dt that needs more than max_steps steps to reach the model's t_end.
+void check_step_count(const Model& model, double dt, long max_steps) {
+  const double steps_needed = std::ceil(model.simulation.t_end / dt - 1e-9);  // [steps], a double: never overflows
+  if (!(steps_needed <= static_cast<double>(max_steps))) {
+    std::ostringstream msg;
+    msg << SourceLocation{model.file, 0}.prefix() << "explicit Euler with dt = " << dt << " needs " << steps_needed
+        << " steps to reach t_end = " << model.simulation.t_end << ", more than --max-steps " << max_steps
+        << "; use a larger dt (above " << model.simulation.t_end / static_cast<double>(max_steps)
+        << "), a shorter t_end, or raise --max-steps";
+    throw InputError(msg.str());
+  }
+}
+
+}  // namespace
+
 EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings)
     : system_(system), settings_(settings) {
   const Model& model = system.model();
@@ -126,6 +143,7 @@ EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings
   if (settings_.dt < 0.0 || !std::isfinite(settings_.dt)) throw InputError("dt must be a positive step (or 0 for automatic)");
   if (settings_.dt > 0.0) {
     dt_ = settings_.dt;
+    check_step_count(model, dt_, settings_.max_steps);  // before penalties sized for a dt that cannot run
     penalty_ = make_penalty(dt_);
     stability_limit_ = estimate_stability_limit(system, y0_, &penalty_);
   } else {
@@ -147,6 +165,7 @@ EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings
         << " (e.g. --dt " << 0.5 * stability_limit_ << "), or --force-dt to run anyway";
     throw InputError(msg.str());
   }
+  check_step_count(model, dt_, settings_.max_steps);
 }
 
 RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserver& observer,
@@ -203,15 +222,27 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
   observer.sample(0.0, y.data(), y_lambda, quad.data());
   outcome.max_constraint_residual = system_.constraint_residual(q);
 
-  const long total_steps = static_cast<long>(std::ceil(t_end / dt_ - 1e-9));
+  // The loop runs on time: step k ends at k dt (no drift), the last one at t_end exactly; the
+  // step count is bounded by max_steps, so it never overflows.
   long output_index = 1;
   double t = 0.0;
-  for (long step = 1; step <= total_steps; ++step) {
+  long step = 0;
+  while (t < t_end) {
     if (stop && stop->load()) {
       outcome.message = "interrupted at t = " + std::to_string(t);
       break;
     }
-    const double h = (step == total_steps) ? t_end - t : dt_;
+    if (step >= settings_.max_steps) {
+      std::ostringstream msg;
+      msg << "stopped at t = " << t << " after --max-steps " << settings_.max_steps << " steps of dt = " << dt_
+          << ", before t_end = " << t_end << "; use a larger dt or raise --max-steps";
+      outcome.message = msg.str();
+      break;
+    }
+    ++step;
+    const bool last = static_cast<double>(step) >= t_end / dt_ - 1e-9;
+    const double t_next = last ? t_end : static_cast<double>(step) * dt_;
+    const double h = t_next - t;
     system_.generalized_forces(t, q, v, force.data(), &penalty_, lambda.data());
     system_.quadrature_rates(t, y.data(), rates.data(), lambda.data());
     for (int k = 0; k < nquad; ++k) quad[static_cast<std::size_t>(k)] += h * rates[static_cast<std::size_t>(k)];
@@ -219,7 +250,7 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
       v[k] += h * force[static_cast<std::size_t>(k)] * inverse_mass[static_cast<std::size_t>(k)];
       q[k] += h * v[k];
     }
-    t = (step == total_steps) ? t_end : static_cast<double>(step) * dt_;
+    t = t_next;
     ++outcome.stats.steps;
     outcome.stats.residual_evaluations += 1;
     if (root_count > 0) {
@@ -253,14 +284,14 @@ RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserve
       outcome.message = msg.str();
       break;
     }
-    if (t >= std::min(t_end, static_cast<double>(output_index) * output_interval) * (1.0 - 1e-12) || step == total_steps) {
+    if (t >= std::min(t_end, static_cast<double>(output_index) * output_interval) * (1.0 - 1e-12) || last) {
       std::copy(lambda.begin(), lambda.end(), y_lambda);
       observer.sample(t, y.data(), y_lambda, quad.data());
       outcome.max_constraint_residual = std::max(outcome.max_constraint_residual, system_.constraint_residual(q));
       while (static_cast<double>(output_index) * output_interval <= t * (1.0 + 1e-12)) ++output_index;
     }
   }
-  outcome.ok = outcome.message.empty();
+  outcome.ok = outcome.message.empty() && t >= t_end;  // a run that did not reach t_end is never ok
   outcome.t_reached = t;
   outcome.y = y;
   outcome.quadratures = quad;

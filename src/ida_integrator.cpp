@@ -464,9 +464,17 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
         if (t_out >= t_end) break;
       }
     };
+    long steps_taken = 0;  // IDASolve calls (steps and restarts) in this run
     while (t_reached < t_end) {
       if (stop && stop->load()) {
         outcome.message = "interrupted at t = " + std::to_string(t_sampled);
+        break;
+      }
+      if (steps_taken++ >= settings_.max_steps) {
+        std::ostringstream msg;
+        msg << "stopped at t = " << t_reached << " after --max-steps " << settings_.max_steps << " steps, before t_end = "
+            << t_end << " (the model is stiff there or its tolerances are tight); raise --max-steps or check the model";
+        outcome.message = msg.str();
         break;
       }
       double t_n = t_reached;
@@ -603,7 +611,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
       double t_quad = t_reached;
       IDAGetQuad(impl.ida, &t_quad, impl.quad);  // on failure impl.quad keeps the last known values
     }
-    outcome.ok = outcome.message.empty();
+    outcome.ok = outcome.message.empty() && t_reached >= t_end;  // a run that did not reach t_end is never ok
     if (outcome.ok) {
       outcome.t_reached = t_reached;
       outcome.y.assign(y, y + n);

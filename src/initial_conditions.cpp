@@ -81,7 +81,7 @@ void check_constraint_rank(const DaeSystem& system, const double* q) {
     involved.push_back(permutation(k));
     const Eigen::VectorXd column = Eigen::VectorXd(r.block(0, k, rank, 1));
     const Eigen::VectorXd weights = r11.triangularView<Eigen::Upper>().solve(column);
-    const double largest = weights.cwiseAbs().maxCoeff();
+    const double largest = weights.size() > 0 ? weights.cwiseAbs().maxCoeff() : 0.0;  // rank 0: no leading rows
     for (int i = 0; i < rank; ++i)
       if (std::abs(weights[i]) > 1e-8 * largest) involved.push_back(permutation(i));
   }

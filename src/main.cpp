@@ -117,6 +117,7 @@ int report_command(const std::string& run_dir, double cfc) {
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
                 const std::string& out_dir, bool with_report, bool quiet) {
   using namespace railcrash;
+  if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   Model model = load_model(path, settings);
   apply_overrides(model, overrides);
   std::signal(SIGINT, on_interrupt);
@@ -351,6 +352,11 @@ int main(int argc, char** argv) {
   CLI::Option* dt_option = run->add_option("--dt", dt, "euler step");
   CLI::Option* output_option = run->add_option("--output-interval", output_interval, "time between output rows");
   run->add_flag("--force-dt", overrides.force_dt, "euler: run even above the stability limit");
+  long max_steps = railcrash::SimulationSettings{}.max_steps;
+  CLI::Option* max_steps_option =
+      run->add_option("--max-steps", max_steps, "steps either integrator may take; euler refuses a dt that needs more, "
+                                                "ida stops there (a failed run)")
+          ->capture_default_str();
   run->add_option("--out", out_dir, "output folder")->capture_default_str();
   run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
   bool with_report = false;
@@ -532,6 +538,7 @@ int main(int argc, char** argv) {
     if (*atol_option) overrides.atol = atol;
     if (*dt_option) overrides.dt = dt;
     if (*output_option) overrides.output_interval = output_interval;
+    if (*max_steps_option) overrides.max_steps = max_steps;
     return run_command(model_path, settings, overrides, out_dir, with_report, quiet);
   } catch (const railcrash::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace railcrash {
 
@@ -21,6 +22,17 @@ std::array<double, 2> TimeTable::at(double t) const {
   std::array<double, 2> out{};
   for (std::size_t c = 0; c < 2; ++c) out[c] = (1.0 - w) * values[i - 1][c] + w * values[i][c];
   return out;
+}
+
+std::string output_rows_problem(const SimulationSettings& settings) {
+  if (!(settings.output_interval > 0.0)) return "";  // the default, t_end / 500
+  const double rows = settings.t_end / settings.output_interval;  // [rows]
+  if (rows <= kMaxOutputRows) return "";
+  std::ostringstream msg;
+  msg << "output_interval " << settings.output_interval << " with t_end " << settings.t_end << " gives " << rows
+      << " output rows, more than the limit " << kMaxOutputRows << "; use output_interval >= "
+      << settings.t_end / kMaxOutputRows;
+  return msg.str();
 }
 
 void Model::require_editable(const char* what) const {

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "railcrash/element_registry.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -295,6 +296,9 @@ bool apply_scaling(YAML::Node& root, const std::string& setting, const std::stri
   } catch (const YAML::Exception&) {
     throw InputError(where + "'" + holder[key].Scalar() + "' is not a number");
   }
+  if (value == 0.0 && factor != 1.0)
+    throw ZeroScaledError(where + "'" + setting.substr(0, star) + "' is 0 in the model, so a factor changes nothing; "
+                     "set a value with KEY=VALUE instead (or leave this parameter out)");
   char text[40];
   std::snprintf(text, sizeof text, "%.17g", value * factor);
   holder[key] = std::string(text);
@@ -312,7 +316,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
   const std::string key = setting.substr(0, equals);
   YAML::Node value;
   try {
-    value = YAML::Load(setting.substr(equals + 1));
+    value = load_yaml_text(setting.substr(equals + 1), label);
   } catch (const YAML::Exception& e) {
     throw InputError(where + "the value is not valid YAML (" + e.msg + ")");
   }
@@ -682,6 +686,8 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   s.atol = positive("atol");
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
+  const std::string rows_problem = output_rows_problem(s);
+  if (!rows_problem.empty()) r.fail(node["output_interval"], "simulation: " + rows_problem);
   if (node["force_dt"]) s.force_dt = r.boolean(node["force_dt"], "simulation: force_dt");
   if (node["static_equilibrium"])
     s.static_equilibrium = r.boolean(node["static_equilibrium"], "simulation: static_equilibrium");
@@ -802,7 +808,7 @@ namespace {
 
 YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
   try {
-    return YAML::Load(text);
+    return load_yaml_text(text, path);
   } catch (const YAML::ParserException& e) {
     const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
     // A ']' or '}' left out is noticed only where the next thing starts (often the next

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/ida_integrator.hpp"
@@ -22,15 +23,34 @@ double checked_positive(double value, const char* option) {
 
 /// Forwards samples to the writer and the response tracker (if any) and shows progress
 /// (progress.hpp: a bar on a terminal, a line every few seconds otherwise).
+/// Also checks every sample's element outputs: the first non-finite one fails the run.
 class ProgressObserver : public RunObserver {
  public:
-  ProgressObserver(std::vector<RunObserver*> next, double t_end, bool show)
-      : next_(std::move(next)), meter_(t_end, ProgressMeter::style_for(show, stderr)) {}
+  ProgressObserver(const DaeSystem& system, std::vector<RunObserver*> next, double t_end, bool show)
+      : system_(system), next_(std::move(next)), meter_(t_end, ProgressMeter::style_for(show, stderr)) {
+    for (const auto& el : system.model().elements())
+      for (const std::string& output : el->output_names()) output_owner_.push_back({el.get(), output});
+    output_values_.resize(output_owner_.size());
+  }
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
     for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures);
     meter_.update(t);
     t_last_ = t;
+    if (!non_finite_output_.empty()) return;
+    system_.outputs(y, lambda, output_values_.data());
+    for (std::size_t k = 0; k < output_values_.size(); ++k)
+      if (!std::isfinite(output_values_[k])) {
+        const Element& el = *output_owner_[k].first;
+        std::ostringstream msg;
+        msg << el.where().prefix() << "element '" << el.name() << "' (" << el.type() << "): its output '"
+            << output_owner_[k].second << "' is " << output_values_[k] << " at t = " << t
+            << "; check the element's numbers (a value too large or too small)";
+        non_finite_output_ = msg.str();
+        break;
+      }
   }
+  /// Why the outputs were not all finite ("" when they were).
+  const std::string& non_finite_output() const { return non_finite_output_; }
 
   void event(const EventRecord& record, const double* y) override {
     for (RunObserver* o : next_) o->event(record, y);
@@ -39,8 +59,12 @@ class ProgressObserver : public RunObserver {
   void finish() { meter_.finish(t_last_); }
 
  private:
+  const DaeSystem& system_;
   std::vector<RunObserver*> next_;
   ProgressMeter meter_;
+  std::vector<std::pair<const Element*, std::string>> output_owner_;  // element and output of each value
+  std::vector<double> output_values_;
+  std::string non_finite_output_;
   double t_last_ = 0.0;
 };
 
@@ -55,6 +79,13 @@ void apply_overrides(Model& model, const RunOverrides& o) {
   if (o.dt) s.dt = checked_positive(*o.dt, "--dt");
   if (o.output_interval) s.output_interval = checked_positive(*o.output_interval, "--output-interval");
   if (o.force_dt) s.force_dt = true;
+  const std::string rows_problem = output_rows_problem(s);
+  if (!rows_problem.empty())
+    throw InputError(SourceLocation{model.file, 0}.prefix() + "--output-interval / --t-end: " + rows_problem);
+  if (o.max_steps) {
+    if (*o.max_steps < 1) throw InputError("--max-steps must be at least 1, not " + std::to_string(*o.max_steps));
+    s.max_steps = *o.max_steps;
+  }
 }
 
 double output_interval_of(const SimulationSettings& settings) {
@@ -63,10 +94,12 @@ double output_interval_of(const SimulationSettings& settings) {
 
 std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const SimulationSettings& settings) {
   if (settings.integrator == IntegratorKind::Euler)
-    return std::make_unique<EulerIntegrator>(system, EulerSettings{settings.dt, settings.force_dt, settings.penalty});
+    return std::make_unique<EulerIntegrator>(system,
+                                             EulerSettings{settings.dt, settings.force_dt, settings.penalty, settings.max_steps});
   IdaSettings ida;
   ida.rtol = settings.rtol;
   ida.atol = settings.atol;
+  ida.max_steps = settings.max_steps;
   return std::make_unique<IdaIntegrator>(system, ida);
 }
 
@@ -83,11 +116,15 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
   std::unique_ptr<ScenarioTracker> scenario;
   if (model.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *model.scenario)).get());
-  ProgressObserver observer(observers, model.simulation.t_end, show_progress);
+  ProgressObserver observer(system, observers, model.simulation.t_end, show_progress);
   RunReport report;
   report.integrator = integrator->name();
   report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
   observer.finish();
+  if (report.outcome.ok && !observer.non_finite_output().empty()) {
+    report.outcome.ok = false;
+    report.outcome.message = observer.non_finite_output();
+  }
   if (responses) {
     report.responses = responses->result();
     report.has_responses = true;

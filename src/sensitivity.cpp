@@ -189,6 +189,22 @@ struct Job {
 
 // model_text: the model file as read once at the start of the study, so that every run sees the
 // same model even if the file is edited while the study runs.
+/// The settings of a job's run: the study's own, then the job's parameter factors as KEY*=FACTOR.
+std::vector<std::string> job_settings(const SensitivityDesign& design, const Job& job,
+                                      const std::vector<std::string>& base_settings) {
+  std::vector<std::string> settings = base_settings;
+  for (const auto& [name, value] : job.variation) {
+    const SensitivityParameter* parameter = find_parameter(design, name);
+    RAILCRASH_DEMAND(parameter != nullptr);  // load_design and run_sensitivity checked the names
+    for (const auto& [key, power] : parameter->scales) {
+      char text[64];
+      std::snprintf(text, sizeof text, "%.17g", std::pow(value, power));
+      settings.push_back(key + "*=" + text);
+    }
+  }
+  return settings;
+}
+
 SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
                        const Job& job, const std::vector<std::string>& base_settings, double time_limit,
                        const RunControl& control) {
@@ -198,17 +214,7 @@ SensitivityRun run_one(const std::string& model_path, const std::string& model_t
   run.factor = job.factor;
   const auto start = std::chrono::steady_clock::now();
   try {
-    std::vector<std::string> settings = base_settings;
-    for (const auto& [name, value] : job.variation) {
-      const SensitivityParameter* parameter = find_parameter(design, name);
-      RAILCRASH_DEMAND(parameter != nullptr);  // load_design and run_sensitivity checked the names
-      for (const auto& [key, power] : parameter->scales) {
-        char text[64];
-        std::snprintf(text, sizeof text, "%.17g", std::pow(value, power));
-        settings.push_back(key + "*=" + text);
-      }
-    }
-    const Model model = load_model_text(model_text, model_path, settings);
+    const Model model = load_model_text(model_text, model_path, job_settings(design, job, base_settings));
     if (!model.responses.defined())
       throw InputError(model_path + ": a parameter study needs a 'responses' section (R1-R3) in the model");
     const RunReport report = run_model(model, "", control.stop_flag());
@@ -428,6 +434,17 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
     for (const SensitivityTerm& t : design.second_order.terms)
       if (chosen(t.first) && (t.linear() || chosen(t.second))) terms.push_back(t);
   }
+
+  // Every run's model is loaded once before the first run, so that a parameter whose model value
+  // is 0 (a factor would change nothing, and the study would call it "no effect") stops the study
+  // at once. Other input errors stay with their run (reported failed; the others go on).
+  for (const Job& job : jobs)
+    try {
+      (void)load_model_text(model_text, model_path, job_settings(design, job, options.settings));
+    } catch (const ZeroScaledError& e) {
+      throw InputError(std::string(e.what()) + " (design parameter " + job.parameter + ")");
+    } catch (const InputError&) {
+    }
 
   std::vector<SensitivityRun> runs(jobs.size());
   std::size_t done = 0;

@@ -89,3 +89,16 @@ TEST_CASE("consist: a template without the car1_/car2_ naming is refused with th
   CHECK_THROWS_AS(make_consist_model(path.string(), 0), InputError);
   std::filesystem::remove(path);
 }
+
+TEST_CASE("consist: a size that would not fit in memory is refused with the memory it needs", "[consist]") {
+  // 2 x 1000 cars at 0.8 MB: 1.6 GB; with 1 GB available at most 1e9 / 1.6e6 = 625 cars per side.
+  try {
+    check_consist_memory("t.yaml", 1000, 1e9);
+    FAIL("accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(std::string(e.what()), Catch::Matchers::StartsWith("t.yaml: consist: 1000 + 1000 cars would need about 1.6 GB"));
+    CHECK_THAT(std::string(e.what()), Catch::Matchers::Contains("use --cars 625 or fewer"));
+  }
+  CHECK_NOTHROW(check_consist_memory("t.yaml", 625, 1e9));
+  CHECK(available_memory_bytes() > 0.0);
+}

@@ -206,7 +206,7 @@ TEST_CASE("convergence study: a run over its time limit is stopped and reported 
   ConvergeOptions options;
   options.quantities = {"displacement_rms"};
   options.t_end = 1.0;
-  options.euler_first_step = 1e-8;  // a hundred million steps (about a minute): far longer than the limit
+  options.euler_first_step = 1e-7;  // ten million steps, the --max-steps default (seconds): longer than the limit
   options.euler_runs = 1;
   options.rtols = {1e-4};
   options.run_time_limit = 1.0;     // the IDA runs take milliseconds (a tenth of a second under ASan)

@@ -131,6 +131,57 @@ TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
   }
 }
 
+TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizing penalties", "[integrators]") {
+  // t_end 1 at dt 1e-300 needs 1e300 steps (a long step count would overflow); dt 1e-3 needs
+  // exactly 1000 steps: refused at max_steps 999, accepted at 1000.
+  Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, ", integrator: euler, dt: 1e-300"));
+  const DaeSystem tiny_step(model);
+  CHECK_THROWS_WITH(make_integrator(tiny_step, model.simulation),
+                    Catch::Contains("needs 1e+300 steps to reach t_end = 1, more than --max-steps 10000000") &&
+                        Catch::Contains("use a larger dt (above 1e-07)"));
+  model.simulation.dt = 1e-3;
+  model.simulation.max_steps = 999;
+  const DaeSystem system(model);
+  CHECK_THROWS_WITH(make_integrator(system, model.simulation), Catch::Contains("needs 1000 steps"));
+  model.simulation.max_steps = 1000;
+  auto run = make_integrator(system, model.simulation);
+  CountingObserver observer;
+  const RunOutcome outcome = run->run(1.0, 0.5, observer);
+  CHECK(outcome.ok);
+  CHECK(outcome.stats.steps == 1000);
+  // Asked for a longer run than the model's t_end, the loop stops at max_steps: a failed run.
+  const RunOutcome longer = run->run(2.0, 0.5, observer);
+  CHECK_FALSE(longer.ok);
+  CHECK_THAT(longer.message, Catch::Contains("after --max-steps 1000 steps of dt = 0.001, before t_end = 2"));
+  CHECK(longer.t_reached == Approx(1.0).epsilon(1e-12));
+}
+
+TEST_CASE("IDA stops at max_steps as a failed run that says so", "[integrators]") {
+  Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0));
+  model.simulation.max_steps = 20;
+  const DaeSystem system(model);
+  auto run = make_integrator(system, model.simulation);
+  CountingObserver observer;
+  const RunOutcome outcome = run->run(1.0, 0.01, observer);
+  CHECK_FALSE(outcome.ok);
+  CHECK_THAT(outcome.message, Catch::Contains("after --max-steps 20 steps, before t_end = 1"));
+  CHECK(outcome.t_reached < 1.0);
+  CHECK(outcome.stats.steps <= 20);
+}
+
+TEST_CASE("a run whose element output is not finite fails naming the element", "[integrators]") {
+  // The point at 1e308 is 2.7e308 from the circle's centre: the penetration overflows to -inf
+  // while the contact stays open (no force, so the motion itself stays finite).
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: far\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: ball, mass: 2, inertia: 0.1, position: [1.0e308, 0], velocity: [1, 0]}\nelements:\n"
+      "  - {name: bump, type: contact, circle_center: [-1.7e308, 0], circle_radius: 1, stiffness: 1.0e6, "
+      "points: [{body: ball, at: [0, 0]}]}\nsimulation: {t_end: 0.1, output_interval: 0.01}\n");
+  const RunReport report = run_model(model, "", nullptr, false);
+  CHECK_FALSE(report.outcome.ok);
+  CHECK_THAT(report.outcome.message, Catch::Contains("element 'bump' (contact): its output 'penetration' is -inf at t = 0"));
+}
+
 TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
   const Model model = testing::model_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
   const DaeSystem system(model);

@@ -14,6 +14,7 @@
 #include "railcrash/elements/springs.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;
@@ -712,6 +713,30 @@ TEST_CASE("elements need the right points and a usable axis", "[model_io]") {
   expect_error("signed zero axis", text, line_of(text, "axis"), {"axis must be a non-zero direction"});
   text = edit(kBase, "{body: bob, at: [0, 0]}, {body: cart, at: [0.5, 0]}", "{body: bob, at: [0, 0]}, {body: bob, at: [0, 0]}");
   expect_error("coincident spring points", text, line_of(text, "- name: spring"), {"linear_spring 'spring'", "coincide"});
+}
+
+TEST_CASE("an output_interval that would give more than a million rows is refused with the figure", "[model_io]") {
+  // t_end 2 / 1e-6 = 2e6 rows; the smallest interval that fits is 2 / 1e6 = 2e-6.
+  const std::string text = edit(kBase, "output_interval: 0.01", "output_interval: 1.0e-6");
+  expect_error("tiny output interval", text, line_of(text, "output_interval"),
+               {"simulation: output_interval 1e-06 with t_end 2 gives 2e+06 output rows, more than the limit 1e+06",
+                "use output_interval >= 2e-06"});
+  CHECK_NOTHROW(load_model_text(edit(kBase, "output_interval: 0.01", "output_interval: 2.0e-6"), "test.yaml"));
+  Model model = load_model_text(kBase, "test.yaml");
+  RunOverrides longer;
+  longer.t_end = 1e6;  // 1e8 rows at the model's 0.01
+  CHECK_THROWS_WITH(apply_overrides(model, longer), Catch::Contains("test.yaml: --output-interval / --t-end: output_interval "
+                                                                    "0.01 with t_end 1e+06 gives 1e+08 output rows"));
+}
+
+TEST_CASE("a joint with all its points on one body or on ground is refused at load", "[model_io]") {
+  const std::string slide_points = "points: [{body: ground, at: [0, 0]}, {body: cart, at: [0, 0]}]";
+  std::string text = edit(kBase, slide_points, "points: [{body: cart, at: [0, 0]}, {body: cart, at: [1, 0]}]");
+  expect_error("joint from a body to itself", text, line_of(text, "- name: slide"),
+               {"joint 'slide' (slider_joint) has all its points on one body", "constrains nothing"});
+  text = edit(kBase, slide_points, "points: [{body: ground, at: [0, 0]}, {body: ground, at: [1, 0]}]");
+  expect_error("joint from ground to ground", text, line_of(text, "- name: slide"),
+               {"joint 'slide' (slider_joint) has all its points on ground", "two different bodies"});
 }
 
 TEST_CASE("tabulated loads need strictly increasing times", "[model_io]") {

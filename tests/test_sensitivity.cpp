@@ -106,6 +106,23 @@ TEST_CASE("scaling overrides multiply a model number", "[sensitivity]") {
   const Model model = load_model(files.model, {"elements.ac.horizontal_yield_deflection*=1.5", "simulation.t_end*=2"});
   CHECK(model.simulation.t_end == Approx(0.3));
   CHECK_THROWS_WITH(load_model(files.model, {"elements.ac.face_height*=x"}), Catch::Contains("KEY*=FACTOR"));
+  CHECK_THROWS_AS(load_model(files.model, {"elements.ac.horizontal_yield_deflection=0", "elements.ac.horizontal_yield_deflection*=1.2"}),
+                  ZeroScaledError);
+}
+
+TEST_CASE("a design parameter whose model value is 0 stops the study before any run", "[sensitivity]") {
+  Files files;
+  std::ofstream(files.design) << "sensitivity: 1\nfactor: 1.2\nparameters:\n"
+                                 "  - name: P4\n    description: vertical plastic slope\n"
+                                 "    scale: [{key: elements.ac.vertical_plastic_stiffness, power: 1}]\n";
+  const SensitivityDesign design = load_design(files.design);
+  SensitivityOptions options;
+  options.settings = {"elements.ac.vertical_plastic_stiffness=0"};  // a valid model in which P4 is 0
+  CHECK_NOTHROW(load_model(files.model, options.settings));
+  CHECK_THROWS_WITH(run_sensitivity(files.model, design, options),
+                    Catch::Contains("'elements.ac.vertical_plastic_stiffness' is 0 in the model, so a factor changes "
+                                    "nothing") &&
+                        Catch::Contains("(design parameter P4)"));
 }
 
 namespace {
@@ -339,12 +356,13 @@ TEST_CASE("design files: unknown parameters in the second-order study are refuse
 
 TEST_CASE("a run that exceeds the run time limit is stopped and reported failed", "[sensitivity]") {
   Files files;
-  // The same car end run for 1e6 s with output every 1e-4 s: far longer than the limit.
+  // The same car end run for 99 s with output every 1e-4 s (990,000 rows, just under the
+  // output limit): far longer than the run time limit.
   std::ifstream in(files.model);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const auto at = text.find("t_end: 0.15");
   REQUIRE(at != std::string::npos);
-  text.replace(at, 11, "t_end: 1.0e6");
+  text.replace(at, 11, "t_end: 99.0");
   std::ofstream(files.model) << text;
   const SensitivityDesign design = load_design(files.design);
   SensitivityOptions options;

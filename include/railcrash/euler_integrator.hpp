@@ -25,6 +25,7 @@ struct EulerSettings {
   double dt = 0.0;          // [time]; 0 = half the stability limit
   bool force_dt = false;    // run even when dt exceeds the stability limit
   Element::PenaltyOverrides penalty;  // model-wide defaults (a joint's own keys win)
+  long max_steps = 10000000;          // [steps]; a t_end that needs more is refused
 };
 
 class EulerIntegrator : public Integrator {

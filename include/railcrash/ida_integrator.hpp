@@ -34,6 +34,7 @@ struct IdaSettings {
   double rtol = 1e-6;
   std::optional<double> atol;  // [length]
   long max_steps_per_output = 500000;
+  long max_steps = 10000000;  // [steps] in the whole run; the run fails (not ok) beyond
 };
 
 class IdaIntegrator : public Integrator {

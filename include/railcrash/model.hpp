@@ -99,7 +99,15 @@ struct SimulationSettings {
   bool force_dt = false;            // euler: accept a step above the stability limit
   bool static_equilibrium = false;  // settle the bodies under gravity and loads at t = 0 first
   Element::PenaltyOverrides penalty;  // euler: model-wide penalty settings
+  long max_steps = 10000000;        // [steps] either integrator may take; the run fails beyond (run --max-steps)
 };
+
+/// The most output rows a run may write: t_end / output_interval above it is refused.
+constexpr double kMaxOutputRows = 1e6;  // [rows]
+
+/// Why the settings' output rows exceed kMaxOutputRows ("" when they do not), with the figure
+/// and the smallest output_interval that fits.
+std::string output_rows_problem(const SimulationSettings& settings);
 
 struct ScenarioCriteria;  // scenario/criteria.hpp
 

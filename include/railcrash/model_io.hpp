@@ -9,6 +9,12 @@
 
 namespace railcrash {
 
+/// A KEY*=FACTOR setting whose model value is 0: the factor would change nothing.
+class ZeroScaledError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Reads and checks a model file; the model comes back finalized.
 Model load_model(const std::string& path);
 /// Same, from text (path is only used in messages). `overrides` are KEY=VALUE settings

@@ -17,6 +17,7 @@ namespace railcrash {
 struct RunOverrides {
   std::optional<IntegratorKind> integrator;
   std::optional<double> t_end, rtol, atol, dt, output_interval;
+  std::optional<long> max_steps;
   bool force_dt = false;
 };
 

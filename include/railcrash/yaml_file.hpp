@@ -4,22 +4,29 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cstddef>
 #include <string>
 
 #include "railcrash/error.hpp"
 
 namespace railcrash {
 
-/// Parses the YAML file at `path`; `what` names it in the message ("design file").
-inline YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
-  try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(path + ": cannot open the " + what + " (check the path)");
-  } catch (const YAML::ParserException& e) {
-    throw InputError(SourceLocation{path, e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
-  }
-}
+/// Limits on what a YAML input may expand to: aliases (*name) are counted as the values they
+/// stand for, so an alias "billion laughs" or an alias inside its own anchor is refused before
+/// anything walks the nodes.
+constexpr std::size_t kYamlMaxAliasedNodes = 2000000;  // [values] that aliases may add beyond the text's size
+constexpr std::size_t kYamlMaxDepth = 64;              // [levels] of nested lists and maps
+
+/// Throws InputError "path:line: ..." if `text` nests deeper than kYamlMaxDepth, expands to more
+/// than kYamlMaxAliasedNodes + (its size in bytes) values, or has an alias inside the node it refers to. Parse
+/// errors are thrown as YAML::ParserException (with their mark), as YAML::Load does.
+void check_yaml_structure(const std::string& text, const std::string& path);
+
+/// check_yaml_structure, then YAML::Load.
+YAML::Node load_yaml_text(const std::string& text, const std::string& path);
+
+/// Parses the YAML file at `path` (checked as above); `what` names it in the message ("design file").
+YAML::Node load_yaml_file(const std::string& path, const std::string& what);
 
 /// The flow-style sequence [a, b] (positions, points and velocities of generated models).
 inline YAML::Node flow_pair(double a, double b) {

@@ -99,7 +99,7 @@ Template read_template(const std::string& path) {
   Template t;
   t.path = path;
   try {
-    t.root = YAML::LoadFile(path);
+    t.root = load_yaml_file(path, "train model");
   } catch (const YAML::Exception& e) {
     throw InputError(path + ": cannot read the train model: " + e.what());
   }

@@ -1,0 +1,116 @@
+#include "railcrash/yaml_file.hpp"
+
+#include <yaml-cpp/eventhandler.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+namespace railcrash {
+
+namespace {
+
+/// Walks the parser's events once (aliases are not followed) and counts what the document
+/// becomes once every alias is expanded: the size of an anchored node is known when it ends,
+/// so an alias adds that size without being walked again.
+class StructureCheck : public YAML::EventHandler {
+ public:
+  /// `limit`: the most values the document may expand to.
+  StructureCheck(const std::string& path, std::size_t limit) : path_(path), limit_(limit) {}
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { leaf(mark, anchor); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, const std::string&) override {
+    leaf(mark, anchor);
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    for (const Open& open : open_)
+      if (open.anchor == anchor)
+        fail(mark, "an alias refers to the node that contains it (a cycle through an anchor opened at line " +
+                       std::to_string(open.line) + "); replace the alias by the values it stands for");
+    const auto size = anchored_size_.find(anchor);
+    add(mark, size == anchored_size_.end() ? 1 : size->second);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor);
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Open {
+    YAML::anchor_t anchor;
+    int line;            // 1-based
+    std::size_t nodes;   // expanded nodes inside, itself included
+  };
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& message) const {
+    throw InputError(SourceLocation{path_, mark.is_null() ? 0 : mark.line + 1}.prefix() + message);
+  }
+  void add(const YAML::Mark& mark, std::size_t nodes) {
+    if (!open_.empty()) open_.back().nodes += nodes;
+    expanded_ += nodes;
+    if (expanded_ > limit_)
+      fail(mark, "the document expands to more than " + std::to_string(limit_) +
+                     " values once its aliases (*name) are replaced by what they refer to; a model needs far fewer: "
+                     "remove the aliases that repeat other aliases");
+  }
+  void leaf(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    if (anchor != YAML::NullAnchor) anchored_size_[anchor] = 1;
+    add(mark, 1);
+  }
+  void open(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    if (open_.size() >= kYamlMaxDepth)
+      fail(mark, "lists and maps are nested more than " + std::to_string(kYamlMaxDepth) +
+                     " deep; a model needs far fewer levels: check the brackets");
+    add(mark, 1);
+    open_.push_back({anchor, mark.line + 1, 1});
+  }
+  void close() {
+    const Open done = open_.back();
+    open_.pop_back();
+    if (done.anchor != YAML::NullAnchor) anchored_size_[done.anchor] = done.nodes;
+    if (!open_.empty()) open_.back().nodes += done.nodes - 1;  // the 1 for the node itself was added at its start
+  }
+
+  const std::string& path_;
+  std::vector<Open> open_;
+  std::map<YAML::anchor_t, std::size_t> anchored_size_;
+  const std::size_t limit_;
+  std::size_t expanded_ = 0;
+};
+
+}  // namespace
+
+void check_yaml_structure(const std::string& text, const std::string& path) {
+  std::istringstream stream(text);
+  YAML::Parser parser(stream);
+  // A value takes at least one byte of text, so a file without aliases never reaches the limit.
+  StructureCheck check(path, kYamlMaxAliasedNodes + text.size());
+  while (parser.HandleNextDocument(check)) {
+  }
+}
+
+YAML::Node load_yaml_text(const std::string& text, const std::string& path) {
+  check_yaml_structure(text, path);
+  return YAML::Load(text);
+}
+
+YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the " + what + " (check the path)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    return load_yaml_text(text.str(), path);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(SourceLocation{path, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
+  }
+}
+
+}  // namespace railcrash

@@ -1,0 +1,83 @@
+// The YAML structure check every reader goes through: aliases counted as what they expand
+// to, an alias inside its own anchor, and nesting depth, each refused with file and line.
+#include <catch2/catch.hpp>
+
+#include <string>
+
+#include "railcrash/model_io.hpp"
+#include "railcrash/yaml_file.hpp"
+
+using namespace railcrash;
+using Catch::Matchers::Contains;
+using Catch::Matchers::StartsWith;
+
+namespace {
+
+std::string structure_error(const std::string& text) {
+  try {
+    check_yaml_structure(text, "in.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// A document whose list `level<k>` repeats `level<k-1>` `fan_out` times: it expands to
+/// fan_out^levels + ... values although it is only a few lines long.
+std::string alias_tree(int levels, int fan_out) {
+  std::string text = "top:\n  level0: &l0 x\n";
+  for (int k = 1; k <= levels; ++k) {
+    text += "  level" + std::to_string(k) + ": &l" + std::to_string(k) + " [";
+    for (int i = 0; i < fan_out; ++i) text += std::string(i ? ", " : "") + "*l" + std::to_string(k - 1);
+    text += "]\n";
+  }
+  return text;
+}
+
+}  // namespace
+
+TEST_CASE("aliases are counted as the values they stand for, each node read once", "[yaml_file]") {
+  // level k expands to 1 + 3 * size(k - 1) values (1, 4, 13, 40): far below the limit.
+  CHECK(structure_error(alias_tree(3, 3)).empty());
+  const YAML::Node loaded = load_yaml_text(alias_tree(3, 3), "in.yaml");
+  CHECK(loaded["top"]["level3"][2][1][0].as<std::string>() == "x");
+  // 10 levels of 10 aliases: 10^10 values from 300 bytes ("billion laughs").
+  const std::string laughs = alias_tree(10, 10);
+  const std::string message = structure_error(laughs);
+  CHECK_THAT(message, StartsWith("in.yaml:"));
+  CHECK_THAT(message, Contains("expands to more than " + std::to_string(kYamlMaxAliasedNodes + laughs.size()) + " values"));
+}
+
+TEST_CASE("an alias inside the node it refers to is refused with its line", "[yaml_file]") {
+  CHECK_THAT(structure_error("name: x\ndescription: &r [*r]\n"),
+             StartsWith("in.yaml:2: an alias refers to the node that contains it"));
+  CHECK_THAT(structure_error("a: &m\n  b: [1, {c: *m}]\n"), StartsWith("in.yaml:2: an alias refers to the node"));
+  // The same anchor used after it is closed is fine.
+  CHECK(structure_error("a: &m {b: 1}\nc: *m\n").empty());
+}
+
+TEST_CASE("nesting deeper than the limit is refused with its line", "[yaml_file]") {
+  const std::size_t depth = kYamlMaxDepth;
+  CHECK(structure_error("a: " + std::string(depth - 1, '[') + std::string(depth - 1, ']') + "\n").empty());
+  CHECK_THAT(structure_error("a: 1\nb: " + std::string(depth, '[') + std::string(depth, ']') + "\n"),
+             StartsWith("in.yaml:2: lists and maps are nested more than 64 deep"));
+}
+
+TEST_CASE("the model loader and --set values go through the structure check", "[yaml_file]") {
+  const std::string model = "railcrash: 1\nname: x\nunits: SI\ndescription: &r [*r]\nbodies: []\n";
+  try {
+    (void)load_model_text(model, "model.yaml");
+    FAIL("accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(std::string(e.what()), StartsWith("model.yaml:4: an alias refers to the node that contains it"));
+  }
+  const std::string valid = "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: bob, mass: 1, inertia: 1}\n"
+                            "simulation: {t_end: 1}\n";
+  try {
+    (void)load_model_text(valid, "model.yaml", {"description=&a [*a]"});
+    FAIL("accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(std::string(e.what()), StartsWith("model.yaml: --set 'description=&a [*a]'"));
+    CHECK_THAT(std::string(e.what()), Contains("an alias refers to the node that contains it"));
+  }
+}
