@@ -584,27 +584,27 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
                       const SweepOptions& options) {
   const std::string model_text = read_model_text(model_path);
   SweepResult result = start_sweep(plan, model_text, directory, options.resume);
-  std::vector<std::size_t> todo;
+  std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
-    if (!result.lines[k]) todo.push_back(k);
-  std::vector<SweepRow> rows(todo.size());
+    if (!result.lines[k]) pending.push_back(k);
+  std::vector<SweepRow> rows(pending.size());
   BatchOptions batch;
   batch.jobs = options.jobs;
   batch.run_time_limit = options.run_time_limit;
   batch.stop = options.stop;
   std::size_t done = result.done();
   run_batch(
-      todo.size(),
+      pending.size(),
       [&](std::size_t i, const RunControl& control) {
         char folder[32];
-        std::snprintf(folder, sizeof folder, "/runs/%04zu", todo[i]);
-        rows[i] = run_sweep_spec(plan, model_path, model_text, result.specs[todo[i]], control,
+        std::snprintf(folder, sizeof folder, "/runs/%04zu", pending[i]);
+        rows[i] = run_sweep_spec(plan, model_path, model_text, result.specs[pending[i]], control,
                                  options.keep_runs ? directory + folder : "");
       },
       batch,
       [&](std::size_t i, BatchRunState state) {
         if (state != BatchRunState::finished) return;  // an interrupted run is run again on --resume
-        const std::size_t k = todo[i];
+        const std::size_t k = pending[i];
         result.lines[k] = sweep_csv_line(plan, k, result.specs[k], rows[i]);
         append_sweep_line(directory, *result.lines[k]);
         if (options.progress) options.progress(k, rows[i], ++done, result.specs.size());

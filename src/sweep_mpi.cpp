@@ -72,15 +72,15 @@ std::string run_here(const SweepPlan& plan, const std::string& model_path, const
 int coordinate(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
                const std::string& directory, const SweepOptions& options, int ranks) {
   SweepResult result = start_sweep(plan, model_text, directory, options.resume);
-  std::vector<long> todo;
+  std::vector<long> pending;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
-    if (!result.lines[k]) todo.push_back(static_cast<long>(k));
+    if (!result.lines[k]) pending.push_back(static_cast<long>(k));
   std::mutex mutex;  // guards next, done and result.lines, shared with rank 0's own worker thread
   std::size_t next = 0, done = result.done();
   const auto take = [&]() -> long {
     const std::lock_guard<std::mutex> lock(mutex);
-    if ((options.stop && options.stop->load()) || next >= todo.size()) return -1;
-    return todo[next++];
+    if ((options.stop && options.stop->load()) || next >= pending.size()) return -1;
+    return pending[next++];
   };
   const auto record = [&](long number, const std::string& line) {
     if (line.empty()) return;  // interrupted: run again on --resume
