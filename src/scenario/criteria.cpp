@@ -301,7 +301,10 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     r.value = *std::max_element(car_crush_[k].begin(), car_crush_[k].end());
     r.limit = criteria_.survival_limit;
     r.pass = r.value <= r.limit;
-    if (crush_of_cars_[k].columns.empty()) r.note = "the car has no crush element (no output with the crush role)";
+    if (crush_of_cars_[k].columns.empty()) {  // nothing measured: not a pass
+      r.pass = false;
+      r.note = "not measured: the car has no crush element (no output with the crush role) besides the excluded ones";
+    }
     out.push_back(r);
   }
   for (std::size_t k = 0; k < front_index_.size(); ++k) {

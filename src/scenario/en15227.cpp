@@ -558,7 +558,7 @@ std::string make_scenario_model(const ScenarioRequest& q) {
                     u, trains);
     const double mass_kg = q.obstacle_mass * 1e3;
     header << "# Obstacle " << q.obstacle_mass << " t (" << (u.inch_pound ? mass_kg / kPoundMass : mass_kg) << (u.inch_pound ? " lbf weight" : " kg")
-           << "; 15 t: railwaynews.net, scenario 3; railway-impact-simulator configs/en15227) at rest on a frictionless slider.\n"
+           << "; 15 t: railwaynews.net, scenario 3) at rest on a frictionless slider.\n"
            << "# Its force-crush characteristic --obstacle-curve, unloading " << *q.obstacle_unloading_stiffness
            << " kN/mm, contact point " << *q.obstacle_height << " mm above the rail (--obstacle-height): required inputs; it strikes the "
            << "train's front face (" << trains.front_body << ").\n# No interface: override is judged by the leading bogie's wheel lift.\n";
