@@ -10,7 +10,10 @@
 #include <sstream>
 
 #include "railcrash/consist.hpp"
+#include "railcrash/element.hpp"
 #include "railcrash/error.hpp"
+#include "railcrash/model.hpp"
+#include "railcrash/model_io.hpp"
 #include "railcrash/scenario/train_unit.hpp"
 #include "railcrash/yaml_file.hpp"
 
@@ -64,7 +67,7 @@ struct Template {
   Units units;
   std::string anticlimber;   // interface anticlimber's name ("" if none)
   YAML::Node anticlimber_node;
-  std::vector<std::string> leading_wheels;  // car1_ wheel_rail elements on the foremost wheel-carrying body
+  std::vector<std::string> leading_wheels;  // the striking car's wheel_rail elements on its foremost wheel-carrying body
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
     const int line = node.IsDefined() && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
@@ -90,37 +93,42 @@ Template read_template(const std::string& path) {
   const std::string units = t.root["units"] ? t.root["units"].as<std::string>() : "";
   if (units != "SI" && units != "in-lbf-s") t.fail(t.root["units"], "units must be SI or in-lbf-s");
   t.units.inch_pound = units == "in-lbf-s";
-  bool coupler = false, striking_car = false;
-  for (const YAML::Node& b : t.root["bodies"]) striking_car = striking_car || starts_with(b["name"].as<std::string>(), "car1_");
-  if (!striking_car)
-    t.fail(t.root["bodies"], "no striking car: the scenario builds its trains from the bodies named car1_* (the car at x < 0 "
-                             "whose front faces x = 0), as in models/report/final_two_car.yaml");
-  double foremost = -1e300;
-  std::map<std::string, double> body_x;
-  for (const YAML::Node& b : t.root["bodies"]) body_x[b["name"].as<std::string>()] = b["position"][0].as<double>();
-  for (const YAML::Node& e : t.root["elements"]) {
-    const std::string name = e["name"].as<std::string>(), type = e["type"] ? e["type"].as<std::string>() : "";
-    const bool interface = !starts_with(name, "car1_") && !starts_with(name, "car2_");
-    if (interface && type == "coupler_end" && name == "coupler_faces") coupler = true;
-    if (interface && type == "anticlimber") {
-      t.anticlimber = name;
-      t.anticlimber_node = e;
+  bool coupler = false;
+  std::string striking_car;  // the car the car1_* bodies declare
+  for (const YAML::Node& b : t.root["bodies"])
+    if (striking_car.empty() && starts_with(b["name"].as<std::string>(), "car1_") && b["car"]) striking_car = b["car"].as<std::string>();
+  if (striking_car.empty())
+    t.fail(t.root["bodies"], "no striking car: the scenario builds its trains from the car declared (car: NAME) by the bodies named "
+                             "car1_* (the car at x < 0 whose front faces x = 0), as in models/report/final_two_car.yaml");
+  // The interface anticlimber and the leading wheels from the output roles and car declarations.
+  const Model model = load_model(path);
+  const auto car_of = [&](int body) { return body == kGround ? std::string() : model.bodies()[static_cast<std::size_t>(body)].car; };
+  double foremost = -1e300;  // [length] x of the striking car's foremost wheel-carrying body
+  for (const auto& e : model.elements()) {
+    if (e->name() == "coupler_faces" && e->type() == "coupler_end") coupler = true;
+    const std::string car_1 = car_of(e->point(0).body), car_2 = e->points().size() == 2 ? car_of(e->point(1).body) : "";
+    const bool between_cars = !car_1.empty() && !car_2.empty() && car_1 != car_2;
+    if (between_cars && !e->output_with_role(OutputRole::VerticalInterlockForce).empty()) {
+      if (car_1 != striking_car) t.fail(t.root["elements"], "the interface element '" + e->name() + "' (vertical interlock) must have its first point on the striking car " + striking_car);
+      t.anticlimber = e->name();
+      for (const YAML::Node& node : t.root["elements"])
+        if (node["name"].as<std::string>() == e->name()) t.anticlimber_node = node;
     }
-    if (starts_with(name, "car1_") && type == "wheel_rail") {
-      const double x = body_x[e["points"][0]["body"].as<std::string>()];
+    if (e->type() == "wheel_rail" && car_1 == striking_car) {
+      const double x = model.bodies()[static_cast<std::size_t>(e->point(0).body)].x;
       if (x > foremost + 1e-9) {
         foremost = x;
         t.leading_wheels.clear();
       }
-      if (std::abs(x - foremost) <= 1e-9) t.leading_wheels.push_back(name);
+      if (std::abs(x - foremost) <= 1e-9) t.leading_wheels.push_back(e->name());
     }
   }
   if (!coupler)
     t.fail(t.root["elements"], "no coupler: the trains meet at an interface element 'coupler_faces' of type coupler_end "
                                "(car1_coupler to car2_coupler), which the consist generator needs");
   if (t.anticlimber.empty())
-    t.fail(t.root["elements"], "no front end: the override criterion needs the interface anticlimber (an element of type "
-                               "anticlimber between car1_front_end and car2_front_end)");
+    t.fail(t.root["elements"], "no front end: the override criterion needs the interface anticlimber (an element with a vertical "
+                               "interlock output between the two cars' front ends, e.g. an anticlimber)");
   if (t.leading_wheels.empty())
     t.fail(t.root["elements"], "no wheel_rail elements on the striking car: the wheel lift-off criterion needs the leading bogie's wheels");
   return t;
