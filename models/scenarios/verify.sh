@@ -3,8 +3,10 @@
 # (README.md, "Collision scenarios"). Run from the repository root:
 #   models/scenarios/verify.sh build/railcrash [OUT_DIR]
 #  1. zero-offset scenario 1 (report car, 20 ms, IDA): largest |vx(s body) + vx(mirrored t body)|
-#     over the closing speed up to each millisecond, and how far apart in time IDA located the
-#     mirrored pairs of mode changes (events.csv);
+#     over the closing speed up to each millisecond, the first sample where it exceeds 1e-9 with
+#     the events just before it and the anticlimber's vertical offset there (the element measures
+#     it in body 1's axes, so it is not zero for mirrored faces), and how far apart in time IDA
+#     located the mirrored pairs of mode changes (events.csv);
 #  2. scenario 2 (models/scenarios/scenario2_report_car.yaml, whole run, IDA and Euler): the
 #     change of the total longitudinal momentum over its initial value, and the energy balance.
 set -eu
@@ -29,6 +31,22 @@ for r in rows:
     largest = max([largest] + [abs(float(r[k]) + float(r["t" + k[1:]])) / closing for k in r if k.startswith("s") and k.endswith(".vx")])
     if round(float(r["t"]) * 1e4) % 10 == 0:
         print("  t = %5.1f ms  %.3g" % (1e3 * float(r["t"]), largest))
+previous, first = 0.0, None
+for r in rows:
+    worst = max(abs(float(r[k]) + float(r["t" + k[1:]])) / closing for k in r if k.startswith("s") and k.endswith(".vx"))
+    if worst > 1e-9:
+        first = r
+        break
+    previous = float(r["t"])
+if first:
+    t_first = float(first["t"])
+    print("first sample above 1e-9: t = %.2f ms; events after the sample before it (%.2f ms):" % (1e3 * t_first, 1e3 * previous))
+    for e in csv.DictReader(open(out / "symmetric/events.csv")):
+        if previous < float(e["t"]) <= t_first:
+            print("  t = %.5f ms  %s  %s" % (1e3 * float(e["t"]), e["element"], e["event"]))
+    print("  there: front ends' heights differ by %.3g in, the anticlimber's vertical_offset is %.3g in, its vertical force %.3g"
+          % (abs(float(first["s1_front_end.y"]) - float(first["t1_front_end.y"])), float(first["anticlimber.vertical_offset"]),
+             float(first["anticlimber.vertical_force"])))
 events = {}
 for e in csv.DictReader(open(out / "symmetric/events.csv")):
     name = e["element"]
