@@ -6,7 +6,7 @@
 #     over the closing speed up to each millisecond, the first sample where it exceeds 1e-9 with
 #     the events just before it and the anticlimber's vertical offset there (the element measures
 #     it in body 1's axes, so it is not zero for mirrored faces), and how far apart in time IDA
-#     located the mirrored pairs of mode changes (events.csv);
+#     located the mirrored pairs of mode changes (events.csv); the same run at rtol 1e-9;
 #  2. scenario 2 (models/scenarios/scenario2_report_car.yaml, whole run, IDA and Euler): the
 #     change of the total longitudinal momentum over its initial value, and the energy balance.
 set -eu
@@ -17,6 +17,7 @@ mkdir -p "$out"
   --override-limit 100 --wheel-lift-limit 20 --passenger-bodies center_body --survival-gauge bolster_body,rear_body \
   --t-end 0.02 --out "$out/symmetric.yaml" 2> /dev/null
 "$bin" run "$out/symmetric.yaml" --output-interval 0.0005 --quiet --out "$out/symmetric" > /dev/null
+"$bin" run "$out/symmetric.yaml" --output-interval 0.0005 --set simulation.rtol=1e-9 --quiet --out "$out/symmetric_rtol_1e-9" > /dev/null
 for integrator in ida euler; do
   "$bin" run models/scenarios/scenario2_report_car.yaml --integrator "$integrator" --quiet --out "$out/momentum_$integrator" > /dev/null
 done
@@ -56,6 +57,19 @@ print("mirrored mode changes located apart (first of each pair):")
 for (element, event), times in sorted(events.items(), key=lambda kv: min(min(v) for v in kv[1].values())):
     if "s" in times and "t" in times:
         print("  %-28s %-40s t = %.5f s, apart %.2g s" % ("*" + element, event, times["s"][0], abs(times["s"][0] - times["t"][0])))
+tight = list(csv.DictReader(open(out / "symmetric_rtol_1e-9/timeseries.csv")))
+print("the same at rtol 1e-9: largest |vx_s + vx_t| / closing speed up to t")
+largest = 0.0
+for r in tight:
+    largest = max([largest] + [abs(float(r[k]) + float(r["t" + k[1:]])) / closing for k in r if k.startswith("s") and k.endswith(".vx")])
+    if 9.0 <= round(float(r["t"]) * 1e3, 1) <= 10.0:
+        print("  t = %5.1f ms  %.3g" % (1e3 * float(r["t"]), largest))
+gear = {}
+for e in csv.DictReader(open(out / "symmetric_rtol_1e-9/events.csv")):
+    if e["element"] in ("s1_draft_gear", "t1_draft_gear") and e["event"] == "back on the loading curve (buff)":
+        gear.setdefault(e["element"], float(e["t"]))
+if len(gear) == 2:
+    print("  the draft gears' 'back on the loading curve' at %.5f ms, apart %.2g s" % (1e3 * min(gear.values()), abs(gear["s1_draft_gear"] - gear["t1_draft_gear"])))
 for integrator in ("ida", "euler"):
     run = out / ("momentum_" + integrator)
     masses = {b["name"]: b["mass"] for b in json.loads((run / "model.json").read_text())["bodies"]}
