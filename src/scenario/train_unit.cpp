@@ -37,7 +37,7 @@ YAML::Node transformed_node(const YAML::Node& node, const std::function<std::str
     YAML::Node out = YAML::Clone(node);
     const std::string renamed = rename(key, node.Scalar());
     if (renamed != node.Scalar()) out = renamed;
-    if (mirror && key == "angle") out = -node.as<double>();
+    if (mirror && (key == "angle" || key == "angular_velocity")) out = -node.as<double>();  // pitch changes sign in the mirror
     return out;
   }
   if (node.IsSequence()) {

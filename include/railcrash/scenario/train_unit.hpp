@@ -58,8 +58,10 @@ struct UnitPlacement {
 void append_unit(const TrainUnit& unit, const UnitPlacement& placement, YAML::Node& bodies, YAML::Node& elements);
 
 /// Deep copy of a model node with every scalar passed through `rename(key, scalar)` (key: the
-/// map key the scalar or its list is under) and, when `mirror`, the x component of every
-/// position, velocity, body point and direction negated and every angle negated.
+/// map key the scalar is under; list items get "") and, when `mirror`, the x component of every
+/// position, velocity, body point and direction negated and a body's angle and angular velocity negated
+/// (element parameters that are angles, e.g. a torsional spring's, are not: none of the
+/// shipped unit models has one).
 YAML::Node transformed_node(const YAML::Node& node, const std::function<std::string(const std::string&, const std::string&)>& rename,
                             bool mirror, const std::string& key = "");
 
