@@ -456,12 +456,12 @@ int main(int argc, char** argv) {
   consist->add_option("--out", consist_out, "model file to write (default: standard output)");
 
   railcrash::ScenarioRequest scenario_request;
-  std::string scenario_out, buffer_curve;
+  std::string scenario_out, buffer_curve, obstacle_curve;
   std::map<std::string, double> scenario_values;
-  CLI::App* scenario = app.add_subcommand("scenario", "write a model of an EN 15227 design collision scenario (1 or 2) "
-                                                      "built from a two-car model, with the criteria evaluated after the run");
-  scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon)")->required();
-  scenario->add_option("--train", scenario_request.train_path, "two-car model (car1_* striking), e.g. models/report/final_two_car.yaml")
+  CLI::App* scenario = app.add_subcommand("scenario", "write a model of an EN 15227 design collision scenario (1, 2 or 3) "
+                                                      "built from a car model, with the criteria evaluated after the run");
+  scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon, 3: deformable obstacle)")->required();
+  scenario->add_option("--train", scenario_request.train_path, "two-car template (car1_* striking, e.g. models/report/final_two_car.yaml) or a model whose bodies declare their cars (e.g. models/barrier/two_car_barrier.yaml)")
       ->required();
   scenario->add_option("--cars", scenario_request.cars, "cars per train")->capture_default_str()->check(CLI::Range(1, 1000));
   scenario->add_option("--category", scenario_request.category, "C-I, C-II, C-III or C-IV")->capture_default_str();
@@ -469,8 +469,12 @@ int main(int argc, char** argv) {
                        "comma list of the passenger-area bodies (template names without car1_), e.g. center_body")->delimiter(',');
   scenario->add_option("--survival-gauge", scenario_request.survival_gauge,
                        "FRONT,REAR: template bodies (without car1_) at the ends of the survival space")->delimiter(',');
+  scenario->add_option("--crush-zones", scenario_request.crush_zones,
+                       "comma list of crush elements whose crush is allowed (left out of the survival-space loss)")->delimiter(',');
   scenario->add_option("--buffer-curve", buffer_curve, "scenario 2: one side buffer's force-stroke curve mm:kN,mm:kN,...");
   scenario->add_option("--wagon-mass", scenario_request.wagon_mass, "scenario 2: wagon mass [t]")->capture_default_str();
+  scenario->add_option("--obstacle-curve", obstacle_curve, "scenario 3: the obstacle's force-crush curve mm:kN,mm:kN,... (required)");
+  scenario->add_option("--obstacle-mass", scenario_request.obstacle_mass, "scenario 3: obstacle mass [t]")->capture_default_str();
   for (const auto& [option, help] : std::vector<std::pair<std::string, std::string>>{
            {"--speed", "closing speed [km/h] (default 36 for C-I)"},
            {"--offset", "scenario 1: vertical offset of the standing train [mm] (required)"},
@@ -480,6 +484,10 @@ int main(int argc, char** argv) {
            {"--wheel-lift-limit", "largest allowed wheel lift of the leading bogies [mm] (required)"},
            {"--buffer-unloading-stiffness", "scenario 2: one buffer's unloading stiffness [kN/mm] (required)"},
            {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)"},
+           {"--face-stiffness", "scenario 1 from a model declaring its cars: each front face's stiffness [kN/mm] (required)"},
+           {"--face-height", "scenario 1 from a model declaring its cars: each front face's height [mm] (required)"},
+           {"--obstacle-unloading-stiffness", "scenario 3: the obstacle's unloading stiffness [kN/mm] (required)"},
+           {"--obstacle-height", "scenario 3: height of the obstacle's contact point above the rail [mm] (required)"},
            {"--t-end", "end time of the run [s] (default: the train model's)"}})
     scenario->add_option(option, scenario_values[option], help);
   scenario->add_option("--out", scenario_out, "model file to write (default: standard output)");
@@ -517,8 +525,13 @@ int main(int argc, char** argv) {
       scenario_request.wheel_lift_limit = given("--wheel-lift-limit");
       scenario_request.buffer_unloading_stiffness = given("--buffer-unloading-stiffness");
       scenario_request.buffer_height = given("--buffer-height");
+      scenario_request.face_stiffness = given("--face-stiffness");
+      scenario_request.face_height = given("--face-height");
+      scenario_request.obstacle_unloading_stiffness = given("--obstacle-unloading-stiffness");
+      scenario_request.obstacle_height = given("--obstacle-height");
       scenario_request.t_end = given("--t-end");
       if (!buffer_curve.empty()) scenario_request.buffer_curve = parse_curve(buffer_curve, "--buffer-curve");
+      if (!obstacle_curve.empty()) scenario_request.obstacle_curve = parse_curve(obstacle_curve, "--obstacle-curve");
       return write_generated_model(railcrash::make_scenario_model(scenario_request), scenario_out,
                                    "EN 15227 scenario " + std::to_string(scenario_request.number));
     }

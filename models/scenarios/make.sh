@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Writes the EN 15227 scenario models of the report's car (models/report/final_two_car.yaml)
-# into DIR (default: this folder). Run from the repository root:
+# and of the barrier test's two cars (models/barrier/two_car_barrier.yaml) into DIR (default:
+# this folder). Run from the repository root:
 #   models/scenarios/make.sh build/railcrash [DIR]
 # The limits and the buffer below are the values these examples were generated with, NOT values
 # confirmed from the standard (README.md, "Collision scenarios", says which are and why):
@@ -9,12 +10,20 @@
 #   minimum) on a linear rise to 571.4 kN (5.442 kN/mm), then solid (544.2 kN/mm, 100 times
 #   steeper), unloading at the solid slope (the buffer keeps its stroke: the work is dissipated);
 #   buffer centre 1060 mm above the rail.
+# The barrier cars' front faces in scenario 1 (the test met a wall, not a second train) take the
+# barrier model's own values: 875.6 kN/mm per face = its wall stiffness 5e6 lbf/in (its reading
+# 11), 304.8 mm high = its end beams' 12 in depth (its reading 4).
 set -eu
 bin=$1
 dir=${2:-models/scenarios}
+limits=(--deceleration-limit 5 --survival-space-limit 50 --override-limit 100 --wheel-lift-limit 20)
+buffers=(--buffer-curve 0:0,105:571.4,115:6013.4 --buffer-unloading-stiffness 544.2 --buffer-height 1060)
 train=models/report/final_two_car.yaml
-limits=(--deceleration-limit 5 --survival-space-limit 50 --override-limit 100 --wheel-lift-limit 20
-        --passenger-bodies center_body --survival-gauge bolster_body,rear_body)
-"$bin" scenario 1 --train "$train" --offset 40 "${limits[@]}" --out "$dir/scenario1_report_car.yaml"
-"$bin" scenario 2 --train "$train" "${limits[@]}" --buffer-curve 0:0,105:571.4,115:6013.4 \
-  --buffer-unloading-stiffness 544.2 --buffer-height 1060 --out "$dir/scenario2_report_car.yaml"
+report_car=(--passenger-bodies center_body --survival-gauge bolster_body,rear_body)
+"$bin" scenario 1 --train "$train" --offset 40 "${limits[@]}" "${report_car[@]}" --out "$dir/scenario1_report_car.yaml"
+"$bin" scenario 2 --train "$train" "${limits[@]}" "${report_car[@]}" "${buffers[@]}" --out "$dir/scenario2_report_car.yaml"
+train=models/barrier/two_car_barrier.yaml
+barrier_cars=(--passenger-bodies lead_body,trail_body)
+"$bin" scenario 1 --train "$train" --offset 40 "${limits[@]}" "${barrier_cars[@]}" --face-stiffness 875.6 --face-height 304.8 \
+  --out "$dir/scenario1_barrier_cars.yaml"
+"$bin" scenario 2 --train "$train" "${limits[@]}" "${barrier_cars[@]}" "${buffers[@]}" --out "$dir/scenario2_barrier_cars.yaml"

@@ -6,7 +6,7 @@ set -eu
 bin=$1
 out=${2:-out/scenarios}
 mkdir -p "$out"
-for model in models/scenarios/scenario*_report_car.yaml; do
+for model in models/scenarios/scenario*.yaml; do
   name=$(basename "$model" .yaml)
   for integrator in ida euler; do
     "$bin" run "$model" --integrator "$integrator" --quiet --out "$out/${name}_$integrator" > /dev/null || true

@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <sstream>
 
@@ -121,10 +122,29 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
     c->passenger_bodies.push_back(r.body(b, "mean_deceleration: bodies"));
 
   const YAML::Node survival = r.required(section, "survival_space", "the section");
-  r.only_keys(survival, {"limit", "source", "gauges"}, "survival_space");
+  r.only_keys(survival, {"limit", "source", "cars", "excluded", "gauges"}, "survival_space");
   c->survival_limit = r.positive(r.required(survival, "limit", "survival_space"), "survival_space: limit");
   c->survival_source = r.text(r.required(survival, "source", "survival_space"), "survival_space: source");
-  for (const YAML::Node& g : r.list(r.required(survival, "gauges", "survival_space"), "survival_space: gauges")) {
+  if (!survival["cars"] && !survival["gauges"])
+    r.fail(survival, "survival_space: give 'cars: [..]' (the crush of each car's crush elements) and/or 'gauges: [..]' (body pairs)");
+  if (survival["cars"])
+    for (const YAML::Node& car : r.list(survival["cars"], "survival_space: cars")) {
+      const std::string name = r.text(car, "survival_space: cars");
+      const auto& bodies = model.bodies();
+      if (std::none_of(bodies.begin(), bodies.end(), [&](const Body& b) { return b.car == name; }))
+        r.fail(car, "survival_space: cars: no body declares 'car: " + name + "' in the model");
+      c->survival_cars.push_back(name);
+    }
+  if (survival["excluded"])
+    for (const YAML::Node& e : r.list(survival["excluded"], "survival_space: excluded")) {
+      const std::string name = r.text(e, "survival_space: excluded");
+      const auto& elements = model.elements();
+      if (std::none_of(elements.begin(), elements.end(), [&](const auto& element) { return element->name() == name; }))
+        r.fail(e, "survival_space: excluded: no element named '" + name + "' in the model");
+      c->survival_excluded.push_back(name);
+    }
+  if (survival["gauges"])
+  for (const YAML::Node& g : r.list(survival["gauges"], "survival_space: gauges")) {
     r.only_keys(g, {"name", "front", "rear"}, "survival_space: gauge");
     ScenarioCriteria::Gauge gauge;
     gauge.name = r.text(r.required(g, "name", "survival_space: gauge"), "survival_space: gauge name");
@@ -136,17 +156,24 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
 
   const YAML::Node override_node = r.required(section, "override", "the section");
   r.only_keys(override_node, {"limit", "source", "interface", "bodies", "wheel_lift_limit", "wheel_lift_source", "wheels"}, "override");
-  if (override_node["interface"].IsDefined() == override_node["bodies"].IsDefined())
-    r.fail(override_node, "override: give either 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface)");
+  if (override_node["interface"] && override_node["bodies"])
+    r.fail(override_node, "override: give either 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface), not both");
+  if (!override_node["interface"] && !override_node["bodies"] && c->number != 3)
+    r.fail(override_node, "override: give 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface); "
+                          "only scenario 3 (an obstacle) has no interface");
   if (override_node["interface"]) {
     c->interface_element = r.element(override_node["interface"], "override: interface", "anticlimber");
-  } else {
+  } else if (override_node["bodies"]) {
     const auto bodies = r.list(override_node["bodies"], "override: bodies");
     if (bodies.size() != 2) r.fail(override_node["bodies"], "override: bodies must name two bodies [A, B]");
     for (const YAML::Node& b : bodies) c->interface_bodies.push_back(r.body(b, "override: bodies"));
   }
-  c->override_limit = r.positive(r.required(override_node, "limit", "override"), "override: limit");
-  c->override_source = r.text(r.required(override_node, "source", "override"), "override: source");
+  if (c->has_interface()) {
+    c->override_limit = r.positive(r.required(override_node, "limit", "override"), "override: limit");
+    c->override_source = r.text(r.required(override_node, "source", "override"), "override: source");
+  } else if (override_node["limit"] || override_node["source"]) {
+    r.fail(override_node, "override: 'limit' and 'source' belong to an interface ('interface' or 'bodies'), which this scenario has not");
+  }
   c->wheel_lift_limit = r.positive(r.required(override_node, "wheel_lift_limit", "override"), "override: wheel_lift_limit");
   c->wheel_lift_source = r.text(r.required(override_node, "wheel_lift_source", "override"), "override: wheel_lift_source");
   for (const YAML::Node& w : r.list(r.required(override_node, "wheels", "override"), "override: wheels"))
@@ -179,6 +206,13 @@ double largest_change(const std::vector<double>& values) {
   return largest;
 }
 
+double shared_crush(const std::vector<double>& crush, const std::vector<double>& shares) {
+  assert(crush.size() == shares.size());
+  double total = 0.0;
+  for (std::size_t k = 0; k < crush.size(); ++k) total += shares[k] * std::max(0.0, crush[k]);
+  return total;
+}
+
 double largest_lift(const std::vector<double>& penetration) {
   double largest = 0.0;
   for (const double p : penetration) largest = std::max(largest, -p);
@@ -193,16 +227,34 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
     front_index_.push_back(*model.find_body(g.front_body));
     rear_index_.push_back(*model.find_body(g.rear_body));
   }
+  for (const std::string& name : criteria.survival_cars) {
+    const std::vector<CarCrush> cars = cars_of(system);
+    const auto car = std::find_if(cars.begin(), cars.end(), [&](const CarCrush& c) { return c.car == name; });
+    RAILCRASH_DEMAND(car != cars.end());  // the section reader checked that a body declares the car
+    CarCrush kept = *car;  // without the excluded elements
+    kept.elements.clear();
+    kept.columns.clear();
+    kept.shares.clear();
+    for (std::size_t k = 0; k < car->elements.size(); ++k) {
+      const auto& excluded = criteria.survival_excluded;
+      if (std::find(excluded.begin(), excluded.end(), car->elements[k]) != excluded.end()) continue;
+      kept.elements.push_back(car->elements[k]);
+      kept.columns.push_back(car->columns[k]);
+      kept.shares.push_back(car->shares[k]);
+    }
+    crush_of_cars_.push_back(kept);
+  }
   if (!criteria.interface_element.empty()) {
     vertical_offset_column_ = column_of(system, criteria.interface_element + ".vertical_offset");
     override_column_ = column_of(system, criteria.interface_element + ".override");
-  } else {
+  } else if (!criteria.interface_bodies.empty()) {
     interface_lower_ = *model.find_body(criteria.interface_bodies[0]);
     interface_upper_ = *model.find_body(criteria.interface_bodies[1]);
   }
   for (const std::string& w : criteria.wheels) wheel_columns_.push_back(column_of(system, w + ".penetration"));
   vx_.resize(passenger_index_.size());
   lengths_.resize(front_index_.size());
+  car_crush_.resize(crush_of_cars_.size());
   penetration_.resize(wheel_columns_.size());
 }
 
@@ -212,10 +264,16 @@ void ScenarioTracker::sample(double t, const double* y, const double* lambda, co
   for (std::size_t k = 0; k < passenger_index_.size(); ++k) vx_[k].push_back(velocities[3 * passenger_index_[k]]);
   for (std::size_t k = 0; k < front_index_.size(); ++k) lengths_[k].push_back(distance(y, front_index_[k], rear_index_[k]));
   system_.outputs(y, lambda, outputs_.data());
+  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
+    const CarCrush& car = crush_of_cars_[k];
+    std::vector<double> crush(car.columns.size());
+    for (std::size_t e = 0; e < crush.size(); ++e) crush[e] = outputs_[static_cast<std::size_t>(car.columns[e])];
+    car_crush_[k].push_back(shared_crush(crush, car.shares));
+  }
   if (vertical_offset_column_ >= 0) {
     vertical_offset_.push_back(outputs_[static_cast<std::size_t>(vertical_offset_column_)]);
     overridden_ = overridden_ || outputs_[static_cast<std::size_t>(override_column_)] > 0.0;
-  } else {
+  } else if (interface_upper_ >= 0) {
     vertical_offset_.push_back(y[3 * interface_upper_ + 1] - y[3 * interface_lower_ + 1]);
   }
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
@@ -236,24 +294,29 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     if (!complete) r.note = "the velocity change had not ended at the end of the run";
     out.push_back(r);
   }
-  for (std::size_t k = 0; k < front_index_.size(); ++k) {
+  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
     CriterionResult r;
     r.criterion = "survival_space";
+    r.subject = criteria_.survival_cars[k];
+    r.value = *std::max_element(car_crush_[k].begin(), car_crush_[k].end());
+    r.limit = criteria_.survival_limit;
+    r.pass = r.value <= r.limit;
+    if (crush_of_cars_[k].columns.empty()) {  // nothing measured: not a pass
+      r.pass = false;
+      r.note = "not measured: the car has no crush element (no output with the crush role) besides the excluded ones";
+    }
+    out.push_back(r);
+  }
+  for (std::size_t k = 0; k < front_index_.size(); ++k) {
+    CriterionResult r;
+    r.criterion = "survival_gauge";
     r.subject = criteria_.survival_gauges[k].name;
     r.value = largest_shortening(lengths_[k]);
     r.limit = criteria_.survival_limit;
     r.pass = r.value <= r.limit;
     out.push_back(r);
   }
-  CriterionResult interface;
-  interface.criterion = "override";
-  interface.subject = criteria_.interface_element.empty() ? criteria_.interface_bodies[0] + " / " + criteria_.interface_bodies[1]
-                                                          : criteria_.interface_element;
-  interface.value = largest_change(vertical_offset_);
-  interface.limit = criteria_.override_limit;
-  interface.pass = interface.value <= interface.limit && !overridden_;
-  if (overridden_) interface.note = "the anticlimber faces overrode each other";
-  out.push_back(interface);
+  if (criteria_.has_interface()) out.push_back(interface_result());
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k) {
     CriterionResult r;
     r.criterion = "wheel_lift";
@@ -264,6 +327,18 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     out.push_back(r);
   }
   return out;
+}
+
+CriterionResult ScenarioTracker::interface_result() const {
+  CriterionResult interface;
+  interface.criterion = "override";
+  interface.subject = criteria_.interface_element.empty() ? criteria_.interface_bodies[0] + " / " + criteria_.interface_bodies[1]
+                                                          : criteria_.interface_element;
+  interface.value = largest_change(vertical_offset_);
+  interface.limit = criteria_.override_limit;
+  interface.pass = interface.value <= interface.limit && !overridden_;
+  if (overridden_) interface.note = "the anticlimber faces overrode each other";
+  return interface;
 }
 
 std::string ScenarioTracker::json() const {

@@ -158,13 +158,23 @@ expect_text "it names the train file" "$tmp/stderr" "coupled_cars.yaml"
 expect_status "a bad buffer curve" 2 "$bin" scenario 2 --train "$train" "${limits[@]}" --buffer-curve 0:0,105 \
   --buffer-unloading-stiffness 50 --buffer-height 1060
 expect_text "it names the point" "$tmp/stderr" "--buffer-curve: '105' is not a point stroke:force"
+barrier=$src/models/barrier/two_car_barrier.yaml
+barrier_limits=(--deceleration-limit 5 --survival-space-limit 50 --override-limit 100 --wheel-lift-limit 20 --passenger-bodies lead_body,trail_body)
+expect_status "scenario 1 from the barrier cars without the face stiffness" 2 "$bin" scenario 1 --train "$barrier" "${barrier_limits[@]}" --offset 40
+expect_text "it names the option" "$tmp/stderr" "missing --face-stiffness"
+expect_status "scenario 3 without the obstacle" 2 "$bin" scenario 3 --train "$barrier" "${barrier_limits[@]}" --speed 110
+expect_text "it names the option" "$tmp/stderr" "missing --obstacle-curve"
+expect_status "scenario 3 model" 0 "$bin" scenario 3 --train "$barrier" "${barrier_limits[@]}" --speed 110 --obstacle-curve 0:0,100:500,1000:800 \
+  --obstacle-unloading-stiffness 50 --obstacle-height 1000 --t-end 0.005 --out "$tmp/scenario3.yaml"
+expect_status "scenario 3 runs" 0 "$bin" run "$tmp/scenario3.yaml" --quiet --out "$tmp/scenario3"
+expect_text "summary.json has the survival space of the lead car" "$tmp/scenario3/summary.json" '"criterion": "survival_space", "subject": "s_lead"'
 # The shipped scenario models are what models/scenarios/make.sh generates, and they run
 # (10 ms, both integrators) with their criteria in summary.json.
 mkdir -p "$tmp/scenarios"
 cd "$src"
 expect_status "make.sh regenerates the scenario models" 0 models/scenarios/make.sh "$bin" "$tmp/scenarios"
 cd - > /dev/null
-for name in scenario1_report_car scenario2_report_car; do
+for name in scenario1_report_car scenario2_report_car scenario1_barrier_cars scenario2_barrier_cars; do
   if cmp -s "$tmp/scenarios/$name.yaml" "$src/models/scenarios/$name.yaml"; then passes=$((passes + 1));
   else echo "FAIL: models/scenarios/$name.yaml differs from what make.sh writes now"; failures=$((failures + 1)); fi
   for integrator in ida euler; do

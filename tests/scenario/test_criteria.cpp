@@ -97,6 +97,31 @@ TEST_CASE("scenario criteria: shortening, vertical change and wheel lift of hand
   CHECK(largest_change({0.04, 0.05, -0.02, 0.01}) == Approx(0.06));
   CHECK(largest_lift({0.001, 0.0, -0.004, -0.002}) == Approx(0.004));
   CHECK(largest_lift({0.001, 0.002}) == 0.0);
+  // A car's crush at one time: only the positive parts count, an element between two cars by half.
+  CHECK(shared_crush({0.2, -0.1, 0.6}, {1.0, 1.0, 0.5}) == Approx(0.2 + 0.0 + 0.3));
+  CHECK(shared_crush({}, {}) == 0.0);
+}
+
+TEST_CASE("scenario criteria: survival-space cars, excluded elements and the interface are checked", "[scenario]") {
+  std::string text = with(kTwoCarts, "wheels: [WHEELS]", "wheels: [faces]");
+  text = with(text, "{name: a, mass: 1000,", "{name: a, car: car_a, mass: 1000,");
+  const auto error = [](const std::string& model) {
+    try {
+      load_model_text(model, "cases.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string gauges = "gauges: [{name: ab, front: a, rear: b}]";
+  CHECK_THAT(error(with(text, gauges, "cars: [car_b]")), Catch::Contains("cases.yaml:35") && Catch::Contains("no body declares 'car: car_b'"));
+  CHECK_THAT(error(with(text, gauges, "cars: [car_a], excluded: [face]")), Catch::Contains("excluded: no element named 'face'"));
+  CHECK_THAT(error(with(text, gauges, "limit: 1")), Catch::Contains("give 'cars: [..]'"));
+  // Only scenario 3 (an obstacle) goes without an interface, and then has no override limit.
+  const std::string no_interface = with(text, "limit: 0.1, source: test, interface: faces, ", "");
+  CHECK_THAT(error(no_interface), Catch::Contains("only scenario 3 (an obstacle) has no interface"));
+  CHECK_THAT(error(with(with(text, "number: 1", "number: 3"), "interface: faces, ", "")), Catch::Contains("'limit' and 'source' belong to an interface"));
+  CHECK_THAT(error(with(no_interface, "number: 1", "number: 3")), Catch::Contains("faces' is of type anticlimber"));  // the rest still checked
 }
 
 TEST_CASE("scenario criteria: the section is checked with file:line messages", "[scenario]") {

@@ -8,7 +8,7 @@
 //     standard: EN 15227        number: 1        category: C-I
 //     closing_speed: 393.7      # [length/time] what the scenario was built with
 //     mean_deceleration: {limit: 1930.4, cfc: 60, source: "...", bodies: [s1_center_body, ...]}
-//     survival_space: {limit: 1.97, source: "...",
+//     survival_space: {limit: 1.97, source: "...", cars: [s1, t1], excluded: [wagon_buffers],
 //                      gauges: [{name: s1, front: s1_bolster_body, rear: s1_rear_body}, ...]}
 //     override: {limit: 3.94, source: "...", interface: anticlimber,
 //                wheel_lift_limit: 0.83, wheel_lift_source: "...", wheels: [s1_front_truck_wheel_1, ...]}
@@ -19,13 +19,18 @@
 //   mean deceleration  per body: its longitudinal velocity vx(t), low-pass filtered at the
 //                      channel class `cfc` (results/cfc_filter.hpp), then the collision pulse
 //                      of results/crash_pulse.hpp: |velocity change| / duration of the collision.
-//   survival space     per gauge: the largest shortening of the distance between the two
-//                      bodies' centres of gravity, L(0) - L(t), over the run.
+//   survival space     per car (`cars:`): the largest crush of the car over the run, the sum of
+//                      its crush outputs (OutputRole::Crush) as results' car_crush counts them
+//                      (an element between two cars by half), without the `excluded:` elements
+//                      (crush zones, the struck wagon's buffers or obstacle);
+//   survival gauge     per gauge (`gauges:`, optional, beside): the largest shortening of the
+//                      distance between the two bodies' centres of gravity, L(0) - L(t).
 //   override           the interface anticlimber's vertical_offset: largest |v(t) - v(0)| (the
 //                      vertical relative displacement of the faces), and its `override` output
 //                      (the faces have slid past each other: fails whatever the limit); or,
 //                      with `bodies: [A, B]` instead of `interface`, the largest change of
-//                      y_B - y_A (scenario 2: the train's front end and the wagon);
+//                      y_B - y_A (scenario 2: the train's front end and the wagon); scenario 3
+//                      has neither (and no override limit): only the wheel lift;
 //                      wheel lift: the largest lift max(0, -penetration) of the listed wheel_rail
 //                      elements (the leading bogies' wheels).
 #pragma once
@@ -36,6 +41,7 @@
 #include <vector>
 
 #include "railcrash/integrator.hpp"
+#include "railcrash/results.hpp"
 
 namespace YAML {
 class Node;
@@ -59,6 +65,8 @@ struct ScenarioCriteria {
   struct Gauge {
     std::string name, front_body, rear_body;
   };
+  std::vector<std::string> survival_cars;  // cars (bodies' car:) whose crush outputs are the survival-space loss
+  std::vector<std::string> survival_excluded;  // crush elements that are not survival space (crush zones, the struck body's)
   std::vector<Gauge> survival_gauges;
   double survival_limit = 0.0;  // [length] largest allowed shortening
   std::string survival_source;
@@ -70,6 +78,10 @@ struct ScenarioCriteria {
   std::vector<std::string> wheels; // wheel_rail elements of the leading bogies
   double wheel_lift_limit = 0.0;   // [length]
   std::string wheel_lift_source;
+
+  /// Scenarios 1 and 2 have an interface whose vertical relative displacement is the override
+  /// criterion; scenario 3 (an obstacle) has none.
+  bool has_interface() const { return !interface_element.empty() || !interface_bodies.empty(); }
 };
 
 /// Reads and checks a `scenario:` section against the model's bodies and elements. `fail`
@@ -98,6 +110,9 @@ double filtered_mean_deceleration(const std::vector<double>& times, const std::v
 double largest_shortening(const std::vector<double>& lengths);
 /// Largest |v(t) - v(0)|.
 double largest_change(const std::vector<double>& values);
+/// Crush of a car at one time [length]: sum of share x max(0, crush) over its crush outputs
+/// (as results.hpp's car_crush: share 1, or 1/2 for an element between two cars).
+double shared_crush(const std::vector<double>& crush, const std::vector<double>& shares);
 /// Largest lift max(0, -penetration) of a wheel [length].
 double largest_lift(const std::vector<double>& penetration);
 
@@ -113,12 +128,15 @@ class ScenarioTracker : public RunObserver {
  private:
   const DaeSystem& system_;
   const ScenarioCriteria& criteria_;
+  CriterionResult interface_result() const;
+
   std::vector<int> passenger_index_, front_index_, rear_index_;
+  std::vector<CarCrush> crush_of_cars_;                 // of survival_cars, in their order
   int vertical_offset_column_ = -1, override_column_ = -1;
   int interface_lower_ = -1, interface_upper_ = -1;  // bodies of interface_bodies
   std::vector<int> wheel_columns_;
   std::vector<double> outputs_, times_;
-  std::vector<std::vector<double>> vx_, lengths_, penetration_;
+  std::vector<std::vector<double>> vx_, lengths_, penetration_, car_crush_;
   std::vector<double> vertical_offset_;
   bool overridden_ = false;
 };

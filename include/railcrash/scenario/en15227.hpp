@@ -16,7 +16,9 @@
 //   categories' speeds): for C-II..C-IV, --speed is required.
 //   Required, because no public source confirmed them: the vertical offset of scenario 1, the
 //   mean-deceleration limit, the survival-space limit, the override and wheel-lift limits, the
-//   side buffers' force-stroke characteristic and their height.
+//   side buffers' force-stroke characteristic and their height, scenario 3's speed (any
+//   category), the obstacle's force-crush characteristic and its contact height.
+//   The obstacle mass 15 t: railwaynews.net (above), scenario 3; the default of --obstacle-mass.
 //
 // Scenario 1 (make_scenario_model, number 1): the template's STRIKING car (car1_*) is the unit's
 // car; the standing train is its mirror image about the coupler faces (x -> -x of every
@@ -31,8 +33,18 @@
 // wheels are not modelled) and the two side buffers as one crush_spring (the buffer curve with
 // twice the force: two buffers in parallel) at the buffer height between the train's front end
 // (at its anticlimber face) and the wagon.
-// Scenarios 3 and 4 are refused with the reason: 3's reference obstacle could not be confirmed
-// from a public source; 4's obstacle is pushed sideways, out of the plane.
+// Any other car model whose bodies declare `car: NAME` (e.g. the barrier test's two cars) is a
+// train unit (scenario/train_unit.hpp: its striking end found from the elements' output roles):
+// scenario 1 puts the unit (s_*) against its mirror image (t_*), their front faces meeting at an
+// uncoupled coupler_end (front_faces, the face stiffness and height required inputs); --cars is
+// then the unit's own cars.
+// Scenario 3: the train at --speed (required: the speed per category was not confirmed) into an
+// obstacle of 15 t (railwaynews.net, scenario 3) built like the wagon: one body on a frictionless
+// slider and a crush_spring with the obstacle's force-crush curve (required) at its contact height
+// (required). No interface: override is judged by the leading bogie's wheel lift.
+// The struck body's spring (wagon_buffers, obstacle_crush) and --crush-zones are left out of the
+// survival-space loss (the cars' crush outputs, scenario/criteria.hpp).
+// Scenario 4 is refused with the reason: its obstacle is pushed sideways, out of the plane.
 #pragma once
 
 #include <optional>
@@ -44,7 +56,7 @@ namespace railcrash {
 
 struct ScenarioRequest {
   int number = 0;                    // 1..4
-  std::string train_path;            // two-car template (car1_* striking, car2_* standing)
+  std::string train_path;            // two-car template (car1_* striking, car2_* standing) or a unit model (cars declared)
   int cars = 1;                      // cars per train
   std::string category = "C-I";
   std::optional<double> speed;                  // [km/h] closing speed
@@ -53,12 +65,20 @@ struct ScenarioRequest {
   std::optional<double> survival_limit;         // [mm] largest shortening of a survival-space gauge
   std::optional<double> override_limit;         // [mm] largest vertical relative displacement
   std::optional<double> wheel_lift_limit;       // [mm]
-  std::vector<std::string> passenger_bodies;    // template bodies without the car1_ prefix
-  std::vector<std::string> survival_gauge;      // two template bodies (front, rear) without car1_
+  std::vector<std::string> passenger_bodies;    // train model bodies (a template's without the car1_ prefix)
+  std::vector<std::string> crush_zones;         // crush elements (named as passenger_bodies) whose crush is allowed:
+                                                // left out of the survival-space loss
+  std::vector<std::string> survival_gauge;      // optional: two bodies (front, rear), named as passenger_bodies
   double wagon_mass = 80.0;                     // [t] scenario 2
   std::vector<std::pair<double, double>> buffer_curve;  // [mm, kN] one buffer's force-stroke curve
   std::optional<double> buffer_unloading_stiffness;     // [kN/mm] one buffer
   std::optional<double> buffer_height;                  // [mm] above the rail
+  std::optional<double> face_stiffness;                 // [kN/mm] scenario 1 from a unit model: each front face
+  std::optional<double> face_height;                    // [mm] scenario 1 from a unit model: each front face
+  double obstacle_mass = 15.0;                          // [t] scenario 3
+  std::vector<std::pair<double, double>> obstacle_curve;  // [mm, kN] scenario 3: the obstacle's force-crush curve
+  std::optional<double> obstacle_unloading_stiffness;   // [kN/mm] scenario 3
+  std::optional<double> obstacle_height;                // [mm] scenario 3: its contact point above the rail
   std::optional<double> t_end;                          // [s] default: the template's
 };
 

@@ -162,7 +162,7 @@
       if (sc) {  // EN 15227 criteria (scenario/criteria.hpp): one row per criterion and subject
         row(sc.standard + " scenario " + sc.number + " (" + sc.category + ")",
             (sc.pass ? "PASS" : "FAIL") + ": every criterion below" +
-            ((sc.criteria || []).some(function (c) { return c.note; }) ? " (see the notes: the run may not cover the whole collision)" : "") +
+            ((sc.criteria || []).some(function (c) { return c.note; }) ? " (see the notes below)" : "") +
             "; closing speed " + fmt(sc.closing_speed) + " " + lengthUnit + "/s",
             sc.pass ? "status-ok" : "status-failed");
         (sc.criteria || []).forEach(function (c) {
