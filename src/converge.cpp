@@ -598,13 +598,20 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
       batch, [&](std::size_t k, BatchRunState) {
         if (on_run) on_run(runs[k]);
       });
-  for (std::size_t k = 0; k < jobs.size(); ++k)
-    if (states[k] == BatchRunState::not_started) {
+  result.runs_total = jobs.size();
+  result.runs_finished = finished_runs(states);
+  result.interrupted = result.runs_finished < result.runs_total;
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    if (states[k] == BatchRunState::interrupted) {
+      runs[k].ok = false;
+      runs[k].message = "interrupted (SIGINT/SIGTERM): " + runs[k].message;
+    } else if (states[k] == BatchRunState::not_started) {
       runs[k].method = jobs[k].method;
       runs[k].step = jobs[k].step;
       runs[k].rtol = jobs[k].rtol;
       runs[k].message = "not run (interrupted)";
     }
+  }
   result.jobs = std::max(1, std::min<int>(plan.options.jobs, static_cast<int>(jobs.size())));
 
   result.reference = runs[0];
@@ -636,6 +643,9 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
 std::string convergence_markdown(const ConvergeResult& r) {
   std::ostringstream md;
   const std::size_t nq = r.quantities.size();
+  if (r.interrupted)
+    md << "**Interrupted after " << r.runs_finished << " of " << r.runs_total
+       << " runs** (SIGINT/SIGTERM): the runs not finished are marked failed and left out of the analysis.\n\n";
   md << "Model `" << r.model_path << "` (" << r.model_name << "), t_end " << r.t_end << " s, output every "
      << r.output_interval << " s; " << r.euler.size() << " Euler and " << r.ida.size() << " IDA runs against an IDA reference at rtol "
      << r.reference.rtol << "; " << r.jobs << " job" << (r.jobs > 1 ? "s (wall times under parallel load)" : "") << "; "

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/table_text.hpp"
@@ -44,14 +45,6 @@ void check_keys(const std::string& path, const YAML::Node& map, const std::set<s
 std::string scalar_text(const std::string& path, const YAML::Node& node, const std::string& context) {
   if (!node || !node.IsScalar() || node.Scalar().empty()) readings_error(path, node, context + " must be a word");
   return node.Scalar();
-}
-
-std::string model_text_of(const std::string& model_path) {
-  std::ifstream in(model_path);
-  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
 }
 
 std::string format(double value, const char* spec = "%.3f") { return table_number(value, spec); }
@@ -163,6 +156,7 @@ SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, 
         throw InputError(SourceLocation{path, level.line}.prefix() + "reading '" + readings[r].name + "', level '" + level.name +
                          "': the design has no parameter '" + name + "'");
       it->scales = scales;
+      it->scale_sources.assign(scales.size(), SourceLocation{path, level.line});
     }
   }
   return changed;
@@ -250,7 +244,7 @@ ReadingsPlan load_readings(const std::string& path) {
 }
 
 void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
-  const std::string text = model_text_of(model_path);
+  const std::string text = read_model_text(model_path);
   for (const Reading& reading : plan.readings)
     for (const ReadingLevel& level : reading.levels) {
       try {
@@ -270,25 +264,6 @@ void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
 }
 
 namespace {
-
-// Every key a design parameter scales must be a number of the model (else its run would fail
-// only when it executes). With `unchanged_from`, parameters that scale as they do there are
-// not checked again (a level's settings cannot remove a key the other combination had).
-void check_design_keys(const SensitivityDesign& design, const std::string& model_path, const std::vector<std::string>& settings,
-                       const SensitivityDesign* unchanged_from = nullptr) {
-  const std::string text = model_text_of(model_path);
-  for (std::size_t i = 0; i < design.parameters.size(); ++i) {
-    const SensitivityParameter& p = design.parameters[i];
-    if (unchanged_from && unchanged_from->parameters[i].scales == p.scales) continue;
-    std::vector<std::string> all = settings;
-    for (const auto& scale : p.scales) all.push_back(scale.first + "*=1");
-    try {
-      (void)load_model_text(text, model_path, all);
-    } catch (const InputError& e) {
-      throw InputError("design parameter " + p.name + " does not fit the model: " + e.what());
-    }
-  }
-}
 
 double response_of(const Responses& r, int k) { return k == 0 ? r.r1 : (k == 1 ? r.r2 : r.r3); }
 
@@ -499,17 +474,23 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
                      "models/report/sensitivity_design.yaml does");
   check_readings(plan, model_path);
   const std::vector<std::vector<int>> combinations = plan.combinations();
+  // Every combination's runs are checked before the first run starts (the first combination's
+  // run by run, the others with all their factors at once: check_sensitivity_inputs).
+  const std::string model_text = read_model_text(model_path);
   std::vector<SensitivityDesign> designs;
   for (const std::vector<int>& combination : combinations) {
     designs.push_back(plan.design_for(combination, design));
+    SensitivityOptions study = options.study;
+    study.settings = plan.settings(combination);
     try {
-      check_design_keys(designs.back(), model_path, plan.settings(combination), designs.size() > 1 ? &designs.front() : nullptr);
+      check_sensitivity_inputs(model_text, model_path, designs.back(), study, designs.size() == 1);
     } catch (const InputError& e) {
-      throw InputError(plan.path + ": the combination " + plan.label(combination) + ": " + e.what());
+      throw InputError(e.what() + std::string(" (readings ") + plan.path + ", combination " + plan.label(combination) + ")");
     }
   }
   std::vector<ReadingsCombinationResult> results;
   for (std::size_t c = 0; c < combinations.size(); ++c) {
+    if (options.study.stop && options.study.stop->load()) break;
     const auto start = std::chrono::steady_clock::now();
     SensitivityOptions study = options.study;
     study.settings = plan.settings(combinations[c]);
@@ -517,12 +498,14 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
     r.levels = combinations[c];
     r.study = run_sensitivity(model_path, designs[c], study);
     r.agreement = score_agreement(r.study, designs[c]);
-    r.failed_runs = r.study.base.ok ? 0 : 1;
-    for (const auto& run : r.study.runs) r.failed_runs += run.ok ? 0 : 1;
-    for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok ? 0 : 1;
+    r.failed_runs = r.study.base.ok || r.study.base.interrupted ? 0 : 1;
+    for (const auto& run : r.study.runs) r.failed_runs += run.ok || run.interrupted ? 0 : 1;
+    for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok || run.interrupted ? 0 : 1;
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (options.progress) options.progress(r, c, combinations.size());
+    const bool interrupted = r.study.interrupted;
     results.push_back(std::move(r));
+    if (interrupted) break;
   }
   return results;
 }
@@ -569,7 +552,14 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
   if (!csv) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.csv").string());
 
   std::ostringstream md;
-  md << "# Reading study\n\n"
+  md << "# Reading study\n\n";
+  const std::size_t planned = plan.combinations().size();
+  const std::size_t complete = static_cast<std::size_t>(std::count_if(
+      results.begin(), results.end(), [](const ReadingsCombinationResult& r) { return !r.study.interrupted; }));
+  if (complete < planned)
+    md << "**Interrupted after " << complete << " of " << planned << " combinations** (SIGINT/SIGTERM)"
+       << (complete < results.size() ? "; the last one listed is partial (its unfinished runs count as failed)" : "") << ".\n\n";
+  md
      << "Readings file `" << plan.path << "`, " << results.size() << " combinations ("
      << (plan.one_at_a_time ? "one at a time" : "factorial") << "), each scored against the design's published results"
      << (design.reference && !design.reference->source.empty() ? " (" + design.reference->source + ")" : std::string()) << ".\n\n"

@@ -205,6 +205,73 @@ std::vector<std::string> job_settings(const SensitivityDesign& design, const Job
   return settings;
 }
 
+void check_options(const SensitivityDesign& design, const SensitivityOptions& options) {
+  if (options.central_step < 0.0 || options.central_step >= 1.0)
+    throw InputError("--central H: H must be between 0 and 1 (e.g. 0.05 for runs at 0.95 and 1.05)");
+  for (const std::string& name : options.only)
+    if (!find_parameter(design, name))
+      throw InputError("--only: the design has no parameter '" + name + "' (it has " + parameter_names(design) + ")");
+}
+
+bool is_chosen(const SensitivityOptions& options, const std::string& name) {
+  return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+}
+
+/// The study's runs in order: the base run, the first-order runs (first_order_count of them),
+/// then the second-order runs whose parameters are all chosen.
+std::vector<Job> study_jobs(const SensitivityDesign& design, const SensitivityOptions& options, std::size_t& first_order_count) {
+  check_options(design, options);
+  const bool central = options.central_step > 0.0;
+  std::vector<Job> jobs{Job{}};
+  first_order_count = 0;
+  for (const SensitivityParameter& p : design.parameters) {
+    if (!is_chosen(options, p.name)) continue;
+    const std::vector<double> values = central ? std::vector<double>{1.0 + options.central_step, 1.0 - options.central_step}
+                                               : std::vector<double>{design.factor};
+    for (double value : values) jobs.push_back(Job{{{p.name, value}}, p.name, value});
+    first_order_count += values.size();
+  }
+  if (options.second_order)
+    for (const SensitivityPoint& point : design.second_order.runs) {
+      if (!std::all_of(point.begin(), point.end(), [&](const auto& entry) { return is_chosen(options, entry.first); })) continue;
+      Job job{point, "", point.size() == 1 ? point[0].second : kNaN};
+      for (const auto& entry : point) job.parameter += (job.parameter.empty() ? "" : "+") + entry.first;
+      jobs.push_back(job);
+    }
+  return jobs;
+}
+
+/// The scale entry of a job's parameters that the model does not accept on its own, as
+/// "design.yaml:12: design parameter 'P7', scale key 'K' does not fit the model: ...", or "".
+std::string bad_scale_entry(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+                            const Job& job, const std::vector<std::string>& base_settings) {
+  for (const auto& [name, value] : job.variation) {
+    const SensitivityParameter* parameter = find_parameter(design, name);
+    RAILCRASH_DEMAND(parameter != nullptr);
+    for (std::size_t k = 0; k < parameter->scales.size(); ++k) {
+      const auto& [key, power] = parameter->scales[k];
+      const SensitivityParameter single{name, "", {{key, power}}, {}};
+      const SensitivityDesign alone{1.2, {single}, {}, std::nullopt};
+      try {
+        (void)load_model_text(model_text, model_path, job_settings(alone, Job{{{name, value}}, name, value}, base_settings));
+      } catch (const InputError& e) {
+        const SourceLocation where = k < parameter->scale_sources.size() ? parameter->scale_sources[k] : SourceLocation{};
+        return where.prefix() + "design parameter '" + name + "', scale key '" + key + "' does not fit the model: " + e.what();
+      }
+    }
+  }
+  return "";
+}
+
+/// A run the study's interruption stopped (or never started): failed, with no responses (a
+/// partial run's would look like results).
+void mark_interrupted(SensitivityRun& run) {
+  run.ok = false;
+  run.interrupted = true;
+  run.responses.r1 = run.responses.r2 = run.responses.r3 = kNaN;
+  if (run.message.empty()) run.message = "interrupted (SIGINT/SIGTERM)";
+}
+
 SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
                        const Job& job, const std::vector<std::string>& base_settings, double time_limit,
                        const RunControl& control) {
@@ -293,6 +360,7 @@ SensitivityDesign load_design(const std::string& path) {
       const YAML::Node s = p["scale"][k];
       if (!s.IsMap() || !s["key"]) design_error(path, s, "parameter '" + parameter.name + "': each scale entry needs 'key'");
       parameter.scales.emplace_back(s["key"].as<std::string>(), s["power"] ? s["power"].as<double>() : 1.0);
+      parameter.scale_sources.push_back(SourceLocation{path, yaml_line(s)});
     }
     design.parameters.push_back(std::move(parameter));
   }
@@ -392,74 +460,80 @@ QuadraticFit fit_quadratic(const std::vector<SensitivityTerm>& terms, const std:
   return fit;
 }
 
-SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
-                                  const SensitivityOptions& options) {
-  if (options.central_step < 0.0 || options.central_step >= 1.0)
-    throw InputError("--central H: H must be between 0 and 1 (e.g. 0.05 for runs at 0.95 and 1.05)");
-  for (const std::string& name : options.only)
-    if (!find_parameter(design, name))
-      throw InputError("--only: the design has no parameter '" + name + "' (it has " + parameter_names(design) + ")");
-  const auto chosen = [&](const std::string& name) {
-    return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
-  };
-  std::string model_text;
-  {
-    std::ifstream in(model_path);
-    if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    model_text = buffer.str();
-  }
-  SensitivityResult result;
-  result.central = options.central_step > 0.0;
-
-  std::vector<Job> jobs{Job{}};
+void check_sensitivity_inputs(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+                              const SensitivityOptions& options, bool every_run) {
   std::size_t first_order_count = 0;
-  for (const SensitivityParameter& p : design.parameters) {
-    if (!chosen(p.name)) continue;
-    const std::vector<double> values =
-        result.central ? std::vector<double>{1.0 + options.central_step, 1.0 - options.central_step}
-                       : std::vector<double>{design.factor};
-    for (double value : values) jobs.push_back(Job{{{p.name, value}}, p.name, value});
-    first_order_count += values.size();
-  }
-  std::vector<SensitivityTerm> terms;
-  if (options.second_order) {
-    for (const SensitivityPoint& point : design.second_order.runs) {
-      if (!std::all_of(point.begin(), point.end(), [&](const auto& entry) { return chosen(entry.first); })) continue;
-      Job job{point, "", point.size() == 1 ? point[0].second : kNaN};
-      for (const auto& entry : point) job.parameter += (job.parameter.empty() ? "" : "+") + entry.first;
-      jobs.push_back(job);
-    }
-    for (const SensitivityTerm& t : design.second_order.terms)
-      if (chosen(t.first) && (t.linear() || chosen(t.second))) terms.push_back(t);
-  }
-
-  // Every run's model is loaded once before the first run, so that a parameter whose model value
-  // is 0 (a factor would change nothing, and the study would call it "no effect") stops the study
-  // at once. Other input errors stay with their run (reported failed; the others go on).
-  for (const Job& job : jobs)
+  const std::vector<Job> jobs = study_jobs(design, options, first_order_count);
+  const auto check = [&](const std::vector<std::string>& settings, const Job& job) {
     try {
-      (void)load_model_text(model_text, model_path, job_settings(design, job, options.settings));
-    } catch (const ZeroScaledError& e) {
-      throw InputError(std::string(e.what()) + " (design parameter " + job.parameter + ")");
+      (void)load_model_text(model_text, model_path, settings);
+    } catch (const InputError& e) {
+      const std::string entry = bad_scale_entry(model_text, model_path, design, job, options.settings);
+      if (!entry.empty()) throw InputError(entry);
+      throw InputError(std::string(e.what()) + (job.parameter.empty() ? " (the base run)" : " (design parameter " + job.parameter + ")"));
+    }
+  };
+  if (!every_run) {
+    // Every parameter's factors at once: one load finds a missing key or a zero value; the runs
+    // are loaded one by one only to name the entry.
+    std::vector<std::string> all = options.settings;
+    for (std::size_t k = 1; k < jobs.size(); ++k) {
+      const std::vector<std::string> settings = job_settings(design, jobs[k], {});
+      all.insert(all.end(), settings.begin(), settings.end());
+    }
+    try {
+      (void)load_model_text(model_text, model_path, all);
+      return;
     } catch (const InputError&) {
     }
+  }
+  // Every run's model, as the run will load it: a scale key the model lacks, a bad value, or a
+  // parameter whose model value is 0 (a factor would change nothing, and the study would call it
+  // "no effect") stops the study before its first run.
+  for (const Job& job : jobs) check(job_settings(design, job, options.settings), job);
+}
+
+SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
+                                  const SensitivityOptions& options) {
+  const std::string model_text = read_model_text(model_path);
+  check_sensitivity_inputs(model_text, model_path, design, options, true);
+  SensitivityResult result;
+  result.central = options.central_step > 0.0;
+  std::size_t first_order_count = 0;
+  const std::vector<Job> jobs = study_jobs(design, options, first_order_count);
+  std::vector<SensitivityTerm> terms;
+  if (options.second_order)
+    for (const SensitivityTerm& t : design.second_order.terms)
+      if (is_chosen(options, t.first) && (t.linear() || is_chosen(options, t.second))) terms.push_back(t);
 
   std::vector<SensitivityRun> runs(jobs.size());
   std::size_t done = 0;
   BatchOptions batch;
   batch.jobs = options.jobs;
   batch.run_time_limit = options.run_time_limit;
-  run_batch(
+  batch.stop = options.stop;
+  const std::vector<BatchRunState> states = run_batch(
       jobs.size(),
       [&](std::size_t k, const RunControl& control) {
         runs[k] = run_one(model_path, model_text, design, jobs[k], options.settings, options.run_time_limit, control);
       },
       batch,
-      [&](std::size_t k, BatchRunState) {
+      [&](std::size_t k, BatchRunState state) {
+        if (state == BatchRunState::interrupted) mark_interrupted(runs[k]);
         if (options.progress) options.progress(runs[k], k, ++done, jobs.size());
       });
+  result.runs_total = jobs.size();
+  result.runs_finished = finished_runs(states);
+  result.interrupted = result.runs_finished < result.runs_total;
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    if (states[k] == BatchRunState::not_started) {
+      runs[k].variation = jobs[k].variation;
+      runs[k].parameter = jobs[k].parameter;
+      runs[k].factor = jobs[k].factor;
+      mark_interrupted(runs[k]);
+      runs[k].message = "not run: the study was interrupted";
+    }
+  }
 
   result.base = runs[0];
   result.runs.assign(runs.begin() + 1, runs.begin() + 1 + static_cast<std::ptrdiff_t>(first_order_count));
@@ -545,6 +619,9 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
   const auto parameter_of = [&](std::size_t i) { return result.runs[per_parameter * i].parameter; };
   const auto percent = [&](double now, double base) { return base != 0.0 ? 100.0 * (now - base) / base : 0.0; };
   std::ostringstream md;
+  if (result.interrupted)
+    md << "**Interrupted after " << result.runs_finished << " of " << result.runs_total
+       << " runs** (SIGINT/SIGTERM): the runs not finished are marked interrupted, and the fits use the finished runs only.\n\n";
 
   // Runs: sensitivity.csv, and Table 11 / Tables 12-13 in the Markdown.
   {
@@ -561,7 +638,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
         values += (values.empty() ? "" : " ") + number(value, "%g");
       }
       const int order = k == 0 ? 0 : (k <= result.runs.size() ? 1 : 2);
-      csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : "failed") << ','
+      csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : (r.interrupted ? "interrupted" : "failed")) << ','
           << csv_number(r.responses.r1) << ',' << csv_number(r.responses.r2) << ',' << csv_number(r.responses.r3) << ','
           << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << '\n';
     }

@@ -14,6 +14,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
@@ -246,14 +247,6 @@ std::vector<std::vector<double>> monte_carlo(std::size_t samples, std::size_t fa
 }
 
 // ---------------------------------------------------------------- plan
-
-std::string read_model_text(const std::string& model_path) {
-  std::ifstream in(model_path);
-  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
 
 SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path) {
   const YAML::Node root = load_yaml_file(path, "plan file");

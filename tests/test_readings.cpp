@@ -63,7 +63,7 @@ TEST_CASE("combinations: factorial odometer and one at a time", "[readings]") {
 
 TEST_CASE("a study is scored against published results: errors, signs, rank correlation, top five", "[readings]") {
   SensitivityDesign design;
-  for (int i = 1; i <= 6; ++i) design.parameters.push_back({"P" + std::to_string(i), "", {}});
+  for (int i = 1; i <= 6; ++i) design.parameters.push_back({"P" + std::to_string(i), "", {}, {}});
   PublishedResults published;
   published.base = {1.0, 0.5, 1.5};
   // Published R1 changes: -0.1, -0.05, 0, +0.01, +0.002, -0.02 (P5's is below 0.005: no sign).
@@ -194,8 +194,8 @@ TEST_CASE("a reading study ranks first the reading that reproduces the published
 
 TEST_CASE("a reading level may change what a design parameter scales", "[readings]") {
   SensitivityDesign design;
-  design.parameters.push_back({"P5", "elastic slope", {{"elements.a.k", 1.0}}});
-  design.parameters.push_back({"P7", "yield force", {{"elements.a.d", 1.0}}});
+  design.parameters.push_back({"P5", "elastic slope", {{"elements.a.k", 1.0}}, {}});
+  design.parameters.push_back({"P7", "yield force", {{"elements.a.d", 1.0}}, {}});
   const ReadingsPlan plan = load_readings(temporary_file(
       "plan3.yaml", "reading_study: 1\nreadings:\n  - name: slope_holds\n    levels:\n      - {name: deflection}\n"
                     "      - name: force\n        scale: {P5: [{key: elements.a.k}, {key: elements.a.d, power: -1}]}\n"
