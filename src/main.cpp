@@ -312,11 +312,13 @@ int sweep_command(const std::string& path, const std::string& plan_path, int job
   const SweepPlan plan = load_sweep_plan(plan_path, path);  // every key and level checked before any run
   const auto start = std::chrono::steady_clock::now();
   const SweepResult result = run_sweep(path, plan, out_dir, options);
-  std::printf("%zu of %zu runs done (%zu resumed) with %d jobs in %.1f s; results in %s/ (runs.csv, summary.md)\n",
-              result.done(), result.specs.size(), result.resumed, options.jobs,
+  const std::size_t failed = failed_sweep_runs(plan, result);
+  std::printf("%zu of %zu runs done (%zu resumed), %zu failed, with %d jobs in %.1f s; results in %s/ (runs.csv, summary.md)\n",
+              result.done(), result.specs.size(), result.resumed, failed, options.jobs,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), out_dir.c_str());
   if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
-  return result.done() == result.specs.size() && !g_stop.load() ? 0 : 1;
+  if (failed > 0) std::printf("%zu run%s failed (status and message in runs.csv)\n", failed, failed == 1 ? "" : "s");
+  return result.done() == result.specs.size() && failed == 0 && !g_stop.load() ? 0 : 1;
 }
 
 /// Writes a generated model to out_path (standard output when empty); `what` names it on stderr.

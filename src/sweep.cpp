@@ -641,6 +641,13 @@ const char* design_name(SweepDesignKind kind) {
 
 }  // namespace
 
+std::size_t failed_sweep_runs(const SweepPlan& plan, const SweepResult& result) {
+  std::size_t failed = 0;
+  for (const auto& line : result.lines)
+    if (line && csv_fields(*line)[2 + plan.factors.size()] != "ok") ++failed;
+  return failed;
+}
+
 std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const std::string& directory) {
   std::filesystem::create_directories(directory);
   {
@@ -653,14 +660,11 @@ std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const 
   // Per finished run: the levels and the responses of ok runs.
   std::vector<std::vector<std::string>> levels;
   std::vector<std::vector<double>> values;
-  std::size_t failed = 0;
+  const std::size_t failed = failed_sweep_runs(plan, result);
   for (const auto& line : result.lines) {
     if (!line) continue;
     const std::vector<std::string> fields = csv_fields(*line);
-    if (fields[2 + factor_count] != "ok") {
-      ++failed;
-      continue;
-    }
+    if (fields[2 + factor_count] != "ok") continue;
     levels.emplace_back(fields.begin() + 2, fields.begin() + 2 + static_cast<std::ptrdiff_t>(factor_count));
     values.emplace_back();
     for (std::size_t r = 0; r < plan.responses.size(); ++r) {
