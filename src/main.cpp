@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -53,6 +54,31 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
   const DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const AssemblyReport assembly = assemble_initial_state(system, y);
+  // What `run` does next: consistent accelerations and joint reactions at the start. A model
+  // whose equations are singular there (a body with zero inertia that no joint holds) cannot
+  // run, so `check` refuses it as input.
+  std::vector<double> y_start = y, yp_start;
+  try {
+    consistent_rates(system, 0.0, y_start, yp_start);
+  } catch (const SolverError& e) {
+    SourceLocation where{path, 0};
+    for (const Body& b : model.bodies())
+      if (b.inertia == 0.0 && where.line == 0) where = b.where;  // the first body the message names
+    throw InputError(where.prefix() + e.what());
+  }
+  // The element outputs at the start: a run whose first sample has a non-finite one fails.
+  std::vector<double> outputs(system.output_names().size());
+  system.outputs(y_start.data(), y_start.data() + 2 * system.body_unknowns(), outputs.data());
+  for (std::size_t k = 0; k < outputs.size(); ++k)
+    if (!std::isfinite(outputs[k])) {
+      const std::string& column = system.output_names()[k];  // "<element>.<output>"
+      const std::string element = column.substr(0, column.rfind('.'));
+      SourceLocation where{path, 0};
+      for (const auto& e : model.elements())
+        if (e->name() == element) where = e->where();
+      throw InputError(where.prefix() + "element '" + element + "': its output '" + column.substr(column.rfind('.') + 1) + "' is " +
+                       std::to_string(outputs[k]) + " at t = 0; check the element's numbers (a value too large or too small)");
+    }
   int constraint_elements = 0;
   for (const auto& e : model.elements()) constraint_elements += e->constraint_count() > 0;
   std::printf("model      %s  (%s)\n", model.name.c_str(), path.c_str());
