@@ -26,24 +26,17 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-[[noreturn]] void readings_error(const std::string& path, const YAML::Node& node, const std::string& message) {
-  const int line = node && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-  throw InputError(SourceLocation{path, line}.prefix() + message);
-}
-
-int line_of(const YAML::Node& node) { return node && !node.Mark().is_null() ? node.Mark().line + 1 : 0; }
-
 void check_keys(const std::string& path, const YAML::Node& map, const std::set<std::string>& allowed, const std::string& context) {
   std::string list;
   for (const std::string& k : allowed) list += (list.empty() ? "" : ", ") + k;
   for (const auto& entry : map) {
     const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-    if (!allowed.count(key)) readings_error(path, entry.first, context + ": unknown key '" + key + "' (allowed: " + list + ")");
+    if (!allowed.count(key)) yaml_error(path, entry.first, context + ": unknown key '" + key + "' (allowed: " + list + ")");
   }
 }
 
 std::string scalar_text(const std::string& path, const YAML::Node& node, const std::string& context) {
-  if (!node || !node.IsScalar() || node.Scalar().empty()) readings_error(path, node, context + " must be a word");
+  if (!node || !node.IsScalar() || node.Scalar().empty()) yaml_error(path, node, context + " must be a word");
   return node.Scalar();
 }
 
@@ -165,70 +158,70 @@ SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, 
 ReadingsPlan load_readings(const std::string& path) {
   const YAML::Node root = load_yaml_file(path, "readings file");
   if (!root.IsMap() || !root["reading_study"])
-    readings_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
+    yaml_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
   check_keys(path, root, {"reading_study", "description", "combinations", "readings"}, "readings file");
   if (!root["reading_study"].IsScalar() || root["reading_study"].Scalar() != "1")
-    readings_error(path, root["reading_study"], "reading_study must be 1");
+    yaml_error(path, root["reading_study"], "reading_study must be 1");
   ReadingsPlan plan;
   plan.path = path;
   if (root["combinations"]) {
     const std::string how = scalar_text(path, root["combinations"], "combinations");
     if (how != "factorial" && how != "one_at_a_time")
-      readings_error(path, root["combinations"], "combinations must be factorial or one_at_a_time");
+      yaml_error(path, root["combinations"], "combinations must be factorial or one_at_a_time");
     plan.one_at_a_time = how == "one_at_a_time";
   }
   const YAML::Node list = root["readings"];
   if (!list || !list.IsSequence() || list.size() == 0)
-    readings_error(path, list ? list : root, "'readings' must list at least one reading: - {name, levels: [{name, set: {KEY: VALUE}}]}");
+    yaml_error(path, list ? list : root, "'readings' must list at least one reading: - {name, levels: [{name, set: {KEY: VALUE}}]}");
   std::set<std::string> names;
   for (const YAML::Node& node : list) {
-    if (!node.IsMap()) readings_error(path, node, "each reading is a map with name, description and levels");
+    if (!node.IsMap()) yaml_error(path, node, "each reading is a map with name, description and levels");
     check_keys(path, node, {"name", "description", "levels"}, "reading");
     Reading reading;
     reading.name = scalar_text(path, node["name"], "reading: name");
-    reading.line = line_of(node);
-    if (!names.insert(reading.name).second) readings_error(path, node["name"], "reading '" + reading.name + "' is listed twice");
+    reading.line = yaml_line(node);
+    if (!names.insert(reading.name).second) yaml_error(path, node["name"], "reading '" + reading.name + "' is listed twice");
     if (node["description"]) reading.description = node["description"].as<std::string>();
     const std::string context = "reading '" + reading.name + "'";
     const YAML::Node levels = node["levels"];
     if (!levels || !levels.IsSequence() || levels.size() == 0)
-      readings_error(path, levels ? levels : node, context + ": 'levels' must list at least one level {name, set: {KEY: VALUE}}");
+      yaml_error(path, levels ? levels : node, context + ": 'levels' must list at least one level {name, set: {KEY: VALUE}}");
     std::set<std::string> level_names;
     for (const YAML::Node& l : levels) {
-      if (!l.IsMap()) readings_error(path, l, context + ": each level is a map {name, set}");
+      if (!l.IsMap()) yaml_error(path, l, context + ": each level is a map {name, set}");
       check_keys(path, l, {"name", "set", "scale"}, context + " level");
       ReadingLevel level;
       level.name = scalar_text(path, l["name"], context + ": level name");
-      level.line = line_of(l);
-      if (!level_names.insert(level.name).second) readings_error(path, l["name"], context + ": level '" + level.name + "' is listed twice");
+      level.line = yaml_line(l);
+      if (!level_names.insert(level.name).second) yaml_error(path, l["name"], context + ": level '" + level.name + "' is listed twice");
       if (const YAML::Node set = l["set"]) {
-        if (!set.IsMap()) readings_error(path, set, context + ", level '" + level.name + "': 'set' must map model keys to values");
+        if (!set.IsMap()) yaml_error(path, set, context + ", level '" + level.name + "': 'set' must map model keys to values");
         for (const auto& entry : set) {
           const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-          if (key.empty()) readings_error(path, entry.first, context + ": a key must be a model key such as elements.x.stiffness");
+          if (key.empty()) yaml_error(path, entry.first, context + ": a key must be a model key such as elements.x.stiffness");
           if (!entry.second.IsDefined() || entry.second.IsNull())
-            readings_error(path, entry.first, context + ", level '" + level.name + "': give a value for '" + key + "'");
+            yaml_error(path, entry.first, context + ", level '" + level.name + "': give a value for '" + key + "'");
           // "elements.x.stiffness*: 1.2" becomes KEY*=FACTOR (a scaling), anything else KEY=VALUE.
           level.settings.push_back(key + "=" + YAML::Dump(entry.second));
         }
       }
       if (const YAML::Node scale = l["scale"]) {
         const std::string where = context + ", level '" + level.name + "': scale";
-        if (!scale.IsMap()) readings_error(path, scale, where + " must map parameters to lists of {key, power}");
+        if (!scale.IsMap()) yaml_error(path, scale, where + " must map parameters to lists of {key, power}");
         for (const auto& entry : scale) {
           const std::string parameter = scalar_text(path, entry.first, where + ": a parameter name");
           if (!entry.second.IsSequence() || entry.second.size() == 0)
-            readings_error(path, entry.second, where + ": " + parameter + " needs a list of {key, power}");
+            yaml_error(path, entry.second, where + ": " + parameter + " needs a list of {key, power}");
           std::vector<std::pair<std::string, double>> scales;
           for (const YAML::Node& item : entry.second) {
-            if (!item.IsMap() || !item["key"]) readings_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
+            if (!item.IsMap() || !item["key"]) yaml_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
             check_keys(path, item, {"key", "power"}, where);
             double power = 1.0;
             if (item["power"]) {
               try {
                 power = item["power"].as<double>();
               } catch (const YAML::Exception&) {
-                readings_error(path, item["power"], where + ": power must be a number");
+                yaml_error(path, item["power"], where + ": power must be a number");
               }
             }
             scales.emplace_back(scalar_text(path, item["key"], where + ": key"), power);

@@ -28,11 +28,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // entries are products of nondimensional values near 1, so round-off is near 1e-16).
 constexpr double kRankTolerance = 1e-10;
 
-[[noreturn]] void design_error(const std::string& path, const YAML::Node& node, const std::string& message) {
-  const int line = node && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-  throw InputError(SourceLocation{path, line}.prefix() + message);
-}
-
 const SensitivityParameter* find_parameter(const SensitivityDesign& design, const std::string& name) {
   for (const SensitivityParameter& p : design.parameters)
     if (p.name == name) return &p;
@@ -48,7 +43,7 @@ std::string parameter_names(const SensitivityDesign& design) {
 void require_parameter(const std::string& path, const YAML::Node& node, const SensitivityDesign& design,
                        const std::string& name, const std::string& context) {
   if (!find_parameter(design, name))
-    design_error(path, node,
+    yaml_error(path, node,
                  context + ": no parameter '" + name + "' in 'parameters' (use one of " + parameter_names(design) + ")");
 }
 
@@ -64,7 +59,7 @@ SensitivityTerm parse_term(const std::string& path, const YAML::Node& node, cons
   const std::string context = "second_order term '" + text + "'";
   SensitivityTerm term;
   if (const auto caret = text.find('^'); caret != std::string::npos) {
-    if (trim(text.substr(caret + 1)) != "2") design_error(path, node, context + ": only squares are allowed (P6^2)");
+    if (trim(text.substr(caret + 1)) != "2") yaml_error(path, node, context + ": only squares are allowed (P6^2)");
     term.first = term.second = trim(text.substr(0, caret));
   } else if (const auto star = text.find('*'); star != std::string::npos) {
     term.first = trim(text.substr(0, star));
@@ -73,7 +68,7 @@ SensitivityTerm parse_term(const std::string& path, const YAML::Node& node, cons
     term.first = trim(text);
   }
   if (term.first.empty() || (text.find('*') != std::string::npos && term.second.empty()))
-    design_error(path, node, context + ": write a term as P6, P6^2 or P6*P7");
+    yaml_error(path, node, context + ": write a term as P6, P6^2 or P6*P7");
   require_parameter(path, node, design, term.first, context);
   if (!term.linear()) require_parameter(path, node, design, term.second, context);
   return term;
@@ -86,13 +81,13 @@ bool same_term(const SensitivityTerm& a, const SensitivityTerm& b) {
 
 void load_second_order(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
   if (!node.IsMap() || !node["terms"] || !node["terms"].IsSequence() || !node["runs"] || !node["runs"].IsSequence())
-    design_error(path, node,
+    yaml_error(path, node,
                  "'second_order' needs 'terms' (a list such as [P6, P6^2, P6*P7]) and 'runs' (a list of "
                  "{parameter: value} maps, e.g. - {P6: 0.8})");
   for (const YAML::Node& t : node["terms"]) {
     SensitivityTerm term = parse_term(path, t, design);
     for (const SensitivityTerm& other : design.second_order.terms)
-      if (same_term(term, other)) design_error(path, t, "second_order term '" + term.label() + "' is listed twice");
+      if (same_term(term, other)) yaml_error(path, t, "second_order term '" + term.label() + "' is listed twice");
     design.second_order.terms.push_back(std::move(term));
   }
   std::size_t number = 0;
@@ -100,7 +95,7 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
     ++number;
     const std::string context = "second_order run " + std::to_string(number);
     if (!r.IsMap() || r.size() == 0)
-      design_error(path, r, context + ": write a run as a map of parameter values, e.g. {P6: 1.2, P7: 1.2}");
+      yaml_error(path, r, context + ": write a run as a map of parameter values, e.g. {P6: 1.2, P7: 1.2}");
     SensitivityPoint point;
     for (auto it = r.begin(); it != r.end(); ++it) {
       const std::string name = it->first.as<std::string>();
@@ -109,9 +104,9 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
       try {
         value = it->second.as<double>();
       } catch (const YAML::Exception&) {
-        design_error(path, it->second, context + ": the value of " + name + " must be a number (e.g. 0.8)");
+        yaml_error(path, it->second, context + ": the value of " + name + " must be a number (e.g. 0.8)");
       }
-      if (!(value > 0.0)) design_error(path, it->second, context + ": the value of " + name + " must be positive");
+      if (!(value > 0.0)) yaml_error(path, it->second, context + ": the value of " + name + " must be positive");
       point.emplace_back(name, value);
     }
     design.second_order.runs.push_back(std::move(point));
@@ -119,13 +114,13 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
 }
 
 std::array<double, 3> response_triple(const std::string& path, const YAML::Node& node, const std::string& context) {
-  if (!node.IsSequence() || node.size() != 3) design_error(path, node, context + ": give [R1, R2, R3], e.g. [1.255, 0.610, 1.865]");
+  if (!node.IsSequence() || node.size() != 3) yaml_error(path, node, context + ": give [R1, R2, R3], e.g. [1.255, 0.610, 1.865]");
   std::array<double, 3> values{};
   for (std::size_t k = 0; k < 3; ++k) {
     try {
       values[k] = node[k].as<double>();
     } catch (const YAML::Exception&) {
-      design_error(path, node[k], context + ": R" + std::to_string(k + 1) + " must be a number");
+      yaml_error(path, node[k], context + ": R" + std::to_string(k + 1) + " must be a number");
     }
   }
   return values;
@@ -133,17 +128,17 @@ std::array<double, 3> response_triple(const std::string& path, const YAML::Node&
 
 void load_reference(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
   if (!node.IsMap() || !node["base"])
-    design_error(path, node, "'reference' needs at least 'base: [R1, R2, R3]' (the published run 0)");
+    yaml_error(path, node, "'reference' needs at least 'base: [R1, R2, R3]' (the published run 0)");
   for (const auto& entry : node) {
     const std::string key = entry.first.as<std::string>();
     if (key != "source" && key != "base" && key != "first_order" && key != "second_order" && key != "ranking")
-      design_error(path, entry.first, "reference: unknown key '" + key + "' (allowed: source, base, first_order, second_order, ranking)");
+      yaml_error(path, entry.first, "reference: unknown key '" + key + "' (allowed: source, base, first_order, second_order, ranking)");
   }
   PublishedResults reference;
   if (node["source"]) reference.source = node["source"].as<std::string>();
   reference.base = response_triple(path, node["base"], "reference: base");
   if (const YAML::Node first = node["first_order"]) {
-    if (!first.IsMap()) design_error(path, first, "reference: first_order must map parameters to [R1, R2, R3]");
+    if (!first.IsMap()) yaml_error(path, first, "reference: first_order must map parameters to [R1, R2, R3]");
     for (const auto& entry : first) {
       const std::string name = entry.first.as<std::string>();
       require_parameter(path, entry.first, design, name, "reference: first_order");
@@ -152,18 +147,18 @@ void load_reference(const std::string& path, const YAML::Node& node, Sensitivity
   }
   if (const YAML::Node second = node["second_order"]) {
     if (!second.IsSequence() || second.size() != design.second_order.runs.size())
-      design_error(path, second, "reference: second_order must list [R1, R2, R3] for each of the " +
+      yaml_error(path, second, "reference: second_order must list [R1, R2, R3] for each of the " +
                                      std::to_string(design.second_order.runs.size()) + " second_order runs, in their order");
     for (std::size_t i = 0; i < second.size(); ++i)
       reference.second_order.push_back(response_triple(path, second[i], "reference: second_order " + std::to_string(i + 1)));
   }
   if (const YAML::Node ranking = node["ranking"]) {
-    if (!ranking.IsMap()) design_error(path, ranking, "reference: ranking must map R1, R2, R3 to lists of parameters");
+    if (!ranking.IsMap()) yaml_error(path, ranking, "reference: ranking must map R1, R2, R3 to lists of parameters");
     for (const auto& entry : ranking) {
       const std::string response = entry.first.as<std::string>();
       if (response != "R1" && response != "R2" && response != "R3")
-        design_error(path, entry.first, "reference: ranking: keys are R1, R2 and R3");
-      if (!entry.second.IsSequence()) design_error(path, entry.second, "reference: ranking: " + response + " must be a list");
+        yaml_error(path, entry.first, "reference: ranking: keys are R1, R2 and R3");
+      if (!entry.second.IsSequence()) yaml_error(path, entry.second, "reference: ranking: " + response + " must be a list");
       auto& list = reference.ranking[static_cast<std::size_t>(response[1] - '1')];
       for (const YAML::Node& p : entry.second) {
         const std::string name = p.as<std::string>();
@@ -339,26 +334,26 @@ std::string SensitivityDerivative::label() const {
 
 SensitivityDesign load_design(const std::string& path) {
   const YAML::Node root = load_yaml_file(path, "design file");
-  if (!root.IsMap() || !root["sensitivity"]) design_error(path, root, "a design file starts with 'sensitivity: 1'");
+  if (!root.IsMap() || !root["sensitivity"]) yaml_error(path, root, "a design file starts with 'sensitivity: 1'");
   SensitivityDesign design;
   if (root["factor"]) {
     design.factor = root["factor"].as<double>();
-    if (!(design.factor > 0.0) || design.factor == 1.0) design_error(path, root["factor"], "factor must be positive and not 1");
+    if (!(design.factor > 0.0) || design.factor == 1.0) yaml_error(path, root["factor"], "factor must be positive and not 1");
   }
   const YAML::Node parameters = root["parameters"];
   if (!parameters || !parameters.IsSequence() || parameters.size() == 0)
-    design_error(path, root, "'parameters' must list the parameters: - {name, description, scale: [{key, power}]}");
+    yaml_error(path, root, "'parameters' must list the parameters: - {name, description, scale: [{key, power}]}");
   for (std::size_t i = 0; i < parameters.size(); ++i) {
     const YAML::Node p = parameters[i];
     if (!p.IsMap() || !p["name"] || !p["scale"] || !p["scale"].IsSequence())
-      design_error(path, p, "each parameter needs 'name' and a 'scale' list of {key, power}");
+      yaml_error(path, p, "each parameter needs 'name' and a 'scale' list of {key, power}");
     SensitivityParameter parameter;
     parameter.name = p["name"].as<std::string>();
-    if (find_parameter(design, parameter.name)) design_error(path, p["name"], "parameter '" + parameter.name + "' is listed twice");
+    if (find_parameter(design, parameter.name)) yaml_error(path, p["name"], "parameter '" + parameter.name + "' is listed twice");
     parameter.description = p["description"] ? p["description"].as<std::string>() : "";
     for (std::size_t k = 0; k < p["scale"].size(); ++k) {
       const YAML::Node s = p["scale"][k];
-      if (!s.IsMap() || !s["key"]) design_error(path, s, "parameter '" + parameter.name + "': each scale entry needs 'key'");
+      if (!s.IsMap() || !s["key"]) yaml_error(path, s, "parameter '" + parameter.name + "': each scale entry needs 'key'");
       parameter.scales.emplace_back(s["key"].as<std::string>(), s["power"] ? s["power"].as<double>() : 1.0);
       parameter.scale_sources.push_back(SourceLocation{path, yaml_line(s)});
     }

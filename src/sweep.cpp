@@ -349,7 +349,8 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
 
   // Every key and level against the model, before any run.
   const std::string model_text = read_model_text(model_path);
-  const YAML::Node model_root = YAML::Load(model_text);
+  (void)load_model_text(model_text, model_path);  // the model's own mistakes first, as they are
+  const YAML::Node model_root = load_yaml_text(model_text, model_path);
   const auto check = [&](const SweepFactor& factor, const std::string& level, int line) {
     std::vector<std::string> settings = plan.settings;
     try {
@@ -415,7 +416,7 @@ std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& m
       levels = plan.runs;
       break;
   }
-  const YAML::Node model_root = YAML::Load(model_text);
+  const YAML::Node model_root = load_yaml_text(model_text, "the model");
   std::vector<SweepRunSpec> specs;
   for (auto& row : levels) {
     SweepRunSpec spec;
@@ -486,7 +487,7 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     row.message = report.outcome.message;
     if (!report.outcome.ok && control.timed_out()) row.message = "stopped at the run time limit (t = " + exact(report.outcome.t_reached) + ")";
     if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
-    const YAML::Node summary = YAML::Load(report.summary_json);
+    const YAML::Node summary = load_yaml_text(report.summary_json, "summary.json");
     for (std::size_t k = 0; k < plan.responses.size(); ++k) {
       const std::string& name = plan.responses[k];
       if (const auto at = name.rfind('@'); at != std::string::npos) {
