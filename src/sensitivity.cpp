@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +28,19 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // A singular value below this fraction of the largest counts as zero (the design matrix's
 // entries are products of nondimensional values near 1, so round-off is near 1e-16).
 constexpr double kRankTolerance = 1e-10;
+
+/// A parameter's name heads CSV columns, Markdown tables and term labels (P6*P7, P6^2): letters,
+/// digits, _ - and . only, starting with a letter or _.
+std::string parameter_name(const std::string& path, const YAML::Node& node) {
+  const std::string name = node.IsScalar() ? node.Scalar() : "";
+  const bool first_ok = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+  const bool rest_ok = std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  });
+  if (!first_ok || !rest_ok)
+    yaml_error(path, node, "parameter name '" + name + "': use letters, digits, _ - and . only, starting with a letter or _ (e.g. P7)");
+  return name;
+}
 
 const SensitivityParameter* find_parameter(const SensitivityDesign& design, const std::string& name) {
   for (const SensitivityParameter& p : design.parameters)
@@ -348,7 +362,7 @@ SensitivityDesign load_design(const std::string& path) {
     if (!p.IsMap() || !p["name"] || !p["scale"] || !p["scale"].IsSequence())
       yaml_error(path, p, "each parameter needs 'name' and a 'scale' list of {key, power}");
     SensitivityParameter parameter;
-    parameter.name = p["name"].as<std::string>();
+    parameter.name = parameter_name(path, p["name"]);
     if (find_parameter(design, parameter.name)) yaml_error(path, p["name"], "parameter '" + parameter.name + "' is listed twice");
     parameter.description = p["description"] ? p["description"].as<std::string>() : "";
     for (std::size_t k = 0; k < p["scale"].size(); ++k) {

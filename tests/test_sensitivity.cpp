@@ -406,6 +406,13 @@ TEST_CASE("design files: unknown parameters in the second-order study are refuse
   refused("second_order:\n  terms: [P6*P7, P7*P6]\n  runs: [{P6: 0.8}]\n", "'P7*P6' is listed twice");
   refused("second_order:\n  terms: [P6]\n  runs: [{P6: -0.8}]\n", "the value of P6 must be positive");
   refused("second_order:\n  - {P6: 0.8}\n", "'second_order' needs 'terms'");
+  // Parameter names head CSV columns and term labels: a comma, a star or a leading digit is refused at its line.
+  for (const char* name : {"\"P,6\"", "P*8", "8P", "\"\""}) {
+    const std::string path = files.dir + "/bad_name.yaml";
+    std::ofstream(path) << "sensitivity: 1\nparameters:\n  - name: " << name << "\n    scale: [{key: a.b}]\n";
+    CHECK_THROWS_WITH(load_design(path), Catch::StartsWith(path + ":3: parameter name '") &&
+                                             Catch::Contains("use letters, digits, _ - and . only"));
+  }
   // The report's design is the file beside the model.
   const std::string report_model = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml";
   CHECK(std::filesystem::equivalent(default_design_path(report_model), report_design_path()));
