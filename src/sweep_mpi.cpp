@@ -159,6 +159,7 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
   SweepPlan plan;
   std::string problem;
   try {
+    if (rank == 0) check_output_folder(directory);  // only rank 0 writes there
     plan = load_sweep_plan(plan_path, model_path);
     if (rank == 0) model_text = read_model_text(model_path);
   } catch (const InputError& e) {
