@@ -555,6 +555,15 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   }
   plan.stability_limit = euler->stability_limit();
   for (int k = 0; k < options.euler_runs; ++k) plan.euler_steps.push_back(dt0 / std::pow(2.0, k));
+  // Every Euler run must be one the integrator takes: a step that needs more than max_steps
+  // steps is refused now, not when its run comes (after the others have run).
+  const double smallest_step = plan.euler_steps.back();
+  const double steps_needed = std::ceil(plan.t_end / smallest_step - 1e-9);  // [steps]
+  if (!(steps_needed <= static_cast<double>(model.simulation.max_steps)))
+    throw InputError(model_path + ": --euler-steps " + std::to_string(options.euler_runs) + " from dt " + format_number(dt0) +
+                     " s goes down to " + fmt("%.4g", smallest_step) + " s, which needs " + fmt("%.4g", steps_needed) +
+                     " steps to reach t_end = " + format_number(plan.t_end) + ", more than max_steps " +
+                     std::to_string(model.simulation.max_steps) + "; use fewer --euler-steps, a larger --euler-dt or a shorter --t-end");
   // Time a short run at dt_0 for the cost per step (the same for every step size).
   NullObserver none;
   const double probe_end = std::min(plan.t_end, static_cast<double>(kProbeSteps) * dt0);
