@@ -225,7 +225,11 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   if (design.reference && !result.central && result.base.ok) {
     const std::string comparison = comparison_markdown(result, design);
     std::ofstream file(std::filesystem::path(out_dir) / "comparison.md");
-    file << "# The study against the design's published results\n\n" << comparison;
+    file << "# The study against the design's published results\n\n";
+    if (result.interrupted)
+      file << "**Interrupted after " << result.runs_finished << " of " << result.runs_total
+           << " runs**: the runs not finished have no results here.\n\n";
+    file << comparison;
     if (!file) throw std::runtime_error("cannot write " + (std::filesystem::path(out_dir) / "comparison.md").string());
     table += "\n" + comparison;
   }

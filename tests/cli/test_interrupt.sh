@@ -57,6 +57,7 @@ check "sensitivity.csv keeps the finished base run" grep -q '^0,0,,,ok,[0-9]' "$
 check "sensitivity.csv keeps the first parameter's run" grep -q '^1,1,P1,1.2,ok,[0-9]' "$tmp/sens/sensitivity.csv"
 check "the runs not finished are marked, without responses" grep -q '^31,1,P31,1.2,interrupted,,,,0,0.00,"not run: the study was interrupted"' "$tmp/sens/sensitivity.csv"
 check "sensitivity.md says it was interrupted" grep -q '^\*\*Interrupted after [0-9]* of 32 runs\*\*' "$tmp/sens/sensitivity.md"
+check "so does comparison.md" grep -q '^\*\*Interrupted after [0-9]* of 32 runs\*\*' "$tmp/sens/comparison.md"
 check "no run started after the signal (at most one was in progress)" \
   [ "$(grep -c ',interrupted,' "$tmp/sens/sensitivity.csv")" -ge 29 ]
 
