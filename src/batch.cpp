@@ -1,7 +1,13 @@
 #include "railcrash/batch.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <condition_variable>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -16,7 +22,93 @@ using Clock = std::chrono::steady_clock;
 // How often the supervisor looks at the runs in progress [ms]: the resolution of the run limit.
 constexpr int kSupervisorPeriodMs = 10;
 
+namespace fs = std::filesystem;
+
+/// The folder without trailing slashes ("out/" -> "out"; "/" stays).
+fs::path without_trailing_slash(std::string text) {
+  while (text.size() > 1 && text.back() == '/') text.pop_back();
+  return fs::path(text);
+}
+
+/// What the OS says when `path` is opened for writing ("" if it could be: the file is removed
+/// again unless it existed before).
+std::string write_refusal(const fs::path& path) {
+  std::error_code error;
+  const bool existed = fs::exists(path, error);
+  std::FILE* file = std::fopen(path.c_str(), "a");
+  if (!file) return std::strerror(errno);
+  std::fclose(file);
+  if (!existed) fs::remove(path, error);
+  return "";
+}
+
+/// The type of `path`, or InputError with the OS's reason when it cannot be looked at.
+fs::file_status status_of(const fs::path& path, const std::string& what) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (error && status.type() != fs::file_type::not_found)
+    throw InputError(what + " '" + path.string() + "': cannot look at it: " + error.message());
+  return status;
+}
+
+/// InputError unless `folder` (the parent of a --out) is an existing folder.
+void require_parent_folder(const fs::path& folder, const std::string& what, const std::string& out) {
+  const fs::path parent = folder.empty() ? fs::path(".") : folder;
+  const fs::file_status status = status_of(parent, what);
+  if (!fs::exists(status))
+    throw InputError(what + " '" + out + "': its folder '" + parent.string() + "' does not exist (" + std::strerror(ENOENT) +
+                     "); create it first or give another path");
+  if (!fs::is_directory(status))
+    throw InputError(what + " '" + out + "': '" + parent.string() + "' is a file, not a folder (" + std::strerror(ENOTDIR) + ")");
+}
+
 }  // namespace
+
+std::size_t finished_runs(const std::vector<BatchRunState>& states) {
+  return static_cast<std::size_t>(std::count(states.begin(), states.end(), BatchRunState::finished));
+}
+
+std::string read_model_text(const std::string& model_path) {
+  std::ifstream in(model_path);
+  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+void check_output_folder(const std::string& folder) {
+  if (folder.empty()) throw InputError("--out is empty; give the output folder, e.g. --out results");
+  const fs::path path = without_trailing_slash(folder);
+  const fs::file_status status = status_of(path, "--out");
+  if (fs::exists(status) && !fs::is_directory(status))
+    throw InputError("--out '" + folder + "' is a file, not a folder (" + std::strerror(ENOTDIR) + "); give a folder");
+  bool created = false;
+  if (!fs::exists(status)) {
+    require_parent_folder(path.parent_path(), "--out", folder);
+    std::error_code error;
+    if (!fs::create_directory(path, error) && error)
+      throw InputError("--out '" + folder + "': cannot create the folder: " + error.message());
+    created = true;
+  }
+  const std::string refusal = write_refusal(path / ".railcrash_write_check");
+  if (created) {
+    std::error_code error;
+    fs::remove(path, error);
+  }
+  if (!refusal.empty()) throw InputError("--out '" + folder + "': cannot write in the folder: " + refusal);
+}
+
+void check_output_file(const std::string& file) {
+  if (file.empty()) throw InputError("--out is empty; give the file to write, or leave --out out for standard output");
+  const fs::path path(file);
+  const fs::file_status status = status_of(path, "--out");
+  if (fs::is_directory(status))
+    throw InputError("--out '" + file + "' is a folder (" + std::strerror(EISDIR) + "); give a file name, e.g. " +
+                     (path / "model.yaml").string());
+  require_parent_folder(path.parent_path(), "--out", file);
+  const std::string refusal = write_refusal(path);
+  if (!refusal.empty()) throw InputError("--out '" + file + "': cannot write it: " + refusal);
+}
 
 /// Raises a run's stop flag once it has had its time limit, or every run's when the caller's
 /// stop flag rises. One thread for the whole batch, and none when there is nothing to watch.

@@ -555,6 +555,15 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   }
   plan.stability_limit = euler->stability_limit();
   for (int k = 0; k < options.euler_runs; ++k) plan.euler_steps.push_back(dt0 / std::pow(2.0, k));
+  // Every Euler run must be one the integrator takes: a step that needs more than max_steps
+  // steps is refused now, not when its run comes (after the others have run).
+  const double smallest_step = plan.euler_steps.back();
+  const double steps_needed = std::ceil(plan.t_end / smallest_step - 1e-9);  // [steps]
+  if (!(steps_needed <= static_cast<double>(model.simulation.max_steps)))
+    throw InputError(model_path + ": --euler-steps " + std::to_string(options.euler_runs) + " from dt " + format_number(dt0) +
+                     " s goes down to " + fmt("%.4g", smallest_step) + " s, which needs " + fmt("%.4g", steps_needed) +
+                     " steps to reach t_end = " + format_number(plan.t_end) + ", more than max_steps " +
+                     std::to_string(model.simulation.max_steps) + "; use fewer --euler-steps, a larger --euler-dt or a shorter --t-end");
   // Time a short run at dt_0 for the cost per step (the same for every step size).
   NullObserver none;
   const double probe_end = std::min(plan.t_end, static_cast<double>(kProbeSteps) * dt0);
@@ -598,13 +607,20 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
       batch, [&](std::size_t k, BatchRunState) {
         if (on_run) on_run(runs[k]);
       });
-  for (std::size_t k = 0; k < jobs.size(); ++k)
-    if (states[k] == BatchRunState::not_started) {
+  result.runs_total = jobs.size();
+  result.runs_finished = finished_runs(states);
+  result.interrupted = result.runs_finished < result.runs_total;
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    if (states[k] == BatchRunState::interrupted) {
+      runs[k].ok = false;
+      runs[k].message = "interrupted (SIGINT/SIGTERM): " + runs[k].message;
+    } else if (states[k] == BatchRunState::not_started) {
       runs[k].method = jobs[k].method;
       runs[k].step = jobs[k].step;
       runs[k].rtol = jobs[k].rtol;
       runs[k].message = "not run (interrupted)";
     }
+  }
   result.jobs = std::max(1, std::min<int>(plan.options.jobs, static_cast<int>(jobs.size())));
 
   result.reference = runs[0];
@@ -636,6 +652,9 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
 std::string convergence_markdown(const ConvergeResult& r) {
   std::ostringstream md;
   const std::size_t nq = r.quantities.size();
+  if (r.interrupted)
+    md << "**Interrupted after " << r.runs_finished << " of " << r.runs_total
+       << " runs** (SIGINT/SIGTERM): the runs not finished are marked failed and left out of the analysis.\n\n";
   md << "Model `" << r.model_path << "` (" << r.model_name << "), t_end " << r.t_end << " s, output every "
      << r.output_interval << " s; " << r.euler.size() << " Euler and " << r.ida.size() << " IDA runs against an IDA reference at rtol "
      << r.reference.rtol << "; " << r.jobs << " job" << (r.jobs > 1 ? "s (wall times under parallel load)" : "") << "; "

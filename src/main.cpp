@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <map>
 #include <optional>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/consist.hpp"
 #include "railcrash/scenario/en15227.hpp"
 #include "railcrash/dae_system.hpp"
@@ -39,12 +41,44 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_interrupt(int) { g_stop.store(true); }
 
+/// From here on SIGINT and SIGTERM raise g_stop: the runs in progress stop at their next step,
+/// the results so far are written, and the command exits 1 (as a failed run).
+void catch_interrupts() {
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+}
+
 int check_command(const std::string& path, const std::vector<std::string>& settings) {
   using namespace railcrash;
   const Model model = load_model(path, settings);
   const DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const AssemblyReport assembly = assemble_initial_state(system, y);
+  // What `run` does next: consistent accelerations and joint reactions at the start. A model
+  // whose equations are singular there (a body with zero inertia that no joint holds) cannot
+  // run, so `check` refuses it as input.
+  std::vector<double> y_start = y, yp_start;
+  try {
+    consistent_rates(system, 0.0, y_start, yp_start);
+  } catch (const SolverError& e) {
+    SourceLocation where{path, 0};
+    for (const Body& b : model.bodies())
+      if (b.inertia == 0.0 && where.line == 0) where = b.where;  // the first body the message names
+    throw InputError(where.prefix() + e.what());
+  }
+  // The element outputs at the start: a run whose first sample has a non-finite one fails.
+  std::vector<double> outputs(system.output_names().size());
+  system.outputs(y_start.data(), y_start.data() + 2 * system.body_unknowns(), outputs.data());
+  for (std::size_t k = 0; k < outputs.size(); ++k)
+    if (!std::isfinite(outputs[k])) {
+      const std::string& column = system.output_names()[k];  // "<element>.<output>"
+      const std::string element = column.substr(0, column.rfind('.'));
+      SourceLocation where{path, 0};
+      for (const auto& e : model.elements())
+        if (e->name() == element) where = e->where();
+      throw InputError(where.prefix() + "element '" + element + "': its output '" + column.substr(column.rfind('.') + 1) + "' is " +
+                       std::to_string(outputs[k]) + " at t = 0; check the element's numbers (a value too large or too small)");
+    }
   int constraint_elements = 0;
   for (const auto& e : model.elements()) constraint_elements += e->constraint_count() > 0;
   std::printf("model      %s  (%s)\n", model.name.c_str(), path.c_str());
@@ -120,8 +154,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   Model model = load_model(path, settings);
   apply_overrides(model, overrides);
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
+  catch_interrupts();
   const RunReport report = run_model(model, out_dir, &g_stop, !quiet);
   const RunOutcome& o = report.outcome;
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
@@ -165,6 +198,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
 int sensitivity_command(const std::string& path, const std::string& design_option, int jobs, double central,
                         const std::string& only, bool first_order_only, double run_limit, const std::string& out_dir) {
   using namespace railcrash;
+  check_output_folder(out_dir);
   // "report" (the default): the report's design for this model, sensitivity_design.yaml beside it.
   const std::string design_path = design_option == "report" ? default_design_path(path) : design_option;
   const SensitivityDesign design = load_design(design_path);
@@ -178,37 +212,46 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
     for (const auto& [name, value] : run.variation)
       varied += (varied.empty() ? "" : " ") + name + "=" + std::to_string(value).substr(0, 4);
     std::fprintf(stderr, "[%zu/%zu] run %zu (%s) %s in %.1f s\n", done, total, number, varied.c_str(),
-                 run.ok ? "done" : "FAILED", run.wall_seconds);
+                 run.ok ? "done" : (run.interrupted ? "interrupted" : "FAILED"), run.wall_seconds);
   };
   std::stringstream names(only);
   for (std::string name; std::getline(names, name, ',');)
     if (!name.empty()) options.only.push_back(name);
+  options.stop = &g_stop;
+  catch_interrupts();
   const auto start = std::chrono::steady_clock::now();
   const SensitivityResult result = run_sensitivity(path, design, options);
   std::string table = write_sensitivity(result, design, out_dir);
   if (design.reference && !result.central && result.base.ok) {
     const std::string comparison = comparison_markdown(result, design);
     std::ofstream file(std::filesystem::path(out_dir) / "comparison.md");
-    file << "# The study against the design's published results\n\n" << comparison;
+    file << "# The study against the design's published results\n\n";
+    if (result.interrupted)
+      file << "**Interrupted after " << result.runs_finished << " of " << result.runs_total
+           << " runs**: the runs not finished have no results here.\n\n";
+    file << comparison;
     if (!file) throw std::runtime_error("cannot write " + (std::filesystem::path(out_dir) / "comparison.md").string());
     table += "\n" + comparison;
   }
   std::fputs(table.c_str(), stdout);
-  int failed = result.base.ok ? 0 : 1;
-  for (const auto& r : result.runs) failed += r.ok ? 0 : 1;
-  for (const auto& r : result.second_order_runs) failed += r.ok ? 0 : 1;
+  int failed = result.base.ok || result.base.interrupted ? 0 : 1;
+  for (const auto& r : result.runs) failed += r.ok || r.interrupted ? 0 : 1;
+  for (const auto& r : result.second_order_runs) failed += r.ok || r.interrupted ? 0 : 1;
   std::printf("\n%s: %zu runs with %d jobs in %.1f s; %d failed; results in %s/ (sensitivity.md, sensitivity.csv, "
               "sensitivity_first_order.csv, sensitivity_second_order.csv, sensitivity_derivatives.csv, "
               "sensitivity_ranking.csv%s)\n",
               design_path.c_str(), result.runs.size() + result.second_order_runs.size() + 1, options.jobs,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed, out_dir.c_str(),
               design.reference && !result.central && result.base.ok ? ", comparison.md" : "");
-  return failed == 0 ? 0 : 1;
+  if (result.interrupted)
+    std::printf("interrupted after %zu of %zu runs: the tables hold the finished runs\n", result.runs_finished, result.runs_total);
+  return failed == 0 && !result.interrupted ? 0 : 1;
 }
 
 int readings_command(const std::string& path, const std::string& design_option, const std::string& readings_path, int jobs,
                      bool first_order_only, double run_limit, const std::string& out_dir) {
   using namespace railcrash;
+  check_output_folder(out_dir);
   const std::string design_path = design_option == "report" ? default_design_path(path) : design_option;
   const SensitivityDesign design = load_design(design_path);
   const ReadingsPlan plan = load_readings(readings_path);
@@ -222,6 +265,8 @@ int readings_command(const std::string& path, const std::string& design_option, 
                  number + 1, total, plan.label(r.levels).c_str(), a[0].value, a[1].value, a[2].value, a[0].spearman,
                  a[1].spearman, r.agreement.goals_met, Agreement::kGoals, r.failed_runs, r.wall_seconds);
   };
+  options.study.stop = &g_stop;
+  catch_interrupts();
   const auto start = std::chrono::steady_clock::now();
   const auto results = run_readings(path, design, plan, options);
   const std::string table = write_readings(results, plan, design, out_dir);
@@ -233,11 +278,18 @@ int readings_command(const std::string& path, const std::string& design_option, 
               results.size(), results.empty() ? 0 : 1 + results.front().study.runs.size() + results.front().study.second_order_runs.size(),
               options.study.jobs, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed,
               out_dir.c_str());
-  return failed == 0 ? 0 : 1;
+  const std::size_t planned = plan.combinations().size();
+  const std::size_t complete = static_cast<std::size_t>(
+      std::count_if(results.begin(), results.end(), [](const ReadingsCombinationResult& r) { return !r.study.interrupted; }));
+  if (complete < planned)
+    std::printf("interrupted after %zu of %zu combinations: the tables hold the finished ones%s\n", complete, planned,
+                complete < results.size() ? " and the finished runs of the partial one" : "");
+  return failed == 0 && complete == planned ? 0 : 1;
 }
 
 int converge_command(const std::string& path, const railcrash::ConvergeOptions& options, const std::string& out_dir) {
   using namespace railcrash;
+  check_output_folder(out_dir);
   const ConvergePlan plan = plan_convergence(path, options);
   std::printf("convergence study of %s (%s): t_end %g s, output every %g s\n", path.c_str(), plan.model_name.c_str(), plan.t_end,
               plan.output_interval);
@@ -254,8 +306,7 @@ int converge_command(const std::string& path, const railcrash::ConvergeOptions& 
   std::printf("; %d job%s%s\n", options.jobs, options.jobs > 1 ? "s" : "",
               options.jobs > 1 ? " (wall times are noisier under parallel load)" : "");
   std::fflush(stdout);
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
+  catch_interrupts();
   const auto progress = [](const ConvergeRun& run) {
     char setting[32];
     std::snprintf(setting, sizeof setting, run.method == "euler" ? "dt %.4g" : "rtol %.0e", run.method == "euler" ? run.step : run.rtol);
@@ -265,6 +316,8 @@ int converge_command(const std::string& path, const railcrash::ConvergeOptions& 
   const ConvergeResult result = run_convergence(plan, progress, &g_stop);
   const std::string summary = write_convergence(result, out_dir);
   std::printf("\n%s\nresults in %s/ (converge.csv, converge.svg, converge.md)\n", summary.c_str(), out_dir.c_str());
+  if (result.interrupted)
+    std::printf("interrupted after %zu of %zu runs: the tables hold the finished runs\n", result.runs_finished, result.runs_total);
   return result.reference.ok && !g_stop.load() ? 0 : 1;
 }
 
@@ -281,19 +334,21 @@ int sweep_command(const std::string& path, const std::string& plan_path, int job
     std::fprintf(stderr, "[%zu/%zu] run %zu %s %.2f s%s%s\n", done, total, number, row.status.c_str(), row.wall_seconds,
                  row.message.empty() ? "" : ": ", row.message.c_str());
   };
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
+  catch_interrupts();
 #ifdef RAILCRASH_MPI
   if (launched_by_mpi()) return sweep_with_mpi(path, plan_path, out_dir, options);
 #endif
+  check_output_folder(out_dir);
   const SweepPlan plan = load_sweep_plan(plan_path, path);  // every key and level checked before any run
   const auto start = std::chrono::steady_clock::now();
   const SweepResult result = run_sweep(path, plan, out_dir, options);
-  std::printf("%zu of %zu runs done (%zu resumed) with %d jobs in %.1f s; results in %s/ (runs.csv, summary.md)\n",
-              result.done(), result.specs.size(), result.resumed, options.jobs,
+  const std::size_t failed = failed_sweep_runs(plan, result);
+  std::printf("%zu of %zu runs done (%zu resumed), %zu failed, with %d jobs in %.1f s; results in %s/ (runs.csv, summary.md)\n",
+              result.done(), result.specs.size(), result.resumed, failed, options.jobs,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), out_dir.c_str());
   if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
-  return result.done() == result.specs.size() && !g_stop.load() ? 0 : 1;
+  if (failed > 0) std::printf("%zu run%s failed (status and message in runs.csv)\n", failed, failed == 1 ? "" : "s");
+  return result.done() == result.specs.size() && failed == 0 && !g_stop.load() ? 0 : 1;
 }
 
 /// Writes a generated model to out_path (standard output when empty); `what` names it on stderr.
@@ -309,7 +364,8 @@ int write_generated_model(const std::string& text, const std::string& out_path, 
   return 0;
 }
 
-int consist_command(const std::string& template_path, int cars, const std::string& out_path) {
+int consist_command(const std::string& template_path, int cars, const std::string& out_path, bool out_given) {
+  if (out_given) railcrash::check_output_file(out_path);
   return write_generated_model(railcrash::make_consist_model(template_path, cars), out_path,
                                std::to_string(cars) + " + " + std::to_string(cars) + " cars");
 }
@@ -511,8 +567,9 @@ int main(int argc, char** argv) {
     if (*check) return check_command(model_path, settings);
     if (*elements) return elements_command(element_type_name, elements_markdown);
     if (*report) return report_command(report_dir, report_cfc);
-    if (*consist) return consist_command(model_path, consist_cars, consist_out);
+    if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
+      if (scenario->count("--out") > 0) railcrash::check_output_file(scenario_out);
       const auto given = [&](const std::string& option) -> std::optional<double> {
         if (scenario->count(option) == 0) return std::nullopt;
         return scenario_values[option];

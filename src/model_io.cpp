@@ -319,6 +319,10 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
     value = load_yaml_text(setting.substr(equals + 1), label);
   } catch (const YAML::Exception& e) {
     throw InputError(where + "the value is not valid YAML (" + e.msg + ")");
+  } catch (const InputError& e) {
+    // A --set value is one line: "--set 'KEY=VALUE':1:" would name a line of nothing.
+    const std::string message = e.what(), numbered = label + ":1: ";
+    throw InputError(message.rfind(numbered, 0) == 0 ? where + message.substr(numbered.size()) : message);
   }
   reader.add_override(value, label);
   std::vector<std::string> parts;

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/table_text.hpp"
@@ -25,33 +26,18 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-[[noreturn]] void readings_error(const std::string& path, const YAML::Node& node, const std::string& message) {
-  const int line = node && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-  throw InputError(SourceLocation{path, line}.prefix() + message);
-}
-
-int line_of(const YAML::Node& node) { return node && !node.Mark().is_null() ? node.Mark().line + 1 : 0; }
-
 void check_keys(const std::string& path, const YAML::Node& map, const std::set<std::string>& allowed, const std::string& context) {
   std::string list;
   for (const std::string& k : allowed) list += (list.empty() ? "" : ", ") + k;
   for (const auto& entry : map) {
     const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-    if (!allowed.count(key)) readings_error(path, entry.first, context + ": unknown key '" + key + "' (allowed: " + list + ")");
+    if (!allowed.count(key)) yaml_error(path, entry.first, context + ": unknown key '" + key + "' (allowed: " + list + ")");
   }
 }
 
 std::string scalar_text(const std::string& path, const YAML::Node& node, const std::string& context) {
-  if (!node || !node.IsScalar() || node.Scalar().empty()) readings_error(path, node, context + " must be a word");
+  if (!node || !node.IsScalar() || node.Scalar().empty()) yaml_error(path, node, context + " must be a word");
   return node.Scalar();
-}
-
-std::string model_text_of(const std::string& model_path) {
-  std::ifstream in(model_path);
-  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
 }
 
 std::string format(double value, const char* spec = "%.3f") { return table_number(value, spec); }
@@ -163,6 +149,7 @@ SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, 
         throw InputError(SourceLocation{path, level.line}.prefix() + "reading '" + readings[r].name + "', level '" + level.name +
                          "': the design has no parameter '" + name + "'");
       it->scales = scales;
+      it->scale_sources.assign(scales.size(), SourceLocation{path, level.line});
     }
   }
   return changed;
@@ -171,70 +158,70 @@ SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, 
 ReadingsPlan load_readings(const std::string& path) {
   const YAML::Node root = load_yaml_file(path, "readings file");
   if (!root.IsMap() || !root["reading_study"])
-    readings_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
+    yaml_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
   check_keys(path, root, {"reading_study", "description", "combinations", "readings"}, "readings file");
   if (!root["reading_study"].IsScalar() || root["reading_study"].Scalar() != "1")
-    readings_error(path, root["reading_study"], "reading_study must be 1");
+    yaml_error(path, root["reading_study"], "reading_study must be 1");
   ReadingsPlan plan;
   plan.path = path;
   if (root["combinations"]) {
     const std::string how = scalar_text(path, root["combinations"], "combinations");
     if (how != "factorial" && how != "one_at_a_time")
-      readings_error(path, root["combinations"], "combinations must be factorial or one_at_a_time");
+      yaml_error(path, root["combinations"], "combinations must be factorial or one_at_a_time");
     plan.one_at_a_time = how == "one_at_a_time";
   }
   const YAML::Node list = root["readings"];
   if (!list || !list.IsSequence() || list.size() == 0)
-    readings_error(path, list ? list : root, "'readings' must list at least one reading: - {name, levels: [{name, set: {KEY: VALUE}}]}");
+    yaml_error(path, list ? list : root, "'readings' must list at least one reading: - {name, levels: [{name, set: {KEY: VALUE}}]}");
   std::set<std::string> names;
   for (const YAML::Node& node : list) {
-    if (!node.IsMap()) readings_error(path, node, "each reading is a map with name, description and levels");
+    if (!node.IsMap()) yaml_error(path, node, "each reading is a map with name, description and levels");
     check_keys(path, node, {"name", "description", "levels"}, "reading");
     Reading reading;
     reading.name = scalar_text(path, node["name"], "reading: name");
-    reading.line = line_of(node);
-    if (!names.insert(reading.name).second) readings_error(path, node["name"], "reading '" + reading.name + "' is listed twice");
+    reading.line = yaml_line(node);
+    if (!names.insert(reading.name).second) yaml_error(path, node["name"], "reading '" + reading.name + "' is listed twice");
     if (node["description"]) reading.description = node["description"].as<std::string>();
     const std::string context = "reading '" + reading.name + "'";
     const YAML::Node levels = node["levels"];
     if (!levels || !levels.IsSequence() || levels.size() == 0)
-      readings_error(path, levels ? levels : node, context + ": 'levels' must list at least one level {name, set: {KEY: VALUE}}");
+      yaml_error(path, levels ? levels : node, context + ": 'levels' must list at least one level {name, set: {KEY: VALUE}}");
     std::set<std::string> level_names;
     for (const YAML::Node& l : levels) {
-      if (!l.IsMap()) readings_error(path, l, context + ": each level is a map {name, set}");
+      if (!l.IsMap()) yaml_error(path, l, context + ": each level is a map {name, set}");
       check_keys(path, l, {"name", "set", "scale"}, context + " level");
       ReadingLevel level;
       level.name = scalar_text(path, l["name"], context + ": level name");
-      level.line = line_of(l);
-      if (!level_names.insert(level.name).second) readings_error(path, l["name"], context + ": level '" + level.name + "' is listed twice");
+      level.line = yaml_line(l);
+      if (!level_names.insert(level.name).second) yaml_error(path, l["name"], context + ": level '" + level.name + "' is listed twice");
       if (const YAML::Node set = l["set"]) {
-        if (!set.IsMap()) readings_error(path, set, context + ", level '" + level.name + "': 'set' must map model keys to values");
+        if (!set.IsMap()) yaml_error(path, set, context + ", level '" + level.name + "': 'set' must map model keys to values");
         for (const auto& entry : set) {
           const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-          if (key.empty()) readings_error(path, entry.first, context + ": a key must be a model key such as elements.x.stiffness");
+          if (key.empty()) yaml_error(path, entry.first, context + ": a key must be a model key such as elements.x.stiffness");
           if (!entry.second.IsDefined() || entry.second.IsNull())
-            readings_error(path, entry.first, context + ", level '" + level.name + "': give a value for '" + key + "'");
+            yaml_error(path, entry.first, context + ", level '" + level.name + "': give a value for '" + key + "'");
           // "elements.x.stiffness*: 1.2" becomes KEY*=FACTOR (a scaling), anything else KEY=VALUE.
           level.settings.push_back(key + "=" + YAML::Dump(entry.second));
         }
       }
       if (const YAML::Node scale = l["scale"]) {
         const std::string where = context + ", level '" + level.name + "': scale";
-        if (!scale.IsMap()) readings_error(path, scale, where + " must map parameters to lists of {key, power}");
+        if (!scale.IsMap()) yaml_error(path, scale, where + " must map parameters to lists of {key, power}");
         for (const auto& entry : scale) {
           const std::string parameter = scalar_text(path, entry.first, where + ": a parameter name");
           if (!entry.second.IsSequence() || entry.second.size() == 0)
-            readings_error(path, entry.second, where + ": " + parameter + " needs a list of {key, power}");
+            yaml_error(path, entry.second, where + ": " + parameter + " needs a list of {key, power}");
           std::vector<std::pair<std::string, double>> scales;
           for (const YAML::Node& item : entry.second) {
-            if (!item.IsMap() || !item["key"]) readings_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
+            if (!item.IsMap() || !item["key"]) yaml_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
             check_keys(path, item, {"key", "power"}, where);
             double power = 1.0;
             if (item["power"]) {
               try {
                 power = item["power"].as<double>();
               } catch (const YAML::Exception&) {
-                readings_error(path, item["power"], where + ": power must be a number");
+                yaml_error(path, item["power"], where + ": power must be a number");
               }
             }
             scales.emplace_back(scalar_text(path, item["key"], where + ": key"), power);
@@ -250,7 +237,7 @@ ReadingsPlan load_readings(const std::string& path) {
 }
 
 void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
-  const std::string text = model_text_of(model_path);
+  const std::string text = read_model_text(model_path);
   for (const Reading& reading : plan.readings)
     for (const ReadingLevel& level : reading.levels) {
       try {
@@ -270,25 +257,6 @@ void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
 }
 
 namespace {
-
-// Every key a design parameter scales must be a number of the model (else its run would fail
-// only when it executes). With `unchanged_from`, parameters that scale as they do there are
-// not checked again (a level's settings cannot remove a key the other combination had).
-void check_design_keys(const SensitivityDesign& design, const std::string& model_path, const std::vector<std::string>& settings,
-                       const SensitivityDesign* unchanged_from = nullptr) {
-  const std::string text = model_text_of(model_path);
-  for (std::size_t i = 0; i < design.parameters.size(); ++i) {
-    const SensitivityParameter& p = design.parameters[i];
-    if (unchanged_from && unchanged_from->parameters[i].scales == p.scales) continue;
-    std::vector<std::string> all = settings;
-    for (const auto& scale : p.scales) all.push_back(scale.first + "*=1");
-    try {
-      (void)load_model_text(text, model_path, all);
-    } catch (const InputError& e) {
-      throw InputError("design parameter " + p.name + " does not fit the model: " + e.what());
-    }
-  }
-}
 
 double response_of(const Responses& r, int k) { return k == 0 ? r.r1 : (k == 1 ? r.r2 : r.r3); }
 
@@ -499,17 +467,23 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
                      "models/report/sensitivity_design.yaml does");
   check_readings(plan, model_path);
   const std::vector<std::vector<int>> combinations = plan.combinations();
+  // Every combination's runs are checked before the first run starts (the first combination's
+  // run by run, the others with all their factors at once: check_sensitivity_inputs).
+  const std::string model_text = read_model_text(model_path);
   std::vector<SensitivityDesign> designs;
   for (const std::vector<int>& combination : combinations) {
     designs.push_back(plan.design_for(combination, design));
+    SensitivityOptions study = options.study;
+    study.settings = plan.settings(combination);
     try {
-      check_design_keys(designs.back(), model_path, plan.settings(combination), designs.size() > 1 ? &designs.front() : nullptr);
+      check_sensitivity_inputs(model_text, model_path, designs.back(), study, designs.size() == 1);
     } catch (const InputError& e) {
-      throw InputError(plan.path + ": the combination " + plan.label(combination) + ": " + e.what());
+      throw InputError(e.what() + std::string(" (readings ") + plan.path + ", combination " + plan.label(combination) + ")");
     }
   }
   std::vector<ReadingsCombinationResult> results;
   for (std::size_t c = 0; c < combinations.size(); ++c) {
+    if (options.study.stop && options.study.stop->load()) break;
     const auto start = std::chrono::steady_clock::now();
     SensitivityOptions study = options.study;
     study.settings = plan.settings(combinations[c]);
@@ -517,12 +491,14 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
     r.levels = combinations[c];
     r.study = run_sensitivity(model_path, designs[c], study);
     r.agreement = score_agreement(r.study, designs[c]);
-    r.failed_runs = r.study.base.ok ? 0 : 1;
-    for (const auto& run : r.study.runs) r.failed_runs += run.ok ? 0 : 1;
-    for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok ? 0 : 1;
+    r.failed_runs = r.study.base.ok || r.study.base.interrupted ? 0 : 1;
+    for (const auto& run : r.study.runs) r.failed_runs += run.ok || run.interrupted ? 0 : 1;
+    for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok || run.interrupted ? 0 : 1;
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (options.progress) options.progress(r, c, combinations.size());
+    const bool interrupted = r.study.interrupted;
     results.push_back(std::move(r));
+    if (interrupted) break;
   }
   return results;
 }
@@ -569,7 +545,14 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
   if (!csv) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.csv").string());
 
   std::ostringstream md;
-  md << "# Reading study\n\n"
+  md << "# Reading study\n\n";
+  const std::size_t planned = plan.combinations().size();
+  const std::size_t complete = static_cast<std::size_t>(std::count_if(
+      results.begin(), results.end(), [](const ReadingsCombinationResult& r) { return !r.study.interrupted; }));
+  if (complete < planned)
+    md << "**Interrupted after " << complete << " of " << planned << " combinations** (SIGINT/SIGTERM)"
+       << (complete < results.size() ? "; the last one listed is partial (its unfinished runs count as failed)" : "") << ".\n\n";
+  md
      << "Readings file `" << plan.path << "`, " << results.size() << " combinations ("
      << (plan.one_at_a_time ? "one at a time" : "factorial") << "), each scored against the design's published results"
      << (design.reference && !design.reference->source.empty() ? " (" + design.reference->source + ")" : std::string()) << ".\n\n"

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -28,9 +29,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // entries are products of nondimensional values near 1, so round-off is near 1e-16).
 constexpr double kRankTolerance = 1e-10;
 
-[[noreturn]] void design_error(const std::string& path, const YAML::Node& node, const std::string& message) {
-  const int line = node && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-  throw InputError(SourceLocation{path, line}.prefix() + message);
+/// A parameter's name heads CSV columns, Markdown tables and term labels (P6*P7, P6^2): letters,
+/// digits, _ - and . only, starting with a letter or _.
+std::string parameter_name(const std::string& path, const YAML::Node& node) {
+  const std::string name = node.IsScalar() ? node.Scalar() : "";
+  const bool first_ok = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+  const bool rest_ok = std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  });
+  if (!first_ok || !rest_ok)
+    yaml_error(path, node, "parameter name '" + name + "': use letters, digits, _ - and . only, starting with a letter or _ (e.g. P7)");
+  return name;
 }
 
 const SensitivityParameter* find_parameter(const SensitivityDesign& design, const std::string& name) {
@@ -48,7 +57,7 @@ std::string parameter_names(const SensitivityDesign& design) {
 void require_parameter(const std::string& path, const YAML::Node& node, const SensitivityDesign& design,
                        const std::string& name, const std::string& context) {
   if (!find_parameter(design, name))
-    design_error(path, node,
+    yaml_error(path, node,
                  context + ": no parameter '" + name + "' in 'parameters' (use one of " + parameter_names(design) + ")");
 }
 
@@ -64,7 +73,7 @@ SensitivityTerm parse_term(const std::string& path, const YAML::Node& node, cons
   const std::string context = "second_order term '" + text + "'";
   SensitivityTerm term;
   if (const auto caret = text.find('^'); caret != std::string::npos) {
-    if (trim(text.substr(caret + 1)) != "2") design_error(path, node, context + ": only squares are allowed (P6^2)");
+    if (trim(text.substr(caret + 1)) != "2") yaml_error(path, node, context + ": only squares are allowed (P6^2)");
     term.first = term.second = trim(text.substr(0, caret));
   } else if (const auto star = text.find('*'); star != std::string::npos) {
     term.first = trim(text.substr(0, star));
@@ -73,7 +82,7 @@ SensitivityTerm parse_term(const std::string& path, const YAML::Node& node, cons
     term.first = trim(text);
   }
   if (term.first.empty() || (text.find('*') != std::string::npos && term.second.empty()))
-    design_error(path, node, context + ": write a term as P6, P6^2 or P6*P7");
+    yaml_error(path, node, context + ": write a term as P6, P6^2 or P6*P7");
   require_parameter(path, node, design, term.first, context);
   if (!term.linear()) require_parameter(path, node, design, term.second, context);
   return term;
@@ -86,13 +95,13 @@ bool same_term(const SensitivityTerm& a, const SensitivityTerm& b) {
 
 void load_second_order(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
   if (!node.IsMap() || !node["terms"] || !node["terms"].IsSequence() || !node["runs"] || !node["runs"].IsSequence())
-    design_error(path, node,
+    yaml_error(path, node,
                  "'second_order' needs 'terms' (a list such as [P6, P6^2, P6*P7]) and 'runs' (a list of "
                  "{parameter: value} maps, e.g. - {P6: 0.8})");
   for (const YAML::Node& t : node["terms"]) {
     SensitivityTerm term = parse_term(path, t, design);
     for (const SensitivityTerm& other : design.second_order.terms)
-      if (same_term(term, other)) design_error(path, t, "second_order term '" + term.label() + "' is listed twice");
+      if (same_term(term, other)) yaml_error(path, t, "second_order term '" + term.label() + "' is listed twice");
     design.second_order.terms.push_back(std::move(term));
   }
   std::size_t number = 0;
@@ -100,7 +109,7 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
     ++number;
     const std::string context = "second_order run " + std::to_string(number);
     if (!r.IsMap() || r.size() == 0)
-      design_error(path, r, context + ": write a run as a map of parameter values, e.g. {P6: 1.2, P7: 1.2}");
+      yaml_error(path, r, context + ": write a run as a map of parameter values, e.g. {P6: 1.2, P7: 1.2}");
     SensitivityPoint point;
     for (auto it = r.begin(); it != r.end(); ++it) {
       const std::string name = it->first.as<std::string>();
@@ -109,9 +118,9 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
       try {
         value = it->second.as<double>();
       } catch (const YAML::Exception&) {
-        design_error(path, it->second, context + ": the value of " + name + " must be a number (e.g. 0.8)");
+        yaml_error(path, it->second, context + ": the value of " + name + " must be a number (e.g. 0.8)");
       }
-      if (!(value > 0.0)) design_error(path, it->second, context + ": the value of " + name + " must be positive");
+      if (!(value > 0.0)) yaml_error(path, it->second, context + ": the value of " + name + " must be positive");
       point.emplace_back(name, value);
     }
     design.second_order.runs.push_back(std::move(point));
@@ -119,13 +128,13 @@ void load_second_order(const std::string& path, const YAML::Node& node, Sensitiv
 }
 
 std::array<double, 3> response_triple(const std::string& path, const YAML::Node& node, const std::string& context) {
-  if (!node.IsSequence() || node.size() != 3) design_error(path, node, context + ": give [R1, R2, R3], e.g. [1.255, 0.610, 1.865]");
+  if (!node.IsSequence() || node.size() != 3) yaml_error(path, node, context + ": give [R1, R2, R3], e.g. [1.255, 0.610, 1.865]");
   std::array<double, 3> values{};
   for (std::size_t k = 0; k < 3; ++k) {
     try {
       values[k] = node[k].as<double>();
     } catch (const YAML::Exception&) {
-      design_error(path, node[k], context + ": R" + std::to_string(k + 1) + " must be a number");
+      yaml_error(path, node[k], context + ": R" + std::to_string(k + 1) + " must be a number");
     }
   }
   return values;
@@ -133,17 +142,17 @@ std::array<double, 3> response_triple(const std::string& path, const YAML::Node&
 
 void load_reference(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
   if (!node.IsMap() || !node["base"])
-    design_error(path, node, "'reference' needs at least 'base: [R1, R2, R3]' (the published run 0)");
+    yaml_error(path, node, "'reference' needs at least 'base: [R1, R2, R3]' (the published run 0)");
   for (const auto& entry : node) {
     const std::string key = entry.first.as<std::string>();
     if (key != "source" && key != "base" && key != "first_order" && key != "second_order" && key != "ranking")
-      design_error(path, entry.first, "reference: unknown key '" + key + "' (allowed: source, base, first_order, second_order, ranking)");
+      yaml_error(path, entry.first, "reference: unknown key '" + key + "' (allowed: source, base, first_order, second_order, ranking)");
   }
   PublishedResults reference;
   if (node["source"]) reference.source = node["source"].as<std::string>();
   reference.base = response_triple(path, node["base"], "reference: base");
   if (const YAML::Node first = node["first_order"]) {
-    if (!first.IsMap()) design_error(path, first, "reference: first_order must map parameters to [R1, R2, R3]");
+    if (!first.IsMap()) yaml_error(path, first, "reference: first_order must map parameters to [R1, R2, R3]");
     for (const auto& entry : first) {
       const std::string name = entry.first.as<std::string>();
       require_parameter(path, entry.first, design, name, "reference: first_order");
@@ -152,18 +161,18 @@ void load_reference(const std::string& path, const YAML::Node& node, Sensitivity
   }
   if (const YAML::Node second = node["second_order"]) {
     if (!second.IsSequence() || second.size() != design.second_order.runs.size())
-      design_error(path, second, "reference: second_order must list [R1, R2, R3] for each of the " +
+      yaml_error(path, second, "reference: second_order must list [R1, R2, R3] for each of the " +
                                      std::to_string(design.second_order.runs.size()) + " second_order runs, in their order");
     for (std::size_t i = 0; i < second.size(); ++i)
       reference.second_order.push_back(response_triple(path, second[i], "reference: second_order " + std::to_string(i + 1)));
   }
   if (const YAML::Node ranking = node["ranking"]) {
-    if (!ranking.IsMap()) design_error(path, ranking, "reference: ranking must map R1, R2, R3 to lists of parameters");
+    if (!ranking.IsMap()) yaml_error(path, ranking, "reference: ranking must map R1, R2, R3 to lists of parameters");
     for (const auto& entry : ranking) {
       const std::string response = entry.first.as<std::string>();
       if (response != "R1" && response != "R2" && response != "R3")
-        design_error(path, entry.first, "reference: ranking: keys are R1, R2 and R3");
-      if (!entry.second.IsSequence()) design_error(path, entry.second, "reference: ranking: " + response + " must be a list");
+        yaml_error(path, entry.first, "reference: ranking: keys are R1, R2 and R3");
+      if (!entry.second.IsSequence()) yaml_error(path, entry.second, "reference: ranking: " + response + " must be a list");
       auto& list = reference.ranking[static_cast<std::size_t>(response[1] - '1')];
       for (const YAML::Node& p : entry.second) {
         const std::string name = p.as<std::string>();
@@ -203,6 +212,73 @@ std::vector<std::string> job_settings(const SensitivityDesign& design, const Job
     }
   }
   return settings;
+}
+
+void check_options(const SensitivityDesign& design, const SensitivityOptions& options) {
+  if (options.central_step < 0.0 || options.central_step >= 1.0)
+    throw InputError("--central H: H must be between 0 and 1 (e.g. 0.05 for runs at 0.95 and 1.05)");
+  for (const std::string& name : options.only)
+    if (!find_parameter(design, name))
+      throw InputError("--only: the design has no parameter '" + name + "' (it has " + parameter_names(design) + ")");
+}
+
+bool is_chosen(const SensitivityOptions& options, const std::string& name) {
+  return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
+}
+
+/// The study's runs in order: the base run, the first-order runs (first_order_count of them),
+/// then the second-order runs whose parameters are all chosen.
+std::vector<Job> study_jobs(const SensitivityDesign& design, const SensitivityOptions& options, std::size_t& first_order_count) {
+  check_options(design, options);
+  const bool central = options.central_step > 0.0;
+  std::vector<Job> jobs{Job{}};
+  first_order_count = 0;
+  for (const SensitivityParameter& p : design.parameters) {
+    if (!is_chosen(options, p.name)) continue;
+    const std::vector<double> values = central ? std::vector<double>{1.0 + options.central_step, 1.0 - options.central_step}
+                                               : std::vector<double>{design.factor};
+    for (double value : values) jobs.push_back(Job{{{p.name, value}}, p.name, value});
+    first_order_count += values.size();
+  }
+  if (options.second_order)
+    for (const SensitivityPoint& point : design.second_order.runs) {
+      if (!std::all_of(point.begin(), point.end(), [&](const auto& entry) { return is_chosen(options, entry.first); })) continue;
+      Job job{point, "", point.size() == 1 ? point[0].second : kNaN};
+      for (const auto& entry : point) job.parameter += (job.parameter.empty() ? "" : "+") + entry.first;
+      jobs.push_back(job);
+    }
+  return jobs;
+}
+
+/// The scale entry of a job's parameters that the model does not accept on its own, as
+/// "design.yaml:12: design parameter 'P7', scale key 'K' does not fit the model: ...", or "".
+std::string bad_scale_entry(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+                            const Job& job, const std::vector<std::string>& base_settings) {
+  for (const auto& [name, value] : job.variation) {
+    const SensitivityParameter* parameter = find_parameter(design, name);
+    RAILCRASH_DEMAND(parameter != nullptr);
+    for (std::size_t k = 0; k < parameter->scales.size(); ++k) {
+      const auto& [key, power] = parameter->scales[k];
+      const SensitivityParameter single{name, "", {{key, power}}, {}};
+      const SensitivityDesign alone{1.2, {single}, {}, std::nullopt};
+      try {
+        (void)load_model_text(model_text, model_path, job_settings(alone, Job{{{name, value}}, name, value}, base_settings));
+      } catch (const InputError& e) {
+        const SourceLocation where = k < parameter->scale_sources.size() ? parameter->scale_sources[k] : SourceLocation{};
+        return where.prefix() + "design parameter '" + name + "', scale key '" + key + "' does not fit the model: " + e.what();
+      }
+    }
+  }
+  return "";
+}
+
+/// A run the study's interruption stopped (or never started): failed, with no responses (a
+/// partial run's would look like results).
+void mark_interrupted(SensitivityRun& run) {
+  run.ok = false;
+  run.interrupted = true;
+  run.responses.r1 = run.responses.r2 = run.responses.r3 = kNaN;
+  if (run.message.empty()) run.message = "interrupted (SIGINT/SIGTERM)";
 }
 
 SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
@@ -272,27 +348,28 @@ std::string SensitivityDerivative::label() const {
 
 SensitivityDesign load_design(const std::string& path) {
   const YAML::Node root = load_yaml_file(path, "design file");
-  if (!root.IsMap() || !root["sensitivity"]) design_error(path, root, "a design file starts with 'sensitivity: 1'");
+  if (!root.IsMap() || !root["sensitivity"]) yaml_error(path, root, "a design file starts with 'sensitivity: 1'");
   SensitivityDesign design;
   if (root["factor"]) {
     design.factor = root["factor"].as<double>();
-    if (!(design.factor > 0.0) || design.factor == 1.0) design_error(path, root["factor"], "factor must be positive and not 1");
+    if (!(design.factor > 0.0) || design.factor == 1.0) yaml_error(path, root["factor"], "factor must be positive and not 1");
   }
   const YAML::Node parameters = root["parameters"];
   if (!parameters || !parameters.IsSequence() || parameters.size() == 0)
-    design_error(path, root, "'parameters' must list the parameters: - {name, description, scale: [{key, power}]}");
+    yaml_error(path, root, "'parameters' must list the parameters: - {name, description, scale: [{key, power}]}");
   for (std::size_t i = 0; i < parameters.size(); ++i) {
     const YAML::Node p = parameters[i];
     if (!p.IsMap() || !p["name"] || !p["scale"] || !p["scale"].IsSequence())
-      design_error(path, p, "each parameter needs 'name' and a 'scale' list of {key, power}");
+      yaml_error(path, p, "each parameter needs 'name' and a 'scale' list of {key, power}");
     SensitivityParameter parameter;
-    parameter.name = p["name"].as<std::string>();
-    if (find_parameter(design, parameter.name)) design_error(path, p["name"], "parameter '" + parameter.name + "' is listed twice");
+    parameter.name = parameter_name(path, p["name"]);
+    if (find_parameter(design, parameter.name)) yaml_error(path, p["name"], "parameter '" + parameter.name + "' is listed twice");
     parameter.description = p["description"] ? p["description"].as<std::string>() : "";
     for (std::size_t k = 0; k < p["scale"].size(); ++k) {
       const YAML::Node s = p["scale"][k];
-      if (!s.IsMap() || !s["key"]) design_error(path, s, "parameter '" + parameter.name + "': each scale entry needs 'key'");
+      if (!s.IsMap() || !s["key"]) yaml_error(path, s, "parameter '" + parameter.name + "': each scale entry needs 'key'");
       parameter.scales.emplace_back(s["key"].as<std::string>(), s["power"] ? s["power"].as<double>() : 1.0);
+      parameter.scale_sources.push_back(SourceLocation{path, yaml_line(s)});
     }
     design.parameters.push_back(std::move(parameter));
   }
@@ -392,74 +469,80 @@ QuadraticFit fit_quadratic(const std::vector<SensitivityTerm>& terms, const std:
   return fit;
 }
 
-SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
-                                  const SensitivityOptions& options) {
-  if (options.central_step < 0.0 || options.central_step >= 1.0)
-    throw InputError("--central H: H must be between 0 and 1 (e.g. 0.05 for runs at 0.95 and 1.05)");
-  for (const std::string& name : options.only)
-    if (!find_parameter(design, name))
-      throw InputError("--only: the design has no parameter '" + name + "' (it has " + parameter_names(design) + ")");
-  const auto chosen = [&](const std::string& name) {
-    return options.only.empty() || std::find(options.only.begin(), options.only.end(), name) != options.only.end();
-  };
-  std::string model_text;
-  {
-    std::ifstream in(model_path);
-    if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    model_text = buffer.str();
-  }
-  SensitivityResult result;
-  result.central = options.central_step > 0.0;
-
-  std::vector<Job> jobs{Job{}};
+void check_sensitivity_inputs(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+                              const SensitivityOptions& options, bool every_run) {
   std::size_t first_order_count = 0;
-  for (const SensitivityParameter& p : design.parameters) {
-    if (!chosen(p.name)) continue;
-    const std::vector<double> values =
-        result.central ? std::vector<double>{1.0 + options.central_step, 1.0 - options.central_step}
-                       : std::vector<double>{design.factor};
-    for (double value : values) jobs.push_back(Job{{{p.name, value}}, p.name, value});
-    first_order_count += values.size();
-  }
-  std::vector<SensitivityTerm> terms;
-  if (options.second_order) {
-    for (const SensitivityPoint& point : design.second_order.runs) {
-      if (!std::all_of(point.begin(), point.end(), [&](const auto& entry) { return chosen(entry.first); })) continue;
-      Job job{point, "", point.size() == 1 ? point[0].second : kNaN};
-      for (const auto& entry : point) job.parameter += (job.parameter.empty() ? "" : "+") + entry.first;
-      jobs.push_back(job);
-    }
-    for (const SensitivityTerm& t : design.second_order.terms)
-      if (chosen(t.first) && (t.linear() || chosen(t.second))) terms.push_back(t);
-  }
-
-  // Every run's model is loaded once before the first run, so that a parameter whose model value
-  // is 0 (a factor would change nothing, and the study would call it "no effect") stops the study
-  // at once. Other input errors stay with their run (reported failed; the others go on).
-  for (const Job& job : jobs)
+  const std::vector<Job> jobs = study_jobs(design, options, first_order_count);
+  const auto check = [&](const std::vector<std::string>& settings, const Job& job) {
     try {
-      (void)load_model_text(model_text, model_path, job_settings(design, job, options.settings));
-    } catch (const ZeroScaledError& e) {
-      throw InputError(std::string(e.what()) + " (design parameter " + job.parameter + ")");
+      (void)load_model_text(model_text, model_path, settings);
+    } catch (const InputError& e) {
+      const std::string entry = bad_scale_entry(model_text, model_path, design, job, options.settings);
+      if (!entry.empty()) throw InputError(entry);
+      throw InputError(std::string(e.what()) + (job.parameter.empty() ? " (the base run)" : " (design parameter " + job.parameter + ")"));
+    }
+  };
+  if (!every_run) {
+    // Every parameter's factors at once: one load finds a missing key or a zero value; the runs
+    // are loaded one by one only to name the entry.
+    std::vector<std::string> all = options.settings;
+    for (std::size_t k = 1; k < jobs.size(); ++k) {
+      const std::vector<std::string> settings = job_settings(design, jobs[k], {});
+      all.insert(all.end(), settings.begin(), settings.end());
+    }
+    try {
+      (void)load_model_text(model_text, model_path, all);
+      return;
     } catch (const InputError&) {
     }
+  }
+  // Every run's model, as the run will load it: a scale key the model lacks, a bad value, or a
+  // parameter whose model value is 0 (a factor would change nothing, and the study would call it
+  // "no effect") stops the study before its first run.
+  for (const Job& job : jobs) check(job_settings(design, job, options.settings), job);
+}
+
+SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
+                                  const SensitivityOptions& options) {
+  const std::string model_text = read_model_text(model_path);
+  check_sensitivity_inputs(model_text, model_path, design, options, true);
+  SensitivityResult result;
+  result.central = options.central_step > 0.0;
+  std::size_t first_order_count = 0;
+  const std::vector<Job> jobs = study_jobs(design, options, first_order_count);
+  std::vector<SensitivityTerm> terms;
+  if (options.second_order)
+    for (const SensitivityTerm& t : design.second_order.terms)
+      if (is_chosen(options, t.first) && (t.linear() || is_chosen(options, t.second))) terms.push_back(t);
 
   std::vector<SensitivityRun> runs(jobs.size());
   std::size_t done = 0;
   BatchOptions batch;
   batch.jobs = options.jobs;
   batch.run_time_limit = options.run_time_limit;
-  run_batch(
+  batch.stop = options.stop;
+  const std::vector<BatchRunState> states = run_batch(
       jobs.size(),
       [&](std::size_t k, const RunControl& control) {
         runs[k] = run_one(model_path, model_text, design, jobs[k], options.settings, options.run_time_limit, control);
       },
       batch,
-      [&](std::size_t k, BatchRunState) {
+      [&](std::size_t k, BatchRunState state) {
+        if (state == BatchRunState::interrupted) mark_interrupted(runs[k]);
         if (options.progress) options.progress(runs[k], k, ++done, jobs.size());
       });
+  result.runs_total = jobs.size();
+  result.runs_finished = finished_runs(states);
+  result.interrupted = result.runs_finished < result.runs_total;
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    if (states[k] == BatchRunState::not_started) {
+      runs[k].variation = jobs[k].variation;
+      runs[k].parameter = jobs[k].parameter;
+      runs[k].factor = jobs[k].factor;
+      mark_interrupted(runs[k]);
+      runs[k].message = "not run: the study was interrupted";
+    }
+  }
 
   result.base = runs[0];
   result.runs.assign(runs.begin() + 1, runs.begin() + 1 + static_cast<std::ptrdiff_t>(first_order_count));
@@ -545,6 +628,9 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
   const auto parameter_of = [&](std::size_t i) { return result.runs[per_parameter * i].parameter; };
   const auto percent = [&](double now, double base) { return base != 0.0 ? 100.0 * (now - base) / base : 0.0; };
   std::ostringstream md;
+  if (result.interrupted)
+    md << "**Interrupted after " << result.runs_finished << " of " << result.runs_total
+       << " runs** (SIGINT/SIGTERM): the runs not finished are marked interrupted, and the fits use the finished runs only.\n\n";
 
   // Runs: sensitivity.csv, and Table 11 / Tables 12-13 in the Markdown.
   {
@@ -561,7 +647,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
         values += (values.empty() ? "" : " ") + number(value, "%g");
       }
       const int order = k == 0 ? 0 : (k <= result.runs.size() ? 1 : 2);
-      csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : "failed") << ','
+      csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : (r.interrupted ? "interrupted" : "failed")) << ','
           << csv_number(r.responses.r1) << ',' << csv_number(r.responses.r2) << ',' << csv_number(r.responses.r3) << ','
           << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << '\n';
     }

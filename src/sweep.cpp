@@ -14,6 +14,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
@@ -247,14 +248,6 @@ std::vector<std::vector<double>> monte_carlo(std::size_t samples, std::size_t fa
 
 // ---------------------------------------------------------------- plan
 
-std::string read_model_text(const std::string& model_path) {
-  std::ifstream in(model_path);
-  if (!in) throw InputError(model_path + ": cannot open the model file (check the path)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path) {
   const YAML::Node root = load_yaml_file(path, "plan file");
   if (!root.IsMap() || !root["sweep"]) yaml_error(path, root, "a plan file starts with 'sweep: 1'");
@@ -356,7 +349,8 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
 
   // Every key and level against the model, before any run.
   const std::string model_text = read_model_text(model_path);
-  const YAML::Node model_root = YAML::Load(model_text);
+  (void)load_model_text(model_text, model_path);  // the model's own mistakes first, as they are
+  const YAML::Node model_root = load_yaml_text(model_text, model_path);
   const auto check = [&](const SweepFactor& factor, const std::string& level, int line) {
     std::vector<std::string> settings = plan.settings;
     try {
@@ -422,7 +416,7 @@ std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& m
       levels = plan.runs;
       break;
   }
-  const YAML::Node model_root = YAML::Load(model_text);
+  const YAML::Node model_root = load_yaml_text(model_text, "the model");
   std::vector<SweepRunSpec> specs;
   for (auto& row : levels) {
     SweepRunSpec spec;
@@ -493,7 +487,7 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     row.message = report.outcome.message;
     if (!report.outcome.ok && control.timed_out()) row.message = "stopped at the run time limit (t = " + exact(report.outcome.t_reached) + ")";
     if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
-    const YAML::Node summary = YAML::Load(report.summary_json);
+    const YAML::Node summary = load_yaml_text(report.summary_json, "summary.json");
     for (std::size_t k = 0; k < plan.responses.size(); ++k) {
       const std::string& name = plan.responses[k];
       if (const auto at = name.rfind('@'); at != std::string::npos) {
@@ -648,6 +642,13 @@ const char* design_name(SweepDesignKind kind) {
 
 }  // namespace
 
+std::size_t failed_sweep_runs(const SweepPlan& plan, const SweepResult& result) {
+  std::size_t failed = 0;
+  for (const auto& line : result.lines)
+    if (line && csv_fields(*line)[2 + plan.factors.size()] != "ok") ++failed;
+  return failed;
+}
+
 std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const std::string& directory) {
   std::filesystem::create_directories(directory);
   {
@@ -660,14 +661,11 @@ std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const 
   // Per finished run: the levels and the responses of ok runs.
   std::vector<std::vector<std::string>> levels;
   std::vector<std::vector<double>> values;
-  std::size_t failed = 0;
+  const std::size_t failed = failed_sweep_runs(plan, result);
   for (const auto& line : result.lines) {
     if (!line) continue;
     const std::vector<std::string> fields = csv_fields(*line);
-    if (fields[2 + factor_count] != "ok") {
-      ++failed;
-      continue;
-    }
+    if (fields[2 + factor_count] != "ok") continue;
     levels.emplace_back(fields.begin() + 2, fields.begin() + 2 + static_cast<std::ptrdiff_t>(factor_count));
     values.emplace_back();
     for (std::size_t r = 0; r < plan.responses.size(); ++r) {

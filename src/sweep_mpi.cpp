@@ -115,10 +115,11 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const std::
   }
   own.join();
   write_sweep(plan, result, directory);
-  std::printf("%zu of %zu runs done (%zu resumed) on %d MPI ranks; results in %s/ (runs.csv, summary.md)\n", result.done(),
-              result.specs.size(), result.resumed, ranks, directory.c_str());
+  const std::size_t failed = failed_sweep_runs(plan, result);
+  std::printf("%zu of %zu runs done (%zu resumed), %zu failed, on %d MPI ranks; results in %s/ (runs.csv, summary.md)\n",
+              result.done(), result.specs.size(), result.resumed, failed, ranks, directory.c_str());
   if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
-  return result.done() == result.specs.size() ? 0 : 1;
+  return result.done() == result.specs.size() && failed == 0 ? 0 : 1;
 }
 
 /// Ranks above 0: ask for a run, run it, send its line, until told to stop.
@@ -158,6 +159,7 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
   SweepPlan plan;
   std::string problem;
   try {
+    if (rank == 0) check_output_folder(directory);  // only rank 0 writes there
     plan = load_sweep_plan(plan_path, model_path);
     if (rank == 0) model_text = read_model_text(model_path);
   } catch (const InputError& e) {
@@ -174,7 +176,7 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
   try {
     if (ranks == 1) {
       const SweepResult result = run_sweep(model_path, plan, directory, options);
-      status = result.done() == result.specs.size() ? 0 : 1;
+      status = result.done() == result.specs.size() && failed_sweep_runs(plan, result) == 0 ? 0 : 1;
     } else if (rank == 0) {
       status = coordinate(plan, model_path, model_text, directory, options, ranks);
     } else {

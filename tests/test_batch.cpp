@@ -1,8 +1,13 @@
 // The batch runner (batch.hpp): order, the per-run limit, interruption, job count.
 #include <catch2/catch.hpp>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -79,4 +84,36 @@ TEST_CASE("batch: the caller's stop flag stops the runs in progress and starts n
   CHECK(states[3] == BatchRunState::interrupted);
   CHECK(states[9] == BatchRunState::not_started);
   for (std::size_t k = 0; k < 3; ++k) CHECK(states[k] == BatchRunState::finished);
+}
+
+TEST_CASE("batch: --out is checked before any run, with the path and the OS's reason", "[batch]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_out_check_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string file = (dir / "a_file").string();
+  std::ofstream(file) << "x";
+  CHECK_THROWS_WITH(check_output_folder(""), Catch::StartsWith("--out is empty"));
+  CHECK_THROWS_WITH(check_output_folder(file), "--out '" + file + "' is a file, not a folder (Not a directory); give a folder");
+  CHECK_THROWS_WITH(check_output_folder(file + "/sub"), Catch::Contains("'" + file + "' is a file, not a folder"));
+  const std::string missing = (dir / "missing" / "out").string();
+  CHECK_THROWS_WITH(check_output_folder(missing), "--out '" + missing + "': its folder '" + (dir / "missing").string() +
+                                                      "' does not exist (No such file or directory); create it first or give another path");
+  CHECK_THROWS_WITH(check_output_folder("/proc"), Catch::StartsWith("--out '/proc': cannot write in the folder: "));
+  // A new folder is fine, and the check leaves nothing behind; an existing folder keeps its files.
+  const std::string fresh = (dir / "fresh").string();
+  CHECK_NOTHROW(check_output_folder(fresh + "/"));
+  CHECK_FALSE(fs::exists(fresh));
+  CHECK_NOTHROW(check_output_folder(dir.string()));
+  CHECK(fs::exists(file));
+  CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+  // A file to write (consist, scenario).
+  CHECK_THROWS_WITH(check_output_file(dir.string()), Catch::StartsWith("--out '" + dir.string() + "' is a folder (Is a directory)"));
+  CHECK_THROWS_WITH(check_output_file(missing), Catch::Contains("does not exist (No such file or directory)"));
+  CHECK_THROWS_WITH(check_output_file(""), Catch::StartsWith("--out is empty"));
+  CHECK_NOTHROW(check_output_file((dir / "model.yaml").string()));
+  CHECK_FALSE(fs::exists(dir / "model.yaml"));
+  CHECK_NOTHROW(check_output_file(file));
+  CHECK(fs::file_size(file) == 1);  // an existing file is not truncated by the check
+  fs::remove_all(dir);
 }

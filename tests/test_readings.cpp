@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -63,7 +64,7 @@ TEST_CASE("combinations: factorial odometer and one at a time", "[readings]") {
 
 TEST_CASE("a study is scored against published results: errors, signs, rank correlation, top five", "[readings]") {
   SensitivityDesign design;
-  for (int i = 1; i <= 6; ++i) design.parameters.push_back({"P" + std::to_string(i), "", {}});
+  for (int i = 1; i <= 6; ++i) design.parameters.push_back({"P" + std::to_string(i), "", {}, {}});
   PublishedResults published;
   published.base = {1.0, 0.5, 1.5};
   // Published R1 changes: -0.1, -0.05, 0, +0.01, +0.002, -0.02 (P5's is below 0.005: no sign).
@@ -190,12 +191,34 @@ TEST_CASE("a reading study ranks first the reading that reproduces the published
   char r1[16];
   std::snprintf(r1, sizeof r1, "%.3f", truth.base.responses.r1);
   CHECK_THAT(comparison, Contains("| run 0, ours | " + std::string(r1)) && Contains("| run 0, published | " + std::string(r1)));
+
+  // Interrupted (SIGINT/SIGTERM in the command line) as the first run of combination 0
+  // finishes: that combination is kept, partial, with its finished run; no other starts.
+  std::atomic<bool> stop{false};
+  ReadingsOptions interrupted_options;
+  interrupted_options.study.jobs = 1;
+  interrupted_options.study.stop = &stop;
+  interrupted_options.study.progress = [&](const SensitivityRun&, std::size_t, std::size_t, std::size_t) { stop = true; };
+  const auto partial = run_readings(model, design, plan, interrupted_options);
+  REQUIRE(partial.size() == 1);
+  CHECK(partial[0].study.interrupted);
+  CHECK(partial[0].study.runs_finished == 1);
+  CHECK(partial[0].study.runs_total == 4);
+  REQUIRE(partial[0].study.base.ok);
+  CHECK(partial[0].study.base.responses.r1 == Approx(results[0].study.base.responses.r1).epsilon(1e-12));
+  CHECK(partial[0].failed_runs == 0);  // the runs not run are not failures
+  const std::string partial_md = write_readings(partial, plan, design, out + "_partial");
+  CHECK_THAT(partial_md, StartsWith("# Reading study\n\n**Interrupted after 0 of 2 combinations** (SIGINT/SIGTERM); the last "
+                                    "one listed is partial"));
+  CHECK(std::filesystem::exists(out + "_partial/combination_000/sensitivity.csv"));
+  CHECK_FALSE(std::filesystem::exists(out + "_partial/combination_001"));
+  std::filesystem::remove_all(out + "_partial");
 }
 
 TEST_CASE("a reading level may change what a design parameter scales", "[readings]") {
   SensitivityDesign design;
-  design.parameters.push_back({"P5", "elastic slope", {{"elements.a.k", 1.0}}});
-  design.parameters.push_back({"P7", "yield force", {{"elements.a.d", 1.0}}});
+  design.parameters.push_back({"P5", "elastic slope", {{"elements.a.k", 1.0}}, {}});
+  design.parameters.push_back({"P7", "yield force", {{"elements.a.d", 1.0}}, {}});
   const ReadingsPlan plan = load_readings(temporary_file(
       "plan3.yaml", "reading_study: 1\nreadings:\n  - name: slope_holds\n    levels:\n      - {name: deflection}\n"
                     "      - name: force\n        scale: {P5: [{key: elements.a.k}, {key: elements.a.d, power: -1}]}\n"

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <functional>
 #include <mutex>
+#include <string>
 #include <vector>
 
 namespace railcrash {
@@ -55,5 +56,22 @@ enum class BatchRunState {
 std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void(std::size_t, const RunControl&)>& task,
                                      const BatchOptions& options,
                                      const std::function<void(std::size_t, BatchRunState)>& on_finished = {});
+
+/// How many runs ended by themselves (fewer than states.size() when the batch was interrupted).
+std::size_t finished_runs(const std::vector<BatchRunState>& states);
+
+/// The model file's text, read once at the start of a study so that every run sees the same
+/// model even if the file is edited while the study runs (InputError if it cannot be read).
+std::string read_model_text(const std::string& model_path);
+
+/// Checks a study's output folder (--out) before any run, so that a study never runs for hours
+/// and then cannot write: InputError naming the folder and the OS's reason if it is empty, is a
+/// file, has no parent folder, or cannot be written (a file is created in it and removed). A
+/// missing folder is created for the check and removed again (a rejected study leaves nothing).
+void check_output_folder(const std::string& folder);
+
+/// The same for a file a command writes (--out of consist and scenario): its folder exists, it
+/// is not a folder, and it can be written (a new file is created for the check and removed).
+void check_output_file(const std::string& file);
 
 }  // namespace railcrash

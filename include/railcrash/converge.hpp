@@ -150,6 +150,9 @@ struct ConvergeResult {
   std::vector<ConvergeFit> ida_time_slope;     // log e vs log wall time
   std::vector<ConvergeLevel> levels;           // headline quantity at equal accuracy
   double total_seconds = 0.0;
+  std::size_t runs_total = 0;     // the reference and the Euler and IDA runs planned
+  std::size_t runs_finished = 0;  // of those, the runs that ended by themselves (fewer if interrupted)
+  bool interrupted = false;       // the stop flag rose (SIGINT/SIGTERM): the other runs are failed "not run"
 };
 
 /// What the study will do, worked out before it runs (the caller may print it).

@@ -50,6 +50,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <optional>
@@ -57,6 +58,7 @@
 #include <utility>
 #include <vector>
 
+#include "railcrash/error.hpp"
 #include "railcrash/responses.hpp"
 
 namespace railcrash {
@@ -65,6 +67,7 @@ struct SensitivityParameter {
   std::string name;
   std::string description;
   std::vector<std::pair<std::string, double>> scales;  // (model key, power)
+  std::vector<SourceLocation> scale_sources;           // where each scale entry is written (design or readings file)
 };
 
 /// A term of the second-order form: P_first (linear), P_first^2 (second == first) or
@@ -125,6 +128,7 @@ struct SensitivityRun {
   std::string message;
   Responses responses;
   double wall_seconds = 0.0;
+  bool interrupted = false;    // stopped, or never started, because the study was interrupted
 };
 
 /// One run's data for a fit.
@@ -165,6 +169,9 @@ struct SensitivityResult {
   QuadraticFit fit;                                // empty terms: no second-order study
   std::string fit_note;                            // runs left out of the fit and why
   bool central = false;
+  std::size_t runs_total = 0;     // runs the study has (base, first order, second order)
+  std::size_t runs_finished = 0;  // runs that ended by themselves (ok or failed); fewer if interrupted
+  bool interrupted = false;       // the stop flag rose: runs not finished are failed "not run" / "interrupted"
 };
 
 struct SensitivityOptions {
@@ -175,9 +182,18 @@ struct SensitivityOptions {
                                      // terms are kept when all their parameters are among them
   bool second_order = true;          // run the design's second-order runs and fit
   double run_time_limit = 0.0;       // [s] wall time after which a run is stopped and reported failed (0: none)
+  const std::atomic<bool>* stop = nullptr;  // raised (SIGINT/SIGTERM): runs in progress stop, no new run starts
   /// Called (one call at a time) as each run finishes: the run, its number (0 = base), runs done, runs in all.
   std::function<void(const SensitivityRun&, std::size_t, std::size_t, std::size_t)> progress;
 };
+
+/// Loads the model with every run's settings without running it, so that any input error (a
+/// scale key the model does not have, a parameter whose model value is 0, a bad --set) stops the
+/// study before its first run; the message names the design file's line of the scale entry.
+/// Without every_run, the model is first loaded once with every parameter's factors at once
+/// (what a reading study does for each of its many combinations), and run by run only if that fails.
+void check_sensitivity_inputs(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+                              const SensitivityOptions& options, bool every_run);
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
                                   const SensitivityOptions& options);

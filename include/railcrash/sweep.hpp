@@ -144,8 +144,9 @@ struct SweepResult {
 SweepResult start_sweep(const SweepPlan& plan, const std::string& model_text, const std::string& directory, bool resume);
 /// Appends one finished line to DIR/runs.csv (flushed: a killed sweep keeps it).
 void append_sweep_line(const std::string& directory, const std::string& line);
-/// The model file's text, read once so every run sees the same model.
-std::string read_model_text(const std::string& model_path);
+
+/// The runs done whose status is not ok (runs.csv's status column).
+std::size_t failed_sweep_runs(const SweepPlan& plan, const SweepResult& result);
 
 /// Runs the plan with threads, writing DIR/runs.csv as runs finish and again in run order at
 /// the end, and DIR/summary.md.

@@ -17,9 +17,17 @@ while IFS= read -r line; do
   expected=$(echo "$line" | cut -d'|' -f1 | xargs)
   fragment=$(echo "$line" | cut -d'|' -f2 | sed 's/^ //; s/ $//')
   arguments=$(echo "$line" | cut -d'|' -f3- | sed 's/^ //')
-  arguments=${arguments//@M@/$here/models}
-  arguments=${arguments//@SRC@/$source_dir}
-  arguments=${arguments//@OUT@/$work/out$cases}
+  touch "$work/file$cases"
+  mkdir -p "$work/dir$cases"
+  for placeholder in arguments fragment; do
+    text=${!placeholder}
+    text=${text//@M@/$here/models}
+    text=${text//@SRC@/$source_dir}
+    text=${text//@OUT@/$work/out$cases}
+    text=${text//@FILE@/$work/file$cases}
+    text=${text//@DIR@/$work/dir$cases}
+    printf -v "$placeholder" '%s' "$text"
+  done
   # Words split on spaces, except that a --set value keeps its spaces (the rest of the line).
   if [[ "$arguments" == *"--set "* ]]; then
     read -r -a words <<< "${arguments%%--set *}"
