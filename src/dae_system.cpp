@@ -500,6 +500,22 @@ const Element& DaeSystem::constraint_owner(int row) const {
   return *model_.elements()[static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)])];
 }
 
+std::string DaeSystem::unknown_name(int k) const {
+  static const char* const kPosition[3] = {"x", "y", "theta"};
+  static const char* const kVelocity[3] = {"vx", "vy", "omega"};
+  const int nq = body_unknowns();
+  const int m = constraint_rows();
+  if (k < 2 * nq) {
+    const Body& body = model_.bodies()[static_cast<std::size_t>((k % nq) / 3)];
+    return body.where.prefix() + "body '" + body.name + "' " + (k < nq ? kPosition : kVelocity)[k % 3];
+  }
+  const int row = (k - 2 * nq) % m;
+  const Element& owner = constraint_owner(row);
+  const int local = row - model_.constraint_offset(static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)]));
+  return owner.where().prefix() + "element '" + owner.name() + "' (" + owner.type() + ") " +
+         (k < 2 * nq + m ? "multiplier" : "velocity multiplier") + " of its constraint row " + std::to_string(local);
+}
+
 double DaeSystem::kinetic_energy(const double* v) const {
   double ke = 0.0;
   for (int k = 0; k < body_unknowns(); ++k) ke += 0.5 * mass_[static_cast<std::size_t>(k)] * v[k] * v[k];

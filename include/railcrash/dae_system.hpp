@@ -105,6 +105,9 @@ class DaeSystem {
   double constraint_residual(const double* q) const;
   /// Element owning constraint row `row`.
   const Element& constraint_owner(int row) const;
+  /// Unknown k of y in the model's terms, with file:line: "model.yaml:7: body 'cab' vx",
+  /// "model.yaml:20: element 'pin' (revolute) multiplier of its constraint row 1".
+  std::string unknown_name(int k) const;
   /// False once the element owning constraint row `row` has failed (its rows: lambda = mu = 0).
   bool constraint_row_active(int row) const { return !constraint_owner(row).failed(); }
   /// True when constraint row `row` is an angle equation.

@@ -42,14 +42,24 @@ class IdaIntegrator : public Integrator {
   IdaIntegrator(const DaeSystem& system, IdaSettings settings);
   ~IdaIntegrator() override;
   const char* name() const override { return "ida"; }
-  RunOutcome run(double t_end, double output_interval, RunObserver& observer,
-                 const std::atomic<bool>* stop = nullptr) override;
 
   struct Impl;
 
  private:
-  const DaeSystem& system_;
+  // Integrator's steps (integrator.hpp).
+  void start(double t_end) override;
+  double advance(double t_end) override;
+  bool dense_output() const override { return true; }
+  void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) override;
+  const double* current_state() const override;
+  void final_state(std::vector<double>& y, std::vector<double>& quadratures) override;
+  std::string step_limit_advice(double t_end) const override;
+  std::string divergence_phrase() const override { return "IDA's solution is not finite"; }
+  long max_steps() const override { return settings_.max_steps; }
+  void finish() override;
+
   IdaSettings settings_;
+  std::unique_ptr<Impl> impl_;  // SUNDIALS' objects of the run in progress
 };
 
 }  // namespace railcrash
