@@ -33,6 +33,12 @@ void Integrator::deliver_sample(double t) {
   }
   const int nq = system_.body_unknowns();
   observer_->sample(t, sample_y_.data(), sample_y_.data() + 2 * nq, sample_quadratures_.data());
+  const std::string observer_failure = observer_->failure();  // a failed write: stop at once
+  if (!observer_failure.empty()) {
+    std::ostringstream msg;
+    msg << observer_failure << "; the run stopped at t = " << t << ", the files hold the samples up to t = " << t_sampled_;
+    throw StepFailure(msg.str());
+  }
   outcome_.max_constraint_residual = std::max(outcome_.max_constraint_residual, system_.constraint_residual(sample_y_.data()));
   t_sampled_ = t;
   last_sample_y_ = sample_y_;

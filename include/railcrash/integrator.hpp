@@ -37,6 +37,9 @@ class RunObserver {
   virtual void sample(double t, const double* y, const double* lambda, const double* quadratures) = 0;
   /// A committed mode change (contact, yield, rupture, ...); y is the state at that instant.
   virtual void event(const EventRecord& /*record*/, const double* /*y*/) {}
+  /// Why the observer cannot go on (a failed write: the OS's reason), "" while it can; the
+  /// run loop stops at once when it is not empty.
+  virtual std::string failure() const { return ""; }
 };
 
 struct RunOutcome {
