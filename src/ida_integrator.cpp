@@ -88,7 +88,7 @@ struct IdaIntegrator::Impl {
   const DaeSystem& system;
   SUNContext context = nullptr;
   N_Vector y = nullptr, yp = nullptr, ids = nullptr, atol = nullptr, quad = nullptr, quad_atol = nullptr;
-  N_Vector y_internal = nullptr;  // IDA's solution at its own time t_n
+  N_Vector local_errors = nullptr;  // IDA's estimated local errors (failure diagnosis)
   SUNMatrix jacobian = nullptr;
   SUNLinearSolver linear_solver = nullptr;
   N_Vector derivative = nullptr;   // IDAGetDky's output
@@ -114,13 +114,16 @@ struct IdaIntegrator::Impl {
   };
   std::vector<Crossing> crossings;
   bool at_start = true;  // no step taken since start()
+  // The first trial state whose residual was not finite (cleared before every step).
+  double non_finite_t = 0.0;
+  std::vector<double> non_finite_y, non_finite_yp;
 
   explicit Impl(const DaeSystem& s) : system(s) {}
   ~Impl() {
     if (ida) IDAFree(&ida);
     if (linear_solver) SUNLinSolFree(linear_solver);
     if (jacobian) SUNMatDestroy(jacobian);
-    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &y_internal, &derivative, &y_out, &quad_out})
+    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &local_errors, &derivative, &y_out, &quad_out})
       if (*v) N_VDestroy(*v);
     if (context) SUNContext_Free(&context);
   }
@@ -144,7 +147,14 @@ struct IdaIntegrator::Impl {
       self->system.residual(t, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), N_VGetArrayPointer(rr));
       const double* r = N_VGetArrayPointer(rr);
       for (sunindextype k = 0; k < N_VGetLength(rr); ++k)
-        if (!std::isfinite(r[k])) return 1;  // recoverable: IDA cuts the step
+        if (!std::isfinite(r[k])) {  // recoverable: IDA cuts the step; kept to explain a failure
+          if (self->non_finite_y.empty()) {
+            self->non_finite_t = t;
+            self->non_finite_y.assign(N_VGetArrayPointer(yy), N_VGetArrayPointer(yy) + N_VGetLength(yy));
+            self->non_finite_yp.assign(N_VGetArrayPointer(ypv), N_VGetArrayPointer(ypv) + N_VGetLength(ypv));
+          }
+          return 1;
+        }
       return 0;
     } catch (...) {
       self->callback_error = std::current_exception();
@@ -302,6 +312,7 @@ void IdaIntegrator::start(double t_end) {
     double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
     for (int k = 0; k < nquad; ++k) quad_atol[k] = 0.1 * rtol * energy_scale;
     quad_atol[DaeSystem::kKineticIntegral] *= t_end;
+    check_start(y, yp, atol, t_end);
 
     impl.ida = impl.created(IDACreate(impl.context), "IDACreate");
     impl.check(IDASetErrHandlerFn(impl.ida, &Impl::error_handler, &impl), "IDASetErrHandlerFn");
@@ -323,7 +334,7 @@ void IdaIntegrator::start(double t_end) {
     impl.check(IDAQuadSVtolerances(impl.ida, rtol, impl.quad_atol), "IDAQuadSVtolerances");
     impl.check(IDASetQuadErrCon(impl.ida, SUNTRUE), "IDASetQuadErrCon");
     impl.rtol = rtol;
-    impl.y_internal = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.local_errors = impl.created(N_VClone(impl.y), "N_VClone");
     impl.derivative = impl.created(N_VClone(impl.y), "N_VClone");
     impl.y_out = impl.created(N_VClone(impl.y), "N_VClone");
     impl.quad_out = impl.created(N_VClone(impl.quad), "N_VClone");
@@ -465,12 +476,14 @@ double IdaIntegrator::advance(double t_end) {
 
   double t_n = impl.t_reached;
   impl.last_sundials_message.clear();
+  impl.non_finite_y.clear();
   const int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
   impl.rethrow_callback_error();
   if (flag < 0) {
     std::ostringstream msg;
     msg << "IDA failed at t = " << t_n << " with " << flag_name(flag);
     if (!impl.last_sundials_message.empty()) msg << " (" << impl.last_sundials_message << ")";
+    msg << explain_failure(flag);
     throw StepFailure(msg.str());
   }
   impl.at_start = false;
@@ -584,6 +597,82 @@ double IdaIntegrator::advance(double t_end) {
   }
   if (!restarted) impl.t_reached = t_n;  // (the run loop samples up to it)
   return impl.t_reached;
+}
+
+void IdaIntegrator::check_start(const double* y, const double* yp, const double* atol, double t_end) const {
+  const std::string source = system_.non_finite_source(0.0, y, yp);
+  if (!source.empty())
+    throw InputError(source + " at t = 0, before the first step; check its numbers (a value too large or too small)");
+  // A rate so large against its tolerance that IDA's weighted norms overflow (its first step
+  // would be zero): a mass or inertia far too small, or a stiffness far too large, acting there.
+  constexpr double kLargestWeightedChange = 1e150;  // squared in a norm: below the largest double
+  const int nq = system_.body_unknowns();
+  for (int k = 0; k < 2 * nq; ++k) {
+    const double weighted_change = std::abs(yp[k]) * t_end / (settings_.rtol * std::abs(y[k]) + atol[k]);
+    if (weighted_change > kLargestWeightedChange) {
+      std::ostringstream msg;
+      msg << system_.unknown_name(k) << " changes at " << yp[k] << " per unit time at t = 0, " << weighted_change
+          << " times its tolerance over t_end: too fast to integrate (IDA's error norms overflow); check the "
+             "masses, inertias and stiffnesses acting there (a value too small or too large)";
+      if (k >= nq) msg << largest_force_on(k - nq, y);
+      throw InputError(msg.str());
+    }
+  }
+}
+
+std::string IdaIntegrator::largest_force_on(int k, const double* y) const {
+  const int body = k / 3, component = k % 3;
+  const Model& model = system_.model();
+  double largest = 0.0;
+  const Element* source = nullptr;
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const DaeSystem::ElementLoad load = system_.element_load(static_cast<int>(e), 0.0, y);
+    for (std::size_t slot = 0; slot < 2; ++slot) {
+      if (load.body[slot] != body) continue;
+      const Pose<double>& f = load.force[slot];
+      const double value = std::abs(component == 0 ? f.x : component == 1 ? f.y : f.theta);
+      if (value > largest) largest = value, source = model.elements()[e].get();
+    }
+  }
+  if (!source) return "";
+  std::ostringstream text;
+  text << "; the largest force on it, " << largest << ", comes from " << source->where().prefix() << "element '"
+       << source->name() << "' (" << source->type() << ")";
+  return text.str();
+}
+
+std::string IdaIntegrator::explain_failure(int flag) {
+  Impl& impl = *impl_;
+  std::ostringstream why;
+  if (!impl.non_finite_y.empty()) {
+    const std::string source =
+        system_.non_finite_source(impl.non_finite_t, impl.non_finite_y.data(), impl.non_finite_yp.data());
+    why << "; the residual was not finite at t = " << impl.non_finite_t << (source.empty() ? "" : ": " + source);
+  }
+  double t_good = 0.0, h = 0.0;
+  if (IDAGetCurrentTime(impl.ida, &t_good) != IDA_SUCCESS || IDAGetCurrentStep(impl.ida, &h) != IDA_SUCCESS) return why.str();
+  why << "; last good state at t = " << t_good << ", step h = " << h;
+  if (IDAGetDky(impl.ida, t_good, 0, impl.y_out) != IDA_SUCCESS) return why.str();
+  if (flag == IDA_CONV_FAIL || flag == IDA_ERR_FAIL) {
+    const std::string singular = singular_configuration(system_, N_VGetArrayPointer(impl.y_out), t_good);
+    if (!singular.empty()) why << "; " << singular;
+  }
+  // The unknowns with the largest weighted local error estimates (error weight x error).
+  if (IDAGetErrWeights(impl.ida, impl.derivative) == IDA_SUCCESS && IDAGetEstLocalErrors(impl.ida, impl.local_errors) == IDA_SUCCESS) {
+    const double* weights = N_VGetArrayPointer(impl.derivative);
+    const double* errors = N_VGetArrayPointer(impl.local_errors);
+    std::vector<std::pair<double, int>> weighted;
+    for (int k = 0; k < system_.size(); ++k) weighted.emplace_back(std::abs(weights[k] * errors[k]), k);
+    const std::size_t shown = std::min<std::size_t>(3, weighted.size());
+    std::partial_sort(weighted.begin(), weighted.begin() + static_cast<std::ptrdiff_t>(shown), weighted.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first; });
+    if (shown > 0 && weighted.front().first > 0.0) {
+      why << "; largest weighted local errors:";
+      for (std::size_t i = 0; i < shown && weighted[i].first > 0.0; ++i)
+        why << (i ? ", " : " ") << system_.unknown_name(weighted[i].second) << " (" << weighted[i].first << ")";
+    }
+  }
+  return why.str();
 }
 
 void IdaIntegrator::state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) {

@@ -127,14 +127,22 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   ProgressObserver observer(system, observers, model.simulation.t_end, show_progress);
   std::unique_ptr<Integrator> integrator;
   try {
-    integrator = make_integrator(system, model.simulation);
-  } catch (const InputError&) {
+    try {
+      integrator = make_integrator(system, model.simulation);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
+      report.outcome.message = e.what();
+    }
+    if (integrator)
+      report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+  } catch (const InputError& e) {  // found at the start (a non-finite law, joints): the summary says so too
+    if (writer) {
+      report.outcome.message = e.what();
+      writer->write_summary(report.outcome, report.integrator);
+    }
     throw;
-  } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
-    report.outcome.message = e.what();
   }
-  if (integrator)
-    report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
   observer.finish();
   if (report.outcome.ok && !observer.non_finite_output().empty()) {
     report.outcome.ok = false;
