@@ -271,10 +271,30 @@ std::string EulerIntegrator::step_limit_advice(double t_end) const {
   return text.str();
 }
 
-std::string EulerIntegrator::divergence_advice() const {
+std::string EulerIntegrator::divergence_advice(const std::vector<double>& last_good, double t_last_good) const {
   std::ostringstream text;
   text << "; the step " << dt_ << " is too large for the model as it deforms (stability limit at the start: "
        << stability_limit_ << ")";
+  // A penalty joint that went unstable shows as the largest violation of its constraint in the
+  // last good sample (its arms or effective masses changed since the penalties were sized).
+  const int m = system_.constraint_rows();
+  if (m == 0 || last_good.empty()) return text.str();
+  std::vector<double> phi(static_cast<std::size_t>(m));
+  system_.constraints(last_good.data(), phi.data(), nullptr);
+  const double length = system_.model().length_scale();
+  int worst = -1;
+  double worst_violation = 0.0;  // [length]
+  for (int r = 0; r < m; ++r) {
+    if (!system_.constraint_row_active(r)) continue;
+    const double violation = std::abs(phi[static_cast<std::size_t>(r)]) * (system_.constraint_row_is_rotational(r) ? length : 1.0);
+    if (violation > worst_violation) worst_violation = violation, worst = r;
+  }
+  if (worst < 0) return text.str();
+  const Element& joint = system_.constraint_owner(worst);
+  text << "; the largest joint violation at the last good sample (t = " << t_last_good << ") is " << worst_violation
+       << " (length units) in " << joint.where().prefix() << "joint '" << joint.name() << "' (" << joint.type()
+       << "), likely the penalty that went unstable: give it (or the model) penalty_stiffness / penalty_damping "
+          "for its present arms and masses, or a smaller dt";
   return text.str();
 }
 

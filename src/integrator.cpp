@@ -28,7 +28,7 @@ void Integrator::deliver_sample(double t) {
   const std::string bad = non_finite_entry(sample_y_.data());
   if (!bad.empty()) {
     std::ostringstream msg;
-    msg << divergence_phrase() << " at t = " << t << ": " << bad << divergence_advice();
+    msg << divergence_phrase() << " at t = " << t << ": " << bad << divergence_advice(last_sample_y_, t_sampled_);
     throw StepFailure(msg.str());
   }
   const int nq = system_.body_unknowns();
@@ -91,7 +91,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
       const std::string bad = non_finite_entry(current_state());
       if (!bad.empty()) {
         std::ostringstream msg;
-        msg << divergence_phrase() << " at t = " << t_reached << ": " << bad << divergence_advice();
+        msg << divergence_phrase() << " at t = " << t_reached << ": " << bad << divergence_advice(last_sample_y_, t_sampled_);
         throw StepFailure(msg.str());
       }
       if (dense) {

@@ -143,7 +143,7 @@ TEST_CASE("the barrier model's two cars are summarised separately", "[results]")
   CHECK(cars[0].bodies.size() + cars[1].bodies.size() + 1 == static_cast<std::size_t>(model.body_count()));  // + coupler
 }
 
-TEST_CASE("a full disk stops the run at once with the OS's reason; the summary says failed", "[results][faults]") {
+TEST_CASE("a full disk stops the run at once with the OS reason and the summary says failed", "[results][faults]") {
   if (!std::filesystem::exists("/dev/full")) return;  // no device that is always full here
   const std::string dir = temporary_folder("full_disk");
   std::filesystem::create_directories(dir);
@@ -161,7 +161,7 @@ TEST_CASE("a full disk stops the run at once with the OS's reason; the summary s
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("summary.json says running while the run goes; a vanished folder stops the run", "[results][faults]") {
+TEST_CASE("summary.json says running while the run goes and a vanished folder stops the run", "[results][faults]") {
   const std::string dir = temporary_folder("vanishing");
   const Model model = testing::model_from_text(spring_mass_text(10.0));
   const DaeSystem system(model);

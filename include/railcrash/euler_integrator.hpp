@@ -55,7 +55,7 @@ class EulerIntegrator : public Integrator {
   EnergyState energy(const double* y, const double* quadratures) const override;
   std::string step_limit_advice(double t_end) const override;
   std::string divergence_phrase() const override { return "explicit Euler diverged"; }
-  std::string divergence_advice() const override;
+  std::string divergence_advice(const std::vector<double>& last_good, double t_last_good) const override;
   long max_steps() const override { return settings_.max_steps; }
 
   EulerSettings settings_;

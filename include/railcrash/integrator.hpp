@@ -105,8 +105,8 @@ class Integrator {
   virtual std::string step_limit_advice(double t_end) const = 0;
   /// What a non-finite state means for this integrator ("explicit Euler diverged").
   virtual std::string divergence_phrase() const = 0;
-  /// Extra advice after a non-finite state.
-  virtual std::string divergence_advice() const { return ""; }
+  /// Extra advice after a non-finite state; last_good is the last sampled state (t_last_good).
+  virtual std::string divergence_advice(const std::vector<double>& /*last_good*/, double /*t_last_good*/) const { return ""; }
   /// Largest number of advance() calls in one run.
   virtual long max_steps() const = 0;
   /// Called once at the end of every run (also after a failure): counters into stats().
