@@ -66,6 +66,8 @@ struct RunOutcome {
 /// why (interrupted, step limit, solver failure, a non-finite state naming the body
 /// coordinate or element multiplier and t). A failed run ends at its last output sample, the
 /// last good state the observer (and the files) received: a non-finite state is never sampled.
+/// An observer that cannot go on (RunObserver::failure, e.g. a failed write) stops the run at
+/// the sample where it says so.
 class Integrator {
  public:
   virtual ~Integrator() = default;
@@ -124,7 +126,7 @@ class Integrator {
  private:
   void deliver_sample(double t);
   double next_output_time() const;
-  /// Names the first non-finite entry of y (nullptr-safe: "" when all are finite).
+  /// Names the first non-finite entry of y ("" when all are finite).
   std::string non_finite_entry(const double* y) const;
 
   // State of the run in progress.
