@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <utility>
 
 namespace railcrash {
@@ -12,6 +13,7 @@ namespace {
 struct PatternRecorder {
   std::vector<std::pair<int, int>> entries;  // (col, row)
   void add(int row, int col, double) { entries.emplace_back(col, row); }
+  void begin_element(int) {}
 };
 
 /// Adds values through the slots learned by the dry run.
@@ -19,6 +21,20 @@ struct SlotWriter {
   const int* slot;
   double* values;
   void add(int, int, double value) { values[*slot++] += value; }
+  void begin_element(int) {}
+};
+
+/// Finds the first non-finite Jacobian entry and who added it (element index; -1: bodies, loads).
+struct NonFiniteFinder {
+  int owner = -1;  // of the additions now
+  int found_owner = -1, row = -1, col = -1;
+  double value = 0.0;
+  bool found = false;
+  void add(int r, int c, double v) {
+    if (found || std::isfinite(v)) return;
+    found = true, found_owner = owner, row = r, col = c, value = v;
+  }
+  void begin_element(int e) { owner = e; }
 };
 
 std::array<Pose<double>, 2> gather_poses(const Element& e, const double* q) {
@@ -303,6 +319,7 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     const int m = el.constraint_count();
+    sink.begin_element(static_cast<int>(e));
     const ElementState<double> s = gather_state(el, q, v);
     if (m == 0) {
       std::array<Pose<double>, 2> f{};
@@ -498,6 +515,72 @@ double DaeSystem::constraint_residual(const double* q) const {
 
 const Element& DaeSystem::constraint_owner(int row) const {
   return *model_.elements()[static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)])];
+}
+
+std::string DaeSystem::unknown_name(int k) const {
+  static const char* const kPosition[3] = {"x", "y", "theta"};
+  static const char* const kVelocity[3] = {"vx", "vy", "omega"};
+  const int nq = body_unknowns();
+  const int m = constraint_rows();
+  if (k < 2 * nq) {
+    const Body& body = model_.bodies()[static_cast<std::size_t>((k % nq) / 3)];
+    return body.where.prefix() + "body '" + body.name + "' " + (k < nq ? kPosition : kVelocity)[k % 3];
+  }
+  const int row = (k - 2 * nq) % m;
+  const Element& owner = constraint_owner(row);
+  const int local = row - model_.constraint_offset(static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)]));
+  return owner.where().prefix() + "element '" + owner.name() + "' (" + owner.type() + ") " +
+         (k < 2 * nq + m ? "multiplier" : "velocity multiplier") + " of its constraint row " + std::to_string(local);
+}
+
+std::string DaeSystem::non_finite_source(double t, const double* y, const double* yp) const {
+  const int n = size();
+  const int nq = body_unknowns();
+  std::ostringstream msg;
+  for (int k = 0; k < n; ++k) {
+    if (!std::isfinite(y[k])) return (msg << unknown_name(k) << " is " << y[k], msg.str());
+    if (!std::isfinite(yp[k])) return (msg << "the rate of " << unknown_name(k) << " is " << yp[k], msg.str());
+  }
+  const auto element_text = [&](std::size_t e) {
+    const Element& el = *model_.elements()[e];
+    return el.where().prefix() + "element '" + el.name() + "' (" + el.type() + ")";
+  };
+  // Each element alone: its forces and power, its constraint rows and their gradients.
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const ElementLoad load = element_load(static_cast<int>(e), t, y);
+    bool finite = std::isfinite(load.power);
+    for (const Pose<double>& f : load.force) finite = finite && std::isfinite(f.x) && std::isfinite(f.y) && std::isfinite(f.theta);
+    if (!finite) return element_text(e) + ": its force or power is not finite";
+  }
+  std::vector<double> phi(static_cast<std::size_t>(constraint_rows()));
+  std::vector<Triplet> gradient;
+  constraints(y, phi.data(), &gradient);
+  for (int r = 0; r < constraint_rows(); ++r)
+    if (!std::isfinite(phi[static_cast<std::size_t>(r)]))
+      return element_text(static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(r)])) +
+             ": its constraint equation is not finite";
+  for (const Triplet& g : gradient)
+    if (!std::isfinite(g.value))
+      return element_text(static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(g.row)])) +
+             ": its constraint gradient is not finite";
+  // The Jacobian, element by element (cj = 1: the mass terms count).
+  NonFiniteFinder finder;
+  assemble_jacobian(t, 1.0, y, yp, finder);
+  if (finder.found) {
+    if (finder.found_owner >= 0)
+      return (msg << element_text(static_cast<std::size_t>(finder.found_owner)) << ": its derivative with respect to "
+                  << unknown_name(finder.col) << " is " << finder.value,
+              msg.str());
+    return (msg << "the mass matrix or a load acting on " << unknown_name(finder.row % nq) << " is " << finder.value, msg.str());
+  }
+  std::vector<double> r(static_cast<std::size_t>(n));
+  residual(t, y, yp, r.data());
+  for (int k = 0; k < n; ++k)
+    if (!std::isfinite(r[static_cast<std::size_t>(k)]))
+      return (msg << "the equation of " << unknown_name(k) << " is " << r[static_cast<std::size_t>(k)]
+                  << " (a sum of finite terms that overflows: check the masses, inertias and stiffnesses there)",
+              msg.str());
+  return "";
 }
 
 double DaeSystem::kinetic_energy(const double* v) const {

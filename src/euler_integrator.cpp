@@ -128,7 +128,7 @@ void check_step_count(const Model& model, double dt, long max_steps) {
 }  // namespace
 
 EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings)
-    : system_(system), settings_(settings) {
+    : Integrator(system), settings_(settings) {
   const Model& model = system.model();
   for (const Body& b : model.bodies())
     if (!(b.inertia > 0.0))
@@ -168,136 +168,134 @@ EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings
   check_step_count(model, dt_, settings_.max_steps);
 }
 
-RunOutcome EulerIntegrator::run(double t_end, double output_interval, RunObserver& observer,
-                                const std::atomic<bool>* stop) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  RunOutcome outcome;
-  outcome.stats.stability_limit = stability_limit_;
-  outcome.stats.assembly_correction = assembly_correction_;
-  outcome.stats.settling_steps = settling_steps_;
-  outcome.stats.settling_displacement = settling_displacement_;
-  outcome.stats.last_step = dt_;
+void EulerIntegrator::start(double /*t_end*/) {
+  stats().stability_limit = stability_limit_;
+  stats().assembly_correction = assembly_correction_;
+  stats().settling_steps = settling_steps_;
+  stats().settling_displacement = settling_displacement_;
+  stats().last_step = dt_;
   const int nq = system_.body_unknowns();
   const int m = system_.constraint_rows();
   const int nquad = system_.quadrature_count();
-  std::vector<double> y = y0_;
-  std::vector<double> force(static_cast<std::size_t>(nq)), rates(static_cast<std::size_t>(nquad));
-  std::vector<double> quad(static_cast<std::size_t>(nquad), 0.0);
-  std::vector<double> lambda(static_cast<std::size_t>(m), 0.0);
-  std::vector<double> inverse_mass(static_cast<std::size_t>(nq));
-  for (int k = 0; k < nq; ++k) inverse_mass[static_cast<std::size_t>(k)] = 1.0 / system_.mass_diagonal(k);
-  double* q = y.data();
-  double* v = y.data() + nq;
-  // The multipliers stored in y (for output) are the penalty forces.
-  double* y_lambda = y.data() + 2 * nq;
-
+  y_ = y0_;
+  force_.assign(static_cast<std::size_t>(nq), 0.0);
+  rates_.assign(static_cast<std::size_t>(nquad), 0.0);
+  quadratures_.assign(static_cast<std::size_t>(nquad), 0.0);
+  lambda_.assign(static_cast<std::size_t>(m), 0.0);
+  inverse_mass_.resize(static_cast<std::size_t>(nq));
+  for (int k = 0; k < nq; ++k) inverse_mass_[static_cast<std::size_t>(k)] = 1.0 / system_.mass_diagonal(k);
+  t_ = 0.0;
+  step_ = 0;
+  double* q = y_.data();
+  double* v = y_.data() + nq;
   // Modes as prepared (and settled) in the constructor; a second run starts from them too.
-  system_.generalized_forces(0.0, q, v, force.data(), &penalty_, lambda.data());
-  std::copy(lambda.begin(), lambda.end(), y_lambda);
+  // The multipliers' place in y (for output) holds the penalty forces.
+  system_.generalized_forces(0.0, q, v, force_.data(), &penalty_, lambda_.data());
+  std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);
   // Mode changes: the same root functions as IDA, checked at the end of every step (what
   // IITRAIN's "internal logic checks at each time step" did). A root that sits at zero right
   // after its commit is ignored until it leaves zero.
   const int root_count = system_.root_count();
-  std::vector<double> g_before(static_cast<std::size_t>(root_count)), g_after(g_before.size());
-  std::vector<int> direction(g_before.size(), 0);
-  std::vector<EventRecord> events;
-  outcome.events = start_events_;
-  for (const EventRecord& record : start_events_) observer.event(record, y.data());
-  outcome.stats.events += static_cast<long>(start_events_.size());
+  g_before_.assign(static_cast<std::size_t>(root_count), 0.0);
+  g_after_ = g_before_;
+  direction_.assign(g_before_.size(), 0);
+  report_events(start_events_, y_.data());
   if (root_count > 0) {
     // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
-    std::vector<double> yp(y.size(), 0.0);
+    std::vector<double> yp(y_.size(), 0.0);
     for (int k = 0; k < nq; ++k) {
       yp[static_cast<std::size_t>(k)] = v[k];
-      yp[static_cast<std::size_t>(nq + k)] = force[static_cast<std::size_t>(k)] * inverse_mass[static_cast<std::size_t>(k)];
+      yp[static_cast<std::size_t>(nq + k)] = force_[static_cast<std::size_t>(k)] * inverse_mass_[static_cast<std::size_t>(k)];
     }
-    if (system_.commit_boundary_roots(0.0, y.data(), yp.data(), events)) {
-      for (const EventRecord& record : events) observer.event(record, y.data());
-      outcome.events.insert(outcome.events.end(), events.begin(), events.end());
-      outcome.stats.events += static_cast<long>(events.size());
-    }
-    system_.roots(0.0, y.data(), g_before.data());
+    events_.clear();
+    if (system_.commit_boundary_roots(0.0, y_.data(), yp.data(), events_)) report_events(events_, y_.data());
+    system_.roots(0.0, y_.data(), g_before_.data());
   }
-  outcome.initial_energy = system_.energy(y.data(), quad.data(), &penalty_);
-  observer.sample(0.0, y.data(), y_lambda, quad.data());
-  outcome.max_constraint_residual = system_.constraint_residual(q);
+}
 
-  // The loop runs on time: step k ends at k dt (no drift), the last one at t_end exactly; the
-  // step count is bounded by max_steps, so it never overflows.
-  long output_index = 1;
-  double t = 0.0;
-  long step = 0;
-  while (t < t_end) {
-    if (stop && stop->load()) {
-      outcome.message = "interrupted at t = " + std::to_string(t);
-      break;
-    }
-    if (step >= settings_.max_steps) {
-      std::ostringstream msg;
-      msg << "stopped at t = " << t << " after --max-steps " << settings_.max_steps << " steps of dt = " << dt_
-          << ", before t_end = " << t_end << "; use a larger dt or raise --max-steps";
-      outcome.message = msg.str();
-      break;
-    }
-    ++step;
-    const bool last = static_cast<double>(step) >= t_end / dt_ - 1e-9;
-    const double t_next = last ? t_end : static_cast<double>(step) * dt_;
-    const double h = t_next - t;
-    system_.generalized_forces(t, q, v, force.data(), &penalty_, lambda.data());
-    system_.quadrature_rates(t, y.data(), rates.data(), lambda.data());
-    for (int k = 0; k < nquad; ++k) quad[static_cast<std::size_t>(k)] += h * rates[static_cast<std::size_t>(k)];
-    for (int k = 0; k < nq; ++k) {
-      v[k] += h * force[static_cast<std::size_t>(k)] * inverse_mass[static_cast<std::size_t>(k)];
-      q[k] += h * v[k];
-    }
-    t = t_next;
-    ++outcome.stats.steps;
-    outcome.stats.residual_evaluations += 1;
-    if (root_count > 0) {
-      std::copy(lambda.begin(), lambda.end(), y_lambda);
-      system_.roots(t, y.data(), g_after.data());
-      bool fired = false;
-      for (std::size_t k = 0; k < g_after.size(); ++k) {
-        const double before = g_before[k], after = g_after[k];
-        // Roots are positive inside their mode (element.hpp): a fall from >= 0 to < 0 leaves it.
-        direction[k] = (before >= 0.0 && after < 0.0) ? -1 : (before < 0.0 && after >= 0.0) ? 1 : 0;
-        fired = fired || direction[k] != 0;
-      }
-      if (fired) {
-        events.clear();
-        if (system_.commit_roots(t, y.data(), direction.data(), events)) {
-          ++outcome.stats.reinitializations;
-          system_.roots(t, y.data(), g_after.data());
-        }
-        for (const EventRecord& record : events) observer.event(record, y.data());
-        outcome.events.insert(outcome.events.end(), events.begin(), events.end());
-        outcome.stats.events += static_cast<long>(events.size());
-      }
-      std::swap(g_before, g_after);
-    }
-    bool finite = true;
-    for (int k = 0; k < 2 * nq; ++k) finite = finite && std::isfinite(y[static_cast<std::size_t>(k)]);
-    if (!finite) {
-      std::ostringstream msg;
-      msg << "explicit Euler diverged at t = " << t << " (a coordinate became infinite or NaN); the step "
-          << dt_ << " is too large for the model as it deforms (stability limit at the start: " << stability_limit_ << ")";
-      outcome.message = msg.str();
-      break;
-    }
-    if (t >= std::min(t_end, static_cast<double>(output_index) * output_interval) * (1.0 - 1e-12) || last) {
-      std::copy(lambda.begin(), lambda.end(), y_lambda);
-      observer.sample(t, y.data(), y_lambda, quad.data());
-      outcome.max_constraint_residual = std::max(outcome.max_constraint_residual, system_.constraint_residual(q));
-      while (static_cast<double>(output_index) * output_interval <= t * (1.0 + 1e-12)) ++output_index;
-    }
+// The loop runs on time: step k ends at k dt (no drift), the last one at t_end exactly.
+double EulerIntegrator::advance(double t_end) {
+  const int nq = system_.body_unknowns();
+  const int nquad = system_.quadrature_count();
+  double* q = y_.data();
+  double* v = y_.data() + nq;
+  ++step_;
+  const bool last = static_cast<double>(step_) >= t_end / dt_ - 1e-9;
+  const double t_next = last ? t_end : static_cast<double>(step_) * dt_;
+  const double h = t_next - t_;
+  system_.generalized_forces(t_, q, v, force_.data(), &penalty_, lambda_.data());
+  system_.quadrature_rates(t_, y_.data(), rates_.data(), lambda_.data());
+  for (int k = 0; k < nquad; ++k) quadratures_[static_cast<std::size_t>(k)] += h * rates_[static_cast<std::size_t>(k)];
+  for (int k = 0; k < nq; ++k) {
+    v[k] += h * force_[static_cast<std::size_t>(k)] * inverse_mass_[static_cast<std::size_t>(k)];
+    q[k] += h * v[k];
   }
-  outcome.ok = outcome.message.empty() && t >= t_end;  // a run that did not reach t_end is never ok
-  outcome.t_reached = t;
-  outcome.y = y;
-  outcome.quadratures = quad;
-  outcome.final_energy = system_.energy(y.data(), quad.data(), &penalty_);
-  outcome.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  return outcome;
+  t_ = t_next;
+  ++stats().steps;
+  stats().residual_evaluations += 1;
+  std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);
+  if (!g_before_.empty()) {
+    system_.roots(t_, y_.data(), g_after_.data());
+    bool fired = false;
+    for (std::size_t k = 0; k < g_after_.size(); ++k) {
+      const double before = g_before_[k], after = g_after_[k];
+      // Roots are positive inside their mode (element.hpp): a fall from >= 0 to < 0 leaves it.
+      direction_[k] = (before >= 0.0 && after < 0.0) ? -1 : (before < 0.0 && after >= 0.0) ? 1 : 0;
+      fired = fired || direction_[k] != 0;
+    }
+    if (fired) {
+      events_.clear();
+      if (system_.commit_roots(t_, y_.data(), direction_.data(), events_)) {
+        ++stats().reinitializations;
+        system_.roots(t_, y_.data(), g_after_.data());
+      }
+      report_events(events_, y_.data());
+    }
+    std::swap(g_before_, g_after_);
+  }
+  return t_;
+}
+
+void EulerIntegrator::state_at(double /*t*/, std::vector<double>& y, std::vector<double>& quadratures) {
+  y = y_;
+  quadratures = quadratures_;
+}
+
+EnergyState EulerIntegrator::energy(const double* y, const double* quadratures) const {
+  return system_.energy(y, quadratures, &penalty_);
+}
+
+std::string EulerIntegrator::step_limit_advice(double t_end) const {
+  std::ostringstream text;
+  text << " of dt = " << dt_ << ", before t_end = " << t_end << "; use a larger dt or raise --max-steps";
+  return text.str();
+}
+
+std::string EulerIntegrator::divergence_advice(const std::vector<double>& last_good, double t_last_good) const {
+  std::ostringstream text;
+  text << "; the step " << dt_ << " is too large for the model as it deforms (stability limit at the start: "
+       << stability_limit_ << ")";
+  // A penalty joint that went unstable shows as the largest violation of its constraint in the
+  // last good sample (its arms or effective masses changed since the penalties were sized).
+  const int m = system_.constraint_rows();
+  if (m == 0 || last_good.empty()) return text.str();
+  std::vector<double> phi(static_cast<std::size_t>(m));
+  system_.constraints(last_good.data(), phi.data(), nullptr);
+  const double length = system_.model().length_scale();
+  int worst = -1;
+  double worst_violation = 0.0;  // [length]
+  for (int r = 0; r < m; ++r) {
+    if (!system_.constraint_row_active(r)) continue;
+    const double violation = std::abs(phi[static_cast<std::size_t>(r)]) * (system_.constraint_row_is_rotational(r) ? length : 1.0);
+    if (violation > worst_violation) worst_violation = violation, worst = r;
+  }
+  if (worst < 0) return text.str();
+  const Element& joint = system_.constraint_owner(worst);
+  text << "; the largest joint violation at the last good sample (t = " << t_last_good << ") is " << worst_violation
+       << " (length units) in " << joint.where().prefix() << "joint '" << joint.name() << "' (" << joint.type()
+       << "), likely the penalty that went unstable: give it (or the model) penalty_stiffness / penalty_damping "
+          "for its present arms and masses, or a smaller dt";
+  return text.str();
 }
 
 }  // namespace railcrash

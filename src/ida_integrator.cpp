@@ -88,19 +88,42 @@ struct IdaIntegrator::Impl {
   const DaeSystem& system;
   SUNContext context = nullptr;
   N_Vector y = nullptr, yp = nullptr, ids = nullptr, atol = nullptr, quad = nullptr, quad_atol = nullptr;
-  N_Vector y_internal = nullptr;  // IDA's solution at its own time t_n
+  N_Vector local_errors = nullptr;  // IDA's estimated local errors (failure diagnosis)
   SUNMatrix jacobian = nullptr;
   SUNLinearSolver linear_solver = nullptr;
+  N_Vector derivative = nullptr;   // IDAGetDky's output
+  N_Vector y_out = nullptr, quad_out = nullptr;  // dense output
   void* ida = nullptr;
   std::exception_ptr callback_error;
   std::string last_sundials_message;
+
+  // The run in progress (IdaIntegrator::start sets them up, advance takes one step).
+  double rtol = 0.0;
+  double t_reached = 0.0;                   // IDA's last step (or restart) time
+  std::vector<double> g_previous, g_now;    // root functions at the last step and now
+  std::vector<double> taylor;               // (order + 1) x n: y^(j)(t_n) / j!
+  std::vector<double> y_local;              // one element's unknowns, interpolated
+  std::vector<double> g_element;            // one element's roots
+  int taylor_order = -1;
+  double taylor_time = 0.0;
+  std::vector<EventRecord> events;
+  struct Crossing {
+    double t;
+    int element, local;
+    int generation;  // the element's mode changes in this step when it was found
+  };
+  std::vector<Crossing> crossings;
+  bool at_start = true;  // no step taken since start()
+  // The first trial state whose residual was not finite (cleared before every step).
+  double non_finite_t = 0.0;
+  std::vector<double> non_finite_y, non_finite_yp;
 
   explicit Impl(const DaeSystem& s) : system(s) {}
   ~Impl() {
     if (ida) IDAFree(&ida);
     if (linear_solver) SUNLinSolFree(linear_solver);
     if (jacobian) SUNMatDestroy(jacobian);
-    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &y_internal})
+    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &local_errors, &derivative, &y_out, &quad_out})
       if (*v) N_VDestroy(*v);
     if (context) SUNContext_Free(&context);
   }
@@ -124,7 +147,14 @@ struct IdaIntegrator::Impl {
       self->system.residual(t, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), N_VGetArrayPointer(rr));
       const double* r = N_VGetArrayPointer(rr);
       for (sunindextype k = 0; k < N_VGetLength(rr); ++k)
-        if (!std::isfinite(r[k])) return 1;  // recoverable: IDA cuts the step
+        if (!std::isfinite(r[k])) {  // recoverable: IDA cuts the step; kept to explain a failure
+          if (self->non_finite_y.empty()) {
+            self->non_finite_t = t;
+            self->non_finite_y.assign(N_VGetArrayPointer(yy), N_VGetArrayPointer(yy) + N_VGetLength(yy));
+            self->non_finite_yp.assign(N_VGetArrayPointer(ypv), N_VGetArrayPointer(ypv) + N_VGetLength(ypv));
+          }
+          return 1;
+        }
       return 0;
     } catch (...) {
       self->callback_error = std::current_exception();
@@ -195,18 +225,16 @@ struct IdaIntegrator::Impl {
   }
 };
 
-IdaIntegrator::IdaIntegrator(const DaeSystem& system, IdaSettings settings) : system_(system), settings_(settings) {
+IdaIntegrator::IdaIntegrator(const DaeSystem& system, IdaSettings settings) : Integrator(system), settings_(settings) {
   if (!(settings_.rtol > 0.0) || !std::isfinite(settings_.rtol))
     throw InputError("rtol must be a positive number (typical: 1e-6)");
 }
 
 IdaIntegrator::~IdaIntegrator() = default;
 
-RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver& observer,
-                              const std::atomic<bool>* stop) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  RunOutcome outcome;
-  Impl impl(system_);
+void IdaIntegrator::start(double t_end) {
+  impl_ = std::make_unique<Impl>(system_);
+  Impl& impl = *impl_;
   const int n = system_.size();
   const int nq = system_.body_unknowns();
   const int m = system_.constraint_rows();
@@ -216,10 +244,10 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
   // ---- consistent positions and velocities ----
   std::vector<double> y0;
   std::vector<EventRecord> settling_events;
-  const StartReport start = prepare_start(system_, y0, settling_events);
-  outcome.stats.assembly_correction = start.assembly.largest_position_change;
-  outcome.stats.settling_steps = start.equilibrium.steps;
-  outcome.stats.settling_displacement = start.equilibrium.largest_position_change;
+  const StartReport start_report = prepare_start(system_, y0, settling_events);
+  stats().assembly_correction = start_report.assembly.largest_position_change;
+  stats().settling_steps = start_report.equilibrium.steps;
+  stats().settling_displacement = start_report.equilibrium.largest_position_change;
 
   // ---- scales for the tolerances ----
   const double length = model.length_scale();
@@ -251,7 +279,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
   // solution) the speed scale V.
   const double atol_force = std::min(1.0, 100.0 * rtol) * force_scale;
 
-  try {
+  {
     impl.check(SUNContext_Create(nullptr, &impl.context), "SUNContext_Create");
     impl.y = impl.created(N_VNew_Serial(n, impl.context), "N_VNew_Serial");
     impl.yp = impl.created(N_VClone(impl.y), "N_VClone");
@@ -284,6 +312,7 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
     for (int k = 0; k < nquad; ++k) quad_atol[k] = 0.1 * rtol * energy_scale;
     quad_atol[DaeSystem::kKineticIntegral] *= t_end;
+    check_start(y, yp, atol, t_end);
 
     impl.ida = impl.created(IDACreate(impl.context), "IDACreate");
     impl.check(IDASetErrHandlerFn(impl.ida, &Impl::error_handler, &impl), "IDASetErrHandlerFn");
@@ -304,341 +333,388 @@ RunOutcome IdaIntegrator::run(double t_end, double output_interval, RunObserver&
     impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");
     impl.check(IDAQuadSVtolerances(impl.ida, rtol, impl.quad_atol), "IDAQuadSVtolerances");
     impl.check(IDASetQuadErrCon(impl.ida, SUNTRUE), "IDASetQuadErrCon");
-    // ---- events: located element by element on IDA's interpolating polynomial ----
-    // IDA's own root finding evaluates every root function of the model several times per
-    // located root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here
-    // IDA takes one step at a time (IDA_ONE_STEP); after each step the root functions are
-    // evaluated once (~ N), and only a root that fell through zero during the step is located:
-    // on the polynomial IDA itself interpolates with over the step, written as its Taylor
-    // series at t_n (derivatives from IDAGetDky), evaluated only for the unknowns its element
-    // reads (Illinois method, to IDA's own root tolerance 100 eps max(|t|, h)). Events are
-    // committed in time order. IDA's solution is already at t_n, computed with the old laws
-    // over [t_event, t_n]: when the new law agrees with the old one there within the local
-    // tolerance (a kink: a stiffness changes, the force does not jump), IDA goes on as over
-    // any non-smooth right-hand side; a jump (rupture, joint failure, preload) restarts from
-    // consistent values at t_event, and the later crossings of that step are found again.
-    const int root_count = system_.root_count();
-    std::vector<EventRecord> events;
-    std::vector<double> g_previous(static_cast<std::size_t>(root_count)), g_now(g_previous);
-    std::vector<double> taylor;          // (order + 1) x n: y^(j)(t_n) / j!
-    std::vector<double> y_local(static_cast<std::size_t>(n), 0.0), y_event(y_local);
-    std::vector<double> g_element;       // one element's roots
-    impl.y_internal = impl.created(N_VClone(impl.y), "N_VClone");
-    N_Vector derivative = impl.created(N_VClone(impl.y), "N_VClone");
-    struct DerivativeGuard {
-      N_Vector v;
-      ~DerivativeGuard() { N_VDestroy(v); }
-    } derivative_guard{derivative};
-    int taylor_order = -1;
-    double taylor_time = 0.0;
-    const auto load_taylor = [&](double t_n) {
-      int order = 1;
-      impl.check(IDAGetLastOrder(impl.ida, &order), "IDAGetLastOrder");
-      taylor.assign(static_cast<std::size_t>(order + 1) * static_cast<std::size_t>(n), 0.0);
-      double factorial = 1.0;
-      for (int j = 0; j <= order; ++j) {
-        if (j > 0) factorial *= j;
-        impl.check(IDAGetDky(impl.ida, t_n, j, derivative), "IDAGetDky");
-        const double* d = N_VGetArrayPointer(derivative);
-        for (int i = 0; i < n; ++i) taylor[static_cast<std::size_t>(j * n + i)] = d[i] / factorial;
-      }
-      taylor_order = order;
-      taylor_time = t_n;
-    };
-    // Fills the unknowns element e reads at time t from the Taylor series.
-    const auto interpolate_element = [&](int e, double t, std::vector<double>& target) {
-      const double dt = t - taylor_time;
-      for (const int i : system_.element_unknowns(e)) {
-        double value = taylor[static_cast<std::size_t>(taylor_order * n + i)];
-        for (int j = taylor_order - 1; j >= 0; --j) value = value * dt + taylor[static_cast<std::size_t>(j * n + i)];
-        target[static_cast<std::size_t>(i)] = value;
-      }
-    };
-    const auto element_root_at = [&](int e, int local, double t) {
-      interpolate_element(e, t, y_local);
-      g_element.resize(static_cast<std::size_t>(model.elements()[static_cast<std::size_t>(e)]->root_count()));
-      system_.element_roots(e, t, y_local.data(), g_element.data());
-      return g_element[static_cast<std::size_t>(local)];
-    };
-    // Illinois on [a, b] with g(a) > 0 >= g(b): the earliest time where g reaches zero.
-    const auto locate = [&](int e, int local, double a, double ga, double b, double gb, double tolerance) {
-      int side = 0;
-      for (int iteration = 0; iteration < 100 && b - a > tolerance; ++iteration) {
-        double t = b - gb * (b - a) / (gb - ga);
-        const double margin = 0.1 * tolerance;
-        t = std::min(std::max(t, a + margin), b - margin);
-        const double g = element_root_at(e, local, t);
-        if (g > 0.0) {
-          a = t, ga = g;
-          if (side == -1) gb *= 0.5;
-          side = -1;
-        } else {
-          b = t, gb = g;
-          if (side == 1) ga *= 0.5;
-          side = 1;
-        }
-      }
-      return b;
-    };
-
-    // The lag test of a mode change without restart, from the element that changed alone
-    // (so an event costs the same in a 2-car and in a 200-car model): over [t_event, t_n] IDA
-    // used its old law; the velocity error that made is about |change of its forces| / M
-    // (t_n - t_event) on its bodies (trapezoid between t_event and t_n: a kink, continuous at
-    // t_event, counts half), the error of its work quadrature |change of its power|
-    // (t_n - t_event); both must stay within the local tolerances. A constraint element that
-    // failed always restarts: its equations changed.
-    const auto lag_within_tolerance = [&](int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
-                                          const double* y_at_event, double t_n, const double* y_n,
-                                          const double* quadratures) {
-      const Element& el = *model.elements()[static_cast<std::size_t>(e)];
-      if (el.constraint_count() > 0 && el.failed()) return false;
-      const double lag = t_n - t_event;
-      const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
-      const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);
-      const int work = DaeSystem::kFirstElementWork + e;
-      const double power_change =
-          0.5 * (std::abs(after_event.power - before[0].power) + std::abs(after_n.power - before[1].power));
-      if (power_change * lag > rtol * std::abs(quadratures[work]) + quad_atol[work]) return false;
-      for (std::size_t slot = 0; slot < 2; ++slot) {
-        const int b = after_event.body[slot];
-        if (b == kGround) continue;
-        const double changes[3] = {
-            0.5 * (std::abs(after_event.force[slot].x - before[0].force[slot].x) +
-                   std::abs(after_n.force[slot].x - before[1].force[slot].x)),
-            0.5 * (std::abs(after_event.force[slot].y - before[0].force[slot].y) +
-                   std::abs(after_n.force[slot].y - before[1].force[slot].y)),
-            0.5 * (std::abs(after_event.force[slot].theta - before[0].force[slot].theta) +
-                   std::abs(after_n.force[slot].theta - before[1].force[slot].theta))};
-        for (int c = 0; c < 3; ++c) {
-          if (changes[c] == 0.0) continue;
-          const int k = 3 * b + c;
-          const double mass = system_.mass_diagonal(k);
-          // A zero-inertia rotation (mass 0) has no estimate: restart.
-          if (!(mass > 0.0) || changes[c] / mass * lag > rtol * std::abs(y_n[nq + k]) + atol[nq + k]) return false;
-        }
-      }
-      return true;
-    };
-
-    const double* lambda = y + 2 * nq;
-    std::vector<double> quad_now(static_cast<std::size_t>(nquad), 0.0);
-    outcome.initial_energy = system_.energy(y, quad_now.data());
-    for (const EventRecord& record : start_events) observer.event(record, y);
-    outcome.events = start_events;
-    outcome.stats.events += static_cast<long>(start_events.size());
-    observer.sample(0.0, y, lambda, quad_now.data());
-    outcome.max_constraint_residual = system_.constraint_residual(y);
-    if (root_count > 0) system_.roots(0.0, y, g_previous.data());
-
-    N_Vector y_out = impl.created(N_VClone(impl.y), "N_VClone");
-    N_Vector quad_out = impl.created(N_VClone(impl.quad), "N_VClone");
-    struct OutputGuard {
-      N_Vector a, b;
-      ~OutputGuard() { N_VDestroy(a), N_VDestroy(b); }
-    } output_guard{y_out, quad_out};
-    long output_index = 1;
-    std::vector<double> last_sample(y, y + n), last_sample_quadratures(static_cast<std::size_t>(nquad), 0.0);
-    double t_reached = 0.0;   // IDA's last step (or restart) time
-    double t_sampled = 0.0;   // last output sample
-    struct Crossing {
-      double t;
-      int element, local;
-      int generation;  // the element's mode changes in this step when it was found
-    };
-    std::vector<Crossing> crossings;
-    // Output samples at the output times up to t_limit, from the polynomial of IDA's last
-    // step; called before every mode change so that samples show the modes they belong to.
-    const auto emit_outputs = [&](double t_limit) {
-      for (double t_out = std::min(t_end, static_cast<double>(output_index) * output_interval);
-           t_out <= t_limit * (1.0 + 1e-14); t_out = std::min(t_end, static_cast<double>(output_index) * output_interval)) {
-        impl.check(IDAGetDky(impl.ida, t_out, 0, y_out), "IDAGetDky");
-        impl.check(IDAGetQuadDky(impl.ida, t_out, 0, quad_out), "IDAGetQuadDky");
-        const double* yo = N_VGetArrayPointer(y_out);
-        observer.sample(t_out, yo, yo + 2 * nq, N_VGetArrayPointer(quad_out));
-        outcome.max_constraint_residual = std::max(outcome.max_constraint_residual, system_.constraint_residual(yo));
-        t_sampled = t_out;
-        last_sample.assign(yo, yo + n);
-        last_sample_quadratures.assign(N_VGetArrayPointer(quad_out), N_VGetArrayPointer(quad_out) + nquad);
-        ++output_index;
-        if (t_out >= t_end) break;
-      }
-    };
-    long steps_taken = 0;  // IDASolve calls (steps and restarts) in this run
-    while (t_reached < t_end) {
-      if (stop && stop->load()) {
-        outcome.message = "interrupted at t = " + std::to_string(t_sampled);
-        break;
-      }
-      if (steps_taken++ >= settings_.max_steps) {
-        std::ostringstream msg;
-        msg << "stopped at t = " << t_reached << " after --max-steps " << settings_.max_steps << " steps, before t_end = "
-            << t_end << " (the model is stiff there or its tolerances are tight); raise --max-steps or check the model";
-        outcome.message = msg.str();
-        break;
-      }
-      double t_n = t_reached;
-      impl.last_sundials_message.clear();
-      const int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
-      impl.rethrow_callback_error();
-      if (flag < 0) {
-        std::ostringstream msg;
-        msg << "IDA failed at t = " << t_n << " with " << flag_name(flag);
-        if (!impl.last_sundials_message.empty()) msg << " (" << impl.last_sundials_message << ")";
-        outcome.message = msg.str();
-        break;
-      }
-      const double t_step_start = t_reached;
-      bool restarted = false;
-
-      if (root_count > 0) {
-        system_.roots(t_n, y, g_now.data());
-        crossings.clear();
-        for (int k = 0; k < root_count; ++k)
-          if (g_previous[static_cast<std::size_t>(k)] > 0.0 && g_now[static_cast<std::size_t>(k)] <= 0.0)
-            crossings.push_back({t_n, system_.root_owner(k), k - system_.root_offset(system_.root_owner(k)), 0});
-        if (!crossings.empty()) {
-          load_taylor(t_n);
-          double step = 0.0;
-          impl.check(IDAGetLastStep(impl.ida, &step), "IDAGetLastStep");
-          const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), std::abs(step));
-          for (Crossing& c : crossings) {
-            const int k = system_.root_offset(c.element) + c.local;
-            c.t = locate(c.element, c.local, t_step_start, g_previous[static_cast<std::size_t>(k)], t_n,
-                         g_now[static_cast<std::size_t>(k)], tolerance);
-          }
-          std::stable_sort(crossings.begin(), crossings.end(), [](const Crossing& x, const Crossing& z) { return x.t < z.t; });
-          impl.check(IDAGetQuad(impl.ida, &t_n, impl.quad), "IDAGetQuad");
-          const double* quad_n = N_VGetArrayPointer(impl.quad);
-          std::vector<int> done;  // elements that changed mode in this step
-          std::vector<int> changes;  // how often each of them changed (crossings found before are stale)
-          const auto changes_of = [&](int e) {
-            const auto it = std::find(done.begin(), done.end(), e);
-            return it == done.end() ? 0 : changes[static_cast<std::size_t>(it - done.begin())];
-          };
-          for (std::size_t i = 0; i < crossings.size(); ++i) {
-            Crossing c = crossings[i];
-            if (changes_of(c.element) != c.generation) continue;  // found in a mode the element has left
-            if (c.generation >= 20) {  // an element switching back and forth within one step: restart
-              restarted = true;
-            }
-            // The state at the event from IDA's interpolation (the same numbers a restart
-            // uses). The root was located on the Taylor form of the same polynomial; where
-            // round-off leaves it a hair above zero in this state, the event moves forward by
-            // growing multiples of the tolerance until it is at or below zero (at t_n it is).
-            double t_event = c.t;
-            impl.check(IDAGetDky(impl.ida, t_event, 0, derivative), "IDAGetDky");
-            const double* y_at_event = N_VGetArrayPointer(derivative);
-            g_element.resize(static_cast<std::size_t>(model.elements()[static_cast<std::size_t>(c.element)]->root_count()));
-            system_.element_roots(c.element, t_event, y_at_event, g_element.data());
-            for (double nudge = tolerance; g_element[static_cast<std::size_t>(c.local)] > 0.0 && t_event < t_n; nudge *= 4.0) {
-              t_event = std::min(t_n, c.t + nudge);
-              impl.check(IDAGetDky(impl.ida, t_event, 0, derivative), "IDAGetDky");
-              system_.element_roots(c.element, t_event, y_at_event, g_element.data());
-            }
-            c.t = t_event;
-            const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
-                                                               system_.element_load(c.element, t_n, y)};
-            emit_outputs(c.t);  // (uses y_out, not the event state)
-            events.clear();
-            if (!restarted && !system_.commit_element_root(c.element, c.local, -1, c.t, y_at_event, events)) continue;
-            const auto seen = std::find(done.begin(), done.end(), c.element);
-            if (seen == done.end()) {
-              done.push_back(c.element);
-              changes.push_back(1);
-            } else {
-              ++changes[static_cast<std::size_t>(seen - done.begin())];
-            }
-            ++outcome.stats.root_returns;
-            if (!restarted && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
-              for (const EventRecord& record : events) observer.event(record, y_at_event);
-              outcome.events.insert(outcome.events.end(), events.begin(), events.end());
-              outcome.stats.events += static_cast<long>(events.size());
-              // The element's new mode may end within this step too: its roots that are at or
-              // below zero at t_n are located in [t_event, t_n] (or committed at once when
-              // already outside at t_event) and queued in time order.
-              const int offset = system_.root_offset(c.element);
-              const int count = model.elements()[static_cast<std::size_t>(c.element)]->root_count();
-              const int generation = changes_of(c.element);
-              system_.element_roots(c.element, t_n, y, g_now.data() + offset);
-              for (int j = 0; j < count; ++j) {
-                const double g_end = g_now[static_cast<std::size_t>(offset + j)];
-                if (g_end > 0.0) continue;
-                const double g_start = element_root_at(c.element, j, c.t);
-                const double t_next = g_start > 0.0 ? locate(c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
-                const Crossing next{t_next, c.element, j, generation};
-                crossings.insert(std::upper_bound(crossings.begin() + static_cast<std::ptrdiff_t>(i) + 1, crossings.end(), next,
-                                                  [](const Crossing& x, const Crossing& z) { return x.t < z.t; }),
-                                 next);
-              }
-              continue;
-            }
-            restarted = true;
-            // Restart at the event: consistent rates for the new law (and roots that sit on
-            // their boundary there), quadratures interpolated to it.
-            std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
-            restart_state(system_, c.t, y_restart, yp_restart, events);
-            for (const EventRecord& record : events) observer.event(record, y_restart.data());
-            outcome.events.insert(outcome.events.end(), events.begin(), events.end());
-            outcome.stats.events += static_cast<long>(events.size());
-            impl.check(IDAGetQuadDky(impl.ida, c.t, 0, quad_out), "IDAGetQuadDky");
-            std::copy(y_restart.begin(), y_restart.end(), y);
-            std::copy(yp_restart.begin(), yp_restart.end(), yp);
-            std::copy(N_VGetArrayPointer(quad_out), N_VGetArrayPointer(quad_out) + nquad, N_VGetArrayPointer(impl.quad));
-            impl.accumulate(outcome.stats);
-            impl.check(IDAReInit(impl.ida, c.t, impl.y, impl.yp), "IDAReInit");
-            impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
-            impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");  // IDAReInit clears it
-            ++outcome.stats.reinitializations;
-            system_.roots(c.t, y, g_previous.data());
-            t_reached = c.t;
-            restarted = true;
-            break;
-          }
-          if (!restarted)  // the changed elements' roots at t_n, in their new modes
-            for (const int e : done) system_.element_roots(e, t_n, y, g_now.data() + system_.root_offset(e));
-        }
-        if (!restarted) std::swap(g_previous, g_now);
-      }
-      if (!restarted) {
-        emit_outputs(t_n);
-        t_reached = t_n;
-      }
-    }
-    if (outcome.message.empty() && t_reached >= t_end) t_sampled = t_end;
-    // The final quadratures: IDA's at its last step (t_end, or where it stopped).
-    if (t_reached > 0.0) {
-      double t_quad = t_reached;
-      IDAGetQuad(impl.ida, &t_quad, impl.quad);  // on failure impl.quad keeps the last known values
-    }
-    outcome.ok = outcome.message.empty() && t_reached >= t_end;  // a run that did not reach t_end is never ok
-    if (outcome.ok) {
-      outcome.t_reached = t_reached;
-      outcome.y.assign(y, y + n);
-      const double* quad = N_VGetArrayPointer(impl.quad);
-      outcome.quadratures.assign(quad, quad + nquad);
-    } else {  // a failed or interrupted run ends at its last output sample
-      outcome.t_reached = t_sampled;
-      outcome.y = last_sample;
-      outcome.quadratures = last_sample_quadratures;
-    }
-    outcome.final_energy = system_.energy(outcome.y.data(), outcome.quadratures.data());
-
-    impl.accumulate(outcome.stats);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    outcome.ok = false;
-    outcome.message = e.what();
+    impl.rtol = rtol;
+    impl.local_errors = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.derivative = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.y_out = impl.created(N_VClone(impl.y), "N_VClone");
+    impl.quad_out = impl.created(N_VClone(impl.quad), "N_VClone");
+    impl.g_previous.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
+    impl.g_now = impl.g_previous;
+    impl.y_local.assign(static_cast<std::size_t>(n), 0.0);
+    impl.t_reached = 0.0;
+    impl.at_start = true;
+    report_events(start_events, y);
+    if (system_.root_count() > 0) system_.roots(0.0, y, impl.g_previous.data());
   }
-  outcome.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  return outcome;
 }
 
-double max_abs(const std::vector<double>& values) {
-  double worst = 0.0;
-  for (double v : values) worst = std::max(worst, std::abs(v));
-  return worst;
+double IdaIntegrator::advance(double t_end) {
+  Impl& impl = *impl_;
+  const int n = system_.size();
+  const int nq = system_.body_unknowns();
+  const int nquad = system_.quadrature_count();
+  const Model& model = system_.model();
+  const double rtol = impl.rtol;
+  const double* atol = N_VGetArrayPointer(impl.atol);
+  const double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
+  double* y = N_VGetArrayPointer(impl.y);
+  double* yp = N_VGetArrayPointer(impl.yp);
+  std::vector<Impl::Crossing>& crossings = impl.crossings;
+  using Crossing = Impl::Crossing;
+  // ---- events: located element by element on IDA's interpolating polynomial ----
+  // IDA's own root finding evaluates every root function of the model several times per
+  // located root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here
+  // IDA takes one step at a time (IDA_ONE_STEP); after each step the root functions are
+  // evaluated once (~ N), and only a root that fell through zero during the step is located:
+  // on the polynomial IDA itself interpolates with over the step, written as its Taylor
+  // series at t_n (derivatives from IDAGetDky), evaluated only for the unknowns its element
+  // reads (Illinois method, to IDA's own root tolerance 100 eps max(|t|, h)). Events are
+  // committed in time order. IDA's solution is already at t_n, computed with the old laws
+  // over [t_event, t_n]: when the new law agrees with the old one there within the local
+  // tolerance (a kink: a stiffness changes, the force does not jump), IDA goes on as over
+  // any non-smooth right-hand side; a jump (rupture, joint failure, preload) restarts from
+  // consistent values at t_event, and the later crossings of that step are found again.
+  const int root_count = system_.root_count();
+  std::vector<EventRecord>& events = impl.events;
+  std::vector<double>& g_previous = impl.g_previous;
+  std::vector<double>& g_now = impl.g_now;
+  std::vector<double>& taylor = impl.taylor;
+  std::vector<double>& y_local = impl.y_local;
+  std::vector<double>& g_element = impl.g_element;
+  N_Vector derivative = impl.derivative;
+  int& taylor_order = impl.taylor_order;
+  double& taylor_time = impl.taylor_time;
+  const auto load_taylor = [&](double t_n) {
+    int order = 1;
+    impl.check(IDAGetLastOrder(impl.ida, &order), "IDAGetLastOrder");
+    taylor.assign(static_cast<std::size_t>(order + 1) * static_cast<std::size_t>(n), 0.0);
+    double factorial = 1.0;
+    for (int j = 0; j <= order; ++j) {
+      if (j > 0) factorial *= j;
+      impl.check(IDAGetDky(impl.ida, t_n, j, derivative), "IDAGetDky");
+      const double* d = N_VGetArrayPointer(derivative);
+      for (int i = 0; i < n; ++i) taylor[static_cast<std::size_t>(j * n + i)] = d[i] / factorial;
+    }
+    taylor_order = order;
+    taylor_time = t_n;
+  };
+  // Fills the unknowns element e reads at time t from the Taylor series.
+  const auto interpolate_element = [&](int e, double t, std::vector<double>& target) {
+    const double dt = t - taylor_time;
+    for (const int i : system_.element_unknowns(e)) {
+      double value = taylor[static_cast<std::size_t>(taylor_order * n + i)];
+      for (int j = taylor_order - 1; j >= 0; --j) value = value * dt + taylor[static_cast<std::size_t>(j * n + i)];
+      target[static_cast<std::size_t>(i)] = value;
+    }
+  };
+  const auto element_root_at = [&](int e, int local, double t) {
+    interpolate_element(e, t, y_local);
+    g_element.resize(static_cast<std::size_t>(model.elements()[static_cast<std::size_t>(e)]->root_count()));
+    system_.element_roots(e, t, y_local.data(), g_element.data());
+    return g_element[static_cast<std::size_t>(local)];
+  };
+  // Illinois on [a, b] with g(a) > 0 >= g(b): the earliest time where g reaches zero.
+  const auto locate = [&](int e, int local, double a, double ga, double b, double gb, double tolerance) {
+    int side = 0;
+    for (int iteration = 0; iteration < 100 && b - a > tolerance; ++iteration) {
+      double t = b - gb * (b - a) / (gb - ga);
+      const double margin = 0.1 * tolerance;
+      t = std::min(std::max(t, a + margin), b - margin);
+      const double g = element_root_at(e, local, t);
+      if (g > 0.0) {
+        a = t, ga = g;
+        if (side == -1) gb *= 0.5;
+        side = -1;
+      } else {
+        b = t, gb = g;
+        if (side == 1) ga *= 0.5;
+        side = 1;
+      }
+    }
+    return b;
+  };
+
+  // The lag test of a mode change without restart, from the element that changed alone
+  // (so an event costs the same in a 2-car and in a 200-car model): over [t_event, t_n] IDA
+  // used its old law; the velocity error that made is about |change of its forces| / M
+  // (t_n - t_event) on its bodies (trapezoid between t_event and t_n: a kink, continuous at
+  // t_event, counts half), the error of its work quadrature |change of its power|
+  // (t_n - t_event); both must stay within the local tolerances. A constraint element that
+  // failed always restarts: its equations changed.
+  const auto lag_within_tolerance = [&](int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
+                                        const double* y_at_event, double t_n, const double* y_n,
+                                        const double* quadratures) {
+    const Element& el = *model.elements()[static_cast<std::size_t>(e)];
+    if (el.constraint_count() > 0 && el.failed()) return false;
+    const double lag = t_n - t_event;
+    const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
+    const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);
+    const int work = DaeSystem::kFirstElementWork + e;
+    const double power_change =
+        0.5 * (std::abs(after_event.power - before[0].power) + std::abs(after_n.power - before[1].power));
+    if (power_change * lag > rtol * std::abs(quadratures[work]) + quad_atol[work]) return false;
+    for (std::size_t slot = 0; slot < 2; ++slot) {
+      const int b = after_event.body[slot];
+      if (b == kGround) continue;
+      const double changes[3] = {
+          0.5 * (std::abs(after_event.force[slot].x - before[0].force[slot].x) +
+                 std::abs(after_n.force[slot].x - before[1].force[slot].x)),
+          0.5 * (std::abs(after_event.force[slot].y - before[0].force[slot].y) +
+                 std::abs(after_n.force[slot].y - before[1].force[slot].y)),
+          0.5 * (std::abs(after_event.force[slot].theta - before[0].force[slot].theta) +
+                 std::abs(after_n.force[slot].theta - before[1].force[slot].theta))};
+      for (int c = 0; c < 3; ++c) {
+        if (changes[c] == 0.0) continue;
+        const int k = 3 * b + c;
+        const double mass = system_.mass_diagonal(k);
+        // A zero-inertia rotation (mass 0) has no estimate: restart.
+        if (!(mass > 0.0) || changes[c] / mass * lag > rtol * std::abs(y_n[nq + k]) + atol[nq + k]) return false;
+      }
+    }
+    return true;
+  };
+
+  double t_n = impl.t_reached;
+  impl.last_sundials_message.clear();
+  impl.non_finite_y.clear();
+  const int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
+  impl.rethrow_callback_error();
+  if (flag < 0) {
+    std::ostringstream msg;
+    msg << "IDA failed at t = " << t_n << " with " << flag_name(flag);
+    if (!impl.last_sundials_message.empty()) msg << " (" << impl.last_sundials_message << ")";
+    msg << explain_failure(flag);
+    throw StepFailure(msg.str());
+  }
+  impl.at_start = false;
+  const double t_step_start = impl.t_reached;
+  bool restarted = false;
+
+  if (root_count > 0) {
+    system_.roots(t_n, y, g_now.data());
+    crossings.clear();
+    for (int k = 0; k < root_count; ++k)
+      if (g_previous[static_cast<std::size_t>(k)] > 0.0 && g_now[static_cast<std::size_t>(k)] <= 0.0)
+        crossings.push_back({t_n, system_.root_owner(k), k - system_.root_offset(system_.root_owner(k)), 0});
+    if (!crossings.empty()) {
+      load_taylor(t_n);
+      double step = 0.0;
+      impl.check(IDAGetLastStep(impl.ida, &step), "IDAGetLastStep");
+      const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), std::abs(step));
+      for (Crossing& c : crossings) {
+        const int k = system_.root_offset(c.element) + c.local;
+        c.t = locate(c.element, c.local, t_step_start, g_previous[static_cast<std::size_t>(k)], t_n,
+                     g_now[static_cast<std::size_t>(k)], tolerance);
+      }
+      std::stable_sort(crossings.begin(), crossings.end(), [](const Crossing& x, const Crossing& z) { return x.t < z.t; });
+      impl.check(IDAGetQuad(impl.ida, &t_n, impl.quad), "IDAGetQuad");
+      const double* quad_n = N_VGetArrayPointer(impl.quad);
+      std::vector<int> done;  // elements that changed mode in this step
+      std::vector<int> changes;  // how often each of them changed (crossings found before are stale)
+      const auto changes_of = [&](int e) {
+        const auto it = std::find(done.begin(), done.end(), e);
+        return it == done.end() ? 0 : changes[static_cast<std::size_t>(it - done.begin())];
+      };
+      for (std::size_t i = 0; i < crossings.size(); ++i) {
+        Crossing c = crossings[i];
+        if (changes_of(c.element) != c.generation) continue;  // found in a mode the element has left
+        if (c.generation >= 20) {  // an element switching back and forth within one step: restart
+          restarted = true;
+        }
+        // The state at the event from IDA's interpolation (the same numbers a restart
+        // uses). The root was located on the Taylor form of the same polynomial; where
+        // round-off leaves it a hair above zero in this state, the event moves forward by
+        // growing multiples of the tolerance until it is at or below zero (at t_n it is).
+        double t_event = c.t;
+        impl.check(IDAGetDky(impl.ida, t_event, 0, derivative), "IDAGetDky");
+        const double* y_at_event = N_VGetArrayPointer(derivative);
+        g_element.resize(static_cast<std::size_t>(model.elements()[static_cast<std::size_t>(c.element)]->root_count()));
+        system_.element_roots(c.element, t_event, y_at_event, g_element.data());
+        for (double nudge = tolerance; g_element[static_cast<std::size_t>(c.local)] > 0.0 && t_event < t_n; nudge *= 4.0) {
+          t_event = std::min(t_n, c.t + nudge);
+          impl.check(IDAGetDky(impl.ida, t_event, 0, derivative), "IDAGetDky");
+          system_.element_roots(c.element, t_event, y_at_event, g_element.data());
+        }
+        c.t = t_event;
+        const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
+                                                           system_.element_load(c.element, t_n, y)};
+        sample_up_to(c.t);  // (uses y_out, not the event state)
+        events.clear();
+        if (!restarted && !system_.commit_element_root(c.element, c.local, -1, c.t, y_at_event, events)) continue;
+        const auto seen = std::find(done.begin(), done.end(), c.element);
+        if (seen == done.end()) {
+          done.push_back(c.element);
+          changes.push_back(1);
+        } else {
+          ++changes[static_cast<std::size_t>(seen - done.begin())];
+        }
+        ++stats().root_returns;
+        if (!restarted && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
+          report_events(events, y_at_event);
+          // The element's new mode may end within this step too: its roots that are at or
+          // below zero at t_n are located in [t_event, t_n] (or committed at once when
+          // already outside at t_event) and queued in time order.
+          const int offset = system_.root_offset(c.element);
+          const int count = model.elements()[static_cast<std::size_t>(c.element)]->root_count();
+          const int generation = changes_of(c.element);
+          system_.element_roots(c.element, t_n, y, g_now.data() + offset);
+          for (int j = 0; j < count; ++j) {
+            const double g_end = g_now[static_cast<std::size_t>(offset + j)];
+            if (g_end > 0.0) continue;
+            const double g_start = element_root_at(c.element, j, c.t);
+            const double t_next = g_start > 0.0 ? locate(c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
+            const Crossing next{t_next, c.element, j, generation};
+            crossings.insert(std::upper_bound(crossings.begin() + static_cast<std::ptrdiff_t>(i) + 1, crossings.end(), next,
+                                              [](const Crossing& x, const Crossing& z) { return x.t < z.t; }),
+                             next);
+          }
+          continue;
+        }
+        restarted = true;
+        // Restart at the event: consistent rates for the new law (and roots that sit on
+        // their boundary there), quadratures interpolated to it.
+        std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
+        restart_state(system_, c.t, y_restart, yp_restart, events);
+        report_events(events, y_restart.data());
+        impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
+        std::copy(y_restart.begin(), y_restart.end(), y);
+        std::copy(yp_restart.begin(), yp_restart.end(), yp);
+        std::copy(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad, N_VGetArrayPointer(impl.quad));
+        impl.accumulate(stats());
+        impl.check(IDAReInit(impl.ida, c.t, impl.y, impl.yp), "IDAReInit");
+        impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
+        impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");  // IDAReInit clears it
+        ++stats().reinitializations;
+        system_.roots(c.t, y, g_previous.data());
+        impl.t_reached = c.t;
+        restarted = true;
+        break;
+      }
+      if (!restarted)  // the changed elements' roots at t_n, in their new modes
+        for (const int e : done) system_.element_roots(e, t_n, y, g_now.data() + system_.root_offset(e));
+    }
+    if (!restarted) std::swap(g_previous, g_now);
+  }
+  if (!restarted) impl.t_reached = t_n;  // (the run loop samples up to it)
+  return impl.t_reached;
+}
+
+void IdaIntegrator::check_start(const double* y, const double* yp, const double* atol, double t_end) const {
+  const std::string source = system_.non_finite_source(0.0, y, yp);
+  if (!source.empty())
+    throw InputError(source + " at t = 0, before the first step; check its numbers (a value too large or too small)");
+  // A rate so large against its tolerance that IDA's weighted norms overflow (its first step
+  // would be zero): a mass or inertia far too small, or a stiffness far too large, acting there.
+  constexpr double kLargestWeightedChange = 1e150;  // squared in a norm: below the largest double
+  const int nq = system_.body_unknowns();
+  for (int k = 0; k < 2 * nq; ++k) {
+    const double weighted_change = std::abs(yp[k]) * t_end / (settings_.rtol * std::abs(y[k]) + atol[k]);
+    if (weighted_change > kLargestWeightedChange) {
+      std::ostringstream msg;
+      msg << system_.unknown_name(k) << " changes at " << yp[k] << " per unit time at t = 0, " << weighted_change
+          << " times its tolerance over t_end: too fast to integrate (IDA's error norms overflow); check the "
+             "masses, inertias and stiffnesses acting there (a value too small or too large)";
+      if (k >= nq) msg << largest_force_on(k - nq, y);
+      throw InputError(msg.str());
+    }
+  }
+}
+
+std::string IdaIntegrator::largest_force_on(int k, const double* y) const {
+  const int body = k / 3, component = k % 3;
+  const Model& model = system_.model();
+  double largest = 0.0;
+  const Element* source = nullptr;
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const DaeSystem::ElementLoad load = system_.element_load(static_cast<int>(e), 0.0, y);
+    for (std::size_t slot = 0; slot < 2; ++slot) {
+      if (load.body[slot] != body) continue;
+      const Pose<double>& f = load.force[slot];
+      const double value = std::abs(component == 0 ? f.x : component == 1 ? f.y : f.theta);
+      if (value > largest) largest = value, source = model.elements()[e].get();
+    }
+  }
+  if (!source) return "";
+  std::ostringstream text;
+  text << "; the largest force on it, " << largest << ", comes from " << source->where().prefix() << "element '"
+       << source->name() << "' (" << source->type() << ")";
+  return text.str();
+}
+
+std::string IdaIntegrator::explain_failure(int flag) {
+  Impl& impl = *impl_;
+  std::ostringstream why;
+  if (!impl.non_finite_y.empty()) {
+    const std::string source =
+        system_.non_finite_source(impl.non_finite_t, impl.non_finite_y.data(), impl.non_finite_yp.data());
+    why << "; the residual was not finite at t = " << impl.non_finite_t << (source.empty() ? "" : ": " + source);
+  }
+  double t_good = 0.0, h = 0.0;
+  if (IDAGetCurrentTime(impl.ida, &t_good) != IDA_SUCCESS || IDAGetCurrentStep(impl.ida, &h) != IDA_SUCCESS) return why.str();
+  why << "; last good state at t = " << t_good << ", step h = " << h;
+  if (IDAGetDky(impl.ida, t_good, 0, impl.y_out) != IDA_SUCCESS) return why.str();
+  if (flag == IDA_CONV_FAIL || flag == IDA_ERR_FAIL) {
+    const std::string singular = singular_configuration(system_, N_VGetArrayPointer(impl.y_out), t_good);
+    if (!singular.empty()) why << "; " << singular;
+  }
+  // The unknowns with the largest weighted local error estimates (error weight x error).
+  if (IDAGetErrWeights(impl.ida, impl.derivative) == IDA_SUCCESS && IDAGetEstLocalErrors(impl.ida, impl.local_errors) == IDA_SUCCESS) {
+    const double* weights = N_VGetArrayPointer(impl.derivative);
+    const double* errors = N_VGetArrayPointer(impl.local_errors);
+    std::vector<std::pair<double, int>> weighted;
+    for (int k = 0; k < system_.size(); ++k) weighted.emplace_back(std::abs(weights[k] * errors[k]), k);
+    const std::size_t shown = std::min<std::size_t>(3, weighted.size());
+    std::partial_sort(weighted.begin(), weighted.begin() + static_cast<std::ptrdiff_t>(shown), weighted.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first; });
+    if (shown > 0 && weighted.front().first > 0.0) {
+      why << "; largest weighted local errors:";
+      for (std::size_t i = 0; i < shown && weighted[i].first > 0.0; ++i)
+        why << (i ? ", " : " ") << system_.unknown_name(weighted[i].second) << " (" << weighted[i].first << ")";
+    }
+  }
+  return why.str();
+}
+
+void IdaIntegrator::state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) {
+  Impl& impl = *impl_;
+  N_Vector y_source = impl.y, quad_source = impl.quad;  // at the start: the initial values
+  if (!impl.at_start) {
+    impl.check(IDAGetDky(impl.ida, t, 0, impl.y_out), "IDAGetDky");
+    impl.check(IDAGetQuadDky(impl.ida, t, 0, impl.quad_out), "IDAGetQuadDky");
+    y_source = impl.y_out;
+    quad_source = impl.quad_out;
+  }
+  y.assign(N_VGetArrayPointer(y_source), N_VGetArrayPointer(y_source) + N_VGetLength(y_source));
+  quadratures.assign(N_VGetArrayPointer(quad_source), N_VGetArrayPointer(quad_source) + N_VGetLength(quad_source));
+}
+
+const double* IdaIntegrator::current_state() const { return N_VGetArrayPointer(impl_->y); }
+
+void IdaIntegrator::final_state(std::vector<double>& y, std::vector<double>& quadratures) {
+  Impl& impl = *impl_;
+  // The final quadratures: IDA's at its last step (t_end).
+  if (impl.t_reached > 0.0) {
+    double t_quad = impl.t_reached;
+    IDAGetQuad(impl.ida, &t_quad, impl.quad);  // on failure impl.quad keeps the last known values
+  }
+  y.assign(N_VGetArrayPointer(impl.y), N_VGetArrayPointer(impl.y) + N_VGetLength(impl.y));
+  quadratures.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + N_VGetLength(impl.quad));
+}
+
+std::string IdaIntegrator::step_limit_advice(double t_end) const {
+  std::ostringstream text;
+  text << ", before t_end = " << t_end << " (the model is stiff there or its tolerances are tight); raise --max-steps or check the model";
+  return text.str();
+}
+
+void IdaIntegrator::finish() {
+  if (impl_ && impl_->ida) {
+    try {
+      impl_->accumulate(stats());
+    } catch (const std::exception&) {  // counters are a report, not a result: keep the outcome
+    }
+  }
+  impl_.reset();
 }
 
 }  // namespace railcrash

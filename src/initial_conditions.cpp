@@ -42,34 +42,39 @@ double row_scale(const DaeSystem& system, int row) {
   return system.constraint_row_is_rotational(row) ? system.model().length_scale() : 1.0;
 }
 
-std::string describe_rows(const DaeSystem& system, const std::vector<int>& rows) {
+/// The elements owning rows, at most `most` of them named ("and N more" after).
+std::string describe_rows(const DaeSystem& system, const std::vector<int>& rows, std::size_t most = 1000000) {
   std::set<std::string> names;
   for (int row : rows) {
     const Element& e = system.constraint_owner(row);
     names.insert("'" + e.name() + "' (" + e.type() + (e.where().line > 0 ? ", line " + std::to_string(e.where().line) : "") + ")");
   }
   std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  std::size_t named = 0;
+  for (const auto& n : names)
+    if (named++ < most) out += (out.empty() ? "" : ", ") + n;
+  if (names.size() > most) out += " and " + std::to_string(names.size() - most) + " more";
   return out;
 }
 
 }  // namespace
 
-void check_constraint_rank(const DaeSystem& system, const double* q) {
+std::vector<int> dependent_constraint_rows(const DaeSystem& system, const double* q, double pivot_threshold, int& rank) {
   const int m = system.constraint_rows();
-  if (m == 0) return;
+  rank = m;
+  if (m == 0) return {};
   Eigen::VectorXd phi;
   const SparseMatrix g = constraint_gradient(system, q, phi);
   const Eigen::VectorXd root_w = assembly_weights(system).cwiseSqrt();
   SparseMatrix scaled_transpose = (g * root_w.asDiagonal()).transpose();
   scaled_transpose.makeCompressed();
   Eigen::SparseQR<SparseMatrix, Eigen::COLAMDOrdering<int>> qr;
-  qr.setPivotThreshold(1e-10);
+  qr.setPivotThreshold(pivot_threshold);
   qr.compute(scaled_transpose);
   if (qr.info() != Eigen::Success)
     throw SolverError("could not factor the constraint gradient to check the joints for redundancy");
-  const int rank = static_cast<int>(qr.rank());
-  if (rank >= m) return;
+  rank = static_cast<int>(qr.rank());
+  if (rank >= m) return {};
   // (A P).col(k) = A.col(P.indices()(k)): the trailing permuted columns are the dependent
   // rows. Each is a combination x of the leading ones, R11 x = R12(:, k); the rows with a
   // non-zero weight in x are the joints it repeats.
@@ -85,6 +90,38 @@ void check_constraint_rank(const DaeSystem& system, const double* q) {
     for (int i = 0; i < rank; ++i)
       if (std::abs(weights[i]) > 1e-8 * largest) involved.push_back(permutation(i));
   }
+  return involved;
+}
+
+std::string singular_configuration(const DaeSystem& system, const double* q, double t) {
+  constexpr int kLargestCheckedRows = 2000;  // a sparse QR of G^T: cheap up to here, and a failure is rare
+  const int m = system.constraint_rows();
+  if (m == 0) return "";
+  if (m > kLargestCheckedRows)
+    return "the rank check of the joints was skipped (" + std::to_string(m) + " constraint rows, more than " +
+           std::to_string(kLargestCheckedRows) + ")";
+  // Near a singular configuration G is nearly, not exactly, rank deficient at the last good
+  // state: IDA's Newton iteration fails while the links are still a few degrees from it (the
+  // IFToMM N-four-bar, N = 40, at rtol 1e-8: 0.02 rad from flat, found at 1e-2, not at 1e-3).
+  constexpr double kNearlyDependent = 1e-2;  // pivot threshold on G^T W^1/2, times the length scale
+  int rank = m;
+  const std::vector<int> rows =
+      dependent_constraint_rows(system, q, kNearlyDependent * system.model().length_scale(), rank);
+  if (rows.empty()) return "";
+  std::ostringstream msg;
+  msg << "singular configuration: joints " << describe_rows(system, rows, 6) << " lose rank at t = " << t << " ("
+      << m - rank << " of the " << m << " constraint equations depend on the others there)";
+  return msg.str();
+}
+
+void check_constraint_rank(const DaeSystem& system, const double* q) {
+  const int m = system.constraint_rows();
+  if (m == 0) return;
+  int rank = m;
+  const std::vector<int> involved = dependent_constraint_rows(system, q, 1e-10, rank);
+  if (involved.empty()) return;
+  Eigen::VectorXd phi;
+  constraint_gradient(system, q, phi);
   double worst = 0.0;
   for (int row : involved) worst = std::max(worst, std::abs(phi[row]) * row_scale(system, row));
   const std::string file_prefix = SourceLocation{system.model().file, 0}.prefix();

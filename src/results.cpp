@@ -1,6 +1,8 @@
 #include "railcrash/results.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -107,7 +109,7 @@ std::vector<std::string> timeseries_columns(const DaeSystem& system) {
 }
 
 ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory)
-    : system_(system), directory_(directory), last_flush_(std::chrono::steady_clock::now()) {
+    : system_(system), directory_(directory), last_flush_(std::chrono::steady_clock::now()), last_summary_(last_flush_) {
   const std::vector<std::string> names = timeseries_columns(system);
   if (!directory.empty()) {
     std::error_code error;
@@ -150,6 +152,7 @@ ResultWriter::~ResultWriter() {
 }
 
 void ResultWriter::sample(double t, const double* y, const double* lambda, const double* quadratures) {
+  errno = 0;  // a failed write below leaves its reason here (check_files)
   const int n = system_.model().body_count();
   const int nq = 3 * n;
   if (timeseries_) {
@@ -210,16 +213,66 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
       crush += car.shares[k] * std::max(0.0, output_values_[static_cast<std::size_t>(car.columns[k])]);
     if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
   }
-  // Keep what is on disk current without flushing every row.
-  if (!timeseries_) return;
+  t_last_sample_ = t;
+  // Keep what is on disk current without flushing every row; every write checked.
+  if (!timeseries_ || !failure_.empty()) return;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_flush_ > std::chrono::milliseconds(500)) {
-    std::fflush(timeseries_);
-    std::fflush(events_);
-    std::fflush(accelerations_file_);
-    std::fflush(energy_file_);
-    last_flush_ = now;
+  const bool flush = now - last_flush_ > std::chrono::milliseconds(500);
+  check_files(flush);
+  if (flush) last_flush_ = now;
+  if (failure_.empty() && now - last_summary_ > std::chrono::seconds(2)) {
+    write_running_summary(integrator_);
+    last_summary_ = now;
   }
+}
+
+void ResultWriter::fail(const std::string& what, int error_number) {
+  if (failure_.empty()) failure_ = what + ": " + std::strerror(error_number);
+}
+
+void ResultWriter::check_files(bool flush) {
+  const std::pair<std::FILE*, const char*> files[] = {
+      {timeseries_, "timeseries.csv"}, {events_, "events.csv"}, {accelerations_file_, "accelerations.csv"}, {energy_file_, "energy.csv"}};
+  const int write_error = errno;  // set by a failed write since sample() cleared it
+  for (const auto& [file, name] : files) {
+    if (!file) continue;
+    if (std::ferror(file)) fail("cannot write " + directory_ + "/" + name, write_error != 0 ? write_error : EIO);
+    errno = 0;
+    if (flush && std::fflush(file) != 0) fail("cannot write " + directory_ + "/" + name, errno != 0 ? errno : EIO);
+  }
+  std::error_code error;  // one stat per sample: a removed folder stops the run at its next sample
+  if (!std::filesystem::is_directory(directory_, error)) fail("the output folder " + directory_ + " is gone", ENOENT);
+}
+
+void ResultWriter::write_running_summary(const std::string& integrator) {
+  integrator_ = integrator;
+  if (directory_.empty() || !failure_.empty()) return;
+  RunOutcome so_far;
+  so_far.t_reached = t_last_sample_;
+  replace_summary(summary_text(so_far, "running", integrator, ""));
+}
+
+bool ResultWriter::replace_summary(const std::string& text) {
+  const std::string path = directory_ + "/summary.json";
+  const std::string temporary = path + ".tmp";
+  std::FILE* file = std::fopen(temporary.c_str(), "w");
+  if (!file) {
+    fail("cannot write " + temporary, errno);
+    return false;
+  }
+  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size() && std::fflush(file) == 0;
+  const int write_error = errno;
+  if (std::fclose(file) != 0 || !written) {
+    fail("cannot write " + temporary, written ? errno : write_error);
+    std::remove(temporary.c_str());
+    return false;
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    fail("cannot rename " + temporary + " to summary.json", errno);
+    std::remove(temporary.c_str());
+    return false;
+  }
+  return true;
 }
 
 void ResultWriter::event(const EventRecord& record, const double*) {
@@ -231,7 +284,9 @@ void ResultWriter::event(const EventRecord& record, const double*) {
       for (char c : *text) quoted += (c == '"') ? std::string("\"\"") : std::string(1, c);
       *text = quoted + "\"";
     }
+  errno = 0;
   std::fprintf(events_, "%.12g,%s,%s,%.12g\n", record.t, element.c_str(), what.c_str(), record.value);
+  if (std::ferror(events_)) fail("cannot write " + directory_ + "/events.csv", errno != 0 ? errno : EIO);
 }
 
 std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const {
@@ -258,15 +313,21 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
 }
 
 std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json) {
-  for (std::FILE* file : {timeseries_, events_, accelerations_file_, energy_file_})
-    if (file) std::fflush(file);
+  if (timeseries_ && failure_.empty()) check_files(/*flush=*/true);
+  const std::string text = summary_text(outcome, outcome.ok ? "ok" : "failed", integrator, extra_json);
+  if (!directory_.empty()) replace_summary(text);  // also after a failed CSV write: the summary may still fit
+  return text;
+}
+
+std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::string& status, const std::string& integrator,
+                                       const std::string& extra_json) const {
   const Model& model = system_.model();
   const bool si = model.units == UnitSystem::SI;
   const EnergyBalance energy = EnergyBalance::between(outcome.initial_energy, outcome.final_energy);
   const RunStatistics& s = outcome.stats;
   std::ostringstream j;
   j << "{\n";
-  j << "  \"status\": " << json_string(outcome.ok ? "ok" : "failed") << ",\n";
+  j << "  \"status\": " << json_string(status) << ",\n";
   j << "  \"message\": " << json_string(outcome.message) << ",\n";
   j << "  \"model\": " << json_string(model.name) << ",\n";
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
@@ -351,10 +412,6 @@ std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::st
     j << "]}";
   }
   j << "}" << extra_json << "\n}\n";
-  if (directory_.empty()) return j.str();
-  std::ofstream out(directory_ + "/summary.json");
-  out << j.str();
-  if (!out) throw SolverError("could not write " + directory_ + "/summary.json");
   return j.str();
 }
 

@@ -55,6 +55,11 @@ class ProgressObserver : public RunObserver {
   void event(const EventRecord& record, const double* y) override {
     for (RunObserver* o : next_) o->event(record, y);
   }
+  std::string failure() const override {
+    for (const RunObserver* o : next_)
+      if (std::string why = o->failure(); !why.empty()) return why;
+    return "";
+  }
 
   void finish() { meter_.finish(t_last_); }
 
@@ -106,20 +111,38 @@ std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const Simul
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
                     bool keep_in_memory) {
   const DaeSystem system(model);
-  std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;
   std::vector<RunObserver*> observers;
-  if (!out_dir.empty() || keep_in_memory)
+  RunReport report;
+  report.integrator = model.simulation.integrator == IntegratorKind::Euler ? "euler" : "ida";
+  if (!out_dir.empty() || keep_in_memory) {
     observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory)).get());
+    writer->write_running_summary(report.integrator);
+  }
   if (model.responses.defined())
     observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
   std::unique_ptr<ScenarioTracker> scenario;
   if (model.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *model.scenario)).get());
   ProgressObserver observer(system, observers, model.simulation.t_end, show_progress);
-  RunReport report;
-  report.integrator = integrator->name();
-  report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+  std::unique_ptr<Integrator> integrator;
+  try {
+    try {
+      integrator = make_integrator(system, model.simulation);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
+      report.outcome.message = e.what();
+    }
+    if (integrator)
+      report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+  } catch (const InputError& e) {  // found at the start (a non-finite law, joints): the summary says so too
+    if (writer) {
+      report.outcome.message = e.what();
+      writer->write_summary(report.outcome, report.integrator);
+    }
+    throw;
+  }
   observer.finish();
   if (report.outcome.ok && !observer.non_finite_output().empty()) {
     report.outcome.ok = false;
@@ -134,6 +157,10 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
         writer->write_summary(report.outcome, report.integrator,
                               (responses ? ",\n  \"responses\": " + responses->json() : "") +
                                   (scenario ? ",\n  \"scenario\": " + scenario->json() : ""));
+    if (report.outcome.ok && !writer->failure().empty()) {  // the last write failed
+      report.outcome.ok = false;
+      report.outcome.message = writer->failure();
+    }
     report.acceleration_peaks = writer->acceleration_peaks();
     report.car_crush = writer->car_crush();
     report.filtered_accelerations = writer->filtered_accelerations();

@@ -196,3 +196,33 @@ TEST_CASE("static equilibrium settles onto the kink of a stop spring", "[initial
   CHECK(o.y[1] == Approx(1.0).margin(1e-8));
   CHECK(std::abs(o.y[4]) < 1e-6);
 }
+
+TEST_CASE("a parallelogram four-bar lying flat is a singular configuration that names its joints", "[initial][faults]") {
+  // Ground pins A (0, 0) and D (2, 0), crank and rocker 1 m, coupler 2 m. Upright (crank at
+  // 90 degrees) the joints' gradient has full rank; flat (crank at 0) every link lies on the x
+  // axis and the four pins' eight equations have rank 7 (the y rows of the chain repeat).
+  std::string text =
+      "railcrash: 1\nname: four-bar\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: crank, mass: 1, inertia: 0.08, position: [0, 0.5], angle: 1.5707963267949}\n"
+      "  - {name: coupler, mass: 2, inertia: 0.67, position: [1, 1]}\n"
+      "  - {name: rocker, mass: 1, inertia: 0.08, position: [2, 0.5], angle: 1.5707963267949}\nelements:\n"
+      "  - {name: pin_a, type: pin_joint, points: [{body: ground, at: [0, 0]}, {body: crank, at: [-0.5, 0]}]}\n"
+      "  - {name: pin_b, type: pin_joint, points: [{body: crank, at: [0.5, 0]}, {body: coupler, at: [-1, 0]}]}\n"
+      "  - {name: pin_c, type: pin_joint, points: [{body: coupler, at: [1, 0]}, {body: rocker, at: [0.5, 0]}]}\n"
+      "  - {name: pin_d, type: pin_joint, points: [{body: ground, at: [2, 0]}, {body: rocker, at: [-0.5, 0]}]}\n"
+      "simulation: {t_end: 1}\n";
+  const Model model = testing::model_from_text(text);
+  const DaeSystem system(model);
+  std::vector<double> q = system.initial_state();
+  CHECK(singular_configuration(system, q.data(), 0.0).empty());
+  // Flat: crank centre (0.5, 0), coupler (2, 0), rocker (2.5, 0), all at angle 0.
+  const double flat[9] = {0.5, 0.0, 0.0, 2.0, 0.0, 0.0, 2.5, 0.0, 0.0};
+  std::copy(flat, flat + 9, q.begin());
+  int rank = 0;
+  CHECK_FALSE(dependent_constraint_rows(system, q.data(), 1e-10, rank).empty());
+  CHECK(rank == 7);
+  CHECK_THAT(singular_configuration(system, q.data(), 1.5),
+             Catch::Contains("singular configuration: joints 'pin_a' (pin_joint, line 10), 'pin_b' (pin_joint, line 11), "
+                             "'pin_c' (pin_joint, line 12), 'pin_d' (pin_joint, line 13) lose rank at t = 1.5 "
+                             "(1 of the 8 constraint equations depend on the others there)"));
+}

@@ -1,7 +1,10 @@
-// Cars in the run summary (results.hpp): declared by the bodies' `car:` key, never guessed.
+// Cars in the run summary (results.hpp): declared by the bodies' `car:` key, never guessed;
+// results that survive faults (a full disk, a vanished folder).
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "railcrash/model_io.hpp"
@@ -34,6 +37,37 @@ std::string two_car_text(const std::string& car_a, const std::string& car_b) {
          "points: [{body: striker_rear, at: [0, 0]}, {body: striker_end, at: [0, 0]}]}\n"
          "simulation: {t_end: 0.05, output_interval: 0.001}\n";
 }
+
+// A mass on a spring (period 2 pi sqrt(2 / 200) = 0.63 s) for T seconds, sampled every millisecond.
+std::string spring_mass_text(double t_end) {
+  return "railcrash: 1\nname: osc\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+         "  - {name: mass, mass: 2.0, inertia: 0.1, position: [1.1, 0]}\nelements:\n"
+         "  - {name: spring, type: linear_spring, stiffness: 200, free_length: 1.0, "
+         "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+         "simulation: {t_end: " + std::to_string(t_end) + ", output_interval: 0.001}\n";
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// Forwards to the writer; at sample `look_at` keeps summary.json's text, at sample `remove_at` removes the folder.
+struct FolderRemover : RunObserver {
+  ResultWriter* writer;
+  std::string folder;
+  int look_at, remove_at;
+  int samples = 0;
+  std::string summary_mid_run;
+  void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
+    writer->sample(t, y, lambda, quadratures);
+    if (++samples == look_at) summary_mid_run = file_text(folder + "/summary.json");
+    if (samples == remove_at) std::filesystem::remove_all(folder);
+  }
+  std::string failure() const override { return writer->failure(); }
+};
 
 }  // namespace
 
@@ -107,4 +141,58 @@ TEST_CASE("the barrier model's two cars are summarised separately", "[results]")
   CHECK(cars[1].bodies == prefixed("trail_"));
   CHECK(cars[1].elements == std::vector<std::string>{"trail_draft_sill"});
   CHECK(cars[0].bodies.size() + cars[1].bodies.size() + 1 == static_cast<std::size_t>(model.body_count()));  // + coupler
+}
+
+TEST_CASE("a full disk stops the run at once with the OS reason and the summary says failed", "[results][faults]") {
+  if (!std::filesystem::exists("/dev/full")) return;  // no device that is always full here
+  const std::string dir = temporary_folder("full_disk");
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink("/dev/full", dir + "/timeseries.csv");  // every write: ENOSPC
+  const Model model = testing::model_from_text(spring_mass_text(10.0));
+  const RunReport report = run_model(model, dir);
+  CHECK_FALSE(report.outcome.ok);
+  CHECK_THAT(report.outcome.message, Catch::Contains("cannot write " + dir + "/timeseries.csv: No space left on device") &&
+                                         Catch::Contains("the run stopped at t = "));
+  // Stopped once stdio's buffer (a few kB: some tens of 120-byte rows) reached the device, not at t_end.
+  CHECK(report.outcome.t_reached < 1.0);
+  const std::string summary = file_text(dir + "/summary.json");
+  CHECK_THAT(summary, Catch::Contains("\"status\": \"failed\"") && Catch::Contains("No space left on device"));
+  CHECK_FALSE(std::filesystem::exists(dir + "/summary.json.tmp"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("summary.json says running while the run goes and a vanished folder stops the run", "[results][faults]") {
+  const std::string dir = temporary_folder("vanishing");
+  const Model model = testing::model_from_text(spring_mass_text(10.0));
+  const DaeSystem system(model);
+  ResultWriter writer(dir, system);
+  writer.write_running_summary("ida");
+  FolderRemover observer;
+  observer.writer = &writer;
+  observer.folder = dir;
+  observer.look_at = 3;
+  observer.remove_at = 100;  // t = 0.099
+  const RunOutcome outcome = make_integrator(system, model.simulation)->run(10.0, 0.001, observer);
+  CHECK_THAT(observer.summary_mid_run, Catch::Contains("\"status\": \"running\"") && Catch::Contains("\"integrator\": \"ida\""));
+  CHECK_FALSE(outcome.ok);
+  CHECK_THAT(outcome.message, Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
+  // The check runs at every sample: the run stops at the first one after the removal and
+  // ends at the last sample written whole.
+  CHECK(outcome.t_reached == Approx(0.099).margin(1e-9));
+  CHECK(observer.samples == 101);
+  // The final summary cannot be written; the writer says why instead of throwing.
+  CHECK_THAT(writer.write_summary(outcome, "ida"), Catch::Contains("\"status\": \"failed\""));
+  CHECK_FALSE(std::filesystem::exists(dir));
+}
+
+TEST_CASE("a finished run's summary.json replaces the running one and leaves no temporary file", "[results][faults]") {
+  const std::string dir = temporary_folder("finished");
+  const Model model = testing::model_from_text(spring_mass_text(0.05));
+  const RunReport report = run_model(model, dir);
+  REQUIRE(report.outcome.ok);
+  const std::string summary = file_text(dir + "/summary.json");
+  CHECK(summary == report.summary_json);
+  CHECK_THAT(summary, Catch::StartsWith("{\n  \"status\": \"ok\"") && Catch::EndsWith("}\n"));
+  CHECK_FALSE(std::filesystem::exists(dir + "/summary.json.tmp"));
+  std::filesystem::remove_all(dir);
 }

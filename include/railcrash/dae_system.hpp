@@ -105,6 +105,14 @@ class DaeSystem {
   double constraint_residual(const double* q) const;
   /// Element owning constraint row `row`.
   const Element& constraint_owner(int row) const;
+  /// Unknown k of y in the model's terms, with file:line: "model.yaml:7: body 'cab' vx",
+  /// "model.yaml:20: element 'pin' (revolute) multiplier of its constraint row 1".
+  std::string unknown_name(int k) const;
+  /// Where a non-finite value at (t, y, y') comes from, in the model's terms with file:line:
+  /// a non-finite unknown or rate, else the first element whose forces, constraint equations,
+  /// gradients or Jacobian entries are not finite (each element evaluated alone), else the mass
+  /// matrix or a load, else the residual row that overflows; "" when everything is finite.
+  std::string non_finite_source(double t, const double* y, const double* yp) const;
   /// False once the element owning constraint row `row` has failed (its rows: lambda = mu = 0).
   bool constraint_row_active(int row) const { return !constraint_owner(row).failed(); }
   /// True when constraint row `row` is an angle equation.

@@ -32,8 +32,6 @@ class EulerIntegrator : public Integrator {
  public:
   EulerIntegrator(const DaeSystem& system, EulerSettings settings);
   const char* name() const override { return "euler"; }
-  RunOutcome run(double t_end, double output_interval, RunObserver& observer,
-                 const std::atomic<bool>* stop = nullptr) override;
 
   /// Step actually used and the stability limit (valid after construction).
   double step() const { return dt_; }
@@ -47,7 +45,19 @@ class EulerIntegrator : public Integrator {
  private:
   PenaltyRows make_penalty(double dt) const;
 
-  const DaeSystem& system_;
+  // Integrator's steps (integrator.hpp).
+  void start(double t_end) override;
+  double advance(double t_end) override;
+  bool dense_output() const override { return false; }
+  void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) override;
+  const double* current_state() const override { return y_.data(); }
+  void final_state(std::vector<double>& y, std::vector<double>& quadratures) override { state_at(t_, y, quadratures); }
+  EnergyState energy(const double* y, const double* quadratures) const override;
+  std::string step_limit_advice(double t_end) const override;
+  std::string divergence_phrase() const override { return "explicit Euler diverged"; }
+  std::string divergence_advice(const std::vector<double>& last_good, double t_last_good) const override;
+  long max_steps() const override { return settings_.max_steps; }
+
   EulerSettings settings_;
   std::vector<double> y0_;
   double dt_ = 0.0;
@@ -57,6 +67,16 @@ class EulerIntegrator : public Integrator {
   double settling_displacement_ = 0.0;
   std::vector<EventRecord> start_events_;  // mode changes while settling
   PenaltyRows penalty_;
+
+  // The run in progress: y = [q, v, penalty forces] (the multipliers' place holds the
+  // penalty forces of the last step), quadratures, time and step count.
+  std::vector<double> y_, quadratures_;
+  std::vector<double> force_, rates_, lambda_, inverse_mass_;
+  std::vector<double> g_before_, g_after_;  // root functions before and after a step
+  std::vector<int> direction_;
+  std::vector<EventRecord> events_;
+  double t_ = 0.0;  // [time]
+  long step_ = 0;
 };
 
 }  // namespace railcrash

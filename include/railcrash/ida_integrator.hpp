@@ -42,14 +42,32 @@ class IdaIntegrator : public Integrator {
   IdaIntegrator(const DaeSystem& system, IdaSettings settings);
   ~IdaIntegrator() override;
   const char* name() const override { return "ida"; }
-  RunOutcome run(double t_end, double output_interval, RunObserver& observer,
-                 const std::atomic<bool>* stop = nullptr) override;
 
   struct Impl;
 
  private:
-  const DaeSystem& system_;
+  // Integrator's steps (integrator.hpp).
+  void start(double t_end) override;
+  double advance(double t_end) override;
+  bool dense_output() const override { return true; }
+  void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) override;
+  const double* current_state() const override;
+  void final_state(std::vector<double>& y, std::vector<double>& quadratures) override;
+  std::string step_limit_advice(double t_end) const override;
+  std::string divergence_phrase() const override { return "IDA's solution is not finite"; }
+  long max_steps() const override { return settings_.max_steps; }
+  void finish() override;
+  /// Before the first step: InputError naming the element or body whose residual, Jacobian or
+  /// rates are not finite (or so large that IDA's norms overflow) at t = 0.
+  void check_start(const double* y, const double* yp, const double* atol, double t_end) const;
+  /// Why IDA failed, in the model's terms: a non-finite residual's element or body, a
+  /// singular configuration of the joints, the unknowns with the largest weighted errors.
+  std::string explain_failure(int flag);
+  /// "; the largest force on it, F, comes from FILE:LINE: element 'NAME' (TYPE)" for body unknown k at t = 0.
+  std::string largest_force_on(int k, const double* y) const;
+
   IdaSettings settings_;
+  std::unique_ptr<Impl> impl_;  // SUNDIALS' objects of the run in progress
 };
 
 }  // namespace railcrash

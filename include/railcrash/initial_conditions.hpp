@@ -85,4 +85,13 @@ StartReport prepare_start(const DaeSystem& system, std::vector<double>& y, std::
 /// Throws InputError when the constraint rows are linearly dependent at q, naming them.
 void check_constraint_rank(const DaeSystem& system, const double* q);
 
+/// Constraint rows in a linearly dependent set at q (a column-pivoted sparse QR of G^T with the
+/// given pivot threshold); rank receives G's rank. Empty when G has full rank.
+std::vector<int> dependent_constraint_rows(const DaeSystem& system, const double* q, double pivot_threshold, int& rank);
+
+/// After a solver failure: "singular configuration: joints 'a' (pin_joint, line 9), ... lose
+/// rank at t = ..." when G at q is nearly rank deficient; a note when the model is too large
+/// to check (more than 2000 constraint rows); "" otherwise.
+std::string singular_configuration(const DaeSystem& system, const double* q, double t);
+
 }  // namespace railcrash

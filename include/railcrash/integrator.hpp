@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ class RunObserver {
   virtual void sample(double t, const double* y, const double* lambda, const double* quadratures) = 0;
   /// A committed mode change (contact, yield, rupture, ...); y is the state at that instant.
   virtual void event(const EventRecord& /*record*/, const double* /*y*/) {}
+  /// Why the observer cannot go on (a failed write: the OS's reason), "" while it can; the
+  /// run loop stops at once when it is not empty.
+  virtual std::string failure() const { return ""; }
 };
 
 struct RunOutcome {
@@ -51,14 +55,89 @@ struct RunOutcome {
   std::vector<EventRecord> events;       // every committed mode change, in order
 };
 
+/// The run loop both integrators share (Drake's IntegrateTo over DoStep): run() starts the
+/// integrator, forwards its mode changes to the observer, samples the state at the output
+/// times, checks after every accepted step that the state is finite, obeys the stop flag and
+/// the step limit, and fills the outcome and the statistics, once for every integrator. An
+/// integrator implements only its own steps: start(), advance() (one step) and the state at
+/// a time (state_at; dense output, or the state at the end of the last step).
+///
+/// The failure contract: a run is ok only when it reached t_end; otherwise its message says
+/// why (interrupted, step limit, solver failure, a non-finite state naming the body
+/// coordinate or element multiplier and t). A failed run ends at its last output sample, the
+/// last good state the observer (and the files) received: a non-finite state is never sampled.
+/// An observer that cannot go on (RunObserver::failure, e.g. a failed write) stops the run at
+/// the sample where it says so.
 class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual const char* name() const = 0;
   /// Integrates from 0 to t_end, sampling every output_interval; stops early (ok = false,
-  /// message says why) on failure or when *stop becomes true.
-  virtual RunOutcome run(double t_end, double output_interval, RunObserver& observer,
-                         const std::atomic<bool>* stop = nullptr) = 0;
+  /// message says why) on failure or when *stop becomes true. Input errors throw InputError.
+  RunOutcome run(double t_end, double output_interval, RunObserver& observer, const std::atomic<bool>* stop = nullptr);
+
+ protected:
+  /// A failure of the integration itself (not of the input): becomes the outcome's message.
+  class StepFailure : public std::runtime_error {
+   public:
+    using std::runtime_error::runtime_error;
+  };
+
+  explicit Integrator(const DaeSystem& system) : system_(system) {}
+
+  // ---- per-integrator steps ----
+  /// Prepares the state at t = 0 (reporting start events through report_events).
+  virtual void start(double t_end) = 0;
+  /// Takes one step towards t_end and returns the time reached. Dense integrators call
+  /// sample_up_to(t_event) before reporting a mode change at t_event. Throws StepFailure.
+  virtual double advance(double t_end) = 0;
+  /// True when state_at gives the state at any time within the last step (samples fall on
+  /// the output times); false: samples are taken at the end of the step that passes one.
+  virtual bool dense_output() const = 0;
+  /// The state y (q, v, multipliers) and the quadratures at t (a dense integrator: within
+  /// its last step; otherwise the current state).
+  virtual void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) = 0;
+  /// The current state (at the time advance returned), for the finiteness check of every step.
+  virtual const double* current_state() const = 0;
+  /// The state and quadratures a run that reached t_end ends with.
+  virtual void final_state(std::vector<double>& y, std::vector<double>& quadratures) = 0;
+  /// Energy figures of a state (Euler adds its penalty springs).
+  virtual EnergyState energy(const double* y, const double* quadratures) const { return system_.energy(y, quadratures); }
+  /// Advice after "stopped at t = ... after --max-steps N steps": what the step was, what to do.
+  virtual std::string step_limit_advice(double t_end) const = 0;
+  /// What a non-finite state means for this integrator ("explicit Euler diverged").
+  virtual std::string divergence_phrase() const = 0;
+  /// Extra advice after a non-finite state; last_good is the last sampled state (t_last_good).
+  virtual std::string divergence_advice(const std::vector<double>& /*last_good*/, double /*t_last_good*/) const { return ""; }
+  /// Largest number of advance() calls in one run.
+  virtual long max_steps() const = 0;
+  /// Called once at the end of every run (also after a failure): counters into stats().
+  virtual void finish() {}
+
+  // ---- for the integrators: what the run loop owns ----
+  /// Forwards committed mode changes (the state at that instant: y) to the observer and the outcome.
+  void report_events(const std::vector<EventRecord>& events, const double* y);
+  /// Dense output: samples every output time up to t_limit not sampled yet.
+  void sample_up_to(double t_limit);
+  RunStatistics& stats() { return outcome_.stats; }
+
+  const DaeSystem& system_;
+
+ private:
+  void deliver_sample(double t);
+  double next_output_time() const;
+  /// Names the first non-finite entry of y ("" when all are finite).
+  std::string non_finite_entry(const double* y) const;
+
+  // State of the run in progress.
+  RunOutcome outcome_;
+  RunObserver* observer_ = nullptr;
+  double t_end_ = 0.0;
+  double output_interval_ = 0.0;
+  long output_index_ = 1;       // next output time: output_index_ * output_interval_
+  double t_sampled_ = 0.0;      // last sample
+  std::vector<double> sample_y_, sample_quadratures_;
+  std::vector<double> last_sample_y_, last_sample_quadratures_;
 };
 
 /// Largest |Phi| tracker shared by the integrators.

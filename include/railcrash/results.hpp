@@ -100,8 +100,15 @@ class ResultWriter : public RunObserver {
 
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
   void event(const EventRecord& record, const double* y) override;
-  /// Writes summary.json when there is a folder (call once, at the end, whatever the
-  /// outcome); returns its text.
+  /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.
+  std::string failure() const override { return failure_; }
+  /// Writes summary.json with "status": "running" (t_reached and peaks so far; stats and
+  /// energy come at the end); sample() replaces it every few seconds of wall time.
+  void write_running_summary(const std::string& integrator);
+  /// Flushes the CSV files and writes summary.json when there is a folder (call once, at the
+  /// end, whatever the outcome); returns its text. Every summary.json is written to a
+  /// temporary file in the folder and renamed over the old one, so the file is always whole.
+  /// A failed write (also of an earlier CSV row) sets failure().
   std::string write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json = "");
   const std::string& directory() const { return directory_; }
   /// The kept samples (keep_in_memory): columns[k] is timeseries column k over the samples.
@@ -138,6 +145,18 @@ class ResultWriter : public RunObserver {
   std::vector<std::vector<float>> vx_, ax_, ay_;
   std::vector<double> point_values_;                  // output points' columns at the last sample
   std::chrono::steady_clock::time_point last_flush_;
+  std::chrono::steady_clock::time_point last_summary_;  // last running summary.json
+  std::string integrator_;                               // for the running summary
+  double t_last_sample_ = 0.0;                           // [time]
+  std::string failure_;                                  // first failed write, with the OS's reason
+
+  std::string summary_text(const RunOutcome& outcome, const std::string& status, const std::string& integrator,
+                           const std::string& extra_json) const;
+  /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.
+  bool replace_summary(const std::string& text);
+  /// Checks the CSV files' error flags (and flushes them with `flush`) and that the folder still exists.
+  void check_files(bool flush);
+  void fail(const std::string& what, int error_number);
 };
 
 /// Minimal JSON string escaping.

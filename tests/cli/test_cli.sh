@@ -70,6 +70,12 @@ expect_text "the refusal gives the limit" "$tmp/stderr" "above the stability lim
 expect_status "forced euler divergence exits 1" 1 "$bin" run "$tmp/stiff.yaml" --force-dt --out "$tmp/stiff"
 expect_text "failed summary" "$tmp/stiff/summary.json" '"status": "failed"'
 expect_text "failed summary says why" "$tmp/stiff/summary.json" 'diverged'
+expect_status "the failed run's summary.json is valid JSON" 0 python3 -m json.tool "$tmp/stiff/summary.json"
+expect_status "no temporary summary left" 1 test -e "$tmp/stiff/summary.json.tmp"
+# A failed static settle (before the first step) still writes summary.json, status failed.
+expect_status "failed static settle exits 1" 1 "$bin" run "$src/tests/robustness/models/no_static_equilibrium.yaml" --out "$tmp/settle"
+expect_text "its summary says failed" "$tmp/settle/summary.json" '"status": "failed"'
+expect_text "and why" "$tmp/settle/summary.json" 'no static equilibrium found'
 
 # sensitivity: the default design is sensitivity_design.yaml beside the model; none there -> input error.
 expect_status "sensitivity without a design beside the model exits 2" 2 "$bin" sensitivity "$crank" --out "$tmp/sens"

@@ -1,0 +1,133 @@
+#include "railcrash/integrator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace railcrash {
+
+void Integrator::report_events(const std::vector<EventRecord>& events, const double* y) {
+  for (const EventRecord& record : events) observer_->event(record, y);
+  outcome_.events.insert(outcome_.events.end(), events.begin(), events.end());
+  outcome_.stats.events += static_cast<long>(events.size());
+}
+
+std::string Integrator::non_finite_entry(const double* y) const {
+  for (int k = 0; k < system_.size(); ++k)
+    if (!std::isfinite(y[k])) {
+      std::ostringstream text;
+      text << system_.unknown_name(k) << " is " << y[k];
+      return text.str();
+    }
+  return "";
+}
+
+void Integrator::deliver_sample(double t) {
+  state_at(t, sample_y_, sample_quadratures_);
+  const std::string bad = non_finite_entry(sample_y_.data());
+  if (!bad.empty()) {
+    std::ostringstream msg;
+    msg << divergence_phrase() << " at t = " << t << ": " << bad << divergence_advice(last_sample_y_, t_sampled_);
+    throw StepFailure(msg.str());
+  }
+  const int nq = system_.body_unknowns();
+  observer_->sample(t, sample_y_.data(), sample_y_.data() + 2 * nq, sample_quadratures_.data());
+  const std::string observer_failure = observer_->failure();  // a failed write: stop at once
+  if (!observer_failure.empty()) {
+    std::ostringstream msg;
+    msg << observer_failure << "; the run stopped at t = " << t << ", the files hold the samples up to t = " << t_sampled_;
+    throw StepFailure(msg.str());
+  }
+  outcome_.max_constraint_residual = std::max(outcome_.max_constraint_residual, system_.constraint_residual(sample_y_.data()));
+  t_sampled_ = t;
+  last_sample_y_ = sample_y_;
+  last_sample_quadratures_ = sample_quadratures_;
+}
+
+double Integrator::next_output_time() const {
+  return std::min(t_end_, static_cast<double>(output_index_) * output_interval_);
+}
+
+void Integrator::sample_up_to(double t_limit) {
+  for (double t_out = next_output_time(); t_sampled_ < t_end_ && t_out <= t_limit * (1.0 + 1e-14); t_out = next_output_time()) {
+    deliver_sample(t_out);
+    ++output_index_;
+  }
+}
+
+RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& observer, const std::atomic<bool>* stop) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  outcome_ = RunOutcome{};
+  observer_ = &observer;
+  t_end_ = t_end;
+  output_interval_ = output_interval;
+  output_index_ = 1;
+  t_sampled_ = 0.0;
+  last_sample_y_.clear();
+  last_sample_quadratures_.clear();
+  double t_reached = 0.0;
+  try {
+    start(t_end);
+    state_at(0.0, sample_y_, sample_quadratures_);
+    outcome_.initial_energy = energy(sample_y_.data(), sample_quadratures_.data());
+    outcome_.max_constraint_residual = 0.0;
+    deliver_sample(0.0);
+    const bool dense = dense_output();
+    long steps_taken = 0;  // advance() calls in this run
+    while (t_reached < t_end) {
+      if (stop && stop->load()) {
+        outcome_.message = "interrupted at t = " + std::to_string(t_sampled_);
+        break;
+      }
+      if (steps_taken++ >= max_steps()) {
+        std::ostringstream msg;
+        msg << "stopped at t = " << t_reached << " after --max-steps " << max_steps() << " steps"
+            << step_limit_advice(t_end);
+        outcome_.message = msg.str();
+        break;
+      }
+      t_reached = advance(t_end);
+      const std::string bad = non_finite_entry(current_state());
+      if (!bad.empty()) {
+        std::ostringstream msg;
+        msg << divergence_phrase() << " at t = " << t_reached << ": " << bad << divergence_advice(last_sample_y_, t_sampled_);
+        throw StepFailure(msg.str());
+      }
+      if (dense) {
+        sample_up_to(t_reached);
+      } else if (t_reached >= next_output_time() * (1.0 - 1e-12)) {
+        // The end of the step that passes an output time is the sample.
+        deliver_sample(t_reached);
+        while (static_cast<double>(output_index_) * output_interval_ <= t_reached * (1.0 + 1e-12)) ++output_index_;
+      }
+    }
+  } catch (const InputError&) {
+    finish();
+    throw;
+  } catch (const std::exception& e) {
+    outcome_.message = e.what();
+  }
+  outcome_.ok = outcome_.message.empty() && t_reached >= t_end;  // a run that did not reach t_end is never ok
+  if (outcome_.ok) {
+    outcome_.t_reached = t_reached;
+    final_state(outcome_.y, outcome_.quadratures);
+  } else {  // a failed or interrupted run ends at its last output sample, the last good state
+    outcome_.t_reached = t_sampled_;
+    outcome_.y = last_sample_y_;
+    outcome_.quadratures = last_sample_quadratures_;
+  }
+  if (!outcome_.y.empty()) outcome_.final_energy = energy(outcome_.y.data(), outcome_.quadratures.data());
+  finish();
+  outcome_.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  observer_ = nullptr;
+  return std::move(outcome_);
+}
+
+double max_abs(const std::vector<double>& values) {
+  double worst = 0.0;
+  for (double v : values) worst = std::max(worst, std::abs(v));
+  return worst;
+}
+
+}  // namespace railcrash
