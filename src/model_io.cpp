@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 #include "railcrash/element_registry.hpp"
 #include "railcrash/yaml_file.hpp"
@@ -73,7 +74,11 @@ class Reader {
 
   /// Remembers the line of the key of every empty value ("t_end:" with nothing after it):
   /// yaml-cpp places an empty value where the next token starts, often the next line.
+  /// Each list or map is walked once: an alias (*name) is the anchored node itself, at the
+  /// anchor's place in the text, so a document of aliases costs its text, not its expansion.
   void index_empty_values(const YAML::Node& node) {
+    if ((node.IsMap() || node.IsSequence()) && !node.Mark().is_null() && !walked_positions_.insert(node.Mark().pos).second)
+      return;
     if (node.IsMap()) {
       for (const auto& entry : node) {
         if (entry.second.IsNull() && !entry.first.Mark().is_null()) empty_values_.emplace_back(entry.second, entry.first.Mark().line + 1);
@@ -202,6 +207,7 @@ class Reader {
   std::string file_;
   std::vector<std::pair<YAML::Node, std::string>> overridden_;
   std::vector<std::pair<YAML::Node, int>> empty_values_;
+  std::unordered_set<int> walked_positions_;  // text positions of the lists and maps index_empty_values walked
 };
 
 class YamlParameterReader : public ParameterReader {
