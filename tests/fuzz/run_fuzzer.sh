@@ -35,12 +35,14 @@ started=$(date +%s)
 cd "$work"  # a `variant_of` in an input is resolved here
 status=0
 timeout -k 10 "$time_limit" "$fuzzer" "${options[@]}" corpus seeds > "$work/fuzz.log" 2>&1 || status=$?
-cat "$work"/fuzz-*.log >> "$work/fuzz.log" 2>/dev/null || true
 [[ $status -eq 124 || $status -eq 137 ]] && echo "fuzz: the run did not end within $time_limit s (RAILCRASH_FUZZ_TIME_LIMIT)"
 seconds=$(($(date +%s) - started))
-executions=$(grep -ho 'stat::number_of_executed_units: *[0-9]*' "$work/fuzz.log" | awk '{sum += $2} END {print sum + 0}')
+# With -jobs, each process writes fuzz-N.log (copied into fuzz.log as it ends): count those.
+job_logs=("$work/fuzz.log")
+[[ $jobs -gt 1 ]] && job_logs=("$work"/fuzz-*.log)
+executions=$(grep -ho 'stat::number_of_executed_units: *[0-9]*' "${job_logs[@]}" | awk '{sum += $2} END {print sum + 0}' || true)
 if [[ $status -ne 0 || -n "$(ls -A "$work/artifacts")" ]]; then
-  grep -h -B2 -A30 'ERROR: \|runtime error\|deadly signal\|timeout after\|terminate called' "$work/fuzz.log" | head -80
+  grep -h -B2 -A30 'ERROR: \|runtime error\|deadly signal\|timeout after\|terminate called' "$work/fuzz.log" | head -80 || true
   echo "fuzz: FAILED after $executions executions in $seconds s; inputs in $work/artifacts:"
   ls "$work/artifacts"
   exit 1
