@@ -8,10 +8,12 @@ set -euo pipefail
 # nodejs + npm: the build fetches the run report's plotting library (uPlot, pinned in
 # src/report/js/package-lock.json) from the npm registry; chromium: the report's browser test.
 # libopenmpi-dev + openmpi-bin: `railcrash sweep` across ranks (mpirun/srun) and its test.
+# clang + libclang-rt-14-dev: the libFuzzer target (README "Fuzzing"; libFuzzer and the
+# sanitizer runtimes are in libclang-rt-14-dev).
 packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
           libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib
-          libopenmpi-dev openmpi-bin)
+          libopenmpi-dev openmpi-bin clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

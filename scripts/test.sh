@@ -2,7 +2,8 @@
 # One command: install dependencies, build, run the whole test suite (unit tests,
 # verification cases, the Python module's tests and example, the installed package used from
 # an outside project, the Debian packages), then build the unit tests with AddressSanitizer
-# and UndefinedBehaviorSanitizer and run them again.
+# and UndefinedBehaviorSanitizer and run them again, then fuzz the model loader (clang,
+# libFuzzer) for a fixed number of executions.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -14,6 +15,16 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build, unit tests"
 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAILCRASH_SANITIZE=ON > /dev/null
-cmake --build build-sanitize --parallel "$jobs" --target railcrash_tests railcrash
+cmake --build build-sanitize --parallel "$jobs" --target railcrash_tests railcrash railcrash_fuzz_replay
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-sanitize --output-on-failure -j "$jobs" -L unit
+
+echo "== Fuzzing the model loader and assembly (libFuzzer, ASan + UBSan; README \"Fuzzing\")"
+if ! command -v clang++ > /dev/null; then
+  echo "no clang++: the fuzzer is not run (scripts/install-deps.sh installs clang and libclang-rt-14-dev)"
+  exit 1
+fi
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=None "-DCMAKE_CXX_FLAGS=-O1 -gline-tables-only" \
+  -DRAILCRASH_FUZZ=ON -DRAILCRASH_REPORT_PLOTS=OFF -DRAILCRASH_MPI=OFF > /dev/null
+cmake --build build-fuzz --parallel "$jobs" --target railcrash_fuzz railcrash_fuzz_dict
+tests/fuzz/run_fuzzer.sh build-fuzz 100000 "$jobs"

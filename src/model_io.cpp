@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 #include "railcrash/element_registry.hpp"
 #include "railcrash/yaml_file.hpp"
@@ -73,7 +74,11 @@ class Reader {
 
   /// Remembers the line of the key of every empty value ("t_end:" with nothing after it):
   /// yaml-cpp places an empty value where the next token starts, often the next line.
+  /// Each list or map is walked once: an alias (*name) is the anchored node itself, at the
+  /// anchor's place in the text, so a document of aliases costs its text, not its expansion.
   void index_empty_values(const YAML::Node& node) {
+    if ((node.IsMap() || node.IsSequence()) && !node.Mark().is_null() && !walked_positions_.insert(node.Mark().pos).second)
+      return;
     if (node.IsMap()) {
       for (const auto& entry : node) {
         if (entry.second.IsNull() && !entry.first.Mark().is_null()) empty_values_.emplace_back(entry.second, entry.first.Mark().line + 1);
@@ -202,6 +207,7 @@ class Reader {
   std::string file_;
   std::vector<std::pair<YAML::Node, std::string>> overridden_;
   std::vector<std::pair<YAML::Node, int>> empty_values_;
+  std::unordered_set<int> walked_positions_;  // text positions of the lists and maps index_empty_values walked
 };
 
 class YamlParameterReader : public ParameterReader {
@@ -370,6 +376,12 @@ const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravit
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity",
                                             "car"};
 const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
+const std::vector<std::string> kPointKeys = {"body", "at"};
+const std::vector<std::string> kOutputKeys = {"name", "body", "at", "quantities"};
+const std::vector<std::string> kResponseKeys = {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force",
+                                                "reference_velocity", "vertical_force_window"};
+const std::vector<std::string> kCrushGaugeKeys = {"name", "points"};
+const std::vector<std::string> kVariantKeys = {"railcrash", "variant_of", "name", "description", "set"};
 const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt",
                                                   "static_equilibrium",
                                                   "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
@@ -437,7 +449,7 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
     const YAML::Node p = points[i];
     const std::string pc = context + ": point " + std::to_string(i + 1);
     r.require_map(p, pc);
-    r.check_keys(p, {"body", "at"}, pc);
+    r.check_keys(p, kPointKeys, pc);
     const YAML::Node body_node = r.required(p, "body", pc);
     const std::string body = r.text(body_node, pc + ": body");
     const auto index = model.find_body(body);
@@ -534,7 +546,7 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
 
 PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, const std::string& context) {
   r.require_map(p, context);
-  r.check_keys(p, {"body", "at"}, context);
+  r.check_keys(p, kPointKeys, context);
   const YAML::Node body_node = r.required(p, "body", context);
   const std::string body = r.text(body_node, context + ": body");
   const auto index = model.find_body(body);
@@ -558,7 +570,7 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
     const YAML::Node item = node[i];
     const std::string context = "outputs: item " + std::to_string(i + 1);
     r.require_map(item, context);
-    r.check_keys(item, {"name", "body", "at", "quantities"}, context);
+    r.check_keys(item, kOutputKeys, context);
     OutputPoint output;
     output.where = r.at(item);
     const YAML::Node body_node = r.required(item, "body", context);
@@ -606,9 +618,7 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
 
 void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
   r.require_map(node, "responses");
-  r.check_keys(node, {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force", "reference_velocity",
-                      "vertical_force_window"},
-               "responses");
+  r.check_keys(node, kResponseKeys, "responses");
   ResponseSettings& s = model.responses;
   if (node["crush_gauges"]) {
     r.require_list(node["crush_gauges"], "responses: crush_gauges");
@@ -616,7 +626,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
       const YAML::Node g = node["crush_gauges"][i];
       const std::string context = "responses: crush gauge " + std::to_string(i + 1);
       r.require_map(g, context);
-      r.check_keys(g, {"name", "points"}, context);
+      r.check_keys(g, kCrushGaugeKeys, context);
       CrushGauge gauge;
       gauge.name = r.text(r.required(g, "name", context), context + ": name");
       const YAML::Node points = r.required(g, "points", context);
@@ -840,7 +850,7 @@ struct VariantSetting {
 YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, std::string& file,
                            std::vector<VariantSetting>& settings) {
   const Reader reader(path);
-  reader.check_keys(variant, {"railcrash", "variant_of", "name", "description", "set"}, "model variant");
+  reader.check_keys(variant, kVariantKeys, "model variant");
   const YAML::Node version = reader.required(variant, "railcrash", "model variant (add 'railcrash: 1')");
   if (!version.IsScalar() || version.Scalar() != "1") reader.fail(version, "model variant: 'railcrash' must be 1");
   const YAML::Node base_node = variant["variant_of"];
@@ -848,14 +858,14 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
   const std::filesystem::path base_path =
       std::filesystem::path(base_name).is_absolute() ? std::filesystem::path(base_name)
                                                      : std::filesystem::path(path).parent_path() / base_name;
-  std::ifstream in(base_path);
-  if (!in)
-    reader.fail(base_node, "model variant: cannot open the base model '" + base_path.string() +
-                               "' (variant_of is relative to the variant's folder)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
+  std::string base_text;
+  try {
+    base_text = read_input_file(base_path.string(), "base model");
+  } catch (const InputError& e) {
+    reader.fail(base_node, "model variant: variant_of (relative to the variant's folder): " + std::string(e.what()));
+  }
   file = base_path.string();
-  YAML::Node base = parse_model_yaml(buffer.str(), file);
+  YAML::Node base = parse_model_yaml(base_text, file);
   if (base.IsMap() && base["variant_of"])
     reader.fail(base_node, "model variant: '" + file + "' is itself a variant; name the model it is a variant of");
   const auto add = [&](const YAML::Node& key, const std::string& name, const YAML::Node& value) {
@@ -898,13 +908,18 @@ Model load_model_text(const std::string& text, const std::string& path, const st
 }
 
 Model load_model(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the model file (check the path)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return load_model_text(buffer.str(), path, overrides);
+  return load_model_text(read_input_file(path, "model file"), path, overrides);
 }
 
 Model load_model(const std::string& path) { return load_model(path, {}); }
+
+std::vector<std::string> model_file_keys() {
+  std::vector<std::string> keys;
+  for (const auto* list : {&kTopKeys, &kBodyKeys, &kLoadKeys, &kSimulationKeys, &kPointKeys, &kOutputKeys, &kResponseKeys,
+                           &kCrushGaugeKeys, &kVariantKeys})
+    for (const std::string& key : *list)
+      if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+  return keys;
+}
 
 }  // namespace railcrash

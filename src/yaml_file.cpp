@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/eventhandler.h>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -61,6 +62,12 @@ class StructureCheck : public YAML::EventHandler {
                      "remove the aliases that repeat other aliases");
   }
   void leaf(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    // yaml-cpp 0.7 meets a ',' at the start of a block document (",x") with empty values at
+    // the same place, without end: a parser that stays put is stopped here.
+    leaves_at_same_place_ = mark.pos == last_leaf_pos_ ? leaves_at_same_place_ + 1 : 0;
+    last_leaf_pos_ = mark.pos;
+    if (leaves_at_same_place_ > kMaxLeavesAtSamePlace)
+      fail(mark, "not valid YAML: the parser makes no progress here (a ',' outside [ ] or { }?); check this line");
     if (anchor != YAML::NullAnchor) anchored_size_[anchor] = 1;
     add(mark, 1);
   }
@@ -83,6 +90,9 @@ class StructureCheck : public YAML::EventHandler {
   std::map<YAML::anchor_t, std::size_t> anchored_size_;
   const std::size_t limit_;
   std::size_t expanded_ = 0;
+  static constexpr int kMaxLeavesAtSamePlace = 1000;  // a valid document has a few (empty values)
+  int last_leaf_pos_ = -1;
+  int leaves_at_same_place_ = 0;
 };
 
 }  // namespace
@@ -101,13 +111,31 @@ YAML::Node load_yaml_text(const std::string& text, const std::string& path) {
   return YAML::Load(text);
 }
 
-YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
+std::string read_input_file(const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  // A folder or a device (/dev/zero never ends) is not a file to read; a pipe is (<(command)).
+  if (fs::exists(status) && !fs::is_regular_file(status) && !fs::is_fifo(status))
+    throw InputError(path + ": the " + what + " is a " + (fs::is_directory(status) ? "folder" : "device or socket") +
+                     ", not a file; give the path of a YAML file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the " + what + " (check the path)");
-  std::ostringstream text;
-  text << in.rdbuf();
+  std::string text;
+  char block[65536];
+  while (in.read(block, sizeof block) || in.gcount() > 0) {
+    text.append(block, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kYamlMaxFileBytes)
+      throw InputError(path + ": the " + what + " is larger than " + std::to_string(kYamlMaxFileBytes >> 20) +
+                       " MiB; a model is far smaller: check that this is the right file");
+  }
+  return text;
+}
+
+YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
+  const std::string text = read_input_file(path, what);
   try {
-    return load_yaml_text(text.str(), path);
+    return load_yaml_text(text, path);
   } catch (const YAML::ParserException& e) {
     throw InputError(SourceLocation{path, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
   }

@@ -81,3 +81,21 @@ TEST_CASE("the model loader and --set values go through the structure check", "[
     CHECK_THAT(std::string(e.what()), Contains("an alias refers to the node that contains it"));
   }
 }
+
+TEST_CASE("input files that are folders or devices are refused before they are read", "[yaml_file]") {
+  // /dev/zero never ends: reading it as a model (or as a variant's base) took all memory.
+  CHECK_THROWS_WITH(read_input_file("/dev/zero", "model file"),
+                    StartsWith("/dev/zero: the model file is a device or socket, not a file"));
+  CHECK_THROWS_WITH(load_model("/dev/zero"), StartsWith("/dev/zero: the model file is a device"));
+  CHECK_THROWS_WITH(read_input_file("/", "design file"), StartsWith("/: the design file is a folder, not a file"));
+  CHECK_THROWS_WITH(load_model_text("railcrash: 1\nvariant_of: /dev/zero\n", "variant.yaml"),
+                    StartsWith("variant.yaml:2: model variant: variant_of") && Contains("/dev/zero: the base model is a device"));
+  CHECK_THROWS_WITH(read_input_file("/no/such/file.yaml", "model file"), Contains("cannot open the model file"));
+}
+
+TEST_CASE("a ',' at the start of a document is refused at once, not parsed without end", "[yaml_file]") {
+  // yaml-cpp 0.7 answers ",x" with empty values at the same place, without end (found by the fuzzer).
+  CHECK_THAT(structure_error(",l"), StartsWith("in.yaml:1: not valid YAML: the parser makes no progress here"));
+  CHECK_THAT(structure_error("\n\n,"), StartsWith("in.yaml:3: not valid YAML"));
+  CHECK(structure_error("a:\nb:\nc: [, ]\n").find("no progress") == std::string::npos);
+}

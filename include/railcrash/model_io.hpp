@@ -22,6 +22,11 @@ Model load_model(const std::string& path);
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
 Model load_model(const std::string& path, const std::vector<std::string>& overrides);
 
+/// Every key of the model file outside the element parameters (top-level sections, body, load,
+/// simulation, outputs, responses and variant keys; the scenario section's are its own), each
+/// once: with the element registry's parameter names, the fuzzer's dictionary (tests/fuzz).
+std::vector<std::string> model_file_keys();
+
 /// " (did you mean 'x'?)" when a word of `known` is close to `word` (edit distance < 3), else "".
 std::string suggestion(const std::string& word, const std::vector<std::string>& known);
 

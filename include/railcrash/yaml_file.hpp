@@ -16,6 +16,12 @@ namespace railcrash {
 /// anything walks the nodes.
 constexpr std::size_t kYamlMaxAliasedNodes = 2000000;  // [values] that aliases may add beyond the text's size
 constexpr std::size_t kYamlMaxDepth = 64;              // [levels] of nested lists and maps
+constexpr std::size_t kYamlMaxFileBytes = 64u << 20;  // [bytes] of an input file
+
+/// The text of the file at `path` (`what` names it in messages: "model file"). InputError when
+/// it cannot be opened, is a folder or a device (/dev/zero would never end), or is larger than
+/// kYamlMaxFileBytes.
+std::string read_input_file(const std::string& path, const std::string& what);
 
 /// Throws InputError "path:line: ..." if `text` nests deeper than kYamlMaxDepth, expands to more
 /// than kYamlMaxAliasedNodes + (its size in bytes) values, or has an alias inside the node it refers to. Parse
