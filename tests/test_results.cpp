@@ -196,3 +196,17 @@ TEST_CASE("a finished run's summary.json replaces the running one and leaves no 
   CHECK_FALSE(std::filesystem::exists(dir + "/summary.json.tmp"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("JSON strings stay valid UTF-8 and escaped whatever bytes a name or path holds", "[results]") {
+  // Well-formed UTF-8 is kept: e-acute (2 bytes), the euro sign (3), U+1F682 steam locomotive (4).
+  CHECK(json_string("caf\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x9A\x82") == "\"caf\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x9A\x82\"");
+  // RFC 3629's ill-formed sequences become U+FFFD, one per byte that cannot start a character.
+  const std::string replacement = "\xEF\xBF\xBD";
+  CHECK(json_string("run_\xE9.yaml") == "\"run_" + replacement + ".yaml\"");            // Latin-1 e-acute
+  CHECK(json_string("\xC0\xAF") == "\"" + replacement + replacement + "\"");            // overlong '/'
+  CHECK(json_string("\xED\xA0\x80") == "\"" + replacement + replacement + replacement + "\"");  // surrogate D800
+  CHECK(json_string("\xF4\x90\x80\x80") == "\"" + replacement + replacement + replacement + replacement + "\"");  // > U+10FFFF
+  CHECK(json_string("end\xE2\x82") == "\"end" + replacement + replacement + "\"");      // truncated
+  // Quotes, backslashes and control bytes are escaped (RFC 8259, section 7).
+  CHECK(json_string("a\"b\\c\nd\te\x01") == "\"a\\\"b\\\\c\\nd\\te\\u0001\"");
+}

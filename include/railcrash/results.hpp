@@ -159,7 +159,12 @@ class ResultWriter : public RunObserver {
   void fail(const std::string& what, int error_number);
 };
 
-/// Minimal JSON string escaping.
+/// Text with every byte sequence that is not well-formed UTF-8 (RFC 3629: no overlong forms,
+/// no surrogates, nothing above U+10FFFF, no truncated sequence) replaced by U+FFFD.
+std::string valid_utf8(const std::string& text);
+/// A JSON string literal (RFC 8259) for any text: quotes, backslashes and control bytes escaped,
+/// and invalid UTF-8 (a model path in Latin-1, say) replaced through valid_utf8, so the
+/// document stays parseable whatever the user's file names hold.
 std::string json_string(const std::string& text);
 /// Number formatted for JSON (non-finite values become null).
 std::string json_number(double value);

@@ -27,26 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Text with invalid UTF-8 bytes replaced by U+FFFD, so that the page stays valid UTF-8.
-std::string valid_utf8(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (std::size_t i = 0; i < text.size();) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    std::size_t length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-    bool ok = length > 0 && i + length <= text.size();
-    for (std::size_t k = 1; ok && k < length; ++k) ok = (static_cast<unsigned char>(text[i + k]) >> 6) == 0x2;
-    if (ok) {
-      out.append(text, i, length);
-      i += length;
-    } else {
-      out += "\xEF\xBF\xBD";
-      ++i;
-    }
-  }
-  return out;
-}
-
 /// Text safe inside <script type="application/json">: no "<" (so no "</script>"), valid UTF-8.
 std::string script_safe(const std::string& json) {
   std::string out;
@@ -57,7 +37,7 @@ std::string script_safe(const std::string& json) {
   return out;
 }
 
-std::string js(const std::string& text) { return json_string(valid_utf8(text)); }
+std::string js(const std::string& text) { return json_string(text); }
 
 std::string number(double value) {
   if (!std::isfinite(value)) return "null";

@@ -76,6 +76,13 @@ expect_status "no temporary summary left" 1 test -e "$tmp/stiff/summary.json.tmp
 expect_status "failed static settle exits 1" 1 "$bin" run "$src/tests/robustness/models/no_static_equilibrium.yaml" --out "$tmp/settle"
 expect_text "its summary says failed" "$tmp/settle/summary.json" '"status": "failed"'
 expect_text "and why" "$tmp/settle/summary.json" 'no static equilibrium found'
+# A model path that is not UTF-8 (a Latin-1 e-acute): summary.json stays strict UTF-8 JSON.
+# The failure message names the file, so the path is in summary.json.
+latin1_model="$tmp/caf$(printf '\351').yaml"
+cp "$src/tests/robustness/models/tiny_mass.yaml" "$latin1_model"
+expect_status "a Latin-1 model path that fails at t = 0 exits 2" 2 "$bin" run "$latin1_model" --out "$tmp/latin1" --quiet
+expect_text "its summary.json holds the message" "$tmp/latin1/summary.json" "vx changes at"
+expect_status "its summary.json is strict UTF-8 JSON" 0 python3 -c 'import json, sys; json.loads(open(sys.argv[1], "rb").read().decode("utf-8", "strict"))' "$tmp/latin1/summary.json"
 
 # sensitivity: the default design is sensitivity_design.yaml beside the model; none there -> input error.
 expect_status "sensitivity without a design beside the model exits 2" 2 "$bin" sensitivity "$crank" --out "$tmp/sens"
