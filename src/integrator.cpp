@@ -36,7 +36,9 @@ void Integrator::deliver_sample(double t) {
   const std::string observer_failure = observer_->failure();  // a failed write: stop at once
   if (!observer_failure.empty()) {
     std::ostringstream msg;
-    msg << observer_failure << "; the run stopped at t = " << t << ", the files hold the samples up to t = " << t_sampled_;
+    msg << observer_failure << "; the run stopped at t = " << t;
+    if (last_sample_y_.empty()) msg << " before its first sample, the files hold no samples";
+    else msg << ", the files hold the samples up to t = " << t_sampled_;
     throw StepFailure(msg.str());
   }
   outcome_.max_constraint_residual = std::max(outcome_.max_constraint_residual, system_.constraint_residual(sample_y_.data()));
@@ -118,6 +120,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
     outcome_.quadratures = last_sample_quadratures_;
   }
   if (!outcome_.y.empty()) outcome_.final_energy = energy(outcome_.y.data(), outcome_.quadratures.data());
+  else outcome_.final_energy = outcome_.initial_energy;  // stopped before the first sample, at t = 0
   finish();
   outcome_.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   observer_ = nullptr;

@@ -1,5 +1,6 @@
 #include "railcrash/run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -15,6 +16,12 @@ namespace railcrash {
 
 namespace {
 
+std::string number_text(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
 double checked_positive(double value, const char* option) {
   if (!(value > 0.0) || !std::isfinite(value))
     throw InputError(std::string(option) + " must be a positive number, not " + std::to_string(value));
@@ -23,7 +30,7 @@ double checked_positive(double value, const char* option) {
 
 /// Forwards samples to the writer and the response tracker (if any) and shows progress
 /// (progress.hpp: a bar on a terminal, a line every few seconds otherwise).
-/// Also checks every sample's element outputs: the first non-finite one fails the run.
+/// Also checks every sample's element outputs: from the first non-finite one on, no sample is passed on.
 class ProgressObserver : public RunObserver {
  public:
   ProgressObserver(const DaeSystem& system, std::vector<RunObserver*> next, double t_end, bool show)
@@ -32,25 +39,20 @@ class ProgressObserver : public RunObserver {
       for (const std::string& output : el->output_names()) output_owner_.push_back({el.get(), output});
     output_values_.resize(output_owner_.size());
   }
+  /// From the first sample whose element outputs are not all finite on, nothing is passed on:
+  /// the files end at the last good sample. The run itself goes on, so that an integrator that
+  /// is diverging says so (Euler names the joint); run_model fails it in any case.
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
-    for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures);
     meter_.update(t);
     t_last_ = t;
-    if (!non_finite_output_.empty()) return;
-    system_.outputs(y, lambda, output_values_.data());
-    for (std::size_t k = 0; k < output_values_.size(); ++k)
-      if (!std::isfinite(output_values_[k])) {
-        const Element& el = *output_owner_[k].first;
-        std::ostringstream msg;
-        msg << el.where().prefix() << "element '" << el.name() << "' (" << el.type() << "): its output '"
-            << output_owner_[k].second << "' is " << output_values_[k] << " at t = " << t
-            << "; check the element's numbers (a value too large or too small)";
-        non_finite_output_ = msg.str();
-        break;
-      }
+    if (!non_finite_output_.empty() || !outputs_finite(t, y, lambda)) return;
+    for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures);
+    t_passed_on_ = t;
   }
   /// Why the outputs were not all finite ("" when they were).
   const std::string& non_finite_output() const { return non_finite_output_; }
+  /// The last sample passed on to the writers (-1: none).
+  double last_sample_passed_on() const { return t_passed_on_; }
 
   void event(const EventRecord& record, const double* y) override {
     for (RunObserver* o : next_) o->event(record, y);
@@ -64,6 +66,22 @@ class ProgressObserver : public RunObserver {
   void finish() { meter_.finish(t_last_); }
 
  private:
+  /// Element outputs at the sample; the first non-finite one is recorded in non_finite_output_.
+  bool outputs_finite(double t, const double* y, const double* lambda) {
+    system_.outputs(y, lambda, output_values_.data());
+    for (std::size_t k = 0; k < output_values_.size(); ++k)
+      if (!std::isfinite(output_values_[k])) {
+        const Element& el = *output_owner_[k].first;
+        std::ostringstream msg;
+        msg << el.where().prefix() << "element '" << el.name() << "' (" << el.type() << "): its output '"
+            << output_owner_[k].second << "' is " << output_values_[k] << " at t = " << t
+            << "; check the element's numbers (a value too large or too small)";
+        non_finite_output_ = msg.str();
+        return false;
+      }
+    return true;
+  }
+
   const DaeSystem& system_;
   std::vector<RunObserver*> next_;
   ProgressMeter meter_;
@@ -71,6 +89,7 @@ class ProgressObserver : public RunObserver {
   std::vector<double> output_values_;
   std::string non_finite_output_;
   double t_last_ = 0.0;
+  double t_passed_on_ = -1.0;
 };
 
 }  // namespace
@@ -144,9 +163,17 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     throw;
   }
   observer.finish();
-  if (report.outcome.ok && !observer.non_finite_output().empty()) {
-    report.outcome.ok = false;
-    report.outcome.message = observer.non_finite_output();
+  if (!observer.non_finite_output().empty()) {  // the files end before the first non-finite output
+    const double t_good = observer.last_sample_passed_on();
+    const std::string held = t_good < 0.0 ? "the files hold no samples"
+                                          : "the files hold the samples up to t = " + number_text(t_good);
+    if (report.outcome.ok) {
+      report.outcome.ok = false;
+      report.outcome.message = observer.non_finite_output() + "; " + held;
+      report.outcome.t_reached = std::max(t_good, 0.0);
+    } else {
+      report.outcome.message += "; before that, " + observer.non_finite_output() + "; " + held;
+    }
   }
   if (responses) {
     report.responses = responses->result();

@@ -180,6 +180,9 @@ TEST_CASE("a run whose element output is not finite fails naming the element", "
   const RunReport report = run_model(model, "", nullptr, false);
   CHECK_FALSE(report.outcome.ok);
   CHECK_THAT(report.outcome.message, Catch::Contains("element 'bump' (contact): its output 'penetration' is -inf at t = 0"));
+  // That sample and every later one is held back: nothing non-finite reaches the files.
+  CHECK_THAT(report.outcome.message, Catch::Contains("the files hold no samples"));
+  CHECK(report.outcome.t_reached == 0.0);
 }
 
 TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
