@@ -53,7 +53,12 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
   const Model model = load_model(path, settings);
   const DaeSystem system(model);
   std::vector<double> y = system.initial_state();
-  const AssemblyReport assembly = assemble_initial_state(system, y);
+  AssemblyReport assembly;
+  try {
+    assembly = assemble_initial_state(system, y);
+  } catch (const SolverError& e) {  // exit 1 as in `run`, with the file named
+    throw SolverError(SourceLocation{path, 0}.prefix() + e.what());
+  }
   // What `run` does next: consistent accelerations and joint reactions at the start. A model
   // whose equations are singular there (a body with zero inertia that no joint holds) cannot
   // run, so `check` refuses it as input.
