@@ -157,8 +157,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
                 const std::string& out_dir, bool with_report, bool quiet) {
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
-  Model model = load_model(path, settings);
-  apply_overrides(model, overrides);
+  Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   catch_interrupts();
   const RunReport report = run_model(model, out_dir, &g_stop, !quiet);
   const RunOutcome& o = report.outcome;

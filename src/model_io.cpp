@@ -89,6 +89,9 @@ class Reader {
     }
   }
 
+  /// Whether `value` came from a setting (--set, a command-line option, a variant's set).
+  bool overridden(const YAML::Node& value) const { return from_override(value) != nullptr; }
+
   SourceLocation at(const YAML::Node& node) const {
     if (!node.IsDefined() || from_override(node)) return {file_, 0};
     if (node.IsNull())
@@ -382,7 +385,7 @@ const std::vector<std::string> kResponseKeys = {"crush_gauges", "crush", "refere
                                                 "reference_velocity", "vertical_force_window"};
 const std::vector<std::string> kCrushGaugeKeys = {"name", "points"};
 const std::vector<std::string> kVariantKeys = {"railcrash", "variant_of", "name", "description", "set"};
-const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt",
+const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt", "max_steps",
                                                   "static_equilibrium",
                                                   "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
                                                   "penalty_rotational_damping"};
@@ -701,8 +704,18 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
   const std::string rows_problem = output_rows_problem(s);
-  if (!rows_problem.empty()) r.fail(node["output_interval"], "simulation: " + rows_problem);
+  if (!rows_problem.empty()) {  // named where it was set: the interval, or t_end when only that was overridden
+    const YAML::Node interval = node["output_interval"];
+    r.fail(interval && (r.overridden(interval) || !r.overridden(t_end)) ? interval : t_end, "simulation: " + rows_problem);
+  }
   if (node["force_dt"]) s.force_dt = r.boolean(node["force_dt"], "simulation: force_dt");
+  if (node["max_steps"]) {
+    const double steps = r.number(node["max_steps"], "simulation: max_steps");
+    if (!(steps >= 1.0) || steps != std::floor(steps) || steps > 9.0e18)
+      r.fail(node["max_steps"], "simulation: max_steps must be a whole number of at least 1 (the steps either integrator "
+                                "may take)");
+    s.max_steps = static_cast<long>(steps);
+  }
   if (node["static_equilibrium"])
     s.static_equilibrium = r.boolean(node["static_equilibrium"], "simulation: static_equilibrium");
   s.penalty.stiffness = positive("penalty_stiffness");
@@ -887,7 +900,10 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
 
 }  // namespace
 
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+namespace {
+
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+                      const std::vector<OptionSetting>& options) {
   YAML::Node root = parse_model_yaml(text, path);
   std::string file = path;
   std::vector<VariantSetting> variant_settings;
@@ -897,6 +913,8 @@ Model load_model_text(const std::string& text, const std::string& path, const st
   if (root.IsMap() || root.IsNull()) {  // otherwise build() says what the file should look like
     for (const VariantSetting& v : variant_settings) apply_override(root, v.setting, reader, v.label);
     for (const auto& setting : overrides) apply_override(root, setting, reader);
+    for (const OptionSetting& o : options)
+      apply_override(root, o.setting, reader, SourceLocation{reader.file(), 0}.prefix() + o.option);
   }
   try {
     Model model = build(root, reader);
@@ -907,8 +925,18 @@ Model load_model_text(const std::string& text, const std::string& path, const st
   }
 }
 
+}  // namespace
+
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  return load_model_text(text, path, overrides, {});
+}
+
 Model load_model(const std::string& path, const std::vector<std::string>& overrides) {
-  return load_model_text(read_input_file(path, "model file"), path, overrides);
+  return load_model_text(read_input_file(path, "model file"), path, overrides, {});
+}
+
+Model load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options) {
+  return load_model_text(read_input_file(path, "model file"), path, overrides, options);
 }
 
 Model load_model(const std::string& path) { return load_model(path, {}); }

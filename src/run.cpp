@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "railcrash/euler_integrator.hpp"
@@ -110,6 +111,30 @@ void apply_overrides(Model& model, const RunOverrides& o) {
     if (*o.max_steps < 1) throw InputError("--max-steps must be at least 1, not " + std::to_string(*o.max_steps));
     s.max_steps = *o.max_steps;
   }
+}
+
+std::vector<OptionSetting> option_settings(const RunOverrides& o) {
+  std::vector<OptionSetting> settings;
+  const auto add = [&](const char* key, const char* option, const std::string& value) {
+    settings.push_back({std::string("simulation.") + key + "=" + value, std::string(option) + " " + value});
+  };
+  const auto number = [](double value) {  // the shortest text that reads back as the same double
+    char text[40];
+    for (int digits = 15; digits <= 17; ++digits) {
+      std::snprintf(text, sizeof text, "%.*g", digits, value);
+      if (std::strtod(text, nullptr) == value) break;
+    }
+    return std::string(text);
+  };
+  if (o.integrator) add("integrator", "--integrator", *o.integrator == IntegratorKind::Euler ? "euler" : "ida");
+  if (o.t_end) add("t_end", "--t-end", number(*o.t_end));
+  if (o.rtol) add("rtol", "--rtol", number(*o.rtol));
+  if (o.atol) add("atol", "--atol", number(*o.atol));
+  if (o.dt) add("dt", "--dt", number(*o.dt));
+  if (o.output_interval) add("output_interval", "--output-interval", number(*o.output_interval));
+  if (o.max_steps) add("max_steps", "--max-steps", std::to_string(*o.max_steps));
+  if (o.force_dt) settings.push_back({"simulation.force_dt=true", "--force-dt"});
+  return settings;
 }
 
 double output_interval_of(const SimulationSettings& settings) {

@@ -349,6 +349,45 @@ TEST_CASE("overrides given with --set change the model before it is checked", "[
   CHECK(no_section.simulation.t_end == 3.0);
 }
 
+TEST_CASE("the run command's options go through --set's path, after it, and are named in messages", "[model_io]") {
+  const auto path = std::filesystem::temp_directory_path() / "railcrash_test_options.yaml";
+  std::ofstream(path) << kBase;
+  RunOverrides options;
+  options.t_end = 0.25;
+  options.integrator = IntegratorKind::Ida;
+  options.max_steps = 500;
+  options.force_dt = true;
+  const std::vector<OptionSetting> settings = option_settings(options);
+  CHECK(settings.size() == 4);
+  // Applied after --set: the option wins over a --set of the same key.
+  const Model model = load_model(path.string(), {"simulation.t_end=9"}, settings);
+  CHECK(model.simulation.t_end == 0.25);
+  CHECK(model.simulation.integrator == IntegratorKind::Ida);
+  CHECK(model.simulation.max_steps == 500);
+  CHECK(model.simulation.force_dt);
+  // A bad value is reported with the option as the user wrote it, not a file line.
+  RunOverrides bad;
+  bad.t_end = -1.5;
+  CHECK_THROWS_WITH(load_model(path.string(), {}, option_settings(bad)),
+                    Contains("railcrash_test_options.yaml: --t-end -1.5: simulation: t_end must be positive"));
+  bad = RunOverrides{};
+  bad.max_steps = 0;
+  CHECK_THROWS_WITH(load_model(path.string(), {}, option_settings(bad)),
+                    Contains("--max-steps 0: simulation: max_steps must be a whole number of at least 1"));
+  // Only t_end changed: the row bound names --t-end, though the interval is the file's.
+  bad = RunOverrides{};
+  bad.t_end = 1e300;
+  CHECK_THROWS_WITH(load_model(path.string(), {}, option_settings(bad)), Contains("--t-end 1e+300: simulation: output_interval"));
+  std::filesystem::remove(path);
+}
+
+TEST_CASE("simulation: max_steps in a model file bounds the steps and must be a whole number of at least 1", "[model_io]") {
+  CHECK(load_model_text(edit(kBase, "simulation:\n", "simulation:\n  max_steps: 1234\n"), "test.yaml").simulation.max_steps == 1234);
+  const std::string fractional = edit(kBase, "simulation:\n", "simulation:\n  max_steps: 2.5\n");
+  CHECK_THAT(load_error(fractional),
+             Contains("test.yaml:" + std::to_string(line_of(fractional, "max_steps: 2.5")) + ": simulation: max_steps must be a whole number"));
+}
+
 TEST_CASE("bad --set overrides are InputErrors naming the setting", "[model_io]") {
   const auto error = [](const std::vector<std::string>& overrides) {
     try {

@@ -22,6 +22,15 @@ Model load_model(const std::string& path);
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
 Model load_model(const std::string& path, const std::vector<std::string>& overrides);
 
+/// A KEY=VALUE setting that goes through the same path as --set but is named in messages by
+/// the command-line option it came from (e.g. setting "simulation.t_end=-1", option "--t-end -1").
+struct OptionSetting {
+  std::string setting;
+  std::string option;
+};
+/// load_model with the --set settings first, then the command-line options' settings.
+Model load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options);
+
 /// Every key of the model file outside the element parameters (top-level sections, body, load,
 /// simulation, outputs, responses and variant keys; the scenario section's are its own), each
 /// once: with the element registry's parameter names, the fuzzer's dictionary (tests/fuzz).

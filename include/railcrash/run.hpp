@@ -5,9 +5,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "railcrash/integrator.hpp"
 #include "railcrash/model.hpp"
+#include "railcrash/model_io.hpp"
 #include "railcrash/responses.hpp"
 #include "railcrash/results.hpp"
 
@@ -21,7 +23,13 @@ struct RunOverrides {
   bool force_dt = false;
 };
 
-/// Applies overrides (checked) to the model's simulation settings.
+/// The overrides as simulation.KEY=VALUE settings named by their options ("--t-end 2"): the
+/// command line's run options go through the loader's override path, as --set does
+/// (load_model(path, settings, options)), so they are checked, and their mistakes reported, alike.
+std::vector<OptionSetting> option_settings(const RunOverrides& overrides);
+
+/// Applies overrides (checked) to an already loaded model's simulation settings: for the
+/// library's and the studies' programmatic settings; the command line uses option_settings.
 void apply_overrides(Model& model, const RunOverrides& overrides);
 
 /// The integrator the model's settings ask for.

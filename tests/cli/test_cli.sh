@@ -60,7 +60,7 @@ expect_text "bad input names file, line and what to change" "$tmp/stderr" "bad.y
 expect_status "missing model file exits 2" 2 "$bin" check "$tmp/nothing.yaml"
 expect_status "unknown option exits 2" 2 "$bin" run "$crank" --no-such-option
 expect_status "bad command-line value exits 2" 2 "$bin" run "$crank" --t-end -1
-expect_text "bad --t-end says so" "$tmp/stderr" "t-end must be a positive number"
+expect_text "bad --t-end says so, naming the option" "$tmp/stderr" "slider_crank.yaml: --t-end -1: simulation: t_end must be positive"
 
 # Euler above its stability limit: refused (2) unless forced; forced, it diverges (1) and
 # still leaves its results.
