@@ -499,11 +499,10 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   ConvergePlan plan;
   plan.model_path = model_path;
   plan.options = options;
-  Model model = load_model(model_path, options.settings);
-  RunOverrides overrides;
+  RunOverrides overrides;  // converge's --t-end and --output-interval, through --set's path as in run
   overrides.t_end = options.t_end;
   overrides.output_interval = options.output_interval;
-  apply_overrides(model, overrides);
+  const Model model = load_model(model_path, options.settings, option_settings(overrides));
   plan.t_end = model.simulation.t_end;
   plan.output_interval = output_interval_of(model.simulation);
   plan.model_name = model.name;
