@@ -1,6 +1,7 @@
 #include "railcrash/dae_system.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -518,13 +519,14 @@ const Element& DaeSystem::constraint_owner(int row) const {
 }
 
 std::string DaeSystem::unknown_name(int k) const {
-  static const char* const kPosition[3] = {"x", "y", "theta"};
-  static const char* const kVelocity[3] = {"vx", "vy", "omega"};
   const int nq = body_unknowns();
   const int m = constraint_rows();
   if (k < 2 * nq) {
+    // Positions x, y, theta of every body, then their velocities.
+    static const std::array<const char*, 6> kCoordinate = {"x", "y", "theta", "vx", "vy", "omega"};
+    const int coordinate = (k < nq ? 0 : 3) + k % 3;
     const Body& body = model_.bodies()[static_cast<std::size_t>((k % nq) / 3)];
-    return body.where.prefix() + "body '" + body.name + "' " + (k < nq ? kPosition : kVelocity)[k % 3];
+    return body.where.prefix() + "body '" + body.name + "' " + kCoordinate[static_cast<std::size_t>(coordinate)];
   }
   const int row = (k - 2 * nq) % m;
   const Element& owner = constraint_owner(row);
