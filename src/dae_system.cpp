@@ -720,12 +720,14 @@ DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y)
   return load;
 }
 
-bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const {
+bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                             std::vector<char>* changed_elements) const {
   const int nq = body_unknowns();
   const double* lambda = y + 2 * nq;
   bool changed = false;
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     Element& el = *model_.elements()[e];
+    if (changed_elements && (*changed_elements)[e]) continue;
     for (int k = 0; k < el.root_count(); ++k) {
       const int d = direction[root_offset_[e] + k];
       if (d == 0) continue;
@@ -733,6 +735,7 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
       Element::Event event;
       if (el.commit(k, d, t, gather_state(el, y, y + nq), element_lambda, event)) {
         changed = true;
+        if (changed_elements) (*changed_elements)[e] = 1;
         events.push_back({t, el.name(), event.what, event.value});
         break;  // the element's other roots belonged to the mode it just left
       }
@@ -741,7 +744,8 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
   return changed;
 }
 
-bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events) const {
+bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
+                                      std::vector<char>* changed_elements) const {
   if (root_count_ == 0) return false;
   std::vector<double> g(static_cast<std::size_t>(root_count_)), ahead(g.size());
   roots(t, y, g.data());
@@ -763,7 +767,7 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
       direction[k] = -1;
       any = true;
     }
-  return any && commit_roots(t, y, direction.data(), events);
+  return any && commit_roots(t, y, direction.data(), events, changed_elements);
 }
 
 void DaeSystem::reset_modes() const {

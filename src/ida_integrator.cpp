@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <sstream>
 
 #include "railcrash/initial_conditions.hpp"
@@ -28,11 +29,15 @@ std::string flag_name(int flag) {
 }
 
 /// Consistent rates at a (re)start, after committing the roots that sit exactly on a mode
-/// boundary and are about to leave it (IDA would leave them inactive).
+/// boundary and are about to leave it (IDA would leave them inactive). Each element changes
+/// mode at most once here, and not at all when it has just changed at this instant
+/// (`changed_elements`, flags per element; empty: none has): a mode it enters sits on its own
+/// boundary, where round-off alone would decide whether it flips back.
 void restart_state(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
-                   std::vector<EventRecord>& events) {
+                   std::vector<EventRecord>& events, std::vector<char> changed_elements = {}) {
+  changed_elements.resize(system.model().elements().size(), 0);
   consistent_rates(system, t, y, yp);
-  for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events); ++pass)
+  for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events, &changed_elements); ++pass)
     consistent_rates(system, t, y, yp);
 }
 
@@ -104,6 +109,10 @@ struct IdaIntegrator::Impl {
   std::vector<double> taylor;               // (order + 1) x n: y^(j)(t_n) / j!
   std::vector<double> y_local;              // one element's unknowns, interpolated
   std::vector<double> g_element;            // one element's roots
+  std::vector<double> y_probe, g_probe;     // root_noise's perturbed unknowns and roots
+  // Roots that sit on their mode's boundary within round-off (see root_noise in advance()):
+  // they are carried as +0 in g_previous and count as crossed only when clearly below zero.
+  std::vector<char> on_boundary;
   int taylor_order = -1;
   double taylor_time = 0.0;
   std::vector<EventRecord> events;
@@ -344,6 +353,7 @@ void IdaIntegrator::start(double t_end) {
     impl.t_reached = 0.0;
     impl.at_start = true;
     report_events(start_events, y);
+    impl.on_boundary.assign(static_cast<std::size_t>(system_.root_count()), 0);
     if (system_.root_count() > 0) system_.roots(0.0, y, impl.g_previous.data());
   }
 }
@@ -434,6 +444,52 @@ double IdaIntegrator::advance(double t_end) {
     return b;
   };
 
+  // The round-off level of root `local` of element e at state y_state: how much the root moves
+  // when each unknown it reads moves by its own rounding (|y_i| eps), summed over them, times a
+  // safety factor. A root of a mode just entered that is within this of zero sits on the
+  // mode's boundary because the commit put it there (e.g. a crush spring unloading at its
+  // largest crush, where "back on the curve" is zero by construction), not because the
+  // element is leaving the mode: committing it would flip the element back at the same
+  // instant, and round-off decides how often (once for one spring, 20 times for its mirror).
+  std::vector<double>& y_probe = impl.y_probe;
+  std::vector<double>& g_probe = impl.g_probe;
+  std::vector<char>& on_boundary = impl.on_boundary;
+  // After a restart: a root at or below zero that restart_state did not commit (zero, and not
+  // falling within its look-ahead) starts on its boundary rather than unseen.
+  const auto mark_boundary_roots = [&](std::vector<double>& g) {
+    for (std::size_t k = 0; k < g.size(); ++k) {
+      on_boundary[k] = 0;
+      if (g[k] <= 0.0) {
+        g[k] = std::numeric_limits<double>::min();
+        on_boundary[k] = 1;
+      }
+    }
+  };
+  const auto root_noise = [&](int e, int local, double t, const double* y_state) {
+    constexpr double kSafety = 64.0;
+    const double eps = std::numeric_limits<double>::epsilon();
+    const std::vector<int>& unknowns = system_.element_unknowns(e);
+    y_probe.assign(static_cast<std::size_t>(n), 0.0);
+    for (const int i : unknowns) y_probe[static_cast<std::size_t>(i)] = y_state[i];
+    const int count = model.elements()[static_cast<std::size_t>(e)]->root_count();
+    g_element.resize(static_cast<std::size_t>(count));
+    g_probe.resize(static_cast<std::size_t>(count));
+    system_.element_roots(e, t, y_probe.data(), g_element.data());
+    const double g0 = g_element[static_cast<std::size_t>(local)];
+    double noise = kSafety * eps * std::abs(g0);
+    for (const int i : unknowns) {
+      double& yi = y_probe[static_cast<std::size_t>(i)];
+      const double saved = yi;
+      const double magnitude = std::max(std::abs(saved), atol[i]);
+      const double delta = 1e-7 * magnitude;
+      yi = saved + delta;
+      system_.element_roots(e, t, y_probe.data(), g_probe.data());
+      yi = saved;
+      noise += kSafety * eps * magnitude * std::abs(g_probe[static_cast<std::size_t>(local)] - g0) / delta;
+    }
+    return noise;
+  };
+
   // The lag test of a mode change without restart, from the element that changed alone
   // (so an event costs the same in a 2-car and in a 200-car model): over [t_event, t_n] IDA
   // used its old law; the velocity error that made is about |change of its forces| / M
@@ -493,9 +549,21 @@ double IdaIntegrator::advance(double t_end) {
   if (root_count > 0) {
     system_.roots(t_n, y, g_now.data());
     crossings.clear();
-    for (int k = 0; k < root_count; ++k)
-      if (g_previous[static_cast<std::size_t>(k)] > 0.0 && g_now[static_cast<std::size_t>(k)] <= 0.0)
-        crossings.push_back({t_n, system_.root_owner(k), k - system_.root_offset(system_.root_owner(k)), 0});
+    for (int k = 0; k < root_count; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      if (g_now[kk] > 0.0) {
+        on_boundary[kk] = 0;  // inside its mode: an ordinary root again
+        continue;
+      }
+      if (!(g_previous[kk] > 0.0)) continue;
+      const int owner = system_.root_owner(k);
+      const int local = k - system_.root_offset(owner);
+      if (on_boundary[kk] && g_now[kk] >= -root_noise(owner, local, t_n, y)) {
+        g_now[kk] = std::numeric_limits<double>::min();  // still on it: not crossed
+        continue;
+      }
+      crossings.push_back({t_n, owner, local, 0});
+    }
     if (!crossings.empty()) {
       load_taylor(t_n);
       double step = 0.0;
@@ -511,6 +579,7 @@ double IdaIntegrator::advance(double t_end) {
       const double* quad_n = N_VGetArrayPointer(impl.quad);
       std::vector<int> done;  // elements that changed mode in this step
       std::vector<int> changes;  // how often each of them changed (crossings found before are stale)
+      std::vector<double> change_times;  // when each of them last changed
       const auto changes_of = [&](int e) {
         const auto it = std::find(done.begin(), done.end(), e);
         return it == done.end() ? 0 : changes[static_cast<std::size_t>(it - done.begin())];
@@ -541,12 +610,16 @@ double IdaIntegrator::advance(double t_end) {
         sample_up_to(c.t);  // (uses y_out, not the event state)
         events.clear();
         if (!restarted && !system_.commit_element_root(c.element, c.local, -1, c.t, y_at_event, events)) continue;
+        for (int j = 0; j < model.elements()[static_cast<std::size_t>(c.element)]->root_count(); ++j)
+          on_boundary[static_cast<std::size_t>(system_.root_offset(c.element) + j)] = 0;  // a new mode
         const auto seen = std::find(done.begin(), done.end(), c.element);
         if (seen == done.end()) {
           done.push_back(c.element);
           changes.push_back(1);
+          change_times.push_back(c.t);
         } else {
           ++changes[static_cast<std::size_t>(seen - done.begin())];
+          change_times[static_cast<std::size_t>(seen - done.begin())] = c.t;
         }
         ++stats().root_returns;
         if (!restarted && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
@@ -561,7 +634,19 @@ double IdaIntegrator::advance(double t_end) {
           for (int j = 0; j < count; ++j) {
             const double g_end = g_now[static_cast<std::size_t>(offset + j)];
             if (g_end > 0.0) continue;
-            const double g_start = element_root_at(c.element, j, c.t);
+            double g_start = element_root_at(c.element, j, c.t);
+            if (g_start <= 0.0 && g_start >= -root_noise(c.element, j, c.t, y_at_event)) {
+              // On the new mode's boundary by construction (see root_noise): not a second
+              // change at this instant. Still at the boundary at t_n (within round-off): the
+              // root starts the next step armed at +0, so a real later crossing is found;
+              // clearly out by t_n: the crossing is located after the event.
+              const double noise_end = root_noise(c.element, j, t_n, y);
+              if (g_end >= -noise_end) {
+                on_boundary[static_cast<std::size_t>(offset + j)] = 1;
+                continue;
+              }
+              g_start = std::numeric_limits<double>::min();
+            }
             const double t_next = g_start > 0.0 ? locate(c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
             const Crossing next{t_next, c.element, j, generation};
             crossings.insert(std::upper_bound(crossings.begin() + static_cast<std::ptrdiff_t>(i) + 1, crossings.end(), next,
@@ -574,7 +659,10 @@ double IdaIntegrator::advance(double t_end) {
         // Restart at the event: consistent rates for the new law (and roots that sit on
         // their boundary there), quadratures interpolated to it.
         std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
-        restart_state(system_, c.t, y_restart, yp_restart, events);
+        std::vector<char> changed_now(model.elements().size(), 0);  // the elements that changed at c.t
+        for (std::size_t k = 0; k < done.size(); ++k)
+          if (change_times[k] == c.t) changed_now[static_cast<std::size_t>(done[k])] = 1;
+        restart_state(system_, c.t, y_restart, yp_restart, events, changed_now);
         report_events(events, y_restart.data());
         impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
         std::copy(y_restart.begin(), y_restart.end(), y);
@@ -586,12 +674,18 @@ double IdaIntegrator::advance(double t_end) {
         impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");  // IDAReInit clears it
         ++stats().reinitializations;
         system_.roots(c.t, y, g_previous.data());
+        mark_boundary_roots(g_previous);
         impl.t_reached = c.t;
         restarted = true;
         break;
       }
-      if (!restarted)  // the changed elements' roots at t_n, in their new modes
+      if (!restarted) {  // the changed elements' roots at t_n, in their new modes
         for (const int e : done) system_.element_roots(e, t_n, y, g_now.data() + system_.root_offset(e));
+        for (const int e : done)
+          for (int k = system_.root_offset(e); k < system_.root_offset(e) + model.elements()[static_cast<std::size_t>(e)]->root_count(); ++k)
+            if (on_boundary[static_cast<std::size_t>(k)] && g_now[static_cast<std::size_t>(k)] <= 0.0)
+              g_now[static_cast<std::size_t>(k)] = std::numeric_limits<double>::min();
+      }
     }
     if (!restarted) std::swap(g_previous, g_now);
   }

@@ -137,7 +137,10 @@ class DaeSystem {
   /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
   /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
   /// any mode changed (Euler and the static settle; IDA commits element by element).
-  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events) const;
+  /// With `changed_elements` (one flag per element): flagged elements are left alone and the
+  /// ones that change are flagged, so that no element changes mode twice at one instant.
+  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                    std::vector<char>* changed_elements = nullptr) const;
   /// Element-level access for integrators that locate events element by element.
   int root_offset(int e) const { return root_offset_[static_cast<std::size_t>(e)]; }
   /// Element owning root k.
@@ -167,8 +170,9 @@ class DaeSystem {
   /// it). Elements switch a small band past their boundaries (1e-14 to 1e-12 of their size),
   /// so a state exactly on a boundary has a small positive root that the look-ahead sees
   /// cross; IDA itself would leave a root that is exactly zero inactive. Returns true when a
-  /// mode changed.
-  bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events) const;
+  /// mode changed. `changed_elements` as in commit_roots (repeated passes at one restart).
+  bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
+                             std::vector<char>* changed_elements = nullptr) const;
   /// Puts every element back in its starting mode.
   void reset_modes() const;
 

@@ -133,7 +133,10 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
     case Mode::Elastic:
       if (direction > 0) return false;
       if (index == 0) {
-        enter_mode_at(crush, 1.0);  // back on the curve at d_max
+        // Back on the curve at d_max. A restart's look-ahead may commit this a hair before
+        // d_max (crush < d_max by round-off): the element reloads all the same, never a
+        // "reloading" that leaves it elastic (which would fire again at once).
+        enter_mode_at(std::max(crush, st.max_crush), 1.0);
         event = {"reloading on the curve", crush};
       } else {
         st.mode = Mode::Open;
@@ -142,7 +145,7 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
       return true;
     case Mode::Open:
       if (direction > 0 || index != 0) return false;
-      enter_mode_at(crush, 1.0);
+      enter_mode_at(std::max(crush, st.permanent_crush), 1.0);  // contact (as above: never left open)
       event = {st.mode == Mode::Loading ? "contact, crushing" : "contact", crush};
       return true;
   }
