@@ -353,28 +353,36 @@ void evaluate(ConvergeRun& run, const ConvergeRun& reference, const std::vector<
   }
 }
 
-struct TimeAtLevel {
-  double seconds = kNaN;
-  std::string how;
-};
+}  // namespace
 
-/// Wall time at which a method's runs reach a relative error level (see the header).
+/// Wall time at which a method's runs reach a relative error level (see the header). A run
+/// counts only when it and every tighter run of the method (smaller dt or rtol) meet the level:
+/// an error that meets it by luck at a loose setting and misses it again at a tighter one
+/// (events that fire elsewhere, a bifurcation) is not a setting anyone could rely on.
 TimeAtLevel time_at_level(const std::vector<ConvergeRun>& runs, std::size_t quantity, double level) {
-  std::vector<std::pair<double, double>> points;  // (wall time, error), usable runs
+  struct Point {
+    double setting, seconds, error;  // dt or rtol, wall time, relative error
+  };
+  std::vector<Point> points;  // usable runs, loosest setting first
   for (const ConvergeRun& r : runs)
-    if (r.ok && r.wall_seconds > 0.0 && std::isfinite(r.errors[quantity]) && r.errors[quantity] > 0.0)
-      points.emplace_back(r.wall_seconds, r.errors[quantity]);
+    if (r.ok && r.wall_seconds > 0.0 && std::isfinite(r.errors[quantity]))
+      points.push_back({r.method == "euler" ? r.step : r.rtol, r.wall_seconds, r.errors[quantity]});
   if (points.empty()) return {kNaN, "no runs"};
-  std::sort(points.begin(), points.end());
-  if (points[0].second <= level) return {points[0].first, "<="};
-  for (std::size_t k = 1; k < points.size(); ++k) {
-    if (points[k].second > level) continue;
-    const double lt0 = std::log(points[k - 1].first), lt1 = std::log(points[k].first);
-    const double le0 = std::log(points[k - 1].second), le1 = std::log(points[k].second);
+  std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) { return a.setting > b.setting; });
+  std::size_t first_reliable = points.size();  // the loosest run from which on every tighter one meets the level
+  while (first_reliable > 0 && points[first_reliable - 1].error <= level) --first_reliable;
+  if (first_reliable == 0) return {points[0].seconds, "<="};
+  if (first_reliable < points.size()) {
+    const Point& above = points[first_reliable - 1];  // misses the level
+    const Point& below = points[first_reliable];      // meets it, as do all tighter runs
+    if (!(below.error > 0.0)) return {below.seconds, "<="};
+    const double lt0 = std::log(above.seconds), lt1 = std::log(below.seconds);
+    const double le0 = std::log(above.error), le1 = std::log(below.error);
     return {std::exp(lt0 + (std::log(level) - le0) * (lt1 - lt0) / (le1 - le0)), "interpolated"};
   }
   std::vector<double> times, errors;
-  for (const auto& [t, e] : points) times.push_back(t), errors.push_back(e);
+  for (const Point& p : points)
+    if (p.error > 0.0) times.push_back(p.seconds), errors.push_back(p.error);
   const ConvergeFit fit = log_log_slope(times, errors);
   if (fit.points < 2 || !(fit.slope < 0.0)) return {kNaN, "not reached"};
   // Line through the centroid of the points with the fitted slope.
@@ -384,6 +392,8 @@ TimeAtLevel time_at_level(const std::vector<ConvergeRun>& runs, std::size_t quan
   mean_e /= static_cast<double>(times.size());
   return {std::exp(mean_t + (std::log(level) - mean_e) / fit.slope), "extrapolated"};
 }
+
+namespace {
 
 std::vector<double> column(const std::vector<ConvergeRun>& runs, const std::function<double(const ConvergeRun&)>& get) {
   std::vector<double> out;

@@ -255,3 +255,31 @@ TEST_CASE("convergence study: max_crush and the peak forces take the same column
     CHECK(plan.quantities[2].applicable);
   }
 }
+
+TEST_CASE("convergence study: a level counts only from the setting on which every tighter one meets it", "[converge]") {
+  // IDA runs, loosest first: errors 1e-2, 1e-4 (met by luck), 5e-3 (missed again), 1e-5.
+  std::vector<ConvergeRun> runs;
+  const double rtols[] = {1e-3, 1e-4, 1e-5, 1e-6}, seconds[] = {1.0, 2.0, 3.0, 4.0}, errors[] = {1e-2, 1e-4, 5e-3, 1e-5};
+  for (int k = 3; k >= 0; --k) {  // in any order: the setting decides what is tighter
+    ConvergeRun r;
+    r.method = "ida";
+    r.rtol = rtols[k];
+    r.ok = true;
+    r.wall_seconds = seconds[k];
+    r.errors = {errors[k]};
+    runs.push_back(r);
+  }
+  // 1e-3: between the 5e-3 run (3 s) and the 1e-5 run (4 s), log-log, not between the first two.
+  const TimeAtLevel at = time_at_level(runs, 0, 1e-3);
+  CHECK(at.how == "interpolated");
+  const double expected = std::exp(std::log(3.0) + (std::log(1e-3) - std::log(5e-3)) * (std::log(4.0) - std::log(3.0)) /
+                                                       (std::log(1e-5) - std::log(5e-3)));
+  CHECK(at.seconds == Approx(expected).epsilon(1e-12));
+  // 2e-2: every run meets it, the cheapest bounds it.
+  const TimeAtLevel loose = time_at_level(runs, 0, 2e-2);
+  CHECK(loose.how == "<=");
+  CHECK(loose.seconds == 1.0);
+  // A failed tight run does not count either way: 1e-6 is then extrapolated from the others.
+  runs.front().ok = false;  // the rtol 1e-6 run
+  CHECK(time_at_level(runs, 0, 1e-3).how == "extrapolated");
+}

@@ -40,8 +40,9 @@
 // Analysis: observed orders are least-squares slopes of log(error) against log(dt) (Euler,
 // first order expected) and against log(wall time) (both methods; IDA also against log(rtol)).
 // Cost at equal accuracy: for each error level of the headline quantity, the wall time at
-// which each method reaches it, interpolated log-log between the two runs (in order of cost)
-// that bracket it; when no run of a method is that accurate, extrapolated along the method's
+// which each method reaches it for good: from the loosest setting (dt, rtol) at which that run
+// and every tighter run of the method meet the level, interpolated log-log between that run and
+// the next looser one (which misses it); when the tightest run misses it, extrapolated along the method's
 // fitted error-versus-time line (marked as such), and when even its cheapest run is more
 // accurate, bounded by that run's time (marked "<="); Euler time / IDA time is printed with
 // the same marks.
@@ -53,6 +54,7 @@
 #include <atomic>
 #include <functional>
 #include <optional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -181,6 +183,15 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
 
 /// Least-squares slope of log(y) against log(x) over the points where both are positive and finite.
 ConvergeFit log_log_slope(const std::vector<double>& x, const std::vector<double>& y);
+
+/// Wall time at which a method's runs reach a relative error level in one quantity, and how it
+/// was found ("interpolated", "extrapolated", "<=", "not reached", "no runs"): see the header's
+/// "Cost at equal accuracy".
+struct TimeAtLevel {
+  double seconds = std::numeric_limits<double>::quiet_NaN();
+  std::string how;
+};
+TimeAtLevel time_at_level(const std::vector<ConvergeRun>& runs, std::size_t quantity, double level);
 
 /// The summary as Markdown: run table, orders, cost at equal accuracy.
 std::string convergence_markdown(const ConvergeResult& result);
