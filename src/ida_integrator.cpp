@@ -621,8 +621,11 @@ double IdaIntegrator::advance(double t_end) {
       if (!(g_previous[kk] > 0.0)) continue;
       const int owner = system_.root_owner(k);
       const int local = k - system_.root_offset(owner);
-      if (on_boundary[kk] && g_now[kk] >= -root_noise(owner, local, t_n, y)) {
-        g_now[kk] = std::numeric_limits<double>::min();  // still on it: not crossed
+      if (g_now[kk] >= -root_noise(owner, local, t_n, y)) {
+        // Below zero by no more than round-off: an element resting on a boundary (a leveler at
+        // a kink), not leaving its mode; carried as +0 until clearly below.
+        on_boundary[kk] = 1;
+        g_now[kk] = std::numeric_limits<double>::min();
         continue;
       }
       crossings.push_back({t_n, owner, local, 0});
