@@ -20,11 +20,12 @@ says so (then the two rows are different models and only roughly comparable).
 import argparse
 import json
 import os
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
+
+from child_cpu import run_timed
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MODEL = "models/report/final_two_car.yaml"
@@ -48,13 +49,7 @@ def build_commit(commit, scratch):
 
 def timed_run(executable, model, options, out):
     """CPU seconds (user + system) of one `railcrash run`, and its summary.json."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    finished = subprocess.run([executable, "run", model, "--out", out, "--quiet"] + options,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    if finished.returncode != 0:
-        raise RuntimeError(f"{executable} run {model} {' '.join(options)} failed: {finished.stderr.strip()}")
+    cpu, _ = run_timed([executable, "run", model, "--out", out, "--quiet"] + options)
     with open(os.path.join(out, "summary.json")) as f:
         return cpu, json.load(f)
 

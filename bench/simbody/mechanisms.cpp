@@ -1,0 +1,127 @@
+// Simbody 3.7 counterpart of railcrash's verification model verification/cases/slider_crank.yaml
+// (the slider-crank of SUNDIALS' idasSlCrank_dns), for bench/simbody/compare.py.
+//
+//   simbody_mechanisms slider_crank --accuracy 1e-6 --t-end 10 --output-interval 0.4 --out FILE
+//
+// Integrates with Simbody's Runge-Kutta-Merson (its default explicit integrator, error control
+// at the given accuracy, constraints projected to the same accuracy) or CPodes (--integrator
+// cpodes, implicit BDF), writes one CSV row per output time (t, crank angle, rod angle, slider
+// position; formatted with printf like railcrash's rows) and prints the steps taken. The
+// whole process is what the comparison times: set-up, integration and output.
+#include <Simbody.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+using namespace SimTK;
+
+namespace {
+
+struct Options {
+  std::string mechanism;
+  std::string integrator = "rkm";  // rkm or cpodes
+  double accuracy = 1e-6;          // Simbody's relative accuracy
+  double t_end = 10.0;             // [s]
+  double output_interval = 0.4;    // [s]
+  std::string out = "simbody.csv";
+};
+
+[[noreturn]] void usage(const char* why) {
+  std::fprintf(stderr,
+               "simbody_mechanisms: %s\nusage: simbody_mechanisms slider_crank [--integrator rkm|cpodes] "
+               "[--accuracy A] [--t-end T] [--output-interval H] [--out FILE]\n",
+               why);
+  std::exit(2);
+}
+
+Options parse(int argc, char** argv) {
+  if (argc < 2) usage("no mechanism");
+  Options options;
+  options.mechanism = argv[1];
+  for (int i = 2; i < argc; i += 2) {
+    if (i + 1 >= argc) usage("an option without its value");
+    const std::string key = argv[i], value = argv[i + 1];
+    if (key == "--integrator") options.integrator = value;
+    else if (key == "--accuracy") options.accuracy = std::atof(value.c_str());
+    else if (key == "--t-end") options.t_end = std::atof(value.c_str());
+    else if (key == "--output-interval") options.output_interval = std::atof(value.c_str());
+    else if (key == "--out") options.out = value;
+    else usage(("unknown option " + key).c_str());
+  }
+  if (options.mechanism != "slider_crank") usage(("unknown mechanism " + options.mechanism).c_str());
+  if (options.integrator != "rkm" && options.integrator != "cpodes") usage("--integrator is rkm or cpodes");
+  if (!(options.accuracy > 0.0) || !(options.t_end > 0.0) || !(options.output_interval > 0.0))
+    usage("--accuracy, --t-end and --output-interval must be positive");
+  return options;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options options = parse(argc, argv);
+
+  // The slider-crank, as in verification/cases/slider_crank.yaml (SI units, no gravity).
+  const double crank_length = 0.5;   // [m] pivot to crank pin
+  const double rod_length = 1.0;     // [m] crank pin to slider (the rod's centre of mass)
+  const double crank_inertia = 1.0;  // [kg m^2] about the pivot (centre of mass at the pivot)
+  const double rod_mass = 1.0;       // [kg] at the slider
+  const double rod_inertia = 2.0;    // [kg m^2] about its centre of mass
+  const double spring_stiffness = 1.0, spring_free_length = 1.0;  // [N/m], [m]
+  const double damping = 1.0;        // [N s/m]
+  const double end_force = 1.0;      // [N] horizontal, one rod length beyond the slider
+
+  MultibodySystem system;
+  SimbodyMatterSubsystem matter(system);
+  GeneralForceSubsystem forces(system);
+  // Planar motion about z: the in-plane moments of inertia only have to be valid, not right.
+  const Body::Rigid crank_body(MassProperties(1.0, Vec3(0), Inertia(crank_inertia, crank_inertia, crank_inertia)));
+  const Body::Rigid rod_body(MassProperties(rod_mass, Vec3(0), Inertia(rod_inertia / 2, rod_inertia / 2, rod_inertia)));
+  MobilizedBody::Pin crank(matter.Ground(), Transform(), crank_body, Transform());
+  MobilizedBody::Pin rod(crank, Transform(Vec3(crank_length, 0, 0)), rod_body, Transform(Vec3(-rod_length, 0, 0)));
+  // The slider: the rod's centre of mass stays on the ground's x axis.
+  Constraint::PointInPlane slider(matter.Ground(), UnitVec3(0, 1, 0), 0.0, rod, Vec3(0));
+  const Vec3 crank_mid(crank_length / 2, 0, 0), rod_mid(-rod_length / 2, 0, 0);
+  Force::TwoPointLinearSpring(forces, crank, crank_mid, rod, rod_mid, spring_stiffness, spring_free_length);
+  Force::TwoPointLinearDamper(forces, crank, crank_mid, rod, rod_mid, damping);
+  // A force that keeps its direction in the ground frame, applied at a point of the rod.
+  Force::ConstantForce(forces, rod, Vec3(rod_length, 0, 0), Vec3(end_force, 0, 0));
+
+  system.realizeTopology();
+  State state = system.getDefaultState();
+  const double crank_angle = Pi / 2, rod_angle = -std::asin(crank_length / rod_length);  // absolute [rad]
+  crank.setOneQ(state, 0, crank_angle);
+  rod.setOneQ(state, 0, rod_angle - crank_angle);  // the rod's pin is relative to the crank
+
+  std::unique_ptr<Integrator> integrator;
+  if (options.integrator == "rkm") integrator = std::make_unique<RungeKuttaMersonIntegrator>(system);
+  else integrator = std::make_unique<CPodesIntegrator>(system, CPodes::BDF, CPodes::Newton);
+  integrator->setAccuracy(options.accuracy);
+  TimeStepper stepper(system, *integrator);
+  stepper.initialize(state);
+
+  std::FILE* out = std::fopen(options.out.c_str(), "w");
+  if (!out) {
+    std::fprintf(stderr, "simbody_mechanisms: cannot write %s\n", options.out.c_str());
+    return 2;
+  }
+  std::fprintf(out, "t,crank.theta,rod.theta,slider.x\n");
+  const auto write_row = [&](const State& s) {
+    system.realize(s, Stage::Position);
+    const double crank_theta = crank.getOneQ(s, 0);
+    const double rod_theta = crank_theta + rod.getOneQ(s, 0);
+    std::fprintf(out, "%.12g,%.12g,%.12g,%.12g\n", s.getTime(), crank_theta, rod_theta, rod.getBodyOriginLocation(s)[0]);
+  };
+  write_row(integrator->getState());
+  const long rows = std::lround(options.t_end / options.output_interval);
+  for (long k = 1; k <= rows; ++k) {
+    stepper.stepTo(std::min(options.t_end, static_cast<double>(k) * options.output_interval));
+    write_row(integrator->getState());
+  }
+  std::fclose(out);
+  std::printf("steps %d\n", integrator->getNumStepsTaken());
+  return 0;
+}
