@@ -10,12 +10,13 @@ old, new, ...), REPEATS times each; the figure is the median CPU time of the pro
 (user + system, from the kernel's accounting of the child: other work on the machine does
 not inflate it the way it inflates wall time). Cases: IDA at rtol 1e-3 and 1e-4, and
 explicit Euler at the model's own dt (its stability limit, models/report/README.md), each
-over T_END seconds with the model's output interval. Each case also prints steps, R2 and
-car 1's maximum crush of both runs, so a speed-up that changed the answer shows.
+over T_END seconds with the model's output interval. Each case also prints steps, R1 (the crush
+response) and R2 (the override response) of both runs, so a speed-up that changed the answer shows.
 
-The model is this tree's models/report/final_two_car.yaml; when the old executable
-rejects it (keys added since), the old commit's own copy of the model is used and the table
-says so (then the two rows are different models and only roughly comparable).
+Both run one model: this tree's models/report/final_two_car.yaml, or, when the old
+executable rejects it (keys added since), the old commit's copy of it (the table says
+which); only when neither reads the other's does each run its own (then only roughly
+comparable).
 """
 import argparse
 import json
@@ -47,19 +48,17 @@ def build_commit(commit, scratch):
     return source, executable
 
 
+def accepts(executable, model):
+    return subprocess.run([executable, "check", model], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode == 0
+
+
 def timed_run(executable, model, options, out):
     """CPU seconds (user + system) of one `railcrash run`, and its summary.json."""
-    cpu, _ = run_timed([executable, "run", model, "--out", out, "--quiet"] + options)
+    usage = subprocess.run([executable, "run", "--help"], capture_output=True, text=True).stdout
+    quiet = ["--quiet"] if "--quiet" in usage else []  # (older commits print no progress)
+    cpu, _ = run_timed([executable, "run", model, "--out", out] + quiet + options)
     with open(os.path.join(out, "summary.json")) as f:
         return cpu, json.load(f)
-
-
-def car1_crush(summary):
-    crush = summary.get("car_crush", {})
-    value = crush.get("car1")
-    if isinstance(value, dict):
-        value = value.get("max_crush", value.get("max"))
-    return value if isinstance(value, (int, float)) else float("nan")
 
 
 def main():
@@ -72,12 +71,17 @@ def main():
 
     new_executable = os.path.join(ROOT, "build", "railcrash")
     old_source, old_executable = build_commit(args.commit, args.scratch)
-    new_model = os.path.join(ROOT, MODEL)
-    old_model = new_model
+    # One model for both: this tree's, or the old commit's when the old executable rejects
+    # this tree's (keys added since) and the new one still reads the old.
+    new_model = old_model = os.path.join(ROOT, MODEL)
+    model_note = ""
+    if not accepts(old_executable, new_model):
+        new_model = old_model = os.path.join(old_source, MODEL)
+        model_note = f"(the old executable rejects this tree's model: both run {args.commit}'s {MODEL})"
+        if not accepts(new_executable, old_model):
+            new_model = os.path.join(ROOT, MODEL)
+            model_note = "(each executable runs its own commit's model: different models, only roughly comparable)"
     work = tempfile.mkdtemp(prefix="railcrash-compare-")
-    if subprocess.run([old_executable, "check", new_model], stdout=subprocess.DEVNULL,
-                      stderr=subprocess.DEVNULL).returncode != 0:
-        old_model = os.path.join(old_source, MODEL)
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
                            capture_output=True, text=True).stdout.strip()
@@ -88,9 +92,9 @@ def main():
     print(f"two-car crash ({MODEL}), {args.t_end} s; old = {args.commit}, new = {head}; "
           f"median of {args.repeats} interleaved runs, CPU s of the process; {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f} at the start")
-    if old_model != new_model:
-        print(f"(the old executable rejects this tree's model: it runs its own {args.commit}:{MODEL})")
-    print("\n| case | old CPU s | new CPU s | old / new | steps old / new | R2 old / new | car 1 max crush old / new [in] |")
+    if model_note:
+        print(model_note)
+    print("\n| case | old CPU s | new CPU s | old / new | steps old / new | R1 old / new | R2 old / new |")
     print("|---|---|---|---|---|---|---|")
     for label, options in cases:
         options = options + ["--t-end", str(args.t_end)]
@@ -104,7 +108,7 @@ def main():
         old, new = statistics.median(times["old"]), statistics.median(times["new"])
         o, n = last["old"], last["new"]
         print(f"| {label} | {old:.3f} | {new:.3f} | **{old / new:.2f}** | {o['stats']['steps']} / {n['stats']['steps']} | "
-              f"{o['responses']['R2']:.4f} / {n['responses']['R2']:.4f} | {car1_crush(o):.3f} / {car1_crush(n):.3f} |",
+              f"{o['responses']['R1']:.4f} / {n['responses']['R1']:.4f} | {o['responses']['R2']:.4f} / {n['responses']['R2']:.4f} |",
               flush=True)
     print(f"\nload average at the end {os.getloadavg()[0]:.1f}; runs' output in {work}")
     return 0
