@@ -1,21 +1,23 @@
 #!/usr/bin/env python3
-"""railcrash against Simbody 3.7 on the slider-crank, at equal accuracy, output included.
+"""railcrash against Simbody 3.7 on the slider-crank and Andrews' squeezer, at equal accuracy, output included.
 
-    bench/simbody/compare.py [--repeats 3] [--targets 1e-4,1e-6] [--intervals 0.4,0.001]
+    bench/simbody/compare.py [--repeats 3] [--targets 1e-4,1e-6] [--mechanisms slider_crank,andrews_squeezer]
 
-The mechanism is verification/cases/slider_crank.yaml (10 s); its Simbody twin is
+The mechanisms are verification/cases/slider_crank.yaml (10 s) and
+bench/simbody/andrews_squeezer.yaml (0.03 s); their Simbody twins are in
 bench/simbody/mechanisms.cpp (built here into build/bench-simbody when missing; needs
 libsimbody-dev: scripts/install-deps.sh --bench). Each tool runs a ladder of tolerances
-(railcrash IDA: --rtol R --atol R/10; Simbody Runge-Kutta-Merson: accuracy A), whole
+(railcrash IDA: --rtol R --atol R times the model file's atol/rtol; Simbody Runge-Kutta-Merson: accuracy A), whole
 processes timed by their CPU time (set-up, integration and the CSV output), medians of
 REPEATS interleaved runs.
 
-Error measure: the largest difference over the model's own output times (every 0.4 s) in
-the crank angle [rad] or the slider position [m] (both of order 1), against a reference:
-Simbody at accuracy 1e-12 (railcrash at rtol 1e-11 is printed against it, as a check of the
-reference). For each target, each tool's cheapest setting whose error is within the target
-(and every tighter setting's too) is compared. Run at the model's own output interval
-(0.4 s) and at 1 ms (issue 14's other case: output-heavy).
+Error measure: the largest difference over the model's own output times (slider-crank:
+every 0.4 s, crank angle [rad] and slider position [m], both of order 1; Andrews: every
+1 ms, the crank, rod and lever angles [rad]), against a reference: Simbody at accuracy
+1e-12 (railcrash at rtol 1e-11 is printed against it, as a check of the reference). For
+each target, each tool's cheapest setting whose error is within the target (and every
+tighter setting's too) is compared. Run at the model's own output interval and at one 400
+(slider-crank: 1 ms) or 100 (Andrews: 10 us) times denser: output-heavy.
 """
 import argparse
 import csv
@@ -30,10 +32,16 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.dirname(HERE))
 from child_cpu import run_timed  # noqa: E402
 
-MODEL = os.path.join(ROOT, "verification", "cases", "slider_crank.yaml")
-T_END = 10.0
-ERROR_GRID = 0.4  # [s] the model's own output interval: where errors are measured
-LEVELS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
+# name: (model file, t_end [s], the model's output interval [s] = the error grid, a dense
+# output interval [s], railcrash's columns, Simbody's columns (the same quantities),
+# railcrash's atol / rtol (the model file's own ratio: atol is on lengths))
+MECHANISMS = {
+    "slider_crank": (os.path.join(ROOT, "verification", "cases", "slider_crank.yaml"), 10.0, 0.4, 0.001,
+                     ["crank.theta", "rod.x"], ["crank.theta", "slider.x"], 0.1),
+    "andrews_squeezer": (os.path.join(HERE, "andrews_squeezer.yaml"), 0.03, 1e-3, 1e-5,
+                         ["crank.theta", "rod.theta", "lever.theta"], ["crank.theta", "rod.theta", "lever.theta"], 1e-3),
+}
+LEVELS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
 
 
 def harness():
@@ -45,31 +53,33 @@ def harness():
     return executable
 
 
-def on_grid(rows, time_key, columns):
-    """{k: (values)} for the rows at t = k * ERROR_GRID."""
+def on_grid(rows, time_key, columns, grid):
+    """{k: (values)} for the rows at t = k * grid."""
     samples = {}
     for row in rows:
         t = float(row[time_key])
-        k = round(t / ERROR_GRID)
-        if abs(t - k * ERROR_GRID) < 1e-9:
+        k = round(t / grid)
+        if abs(t - k * grid) < 1e-9 * max(1.0, grid):
             samples[k] = tuple(float(row[c]) for c in columns)
     return samples
 
 
-def railcrash_run(level, interval, work):
+def railcrash_run(mechanism, level, interval, work):
+    model, _, grid, _, columns, _, atol_ratio = MECHANISMS[mechanism]
     out = os.path.join(work, "railcrash")
-    cpu, _ = run_timed([os.path.join(ROOT, "build", "railcrash"), "run", MODEL, "--rtol", repr(level), "--atol",
-                        repr(level / 10), "--output-interval", repr(interval), "--out", out, "--quiet"])
+    cpu, _ = run_timed([os.path.join(ROOT, "build", "railcrash"), "run", model, "--rtol", repr(level), "--atol",
+                        repr(level * atol_ratio), "--output-interval", repr(interval), "--out", out, "--quiet"])
     with open(os.path.join(out, "timeseries.csv")) as f:
-        return cpu, on_grid(csv.DictReader(f), "t", ["crank.theta", "rod.x"])
+        return cpu, on_grid(csv.DictReader(f), "t", columns, grid)
 
 
-def simbody_run(executable, level, interval, work):
+def simbody_run(executable, mechanism, level, interval, work):
+    _, t_end, grid, _, _, columns, _ = MECHANISMS[mechanism]
     out = os.path.join(work, "simbody.csv")
-    cpu, _ = run_timed([executable, "slider_crank", "--accuracy", repr(level), "--t-end", repr(T_END),
+    cpu, _ = run_timed([executable, mechanism, "--accuracy", repr(level), "--t-end", repr(t_end),
                         "--output-interval", repr(interval), "--out", out])
     with open(out) as f:
-        return cpu, on_grid(csv.DictReader(f), "t", ["crank.theta", "slider.x"])
+        return cpu, on_grid(csv.DictReader(f), "t", columns, grid)
 
 
 def error(samples, reference):
@@ -89,36 +99,26 @@ def cheapest_within(results, target):
     return chosen, results[chosen][0], results[chosen][1]
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--targets", default="1e-4,1e-6")
-    parser.add_argument("--intervals", default="0.4,0.001")
-    args = parser.parse_args()
-    targets = [float(x) for x in args.targets.split(",")]
-    intervals = [float(x) for x in args.intervals.split(",")]
-    executable = harness()
-    work = tempfile.mkdtemp(prefix="railcrash-simbody-")
-    _, reference = simbody_run(executable, 1e-12, ERROR_GRID, work)
-    _, railcrash_tight = railcrash_run(1e-11, ERROR_GRID, work)
-    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    print(f"slider-crank ({os.path.relpath(MODEL, ROOT)}, {T_END} s), railcrash {head} against Simbody 3.7 "
-          f"(Runge-Kutta-Merson); median CPU s of {args.repeats} interleaved runs per setting, output included; "
-          f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
-    print(f"reference: Simbody at accuracy 1e-12; railcrash at rtol 1e-11 differs from it by {error(railcrash_tight, reference):.1e}")
-    for interval in intervals:
+def compare(mechanism, executable, args, targets, work):
+    model, t_end, grid, dense, _, _, _ = MECHANISMS[mechanism]
+    _, reference = simbody_run(executable, mechanism, 1e-12, grid, work)
+    _, railcrash_tight = railcrash_run(mechanism, 1e-11, grid, work)
+    print(f"\n## {mechanism} ({os.path.relpath(model, ROOT)}, {t_end} s)\n")
+    print(f"reference: Simbody at accuracy 1e-12; railcrash at rtol 1e-11 differs from it by "
+          f"{error(railcrash_tight, reference):.1e}")
+    for interval in (grid, dense):
         results = {"railcrash": {}, "simbody": {}}
         for level in LEVELS:
             times = {"railcrash": [], "simbody": []}
             samples = {}
             for _ in range(args.repeats):
-                cpu, samples["railcrash"] = railcrash_run(level, interval, work)
+                cpu, samples["railcrash"] = railcrash_run(mechanism, level, interval, work)
                 times["railcrash"].append(cpu)
-                cpu, samples["simbody"] = simbody_run(executable, level, interval, work)
+                cpu, samples["simbody"] = simbody_run(executable, mechanism, level, interval, work)
                 times["simbody"].append(cpu)
             for tool in results:
                 results[tool][level] = (statistics.median(times[tool]), error(samples[tool], reference))
-        print(f"\noutput every {interval} s ({round(T_END / interval)} rows)\n")
+        print(f"\noutput every {interval} s ({round(t_end / interval)} rows)\n")
         print("| tolerance | railcrash CPU s | railcrash error | Simbody CPU s | Simbody error |\n|---|---|---|---|---|")
         for level in LEVELS:
             r, s = results["railcrash"][level], results["simbody"][level]
@@ -131,6 +131,22 @@ def main():
             else:
                 print(f"| {target:g} | {'%g, %.4f' % r[:2] if r else 'not reached'} | {'%g, %.4f' % s[:2] if s else 'not reached'} | |")
         sys.stdout.flush()
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--targets", default="1e-4,1e-6")
+    parser.add_argument("--mechanisms", default=",".join(MECHANISMS))
+    args = parser.parse_args()
+    targets = [float(x) for x in args.targets.split(",")]
+    executable = harness()
+    work = tempfile.mkdtemp(prefix="railcrash-simbody-")
+    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    print(f"railcrash {head} against Simbody 3.7 (Runge-Kutta-Merson); median CPU s of {args.repeats} interleaved runs "
+          f"per setting, output included; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
+    for mechanism in args.mechanisms.split(","):
+        compare(mechanism, executable, args, targets, work)
     return 0
 
 
