@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes bench/simbody/andrews_squeezer.yaml: Andrews' squeezer (Hairer and Wanner, Solving ODEs II,
+"""Writes verification/cases/andrews_squeezer.yaml: Andrews' squeezer (Hairer and Wanner, Solving ODEs II,
 section VII.7; the Bari test set's "andrews") as railcrash bodies and pin joints.
 
 The centres of mass are placed at the test set's consistent angles by chaining the joints
@@ -19,7 +19,8 @@ description: >
   0.2227..., delta 0.4874..., Omega -0.2227..., epsilon 1.2305...). Body positions are
   the centres of mass at those angles (bench/simbody/andrews_squeezer.py writes this file);
   each joint point is an offset from its body's centre of mass along the body's axes. Used
-  by bench/simbody/compare.py against the same mechanism in Simbody.
+  by bench/simbody/compare.py against the same mechanism in Simbody and checked against the
+  test set's solution at t = 0.03 s by verification/verify.cpp.
 units: SI
 gravity: [0, 0]
 '''
@@ -85,6 +86,6 @@ out.append(f"  - {{name: spring, type: linear_spring, stiffness: {c0}, free_leng
 out.append('loads:')
 out.append(f"  - {{type: moment, body: crank, value: {mom}}}")
 import os
-with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), 'andrews_squeezer.yaml'), 'w') as f:
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'verification', 'cases', 'andrews_squeezer.yaml'), 'w') as f:
     f.write(HEADER + '\n'.join(out) + '\n' + FOOTER)
 

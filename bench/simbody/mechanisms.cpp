@@ -105,7 +105,7 @@ Mechanism slider_crank(MultibodySystem& system, SimbodyMatterSubsystem& matter, 
           }};
 }
 
-/// Andrews' squeezer, as in bench/simbody/andrews_squeezer.yaml (Hairer and Wanner's data;
+/// Andrews' squeezer, as in verification/cases/andrews_squeezer.yaml (Hairer and Wanner's data;
 /// body frames at the centres of mass, joint points as offsets along the body's axes).
 Mechanism andrews_squeezer(MultibodySystem& system, SimbodyMatterSubsystem& matter, GeneralForceSubsystem& forces,
                            State& state) {
