@@ -16,7 +16,7 @@ case $what in
   # The two-car crash (IDA rtol 1e-3 and 1e-4, Euler at the model's dt) against an older
   # commit built side by side: bench/run.sh compare [COMMIT] (default cbce2b9) [--repeats 3]
   compare) /usr/bin/python3 bench/compare_commit.py "$@" ;;
-  # The slider-crank against Simbody 3.7 at equal accuracy (needs scripts/install-deps.sh --bench)
+  # The slider-crank and Andrews' squeezer against Simbody 3.7 at equal accuracy (install-deps.sh --bench)
   simbody) /usr/bin/python3 bench/simbody/compare.py "$@" ;;
   python) PYTHONPATH=build/python /usr/bin/python3 bench/python_overhead.py "$@" ;;
   sweep) /usr/bin/python3 bench/sweep_bench.py "$@" ;;   # runs/s of `railcrash sweep`, 1 and 2 jobs, 2 MPI ranks
