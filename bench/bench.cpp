@@ -101,11 +101,13 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
   std::ostringstream table;
   char line[512];
   std::snprintf(line, sizeof line,
-                "| cars per consist | bodies | unknowns | wall s | CPU s | CPU s per simulated s | steps | residuals | "
-                "events | located in a step | restarts | peak MiB | R1 |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                "| cars per consist | bodies | unknowns | wall s | CPU s | CPU s per simulated s | steps | CPU ms per step | "
+                "residuals | events | located in a step | restarts | peak MiB | R1 |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   table << line;
   std::fputs(line, stdout);
   std::vector<double> fit_cars, fit_cost;
+  std::vector<double> all_cars, all_cost, all_step_cost, all_peak;  // every size that finished
   bool all_ok = true;
   for (const int n : cars) {
     Model model = load_consist(template_path, n);
@@ -119,17 +121,43 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     const double cpu = cpu_seconds() - cpu_start;
     const RunStatistics& s = report.outcome.stats;
-    std::snprintf(line, sizeof line, "| %d | %d | %d | %.2f | %.2f | %.1f | %ld | %ld | %ld | %ld | %ld | %.0f | %.3f |%s\n", n,
+    const double peak_mib = peak_memory_mib();
+    std::snprintf(line, sizeof line, "| %d | %d | %d | %.2f | %.2f | %.1f | %ld | %.3f | %ld | %ld | %ld | %ld | %.0f | %.3f |%s\n", n,
                   model.body_count(), model.size(), wall, cpu, cpu / report.outcome.t_reached, s.steps,
-                  s.residual_evaluations, s.events, s.root_returns, s.reinitializations, peak_memory_mib(),
+                  1e3 * cpu / static_cast<double>(std::max<long>(s.steps, 1)), s.residual_evaluations, s.events,
+                  s.root_returns, s.reinitializations, peak_mib,
                   report.responses.r1, report.outcome.ok ? "" : (" FAILED: " + report.outcome.message).c_str());
     table << line;
     std::fputs(line, stdout);
     std::fflush(stdout);
     all_ok = all_ok && report.outcome.ok;
+    if (report.outcome.ok) {
+      all_cars.push_back(n);
+      all_cost.push_back(cpu / report.outcome.t_reached);
+      all_step_cost.push_back(cpu / static_cast<double>(std::max<long>(s.steps, 1)));
+      all_peak.push_back(peak_mib);
+    }
     if (n >= 10 && report.outcome.ok) {
       fit_cars.push_back(n);
       fit_cost.push_back(cpu / report.outcome.t_reached);
+    }
+  }
+  // Per segment between consecutive sizes: the exponent of CPU per simulated second and of
+  // the cost per step, and the memory each added car costs (the peak grows with the sizes,
+  // so the process's peak so far is this size's).
+  if (all_cars.size() >= 2) {
+    std::snprintf(line, sizeof line, "\n| cars | exponent of CPU per simulated s | exponent of CPU per step | MiB per added car |\n"
+                  "|---|---|---|---|\n");
+    table << line;
+    std::fputs(line, stdout);
+    for (std::size_t i = 1; i < all_cars.size(); ++i) {
+      const std::vector<double> pair_cars{all_cars[i - 1], all_cars[i]};
+      std::snprintf(line, sizeof line, "| %g -> %g | %.2f | %.2f | %.3f |\n", all_cars[i - 1], all_cars[i],
+                    log_log_slope(pair_cars, {all_cost[i - 1], all_cost[i]}),
+                    log_log_slope(pair_cars, {all_step_cost[i - 1], all_step_cost[i]}),
+                    (all_peak[i] - all_peak[i - 1]) / (2.0 * (all_cars[i] - all_cars[i - 1])));
+      table << line;
+      std::fputs(line, stdout);
     }
   }
   if (fit_cars.size() >= 2) {
@@ -224,7 +252,7 @@ int main(int argc, char** argv) {
   app.add_option("--commit", commit, "commit id written with the figures");
   app.add_option("--results", results, "Markdown file the figures are appended to")->capture_default_str();
 
-  std::string template_path = source + "/models/report/final_two_car.yaml", cars_text = "2,5,10,20,50,100";
+  std::string template_path = source + "/models/report/final_two_car.yaml", cars_text = "10,20,50,100,200";
   double t_end = 0.1;
   CLI::App* consist = app.add_subcommand("consist", "cost against consist length");
   consist->add_option("--template", template_path, "two-car model the consists are built from")->capture_default_str();

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what railcrash needs to build and test, from Debian 12's packages (as root, or
-# through sudo). Does nothing that is already installed.
+# through sudo). Does nothing that is already installed. Usage: scripts/install-deps.sh [--bench]
 set -euo pipefail
 # file + dpkg-dev: CPack's Debian packages (their dependencies come from dpkg-shlibdeps).
 # pybind11 + numpy + python3-dev: the Python module; pandas and matplotlib: its dataframe()
@@ -14,6 +14,9 @@ packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
           libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib
           libopenmpi-dev openmpi-bin clang libclang-rt-14-dev)
+# --bench: also the benchmarks' own (not needed to build or test): libsimbody-dev for the
+# Simbody 3.7 comparison in bench/simbody.
+[ "${1:-}" = "--bench" ] && packages+=(libsimbody-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
