@@ -264,9 +264,11 @@ TEST_CASE("Andrews' squeezer: the seven angles at t = 0.03 s against the test se
   for (int k = 0; k < 7; ++k)
     check("andrews_squeezer", std::string("rtol 1e-10: ") + names[k] + " at t=0.03 [rad]", reference[k], at_end[k], 1e-7,
           false, "test set reference solution (Hairer, Wanner)");
-  // The model's own tolerances (rtol 1e-6): the crank's 2.5 turns within 1e-4 rad.
+  // The model's own tolerances (rtol 1e-6): the crank's 2.5 turns within 2e-4 rad, 1.3e-5 of the
+  // angle (measured 1.54e-4 since each body's angle is held over its own size (91feeab, issue 14:
+  // the crank's 7 mm, not the model's length); below 1e-4 before).
   const Trajectory own = simulate("andrews_squeezer");
-  check("andrews_squeezer", "rtol 1e-6: beta at t=0.03 [rad]", reference[0], angles(own.y.back())[0], 1e-4, false,
+  check("andrews_squeezer", "rtol 1e-6: beta at t=0.03 [rad]", reference[0], angles(own.y.back())[0], 2e-4, false,
         "test set reference solution (Hairer, Wanner)");
 }
 
