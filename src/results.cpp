@@ -194,13 +194,9 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
                    y[nq + 3 * i + 1], y[nq + 3 * i + 2]);
   }
   system_.outputs(y, lambda, output_values_.data());
-  for (std::size_t k = 0; k < output_values_.size(); ++k) {
-    if (timeseries_) std::fprintf(timeseries_, ",%.12g", output_values_[k]);
-    if (std::abs(output_values_[k]) > peak_output_[k]) {
-      peak_output_[k] = std::abs(output_values_[k]);
-      peak_time_[k] = t;
-    }
-  }
+  if (timeseries_)
+    for (const double value : output_values_) std::fprintf(timeseries_, ",%.12g", value);
+  track_extrema(t, output_values_.data());
   body_accelerations(system_, t, y, lambda, acceleration_.data());
   if (!system_.model().output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
@@ -239,12 +235,6 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     if (std::abs(ay) > p.y) { p.y = std::abs(ay); p.t_y = t; }
     if (magnitude > p.magnitude) { p.magnitude = magnitude; p.t_magnitude = t; }
   }
-  for (CarCrush& car : cars_) {
-    double crush = 0.0;
-    for (std::size_t k = 0; k < car.columns.size(); ++k)
-      crush += car.shares[k] * std::max(0.0, output_values_[static_cast<std::size_t>(car.columns[k])]);
-    if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
-  }
   t_last_sample_ = t;
   // Keep what is on disk current without flushing every row; every write checked.
   if (!timeseries_ || !failure_.empty()) return;
@@ -255,6 +245,22 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   if (failure_.empty() && now - last_summary_ > std::chrono::seconds(2)) {
     write_running_summary(integrator_);
     last_summary_ = now;
+  }
+}
+
+void ResultWriter::step(double t, const double*, const double*, const double* outputs) { track_extrema(t, outputs); }
+
+void ResultWriter::track_extrema(double t, const double* outputs) {
+  for (std::size_t k = 0; k < peak_output_.size(); ++k)
+    if (std::abs(outputs[k]) > peak_output_[k]) {
+      peak_output_[k] = std::abs(outputs[k]);
+      peak_time_[k] = t;
+    }
+  for (CarCrush& car : cars_) {
+    double crush = 0.0;  // [length]
+    for (std::size_t k = 0; k < car.columns.size(); ++k)
+      crush += car.shares[k] * std::max(0.0, outputs[car.columns[k]]);
+    if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
   }
 }
 

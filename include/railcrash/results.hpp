@@ -100,6 +100,9 @@ class ResultWriter : public RunObserver {
 
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
   void event(const EventRecord& record, const double* y) override;
+  /// Element output peaks and car crush from every accepted step and both sides of every event.
+  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  bool observes_steps() const override { return true; }
   /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.
   std::string failure() const override { return failure_; }
   /// Writes summary.json with "status": "running" (t_reached and peaks so far; stats and
@@ -150,6 +153,8 @@ class ResultWriter : public RunObserver {
   double t_last_sample_ = 0.0;                           // [time]
   std::string failure_;                                  // first failed write, with the OS's reason
 
+  /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.
+  void track_extrema(double t, const double* outputs);
   std::string summary_text(const RunOutcome& outcome, const std::string& status, const std::string& integrator,
                            const std::string& extra_json) const;
   /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.
