@@ -153,7 +153,7 @@ TEST_CASE("a full disk stops the run at once with the OS reason and the summary 
   CHECK_FALSE(report.outcome.ok);
   CHECK_THAT(report.outcome.message, Catch::Contains("cannot write " + dir + "/timeseries.csv: No space left on device") &&
                                          Catch::Contains("the run stopped at t = "));
-  // Stopped once stdio's buffer (a few kB: some tens of 120-byte rows) reached the device, not at t_end.
+  // Stopped once the writer's 64 kB buffer (some 500 rows of 120 bytes) reached the device, not at t_end.
   CHECK(report.outcome.t_reached < 1.0);
   const std::string summary = file_text(dir + "/summary.json");
   CHECK_THAT(summary, Catch::Contains("\"status\": \"failed\"") && Catch::Contains("No space left on device"));

@@ -33,7 +33,6 @@
 #pragma once
 
 #include <chrono>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -88,6 +87,10 @@ std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole ro
 /// Column names of timeseries.csv: t, the six body columns per body, the element outputs.
 std::vector<std::string> timeseries_columns(const DaeSystem& system);
 class EnergyWriter;
+class BufferedFile;
+
+/// Writes ",value" for every value (as "%.12g") to a CSV row.
+void write_row_tail(BufferedFile& file, const std::vector<double>& values);
 
 class ResultWriter : public RunObserver {
  public:
@@ -129,8 +132,8 @@ class ResultWriter : public RunObserver {
  private:
   const DaeSystem& system_;
   std::string directory_;
-  std::FILE* timeseries_ = nullptr;
-  std::FILE* events_ = nullptr;
+  std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
+  int folder_descriptor_ = -1;                          // the open folder, to notice its removal
   std::vector<std::vector<double>> columns_;  // in memory, per timeseries column
   std::vector<double> output_values_;
   std::vector<double> peak_output_;  // largest |value| of each element output
@@ -138,8 +141,7 @@ class ResultWriter : public RunObserver {
   std::vector<double> acceleration_;  // 3 per body at the last sample
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
-  std::FILE* accelerations_file_ = nullptr;
-  std::FILE* energy_file_ = nullptr;
+  std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
   std::unique_ptr<EnergyWriter> energy_;
   double cfc_ = 60.0;
   std::vector<double> sample_times_;                  // [time]
