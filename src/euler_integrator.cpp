@@ -244,6 +244,7 @@ double EulerIntegrator::advance(double t_end) {
       fired = fired || direction_[k] != 0;
     }
     if (fired) {
+      observe_before_event(t_, y_.data());
       events_.clear();
       if (system_.commit_roots(t_, y_.data(), direction_.data(), events_)) {
         ++stats().reinitializations;

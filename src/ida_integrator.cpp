@@ -682,6 +682,7 @@ double IdaIntegrator::advance(double t_end) {
         const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
                                                            system_.element_load(c.element, t_n, y)};
         sample_up_to(c.t);  // (uses y_out, not the event state)
+        observe_before_event(c.t, y_at_event);
         events.clear();
         if (!restarted && !system_.commit_element_root(c.element, c.local, -1, c.t, y_at_event, events)) continue;
         for (int j = 0; j < model.elements()[static_cast<std::size_t>(c.element)]->root_count(); ++j)

@@ -9,8 +9,20 @@ namespace railcrash {
 
 void Integrator::report_events(const std::vector<EventRecord>& events, const double* y) {
   for (const EventRecord& record : events) observer_->event(record, y);
+  if (!events.empty()) deliver_step(events.front().t, y);
   outcome_.events.insert(outcome_.events.end(), events.begin(), events.end());
   outcome_.stats.events += static_cast<long>(events.size());
+}
+
+void Integrator::observe_before_event(double t, const double* y) {
+  if (observe_steps_ && non_finite_entry(y).empty()) deliver_step(t, y);
+}
+
+void Integrator::deliver_step(double t, const double* y) {
+  if (!observe_steps_) return;
+  const double* lambda = y + 2 * system_.body_unknowns();
+  system_.outputs(y, lambda, step_outputs_.data());
+  observer_->step(t, y, lambda, step_outputs_.data());
 }
 
 std::string Integrator::non_finite_entry(const double* y) const {
@@ -62,6 +74,8 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   const auto wall_start = std::chrono::steady_clock::now();
   outcome_ = RunOutcome{};
   observer_ = &observer;
+  observe_steps_ = observer.observes_steps();
+  step_outputs_.assign(system_.output_names().size(), 0.0);
   t_end_ = t_end;
   output_interval_ = output_interval;
   output_index_ = 1;
@@ -96,6 +110,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
         msg << divergence_phrase() << " at t = " << t_reached << ": " << bad << divergence_advice(last_sample_y_, t_sampled_);
         throw StepFailure(msg.str());
       }
+      deliver_step(t_reached, current_state());
       if (dense) {
         sample_up_to(t_reached);
       } else if (t_reached >= next_output_time() * (1.0 - 1e-12)) {

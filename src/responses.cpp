@@ -47,16 +47,21 @@ void ResponseTracker::sample(double, const double* y, const double* lambda, cons
     for (const CrushGauge& g : settings_.crush_gauges) initial_length_.push_back(gauge_length(g, y));
     started_ = true;
   }
+  if (vertical_force_column_ >= 0) system_.outputs(y, lambda, outputs_.data());
+  track_extrema(y, outputs_.data());
+}
+
+void ResponseTracker::step(double, const double* y, const double*, const double* outputs) {
+  if (started_) track_extrema(y, outputs);  // (events at the start come before the first sample)
+}
+
+void ResponseTracker::track_extrema(const double* y, const double* outputs) {
   for (std::size_t k = 0; k < settings_.crush_gauges.size(); ++k)
     responses_.max_crush[k] = std::max(responses_.max_crush[k], initial_length_[k] - gauge_length(settings_.crush_gauges[k], y));
-  if (vertical_force_column_ >= 0) {
-    system_.outputs(y, lambda, outputs_.data());
-    if (!vertical_window_closed_)
-      responses_.max_vertical_force =
-          std::max(responses_.max_vertical_force, std::abs(outputs_[static_cast<std::size_t>(vertical_force_column_)]));
-    responses_.max_anticlimber_crush =
-        std::max(responses_.max_anticlimber_crush, outputs_[static_cast<std::size_t>(horizontal_deformation_column_)]);
-  }
+  if (vertical_force_column_ < 0) return;
+  if (!vertical_window_closed_)
+    responses_.max_vertical_force = std::max(responses_.max_vertical_force, std::abs(outputs[vertical_force_column_]));
+  responses_.max_anticlimber_crush = std::max(responses_.max_anticlimber_crush, outputs[horizontal_deformation_column_]);
 }
 
 void ResponseTracker::event(const EventRecord& record, const double* y) {

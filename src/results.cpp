@@ -1,7 +1,12 @@
 #include "railcrash/results.hpp"
 
 #include <algorithm>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <filesystem>
@@ -9,6 +14,7 @@
 #include <map>
 #include <sstream>
 
+#include "railcrash/results/buffered_file.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/output_points.hpp"
 #include "railcrash/results/run_files.hpp"
@@ -147,21 +153,23 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
-    timeseries_ = std::fopen((directory + "/timeseries.csv").c_str(), "w");
-    events_ = std::fopen((directory + "/events.csv").c_str(), "w");
-    accelerations_file_ = std::fopen((directory + "/accelerations.csv").c_str(), "w");
-    energy_file_ = std::fopen((directory + "/energy.csv").c_str(), "w");
-    if (!timeseries_ || !events_ || !accelerations_file_ || !energy_file_)
-      throw InputError("cannot write into the output folder '" + directory + "'");
-    write_model_geometry(system, directory + "/model.json");
-    energy_ = std::make_unique<EnergyWriter>(system, energy_file_);
-    std::fputs("t", accelerations_file_);
+    for (auto [file, name] : {std::pair{&timeseries_, "timeseries.csv"}, {&events_, "events.csv"},
+                              {&accelerations_file_, "accelerations.csv"}, {&energy_file_, "energy.csv"}}) {
+      *file = std::make_unique<BufferedFile>(directory + "/" + name);
+      if (!(*file)->is_open())
+        throw InputError("cannot write into the output folder '" + directory + "': " + name + ": " + std::strerror((*file)->error()));
+    }
+    write_model_geometry(system, directory + "/model.json");  // (throws: before the folder is held open)
+    folder_descriptor_ = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (folder_descriptor_ < 0) throw InputError("cannot open the output folder '" + directory + "': " + std::strerror(errno));
+    energy_ = std::make_unique<EnergyWriter>(system, *energy_file_);
+    accelerations_file_->character('t');
     for (const Body& b : system.model().bodies())
-      for (const char* q : {"ax", "ay", "alpha"}) std::fprintf(accelerations_file_, ",%s.%s", b.name.c_str(), q);
-    std::fputs("\n", accelerations_file_);
-    for (std::size_t k = 0; k < names.size(); ++k) std::fprintf(timeseries_, "%s%s", k ? "," : "", names[k].c_str());
-    std::fputs("\n", timeseries_);
-    std::fputs("t,element,event,value\n", events_);
+      for (const char* q : {"ax", "ay", "alpha"}) accelerations_file_->text("," + b.name + "." + q);
+    accelerations_file_->character('\n');
+    for (std::size_t k = 0; k < names.size(); ++k) timeseries_->text((k ? "," : "") + names[k]);
+    timeseries_->character('\n');
+    events_->text("t,element,event,value\n");
   }
   if (keep_in_memory) columns_.resize(names.size());
   const std::size_t body_count = static_cast<std::size_t>(system.model().body_count());
@@ -177,37 +185,29 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
 }
 
 ResultWriter::~ResultWriter() {
-  if (timeseries_) std::fclose(timeseries_);
-  if (events_) std::fclose(events_);
-  if (accelerations_file_) std::fclose(accelerations_file_);
-  if (energy_file_) std::fclose(energy_file_);
+  if (folder_descriptor_ >= 0) ::close(folder_descriptor_);
 }
 
 void ResultWriter::sample(double t, const double* y, const double* lambda, const double* quadratures) {
-  errno = 0;  // a failed write below leaves its reason here (check_files)
   const int n = system_.model().body_count();
   const int nq = 3 * n;
   if (timeseries_) {
-    std::fprintf(timeseries_, "%.12g", t);
+    timeseries_->number(t);
     for (int i = 0; i < n; ++i)
-      std::fprintf(timeseries_, ",%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", y[3 * i], y[3 * i + 1], y[3 * i + 2], y[nq + 3 * i],
-                   y[nq + 3 * i + 1], y[nq + 3 * i + 2]);
+      for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2}) {
+        timeseries_->character(',');
+        timeseries_->number(y[k]);
+      }
   }
   system_.outputs(y, lambda, output_values_.data());
-  for (std::size_t k = 0; k < output_values_.size(); ++k) {
-    if (timeseries_) std::fprintf(timeseries_, ",%.12g", output_values_[k]);
-    if (std::abs(output_values_[k]) > peak_output_[k]) {
-      peak_output_[k] = std::abs(output_values_[k]);
-      peak_time_[k] = t;
-    }
-  }
+  if (timeseries_) write_row_tail(*timeseries_, output_values_);
+  track_extrema(t, output_values_.data());
   body_accelerations(system_, t, y, lambda, acceleration_.data());
   if (!system_.model().output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
-    if (timeseries_)
-      for (double value : point_values_) std::fprintf(timeseries_, ",%.12g", value);
+    if (timeseries_) write_row_tail(*timeseries_, point_values_);
   }
-  if (timeseries_) std::fputs("\n", timeseries_);
+  if (timeseries_) timeseries_->character('\n');
   if (!columns_.empty()) {  // same order as the CSV columns
     std::size_t column = 0;
     columns_[column++].push_back(t);
@@ -219,9 +219,9 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
       for (const double value : point_values_) columns_[column++].push_back(value);
   }
   if (accelerations_file_) {
-    std::fprintf(accelerations_file_, "%.12g", t);
-    for (double a : acceleration_) std::fprintf(accelerations_file_, ",%.12g", a);
-    std::fputs("\n", accelerations_file_);
+    accelerations_file_->number(t);
+    write_row_tail(*accelerations_file_, acceleration_);
+    accelerations_file_->character('\n');
   }
   if (energy_) energy_->sample(t, y, quadratures);
   sample_times_.push_back(t);
@@ -239,12 +239,6 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     if (std::abs(ay) > p.y) { p.y = std::abs(ay); p.t_y = t; }
     if (magnitude > p.magnitude) { p.magnitude = magnitude; p.t_magnitude = t; }
   }
-  for (CarCrush& car : cars_) {
-    double crush = 0.0;
-    for (std::size_t k = 0; k < car.columns.size(); ++k)
-      crush += car.shares[k] * std::max(0.0, output_values_[static_cast<std::size_t>(car.columns[k])]);
-    if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
-  }
   t_last_sample_ = t;
   // Keep what is on disk current without flushing every row; every write checked.
   if (!timeseries_ || !failure_.empty()) return;
@@ -258,22 +252,48 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
 }
 
+void ResultWriter::step(double t, const double*, const double*, const double* outputs) { track_extrema(t, outputs); }
+
+void ResultWriter::track_extrema(double t, const double* outputs) {
+  for (std::size_t k = 0; k < peak_output_.size(); ++k)
+    if (std::abs(outputs[k]) > peak_output_[k]) {
+      peak_output_[k] = std::abs(outputs[k]);
+      peak_time_[k] = t;
+    }
+  for (CarCrush& car : cars_) {
+    double crush = 0.0;  // [length]
+    for (std::size_t k = 0; k < car.columns.size(); ++k)
+      crush += car.shares[k] * std::max(0.0, outputs[car.columns[k]]);
+    if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
+  }
+}
+
+void write_row_tail(BufferedFile& file, const std::vector<double>& values) {
+  for (const double value : values) {
+    file.character(',');
+    file.number(value);
+  }
+}
+
 void ResultWriter::fail(const std::string& what, int error_number) {
   if (failure_.empty()) failure_ = what + ": " + std::strerror(error_number);
 }
 
 void ResultWriter::check_files(bool flush) {
-  const std::pair<std::FILE*, const char*> files[] = {
-      {timeseries_, "timeseries.csv"}, {events_, "events.csv"}, {accelerations_file_, "accelerations.csv"}, {energy_file_, "energy.csv"}};
-  const int write_error = errno;  // set by a failed write since sample() cleared it
+  const std::pair<BufferedFile*, const char*> files[] = {{timeseries_.get(), "timeseries.csv"},
+                                                         {events_.get(), "events.csv"},
+                                                         {accelerations_file_.get(), "accelerations.csv"},
+                                                         {energy_file_.get(), "energy.csv"}};
   for (const auto& [file, name] : files) {
     if (!file) continue;
-    if (std::ferror(file)) fail("cannot write " + directory_ + "/" + name, write_error != 0 ? write_error : EIO);
-    errno = 0;
-    if (flush && std::fflush(file) != 0) fail("cannot write " + directory_ + "/" + name, errno != 0 ? errno : EIO);
+    if (flush) file->flush();
+    if (file->error() != 0) fail("cannot write " + directory_ + "/" + name, file->error());
   }
-  std::error_code error;  // one stat per sample: a removed folder stops the run at its next sample
-  if (!std::filesystem::is_directory(directory_, error)) fail("the output folder " + directory_ + " is gone", ENOENT);
+  // One fstat of the open folder per sample (no path lookup): a removed folder (no links left)
+  // stops the run at its next sample.
+  struct stat folder {};
+  if (::fstat(folder_descriptor_, &folder) != 0 || folder.st_nlink == 0)
+    fail("the output folder " + directory_ + " is gone", ENOENT);
 }
 
 void ResultWriter::write_running_summary(const std::string& integrator) {
@@ -316,9 +336,11 @@ void ResultWriter::event(const EventRecord& record, const double*) {
       for (char c : *text) quoted += (c == '"') ? std::string("\"\"") : std::string(1, c);
       *text = quoted + "\"";
     }
-  errno = 0;
-  std::fprintf(events_, "%.12g,%s,%s,%.12g\n", record.t, element.c_str(), what.c_str(), record.value);
-  if (std::ferror(events_)) fail("cannot write " + directory_ + "/events.csv", errno != 0 ? errno : EIO);
+  events_->number(record.t);
+  events_->text("," + element + "," + what + ",");
+  events_->number(record.value);
+  events_->character('\n');
+  if (events_->error() != 0) fail("cannot write " + directory_ + "/events.csv", events_->error());
 }
 
 std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const {

@@ -58,6 +58,14 @@ class ProgressObserver : public RunObserver {
   void event(const EventRecord& record, const double* y) override {
     for (RunObserver* o : next_) o->event(record, y);
   }
+  /// Steps are passed on while the samples are (the extrema end where the files do).
+  void step(double t, const double* y, const double* lambda, const double* outputs) override {
+    if (non_finite_output_.empty())
+      for (RunObserver* o : next_) o->step(t, y, lambda, outputs);
+  }
+  bool observes_steps() const override {
+    return std::any_of(next_.begin(), next_.end(), [](const RunObserver* o) { return o->observes_steps(); });
+  }
   std::string failure() const override {
     for (const RunObserver* o : next_)
       if (std::string why = o->failure(); !why.empty()) return why;

@@ -153,7 +153,7 @@ TEST_CASE("a full disk stops the run at once with the OS reason and the summary 
   CHECK_FALSE(report.outcome.ok);
   CHECK_THAT(report.outcome.message, Catch::Contains("cannot write " + dir + "/timeseries.csv: No space left on device") &&
                                          Catch::Contains("the run stopped at t = "));
-  // Stopped once stdio's buffer (a few kB: some tens of 120-byte rows) reached the device, not at t_end.
+  // Stopped once the writer's 64 kB buffer (some 500 rows of 120 bytes) reached the device, not at t_end.
   CHECK(report.outcome.t_reached < 1.0);
   const std::string summary = file_text(dir + "/summary.json");
   CHECK_THAT(summary, Catch::Contains("\"status\": \"failed\"") && Catch::Contains("No space left on device"));
@@ -209,4 +209,69 @@ TEST_CASE("JSON strings stay valid UTF-8 and escaped whatever bytes a name or pa
   CHECK(json_string("end\xE2\x82") == "\"end" + replacement + replacement + "\"");      // truncated
   // Quotes, backslashes and control bytes are escaped (RFC 8259, section 7).
   CHECK(json_string("a\"b\\c\nd\te\x01") == "\"a\\\"b\\\\c\\nd\\te\\u0001\"");
+}
+
+// ---- peaks from every accepted step and event, not from the output rows ----
+
+namespace {
+
+/// |value| of summary.json's "peaks" entry of one element output.
+double summary_peak(const std::string& summary, const std::string& output) {
+  const std::string key = "\"" + output + "\": {\"abs_max\": ";
+  const std::size_t at = summary.find(key, summary.find("\"peaks\""));
+  REQUIRE(at != std::string::npos);
+  return std::stod(summary.substr(at + key.size()));
+}
+
+}  // namespace
+
+TEST_CASE("an element output's peak between two output rows does not depend on the output interval", "[results]") {
+  // A 1 kg mass at the spring's free length moving at 1 m/s on a 1e4 N/m spring: x = (v0 / w)
+  // sin(w t), w = 100 rad/s, so the force peaks at k v0 / w = v0 sqrt(k m) = 100 N at
+  // t = pi / 200 = 15.7 ms. Rows every 10 ms see 100 sin(2) = 90.9 N at most.
+  const std::string text =
+      "railcrash: 1\nname: bounce\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: mass, mass: 1.0, inertia: 0.1, position: [1.0, 0], velocity: [1.0, 0]}\nelements:\n"
+      "  - {name: spring, type: linear_spring, stiffness: 1.0e4, free_length: 1.0, "
+      "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+      "simulation: {t_end: 0.03, rtol: 1.0e-8, dt: 1.0e-6}\n";
+  const double exact = 100.0;  // [N]
+  for (const IntegratorKind integrator : {IntegratorKind::Ida, IntegratorKind::Euler}) {
+    std::vector<double> peaks;
+    for (const double output_interval : {0.01, 1.0e-5}) {
+      Model model = testing::model_from_text(text);
+      model.simulation.integrator = integrator;
+      model.simulation.output_interval = output_interval;
+      const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+      REQUIRE(report.outcome.ok);
+      peaks.push_back(summary_peak(report.summary_json, "spring.force"));
+    }
+    INFO((integrator == IntegratorKind::Ida ? "ida" : "euler") << ": peaks " << peaks[0] << " (10 ms rows), " << peaks[1]
+                                                                << " (10 us rows)");
+    // The peak is the largest value at the ends of the steps (not located between them): below
+    // the true one by about (w h)^2 / 8 for a step h across it, 2.4e-5 here for IDA at rtol
+    // 1e-8; Euler adds its O(w dt) amplitude error. The 10 ms rows alone gave 90.9 N.
+    const double tolerance = integrator == IntegratorKind::Ida ? 1e-4 : 1e-3;
+    CHECK(peaks[0] == Approx(exact).epsilon(tolerance));
+    CHECK(peaks[1] == Approx(exact).epsilon(tolerance));
+    CHECK(peaks[0] == Approx(peaks[1]).epsilon(tolerance));
+  }
+}
+
+TEST_CASE("the barrier model's crush-element peak is its force-crush curve's peak with 1 ms and 10 us rows", "[results]") {
+  // models/barrier/two_car_barrier.yaml: lead_crush's curve peaks at 1.67e6 lbf at 5 in of
+  // crush, which it passes at about 12 ms; its 1 ms rows alone saw 1.651e6 lbf.
+  std::vector<double> peaks, crush;
+  for (const double output_interval : {1.0e-3, 1.0e-5}) {
+    const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
+                                   {"simulation.t_end=0.03", "simulation.output_interval=" + std::to_string(output_interval)});
+    const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+    REQUIRE(report.outcome.ok);
+    peaks.push_back(summary_peak(report.summary_json, "lead_crush.force"));
+    crush.push_back(report.car_crush.at(0).max_crush);
+  }
+  INFO("peaks " << peaks[0] << ", " << peaks[1] << "; lead car crush " << crush[0] << ", " << crush[1]);
+  CHECK(peaks[0] == Approx(1.67e6).epsilon(1e-6));
+  CHECK(peaks[1] == Approx(1.67e6).epsilon(1e-6));
+  CHECK(crush[0] == Approx(crush[1]).epsilon(1e-6));
 }

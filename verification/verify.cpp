@@ -371,8 +371,10 @@ namespace {
 // report_comparison.md, from `railcrash sensitivity models/report/final_two_car.yaml`), as the
 // distance from perfect agreement that the case below allows. R1's run 0 is calibrated.
 constexpr double kReachedR1Error = 0.005;                 // rel (ours 1.2535)
-constexpr double kReachedR2Error = 0.09;                  // rel (ours 0.661: +8.3 %)
-constexpr double kReachedR3Error = 0.03;                  // rel (ours 1.914: +2.6 %)
+// R2 and R3 from the largest vertical anticlimber force over every step and event (it was
+// over the 1 ms rows, 0.661 and 1.914, before commit 5ec9569).
+constexpr double kReachedR2Error = 0.10;                  // rel (ours 0.6707: +9.95 %)
+constexpr double kReachedR3Error = 0.033;                 // rel (ours 1.9242: +3.17 %)
 constexpr double kReachedSignShortfall[2] = {0.34, 0.24};  // 1 - share kept (R1 4 of 6, R2 10 of 13)
 constexpr double kReachedRhoShortfall[2] = {0.83, 0.66};   // 1 - rho (R1 0.202, R2 0.367), less 0.03
 constexpr double kReachedTopFiveMissing[2] = {1.0, 2.0};   // R1 4 of 5, R2 3 of 5

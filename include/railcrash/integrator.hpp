@@ -37,6 +37,14 @@ class RunObserver {
   virtual void sample(double t, const double* y, const double* lambda, const double* quadratures) = 0;
   /// A committed mode change (contact, yield, rupture, ...); y is the state at that instant.
   virtual void event(const EventRecord& /*record*/, const double* /*y*/) {}
+  /// The state at the end of every accepted step and on both sides of every committed mode
+  /// change (before it: the old modes; after it: the new ones), whatever the output times:
+  /// for extrema (peaks, crush, responses) that must not depend on the output interval.
+  /// Nothing is written from it. lambda as in sample(); outputs: the element outputs there
+  /// (DaeSystem::outputs), evaluated once for all observers.
+  virtual void step(double /*t*/, const double* /*y*/, const double* /*lambda*/, const double* /*outputs*/) {}
+  /// True when step() does something: only then does the run loop evaluate the outputs per step.
+  virtual bool observes_steps() const { return false; }
   /// Why the observer cannot go on (a failed write: the OS's reason), "" while it can; the
   /// run loop stops at once when it is not empty.
   virtual std::string failure() const { return ""; }
@@ -115,8 +123,12 @@ class Integrator {
   virtual void finish() {}
 
   // ---- for the integrators: what the run loop owns ----
-  /// Forwards committed mode changes (the state at that instant: y) to the observer and the outcome.
+  /// Forwards committed mode changes (the state at that instant: y) to the observer and the
+  /// outcome; the observer's step() then sees y in the new modes.
   void report_events(const std::vector<EventRecord>& events, const double* y);
+  /// The state at t (y: q, v, multipliers) in the modes before a mode change about to be
+  /// committed there, for the observer's step() (a rupture's last force, say).
+  void observe_before_event(double t, const double* y);
   /// Dense output: samples every output time up to t_limit not sampled yet.
   void sample_up_to(double t_limit);
   RunStatistics& stats() { return outcome_.stats; }
@@ -125,6 +137,8 @@ class Integrator {
 
  private:
   void deliver_sample(double t);
+  /// Passes the state y at t, with its element outputs, to the observer's step().
+  void deliver_step(double t, const double* y);
   double next_output_time() const;
   /// Names the first non-finite entry of y ("" when all are finite).
   std::string non_finite_entry(const double* y) const;
@@ -138,6 +152,8 @@ class Integrator {
   double t_sampled_ = 0.0;      // last sample
   std::vector<double> sample_y_, sample_quadratures_;
   std::vector<double> last_sample_y_, last_sample_quadratures_;
+  bool observe_steps_ = false;       // the observer wants step()
+  std::vector<double> step_outputs_;  // element outputs at the last step
 };
 
 /// Largest |Phi| tracker shared by the integrators.

@@ -13,7 +13,9 @@
 //        event (the report takes it when the overriding end sill reaches the collision post,
 //        which the planar model has no mass for: an approximation, stated in summary.json)
 //   R3 = max(R1, R2) when both are below 1, else R1 + R2 (reading R-1)
-// The largest force and crush are taken over the output samples (finer output, finer peaks).
+// The largest force and crush are taken over the output samples, the ends of all accepted
+// steps and both sides of every mode change (RunObserver::step): the output interval does not
+// change them.
 // R2's largest vertical force is taken over the whole run or, as `vertical_force_window`
 // says, only until the anticlimber first unloads horizontally (largest crush) or first
 // separates (a reading: models/report/README.md).
@@ -44,12 +46,17 @@ class ResponseTracker : public RunObserver {
   ResponseTracker(const DaeSystem& system, const ResponseSettings& settings);
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
   void event(const EventRecord& record, const double* y) override;
+  /// The largest crush and forces from every accepted step and both sides of every event.
+  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  bool observes_steps() const override { return true; }
   Responses result() const;
   /// The responses as a JSON object (for summary.json).
   std::string json() const;
 
  private:
   double gauge_length(const CrushGauge& gauge, const double* y) const;
+  /// Updates the largest crush and forces with the state y and its element outputs.
+  void track_extrema(const double* y, const double* outputs);
 
   const DaeSystem& system_;
   ResponseSettings settings_;

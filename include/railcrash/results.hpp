@@ -33,7 +33,6 @@
 #pragma once
 
 #include <chrono>
-#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -88,6 +87,10 @@ std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole ro
 /// Column names of timeseries.csv: t, the six body columns per body, the element outputs.
 std::vector<std::string> timeseries_columns(const DaeSystem& system);
 class EnergyWriter;
+class BufferedFile;
+
+/// Writes ",value" for every value (as "%.12g") to a CSV row.
+void write_row_tail(BufferedFile& file, const std::vector<double>& values);
 
 class ResultWriter : public RunObserver {
  public:
@@ -100,6 +103,9 @@ class ResultWriter : public RunObserver {
 
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
   void event(const EventRecord& record, const double* y) override;
+  /// Element output peaks and car crush from every accepted step and both sides of every event.
+  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  bool observes_steps() const override { return true; }
   /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.
   std::string failure() const override { return failure_; }
   /// Writes summary.json with "status": "running" (t_reached and peaks so far; stats and
@@ -126,8 +132,8 @@ class ResultWriter : public RunObserver {
  private:
   const DaeSystem& system_;
   std::string directory_;
-  std::FILE* timeseries_ = nullptr;
-  std::FILE* events_ = nullptr;
+  std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
+  int folder_descriptor_ = -1;                          // the open folder, to notice its removal
   std::vector<std::vector<double>> columns_;  // in memory, per timeseries column
   std::vector<double> output_values_;
   std::vector<double> peak_output_;  // largest |value| of each element output
@@ -135,8 +141,7 @@ class ResultWriter : public RunObserver {
   std::vector<double> acceleration_;  // 3 per body at the last sample
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
-  std::FILE* accelerations_file_ = nullptr;
-  std::FILE* energy_file_ = nullptr;
+  std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
   std::unique_ptr<EnergyWriter> energy_;
   double cfc_ = 60.0;
   std::vector<double> sample_times_;                  // [time]
@@ -150,6 +155,8 @@ class ResultWriter : public RunObserver {
   double t_last_sample_ = 0.0;                           // [time]
   std::string failure_;                                  // first failed write, with the OS's reason
 
+  /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.
+  void track_extrema(double t, const double* outputs);
   std::string summary_text(const RunOutcome& outcome, const std::string& status, const std::string& integrator,
                            const std::string& extra_json) const;
   /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.

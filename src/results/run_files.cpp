@@ -62,7 +62,7 @@ void write_model_geometry(const DaeSystem& system, const std::string& path) {
   if (!out) throw InputError("cannot write " + path);
 }
 
-EnergyWriter::EnergyWriter(const DaeSystem& system, std::FILE* file) : system_(system), file_(file) {
+EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile& file) : system_(system), file_(file) {
   const Model& model = system.model();
   for (const auto& e : model.elements()) {
     auto it = std::find(types_.begin(), types_.end(), e->type());
@@ -71,9 +71,9 @@ EnergyWriter::EnergyWriter(const DaeSystem& system, std::FILE* file) : system_(s
   }
   if (model.constraint_rows() > 0) types_.push_back("penalty");  // Euler's penalty joints (zero under IDA)
   dissipated_.assign(types_.size(), 0.0);
-  std::fputs("t,kinetic,elastic,gravity,external_work,dissipated", file_);
-  for (const std::string& type : types_) std::fprintf(file_, ",dissipated.%s", type.c_str());
-  std::fputs(",balance_error\n", file_);
+  file_.text("t,kinetic,elastic,gravity,external_work,dissipated");
+  for (const std::string& type : types_) file_.text(",dissipated." + type);
+  file_.text(",balance_error\n");
 }
 
 void EnergyWriter::sample(double t, const double* y, const double* quadratures) {
@@ -101,9 +101,15 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   for (double d : dissipated_) dissipated += d;
   const double gravity = state.gravity - initial_gravity_;
   const double balance = state.kinetic + elastic + gravity + dissipated - initial_total_ - state.load_work;
-  std::fprintf(file_, "%.12g,%.12g,%.12g,%.12g,%.12g,%.12g", t, state.kinetic, elastic, gravity, state.load_work, dissipated);
-  for (double d : dissipated_) std::fprintf(file_, ",%.12g", d);
-  std::fprintf(file_, ",%.12g\n", balance);
+  file_.number(t);
+  for (const double value : {state.kinetic, elastic, gravity, state.load_work, dissipated}) {
+    file_.character(',');
+    file_.number(value);
+  }
+  write_row_tail(file_, dissipated_);
+  file_.character(',');
+  file_.number(balance);
+  file_.character('\n');
 }
 
 }  // namespace railcrash

@@ -256,6 +256,36 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
   lengths_.resize(front_index_.size());
   car_crush_.resize(crush_of_cars_.size());
   penetration_.resize(wheel_columns_.size());
+  step_extremes_.shortening.assign(front_index_.size(), 0.0);
+  step_extremes_.car_crush.assign(crush_of_cars_.size(), 0.0);
+  step_extremes_.lift.assign(wheel_columns_.size(), 0.0);
+}
+
+double ScenarioTracker::car_crush_now(std::size_t k, const double* outputs) const {
+  const CarCrush& car = crush_of_cars_[k];
+  std::vector<double> crush(car.columns.size());
+  for (std::size_t e = 0; e < crush.size(); ++e) crush[e] = outputs[car.columns[e]];
+  return shared_crush(crush, car.shares);
+}
+
+void ScenarioTracker::step(double, const double* y, const double*, const double* outputs) {
+  if (times_.empty()) return;  // the references (L(0), the offset at 0) come from the first sample
+  for (std::size_t k = 0; k < front_index_.size(); ++k)
+    step_extremes_.shortening[k] =
+        std::max(step_extremes_.shortening[k], lengths_[k].front() - distance(y, front_index_[k], rear_index_[k]));
+  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k)
+    step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], car_crush_now(k, outputs));
+  double offset = 0.0;  // [length]
+  if (vertical_offset_column_ >= 0) {
+    offset = outputs[vertical_offset_column_];
+    overridden_ = overridden_ || outputs[override_column_] > 0.0;
+  } else if (interface_upper_ >= 0) {
+    offset = y[3 * interface_upper_ + 1] - y[3 * interface_lower_ + 1];
+  }
+  if (!vertical_offset_.empty())
+    step_extremes_.offset_change = std::max(step_extremes_.offset_change, std::abs(offset - vertical_offset_.front()));
+  for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
+    step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
 }
 
 void ScenarioTracker::sample(double t, const double* y, const double* lambda, const double*) {
@@ -264,12 +294,7 @@ void ScenarioTracker::sample(double t, const double* y, const double* lambda, co
   for (std::size_t k = 0; k < passenger_index_.size(); ++k) vx_[k].push_back(velocities[3 * passenger_index_[k]]);
   for (std::size_t k = 0; k < front_index_.size(); ++k) lengths_[k].push_back(distance(y, front_index_[k], rear_index_[k]));
   system_.outputs(y, lambda, outputs_.data());
-  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
-    const CarCrush& car = crush_of_cars_[k];
-    std::vector<double> crush(car.columns.size());
-    for (std::size_t e = 0; e < crush.size(); ++e) crush[e] = outputs_[static_cast<std::size_t>(car.columns[e])];
-    car_crush_[k].push_back(shared_crush(crush, car.shares));
-  }
+  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) car_crush_[k].push_back(car_crush_now(k, outputs_.data()));
   if (vertical_offset_column_ >= 0) {
     vertical_offset_.push_back(outputs_[static_cast<std::size_t>(vertical_offset_column_)]);
     overridden_ = overridden_ || outputs_[static_cast<std::size_t>(override_column_)] > 0.0;
@@ -298,7 +323,7 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     CriterionResult r;
     r.criterion = "survival_space";
     r.subject = criteria_.survival_cars[k];
-    r.value = *std::max_element(car_crush_[k].begin(), car_crush_[k].end());
+    r.value = std::max(*std::max_element(car_crush_[k].begin(), car_crush_[k].end()), step_extremes_.car_crush[k]);
     r.limit = criteria_.survival_limit;
     r.pass = r.value <= r.limit;
     if (crush_of_cars_[k].columns.empty()) {  // nothing measured: not a pass
@@ -311,7 +336,7 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     CriterionResult r;
     r.criterion = "survival_gauge";
     r.subject = criteria_.survival_gauges[k].name;
-    r.value = largest_shortening(lengths_[k]);
+    r.value = std::max(largest_shortening(lengths_[k]), step_extremes_.shortening[k]);
     r.limit = criteria_.survival_limit;
     r.pass = r.value <= r.limit;
     out.push_back(r);
@@ -321,7 +346,7 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     CriterionResult r;
     r.criterion = "wheel_lift";
     r.subject = criteria_.wheels[k];
-    r.value = largest_lift(penetration_[k]);
+    r.value = std::max(largest_lift(penetration_[k]), step_extremes_.lift[k]);
     r.limit = criteria_.wheel_lift_limit;
     r.pass = r.value <= r.limit;
     out.push_back(r);
@@ -334,7 +359,7 @@ CriterionResult ScenarioTracker::interface_result() const {
   interface.criterion = "override";
   interface.subject = criteria_.interface_element.empty() ? criteria_.interface_bodies[0] + " / " + criteria_.interface_bodies[1]
                                                           : criteria_.interface_element;
-  interface.value = largest_change(vertical_offset_);
+  interface.value = std::max(largest_change(vertical_offset_), step_extremes_.offset_change);
   interface.limit = criteria_.override_limit;
   interface.pass = interface.value <= interface.limit && !overridden_;
   if (overridden_) interface.note = "the anticlimber faces overrode each other";

@@ -16,11 +16,11 @@
 //                          energy; under Euler the penalty joints are one more class, `penalty`.
 #pragma once
 
-#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "railcrash/dae_system.hpp"
+#include "railcrash/results/buffered_file.hpp"
 
 namespace railcrash {
 
@@ -30,12 +30,12 @@ void write_model_geometry(const DaeSystem& system, const std::string& path);
 /// Writes energy.csv one row per sample.
 class EnergyWriter {
  public:
-  EnergyWriter(const DaeSystem& system, std::FILE* file);
+  EnergyWriter(const DaeSystem& system, BufferedFile& file);
   void sample(double t, const double* y, const double* quadratures);
 
  private:
   const DaeSystem& system_;
-  std::FILE* file_;
+  BufferedFile& file_;
   std::vector<std::string> types_;       // element types, in first-appearance order
   std::vector<int> type_of_element_;     // index into types_
   std::vector<double> initial_elastic_;  // per element [energy]

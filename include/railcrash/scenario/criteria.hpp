@@ -121,6 +121,11 @@ class ScenarioTracker : public RunObserver {
  public:
   ScenarioTracker(const DaeSystem& system, const ScenarioCriteria& criteria);
   void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
+  /// The extrema of the crush, gauge, interface and wheel criteria also from every accepted
+  /// step and both sides of every event (the mean deceleration stays on the output rows: it
+  /// filters a uniform record).
+  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  bool observes_steps() const override { return true; }
   std::vector<CriterionResult> results() const;
   /// The scenario and its criteria as a JSON object (summary.json's "scenario").
   std::string json() const;
@@ -129,6 +134,8 @@ class ScenarioTracker : public RunObserver {
   const DaeSystem& system_;
   const ScenarioCriteria& criteria_;
   CriterionResult interface_result() const;
+  /// Crush of survival car k [length] from the element outputs.
+  double car_crush_now(std::size_t k, const double* outputs) const;
 
   std::vector<int> passenger_index_, front_index_, rear_index_;
   std::vector<CarCrush> crush_of_cars_;                 // of survival_cars, in their order
@@ -139,6 +146,12 @@ class ScenarioTracker : public RunObserver {
   std::vector<std::vector<double>> vx_, lengths_, penetration_, car_crush_;
   std::vector<double> vertical_offset_;
   bool overridden_ = false;
+  struct StepExtremes {                  // from step(), beside the rows' histories
+    std::vector<double> shortening;      // [length] per survival gauge
+    std::vector<double> car_crush;       // [length] per survival car
+    std::vector<double> lift;            // [length] per wheel
+    double offset_change = 0.0;          // [length] interface
+  } step_extremes_;
 };
 
 }  // namespace railcrash
