@@ -105,6 +105,7 @@ DaeSystem::DaeSystem(const Model& model) : model_(model) {
       constraint_row_owner_[static_cast<std::size_t>(model.constraint_offset(e) + r)] = static_cast<int>(e);
       row_is_rotational_[static_cast<std::size_t>(model.constraint_offset(e) + r)] = el.constraint_row_is_rotational(r);
     }
+    output_offset_.push_back(static_cast<int>(output_names_.size()));
     for (const std::string& q : el.output_names()) output_names_.push_back(el.name() + "." + q);
     root_offset_.push_back(root_count_);
     root_count_ += el.root_count();
@@ -775,15 +776,17 @@ void DaeSystem::reset_modes() const {
 }
 
 void DaeSystem::outputs(const double* y, const double* lambda, double* out) const {
-  const int nq = body_unknowns();
-  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
-    const Element& el = *model_.elements()[e];
-    const std::size_t count = el.output_names().size();
-    if (count == 0) continue;
-    const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-    el.outputs(gather_state(el, y, y + nq), element_lambda, out);
-    out += count;
-  }
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) element_outputs(static_cast<int>(e), y, lambda, out);
+}
+
+void DaeSystem::element_outputs(int e, const double* y, const double* lambda, double* out) const {
+  const auto k = static_cast<std::size_t>(e);
+  const int first = output_offset_[k];
+  const int end = k + 1 < output_offset_.size() ? output_offset_[k + 1] : static_cast<int>(output_names_.size());
+  if (first == end) return;
+  const Element& el = *model_.elements()[k];
+  const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(k) : nullptr;
+  el.outputs(gather_state(el, y, y + body_unknowns()), element_lambda, out + first);
 }
 
 }  // namespace railcrash

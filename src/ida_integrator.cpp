@@ -682,7 +682,7 @@ double IdaIntegrator::advance(double t_end) {
         const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
                                                            system_.element_load(c.element, t_n, y)};
         sample_up_to(c.t);  // (uses y_out, not the event state)
-        observe_before_event(c.t, y_at_event);
+        observe_before_event(c.t, y_at_event, c.element);
         events.clear();
         if (!restarted && !system_.commit_element_root(c.element, c.local, -1, c.t, y_at_event, events)) continue;
         for (int j = 0; j < model.elements()[static_cast<std::size_t>(c.element)]->root_count(); ++j)
@@ -698,7 +698,7 @@ double IdaIntegrator::advance(double t_end) {
         }
         ++stats().root_returns;
         if (!restarted && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
-          report_events(events, y_at_event);
+          report_events(events, y_at_event, c.element);
           // The element's new mode may end within this step too: its roots that are at or
           // below zero at t_n are located in [t_event, t_n] (or committed at once when
           // already outside at t_event) and queued in time order.

@@ -7,21 +7,27 @@
 
 namespace railcrash {
 
-void Integrator::report_events(const std::vector<EventRecord>& events, const double* y) {
+void Integrator::report_events(const std::vector<EventRecord>& events, const double* y, int element) {
   for (const EventRecord& record : events) observer_->event(record, y);
-  if (!events.empty()) deliver_step(events.front().t, y);
+  if (!events.empty()) deliver_step(events.front().t, y, element);
   outcome_.events.insert(outcome_.events.end(), events.begin(), events.end());
   outcome_.stats.events += static_cast<long>(events.size());
 }
 
-void Integrator::observe_before_event(double t, const double* y) {
-  if (observe_steps_ && non_finite_entry(y).empty()) deliver_step(t, y);
+void Integrator::observe_before_event(double t, const double* y, int element) {
+  if (observe_steps_ && non_finite_entry(y).empty()) deliver_step(t, y, element);
 }
 
-void Integrator::deliver_step(double t, const double* y) {
+void Integrator::deliver_step(double t, const double* y, int element) {
   if (!observe_steps_) return;
   const double* lambda = y + 2 * system_.body_unknowns();
-  system_.outputs(y, lambda, step_outputs_.data());
+  // At a located event only the changed element's outputs are evaluated again: evaluating all
+  // of them at every event made a train's cost grow as N^2 (events grow with N; 100 + 100
+  // cars over 0.01 s: 5.0 s before the per-event evaluation, 7.8 s with it, CPU).
+  if (element >= 0)
+    system_.element_outputs(element, y, lambda, step_outputs_.data());
+  else
+    system_.outputs(y, lambda, step_outputs_.data());
   observer_->step(t, y, lambda, step_outputs_.data());
 }
 

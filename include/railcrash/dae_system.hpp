@@ -179,6 +179,8 @@ class DaeSystem {
   /// Element output columns "<element>.<quantity>" and their values at y.
   const std::vector<std::string>& output_names() const { return output_names_; }
   void outputs(const double* y, const double* lambda, double* out) const;
+  /// Element e's outputs only, into their places in the whole array `out` (as outputs() fills it).
+  void element_outputs(int e, const double* y, const double* lambda, double* out) const;
 
   /// Mass-matrix diagonal entry of body unknown k (mass or inertia).
   double mass_diagonal(int k) const { return mass_[static_cast<std::size_t>(k)]; }
@@ -194,6 +196,7 @@ class DaeSystem {
   SparsePattern pattern_;
   std::vector<int> slots_;    // value slot of every addition, in assembly order
   std::vector<std::string> output_names_;
+  std::vector<int> output_offset_;  // first output of each element in output_names_
   std::vector<int> constraint_row_owner_;  // element index of each constraint row
   std::vector<bool> row_is_rotational_;
   std::vector<int> root_offset_;  // first root of each element

@@ -125,10 +125,12 @@ class Integrator {
   // ---- for the integrators: what the run loop owns ----
   /// Forwards committed mode changes (the state at that instant: y) to the observer and the
   /// outcome; the observer's step() then sees y in the new modes.
-  void report_events(const std::vector<EventRecord>& events, const double* y);
+  /// element: the one element that changed (its outputs are evaluated afresh for step(); the
+  /// others keep their values of the last step: they did not change mode), -1: any number.
+  void report_events(const std::vector<EventRecord>& events, const double* y, int element = -1);
   /// The state at t (y: q, v, multipliers) in the modes before a mode change about to be
   /// committed there, for the observer's step() (a rupture's last force, say).
-  void observe_before_event(double t, const double* y);
+  void observe_before_event(double t, const double* y, int element = -1);
   /// Dense output: samples every output time up to t_limit not sampled yet.
   void sample_up_to(double t_limit);
   RunStatistics& stats() { return outcome_.stats; }
@@ -138,7 +140,7 @@ class Integrator {
  private:
   void deliver_sample(double t);
   /// Passes the state y at t, with its element outputs, to the observer's step().
-  void deliver_step(double t, const double* y);
+  void deliver_step(double t, const double* y, int element = -1);
   double next_output_time() const;
   /// Names the first non-finite entry of y ("" when all are finite).
   std::string non_finite_entry(const double* y) const;
