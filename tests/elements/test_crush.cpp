@@ -148,3 +148,52 @@ TEST_CASE("crush spring input errors name the problem", "[elements][crush]") {
   CHECK_THAT(message("[[0, 0]]"), Catch::Contains("at least two points"));
   CHECK_THAT(message("[[0, 0, 1], [1, 2, 3]]"), Catch::Contains("test.yaml:") && Catch::Contains("curve"));
 }
+
+TEST_CASE("the run's element states: a snapshot restored undoes a commit and its history", "[elements][crush]") {
+  const Model model = testing::model_from_text(impact(10.0, 0.0, "ida"));
+  DaeSystem system(model);
+  const testing::DrivenElement<CrushSpring> c = crush_of(system);
+  std::vector<double> y = system.initial_state();
+  y[0] = 1.0 - 0.03;  // crushed 0.03, at rest: the reversal point
+  y[3] = 0.0;
+  std::vector<double> yp(y.size(), 0.0), before(y.size()), after(y.size());
+  std::vector<EventRecord> events;
+  const int past_first_point[3] = {0, 0, -1};
+  system.commit_roots(0.0, y.data(), past_first_point, events);
+  REQUIRE(c.state().segment == 1);  // on the plateau
+  system.residual(0.0, y.data(), yp.data(), before.data());
+  const ElementStates::Snapshot loading = system.modes().snapshot();
+  Element::Event event;
+  REQUIRE(c.commit(0, -1, 0.0, c.at(y.data(), y.data() + 3), nullptr, event));  // unloading from 0.03
+  REQUIRE(c.state().permanent_crush == Approx(0.02));
+  system.modes().restore(loading);
+  CHECK(c.state().mode == CrushSpring::Mode::Loading);
+  CHECK(c.state().segment == 1);
+  CHECK(c.state().permanent_crush == 0.0);
+  CHECK(c.state().max_crush == 0.0);
+  system.residual(0.0, y.data(), yp.data(), after.data());
+  CHECK(after == before);
+}
+
+TEST_CASE("Euler: a second run of one integrator starts from the same modes and repeats the first", "[elements][crush]") {
+  // The first run ends separated with a permanent crush of 0.045; the second must start in
+  // contact again with no crush history, as the first did.
+  const Model model = testing::model_from_text(impact(10.0, 0.0, "euler"));
+  DaeSystem system(model);
+  const std::unique_ptr<Integrator> euler = make_integrator(system, model.simulation);
+  struct Quiet : RunObserver {
+    void sample(double, const double*, const double*, const double*) override {}
+  } observer;
+  const RunOutcome first = euler->run(model.simulation.t_end, 0.01, observer);
+  const RunOutcome second = euler->run(model.simulation.t_end, 0.01, observer);
+  REQUIRE(first.ok);
+  REQUIRE(second.ok);
+  REQUIRE(first.events.size() == 3);  // starts in contact: curve segment 2, unloading, separation
+  REQUIRE(second.events.size() == first.events.size());
+  for (std::size_t k = 0; k < first.events.size(); ++k) {
+    CHECK(second.events[k].what == first.events[k].what);
+    CHECK(second.events[k].t == first.events[k].t);
+  }
+  CHECK(second.y == first.y);
+  CHECK(first.y[3] == Approx(std::sqrt(10.0)).epsilon(1e-3));
+}
