@@ -647,7 +647,6 @@ TEST_CASE("draft_gear Jacobian matches central differences in every mode", "[ele
       {S::Fractured, {}, 0.0}};
   for (const bool ground_first : {true, false}) {
     Model model = testing::model_from_text(two_bodies(gear_yaml(kGear, "    free_length: 1.0\n"), ground_first));
-    DraftGear& gear = gear_of(model);
     DaeSystem system(model);
     std::mt19937 rng(5);
     for (std::size_t k = 0; k < modes.size(); ++k) {
@@ -852,7 +851,6 @@ TEST_CASE("coupler_end Jacobian matches central differences in every mode", "[el
   for (const bool ground_first : {true, false}) {
     Model model = testing::model_from_text(two_bodies(
         coupler_end_yaml("    friction: 0.3\n    coupled: true\n    total_horizontal_slack: 0.02\n"), ground_first));
-    CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
     DaeSystem system(model);
     std::mt19937 rng(7);
     for (std::size_t k = 0; k < modes.size(); ++k) {
@@ -1093,7 +1091,6 @@ TEST_CASE("coupler_end with restitution and shear_load: Jacobian matches central
   for (const bool ground_first : {true, false}) {
     Model model = testing::model_from_text(
         two_bodies(coupler_end_yaml("    friction: 0.3\n    restitution: 0.6\n    shear_load: 1e9\n"), ground_first));
-    CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
     DaeSystem system(model);
     std::mt19937 rng(11);
     for (std::size_t k = 0; k < modes.size(); ++k) {
@@ -1255,7 +1252,6 @@ TEST_CASE("coupling Jacobian matches central differences in every mode", "[eleme
                        "    vertical_slack: 0.01\n    vertical_stiffness: 2e6\n    misalignment: 0.003\n    friction: 0.3\n"
                        "    free_length: 1.0\n"),
         ground_first));
-    Coupling& c = dynamic_cast<Coupling&>(*model.elements()[0]);
     DaeSystem system(model);
     std::mt19937 rng(13);
     for (const auto& h : horizontal)
