@@ -81,7 +81,6 @@ ElementState<double> gather_state(const Element& e, const double* q, const doubl
     const auto ks = static_cast<std::size_t>(k);
     s.q[ks] = {q[3 * b], q[3 * b + 1], q[3 * b + 2]};
     s.v[ks] = {v[3 * b], v[3 * b + 1], v[3 * b + 2]};
-    s.rotation[ks] = rotation_of(q[3 * b + 2]);
   }
   return s;
 }

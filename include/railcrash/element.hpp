@@ -51,15 +51,13 @@ struct PointRef {
   double sy = 0.0;  // [length] body-fixed offset, body y axis
 };
 
-/// Local state of an element: pose and rate of its two slots (ground slots stay zero), the
-/// cos and sin of their angles, and
+/// Local state of an element: pose and rate of its two slots (ground slots stay zero), and
 /// its mode and history (read-only; its slot in the run's ElementStates, null for an element
 /// without modes).
 template <class T>
 struct ElementState {
   std::array<Pose<T>, 2> q{};
   std::array<Pose<T>, 2> v{};
-  std::array<Rotation<T>, 2> rotation{};  // cos and sin of q[k].theta, computed once per evaluation
   const void* mode = nullptr;
 };
 
@@ -240,7 +238,6 @@ ElementState<D> seeded_state(const ElementState<double>& s) {
     sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
     sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
   }
-  for (std::size_t k = 0; k < 2; ++k) sd.rotation[k] = rotation_of(sd.q[k].theta);
   sd.mode = s.mode;
   return sd;
 }

@@ -163,7 +163,6 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
       *out[c] = D(*q[c]);
       out[c]->grad[0] = *v[c];
     }
-    sd.rotation[k] = rotation_of(sd.q[k].theta);
   }
   sd.mode = s.mode;
   const std::array<D, 3> x = kinematics(sd).strain;

@@ -154,7 +154,7 @@ class BeamElement : public ForceElement<BeamElement> {
     const PointRef& p1 = point(0);
     const PointRef& p2 = point(1);
     Kinematics<T> k;
-    k.d = point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy);
+    k.d = point_position(s.q[k2], p2.sx, p2.sy) - point_position(s.q[k1], p1.sx, p1.sy);
     k.length = sqrt(dot(k.d, k.d));
     k.strain[0] = k.length - length_;
     const Vec2<T> t1 = rotate(T(s.q[k1].theta - initial_angle_[0]), direction_[0], direction_[1]);
