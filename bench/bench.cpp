@@ -184,7 +184,7 @@ int kernels_benchmark(const std::string& template_path, const std::vector<int>& 
   std::fputs(line, stdout);
   for (const int n : cars) {
     const Model model = load_consist(template_path, n);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const std::vector<double> y = system.initial_state();
     std::vector<double> yp(y.size(), 0.0), r(y.size()), values(static_cast<std::size_t>(system.pattern().nonzeros()));
     std::vector<double> g(static_cast<std::size_t>(system.root_count()));

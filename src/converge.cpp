@@ -219,7 +219,7 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
   run.rtol = rtol;
   try {
     const Model model = load_for_run(plan, method, step, rtol);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::unique_ptr<ResponseTracker> responses;
     if (model.responses.defined()) responses = std::make_unique<ResponseTracker>(system, model.responses);
     Recorder recorder(system, run, responses.get());
@@ -520,7 +520,7 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   plan.length_unit = si ? "m" : "in";
   plan.force_unit = si ? "N" : "lbf";
 
-  const DaeSystem system(model);
+  DaeSystem system(model);
   for (const std::string& name : options.quantities.empty() ? default_quantities() : options.quantities)
     plan.quantities.push_back(resolve_quantity(name, system, plan.length_unit, plan.force_unit));
   for (std::size_t k = 0; k < plan.quantities.size(); ++k) {

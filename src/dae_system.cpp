@@ -87,7 +87,7 @@ EnergyBalance EnergyBalance::between(const EnergyState& start, const EnergyState
   return b;
 }
 
-DaeSystem::DaeSystem(const Model& model) : model_(model) {
+DaeSystem::DaeSystem(const Model& model) : model_(model), modes_(model) {
   RAILCRASH_DEMAND(model.finalized());
   const int n = model.body_count();
   mass_.resize(static_cast<std::size_t>(3 * n));
@@ -196,7 +196,7 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
   load_forces(t, q, f);
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
-    const ElementState<double> s = gather_state(el, q, v);
+    const ElementState<double> s = local_state(e, q, v);
     std::array<Pose<double>, 2> fe{};
     const int m = el.constraint_count();
     if (m == 0) {
@@ -205,7 +205,7 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
       const int offset = model_.constraint_offset(e);
       double reactions[kMaxConstraintRows] = {};  // multipliers the joint's friction sees
       if (penalty != nullptr) {
-        if (el.failed()) {
+        if (element_failed(e)) {
           if (penalty_lambda)
             for (int r = 0; r < m; ++r) penalty_lambda[offset + r] = 0.0;
           continue;
@@ -228,7 +228,7 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
       } else {
         continue;
       }
-      if (el.has_joint_force() && !el.failed()) el.add_joint_force(t, s, reactions, fe);
+      if (el.has_joint_force() && !element_failed(e)) el.add_joint_force(t, s, reactions, fe);
     }
     for (int k = 0; k < 2; ++k) {
       const int b = el.slot_body(k);
@@ -261,7 +261,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* r)
     const int m = el.constraint_count();
     if (m == 0) continue;
     const int offset = model_.constraint_offset(e);
-    if (el.failed()) {  // rows become lambda = 0, mu = 0
+    if (element_failed(e)) {  // rows become lambda = 0, mu = 0
       for (int row = 0; row < m; ++row) {
         r_phi[offset + row] = lambda[offset + row];
         r_vel[offset + row] = mu[offset + row];
@@ -322,7 +322,7 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
     const Element& el = *model_.elements()[e];
     const int m = el.constraint_count();
     sink.begin_element(static_cast<int>(e));
-    const ElementState<double> s = gather_state(el, q, v);
+    const ElementState<double> s = local_state(e, q, v);
     if (m == 0) {
       std::array<Pose<double>, 2> f{};
       ForceBlock df_dq{}, df_dv{};
@@ -340,8 +340,8 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
     el.constraint_hessian(s.q, phi, grad, hess);
     // A failed constraint writes the same entries (the pattern never changes) as zeros,
     // and ones on its lambda and mu diagonals.
-    const double active = el.failed() ? 0.0 : 1.0;
-    if (el.failed()) {
+    const double active = element_failed(e) ? 0.0 : 1.0;
+    if (element_failed(e)) {
       for (auto& row : grad)
         for (double& value : row) value = 0.0;
       for (auto& row : hess)
@@ -388,7 +388,7 @@ void DaeSystem::assemble_jacobian(double t, double cj, const double* y, const do
     std::array<Pose<double>, 2> f{};
     ForceBlock df_dq{}, df_dv{};
     double df_dlambda[6][kMaxConstraintRows] = {};
-    if (!el.failed()) el.add_joint_force_jacobian(t, s, lambda + offset, f, df_dq, df_dv, df_dlambda);
+    if (!element_failed(e)) el.add_joint_force_jacobian(t, s, lambda + offset, f, df_dq, df_dv, df_dlambda);
     for_each_body_pair(el, [&](int row, int col, std::size_t li, std::size_t lj) {
       sink.add(nq + row, col, -df_dq[li][lj]);
       sink.add(nq + row, nq + col, -df_dv[li][lj]);
@@ -423,16 +423,16 @@ void DaeSystem::force_jacobian(double t, const double* q, const double* v, const
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     const int m = el.constraint_count();
-    const ElementState<double> s = gather_state(el, q, v);
+    const ElementState<double> s = local_state(e, q, v);
     ForceBlock dq{}, dv{};
     if (m == 0) {
       std::array<Pose<double>, 2> f{};
       if (stiffest)
-        model_.elements()[e]->stiffest_force_jacobian(t, s, dq, dv);
+        el.stiffest_force_jacobian(t, s, dq, dv);
       else
         el.add_force_jacobian(t, s, f, dq, dv);
     } else {
-      if (!penalty || el.failed()) continue;
+      if (!penalty || element_failed(e)) continue;
       // f = -G^T (k Phi + c G v): df/dq ~ -k G^T G (curvature terms of the multiplier dropped:
       // this Jacobian only feeds the stability estimate), df/dv = -c G^T G.
       double phi[kMaxConstraintRows];
@@ -462,7 +462,7 @@ void DaeSystem::constraints(const double* q, double* phi, std::vector<Triplet>* 
     const int m = el.constraint_count();
     if (m == 0) continue;
     const int offset = model_.constraint_offset(e);
-    if (el.failed()) {  // no equation left: Phi = 0, no gradient
+    if (element_failed(e)) {  // no equation left: Phi = 0, no gradient
       for (int row = 0; row < m; ++row) phi[offset + row] = 0.0;
       continue;
     }
@@ -484,11 +484,11 @@ void DaeSystem::constraint_acceleration_bias(const double* q, const double* v, d
     const Element& el = *model_.elements()[e];
     const int m = el.constraint_count();
     if (m == 0) continue;
-    if (el.failed()) {
+    if (element_failed(e)) {
       for (int row = 0; row < m; ++row) gamma[model_.constraint_offset(e) + row] = 0.0;
       continue;
     }
-    const ElementState<double> s = gather_state(el, q, v);
+    const ElementState<double> s = local_state(e, q, v);
     double phi[kMaxConstraintRows];
     double grad[kMaxConstraintRows][6];
     double hess[kMaxConstraintRows][6][6];
@@ -624,13 +624,13 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     double power = 0.0;
-    const ElementState<double> s = gather_state(el, q, v);
+    const ElementState<double> s = local_state(e, q, v);
     if (el.constraint_count() == 0) {
       std::array<Pose<double>, 2> fe{};
       el.add_force(t, s, fe);
       for (std::size_t k = 0; k < 2; ++k)
         power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
-    } else if (el.has_joint_force() && !el.failed()) {
+    } else if (el.has_joint_force() && !element_failed(e)) {
       // Friction of a joint: its reactions are the multipliers (ida) or penalty forces (euler).
       const double* reactions = (penalty_lambda ? penalty_lambda : y + 2 * nq) + model_.constraint_offset(e);
       std::array<Pose<double>, 2> fe{};
@@ -661,7 +661,8 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   EnergyState s;
   s.kinetic = kinetic_energy(y + nq);
   s.gravity = gravity_potential(y);
-  for (const auto& el : model_.elements()) s.elastic += el->potential_energy(gather_state(*el, y, y + nq));
+  for (std::size_t e = 0; e < model_.elements().size(); ++e)
+    s.elastic += model_.elements()[e]->potential_energy(local_state(e, y, y + nq));
   if (penalty && constraint_rows() > 0) {
     std::vector<double> phi(static_cast<std::size_t>(constraint_rows()));
     constraints(y, phi.data(), nullptr);
@@ -681,7 +682,7 @@ void DaeSystem::roots(double t, const double* y, double* g) const {
     const Element& el = *model_.elements()[e];
     if (el.root_count() == 0) continue;
     const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-    el.roots(t, gather_state(el, y, y + nq), element_lambda, g + root_offset_[e]);
+    el.roots(t, local_state(static_cast<std::size_t>(e), y, y + nq), element_lambda, g + root_offset_[e]);
   }
 }
 
@@ -690,17 +691,18 @@ void DaeSystem::element_roots(int e, double t, const double* y, double* g) const
   const int nq = body_unknowns();
   const double* element_lambda =
       el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)) : nullptr;
-  el.roots(t, gather_state(el, y, y + nq), element_lambda, g);
+  el.roots(t, local_state(static_cast<std::size_t>(e), y, y + nq), element_lambda, g);
 }
 
 bool DaeSystem::commit_element_root(int e, int local, int direction, double t, const double* y,
-                                    std::vector<EventRecord>& events) const {
-  Element& el = *model_.elements()[static_cast<std::size_t>(e)];
+                                    std::vector<EventRecord>& events) {
+  const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
   const int nq = body_unknowns();
   const double* element_lambda =
       el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)) : nullptr;
   Element::Event event;
-  if (!el.commit(local, direction, t, gather_state(el, y, y + nq), element_lambda, event)) return false;
+  const auto index = static_cast<std::size_t>(e);
+  if (!el.commit(local, direction, t, local_state(index, y, y + nq), element_lambda, modes_.of(index), event)) return false;
   events.push_back({t, el.name(), event.what, event.value});
   return true;
 }
@@ -708,12 +710,12 @@ bool DaeSystem::commit_element_root(int e, int local, int direction, double t, c
 DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y) const {
   const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
   const int nq = body_unknowns();
-  const ElementState<double> s = gather_state(el, y, y + nq);
+  const ElementState<double> s = local_state(static_cast<std::size_t>(e), y, y + nq);
   ElementLoad load;
   load.body = {el.slot_body(0), el.slot_body(1)};
   if (el.constraint_count() == 0) {
     el.add_force(t, s, load.force);
-  } else if (el.has_joint_force() && !el.failed()) {
+  } else if (el.has_joint_force() && !element_failed(e)) {
     el.add_joint_force(t, s, y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)), load.force);
   }
   for (std::size_t k = 0; k < 2; ++k)
@@ -722,19 +724,19 @@ DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y)
 }
 
 bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                             std::vector<char>* changed_elements) const {
+                             std::vector<char>* changed_elements) {
   const int nq = body_unknowns();
   const double* lambda = y + 2 * nq;
   bool changed = false;
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
-    Element& el = *model_.elements()[e];
+    const Element& el = *model_.elements()[e];
     if (changed_elements && (*changed_elements)[e]) continue;
     for (int k = 0; k < el.root_count(); ++k) {
       const int d = direction[root_offset_[e] + k];
       if (d == 0) continue;
       const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
       Element::Event event;
-      if (el.commit(k, d, t, gather_state(el, y, y + nq), element_lambda, event)) {
+      if (el.commit(k, d, t, local_state(e, y, y + nq), element_lambda, modes_.of(e), event)) {
         changed = true;
         if (changed_elements) (*changed_elements)[e] = 1;
         events.push_back({t, el.name(), event.what, event.value});
@@ -746,7 +748,7 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
 }
 
 bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
-                                      std::vector<char>* changed_elements) const {
+                                      std::vector<char>* changed_elements) {
   if (root_count_ == 0) return false;
   std::vector<double> g(static_cast<std::size_t>(root_count_)), ahead(g.size());
   roots(t, y, g.data());
@@ -771,9 +773,13 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
   return any && commit_roots(t, y, direction.data(), events, changed_elements);
 }
 
-void DaeSystem::reset_modes() const {
-  for (const auto& el : model_.elements()) el->reset_modes();
+void DaeSystem::reset_modes() { modes_.reset(); }
+
+ElementState<double> DaeSystem::local_state(std::size_t e, const double* q, const double* v) const {
+  return gather_state(*model_.elements()[e], q, v, modes_.of(e));
 }
+
+bool DaeSystem::element_failed(std::size_t e) const { return model_.elements()[e]->failed(modes_.of(e)); }
 
 void DaeSystem::outputs(const double* y, const double* lambda, double* out) const {
   for (std::size_t e = 0; e < model_.elements().size(); ++e) element_outputs(static_cast<int>(e), y, lambda, out);
@@ -786,7 +792,7 @@ void DaeSystem::element_outputs(int e, const double* y, const double* lambda, do
   if (first == end) return;
   const Element& el = *model_.elements()[k];
   const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(k) : nullptr;
-  el.outputs(gather_state(el, y, y + body_unknowns()), element_lambda, out + first);
+  el.outputs(local_state(k, y, y + body_unknowns()), element_lambda, out + first);
 }
 
 }  // namespace railcrash

@@ -72,8 +72,9 @@ void Element::constraint_hessian(const std::array<Pose<double>, 2>&, double*, do
 void Element::add_force_jacobian(double, const ElementState<double>&, std::array<Pose<double>, 2>&, ForceBlock&,
                                  ForceBlock&) const {}
 
-ElementState<double> gather_state(const Element& e, const double* q, const double* v) {
+ElementState<double> gather_state(const Element& e, const double* q, const double* v, const void* mode) {
   ElementState<double> s;
+  s.mode = mode;
   for (int k = 0; k < 2; ++k) {
     const int b = e.slot_body(k);
     if (b == kGround) continue;
@@ -82,6 +83,11 @@ ElementState<double> gather_state(const Element& e, const double* q, const doubl
     s.v[ks] = {v[3 * b], v[3 * b + 1], v[3 * b + 2]};
   }
   return s;
+}
+
+ElementState<double> gather_state(const Element& e, const double* q, const double* v) {
+  RAILCRASH_DEMAND(e.mode_bytes() == 0);
+  return gather_state(e, q, v, nullptr);
 }
 
 }  // namespace railcrash

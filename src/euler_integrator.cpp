@@ -127,7 +127,7 @@ void check_step_count(const Model& model, double dt, long max_steps) {
 
 }  // namespace
 
-EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings)
+EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings)
     : Integrator(system), settings_(settings) {
   const Model& model = system.model();
   for (const Body& b : model.bodies())
@@ -136,6 +136,7 @@ EulerIntegrator::EulerIntegrator(const DaeSystem& system, EulerSettings settings
                        "' has zero inertia: explicit Euler needs every body's inertia to be positive "
                        "(use integrator: ida, or give the body an inertia)");
   const StartReport start = prepare_start(system, y0_, start_events_);
+  start_modes_ = system.modes().snapshot();
   assembly_correction_ = start.assembly.largest_position_change;
   settling_steps_ = start.equilibrium.steps;
   settling_displacement_ = start.equilibrium.largest_position_change;
@@ -189,6 +190,7 @@ void EulerIntegrator::start(double /*t_end*/) {
   double* q = y_.data();
   double* v = y_.data() + nq;
   // Modes as prepared (and settled) in the constructor; a second run starts from them too.
+  system_.modes().restore(start_modes_);
   // The multipliers' place in y (for output) holds the penalty forces.
   system_.generalized_forces(0.0, q, v, force_.data(), &penalty_, lambda_.data());
   std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);

@@ -33,7 +33,7 @@ std::string flag_name(int flag) {
 /// mode at most once here, and not at all when it has just changed at this instant
 /// (`changed_elements`, flags per element; empty: none has): a mode it enters sits on its own
 /// boundary, where round-off alone would decide whether it flips back.
-void restart_state(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
+void restart_state(DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
                    std::vector<EventRecord>& events, std::vector<char> changed_elements = {}) {
   changed_elements.resize(system.model().elements().size(), 0);
   consistent_rates(system, t, y, yp);
@@ -265,7 +265,7 @@ struct IdaIntegrator::Impl {
   }
 };
 
-IdaIntegrator::IdaIntegrator(const DaeSystem& system, IdaSettings settings) : Integrator(system), settings_(settings) {
+IdaIntegrator::IdaIntegrator(DaeSystem& system, IdaSettings settings) : Integrator(system), settings_(settings) {
   if (!(settings_.rtol > 0.0) || !std::isfinite(settings_.rtol))
     throw InputError("rtol must be a positive number (typical: 1e-6)");
 }
@@ -539,7 +539,7 @@ double IdaIntegrator::advance(double t_end) {
                                         const double* y_at_event, double t_n, const double* y_n,
                                         const double* quadratures) {
     const Element& el = *model.elements()[static_cast<std::size_t>(e)];
-    if (el.constraint_count() > 0 && el.failed()) return false;
+    if (el.constraint_count() > 0 && system_.element_failed(static_cast<std::size_t>(e))) return false;
     const double lag = t_n - t_event;
     const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
     const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);

@@ -268,7 +268,7 @@ namespace {
 /// Puts every element in the mode its state y belongs to: commits the roots that are
 /// negative (outside their mode), repeatedly, since one commit moves a piecewise law by one
 /// segment. Returns true when a mode changed.
-bool follow_modes(const DaeSystem& system, const std::vector<double>& y, std::vector<EventRecord>& events) {
+bool follow_modes(DaeSystem& system, const std::vector<double>& y, std::vector<EventRecord>& events) {
   const std::size_t count = static_cast<std::size_t>(system.root_count());
   if (count == 0) return false;
   std::vector<double> g(count);
@@ -313,7 +313,7 @@ bool project_positions(const DaeSystem& system, std::vector<double>& y) {
 
 }  // namespace
 
-EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector<double>& y,
+EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<double>& y,
                                             std::vector<EventRecord>& events) {
   EquilibriumReport report;
   const int n = system.size();
@@ -414,7 +414,9 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     std::vector<double> trial = y;
     for (int k = 0; k < nq; ++k) trial[static_cast<std::size_t>(k)] += delta[k];
     for (int k = 0; k < m; ++k) trial[static_cast<std::size_t>(2 * nq + k)] += delta[nq + k];
-    // The trial state on the joints, with every element in the mode the trial state is in.
+    // The trial state on the joints, with every element in the mode the trial state is in
+    // (from the modes and histories of y, restored when the step is rejected).
+    const ElementStates::Snapshot modes_at_y = system.modes().snapshot();
     changes.clear();
     const bool on_joints = project_positions(system, trial);
     if (on_joints) follow_modes(system, trial, changes);
@@ -437,8 +439,7 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
     const bool accept = on_joints && std::isfinite(next) &&
                         (work > work_noise || (work >= -work_noise && next <= current));
     if (!accept) {
-      std::vector<EventRecord> undone;
-      follow_modes(system, y, undone);  // back to the modes of y
+      system.modes().restore(modes_at_y);  // back to the modes and histories of y
       current = unbalance(y, nullptr);
       if ((step *= 0.25) < smallest_step) break;
       continue;
@@ -472,7 +473,7 @@ EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector
   return report;
 }
 
-StartReport prepare_start(const DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events) {
+StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events) {
   StartReport report;
   system.reset_modes();
   y = system.initial_state();

@@ -126,4 +126,29 @@ void Model::finalize() {
   finalized_ = true;
 }
 
+ElementStates::ElementStates(const Model& model) : model_(&model) {
+  RAILCRASH_DEMAND(model.finalized());
+  constexpr std::size_t kBlock = sizeof(std::max_align_t);
+  std::size_t blocks = 0;
+  for (const auto& element : model.elements()) {
+    const std::size_t bytes = element->mode_bytes();
+    offset_.push_back(blocks);
+    bytes_.push_back(bytes);
+    blocks += (bytes + kBlock - 1) / kBlock;
+  }
+  block_.resize(blocks);
+  reset();
+}
+
+void ElementStates::reset() {
+  const auto& elements = model_->elements();
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    if (bytes_[e] > 0) elements[e]->write_start_mode(block_.data() + offset_[e]);
+}
+
+void ElementStates::restore(const Snapshot& snapshot) {
+  RAILCRASH_DEMAND(snapshot.block.size() == block_.size());
+  block_ = snapshot.block;
+}
+
 }  // namespace railcrash

@@ -149,7 +149,7 @@ double output_interval_of(const SimulationSettings& settings) {
   return settings.output_interval > 0.0 ? settings.output_interval : settings.t_end / 500.0;
 }
 
-std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const SimulationSettings& settings) {
+std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings) {
   if (settings.integrator == IntegratorKind::Euler)
     return std::make_unique<EulerIntegrator>(system,
                                              EulerSettings{settings.dt, settings.force_dt, settings.penalty, settings.max_steps});
@@ -162,7 +162,7 @@ std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const Simul
 
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
                     bool keep_in_memory) {
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;
   std::vector<RunObserver*> observers;

@@ -58,7 +58,12 @@ double jacobian_error(const DaeSystem& system, double t, double cj, const std::v
 }
 
 RunOutcome simulate(const Model& model, double output_interval) {
-  const DaeSystem system(model);
+  DaeSystem system(model);
+  return simulate(system, output_interval);
+}
+
+RunOutcome simulate(DaeSystem& system, double output_interval) {
+  const Model& model = system.model();
   struct Quiet : RunObserver {
     void sample(double, const double*, const double*, const double*) override {}
   } observer;

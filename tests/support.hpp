@@ -25,6 +25,45 @@ double jacobian_error(const DaeSystem& system, double t, double cj, const std::v
 /// Runs the model with the integrator its settings ask for (no files, output every
 /// output_interval) and requires success.
 RunOutcome simulate(const Model& model, double output_interval = 0.01);
+/// The same on a given system, whose element modes then hold the run's final ones.
+RunOutcome simulate(DaeSystem& system, double output_interval = 0.01);
+
+/// Puts element e of the system in mode st (State: the element's declared slot type).
+template <class State>
+void set_mode(DaeSystem& system, const State& st, std::size_t e = 0) {
+  system.modes().as<State>(e) = st;
+}
+
+/// Element `index` of a system's model driven by hand (element tests): reads and writes its
+/// slot in the system's ElementStates.
+template <class E>
+class DrivenElement {
+ public:
+  using State = typename E::State;
+  DrivenElement(DaeSystem& system, std::size_t index)
+      : system_(&system), index_(index), element_(dynamic_cast<const E&>(*system.model().elements()[index])) {}
+
+  const E& element() const { return element_; }
+  const E* operator->() const { return &element_; }
+  State& state() const { return system_->modes().template as<State>(index_); }
+  void set_state(const State& st) const { state() = st; }
+  /// Back to the mode the element starts a run in.
+  void reset_modes() const { element_.write_start_mode(system_->modes().of(index_)); }
+  /// The element's local state at (q, v) with its mode.
+  ElementState<double> at(const double* q, const double* v) const {
+    return gather_state(element_, q, v, system_->modes().of(index_));
+  }
+  bool commit(int root, int direction, double t, ElementState<double> s, const double* lambda,
+              Element::Event& event) const {
+    s.mode = system_->modes().of(index_);
+    return element_.commit(root, direction, t, s, lambda, system_->modes().of(index_), event);
+  }
+
+ private:
+  DaeSystem* system_;
+  std::size_t index_;
+  const E& element_;
+};
 
 /// The R1 test model (SI): a 1000 kg car end at 2 m/s into an anticlimber fixed to ground
 /// (elastic to 0.01 m at 1e7 N/m, then 1e5 N/m), with a responses section (reference crush

@@ -28,7 +28,7 @@ using namespace railcrash;
 
 TEST_CASE("residual, Jacobian, roots and quadrature rates allocate no memory", "[dae][performance]") {
   const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   std::vector<double> yp(y.size(), 0.0), r(y.size()), values(static_cast<std::size_t>(system.pattern().nonzeros()));
   std::vector<double> g(static_cast<std::size_t>(system.root_count())), rates(static_cast<std::size_t>(system.quadrature_count()));

@@ -69,7 +69,7 @@ TEST_CASE("consist: three cars per side keep the template's cars, shifted by the
 
 TEST_CASE("consist: couplings start with the faces touching and carry no force", "[consist]") {
   const Model train = testing::model_from_text(make_consist_model(kTemplate, 2));
-  const DaeSystem system(train);
+  DaeSystem system(train);
   const std::vector<double> y = system.initial_state();
   for (const char* coupling : {"s2_coupling", "t2_coupling"}) {
     INFO(coupling);

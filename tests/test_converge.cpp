@@ -48,7 +48,7 @@ class TraceObserver : public RunObserver {
 
 Trace run_by_hand(const std::string& path, const std::string& column, const std::vector<std::string>& settings) {
   const Model model = load_model(path, settings);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   Trace trace;
   TraceObserver observer(system, column, trace);
   const RunOutcome outcome =
@@ -234,7 +234,7 @@ TEST_CASE("convergence study: max_crush and the peak forces take the same column
     INFO(path);
     const ConvergePlan plan = plan_convergence(path, options);
     const Model model = load_model(path);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const auto by_type = [&](const std::vector<std::pair<std::string, std::string>>& type_outputs) {
       std::set<int> columns;
       const auto& names = system.output_names();

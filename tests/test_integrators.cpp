@@ -47,13 +47,13 @@ struct StopAfter : RunObserver {
 TEST_CASE("Euler stability limit matches 2 / (sqrt(w^2 + (c/2m)^2) + c/2m)", "[integrators]") {
   SECTION("undamped: 2 / omega") {
     const Model model = testing::model_from_text(oscillator(200.0, 0.0, 1.0));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     // omega = sqrt(200 / 2) = 10 along x; the other directions have no stiffness.
     CHECK(EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr) == Approx(0.2).epsilon(1e-9));
   }
   SECTION("damped") {
     const Model model = testing::model_from_text(oscillator(200.0, 4.0, 1.0));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const double half_rate = 4.0 / 2.0 / 2.0;  // c / (2 m)
     CHECK(EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr) ==
           Approx(2.0 / (std::sqrt(100.0 + half_rate * half_rate) + half_rate)).epsilon(1e-9));
@@ -72,7 +72,7 @@ TEST_CASE("Gershgorin bound for large models is safe and close for a long chain"
       << ", at: [" << (i == 0 ? "1" : "0") << ", 0]}, {body: m" << i << ", at: [0, 0]}]}\n";
   s << "simulation: {t_end: 1}\n";
   const Model model = testing::model_from_text(s.str());
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const double limit = EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr);
   // Exact largest frequency of a fixed-free chain: 2 sqrt(k/m) sin((2n-1) pi / (2(2n+1))) < 2 sqrt(k/m).
   const double omega_max = 2.0 * 10.0 * std::sin((2.0 * n - 1.0) * M_PI / (2.0 * (2.0 * n + 1.0)));
@@ -82,7 +82,7 @@ TEST_CASE("Gershgorin bound for large models is safe and close for a long chain"
 
 TEST_CASE("Euler refuses a step above the stability limit unless forced, then reports divergence", "[integrators]") {
   Model model = testing::model_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3"));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   CHECK_THROWS_WITH(make_integrator(system, model.simulation),
                     Catch::Contains("above the stability limit") && Catch::Contains("0.2"));
   model.simulation.force_dt = true;
@@ -98,14 +98,14 @@ TEST_CASE("Euler needs positive inertia", "[integrators]") {
   const Model model = testing::model_from_text(
       "railcrash: 1\nname: p\nunits: SI\nbodies:\n  - {name: dot, mass: 1, inertia: 0, position: [0, 0]}\n"
       "simulation: {t_end: 1, integrator: euler}\n");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   CHECK_THROWS_WITH(make_integrator(system, model.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
 }
 
 TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
     Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     auto run = make_integrator(system, model.simulation);
     CountingObserver observer;
     const RunOutcome outcome = run->run(1.0, 0.25, observer);
@@ -119,7 +119,7 @@ TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "
 TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
     Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     auto run = make_integrator(system, model.simulation);
     std::atomic<bool> stop{false};
     StopAfter observer;
@@ -135,13 +135,13 @@ TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizin
   // t_end 1 at dt 1e-300 needs 1e300 steps (a long step count would overflow); dt 1e-3 needs
   // exactly 1000 steps: refused at max_steps 999, accepted at 1000.
   Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, ", integrator: euler, dt: 1e-300"));
-  const DaeSystem tiny_step(model);
+  DaeSystem tiny_step(model);
   CHECK_THROWS_WITH(make_integrator(tiny_step, model.simulation),
                     Catch::Contains("needs 1e+300 steps to reach t_end = 1, more than --max-steps 10000000") &&
                         Catch::Contains("use a larger dt (above 1e-07)"));
   model.simulation.dt = 1e-3;
   model.simulation.max_steps = 999;
-  const DaeSystem system(model);
+  DaeSystem system(model);
   CHECK_THROWS_WITH(make_integrator(system, model.simulation), Catch::Contains("needs 1000 steps"));
   model.simulation.max_steps = 1000;
   auto run = make_integrator(system, model.simulation);
@@ -159,7 +159,7 @@ TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizin
 TEST_CASE("IDA stops at max_steps as a failed run that says so", "[integrators]") {
   Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0));
   model.simulation.max_steps = 20;
-  const DaeSystem system(model);
+  DaeSystem system(model);
   auto run = make_integrator(system, model.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(1.0, 0.01, observer);
@@ -187,7 +187,7 @@ TEST_CASE("a run whose element output is not finite fails naming the element", "
 
 TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
   const Model model = testing::model_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   auto run = make_integrator(system, model.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(3.0, 0.1, observer);
@@ -234,7 +234,7 @@ TEST_CASE("Euler's divergence names the penalty joint with the largest violation
       "  - {name: hinge, type: pin_joint, penalty_stiffness: 1.0e6, "
       "points: [{body: ground, at: [0, 0]}, {body: bob, at: [-1, 0]}]}\n"
       "simulation: {t_end: 10, integrator: euler, dt: 5.0e-3, force_dt: true, output_interval: 0.01}\n");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   auto integrator = make_integrator(system, model.simulation);
   CountingObserver observer;
   const RunOutcome outcome = integrator->run(10.0, 0.01, observer);

@@ -121,7 +121,7 @@ void expect_error(const std::string& what, const std::string& text, int line, co
 /// Loads `text` and runs the initial assembly; returns the InputError message ("" if none).
 std::string assembly_error(const std::string& text) {
   const Model model = testing::model_from_text(text);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   try {
     (void)assemble_initial_state(system, y);
@@ -877,14 +877,14 @@ const std::string kWeld = R"(  - name: weld
 
 TEST_CASE("a properly constrained model assembles", "[model_io]") {
   const Model model = testing::model_from_text(single_body_model(kBar, kPinA));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   CHECK_NOTHROW(check_constraint_rank(system, y.data()));
   const AssemblyReport report = assemble_initial_state(system, y);
   CHECK(report.largest_position_change < 1e-12);
 
   const Model crank = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
-  const DaeSystem crank_system(crank);
+  DaeSystem crank_system(crank);
   std::vector<double> yc = crank_system.initial_state();
   CHECK_NOTHROW(assemble_initial_state(crank_system, yc));
 }
@@ -900,7 +900,7 @@ TEST_CASE("redundant joints are InputErrors naming the elements", "[model_io]") 
     CHECK_THAT(message, Contains("Remove one of them"));
     // check_constraint_rank alone says the same.
     const Model model = testing::model_from_text(text);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const std::vector<double> y = system.initial_state();
     CHECK_THROWS_WITH(check_constraint_rank(system, y.data()), Contains("redundant") && Contains("'weld'"));
   }

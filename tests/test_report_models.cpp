@@ -61,7 +61,7 @@ TEST_CASE("final two-car model, corrected variant: settled, the first 10 ms", "[
   CHECK(ida.stats.settling_steps > 0);
   std::vector<double> y0;
   std::vector<EventRecord> settling;
-  const DaeSystem system(model);
+  DaeSystem system(model);
   prepare_start(system, y0, settling);
   std::vector<double> out(system.output_names().size());
   system.outputs(y0.data(), y0.data() + 2 * system.body_unknowns(), out.data());
@@ -88,7 +88,7 @@ TEST_CASE("final two-car model, corrected variant: settled and without its impac
                            "rear_body", "rear_truck"})
     settings.push_back(std::string("bodies.car1_") + body + ".velocity=[0, 0]");
   const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car_corrected.yaml", settings);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   struct Stillness : RunObserver {
     std::vector<double> start;
     double largest_move = 0.0, largest_speed = 0.0;  // [in], [in/s]

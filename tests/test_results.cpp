@@ -73,7 +73,7 @@ struct FolderRemover : RunObserver {
 
 TEST_CASE("cars are the bodies' car: keys and an element between two cars counts half for each", "[results]") {
   const Model model = testing::model_from_text(two_car_text("car: striking, ", "car: struck, "));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const std::vector<CarCrush> cars = cars_of(system);
   REQUIRE(cars.size() == 2);
   CHECK(cars[0].car == "striking");
@@ -115,7 +115,7 @@ TEST_CASE("the barrier model's two cars are summarised separately", "[results]")
   // springs: lead_crush and lead_draft_sill within the leading car, trail_draft_sill within
   // the trailing one.
   const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const std::vector<CarCrush> cars = cars_of(system);
   REQUIRE(cars.size() == 2);
   const auto prefixed = [&](const std::string& prefix) {
@@ -164,7 +164,7 @@ TEST_CASE("a full disk stops the run at once with the OS reason and the summary 
 TEST_CASE("summary.json says running while the run goes and a vanished folder stops the run", "[results][faults]") {
   const std::string dir = temporary_folder("vanishing");
   const Model model = testing::model_from_text(spring_mass_text(10.0));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   ResultWriter writer(dir, system);
   writer.write_running_summary("ida");
   FolderRemover observer;

@@ -59,7 +59,7 @@ class BarrierRecorder : public RunObserver {
 
 BarrierRun run_barrier(const std::vector<std::string>& overrides, Model& model) {
   model = load_model(kModel, overrides);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   BarrierRun run;
   run.output_names = system.output_names();
   BarrierRecorder recorder(system, run);

@@ -51,7 +51,7 @@ std::string case_path(const std::string& name) { return std::string(RAILCRASH_SO
 /// Runs verification/cases/<name>.yaml with optional KEY=VALUE overrides.
 Trajectory simulate(const std::string& name, const std::vector<std::string>& overrides = {}) {
   const Model model = load_model(case_path(name), overrides);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   Trajectory trajectory;
   Recorder recorder(trajectory);
   recorder.size = system.size();

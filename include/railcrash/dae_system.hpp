@@ -13,6 +13,10 @@
 //
 // The same element code also gives the plain generalized forces for explicit integration,
 // with constraints replaced by penalty spring-dampers.
+//
+// A DaeSystem is one run's view of an immutable Model: it owns the run's ElementStates. Its
+// const methods (residual, Jacobian, forces, roots, outputs, energy) read the element modes
+// and change nothing; the commit methods and reset_modes() are the only ones that change them.
 #pragma once
 
 #include <array>
@@ -114,7 +118,11 @@ class DaeSystem {
   /// matrix or a load, else the residual row that overflows; "" when everything is finite.
   std::string non_finite_source(double t, const double* y, const double* yp) const;
   /// False once the element owning constraint row `row` has failed (its rows: lambda = mu = 0).
-  bool constraint_row_active(int row) const { return !constraint_owner(row).failed(); }
+  bool constraint_row_active(int row) const {
+    return !element_failed(static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)]));
+  }
+  /// True once element e has failed (a failed constraint: lambda = mu = 0).
+  bool element_failed(std::size_t e) const;
   /// True when constraint row `row` is an angle equation.
   bool constraint_row_is_rotational(int row) const { return row_is_rotational_[static_cast<std::size_t>(row)]; }
 
@@ -140,7 +148,7 @@ class DaeSystem {
   /// With `changed_elements` (one flag per element): flagged elements are left alone and the
   /// ones that change are flagged, so that no element changes mode twice at one instant.
   bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                    std::vector<char>* changed_elements = nullptr) const;
+                    std::vector<char>* changed_elements = nullptr);
   /// Element-level access for integrators that locate events element by element.
   int root_offset(int e) const { return root_offset_[static_cast<std::size_t>(e)]; }
   /// Element owning root k.
@@ -152,7 +160,7 @@ class DaeSystem {
   /// Commits element e's root `local` (direction -1: it fell through zero) at y; appends the
   /// event. Returns true when the element changed mode.
   bool commit_element_root(int e, int local, int direction, double t, const double* y,
-                           std::vector<EventRecord>& events) const;
+                           std::vector<EventRecord>& events);
   /// What element e alone contributes at y: its generalized forces on its two body slots (force
   /// elements, and joint friction from the multipliers in y; not the constraint rows) and the
   /// power delivered to it (its work quadrature's rate). Lets an integrator judge a mode change
@@ -172,9 +180,13 @@ class DaeSystem {
   /// cross; IDA itself would leave a root that is exactly zero inactive. Returns true when a
   /// mode changed. `changed_elements` as in commit_roots (repeated passes at one restart).
   bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
-                             std::vector<char>* changed_elements = nullptr) const;
+                             std::vector<char>* changed_elements = nullptr);
   /// Puts every element back in its starting mode.
-  void reset_modes() const;
+  void reset_modes();
+  /// The run's element modes and histories: evaluations read them, only the commits above
+  /// change them; snapshot() / restore() go back to an earlier state.
+  const ElementStates& modes() const { return modes_; }
+  ElementStates& modes() { return modes_; }
 
   /// Element output columns "<element>.<quantity>" and their values at y.
   const std::vector<std::string>& output_names() const { return output_names_; }
@@ -189,9 +201,12 @@ class DaeSystem {
   template <class Sink>
   void assemble_jacobian(double t, double cj, const double* y, const double* yp, Sink& sink) const;
   double gravity_potential(const double* q) const;
+  /// Element e's local state at (q, v), with its mode.
+  ElementState<double> local_state(std::size_t e, const double* q, const double* v) const;
   void load_forces(double t, const double* q, double* f) const;
 
   const Model& model_;
+  ElementStates modes_;  // the run's element modes and histories (the only state a DaeSystem changes)
   std::vector<double> mass_;  // 3n diagonal of M
   SparsePattern pattern_;
   std::vector<int> slots_;    // value slot of every addition, in assembly order

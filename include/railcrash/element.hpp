@@ -18,10 +18,21 @@
 // The integrator locates the root (IDA) or sees it at the end of a step (Euler), then calls
 // commit(), which changes the mode and its history (plastic offsets, ...). History never
 // changes inside a residual evaluation.
+//
+// Data apart from state (the Model/Data split): an element holds only parameters and
+// connection points, immutable once the model is finalized. Its mode and history live in the
+// run's ElementStates (model.hpp), one contiguous block with a slot per element; the element
+// reads its slot through ElementState::mode and commit() writes into it. A stateful element
+// declares its slot type (a trivially copyable struct) with mode_bytes() and
+// write_start_mode(), and reads it with mode_as<State>(s).
 #pragma once
 
 #include <array>
+#include <cassert>
+#include <cstddef>
+#include <new>
 #include <optional>
+#include <type_traits>
 #include <string>
 #include <vector>
 
@@ -40,12 +51,31 @@ struct PointRef {
   double sy = 0.0;  // [length] body-fixed offset, body y axis
 };
 
-/// Local state of an element: pose and rate of its two slots (ground slots stay zero).
+/// Local state of an element: pose and rate of its two slots (ground slots stay zero), and
+/// its mode and history (read-only; its slot in the run's ElementStates, null for an element
+/// without modes).
 template <class T>
 struct ElementState {
   std::array<Pose<T>, 2> q{};
   std::array<Pose<T>, 2> v{};
+  const void* mode = nullptr;
 };
+
+/// The same local state with another mode (e.g. the stiffest one, for a stability estimate).
+template <class T, class State>
+ElementState<T> in_mode(const ElementState<T>& s, const State& mode) {
+  ElementState<T> other = s;
+  other.mode = &mode;
+  return other;
+}
+
+/// The mode and history of a stateful element, State being the type it declared.
+template <class State, class T>
+const State& mode_as(const ElementState<T>& s) {
+  static_assert(std::is_trivially_copyable_v<State>, "element states are copied as bytes (snapshots)");
+  assert(s.mode != nullptr);
+  return *static_cast<const State*>(s.mode);
+}
 
 /// What an element output means to the run summary, `converge`, the responses and the report,
 /// so that none of them has to know element types. Each element type declares, next to its
@@ -137,23 +167,28 @@ class Element {
     double value = 0.0; // the quantity that triggered it (deformation, force, ...)
   };
   /// Root `index` changed sign (direction +1: increasing, -1: decreasing) at state s:
-  /// commit the mode change. Returns false when the crossing needs no change (the element
+  /// commit the mode change into `mode` (the element's slot in the run's ElementStates, the
+  /// one s.mode points to). Returns false when the crossing needs no change (the element
   /// may then log nothing).
   virtual bool commit(int /*index*/, int /*direction*/, double /*t*/, const ElementState<double>& /*s*/,
-                      const double* /*lambda*/, Event& /*event*/) {
+                      const double* /*lambda*/, void* /*mode*/, Event& /*event*/) const {
     return false;
   }
   /// The force Jacobian in the element's stiffest mode at state s, for explicit Euler's
   /// stability limit (an element that starts open has no stiffness at t = 0). Default: the
   /// current mode's.
-  virtual void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+  virtual void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                       ForceBlock& df_dv) const {
     std::array<Pose<double>, 2> f{};
     add_force_jacobian(t, s, f, df_dq, df_dv);
   }
-  /// Back to the mode the element starts a run in.
-  virtual void reset_modes() {}
-  /// A failed constraint keeps its rows as lambda = 0, mu = 0 (so the pattern never changes).
-  virtual bool failed() const { return false; }
+  /// Size of the element's slot in ElementStates [bytes]; 0 for an element without modes.
+  virtual std::size_t mode_bytes() const { return 0; }
+  /// Writes the mode the element starts a run in into its slot (mode_bytes() bytes).
+  virtual void write_start_mode(void* /*mode*/) const {}
+  /// A failed constraint keeps its rows as lambda = 0, mu = 0 (so the pattern never changes);
+  /// mode: the element's slot.
+  virtual bool failed(const void* /*mode*/) const { return false; }
 
   // ---- energy and output ----
   /// Energy stored in the element [force*length].
@@ -203,6 +238,7 @@ ElementState<D> seeded_state(const ElementState<double>& s) {
     sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
     sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
   }
+  sd.mode = s.mode;
   return sd;
 }
 
@@ -322,7 +358,16 @@ class ConstraintElement : public Element {
   }
 };
 
-/// Local state of element e gathered from the global q and v arrays (ground slots are zero).
+/// Local state of element e gathered from the global q and v arrays (ground slots are zero);
+/// mode: its slot in the run's ElementStates (DaeSystem::modes()).
+ElementState<double> gather_state(const Element& e, const double* q, const double* v, const void* mode);
+/// The same for an element without modes (mode_bytes() == 0; an internal error otherwise).
 ElementState<double> gather_state(const Element& e, const double* q, const double* v);
+
+/// Declares a stateful element's slot: State is its type, start_mode the member holding the
+/// mode a run starts in (set by the constructor or initialize()).
+#define RAILCRASH_ELEMENT_MODE(State, start_mode)                                         \
+  std::size_t mode_bytes() const override { return sizeof(State); }                     \
+  void write_start_mode(void* slot) const override { new (slot) State(start_mode); }
 
 }  // namespace railcrash

@@ -30,7 +30,7 @@ struct EulerSettings {
 
 class EulerIntegrator : public Integrator {
  public:
-  EulerIntegrator(const DaeSystem& system, EulerSettings settings);
+  EulerIntegrator(DaeSystem& system, EulerSettings settings);
   const char* name() const override { return "euler"; }
 
   /// Step actually used and the stability limit (valid after construction).
@@ -66,6 +66,7 @@ class EulerIntegrator : public Integrator {
   long settling_steps_ = 0;
   double settling_displacement_ = 0.0;
   std::vector<EventRecord> start_events_;  // mode changes while settling
+  ElementStates::Snapshot start_modes_;    // element modes as prepared (and settled), where every run starts
   PenaltyRows penalty_;
 
   // The run in progress: y = [q, v, penalty forces] (the multipliers' place holds the

@@ -39,7 +39,7 @@ struct IdaSettings {
 
 class IdaIntegrator : public Integrator {
  public:
-  IdaIntegrator(const DaeSystem& system, IdaSettings settings);
+  IdaIntegrator(DaeSystem& system, IdaSettings settings);
   ~IdaIntegrator() override;
   const char* name() const override { return "ida"; }
 

@@ -69,7 +69,7 @@ struct EquilibriumReport {
 /// stays, unlogged (none in the report's models).
 /// A model with several equilibria reaches the one this damped descent leads to.
 /// Throws SolverError when it does not settle.
-EquilibriumReport settle_static_equilibrium(const DaeSystem& system, std::vector<double>& y,
+EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<double>& y,
                                             std::vector<EventRecord>& events);
 
 struct StartReport {
@@ -80,7 +80,7 @@ struct StartReport {
 /// The state a run starts from: every element in its starting mode, the model's coordinates
 /// with the joints assembled, then (simulation.static_equilibrium) settled under gravity
 /// with the model's velocities projected onto the joints.
-StartReport prepare_start(const DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events);
+StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events);
 
 /// Throws InputError when the constraint rows are linearly dependent at q, naming them.
 void check_constraint_rank(const DaeSystem& system, const double* q);

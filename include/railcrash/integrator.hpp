@@ -91,7 +91,7 @@ class Integrator {
     using std::runtime_error::runtime_error;
   };
 
-  explicit Integrator(const DaeSystem& system) : system_(system) {}
+  explicit Integrator(DaeSystem& system) : system_(system) {}
 
   // ---- per-integrator steps ----
   /// Prepares the state at t = 0 (reporting start events through report_events).
@@ -135,7 +135,7 @@ class Integrator {
   void sample_up_to(double t_limit);
   RunStatistics& stats() { return outcome_.stats; }
 
-  const DaeSystem& system_;
+  DaeSystem& system_;
 
  private:
   void deliver_sample(double t);

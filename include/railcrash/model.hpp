@@ -7,6 +7,8 @@
 #pragma once
 
 #include <array>
+#include <cassert>
+#include <cstddef>
 #include <map>
 #include <memory>
 #include <optional>
@@ -168,6 +170,48 @@ class Model {
   int constraint_rows_ = 0;
   double length_scale_ = 1.0;
   bool finalized_ = false;
+};
+
+/// Everything about a model's elements that changes during a run: each element's mode and
+/// history (contact open or closed, plastic offsets, hysteresis memory, permanent set, failed
+/// flags, ...), one slot per element (mode_bytes() of it, 0 for an element without modes) in
+/// one contiguous block. The Model stays immutable; a run owns one ElementStates (DaeSystem
+/// holds it), and events, restarts, the static settle and Euler go back to an earlier state
+/// with snapshot() / restore().
+class ElementStates {
+ public:
+  /// Every element of a finalized model in the mode it starts a run in.
+  explicit ElementStates(const Model& model);
+
+  /// Back to the starting modes.
+  void reset();
+  /// Element e's slot (null for an element without modes).
+  const void* of(std::size_t e) const { return bytes_[e] == 0 ? nullptr : block_.data() + offset_[e]; }
+  void* of(std::size_t e) { return bytes_[e] == 0 ? nullptr : block_.data() + offset_[e]; }
+  /// Element e's slot as the State type it declared.
+  template <class State>
+  const State& as(std::size_t e) const {
+    assert(bytes_[e] == sizeof(State));
+    return *static_cast<const State*>(of(e));
+  }
+  template <class State>
+  State& as(std::size_t e) {
+    assert(bytes_[e] == sizeof(State));
+    return *static_cast<State*>(of(e));
+  }
+
+  /// A copy of every element's mode, to go back to with restore().
+  struct Snapshot {
+    std::vector<std::max_align_t> block;
+  };
+  Snapshot snapshot() const { return {block_}; }
+  void restore(const Snapshot& snapshot);
+
+ private:
+  const Model* model_;
+  std::vector<std::size_t> offset_;  // [blocks] first block of each element's slot
+  std::vector<std::size_t> bytes_;   // [bytes] size of each element's slot
+  std::vector<std::max_align_t> block_;
 };
 
 }  // namespace railcrash

@@ -33,7 +33,7 @@ std::vector<OptionSetting> option_settings(const RunOverrides& overrides);
 void apply_overrides(Model& model, const RunOverrides& overrides);
 
 /// The integrator the model's settings ask for.
-std::unique_ptr<Integrator> make_integrator(const DaeSystem& system, const SimulationSettings& settings);
+std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings);
 
 /// Output interval actually used (the setting, or t_end / 500).
 double output_interval_of(const SimulationSettings& settings);

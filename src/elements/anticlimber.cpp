@@ -128,7 +128,7 @@ Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type,
 
 // ---- geometry and modes -----------------------------------------------------------------------
 
-Anticlimber::Deformations Anticlimber::deformations(const ElementState<double>& s) const {
+Anticlimber::Deformations Anticlimber::deformations(const State& st, const ElementState<double>& s) const {
   const Kinematics<double> k = kinematics(s);
   const PointRef& p1 = point(0);
   const PointRef& p2 = point(1);
@@ -145,25 +145,25 @@ Anticlimber::Deformations Anticlimber::deformations(const ElementState<double>& 
   out.offset = k.vertical;
   out.rotation = k.rotation;
   out.d[0] = k.horizontal;
-  out.d[1] = k.vertical - state_.vertical_reference;
-  out.d[2] = k.rotation - state_.torsional_reference;
+  out.d[1] = k.vertical - st.vertical_reference;
+  out.d[2] = k.rotation - st.torsional_reference;
   out.rate[0] = -(*facing) * along_rate;
   out.rate[1] = across_rate;
   out.rate[2] = v2.theta - v1.theta;
   return out;
 }
 
-void Anticlimber::roots_of(const Deformations& k, double* g) const {
+void Anticlimber::roots_of(const State& st, const Deformations& k, double* g) const {
   for (int i = 0; i < kRootCount; ++i) g[i] = 1.0;
-  switch (state_.contact) {
+  switch (st.contact) {
     case Contact::Open:
-      g[kContactRoot] = state_.horizontal.offset - k.d[0];
+      g[kContactRoot] = st.horizontal.offset - k.d[0];
       break;
     case Contact::Engaged:
-      horizontal.roots(state_.horizontal, k.d[0], k.rate[0], g + kHorizontalRoots);
-      if (!state_.interlock_released) {
-        vertical.roots(state_.vertical, k.d[1], k.rate[1], g + kVerticalRoots);
-        torsional.roots(state_.torsional, k.d[2], k.rate[2], g + kTorsionalRoots);
+      horizontal.roots(st.horizontal, k.d[0], k.rate[0], g + kHorizontalRoots);
+      if (!st.interlock_released) {
+        vertical.roots(st.vertical, k.d[1], k.rate[1], g + kVerticalRoots);
+        torsional.roots(st.torsional, k.d[2], k.rate[2], g + kTorsionalRoots);
       }
       g[kOverrideRoot] = face_height - std::abs(k.offset);
       break;
@@ -173,17 +173,17 @@ void Anticlimber::roots_of(const Deformations& k, double* g) const {
   }
 }
 
-bool Anticlimber::active(int index) const {
-  switch (state_.contact) {
+bool Anticlimber::active(const State& st, int index) const {
+  switch (st.contact) {
     case Contact::Open:
       return index == kContactRoot;
     case Contact::Engaged:
       if (index == kOverrideRoot) return true;
       if (index == kContactRoot) return false;
-      if (index < kVerticalRoots) return horizontal.active(state_.horizontal, index - kHorizontalRoots);
-      if (state_.interlock_released) return false;
-      if (index < kTorsionalRoots) return vertical.active(state_.vertical, index - kVerticalRoots);
-      return torsional.active(state_.torsional, index - kTorsionalRoots);
+      if (index < kVerticalRoots) return horizontal.active(st.horizontal, index - kHorizontalRoots);
+      if (st.interlock_released) return false;
+      if (index < kTorsionalRoots) return vertical.active(st.vertical, index - kVerticalRoots);
+      return torsional.active(st.torsional, index - kTorsionalRoots);
     case Contact::Overridden:
     case Contact::Crushed:
       break;
@@ -191,78 +191,78 @@ bool Anticlimber::active(int index) const {
   return false;
 }
 
-void Anticlimber::seat_interlock(const Deformations& k) {
-  state_.interlock_released = false;
-  state_.vertical_reference = k.offset;
-  state_.torsional_reference = k.rotation;
-  if (state_.vertical.mode != ElasticPlasticLaw::Mode::Failed) state_.vertical = vertical.fresh();
-  if (state_.torsional.mode != ElasticPlasticLaw::Mode::Failed) state_.torsional = torsional.fresh();
+void Anticlimber::seat_interlock(State& st, const Deformations& k) const {
+  st.interlock_released = false;
+  st.vertical_reference = k.offset;
+  st.torsional_reference = k.rotation;
+  if (st.vertical.mode != ElasticPlasticLaw::Mode::Failed) st.vertical = vertical.fresh();
+  if (st.torsional.mode != ElasticPlasticLaw::Mode::Failed) st.torsional = torsional.fresh();
 }
 
-void Anticlimber::transition(int index, double t, const Deformations& k, std::string& what) {
+void Anticlimber::transition(State& st, int index, double t, const Deformations& k, std::string& what) const {
   const auto add = [&what](const std::string& text) { what += (what.empty() ? "" : ", ") + text; };
   if (index == kContactRoot) {
     if (std::abs(k.offset) >= face_height) {  // the faces miss each other
-      state_.contact = Contact::Overridden;
-      state_.override_time = t;
+      st.contact = Contact::Overridden;
+      st.override_time = t;
       add("override");
       return;
     }
-    state_.contact = Contact::Engaged;
-    seat_interlock(k);
+    st.contact = Contact::Engaged;
+    seat_interlock(st, k);
     add("contact");
     return;
   }
   if (index == kOverrideRoot) {
-    state_.contact = Contact::Overridden;
-    state_.override_time = t;
+    st.contact = Contact::Overridden;
+    st.override_time = t;
     add("override");
     return;
   }
   const int direction = index / 3;
   const ElasticPlasticLaw& law = direction == 0 ? horizontal : (direction == 1 ? vertical : torsional);
-  ElasticPlasticLaw::State& st = direction == 0 ? state_.horizontal : (direction == 1 ? state_.vertical : state_.torsional);
+  ElasticPlasticLaw::State& law_state = direction == 0 ? st.horizontal : (direction == 1 ? st.vertical : st.torsional);
   const std::string name = kDirections[direction];
-  switch (law.leave(st, index % 3, k.d[direction])) {
+  switch (law.leave(law_state, index % 3, k.d[direction])) {
     case ElasticPlasticLaw::Outcome::Yield: add(name + " yield"); break;
     case ElasticPlasticLaw::Outcome::Reloading:
       add(name + " reloading");
-      if (direction == 0 && state_.interlock_released) {
-        seat_interlock(k);
+      if (direction == 0 && st.interlock_released) {
+        seat_interlock(st, k);
         add("interlock re-seated");
       }
       break;
     case ElasticPlasticLaw::Outcome::Unloading:
       add(name + " unloading");
       if (direction == 0 && release_while_unloading) {
-        state_.interlock_released = true;
+        st.interlock_released = true;
         add("interlock released");
       }
       break;
     case ElasticPlasticLaw::Outcome::Rupture:
-      if (direction == 0) state_.contact = Contact::Crushed;
+      if (direction == 0) st.contact = Contact::Crushed;
       add(direction == 0 ? "crushing failure" : (direction == 1 ? "shear failure" : "bending failure"));
       break;
     case ElasticPlasticLaw::Outcome::Release:
-      state_.contact = Contact::Open;
-      state_.interlock_released = false;  // the next contact seats it afresh
+      st.contact = Contact::Open;
+      st.interlock_released = false;  // the next contact seats it afresh
       add("separation");
       break;
   }
 }
 
-void Anticlimber::settle(double t, const ElementState<double>& s, std::string& what) {
+void Anticlimber::settle(State& st, double t, const ElementState<double>& s, std::string& what) const {
   // Each pass makes one transition; every chain of them ends in a terminal or elastic mode
   // well within this bound.
   for (int pass = 0; pass < 4 * kRootCount; ++pass) {
-    const Deformations k = deformations(s);
+    const Deformations k = deformations(st, s);
     double g[kRootCount];
-    roots_of(k, g);
+    roots_of(st, k, g);
     int index = -1;
     for (int i = 0; i < kRootCount && index < 0; ++i)
-      if (active(i) && g[i] < 0.0) index = i;
+      if (active(st, i) && g[i] < 0.0) index = i;
     if (index < 0) return;
-    transition(index, t, k, what);
+    transition(st, index, t, k, what);
   }
 }
 
@@ -282,62 +282,66 @@ void Anticlimber::initialize(const ElementState<double>& initial) {
   if (gap < 0.0)
     throw InputError(who + ": the faces overlap by " + std::to_string(-gap) +
                      " in the initial configuration; start them apart or just touching (there is no crush history to start from)");
-  state_ = State{};
-  state_.contact = Contact::Open;
-  state_.horizontal = horizontal.fresh();
-  state_.vertical = vertical.fresh();
-  state_.torsional = torsional.fresh();
-  const Deformations k = deformations(initial);
+  State& st = initial_state_;
+  st = State{};
+  st.contact = Contact::Open;
+  st.horizontal = horizontal.fresh();
+  st.vertical = vertical.fresh();
+  st.torsional = torsional.fresh();
+  const Deformations k = deformations(st, initial);
   if (gap == 0.0 && k.rate[0] > 0.0) {  // touching and closing: engaged from the start
     std::string what;
-    transition(kContactRoot, 0.0, k, what);
-    settle(0.0, initial, what);
+    transition(st, kContactRoot, 0.0, k, what);
+    settle(st, 0.0, initial, what);
   }
-  initial_state_ = state_;
 }
 
 void Anticlimber::roots(double, const ElementState<double>& s, const double*, double* g) const {
-  roots_of(deformations(s), g);
+  const State& st = mode_as<State>(s);
+  roots_of(st, deformations(st, s), g);
 }
 
-bool Anticlimber::commit(int index, int direction, double t, const ElementState<double>& s, const double*,
-                         Event& event) {
-  if (direction > 0 || !active(index)) return false;
-  const Deformations k = deformations(s);
+bool Anticlimber::commit(int index, int direction, double t, const ElementState<double>& s, const double*, void* mode,
+                         Event& event) const {
+  State& st = *static_cast<State*>(mode);
+  if (direction > 0 || !active(st, index)) return false;
+  const Deformations k = deformations(st, s);
   double g[kRootCount];
-  roots_of(k, g);
+  roots_of(st, k, g);
   if (g[index] > 0.0) return false;  // an earlier commit at this instant already changed the mode
   std::string what;
-  transition(index, t, k, what);
+  transition(st, index, t, k, what);
   // The event's value: the offset v for an override (also faces missing each other at
   // contact), else the deformation of the direction concerned (d_h for contact).
-  const double value = (index == kOverrideRoot || (index == kContactRoot && overridden()))
+  const double value = (index == kOverrideRoot || (index == kContactRoot && overridden(st)))
                            ? k.offset
                            : k.d[index == kContactRoot ? 0 : index / 3];
-  settle(t, s, what);
+  settle(st, t, s, what);
   event = {what, value};
   return true;
 }
 
 double Anticlimber::potential_energy(const ElementState<double>& s) const {
-  if (state_.contact != Contact::Engaged) return 0.0;
-  const Deformations k = deformations(s);
-  const double h = horizontal.elastic_energy(state_.horizontal, k.d[0]);
-  if (state_.interlock_released) return h;
-  return h + vertical.elastic_energy(state_.vertical, k.d[1]) + torsional.elastic_energy(state_.torsional, k.d[2]);
+  const State& st = mode_as<State>(s);
+  if (st.contact != Contact::Engaged) return 0.0;
+  const Deformations k = deformations(st, s);
+  const double h = horizontal.elastic_energy(st.horizontal, k.d[0]);
+  if (st.interlock_released) return h;
+  return h + vertical.elastic_energy(st.vertical, k.d[1]) + torsional.elastic_energy(st.torsional, k.d[2]);
 }
 
 void Anticlimber::outputs(const ElementState<double>& s, const double*, double* out) const {
-  const Deformations k = deformations(s);
-  const bool engaged = state_.contact == Contact::Engaged, held = interlocked();
-  out[0] = engaged ? horizontal.force(state_.horizontal, k.d[0]) : 0.0;
-  out[1] = held ? vertical.force(state_.vertical, k.d[1]) : 0.0;
-  out[2] = held ? torsional.force(state_.torsional, k.d[2]) : 0.0;
+  const State& st = mode_as<State>(s);
+  const Deformations k = deformations(st, s);
+  const bool engaged = st.contact == Contact::Engaged, held = interlocked(st);
+  out[0] = engaged ? horizontal.force(st.horizontal, k.d[0]) : 0.0;
+  out[1] = held ? vertical.force(st.vertical, k.d[1]) : 0.0;
+  out[2] = held ? torsional.force(st.torsional, k.d[2]) : 0.0;
   out[3] = k.d[0];
   out[4] = held ? k.d[1] : 0.0;
   out[5] = held ? k.d[2] : 0.0;
   out[6] = k.offset;
-  out[7] = overridden() ? 1.0 : 0.0;
+  out[7] = overridden(st) ? 1.0 : 0.0;
 }
 
 void register_anticlimber_elements(ElementRegistry& registry) {

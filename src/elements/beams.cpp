@@ -148,7 +148,6 @@ void BeamElement::initialize(const ElementState<double>& initial) {
             material.yield_stress * section_.plastic_section_modulus[1]};
   const double ratio = material.plastic_modulus / (e - material.plastic_modulus);
   hardening_ = {axial_stiffness_ * ratio, bending_stiffness_[0] * ratio, bending_stiffness_[2] * ratio};
-  state_ = State{};
 }
 
 void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
@@ -165,8 +164,9 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
       out[c]->grad[0] = *v[c];
     }
   }
+  sd.mode = s.mode;
   const std::array<D, 3> x = kinematics(sd).strain;
-  const std::array<D, 3> p = plastic_offsets(x);
+  const std::array<D, 3> p = plastic_offsets(mode_as<State>(s), x);
   const std::array<D, 3> r = resultants(x, p);
   for (std::size_t k = 0; k < 3; ++k) {
     force[k] = r[k].value;
@@ -181,56 +181,60 @@ double BeamElement::stress(const std::array<double, 3>& force) const {
 }
 
 void BeamElement::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  const State& st = mode_as<State>(s);
   g[0] = g[1] = g[2] = g[3] = 1.0;
-  if (state_.failed) return;
+  if (st.failed) return;
   std::array<double, 3> force{}, offset{}, rate{};
   evaluate(s, force, offset, &rate);
   for (std::size_t k = 0; k < 3; ++k) {
-    const int sign = state_.sign[k];
+    const int sign = st.sign[k];
     g[k] = sign == 0 ? 1.0 + kYieldMargin - std::abs(force[k] - hardening_[k] * offset[k]) / yield_[k] : sign * rate[k];
   }
   g[3] = 1.0 - stress(force) / material.ultimate_stress;
 }
 
-bool BeamElement::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
-  if (state_.failed || direction > 0) return false;
+bool BeamElement::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+                         Event& event) const {
+  State& st = *static_cast<State*>(mode);
+  if (st.failed || direction > 0) return false;
   std::array<double, 3> force{}, offset{};
   evaluate(s, force, offset);
   if (index == 3) {
-    state_.failed = true;
+    st.failed = true;
     event = {"fracture", stress(force)};
     return true;
   }
   const auto k = static_cast<std::size_t>(index);
   const std::string component = kComponentName[k];
-  if (state_.sign[k] == 0) {
-    state_.sign[k] = force[k] - hardening_[k] * offset[k] > 0.0 ? 1 : -1;
+  if (st.sign[k] == 0) {
+    st.sign[k] = force[k] - hardening_[k] * offset[k] > 0.0 ? 1 : -1;
     if (k == 0)
-      event = {state_.sign[k] > 0 ? "axial yield in tension" : "axial yield in compression", force[k]};
+      event = {st.sign[k] > 0 ? "axial yield in tension" : "axial yield in compression", force[k]};
     else
       event = {"plastic hinge at " + component, force[k]};
   } else {
-    state_.offset[k] = offset[k];
-    state_.sign[k] = 0;
+    st.offset[k] = offset[k];
+    st.sign[k] = 0;
     event = {k == 0 ? std::string("axial unloading") : "hinge at " + component + " unloading", force[k]};
   }
   return true;
 }
 
-void BeamElement::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+void BeamElement::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                          ForceBlock& df_dv) const {
   // Elastic in every component is the stiffest mode (plastic slopes are E_t / E times smaller).
-  const State saved = state_;
-  state_.sign = {0, 0, 0};
-  state_.failed = false;
+  State elastic = mode_as<State>(s);
+  elastic.sign = {0, 0, 0};
+  elastic.failed = false;
   std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, s, f, df_dq, df_dv);
-  state_ = saved;
+  add_force_jacobian(t, in_mode(s, elastic), f, df_dq, df_dv);
 }
 
 double BeamElement::potential_energy(const ElementState<double>& s) const {
-  if (state_.failed) return 0.0;
+  const State& st = mode_as<State>(s);
+  if (st.failed) return 0.0;
   const std::array<double, 3> x = kinematics(s).strain;
-  const std::array<double, 3> p = plastic_offsets(x);
+  const std::array<double, 3> p = plastic_offsets(st, x);
   const std::array<double, 3> r = resultants(x, p);
   double energy = 0.0;
   for (std::size_t k = 0; k < 3; ++k) energy += 0.5 * r[k] * (x[k] - p[k]);
@@ -243,17 +247,18 @@ std::vector<std::string> BeamElement::output_names() const {
 }
 
 void BeamElement::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const State& st = mode_as<State>(s);
   const std::array<double, 3> x = kinematics(s).strain;
   std::array<double, 3> force{}, offset{};
   evaluate(s, force, offset);
-  if (state_.failed) force = {0.0, 0.0, 0.0};
+  if (st.failed) force = {0.0, 0.0, 0.0};
   for (std::size_t k = 0; k < 3; ++k) {
     out[k] = force[k];
     out[3 + k] = x[k];
     out[6 + k] = offset[k];
   }
   out[9] = stress(force);
-  out[10] = state_.failed ? 1.0 : 0.0;
+  out[10] = st.failed ? 1.0 : 0.0;
 }
 
 namespace {

@@ -53,33 +53,33 @@ SurfaceContact::SurfaceContact(ElementSpec& spec, bool wheel_rail)
   }
 }
 
-void SurfaceContact::enter_mode(double penetration, double rate) {
+void SurfaceContact::enter_mode(State& st, double penetration, double rate) const {
   if (penetration < 0.0 || (penetration == 0.0 && rate <= 0.0)) {
-    state_.mode = Mode::Open;
+    st.mode = Mode::Open;
     return;
   }
-  state_.segment = penetration > breakpoint ? 1 : 0;
-  state_.mode = normal_force(penetration, rate, state_.segment) >= 0.0 ? Mode::Contact : Mode::Released;
+  st.segment = penetration > breakpoint ? 1 : 0;
+  st.mode = normal_force(penetration, rate, st.segment) >= 0.0 ? Mode::Contact : Mode::Released;
 }
 
 void SurfaceContact::initialize(const ElementState<double>& initial) {
   const Kinematics<double> k = kinematics(initial);
-  state_ = State{};
-  enter_mode(k.penetration, k.rate);
-  initial_state_ = state_;
+  initial_state_ = State{};
+  enter_mode(initial_state_, k.penetration, k.rate);
 }
 
 void SurfaceContact::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  const State& st = mode_as<State>(s);
   const Kinematics<double> k = kinematics(s);
   g[0] = g[1] = g[2] = 1.0;
-  switch (state_.mode) {
+  switch (st.mode) {
     case Mode::Open:
       g[0] = -k.penetration;  // falls through 0 when the point reaches the surface
       break;
     case Mode::Contact:
       g[0] = k.penetration;
-      g[1] = normal_force(k.penetration, k.rate, state_.segment);
-      if (std::isfinite(breakpoint)) g[2] = state_.segment == 0 ? breakpoint - k.penetration : k.penetration - breakpoint;
+      g[1] = normal_force(k.penetration, k.rate, st.segment);
+      if (std::isfinite(breakpoint)) g[2] = st.segment == 0 ? breakpoint - k.penetration : k.penetration - breakpoint;
       break;
     case Mode::Released:
       g[0] = k.penetration;
@@ -88,35 +88,37 @@ void SurfaceContact::roots(double, const ElementState<double>& s, const double*,
   }
 }
 
-bool SurfaceContact::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+bool SurfaceContact::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+                            Event& event) const {
+  State& st = *static_cast<State*>(mode);
   if (direction > 0) return false;  // every root above is written to fall through 0
   const Kinematics<double> k = kinematics(s);
-  switch (state_.mode) {
+  switch (st.mode) {
     case Mode::Open:
       if (index != 0) return false;
-      state_.mode = Mode::Contact;
-      state_.segment = 0;
+      st.mode = Mode::Contact;
+      st.segment = 0;
       event = {wheel_rail_ ? "wheel contact" : "contact", k.rate};
       return true;
     case Mode::Contact:
       if (index == 0) {
-        state_.mode = Mode::Open;
+        st.mode = Mode::Open;
         event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate};
       } else if (index == 1) {
-        state_.mode = Mode::Released;
+        st.mode = Mode::Released;
         event = {wheel_rail_ ? "wheel unloaded (damper would pull)" : "released (damper would pull)", k.penetration};
       } else {
-        state_.segment = 1 - state_.segment;
-        event = {state_.segment == 1 ? "above breakpoint" : "below breakpoint", k.penetration};
+        st.segment = 1 - st.segment;
+        event = {st.segment == 1 ? "above breakpoint" : "below breakpoint", k.penetration};
       }
       return true;
     case Mode::Released:
       if (index == 0) {
-        state_.mode = Mode::Open;
+        st.mode = Mode::Open;
         event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate};
       } else {
-        state_.mode = Mode::Contact;
-        state_.segment = k.penetration > breakpoint ? 1 : 0;
+        st.mode = Mode::Contact;
+        st.segment = k.penetration > breakpoint ? 1 : 0;
         event = {wheel_rail_ ? "wheel contact" : "contact", k.penetration};
       }
       return true;
@@ -124,25 +126,26 @@ bool SurfaceContact::commit(int index, int direction, double, const ElementState
   return false;
 }
 
-void SurfaceContact::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
-  const State saved = state_;
-  state_ = {Mode::Contact, stiffness_above > stiffness ? 1 : 0};
+void SurfaceContact::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                             ForceBlock& df_dv) const {
+  const State stiffest{Mode::Contact, stiffness_above > stiffness ? 1 : 0};
   std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, s, f, df_dq, df_dv);
-  state_ = saved;
+  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
 }
 
 double SurfaceContact::potential_energy(const ElementState<double>& s) const {
-  if (state_.mode != Mode::Contact) return 0.0;
+  const State& st = mode_as<State>(s);
+  if (st.mode != Mode::Contact) return 0.0;
   const double d = kinematics(s).penetration;
-  if (state_.segment == 0) return 0.5 * stiffness * d * d;
+  if (st.segment == 0) return 0.5 * stiffness * d * d;
   const double above = d - breakpoint;
   return 0.5 * stiffness * breakpoint * breakpoint + stiffness * breakpoint * above + 0.5 * stiffness_above * above * above;
 }
 
 void SurfaceContact::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const State& st = mode_as<State>(s);
   const Kinematics<double> k = kinematics(s);
-  const double normal = state_.mode == Mode::Contact ? normal_force(k.penetration, k.rate, state_.segment) : 0.0;
+  const double normal = st.mode == Mode::Contact ? normal_force(k.penetration, k.rate, st.segment) : 0.0;
   out[0] = normal;
   out[1] = friction > 0.0 ? -friction * normal * std::tanh(k.slip / friction_velocity) : 0.0;
   out[2] = k.penetration;

@@ -417,31 +417,31 @@ void DraftGear::initialize(const ElementState<double>& initial) {
                      "': its two points coincide in the initial configuration, so it has no direction; move them apart");
   if (!free_length) free_length = length;
   const Kinematics k = kinematics(initial);
-  state_ = State{};
-  state_.law = law_.initial(k.d, k.rate);
-  const double force = std::abs(gear_force(k.d));
+  State& st = initial_state_;
+  st = State{};
+  st.law = law_.initial(k.d, k.rate);
+  const double force = std::abs(gear_force(st, k.d));
   const auto reject = [&](const char* what, double limit) {
     std::ostringstream msg;
     msg << where_.prefix() << "draft_gear '" << name_ << "' starts with a force " << force << " at or above its " << what
         << " " << limit << "; start it closer to its free_length";
     throw InputError(msg.str());
   };
-  if (pin_shear_load && gear_force(k.d) >= *pin_shear_load) reject("pin_shear_load", *pin_shear_load);
+  if (pin_shear_load && gear_force(st, k.d) >= *pin_shear_load) reject("pin_shear_load", *pin_shear_load);
   if (fracture_load && force >= *fracture_load) reject("fracture_load", *fracture_load);
-  initial_state_ = state_;
 }
 
-void DraftGear::roots_at(const Kinematics& k, double* g) const {
+void DraftGear::roots_at(const State& st, const Kinematics& k, double* g) const {
   std::fill(g, g + kRoots, 1.0);
-  const double force = gear_force(k.d);
-  switch (state_.stage) {
+  const double force = gear_force(st, k.d);
+  switch (st.stage) {
     case Stage::Intact:
-      law_.roots(state_.law, k.d, k.rate, g);
+      law_.roots(st.law, k.d, k.rate, g);
       if (pin_shear_load) g[kPinRoot] = *pin_shear_load - force;
       if (fracture_load) g[kFractureRoot] = *fracture_load - std::abs(force);
       break;
     case Stage::Sheared:
-      g[0] = state_.solid_compression - k.d;
+      g[0] = st.solid_compression - k.d;
       break;
     case Stage::Solid:
       g[1] = force;
@@ -452,11 +452,10 @@ void DraftGear::roots_at(const Kinematics& k, double* g) const {
   }
 }
 
-void DraftGear::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
+void DraftGear::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(mode_as<State>(s), kinematics(s), g); }
 
-void DraftGear::apply(int index, const Kinematics& k, Event& event) {
-  State& st = state_;
-  const double force = gear_force(k.d);
+void DraftGear::apply(State& st, int index, const Kinematics& k, Event& event) const {
+  const double force = gear_force(st, k.d);
   if (index == kFractureRoot) {
     st.stage = Stage::Fractured;
     event = {"fracture", std::abs(force)};
@@ -486,35 +485,38 @@ void DraftGear::apply(int index, const Kinematics& k, Event& event) {
   }
 }
 
-bool DraftGear::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+bool DraftGear::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+                       Event& event) const {
   const Kinematics k = kinematics(s);
+  State& st = *static_cast<State*>(mode);
   return commit_crossing<kRoots>(
-      index, direction, [&](double* g) { roots_at(k, g); }, [&](int i, Event& e) { apply(i, k, e); }, event);
+      index, direction, [&](double* g) { roots_at(st, k, g); }, [&](int i, Event& e) { apply(st, i, k, e); }, event);
 }
 
-void DraftGear::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+void DraftGear::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                        ForceBlock& df_dv) const {
   // Stiffest: the transition stiffness (>= every slope), e.g. the neutral stick line.
-  const State saved = state_;
-  state_ = State{};
-  state_.law.mode = AxialHysteresis::Mode::Neutral;
+  State neutral{};
+  neutral.law.mode = AxialHysteresis::Mode::Neutral;
   std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, s, f, df_dq, df_dv);
-  state_ = saved;
+  add_force_jacobian(t, in_mode(s, neutral), f, df_dq, df_dv);
 }
 
 double DraftGear::potential_energy(const ElementState<double>& s) const {
+  const State& st = mode_as<State>(s);
   const double d = kinematics(s).d;
-  if (state_.stage == Stage::Intact) return law_.energy(state_.law, d);
-  if (state_.stage == Stage::Solid) {
-    const double force = gear_force(d);
+  if (st.stage == Stage::Intact) return law_.energy(st.law, d);
+  if (st.stage == Stage::Solid) {
+    const double force = gear_force(st, d);
     return 0.5 * force * force / stiffness_after_bottoming;
   }
   return 0.0;
 }
 
 void DraftGear::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const State& st = mode_as<State>(s);
   const double d = kinematics(s).d;
-  out[0] = gear_force(d);
+  out[0] = gear_force(st, d);
   out[1] = d;
 }
 
@@ -561,66 +563,65 @@ CouplerEnd::Kinematics CouplerEnd::kinematics(const ElementState<double>& s) con
 void CouplerEnd::initialize(const ElementState<double>& initial) {
   side_ = facing_side(*this, initial);
   const Kinematics k = kinematics(initial);
-  state_ = State{};
-  state_.overlapping = std::abs(k.dy) <= half_overlap();
+  State& st = initial_state_;
+  st = State{};
+  st.overlapping = std::abs(k.dy) <= half_overlap();
   if (lossy()) {
-    state_.band = lossy_band(k);
-    if (state_.band == DeadBand::Mode::Below && !(k.h_rate < 0.0)) {  // deflected, not closing: loaded to here
-      state_.unloading = true;
-      state_.peak = faces_.lo - k.h;
+    st.band = lossy_band(st, k);
+    if (st.band == DeadBand::Mode::Below && !(k.h_rate < 0.0)) {  // deflected, not closing: loaded to here
+      st.unloading = true;
+      st.peak = faces_.lo - k.h;
     }
   } else {
-    state_.band = faces_.initial(k.h, k.h_rate);
+    st.band = faces_.initial(k.h, k.h_rate);
   }
-  if (shear_load && active() && state_.band == DeadBand::Mode::Below && -face_tension(k.h) >= *shear_load) {
+  if (shear_load && active(st) && st.band == DeadBand::Mode::Below && -face_tension(st, k.h) >= *shear_load) {
     std::ostringstream msg;
-    msg << where_.prefix() << "coupler_end '" << name_ << "' starts with a face force " << -face_tension(k.h)
+    msg << where_.prefix() << "coupler_end '" << name_ << "' starts with a face force " << -face_tension(st, k.h)
         << " at or above its shear_load " << *shear_load << "; start the faces closer to touching";
     throw InputError(msg.str());
   }
-  initial_state_ = state_;
 }
 
-DeadBand::Mode CouplerEnd::lossy_band(const Kinematics& k) const {
-  const double touch = faces_.lo - permanent_set(state_);  // spacing at which the faces touch
+DeadBand::Mode CouplerEnd::lossy_band(const State& st, const Kinematics& k) const {
+  const double touch = faces_.lo - permanent_set(st);  // spacing at which the faces touch
   return (k.h < touch || (k.h == touch && k.h_rate < 0.0)) ? DeadBand::Mode::Below : DeadBand::Mode::Inside;
 }
 
-void CouplerEnd::lossy_roots(const Kinematics& k, double* g) const {
-  const double touch = faces_.lo - permanent_set(state_), tol = faces_.tolerance;
-  if (state_.blocked) {
+void CouplerEnd::lossy_roots(const State& st, const Kinematics& k, double* g) const {
+  const double touch = faces_.lo - permanent_set(st), tol = faces_.tolerance;
+  if (st.blocked) {
     g[0] = touch - k.h + tol;  // clear once apart beyond the set
     return;
   }
-  if (state_.band == DeadBand::Mode::Inside) {
+  if (st.band == DeadBand::Mode::Inside) {
     g[0] = k.h - touch + tol;  // contact
-  } else if (!state_.unloading) {
+  } else if (!st.unloading) {
     g[0] = -k.h_rate;  // loading while the penetration grows
   } else {
     g[0] = touch - k.h + tol;                           // separation at the set
-    g[1] = k.h - (faces_.lo - state_.peak) + tol;       // back on the loading line at delta_max
+    g[1] = k.h - (faces_.lo - st.peak) + tol;       // back on the loading line at delta_max
   }
 }
 
-void CouplerEnd::roots_at(const Kinematics& k, double* g) const {
+void CouplerEnd::roots_at(const State& st, const Kinematics& k, double* g) const {
   std::fill(g, g + kRoots, 1.0);
-  if (state_.sheared) return;
-  if (state_.overlapping) {
-    if (lossy()) lossy_roots(k, g);
-    else faces_.roots(state_.band, k.h, g);
+  if (st.sheared) return;
+  if (st.overlapping) {
+    if (lossy()) lossy_roots(st, k, g);
+    else faces_.roots(st.band, k.h, g);
     g[kOverlapRoot] = half_overlap() - std::abs(k.dy) + faces_.tolerance;
   } else {
     g[kOverlapRoot] = std::abs(k.dy) - half_overlap() + faces_.tolerance;
   }
-  if (shear_load && active() && state_.band == DeadBand::Mode::Below) g[kShearRoot] = *shear_load + face_tension(k.h);
+  if (shear_load && active(st) && st.band == DeadBand::Mode::Below) g[kShearRoot] = *shear_load + face_tension(st, k.h);
 }
 
-void CouplerEnd::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
+void CouplerEnd::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(mode_as<State>(s), kinematics(s), g); }
 
-void CouplerEnd::apply(int index, const Kinematics& k, Event& event) {
-  State& st = state_;
+void CouplerEnd::apply(State& st, int index, const Kinematics& k, Event& event) const {
   if (index == kShearRoot) {
-    event = {"face shear failure", -face_tension(k.h)};
+    event = {"face shear failure", -face_tension(st, k.h)};
     st.sheared = true;
     return;
   }
@@ -633,14 +634,14 @@ void CouplerEnd::apply(int index, const Kinematics& k, Event& event) {
     } else {
       st.overlapping = true;
       st.unloading = false;
-      st.band = lossy() ? lossy_band(k) : faces_.initial(k.h, k.h_rate);
+      st.band = lossy() ? lossy_band(st, k) : faces_.initial(k.h, k.h_rate);
       st.blocked = st.band != DeadBand::Mode::Inside;
       event = {st.blocked ? "vertical overlap regained, faces past each other" : "vertical overlap regained", k.dy};
     }
     return;
   }
   if (lossy()) {
-    apply_lossy(index, k, event);
+    apply_lossy(st, index, k, event);
     return;
   }
   using M = DeadBand::Mode;
@@ -659,8 +660,7 @@ void CouplerEnd::apply(int index, const Kinematics& k, Event& event) {
   event = {what, gap};
 }
 
-void CouplerEnd::apply_lossy(int index, const Kinematics& k, Event& event) {
-  State& st = state_;
+void CouplerEnd::apply_lossy(State& st, int index, const Kinematics& k, Event& event) const {
   const double gap = k.h - faces_.lo;  // -delta
   if (st.blocked) {
     st.blocked = false;
@@ -684,32 +684,36 @@ void CouplerEnd::apply_lossy(int index, const Kinematics& k, Event& event) {
   }
 }
 
-bool CouplerEnd::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+bool CouplerEnd::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+                        Event& event) const {
   const Kinematics k = kinematics(s);
+  State& st = *static_cast<State*>(mode);
   return commit_crossing<kRoots>(
-      index, direction, [&](double* g) { roots_at(k, g); }, [&](int i, Event& e) { apply(i, k, e); }, event);
+      index, direction, [&](double* g) { roots_at(st, k, g); }, [&](int i, Event& e) { apply(st, i, k, e); }, event);
 }
 
-void CouplerEnd::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
-  const State saved = state_;
-  state_ = {DeadBand::Mode::Below, true, false, lossy(), saved.peak, false};  // the steeper unloading line if any
+void CouplerEnd::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                         ForceBlock& df_dv) const {
+  // The steeper unloading line if any.
+  const State stiffest{DeadBand::Mode::Below, true, false, lossy(), mode_as<State>(s).peak, false};
   std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, s, f, df_dq, df_dv);
-  state_ = saved;
+  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
 }
 
 double CouplerEnd::potential_energy(const ElementState<double>& s) const {
-  if (!active()) return 0.0;
+  const State& st = mode_as<State>(s);
+  if (!active(st)) return 0.0;
   const double h = kinematics(s).h;
-  if (state_.band != DeadBand::Mode::Below) return faces_.energy(state_.band, h);
-  const double push = -face_tension(h);
+  if (st.band != DeadBand::Mode::Below) return faces_.energy(st.band, h);
+  const double push = -face_tension(st, h);
   return 0.5 * push * push / unloading_stiffness();  // what unloading gives back (k_u = k when elastic)
 }
 
 void CouplerEnd::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const State& st = mode_as<State>(s);
   const Kinematics k = kinematics(s);
-  const bool on = active();
-  const double tension = on ? face_tension(k.h) : 0.0;
+  const bool on = active(st);
+  const double tension = on ? face_tension(st, k.h) : 0.0;
   out[0] = -tension;
   out[1] = on && friction > 0.0
                ? -friction * std::abs(tension) * std::tanh(k.dy_rate / friction_velocity)
@@ -811,64 +815,68 @@ void Coupling::initialize(const ElementState<double>& initial) {
   side_ = facing_side(*this, initial);
   if (!free_length) free_length = side_ * point_offset(*this, initial).d.x;
   const Kinematics k = kinematics(initial);
-  state_ = State{};
-  state_.horizontal = law_.initial(k.u, k.u_rate);
-  state_.vertical = vertical_.initial(k.w, k.w_rate);
-  initial_state_ = state_;
+  State& st = initial_state_;
+  st = State{};
+  st.horizontal = law_.initial(k.u, k.u_rate);
+  st.vertical = vertical_.initial(k.w, k.w_rate);
 }
 
-void Coupling::roots_at(const Kinematics& k, double* g) const {
-  law_.roots(state_.horizontal, k.u, k.u_rate, g);
-  vertical_.roots(state_.vertical, k.w, g + AxialHysteresis::kRoots);
+void Coupling::roots_at(const State& st, const Kinematics& k, double* g) const {
+  law_.roots(st.horizontal, k.u, k.u_rate, g);
+  vertical_.roots(st.vertical, k.w, g + AxialHysteresis::kRoots);
 }
 
-void Coupling::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(kinematics(s), g); }
+void Coupling::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(mode_as<State>(s), kinematics(s), g); }
 
-void Coupling::apply(int index, const Kinematics& k, Event& event) {
+void Coupling::apply(State& st, int index, const Kinematics& k, Event& event) const {
   if (index < AxialHysteresis::kRoots) {
-    event = {describe(law_.transition(state_.horizontal, index, k.u), state_.horizontal, law_), k.u};
+    event = {describe(law_.transition(st.horizontal, index, k.u), st.horizontal, law_), k.u};
     return;
   }
   using M = DeadBand::Mode;
-  state_.vertical = vertical_.transition(state_.vertical, index - AxialHysteresis::kRoots);
-  const char* what = state_.vertical == M::Inside ? "vertical slack"
-                     : state_.vertical == M::Above ? "vertical slack taken up (head L above)"
+  st.vertical = vertical_.transition(st.vertical, index - AxialHysteresis::kRoots);
+  const char* what = st.vertical == M::Inside ? "vertical slack"
+                     : st.vertical == M::Above ? "vertical slack taken up (head L above)"
                                                    : "vertical slack taken up (head L below)";
   event = {what, k.w};
 }
 
-bool Coupling::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+bool Coupling::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+                      Event& event) const {
   const Kinematics k = kinematics(s);
+  State& st = *static_cast<State*>(mode);
   return commit_crossing<kRoots>(
-      index, direction, [&](double* g) { roots_at(k, g); }, [&](int i, Event& e) { apply(i, k, e); }, event);
+      index, direction, [&](double* g) { roots_at(st, k, g); }, [&](int i, Event& e) { apply(st, i, k, e); }, event);
 }
 
-void Coupling::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+void Coupling::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                       ForceBlock& df_dv) const {
   // Horizontal: the transition line (K_t >= every slope); vertical: beyond the slack.
-  const State saved = state_;
+  State stiffest = mode_as<State>(s);
   const Kinematics k = kinematics(s);
-  state_.horizontal = AxialHysteresis::State{};
-  state_.horizontal.mode = AxialHysteresis::Mode::Transition;
-  state_.horizontal.x0 = law_.side_deflection(state_.horizontal, k.u);
-  if (vertical_stiffness > 0.0) state_.vertical = DeadBand::Mode::Above;
+  stiffest.horizontal = AxialHysteresis::State{};
+  stiffest.horizontal.mode = AxialHysteresis::Mode::Transition;
+  stiffest.horizontal.x0 = law_.side_deflection(stiffest.horizontal, k.u);
+  if (vertical_stiffness > 0.0) stiffest.vertical = DeadBand::Mode::Above;
   std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, s, f, df_dq, df_dv);
-  state_ = saved;
+  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
 }
 
 double Coupling::potential_energy(const ElementState<double>& s) const {
+  const State& st = mode_as<State>(s);
   const Kinematics k = kinematics(s);
-  return law_.energy(state_.horizontal, k.u) + vertical_.energy(state_.vertical, k.w);
+  return law_.energy(st.horizontal, k.u) + vertical_.energy(st.vertical, k.w);
 }
 
 void Coupling::outputs(const ElementState<double>& s, const double*, double* out) const {
+  const State& st = mode_as<State>(s);
   const Kinematics k = kinematics(s);
-  out[0] = law_.force(state_.horizontal, k.u);
+  out[0] = law_.force(st.horizontal, k.u);
   out[1] = k.u;
-  out[2] = vertical_.force(state_.vertical, k.w);
+  out[2] = vertical_.force(st.vertical, k.w);
   out[3] = k.w;
   out[4] = friction > 0.0
-               ? -friction * law_.magnitude(state_.horizontal, k.u) * std::tanh(k.w_rate / friction_velocity)
+               ? -friction * law_.magnitude(st.horizontal, k.u) * std::tanh(k.w_rate / friction_velocity)
                : 0.0;
 }
 

@@ -41,8 +41,7 @@ double CrushSpring::crush_rate_of(const ElementState<double>& s) const {
   return -dot(g.d, g.d_rate) / g.length;
 }
 
-void CrushSpring::enter_mode_at(double crush, double rate) {
-  State& st = state_;
+void CrushSpring::enter_mode_at(State& st, double crush, double rate) const {
   if (crush < st.permanent_crush || (crush == st.permanent_crush && rate <= 0.0)) {
     st.mode = Mode::Open;
     return;
@@ -64,56 +63,55 @@ void CrushSpring::initialize(const ElementState<double>& initial) {
     throw InputError(where_.prefix() + "crush_spring '" + name_ +
                      "': its two points coincide in the initial configuration, so it has no direction; move them apart");
   if (!free_length) free_length = length;
-  state_ = State{};
-  enter_mode_at(crush_of(initial), crush_rate_of(initial));
-  if (state_.mode == Mode::Loading && crush_of(initial) > 0.0)
+  initial_state_ = State{};
+  enter_mode_at(initial_state_, crush_of(initial), crush_rate_of(initial));
+  if (initial_state_.mode == Mode::Loading && crush_of(initial) > 0.0)
     throw InputError(where_.prefix() + "crush_spring '" + name_ + "' starts crushed by " + std::to_string(crush_of(initial)) +
                      "; start it at or beyond its free_length (it has no crush history)");
-  initial_state_ = state_;
 }
 
-void CrushSpring::reset_modes() { state_ = initial_state_; }
-
-void CrushSpring::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) {
+void CrushSpring::stiffest_force_jacobian(double, const ElementState<double>& s, ForceBlock& df_dq,
+                                          ForceBlock& df_dv) const {
   // Stiffest of: the unloading stiffness, the curve's slopes, the tension stiffness.
-  const State saved = state_;
   double stiffest = unloading_stiffness;
   for (int k = 0; k + 1 < static_cast<int>(curve_crush.size()); ++k) stiffest = std::max(stiffest, segment_slope(k));
   if (tension_stiffness) stiffest = std::max(stiffest, *tension_stiffness);
-  const double saved_stiffness = unloading_stiffness;
-  unloading_stiffness = stiffest;
-  state_.mode = Mode::Elastic;
-  state_.permanent_crush = crush_of(s);
+  State elastic = mode_as<State>(s);
+  elastic.mode = Mode::Elastic;
+  elastic.permanent_crush = crush_of(s);
+  using D = Dual<double, 12>;
+  std::array<Pose<D>, 2> fd{};
+  line_force_law(ad::seeded_state<D>(s), elastic, stiffest, fd);
   std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, s, f, df_dq, df_dv);
-  unloading_stiffness = saved_stiffness;
-  state_ = saved;
+  ad::extract_forces(fd, f, df_dq, df_dv);
 }
 
 void CrushSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
   const double crush = crush_of(s);
+  const State& st = mode_as<State>(s);
   g[0] = g[1] = g[2] = 1.0;
-  switch (state_.mode) {
+  switch (st.mode) {
     case Mode::Loading: {
-      const auto k = static_cast<std::size_t>(state_.segment);
+      const auto k = static_cast<std::size_t>(st.segment);
       g[0] = crush_rate_of(s);
-      if (state_.segment > 0) g[1] = crush - curve_crush[k];
-      if (state_.segment + 2 < static_cast<int>(curve_crush.size())) g[2] = curve_crush[k + 1] - crush;
+      if (st.segment > 0) g[1] = crush - curve_crush[k];
+      if (st.segment + 2 < static_cast<int>(curve_crush.size())) g[2] = curve_crush[k + 1] - crush;
       break;
     }
     case Mode::Elastic:
-      g[0] = state_.max_crush - crush;
-      g[1] = crush - state_.permanent_crush;
+      g[0] = st.max_crush - crush;
+      g[1] = crush - st.permanent_crush;
       break;
     case Mode::Open:
-      g[0] = state_.permanent_crush - crush;
+      g[0] = st.permanent_crush - crush;
       break;
   }
 }
 
-bool CrushSpring::commit(int index, int direction, double, const ElementState<double>& s, const double*, Event& event) {
+bool CrushSpring::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+                         Event& event) const {
   const double crush = crush_of(s);
-  State& st = state_;
+  State& st = *static_cast<State*>(mode);
   switch (st.mode) {
     case Mode::Loading:
       if (direction > 0) return false;
@@ -136,7 +134,7 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
         // Back on the curve at d_max. A restart's look-ahead may commit this a hair before
         // d_max (crush < d_max by round-off): the element reloads all the same, never a
         // "reloading" that leaves it elastic (which would fire again at once).
-        enter_mode_at(std::max(crush, st.max_crush), 1.0);
+        enter_mode_at(st, std::max(crush, st.max_crush), 1.0);
         event = {"reloading on the curve", crush};
       } else {
         st.mode = Mode::Open;
@@ -145,7 +143,7 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
       return true;
     case Mode::Open:
       if (direction > 0 || index != 0) return false;
-      enter_mode_at(std::max(crush, st.permanent_crush), 1.0);  // contact (as above: never left open)
+      enter_mode_at(st, std::max(crush, st.permanent_crush), 1.0);  // contact (as above: never left open)
       event = {st.mode == Mode::Loading ? "contact, crushing" : "contact", crush};
       return true;
   }
@@ -153,17 +151,19 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
 }
 
 double CrushSpring::potential_energy(const ElementState<double>& s) const {
-  const double force = crush_force(crush_of(s));
-  if (state_.mode != Mode::Open) return force * force / (2.0 * unloading_stiffness);
+  const State& st = mode_as<State>(s);
+  const double force = crush_force(st, crush_of(s));
+  if (st.mode != Mode::Open) return force * force / (2.0 * unloading_stiffness);
   // Open: only a tension spring (if any) stores energy, k (d - d_p)^2 / 2 = P^2 / (2 k).
   return tension_stiffness ? force * force / (2.0 * *tension_stiffness) : 0.0;
 }
 
 void CrushSpring::outputs(const ElementState<double>& s, const double*, double* out) const {
   const double crush = crush_of(s);
-  out[0] = crush_force(crush);
+  const State& st = mode_as<State>(s);
+  out[0] = crush_force(st, crush);
   out[1] = crush;
-  out[2] = state_.permanent_crush;
+  out[2] = st.permanent_crush;
 }
 
 void register_crush_elements(ElementRegistry& registry) {

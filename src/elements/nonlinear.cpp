@@ -106,26 +106,27 @@ void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initi
   Derived& self = *static_cast<Derived*>(this);
   self.prepare(initial);
   const double x = self.measure(initial);
-  mode_ = SegmentMode{};
+  SegmentMode& m = initial_mode_;
+  m = SegmentMode{};
   // On a breakpoint: the segment x moves into; the lower one when that is unknown (the
   // integrators' start check commits the crossing if the motion goes up).
-  mode_.segment = law_.segment_at(x, self.rate_sign(initial) > 0 ? 1 : -1);
+  m.segment = law_.segment_at(x, self.rate_sign(initial) > 0 ? 1 : -1);
   if (fracture_roots() > 0) {
-    const double f = law_.value(x, mode_.segment);
+    const double f = law_.value(x, m.segment);
     if (f >= *fracture_load || (fracture_roots() > 1 && -f >= *fracture_load))
       throw InputError(this->where_.prefix() + this->type_ + " '" + this->name_ + "' starts at a force of " +
                        std::to_string(f) + ", beyond its fracture_load " + std::to_string(*fracture_load) +
                        "; raise fracture_load or start it less deformed");
   }
-  initial_mode_ = mode_;
 }
 
 template <class Derived>
 void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  const SegmentMode& m = mode_as<SegmentMode>(s);
   for (int k = 0; k < root_count(); ++k) g[k] = 1.0;
-  if (mode_.broken) return;
+  if (m.broken) return;
   const double x = measure_of(s);
-  const int k = mode_.segment;
+  const int k = m.segment;
   if (law_.has_lower(k)) g[0] = x - law_.lower(k) + root_band_;
   if (law_.has_upper(k)) g[1] = law_.upper(k) - x + root_band_;
   if (fracture_roots() > 0) {
@@ -137,13 +138,14 @@ void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s,
 
 template <class Derived>
 bool PiecewiseLineElement<Derived>::commit(int index, int direction, double, const ElementState<double>& s,
-                                           const double*, Element::Event& event) {
-  if (mode_.broken) return false;
+                                           const double*, void* mode, Element::Event& event) const {
+  SegmentMode& m = *static_cast<SegmentMode*>(mode);
+  if (m.broken) return false;
   const double x = measure_of(s);
   if (index >= 2) {  // fracture roots: leave when they fall through zero
     if (direction > 0) return false;
-    event = {"fracture", law_.value(x, mode_.segment)};
-    mode_.broken = true;
+    event = {"fracture", law_.value(x, m.segment)};
+    m.broken = true;
     return true;
   }
   // Root 0 (x - lower) falls when x moves down, root 1 (upper - x) when x moves up. The new
@@ -151,22 +153,23 @@ bool PiecewiseLineElement<Derived>::commit(int index, int direction, double, con
   // and a second root of the same crossing finds nothing left to do.
   const int x_direction = index == 0 ? direction : -direction;
   const int to = law_.segment_at(x, x_direction);
-  if (to == mode_.segment) return false;
-  const int from = mode_.segment;
-  mode_.segment = to;
+  if (to == m.segment) return false;
+  const int from = m.segment;
+  m.segment = to;
   event = static_cast<const Derived*>(this)->segment_event(from, to, x);
   return true;
 }
 
 template <class Derived>
 double PiecewiseLineElement<Derived>::law_integral(const ElementState<double>& s) const {
-  return mode_.broken ? 0.0 : law_.integral(measure_of(s), mode_.segment);
+  const SegmentMode& m = mode_as<SegmentMode>(s);
+  return m.broken ? 0.0 : law_.integral(measure_of(s), m.segment);
 }
 
 template <class Derived>
 void PiecewiseLineElement<Derived>::outputs(const ElementState<double>& s, const double*, double* out) const {
   const double x = measure_of(s);
-  out[0] = law_value(x);
+  out[0] = law_value(mode_as<SegmentMode>(s), x);
   out[1] = x;
 }
 

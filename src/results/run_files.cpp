@@ -85,7 +85,7 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   double elastic = 0.0;
   for (std::size_t e = 0; e < model.elements().size(); ++e) {
     const Element& el = *model.elements()[e];
-    const double stored = el.potential_energy(gather_state(el, y, y + nq));
+    const double stored = el.potential_energy(gather_state(el, y, y + nq, system_.modes().of(e)));
     if (first_) initial_elastic_[e] = stored;
     elastic += stored;
     const double work = quadratures ? quadratures[DaeSystem::kFirstElementWork + static_cast<int>(e)] : 0.0;

@@ -116,15 +116,17 @@ struct Samples : RunObserver {
 struct Run {
   RunOutcome outcome;
   Samples samples;
+  Anticlimber::State final_mode;  // the anticlimber's (the model's first element) at the end
 };
 
 Run simulate(const Model& model) {
-  const DaeSystem system(model);
+  DaeSystem system(model);
   Run run;
   run.samples.size = system.size();
   auto integrator = make_integrator(system, model.simulation);
   run.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), run.samples);
   REQUIRE(run.outcome.ok);
+  run.final_mode = system.modes().as<Anticlimber::State>(0);
   return run;
 }
 
@@ -192,10 +194,10 @@ Vec rotated(double angle, double sx, double sy) {
 }
 
 /// Generalized forces of the element alone at body coordinates q (velocities zero).
-std::vector<double> element_forces(const Model& model, const std::vector<double>& q) {
-  const Element& e = *model.elements().front();
+std::vector<double> element_forces(const DaeSystem& system, const std::vector<double>& q) {
+  const Element& e = *system.model().elements().front();
   const std::vector<double> v(q.size(), 0.0);
-  const ElementState<double> s = gather_state(e, q.data(), v.data());
+  const ElementState<double> s = gather_state(e, q.data(), v.data(), system.modes().of(0));
   std::array<Pose<double>, 2> f{};
   e.add_force(0.0, s, f);
   std::vector<double> out(q.size(), 0.0);
@@ -209,10 +211,10 @@ std::vector<double> element_forces(const Model& model, const std::vector<double>
   return out;
 }
 
-double energy_at(const Model& model, const std::vector<double>& q) {
-  const Element& e = *model.elements().front();
+double energy_at(const DaeSystem& system, const std::vector<double>& q) {
+  const Element& e = *system.model().elements().front();
   const std::vector<double> v(q.size(), 0.0);
-  return e.potential_energy(gather_state(e, q.data(), v.data()));
+  return e.potential_energy(gather_state(e, q.data(), v.data(), system.modes().of(0)));
 }
 
 std::vector<double> positions(const DaeSystem& system, const std::vector<double>& y) {
@@ -354,10 +356,10 @@ TEST_CASE("anticlimber rejects bad parameters and starting configurations", "[el
   Parameters faced;
   faced.facing = 1.0;
   const Model engaged = load(faced, ground, body, touching);  // closing at 1 m/s: engaged from the start
-  CHECK(anticlimber_of(engaged).state().contact == Anticlimber::Contact::Engaged);
+  CHECK(DaeSystem(engaged).modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Engaged);
   const std::vector<BodySpec> touching_still{{"b", 1.0, 1.0, 0.0, 0.05, 0.0, 0.0, 0.0, 0.0}};
   const Model open = load(faced, ground, body, touching_still);
-  CHECK(anticlimber_of(open).state().contact == Anticlimber::Contact::Open);
+  CHECK(DaeSystem(open).modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Open);
 }
 
 // ---- the elastic-plastic law on its own -------------------------------------------------------
@@ -470,20 +472,20 @@ TEST_CASE("anticlimber elastic-plastic law: bilinear loading, kinematic hardenin
 TEST_CASE("anticlimber applies no force while open, after override and once crushed", "[elements][anticlimber]") {
   const Model model =
       testing::model_from_text(model_yaml(two_cars(), Parameters{}, kCar1Face, kCar2Face, "t_end: 1"));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   Anticlimber& ac = anticlimber_of(model);
-  REQUIRE(ac.state().contact == Anticlimber::Contact::Open);
+  REQUIRE(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Open);
   std::mt19937 rng(7);
   for (const Anticlimber::Contact contact :
        {Anticlimber::Contact::Open, Anticlimber::Contact::Overridden, Anticlimber::Contact::Crushed}) {
-    Anticlimber::State st = ac.state();
+    Anticlimber::State st = system.modes().as<Anticlimber::State>(0);
     st.contact = contact;
-    ac.set_state(st);
+    testing::set_mode<Anticlimber::State>(system, st);
     for (int trial = 0; trial < 5; ++trial) {
       // Random states, also ones where the faces are pressed together (gap < 0).
       const std::vector<double> y = testing::random_state(system, rng, 0.4);
-      for (double f : element_forces(model, positions(system, y))) CHECK(f == 0.0);
-      CHECK(ac.potential_energy(gather_state(ac, y.data(), y.data() + 6)) == 0.0);
+      for (double f : element_forces(system, positions(system, y))) CHECK(f == 0.0);
+      CHECK(ac.potential_energy(gather_state(ac, y.data(), y.data() + 6, system.modes().of(0))) == 0.0);
       const std::vector<double> out = element_outputs(system, y);
       CHECK(out[0] == 0.0);
       CHECK(out[1] == 0.0);
@@ -501,18 +503,18 @@ TEST_CASE("anticlimber forces follow the three laws at a known configuration", "
   p.misalignment = 0.01;
   const Model model =
       testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", -0.5, 0.02}, "t_end: 1"));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   Anticlimber& ac = anticlimber_of(model);
   // Engaged at v_e = 0.03, phi_e = 0.005; horizontal plastic, vertical elastic with offset
   // 0.004, torsional plastic downwards.
-  Anticlimber::State st = ac.state();
+  Anticlimber::State st = system.modes().as<Anticlimber::State>(0);
   st.contact = Anticlimber::Contact::Engaged;
   st.vertical_reference = 0.03;
   st.torsional_reference = 0.005;
   st.horizontal = law_state(ac.horizontal, Mode::PlasticUp, 0.0);
   st.vertical = law_state(ac.vertical, Mode::Elastic, 0.004);
   st.torsional = law_state(ac.torsional, Mode::PlasticDown, 0.0);
-  ac.set_state(st);
+  testing::set_mode<Anticlimber::State>(system, st);
 
   const double x = 0.47, y = 0.13, theta = 0.02;
   const Vec arm = rotated(theta, -0.5, 0.02);
@@ -526,7 +528,7 @@ TEST_CASE("anticlimber forces follow the three laws at a known configuration", "
   // Force on the car at its face: (H, -V); moment arm x F, minus the torsional moment.
   const double fx = h, fy = -vf;
   const std::vector<double> expected{fx, fy, arm.x * fy - arm.y * fx - m};
-  const std::vector<double> actual = element_forces(model, {x, y, theta});
+  const std::vector<double> actual = element_forces(system, {x, y, theta});
   for (std::size_t k = 0; k < 3; ++k) {
     INFO("component " << k);
     CHECK(actual[k] == Approx(expected[k]).epsilon(1e-12).margin(1e-9));
@@ -550,7 +552,7 @@ TEST_CASE("anticlimber forces follow the three laws at a known configuration", "
   CHECK(out[6] == Approx(v).epsilon(1e-12));
   CHECK(out[7] == 0.0);
   // Elastic energy: each law's F^2 / (2 k_e).
-  CHECK(ac.potential_energy(gather_state(ac, state.data(), state.data() + 3)) ==
+  CHECK(ac.potential_energy(gather_state(ac, state.data(), state.data() + 3, system.modes().of(0))) ==
         Approx(h * h / 2e6 + vf * vf / 4e5 + m * m / 2e4).epsilon(1e-12));
 }
 
@@ -564,29 +566,29 @@ TEST_CASE("anticlimber forces are minus the gradient of the elastic energy and c
     const Point p2{"car2", facing > 0.0 ? -0.7 : 0.7, 0.05};
     const Point p1{"car1", facing > 0.0 ? 0.6 : -0.6, -0.1};
     const Model model = testing::model_from_text(model_yaml(bodies, Parameters{}, p1, p2, "t_end: 1"));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     Anticlimber& ac = anticlimber_of(model);
     REQUIRE(*ac.facing == facing);
     // Engaged, all three laws elastic with plastic offsets: there U is the potential of the forces.
-    Anticlimber::State st = ac.state();
+    Anticlimber::State st = system.modes().as<Anticlimber::State>(0);
     st.contact = Anticlimber::Contact::Engaged;
     st.vertical_reference = 0.25;
     st.torsional_reference = -0.2;
     st.horizontal = law_state(ac.horizontal, Mode::Elastic, -0.08);
     st.vertical = law_state(ac.vertical, Mode::Elastic, 0.01);
     st.torsional = law_state(ac.torsional, Mode::Elastic, -0.02);
-    ac.set_state(st);
+    testing::set_mode<Anticlimber::State>(system, st);
     std::mt19937 rng(11);
     for (int trial = 0; trial < 4; ++trial) {
       const std::vector<double> q = positions(system, testing::random_state(system, rng, 0.1));
-      REQUIRE(energy_at(model, q) > 1.0);  // deformed: the check is not vacuous
-      const std::vector<double> f = element_forces(model, q);
+      REQUIRE(energy_at(system, q) > 1.0);  // deformed: the check is not vacuous
+      const std::vector<double> f = element_forces(system, q);
       for (std::size_t k = 0; k < q.size(); ++k) {
         const double step = 1e-6;
         std::vector<double> plus = q, minus = q;
         plus[k] += step;
         minus[k] -= step;
-        const double gradient = (energy_at(model, plus) - energy_at(model, minus)) / (2.0 * step);
+        const double gradient = (energy_at(system, plus) - energy_at(system, minus)) / (2.0 * step);
         INFO("trial " << trial << " component " << k);
         CHECK(f[k] == Approx(-gradient).epsilon(1e-6).margin(1e-4));
       }
@@ -614,7 +616,7 @@ TEST_CASE("anticlimber Jacobian matches finite differences in every mode", "[ele
   for (const Layout& layout : layouts) {
     INFO(layout.name);
     const Model model = testing::model_from_text(model_yaml(layout.bodies, Parameters{}, layout.p1, layout.p2, "t_end: 1"));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     Anticlimber& ac = anticlimber_of(model);
     std::mt19937 rng(3);
     int checked = 0;
@@ -626,28 +628,28 @@ TEST_CASE("anticlimber Jacobian matches finite differences in every mode", "[ele
       for (const Mode v : law_modes)
         for (const Mode m : law_modes) {
           INFO("modes " << static_cast<int>(h) << static_cast<int>(v) << static_cast<int>(m));
-          Anticlimber::State st = ac.state();
+          Anticlimber::State st = system.modes().as<Anticlimber::State>(0);
           st.contact = Anticlimber::Contact::Engaged;
           st.vertical_reference = 0.2;
           st.torsional_reference = -0.1;
           st.horizontal = law_state(ac.horizontal, h, 0.003);
           st.vertical = law_state(ac.vertical, v, -0.005);
           st.torsional = law_state(ac.torsional, m, 0.002);
-          ac.set_state(st);
+          testing::set_mode<Anticlimber::State>(system, st);
           // Not vacuous: engaged with all laws elastic, the forces are large.
           if (h == Mode::Elastic && v == Mode::Elastic && m == Mode::Elastic) {
             const std::vector<double> y = system.initial_state();
             double norm = 0.0;
-            for (double f : element_forces(model, positions(system, y))) norm += std::abs(f);
+            for (double f : element_forces(system, positions(system, y))) norm += std::abs(f);
             REQUIRE(norm > 1.0);
           }
           check_here();
         }
     for (const Anticlimber::Contact contact :
          {Anticlimber::Contact::Open, Anticlimber::Contact::Overridden, Anticlimber::Contact::Crushed}) {
-      Anticlimber::State st = ac.state();
+      Anticlimber::State st = system.modes().as<Anticlimber::State>(0);
       st.contact = contact;
-      ac.set_state(st);
+      testing::set_mode<Anticlimber::State>(system, st);
       check_here();
     }
     CHECK(checked == 2 * 4 * 4 + 3);
@@ -729,9 +731,8 @@ TEST_CASE("anticlimber crush of a mass: yield, plastic flow, unloading and rebou
     // Euler-Cromer's energy error is O(omega dt) of the energy exchanged: 1e-4 of it.
     CHECK(std::abs(balance.error()) < (ida ? 1e-8 : 1e-4) * balance.initial_total);
     // The permanent crush is remembered while the faces are apart.
-    const Anticlimber& ac = anticlimber_of(model);
-    CHECK(ac.state().contact == Anticlimber::Contact::Open);
-    CHECK(ac.state().horizontal.offset == Approx(c.permanent_crush).epsilon(0).margin(crush_tol));
+    CHECK(run.final_mode.contact == Anticlimber::Contact::Open);
+    CHECK(run.final_mode.horizontal.offset == Approx(c.permanent_crush).epsilon(0).margin(crush_tol));
   }
 }
 
@@ -822,12 +823,12 @@ TEST_CASE("anticlimber shear failure, bending failure then override under prescr
       CHECK(o.events[k].t == Approx(expected[k].t).epsilon(0).margin(time_tol));
       CHECK(o.events[k].value == Approx(expected[k].value).epsilon(0).margin(value_tol));
     }
-    const Anticlimber& ac = anticlimber_of(model);
-    CHECK(ac.overridden());
-    CHECK(ac.override_time() == Approx(0.36).epsilon(0).margin(time_tol));
-    CHECK(ac.state().vertical.mode == Mode::Failed);
-    CHECK(ac.state().torsional.mode == Mode::Failed);
-    const DaeSystem system(model);
+    CHECK(Anticlimber::overridden(run.final_mode));
+    CHECK(run.final_mode.override_time == Approx(0.36).epsilon(0).margin(time_tol));
+    CHECK(run.final_mode.vertical.mode == Mode::Failed);
+    CHECK(run.final_mode.torsional.mode == Mode::Failed);
+    DaeSystem system(model);
+    testing::set_mode(system, run.final_mode);
     const std::vector<double> out = element_outputs(system, o.y);
     CHECK(out[7] == 1.0);
     CHECK(out[0] == 0.0);
@@ -859,12 +860,12 @@ TEST_CASE("anticlimber crushing failure at the horizontal rupture deflection end
     CHECK(o.events[2].what == "crushing failure");
     CHECK(o.events[2].t == Approx(0.6).epsilon(0).margin(5e-6));
     CHECK(o.events[2].value == Approx(0.5).epsilon(0).margin(1e-8));
-    const Anticlimber& ac = anticlimber_of(model);
-    CHECK(ac.state().contact == Anticlimber::Contact::Crushed);
-    CHECK_FALSE(ac.overridden());
+    CHECK(run.final_mode.contact == Anticlimber::Contact::Crushed);
+    CHECK_FALSE(Anticlimber::overridden(run.final_mode));
     CHECK(element_work(o) == Approx(6150.5).epsilon(2e-5));  // 50 + 1e4 * 0.49 + 1e4 * 0.49^2 / 2
     CHECK(bilinear_work(p.horizontal, 0.5) == Approx(6150.5).epsilon(1e-12));
-    const DaeSystem system(model);
+    DaeSystem system(model);
+    testing::set_mode(system, run.final_mode);
     const std::vector<double> out = element_outputs(system, o.y);
     CHECK(out[0] == 0.0);
     CHECK(out[3] > 0.55);  // the car kept going through the crushed structure
@@ -886,7 +887,7 @@ TEST_CASE("anticlimber faces that miss each other override at contact", "[elemen
     CHECK(run.outcome.events[0].t == Approx(0.1).epsilon(0).margin(2e-5));
     CHECK(run.outcome.events[0].value == Approx(0.25).epsilon(1e-12));
     CHECK(run.outcome.y[3] == Approx(-1.0).epsilon(1e-14));  // never touched
-    CHECK(anticlimber_of(model).overridden());
+    CHECK(Anticlimber::overridden(run.final_mode));
   }
 }
 
@@ -929,7 +930,8 @@ TEST_CASE("anticlimber commit engages a fresh interlock after a separation and i
   p.misalignment = 0.01;
   const std::vector<BodySpec> bodies{{"b", 10.0, 1.0, 0.1, 0.03, 0.0, 0.0, 0.0, 0.0}};
   const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, "t_end: 1"));
-  Anticlimber& ac = anticlimber_of(model);
+  const Anticlimber& ac = anticlimber_of(model);
+  DaeSystem system(model);
   const auto state_at = [](double x, double y, double vx) {
     ElementState<double> s;
     s.q[1] = {x, y, 0.0};  // slot 0 is the ground (point 1), slot 1 the body
@@ -938,29 +940,29 @@ TEST_CASE("anticlimber commit engages a fresh interlock after a separation and i
   };
   Element::Event event;
   // Still apart: the contact root is positive, nothing to commit.
-  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.0, state_at(0.01, 0.03, -1.0), nullptr, event));
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.0, state_at(0.01, 0.03, -1.0), nullptr, system.modes().of(0), event));
   // A rising crossing never leaves a mode.
-  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, 1, 0.0, state_at(0.0, 0.03, -1.0), nullptr, event));
-  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, event));
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, 1, 0.0, state_at(0.0, 0.03, -1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "contact");
-  CHECK(ac.state().contact == Anticlimber::Contact::Engaged);
-  CHECK(ac.state().vertical_reference == Approx(0.04).epsilon(1e-15));  // y + misalignment
+  CHECK(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Engaged);
+  CHECK(system.modes().as<Anticlimber::State>(0).vertical_reference == Approx(0.04).epsilon(1e-15));  // y + misalignment
   // A root of the open mode is no longer active.
-  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, event));
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, system.modes().of(0), event));
   // Faces open again (d_h < 0): separation through the horizontal law's lower bound.
-  REQUIRE(ac.commit(Anticlimber::kHorizontalRoots + 1, -1, 0.2, state_at(0.001, 0.05, 1.0), nullptr, event));
+  REQUIRE(ac.commit(Anticlimber::kHorizontalRoots + 1, -1, 0.2, state_at(0.001, 0.05, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "separation");
-  CHECK(ac.state().contact == Anticlimber::Contact::Open);
+  CHECK(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Open);
   // Re-contact higher up: the interlock takes the new offset as its reference.
-  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.3, state_at(0.0, 0.08, -1.0), nullptr, event));
-  CHECK(ac.state().vertical_reference == Approx(0.09).epsilon(1e-15));
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.3, state_at(0.0, 0.08, -1.0), nullptr, system.modes().of(0), event));
+  CHECK(system.modes().as<Anticlimber::State>(0).vertical_reference == Approx(0.09).epsilon(1e-15));
   // An Euler step that lands beyond yield in one go: contact and yield in one commit.
-  ac.reset_modes();
-  REQUIRE(ac.state().contact == Anticlimber::Contact::Open);
-  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(-0.02, 0.03, -1.0), nullptr, event));
+  system.reset_modes();
+  REQUIRE(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Open);
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(-0.02, 0.03, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "contact, horizontal yield");
   CHECK(event.value == Approx(0.02).epsilon(1e-12));
-  CHECK(ac.state().horizontal.mode == Mode::PlasticUp);
+  CHECK(system.modes().as<Anticlimber::State>(0).horizontal.mode == Mode::PlasticUp);
 }
 
 TEST_CASE("anticlimber crush under Euler converges to the closed form as the step shrinks", "[elements][anticlimber]") {
@@ -1030,7 +1032,7 @@ TEST_CASE("anticlimber interlock_while_unloading: hold keeps the vertical force 
     REQUIRE(t_reloading - t_unloading > 0.05);
     // hold: the vertical force of the interlock (reference: the offset at contact) builds up
     // while the faces unload: it reaches a good part of the amplitude m w_v 0.1 = 447 N.
-    const double reference = anticlimber_of(hold_model).state().vertical_reference;
+    const double reference = hold.final_mode.vertical_reference;
     double hold_peak = 0.0;
     int inside = 0;
     for (std::size_t k = 0; k < hold.samples.t.size(); ++k) {
@@ -1058,18 +1060,18 @@ TEST_CASE("anticlimber interlock_while_unloading: hold keeps the vertical force 
     // ... and the force comes back at reloading: the interlock re-seats at the offset of that
     // moment, y_r = y_u + w_u (t_r - t_u), and the mass oscillates about it from there:
     // y = y_r + (w_u / w_v) sin(w_v (t - t_r)).
-    const Anticlimber& ac = anticlimber_of(release_model);
     const double y_u = release.samples.y[*first][1] - release.samples.y[*first][4] * (release.samples.t[*first] - t_unloading);
     const double w_u = release.samples.y[*first][4];
     const double y_r = y_u + w_u * (t_reloading - t_unloading);
-    CHECK(ac.interlocked());
-    CHECK(ac.state().vertical_reference == Approx(y_r).epsilon(0).margin(ida ? 1e-9 : 1e-7));
+    CHECK(Anticlimber::interlocked(release.final_mode));
+    CHECK(release.final_mode.vertical_reference == Approx(y_r).epsilon(0).margin(ida ? 1e-9 : 1e-7));
     CHECK(std::abs(w_u) > 0.02);  // a real slide, so the re-seated interlock is loaded again
     const double y_end = y_r + w_u / omega_v * std::sin(omega_v * (t_end - t_reloading));
     CHECK(release.outcome.y[1] == Approx(y_end).epsilon(0).margin(ida ? 1e-8 : 1e-6));
-    const DaeSystem system(release_model);
+    DaeSystem system(release_model);
+    testing::set_mode(system, release.final_mode);
     const std::vector<double> out = element_outputs(system, release.outcome.y);
-    CHECK(out[1] == Approx(kv * (release.outcome.y[1] - ac.state().vertical_reference)).epsilon(1e-12));
+    CHECK(out[1] == Approx(kv * (release.outcome.y[1] - release.final_mode.vertical_reference)).epsilon(1e-12));
     CHECK(std::abs(out[1]) > 50.0);
     // Energy: the release dissipates the vertical elastic energy of that moment; the balance
     // closes for both readings (Euler-Cromer: O(omega dt) of the energy exchanged).
@@ -1093,13 +1095,13 @@ TEST_CASE("anticlimber Jacobian matches finite differences with the interlock re
   Parameters p;
   p.interlock = "release";
   const Model model = testing::model_from_text(model_yaml(two_cars(), p, kCar1Face, kCar2Face, "t_end: 1"));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   Anticlimber& ac = anticlimber_of(model);
   CHECK(ac.release_while_unloading);
   std::mt19937 rng(5);
   for (const Mode v : {Mode::Elastic, Mode::PlasticUp, Mode::Failed}) {
     INFO("vertical mode " << static_cast<int>(v));
-    Anticlimber::State st = ac.state();
+    Anticlimber::State st = system.modes().as<Anticlimber::State>(0);
     st.contact = Anticlimber::Contact::Engaged;
     st.interlock_released = true;
     st.vertical_reference = 0.2;
@@ -1107,12 +1109,12 @@ TEST_CASE("anticlimber Jacobian matches finite differences with the interlock re
     st.horizontal = law_state(ac.horizontal, Mode::Elastic, 0.003);
     st.vertical = law_state(ac.vertical, v, -0.005);
     st.torsional = law_state(ac.torsional, Mode::Elastic, 0.002);
-    ac.set_state(st);
+    testing::set_mode<Anticlimber::State>(system, st);
     check_jacobian_near_start(system, rng);
     // Released: only the horizontal law acts, along body 1's axis at face 2 (no moment M).
     const std::vector<double> y = system.initial_state();
     const std::vector<double> q = positions(system, y);
-    const std::vector<double> f = element_forces(model, q);
+    const std::vector<double> f = element_forces(system, q);
     const double e1x = std::cos(0.15), e1y = std::sin(0.15);
     CHECK(std::abs(f[3] * e1y - f[4] * e1x) < 1e-9 * (std::abs(f[3]) + std::abs(f[4]) + 1.0));  // along e1
     const std::vector<double> out = element_outputs(system, y);
@@ -1120,9 +1122,9 @@ TEST_CASE("anticlimber Jacobian matches finite differences with the interlock re
     CHECK(out[2] == 0.0);
     CHECK(out[4] == 0.0);
     CHECK(out[5] == 0.0);
-    CHECK(energy_at(model, q) == Approx(ac.horizontal.elastic_energy(st.horizontal, out[3])).epsilon(1e-12));
+    CHECK(energy_at(system, q) == Approx(ac.horizontal.elastic_energy(st.horizontal, out[3])).epsilon(1e-12));
     double g[Anticlimber::kRootCount];
-    ac.roots(0.0, gather_state(ac, y.data(), y.data() + system.body_unknowns()), nullptr, g);
+    ac.roots(0.0, gather_state(ac, y.data(), y.data() + system.body_unknowns(), system.modes().of(0)), nullptr, g);
     for (int i = Anticlimber::kVerticalRoots; i < Anticlimber::kContactRoot; ++i) CHECK(g[i] == 1.0);
   }
 }

@@ -92,7 +92,7 @@ const std::string kUniformProperties = kMaterial + "    area: 0.1\n    second_mo
 const std::string kTapered = kMaterial + "    height_1: 0.5\n    height_2: 0.7\n    width_1: 0.2\n    width_2: 0.15\n";
 const std::string kTaperedEqual = kMaterial + "    height_1: 0.5\n    height_2: 0.5\n    width_1: 0.2\n    width_2: 0.2\n";
 
-BeamElement& beam_of(const Model& model) { return dynamic_cast<BeamElement&>(*model.elements().front()); }
+const BeamElement& beam_of(const Model& model) { return dynamic_cast<const BeamElement&>(*model.elements().front()); }
 
 /// Every mode of the beam, with plastic offsets that are not zero.
 std::vector<BeamElement::State> all_modes() {
@@ -128,10 +128,11 @@ using testing::BodyState;
 using testing::forces;
 using testing::split;
 
-/// The beam's outputs at a state (names in BeamElement::output_names()).
-std::vector<double> beam_outputs(const Element& e, const std::vector<double>& q, const std::vector<double>& v) {
+/// The outputs of the system's beam (its only element) at a state (names in BeamElement::output_names()).
+std::vector<double> beam_outputs(const DaeSystem& system, const std::vector<double>& q, const std::vector<double>& v) {
+  const Element& e = *system.model().elements().front();
   std::vector<double> out(e.output_names().size(), 0.0);
-  e.outputs(gather_state(e, q.data(), v.data()), nullptr, out.data());
+  e.outputs(gather_state(e, q.data(), v.data(), system.modes().of(0)), nullptr, out.data());
   return out;
 }
 enum Output { kForce, kMoment1, kMoment2, kStretch, kRotation1, kRotation2, kPlasticStretch, kHinge1, kHinge2, kStress, kFailed };
@@ -150,7 +151,7 @@ class Quiet : public RunObserver {
 
 Run simulate(const std::string& yaml) {
   const Model model = testing::model_from_text(yaml);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   auto integrator = make_integrator(system, model.simulation);
   Quiet quiet;
   Run run;
@@ -161,8 +162,8 @@ Run simulate(const std::string& yaml) {
   run.q = s.q;
   run.v = s.v;
   const Element& beam = *model.elements().front();
-  run.outputs = beam_outputs(beam, s.q, s.v);
-  run.potential = beam.potential_energy(gather_state(beam, s.q.data(), s.v.data()));
+  run.outputs = beam_outputs(system, s.q, s.v);
+  run.potential = beam.potential_energy(gather_state(beam, s.q.data(), s.v.data(), system.modes().of(0)));
   return run;
 }
 
@@ -195,8 +196,8 @@ TEST_CASE("beam DAE Jacobians match central differences in every mode", "[elemen
   for (const auto& [type, parameters] : beams)
     for (const Ends ends : kAllEnds) {
       const Model model = testing::model_from_text(general_model(type, parameters, ends));
-      const DaeSystem system(model);
-      BeamElement& beam = beam_of(model);
+      DaeSystem system(model);
+      const testing::DrivenElement<BeamElement> beam(system, 0);
       for (const BeamElement::State& mode : all_modes()) {
         INFO(type << " " << ends_name(ends) << " " << mode_name(mode) << "\n" << parameters);
         beam.set_state(mode);
@@ -219,8 +220,8 @@ TEST_CASE("beam forces are in equilibrium and vanish under rigid motions of any 
   for (const auto& [type, parameters] : {std::pair<std::string, std::string>{"elastic_plastic_beam", kUniform},
                                          std::pair<std::string, std::string>{"tapered_beam", kTapered}}) {
     const Model model = testing::model_from_text(general_model(type, parameters, Ends::BodyBody));
-    const DaeSystem system(model);
-    BeamElement& beam = beam_of(model);
+    DaeSystem system(model);
+    const testing::DrivenElement<BeamElement> beam(system, 0);
     const BodyState start = split(system, system.initial_state());
     std::mt19937 rng(9);
     for (const BeamElement::State& mode : all_modes()) {
@@ -274,8 +275,8 @@ TEST_CASE("beam forces in an elastic mode are minus the gradient of its elastic 
                                            std::pair<std::string, std::string>{"tapered_beam", kTapered}}) {
       INFO(type << " " << ends_name(ends));
       const Model model = testing::model_from_text(general_model(type, parameters, ends));
-      const DaeSystem system(model);
-      BeamElement& beam = beam_of(model);
+      DaeSystem system(model);
+      const testing::DrivenElement<BeamElement> beam(system, 0);
       BeamElement::State st;
       st.offset = {0.02, -0.03, 0.05};  // elastic after earlier plastic flow
       beam.set_state(st);
@@ -283,7 +284,7 @@ TEST_CASE("beam forces in an elastic mode are minus the gradient of its elastic 
       for (int trial = 0; trial < 3; ++trial) {
         const BodyState s = split(system, testing::random_state(system, rng, 0.2));
         const auto energy = [&](const std::vector<double>& q) {
-          return beam.potential_energy(gather_state(beam, q.data(), s.v.data()));
+          return beam->potential_energy(beam.at(q.data(), s.v.data()));
         };
         REQUIRE(energy(s.q) > 1e-3);
         const std::vector<double> f = forces(system, s);
@@ -302,7 +303,7 @@ TEST_CASE("beam forces in an elastic mode are minus the gradient of its elastic 
 
 TEST_CASE("beam axial stiffness is E A / L along the chord in any orientation", "[elements][beams]") {
   const Model model = testing::model_from_text(general_model("elastic_plastic_beam", kUniform, Ends::BodyBody));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const BeamElement& beam = beam_of(model);
   const BodyState start = split(system, system.initial_state());
   // Chord of the initial configuration: a's point (0.45, 0.2) at angle 0.4, b's (-0.3, 0.25) at -0.6.
@@ -327,7 +328,7 @@ TEST_CASE("beam axial stiffness is E A / L along the chord in any orientation", 
     // The forces act along the chord through P1 and P2: moments are the arms' cross products.
     const double arm_a_x = p1[0] - 0.3, arm_a_y = p1[1] + 0.2;
     CHECK(f[2] == Approx(arm_a_x * tension * uy - arm_a_y * tension * ux).epsilon(1e-10));
-    const std::vector<double> out = beam_outputs(beam, s.q, s.v);
+    const std::vector<double> out = beam_outputs(system, s.q, s.v);
     CHECK(out[kForce] == Approx(tension).epsilon(1e-12));
     CHECK(out[kStretch] == Approx(stretch).epsilon(1e-12));
   }
@@ -341,7 +342,7 @@ TEST_CASE("cantilever force law gives the tip stiffness 3 E I / L^3 and no tip m
   const double ei = steel.e * steel.second_moment();
   const Model model = testing::model_from_text(
       cantilever_model("mass: 1.0, inertia: 1.0, position: [1.0, 0.0]", steel.parameters(), "t_end: 1.0"));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   BodyState s = split(system, system.initial_state());
   s.q[1] = v;
   s.q[2] = 1.5 * v / length;
@@ -360,7 +361,7 @@ TEST_CASE("cantilever force law gives the tip stiffness 3 E I / L^3 and no tip m
   const std::vector<double> g = forces(system, turned);
   CHECK(g[2] == Approx(-4.0 * ei * 1e-4 / length).epsilon(1e-9));
   CHECK(g[1] == Approx(6.0 * ei * 1e-4 / (length * length)).epsilon(1e-9));
-  const std::vector<double> out = beam_outputs(*model.elements().front(), turned.q, turned.v);
+  const std::vector<double> out = beam_outputs(system, turned.q, turned.v);
   CHECK(out[kMoment1] == Approx(2.0 * ei * 1e-4 / length).epsilon(1e-9));
   CHECK(out[kMoment2] == Approx(4.0 * ei * 1e-4 / length).epsilon(1e-9));
 }
@@ -677,20 +678,20 @@ TEST_CASE("hinge unloading keeps its rotation offset and reverses at M - 2 M_p",
   const Steel steel;
   const Model model = testing::model_from_text(
       cantilever_model("mass: 1.0, inertia: 1.0, position: [1.0, 0.0]", steel.parameters(), "t_end: 1.0"));
-  BeamElement& beam = beam_of(model);
-  const DaeSystem system(model);
+  DaeSystem system(model);
+  const testing::DrivenElement<BeamElement> beam(system, 0);
   BodyState s = split(system, system.initial_state());
-  const double k22 = beam.bending_stiffness()[2], c2 = beam.hardening()[2], mp = beam.yield_levels()[2];
+  const double k22 = beam->bending_stiffness()[2], c2 = beam->hardening()[2], mp = beam->yield_levels()[2];
   CHECK(k22 == Approx(4.0 * steel.e * steel.second_moment()).epsilon(1e-12));
   CHECK(mp == Approx(steel.yield * steel.z()).epsilon(1e-12));
   const auto roots_at = [&](const BodyState& state) {
     std::array<double, 4> g{};
-    beam.roots(0.0, gather_state(beam, state.q.data(), state.v.data()), nullptr, g.data());
+    beam->roots(0.0, beam.at(state.q.data(), state.v.data()), nullptr, g.data());
     return g;
   };
   const auto commit_at = [&](int index, const BodyState& state) {
     Element::Event event;
-    const bool changed = beam.commit(index, -1, 0.0, gather_state(beam, state.q.data(), state.v.data()), nullptr, event);
+    const bool changed = beam.commit(index, -1, 0.0, beam.at(state.q.data(), state.v.data()), nullptr, event);
     CHECK(changed);
     return event;
   };
@@ -708,7 +709,7 @@ TEST_CASE("hinge unloading keeps its rotation offset and reverses at M - 2 M_p",
   s.v[2] = -1.0;
   CHECK(roots_at(s)[2] < 0.0);
   const double m_peak = k22 * (c2 * s.q[2] + mp) / (k22 + c2);
-  CHECK(beam_outputs(beam, s.q, s.v)[kMoment2] == Approx(m_peak).epsilon(1e-12));
+  CHECK(beam_outputs(system, s.q, s.v)[kMoment2] == Approx(m_peak).epsilon(1e-12));
   const Element::Event unload = commit_at(2, s);
   CHECK(unload.what == "hinge at end 2 unloading");
   CHECK(unload.value == Approx(m_peak).epsilon(1e-12));
@@ -840,9 +841,9 @@ TEST_CASE("tapered_beam with equal ends is the uniform beam", "[elements][beams]
     INFO(ends_name(ends));
     const Model uniform = testing::model_from_text(general_model("elastic_plastic_beam", kUniform, ends));
     const Model tapered = testing::model_from_text(general_model("tapered_beam", kTaperedEqual, ends));
-    const DaeSystem uniform_system(uniform), tapered_system(tapered);
-    BeamElement& u = beam_of(uniform);
-    BeamElement& t = beam_of(tapered);
+    DaeSystem uniform_system(uniform), tapered_system(tapered);
+    const BeamElement& u = beam_of(uniform);
+    const BeamElement& t = beam_of(tapered);
     for (std::size_t k = 0; k < 3; ++k) {
       CHECK(t.bending_stiffness()[k] == Approx(u.bending_stiffness()[k]).epsilon(1e-13));
       CHECK(t.yield_levels()[k] == Approx(u.yield_levels()[k]).epsilon(1e-13));
@@ -851,8 +852,8 @@ TEST_CASE("tapered_beam with equal ends is the uniform beam", "[elements][beams]
     std::mt19937 rng(4);
     for (const BeamElement::State& mode : all_modes()) {
       INFO(mode_name(mode));
-      u.set_state(mode);
-      t.set_state(mode);
+      uniform_system.modes().as<BeamElement::State>(0) = mode;
+      tapered_system.modes().as<BeamElement::State>(0) = mode;
       const BodyState s = split(uniform_system, testing::random_state(uniform_system, rng, 0.2));
       const std::vector<double> fu = forces(uniform_system, s), ft = forces(tapered_system, s);
       for (std::size_t k = 0; k < fu.size(); ++k) CHECK(ft[k] == Approx(fu[k]).epsilon(1e-12).margin(1e-12));
@@ -875,7 +876,7 @@ TEST_CASE("tapered_beam stiffness matches the hand-integrated flexibility of a l
   for (const Case& c : cases) {
     INFO(c.name);
     const Model model = testing::model_from_text(tapered_model(c.h1, c.h2, c.w1, c.w2, length));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const BeamElement& beam = beam_of(model);
     const Integrals& f = c.expected;
     // K_b = inverse of (L / E) [a -b; -b c]; k_a = E / (L int ds / A).
@@ -907,26 +908,26 @@ TEST_CASE("tapered_beam stiffness matches the hand-integrated flexibility of a l
 
 TEST_CASE("beam outputs are named and the failed beam reports zero resultants", "[elements][beams]") {
   const Model model = testing::model_from_text(general_model("elastic_plastic_beam", kUniform, Ends::BodyBody));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   CHECK(system.output_names() == std::vector<std::string>{"e.force", "e.moment_1", "e.moment_2", "e.stretch", "e.rotation_1",
                                                          "e.rotation_2", "e.plastic_stretch", "e.hinge_rotation_1",
                                                          "e.hinge_rotation_2", "e.stress", "e.failed"});
-  BeamElement& beam = beam_of(model);
+  const testing::DrivenElement<BeamElement> beam(system, 0);
   std::mt19937 rng(2);
   const BodyState s = split(system, testing::random_state(system, rng, 0.2));
-  const std::vector<double> out = beam_outputs(beam, s.q, s.v);
+  const std::vector<double> out = beam_outputs(system, s.q, s.v);
   // Stress: largest of |N| / A and |M_i| / Z (A = 0.1, Z = 0.0125).
   CHECK(out[kStress] == Approx(std::max({std::abs(out[kForce]) / 0.1, std::abs(out[kMoment1]) / 0.0125,
                                          std::abs(out[kMoment2]) / 0.0125}))
                             .epsilon(1e-12));
-  CHECK(beam.potential_energy(gather_state(beam, s.q.data(), s.v.data())) > 0.0);
+  CHECK(beam->potential_energy(beam.at(s.q.data(), s.v.data())) > 0.0);
   BeamElement::State broken;
   broken.failed = true;
   beam.set_state(broken);
-  const std::vector<double> after = beam_outputs(beam, s.q, s.v);
+  const std::vector<double> after = beam_outputs(system, s.q, s.v);
   CHECK(after[kForce] == 0.0);
   CHECK(after[kMoment1] == 0.0);
   CHECK(after[kFailed] == 1.0);
-  CHECK(beam.potential_energy(gather_state(beam, s.q.data(), s.v.data())) == 0.0);
+  CHECK(beam->potential_energy(beam.at(s.q.data(), s.v.data())) == 0.0);
   for (double x : forces(system, s)) CHECK(x == 0.0);
 }

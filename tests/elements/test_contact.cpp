@@ -155,8 +155,8 @@ TEST_CASE("contact Jacobian matches central differences in every mode", "[elemen
       "  - {name: w, type: wheel_rail, wheel_radius: 0.4, stiffness: 1.0e6, stiffness_above: 4.0e6, breakpoint: 0.001, "
       "damping: 2000, friction: 0.3, friction_velocity: 0.05, points: [{body: ball, at: [0.1, -0.05]}]}\n";
   const Model model = testing::model_from_text(body_on(element, 0.0, 0.5, 0.3, 0.0, "t_end: 1"));
-  auto& contact = dynamic_cast<SurfaceContact&>(*model.elements()[0]);
-  const DaeSystem system(model);
+  DaeSystem system(model);
+  const testing::DrivenElement<SurfaceContact> contact(system, 0);
   std::mt19937 rng(11);
   const auto check_mode = [&](double penetration) {
     for (int trial = 0; trial < 3; ++trial) {
@@ -175,13 +175,13 @@ TEST_CASE("contact Jacobian matches central differences in every mode", "[elemen
   y[1] = 0.45;
   y[4] = -1.0;
   Element::Event event;
-  REQUIRE(contact.commit(0, -1, 0.0, gather_state(contact, y.data(), y.data() + 3), nullptr, event));
+  REQUIRE(contact.commit(0, -1, 0.0, contact.at(y.data(), y.data() + 3), nullptr, event));
   REQUIRE(contact.state().mode == SurfaceContact::Mode::Contact);
   check_mode(0.0005);
-  REQUIRE(contact.commit(2, -1, 0.0, gather_state(contact, y.data(), y.data() + 3), nullptr, event));
+  REQUIRE(contact.commit(2, -1, 0.0, contact.at(y.data(), y.data() + 3), nullptr, event));
   REQUIRE(contact.state().segment == 1);
   check_mode(0.002);
-  REQUIRE(contact.commit(1, -1, 0.0, gather_state(contact, y.data(), y.data() + 3), nullptr, event));
+  REQUIRE(contact.commit(1, -1, 0.0, contact.at(y.data(), y.data() + 3), nullptr, event));
   REQUIRE(contact.state().mode == SurfaceContact::Mode::Released);
   check_mode(0.002);
 }

@@ -116,8 +116,8 @@ struct Run {
   double x = 0.0, y = 0.0, vx = 0.0, vy = 0.0;  // the mass at t_end
 };
 
-Run run(const Model& model) {
-  const DaeSystem system(model);
+Run run(DaeSystem& system) {
+  const Model& model = system.model();
   struct Null : RunObserver {
     void sample(double, const double*, const double*, const double*) override {}
   } observer;
@@ -130,6 +130,11 @@ Run run(const Model& model) {
   r.vx = r.outcome.y[3];
   r.vy = r.outcome.y[4];
   return r;
+}
+
+Run run(const Model& model) {
+  DaeSystem system(model);
+  return run(system);
 }
 
 /// A mass tied to ground by element `e`: the ground point at the origin, the mass's point at
@@ -345,13 +350,14 @@ TEST_CASE("draft_gear: a mass bounces off it in buff and in draft, closed form u
       INFO((side > 0 ? "buff " : "draft ") << integrator);
       const bool ida = std::string(integrator) == "ida";
       const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -side * v0, 0.0, t_end, integrator));
-      const Run r = run(model);
+      DaeSystem system(model);
+      const Run r = run(system);
       check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
       CHECK(r.vx == Approx(side * speed).epsilon(ida ? 1e-8 : 1e-3));
       CHECK(element_work(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
       CHECK(dissipated(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
       CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-7 : 1e-4) * area);
-      CHECK(gear_of(model).state().law.mode == AxialHysteresis::Mode::Released);
+      CHECK(system.modes().as<DraftGear::State>(0).law.mode == AxialHysteresis::Mode::Released);
     }
   }
 }
@@ -431,7 +437,8 @@ TEST_CASE("draft_gear: the pin shears at the pin shear load, travels, goes solid
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
     const Model model = testing::model_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, -v0, 0.0, t_end, integrator));
-    const Run r = run(model);
+    DaeSystem system(model);
+    const Run r = run(system);
     check_events(r.outcome, w.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-3);
     // The pin lets go at the pin shear load, the gear breaks at the fracture load.
     REQUIRE(r.outcome.events.size() == 5);
@@ -440,7 +447,7 @@ TEST_CASE("draft_gear: the pin shears at the pin shear load, travels, goes solid
     CHECK(r.outcome.events[4].value == Approx(fracture).epsilon(ida ? 1e-9 : 3e-3));
     CHECK(r.vx == Approx(-speed).epsilon(ida ? 1e-8 : 1e-4));  // coasting on after fracture
     CHECK(dissipated(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
-    CHECK(gear_of(model).state().stage == DraftGear::Stage::Fractured);
+    CHECK(system.modes().as<DraftGear::State>(0).stage == DraftGear::Stage::Fractured);
   }
 }
 
@@ -506,11 +513,11 @@ TEST_CASE("draft_gear: stored energy is what unloading gives back, and forces fo
           "[elements][couplers]") {
   const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, 0.0, 0.0, 1.0, "ida"));
   DraftGear& gear = gear_of(model);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const auto at = [&](double d) {
     y[0] = 1.0 - d;
-    return gather_state(gear, y.data(), y.data() + 3);
+    return gather_state(gear, y.data(), y.data() + 3, system.modes().of(0));
   };
   const auto force_on_mass = [&](double d) {
     std::array<Pose<double>, 2> f{};
@@ -522,18 +529,18 @@ TEST_CASE("draft_gear: stored energy is what unloading gives back, and forces fo
   DraftGear::State st;
   // Loading, bottomed (draft): F = -(k s + H + K (x - s)) at compression -x.
   st.law = {M::Loading, -1, 1, 0.0, 0.0};
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   CHECK(force_on_mass(-0.06) == Approx(-g.U(0.06)));
   CHECK(gear.potential_energy(at(-0.06)) > 0.0);
   // Unloading (buff) at x: energy = integral of k x - H down to H / k.
   st.law = {M::Unloading, 1, 0, 0.0, 0.0};
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   const double x = 0.03;
   CHECK(force_on_mass(x) == Approx(g.k * x - g.H));
   CHECK(gear.potential_energy(at(x)) == Approx(0.5 * (g.k * x - g.H) * (x - g.H / g.k)));
   // Transition from (0.04, U(0.04)) at 0.0395: energy = trapezoid down to the unloading line + tail.
   st.law = {M::Transition, 1, 0, 0.04, g.U(0.04)};
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   const double f = g.U(0.04) + g.Kt * (0.0395 - 0.04);
   const double meet = (g.U(0.04) - g.Kt * 0.04 + g.H) / (g.k - g.Kt);
   const double f_meet = g.k * meet - g.H;
@@ -542,32 +549,32 @@ TEST_CASE("draft_gear: stored energy is what unloading gives back, and forces fo
         Approx(0.5 * (f + f_meet) * (0.0395 - meet) + 0.5 * f_meet * (meet - g.H / g.k)).epsilon(1e-12));
   // Neutral: Kt d^2 / 2; released, sheared, fractured: nothing.
   st.law = {M::Neutral, 1, 0, 0.0, 0.0};
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   CHECK(force_on_mass(-1e-4) == Approx(-g.Kt * 1e-4));
   CHECK(gear.potential_energy(at(-1e-4)) == Approx(0.5 * g.Kt * 1e-8));
   st.law = {M::Released, 1, 0, 0.0, 0.0};
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   CHECK(force_on_mass(0.01) == 0.0);
   CHECK(gear.potential_energy(at(0.01)) == 0.0);
   st.stage = DraftGear::Stage::Solid;
   st.solid_compression = 0.07;
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   CHECK(force_on_mass(0.075) == Approx(g.K * 0.005));
   CHECK(gear.potential_energy(at(0.075)) == Approx(0.5 * g.K * 0.005 * 0.005));
   st.stage = DraftGear::Stage::Fractured;
-  gear.set_state(st);
+  testing::set_mode<DraftGear::State>(system, st);
   CHECK(force_on_mass(0.075) == 0.0);
 }
 
 TEST_CASE("draft_gear: reloading, rejoining the loading curve, and crossings committed together", "[elements][couplers]") {
   const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, 0.0, 0.0, 1.0, "ida"));
   DraftGear& gear = gear_of(model);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const auto at = [&](double d, double rate) {  // compression d, compression rate
     y[0] = 1.0 - d;
     y[3] = -rate;
-    return gather_state(gear, y.data(), y.data() + 3);
+    return gather_state(gear, y.data(), y.data() + 3, system.modes().of(0));
   };
   const auto force = [&](double d) {
     std::array<Pose<double>, 2> f{};
@@ -576,47 +583,47 @@ TEST_CASE("draft_gear: reloading, rejoining the loading curve, and crossings com
   };
   const Gear& g = kGear;
   using M = AxialHysteresis::Mode;
-  REQUIRE(gear.state().law.mode == M::Neutral);
+  REQUIRE(system.modes().as<DraftGear::State>(0).law.mode == M::Neutral);
   Element::Event event;
   const double x1 = g.H / (g.Kt - g.k);
-  CHECK_FALSE(gear.commit(0, -1, 0.0, at(0.5 * x1, 1.0), nullptr, event));  // not crossed: stale
-  CHECK_FALSE(gear.commit(0, 1, 0.0, at(2.0 * x1, 1.0), nullptr, event));   // upward crossings never leave a mode
-  CHECK(gear.commit(0, -1, 0.0, at(x1, 1.0), nullptr, event));
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(0.5 * x1, 1.0), nullptr, system.modes().of(0), event));  // not crossed: stale
+  CHECK_FALSE(gear.commit(0, 1, 0.0, at(2.0 * x1, 1.0), nullptr, system.modes().of(0), event));   // upward crossings never leave a mode
+  CHECK(gear.commit(0, -1, 0.0, at(x1, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "sliding (buff)");
   // Reversal at 0.03, partial unloading to the lower line, reloading at 0.025.
-  CHECK(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, event));
+  CHECK(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "reversal (buff)");
   CHECK(force(0.0295) == Approx(g.U(0.03) - g.Kt * 0.0005));
   const double meet = 0.03 - 2.0 * g.H / (g.Kt - g.k);
   // (Position roots switch a band of 1e-12 x travel past their boundary: step just past it.)
   const double past = 1e-12;
-  CHECK(gear.commit(1, -1, 0.0, at(meet - past, -1.0), nullptr, event));
+  CHECK(gear.commit(1, -1, 0.0, at(meet - past, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "unloading (buff)");
   CHECK(force(0.026) == Approx(g.Lw(0.026)));
-  CHECK(gear.commit(0, -1, 0.0, at(0.025, 1.0), nullptr, event));
+  CHECK(gear.commit(0, -1, 0.0, at(0.025, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "reloading (buff)");
   CHECK(force(0.026) == Approx(g.Lw(0.025) + g.Kt * 0.001));
   // Elastic back up until the line meets k x + H again, 2 H / (Kt - k) further on.
   const double rejoin = 0.025 + 2.0 * g.H / (g.Kt - g.k);
-  CHECK_FALSE(gear.commit(0, -1, 0.0, at(rejoin - 1e-6, 1.0), nullptr, event));
-  CHECK(gear.commit(0, -1, 0.0, at(rejoin + past, 1.0), nullptr, event));
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(rejoin - 1e-6, 1.0), nullptr, system.modes().of(0), event));
+  CHECK(gear.commit(0, -1, 0.0, at(rejoin + past, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "back on the loading curve (buff)");
   CHECK(force(0.04) == Approx(g.U(0.04)));
   // An Euler step that goes past several boundaries (breakaway, then the reversal): each
   // change is applied in one commit.
-  gear.reset_modes();
-  CHECK(gear.commit(0, -1, 0.0, at(0.03, -1.0), nullptr, event));
+  system.reset_modes();
+  CHECK(gear.commit(0, -1, 0.0, at(0.03, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "sliding (buff), reversal (buff)");
-  CHECK(gear.state().law.mode == M::Transition);
+  CHECK(system.modes().as<DraftGear::State>(0).law.mode == M::Transition);
   CHECK(force(0.03) == Approx(g.U(0.03)));
-  gear.reset_modes();
-  CHECK(gear.commit(0, -1, 0.0, at(0.06, 1.0), nullptr, event));
+  system.reset_modes();
+  CHECK(gear.commit(0, -1, 0.0, at(0.06, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "sliding (buff)");
-  CHECK(gear.state().law.segment == 1);  // on the bottomed part
+  CHECK(system.modes().as<DraftGear::State>(0).law.segment == 1);  // on the bottomed part
   CHECK(force(0.06) == Approx(g.U(0.06)));
   // Bottomed, the transition stiffness equals K: the gear unloads along its loading line
   // (solid, the friction does not slip) until it is back off the bottom.
-  CHECK(gear.commit(0, -1, 0.0, at(0.06, 0.0), nullptr, event));
+  CHECK(gear.commit(0, -1, 0.0, at(0.06, 0.0), nullptr, system.modes().of(0), event));
   CHECK(force(0.055) == Approx(g.U(0.055)));
   double g_roots[DraftGear::kRoots];
   gear.roots(0.0, at(0.055, -1.0), nullptr, g_roots);
@@ -640,12 +647,11 @@ TEST_CASE("draft_gear Jacobian matches central differences in every mode", "[ele
       {S::Fractured, {}, 0.0}};
   for (const bool ground_first : {true, false}) {
     Model model = testing::model_from_text(two_bodies(gear_yaml(kGear, "    free_length: 1.0\n"), ground_first));
-    DraftGear& gear = gear_of(model);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::mt19937 rng(5);
     for (std::size_t k = 0; k < modes.size(); ++k) {
       INFO((ground_first ? "ground-body" : "body-body") << ", mode " << k);
-      gear.set_state(modes[k]);
+      testing::set_mode<DraftGear::State>(system, modes[k]);
       check_jacobian_here(system, rng);
     }
   }
@@ -706,7 +712,7 @@ TEST_CASE("coupler_end friction: regularized Coulomb, bounded by mu times the no
   const Model model = testing::model_from_text(
       one_mass(coupler_end_yaml("    friction: 0.3\n    friction_velocity: 0.01\n"), 10.0, 0.09, 0.02, 0.0, 0.0, 1.0, "ida"));
   const Element& e = *model.elements()[0];
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> gap(-0.02, -1e-4), slip(-0.05, 0.05), lateral(-0.1, 0.1);
   for (int trial = 0; trial < 20; ++trial) {
@@ -716,7 +722,7 @@ TEST_CASE("coupler_end friction: regularized Coulomb, bounded by mu times the no
     y[3] = slip(rng);
     y[4] = slip(rng);
     std::array<Pose<double>, 2> f{};
-    e.add_force(0.0, gather_state(e, y.data(), y.data() + 3), f);
+    e.add_force(0.0, gather_state(e, y.data(), y.data() + 3, system.modes().of(0)), f);
     const Pose<double>& on_mass = f[static_cast<std::size_t>(e.point_slot(1))];
     const double normal = kFaceStiffness * (kContact - y[0]);
     INFO("trial " << trial);
@@ -768,14 +774,14 @@ TEST_CASE("coupler_end: overlap regained with the faces past each other gives no
           "[elements][couplers]") {
   const Model model = testing::model_from_text(one_mass(coupler_end_yaml(), 10.0, 0.09, 0.5, 0.0, 0.0, 1.0, "ida"));
   CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
-  REQUIRE_FALSE(e.state().overlapping);  // starts 0.5 above: no overlap
-  const DaeSystem system(model);
+  DaeSystem system(model);
+  REQUIRE_FALSE(system.modes().as<CouplerEnd::State>(0).overlapping);  // starts 0.5 above: no overlap
   std::vector<double> y = system.initial_state();
   const auto state_at = [&](double x, double dy, double vx) {
     y[0] = x;
     y[1] = dy;
     y[3] = vx;
-    return gather_state(e, y.data(), y.data() + 3);
+    return gather_state(e, y.data(), y.data() + 3, system.modes().of(0));
   };
   const auto force_x = [&](double x, double dy) {
     std::array<Pose<double>, 2> f{};
@@ -785,21 +791,21 @@ TEST_CASE("coupler_end: overlap regained with the faces past each other gives no
   CHECK(force_x(0.08, 0.5) == 0.0);
   Element::Event event;
   // Coming down into overlap while horizontally 0.02 past contact: blocked.
-  CHECK(e.commit(2, -1, 0.0, state_at(0.08, 0.29, 0.0), nullptr, event));
+  CHECK(e.commit(2, -1, 0.0, state_at(0.08, 0.29, 0.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "vertical overlap regained, faces past each other");
-  CHECK(e.state().blocked);
+  CHECK(system.modes().as<CouplerEnd::State>(0).blocked);
   CHECK(force_x(0.08, 0.2) == 0.0);
   // A stale crossing (a root that is positive in the current mode) changes nothing.
-  CHECK_FALSE(e.commit(2, -1, 0.0, state_at(0.08, 0.1, 0.0), nullptr, event));
+  CHECK_FALSE(e.commit(2, -1, 0.0, state_at(0.08, 0.1, 0.0), nullptr, system.modes().of(0), event));
   // Moving apart past the contact spacing: clear, then a new approach makes contact.
-  CHECK(e.commit(0, -1, 0.0, state_at(0.1 + 1e-9, 0.1, 1.0), nullptr, event));
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1 + 1e-9, 0.1, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "faces clear");
-  CHECK_FALSE(e.state().blocked);
-  CHECK(e.commit(0, -1, 0.0, state_at(0.1 - 1e-9, 0.1, -1.0), nullptr, event));
+  CHECK_FALSE(system.modes().as<CouplerEnd::State>(0).blocked);
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1 - 1e-9, 0.1, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "contact");
   CHECK(force_x(0.09, 0.1) == Approx(kFaceStiffness * 0.01));
-  e.reset_modes();
-  CHECK_FALSE(e.state().overlapping);
+  system.reset_modes();
+  CHECK_FALSE(system.modes().as<CouplerEnd::State>(0).overlapping);
 }
 
 TEST_CASE("coupler_end: faces touching at rest at the start; a load closes them, a pull does not", "[elements][couplers]") {
@@ -826,9 +832,9 @@ TEST_CASE("coupler_end: Euler's stability estimate sees the face stiffness while
           "[elements][couplers]") {
   const Model model = testing::model_from_text(one_mass(coupler_end_yaml(), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
   Element& e = *model.elements()[0];
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const std::vector<double> y = system.initial_state();
-  const ElementState<double> s = gather_state(e, y.data(), y.data() + 3);
+  const ElementState<double> s = gather_state(e, y.data(), y.data() + 3, system.modes().of(0));
   ForceBlock now{}, now_v{}, stiffest{}, stiffest_v{};
   std::array<Pose<double>, 2> f{};
   e.add_force_jacobian(0.0, s, f, now, now_v);
@@ -845,12 +851,11 @@ TEST_CASE("coupler_end Jacobian matches central differences in every mode", "[el
   for (const bool ground_first : {true, false}) {
     Model model = testing::model_from_text(two_bodies(
         coupler_end_yaml("    friction: 0.3\n    coupled: true\n    total_horizontal_slack: 0.02\n"), ground_first));
-    CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::mt19937 rng(7);
     for (std::size_t k = 0; k < modes.size(); ++k) {
       INFO((ground_first ? "ground-body" : "body-body") << ", mode " << k);
-      e.set_state(modes[k]);
+      testing::set_mode<CouplerEnd::State>(system, modes[k]);
       check_jacobian_here(system, rng);
     }
   }
@@ -874,7 +879,8 @@ TEST_CASE("coupler_end restitution: a mass hitting the faces rebounds at e times
       const bool ida = std::string(integrator) == "ida";
       const Model model = testing::model_from_text(one_mass(coupler_end_yaml("    restitution: " + num(e) + "\n"), m,
                                                             kContact + gap, 0.0, -v, 0.0, t_end, integrator));
-      const Run r = run(model);
+      DaeSystem system(model);
+      const Run r = run(system);
       check_events(r.outcome, {{"contact", t_contact, 0.0}, {"unloading", t_unloading, -peak}, {"separation", t_separation, -set}},
                    ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
       // Euler (dt 1e-6) sees each switch up to one step late, but the force is continuous at
@@ -890,8 +896,8 @@ TEST_CASE("coupler_end restitution: a mass hitting the faces rebounds at e times
       // on the stiffer unloading line (omega / e).
       CHECK(std::abs(balance_error(r.outcome)) < (ida ? 1e-7 : 3.0 * omega / e * 1e-6) * 0.5 * m * v * v);
       const CouplerEnd& end = dynamic_cast<const CouplerEnd&>(*model.elements()[0]);
-      CHECK(end.state().peak == Approx(peak).epsilon(ida ? 1e-8 : 1e-4));
-      CHECK(end.permanent_set(end.state()) == Approx(set).epsilon(ida ? 1e-8 : 1e-4));
+      CHECK(system.modes().as<CouplerEnd::State>(0).peak == Approx(peak).epsilon(ida ? 1e-8 : 1e-4));
+      CHECK(end.permanent_set(system.modes().as<CouplerEnd::State>(0)) == Approx(set).epsilon(ida ? 1e-8 : 1e-4));
     }
   }
 }
@@ -931,12 +937,12 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
       testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
   CouplerEnd& end = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
   CHECK(end.unloading_stiffness() == Approx(ku));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const auto state_at = [&](double delta, double delta_rate) {
     y[0] = kContact - delta;
     y[3] = -delta_rate;
-    return gather_state(end, y.data(), y.data() + 3);
+    return gather_state(end, y.data(), y.data() + 3, system.modes().of(0));
   };
   const auto push = [&](double delta) {  // force on the mass along +x, the faces' push
     std::array<Pose<double>, 2> f{};
@@ -945,7 +951,7 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   };
   Element::Event event;
   const auto crossing = [&](int index, double delta, double delta_rate) {
-    return end.commit(index, -1, 0.0, state_at(delta, delta_rate), nullptr, event);
+    return end.commit(index, -1, 0.0, state_at(delta, delta_rate), nullptr, system.modes().of(0), event);
   };
   CHECK(push(0.01) == 0.0);
   REQUIRE(crossing(0, 1e-9, 1.0));
@@ -955,7 +961,7 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   REQUIRE(crossing(0, peak, -0.5));
   CHECK(event.what == "unloading");
   CHECK(event.value == Approx(-peak));
-  CHECK(end.state().peak == Approx(peak));
+  CHECK(system.modes().as<CouplerEnd::State>(0).peak == Approx(peak));
   CHECK(push(peak) == Approx(k * peak));  // the lines meet at delta_max
   CHECK(push(0.018) == Approx(ku * (0.018 - set)));
   CHECK(end.potential_energy(state_at(0.018, 0.0)) == Approx(0.5 * std::pow(ku * (0.018 - set), 2) / ku));
@@ -968,7 +974,7 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   CHECK_FALSE(crossing(0, set - 1e-6, 0.5));
   REQUIRE(crossing(0, set + 1e-9, 0.5));
   CHECK(event.what == "contact");
-  CHECK(end.state().unloading);
+  CHECK(system.modes().as<CouplerEnd::State>(0).unloading);
   CHECK(push(0.018) == Approx(ku * (0.018 - set)));
   CHECK_FALSE(crossing(1, peak - 1e-6, 0.5));
   REQUIRE(crossing(1, peak + 1e-9, 0.5));
@@ -977,10 +983,10 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   CHECK(end.potential_energy(state_at(0.025, 0.0)) == Approx(0.5 * std::pow(k * 0.025, 2) / ku));
   // A reversal further in moves the set: delta_max 0.03, p = 0.0225.
   REQUIRE(crossing(0, 0.03, -0.1));
-  CHECK(end.permanent_set(end.state()) == Approx(0.03 * (1.0 - e * e)));
+  CHECK(end.permanent_set(system.modes().as<CouplerEnd::State>(0)) == Approx(0.03 * (1.0 - e * e)));
   CHECK(push(0.025) == Approx(ku * (0.025 - 0.0225)));
-  end.reset_modes();
-  CHECK(end.state().peak == 0.0);
+  system.reset_modes();
+  CHECK(system.modes().as<CouplerEnd::State>(0).peak == 0.0);
   CHECK(push(0.01) == 0.0);
 }
 
@@ -990,31 +996,31 @@ TEST_CASE("coupler_end restitution: loss of overlap while loading keeps the set;
   const Model model =
       testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
   CouplerEnd& end = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const auto state_at = [&](double delta, double dy, double delta_rate) {
     y[0] = kContact - delta;
     y[1] = dy;
     y[3] = -delta_rate;
-    return gather_state(end, y.data(), y.data() + 3);
+    return gather_state(end, y.data(), y.data() + 3, system.modes().of(0));
   };
   Element::Event event;
-  REQUIRE(end.commit(0, -1, 0.0, state_at(1e-9, 0.0, 1.0), nullptr, event));
-  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(peak, 0.3 + 1e-9, 1.0), nullptr, event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(1e-9, 0.0, 1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(peak, 0.3 + 1e-9, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "vertical overlap lost");
-  CHECK(end.permanent_set(end.state()) == Approx(set));
+  CHECK(end.permanent_set(system.modes().as<CouplerEnd::State>(0)) == Approx(set));
   // Back into overlap with the faces deeper than the set: blocked, no force, clear at the set.
-  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(0.018, 0.1, -1.0), nullptr, event));
+  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(0.018, 0.1, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "vertical overlap regained, faces past each other");
   std::array<Pose<double>, 2> f{};
   end.add_force(0.0, state_at(0.018, 0.1, 0.0), f);
   CHECK(f[1].x == 0.0);
-  CHECK_FALSE(end.commit(0, -1, 0.0, state_at(set + 1e-6, 0.1, -1.0), nullptr, event));
-  REQUIRE(end.commit(0, -1, 0.0, state_at(set - 1e-9, 0.1, -1.0), nullptr, event));
+  CHECK_FALSE(end.commit(0, -1, 0.0, state_at(set + 1e-6, 0.1, -1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(set - 1e-9, 0.1, -1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "faces clear");
-  REQUIRE(end.commit(0, -1, 0.0, state_at(set + 1e-9, 0.1, 1.0), nullptr, event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(set + 1e-9, 0.1, 1.0), nullptr, system.modes().of(0), event));
   CHECK(event.what == "contact");
-  CHECK(end.state().unloading);
+  CHECK(system.modes().as<CouplerEnd::State>(0).unloading);
 }
 
 TEST_CASE("coupler_end shear_load: the faces shear off at the stated force and carry nothing afterwards",
@@ -1033,7 +1039,8 @@ TEST_CASE("coupler_end shear_load: the faces shear off at the stated force and c
       const Model model = testing::model_from_text(
           one_mass(coupler_end_yaml("    friction: 0.3\n    restitution: " + std::string(e) + "\n    shear_load: " + num(S) + "\n"),
                    m, kContact + gap, 0.0, -v, 0.0, t_end, integrator));
-      const Run r = run(model);
+      DaeSystem system(model);
+      const Run r = run(system);
       // Euler sees the shear one step late: the force overshoots S by at most k v dt (0.36 here).
       check_events(r.outcome, {{"contact", t_contact, 0.0}, {"face shear failure", t_shear, S}}, ida ? 1e-8 : 3e-6,
                    ida ? 1e-9 : 1e-4);
@@ -1044,17 +1051,16 @@ TEST_CASE("coupler_end shear_load: the faces shear off at the stated force and c
       CHECK(element_work(r.outcome) == Approx(lost).epsilon(ida ? 1e-7 : 2e-3));
       // Sheared: no force in any direction, whatever the faces do.
       CouplerEnd& end = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
-      CHECK(end.state().sheared);
-      const DaeSystem system(model);
+      CHECK(system.modes().as<CouplerEnd::State>(0).sheared);
       std::vector<double> y = system.initial_state();
       y[0] = kContact - 0.05;
       y[4] = 0.5;
       std::array<Pose<double>, 2> f{};
-      end.add_force(0.0, gather_state(end, y.data(), y.data() + 3), f);
+      end.add_force(0.0, gather_state(end, y.data(), y.data() + 3, system.modes().of(0)), f);
       CHECK(f[1].x == 0.0);
       CHECK(f[1].y == 0.0);
       double g[CouplerEnd::kRoots];
-      end.roots(0.0, gather_state(end, y.data(), y.data() + 3), nullptr, g);
+      end.roots(0.0, gather_state(end, y.data(), y.data() + 3, system.modes().of(0)), nullptr, g);
       for (double value : g) CHECK(value > 0.0);
     }
   }
@@ -1064,10 +1070,10 @@ TEST_CASE("coupler_end restitution: Euler's stability estimate sees the unloadin
   const Model model =
       testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), 10.0, 0.5, 0.0, 0.0, 0.0, 1.0, "ida"));
   Element& e = *model.elements()[0];
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const std::vector<double> y = system.initial_state();
   ForceBlock stiffest{}, stiffest_v{};
-  e.stiffest_force_jacobian(0.0, gather_state(e, y.data(), y.data() + 3), stiffest, stiffest_v);
+  e.stiffest_force_jacobian(0.0, gather_state(e, y.data(), y.data() + 3, system.modes().of(0)), stiffest, stiffest_v);
   const auto x = static_cast<std::size_t>(3 * e.point_slot(1));
   CHECK(stiffest[x][x] == Approx(-4.0 * kFaceStiffness));
 }
@@ -1085,12 +1091,11 @@ TEST_CASE("coupler_end with restitution and shear_load: Jacobian matches central
   for (const bool ground_first : {true, false}) {
     Model model = testing::model_from_text(
         two_bodies(coupler_end_yaml("    friction: 0.3\n    restitution: 0.6\n    shear_load: 1e9\n"), ground_first));
-    CouplerEnd& e = dynamic_cast<CouplerEnd&>(*model.elements()[0]);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::mt19937 rng(11);
     for (std::size_t k = 0; k < modes.size(); ++k) {
       INFO((ground_first ? "ground-body" : "body-body") << ", mode " << k);
-      e.set_state(modes[k]);
+      testing::set_mode<CouplerEnd::State>(system, modes[k]);
       check_jacobian_here(system, rng);
     }
   }
@@ -1196,19 +1201,19 @@ TEST_CASE("coupling vertical: slack, flexibility and misalignment; friction prop
     // The mass at 1.0 - 0.004 (buff deflection 0.004 on the first segment), head L at Dy + e.
     const Model model = testing::model_from_text(one_mass(element(0.0), 1000.0, 1.0, 0.0, -0.1, 0.0, 1.0, "ida"));
     Coupling& c = dynamic_cast<Coupling&>(*model.elements()[0]);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::vector<double> y = system.initial_state();
     for (const double dy : {0.03, -0.03, 0.001}) {
       for (const double vy : {0.05, -0.004}) {
         y[0] = 1.0 - 0.004;
         y[1] = dy;
         y[4] = vy;
-        const ElementState<double> s = gather_state(c, y.data(), y.data() + 3);
-        Coupling::State st = c.state();
+        const ElementState<double> s = gather_state(c, y.data(), y.data() + 3, system.modes().of(0));
+        Coupling::State st = system.modes().as<Coupling::State>(0);
         st.horizontal = {AxialHysteresis::Mode::Loading, 1, 0, 0.0, 0.0};
         const double w = dy + e;
         st.vertical = w > 0.5 * sv ? DeadBand::Mode::Above : (w < -0.5 * sv ? DeadBand::Mode::Below : DeadBand::Mode::Inside);
-        c.set_state(st);
+        testing::set_mode<Coupling::State>(system, st);
         std::array<Pose<double>, 2> f{};
         c.add_force(0.0, s, f);
         const double horizontal = 1.0e7 * 0.004;
@@ -1247,14 +1252,13 @@ TEST_CASE("coupling Jacobian matches central differences in every mode", "[eleme
                        "    vertical_slack: 0.01\n    vertical_stiffness: 2e6\n    misalignment: 0.003\n    friction: 0.3\n"
                        "    free_length: 1.0\n"),
         ground_first));
-    Coupling& c = dynamic_cast<Coupling&>(*model.elements()[0]);
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::mt19937 rng(13);
     for (const auto& h : horizontal)
       for (const B v : {B::Below, B::Inside, B::Above}) {
         INFO((ground_first ? "ground-body" : "body-body") << ", horizontal mode " << static_cast<int>(h.mode) << " side "
                                                           << h.side << ", vertical " << static_cast<int>(v));
-        c.set_state({h, v});
+        testing::set_mode<Coupling::State>(system, {h, v});
         check_jacobian_here(system, rng);
       }
   }

@@ -79,7 +79,7 @@ TEST_CASE("joint friction Jacobians match central differences, multipliers inclu
         std::string("  - {name: j, type: pin_joint, friction_radius: 0.03, friction_velocity: 0.05, "
                     "points: [{body: a, at: [0.2, 0.1]}, {body: b, at: [-0.1, 0.3]}]}\n")}) {
     const Model model = testing::model_from_text(bodies + joint + "simulation: {t_end: 1}\n");
-    const DaeSystem system(model);
+    DaeSystem system(model);
     std::mt19937 rng(5);
     for (int trial = 0; trial < 5; ++trial) {
       const std::vector<double> y = testing::random_state(system, rng, 0.5);

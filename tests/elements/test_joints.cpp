@@ -172,7 +172,7 @@ TEST_CASE("joint DAE Jacobians match central differences inside the pattern", "[
     for (const Ends ends : kAllEnds) {
       INFO(joint.type << " " << ends_name(ends));
       const Model model = testing::model_from_text(joint_model(joint, satisfied_layout(joint, ends)));
-      const DaeSystem system(model);
+      DaeSystem system(model);
       REQUIRE(system.constraint_rows() == joint.rows);
       std::mt19937 rng(5);
       for (int trial = 0; trial < 4; ++trial) {
@@ -196,7 +196,7 @@ TEST_CASE("joint constraints vanish in a satisfying layout and follow the docume
       INFO(joint.type << " " << ends_name(ends));
       const JointLayout layout = satisfied_layout(joint, ends);
       const Model model = testing::model_from_text(joint_model(joint, layout));
-      const DaeSystem system(model);
+      DaeSystem system(model);
       REQUIRE(system.constraint_rows() == joint.rows);
       const double a0 = layout.relative_angle();
 
@@ -271,7 +271,7 @@ TEST_CASE("sliding joints stay satisfied when body 2 slides along the axis in bo
     INFO(type);
     const JointLayout layout = satisfied_layout(joint, Ends::BodyBody);
     const Model model = testing::model_from_text(joint_model(joint, layout));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Vec along = rotated(layout.end1.theta, kAxis);  // rotated with body 1, not the global axis
     Poses slid{layout.end1, layout.end2};
     slid.end2.x += 0.4 * along.x;
@@ -296,7 +296,7 @@ TEST_CASE("joints without relative_angle lock the initial relative angle", "[ele
     REQUIRE(locking != nullptr);
     REQUIRE(locking->locked_angle.has_value());
     CHECK(*locking->locked_angle == Approx(0.35).epsilon(1e-12));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     Poses p{layout.end1, layout.end2};
     const std::vector<double> at_start = constraint_values(system, global_q(p));
     p.end2.theta += 0.1;
@@ -425,7 +425,7 @@ TEST_CASE("DaeSystem maps rotational rows and owners through the constraint offs
       "  - {name: double_slider, type: double_slider_joint, points: [{body: a}, {body: b}]}\n"
       "  - {name: rigid, type: rigid_joint, points: [{body: a, at: [0.5, 0]}, {body: b, at: [-0.5, 0]}]}\n"
       "simulation: {t_end: 1.0}\n");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   REQUIRE(system.constraint_rows() == 9);
   const bool rotational[9] = {false, false, false, true, false, true, false, false, true};
   const char* owners[9] = {"pin", "pin", "slider", "slider", "sliding_pin", "double_slider", "rigid", "rigid", "rigid"};

@@ -83,7 +83,7 @@ struct Quiet : RunObserver {
 
 RunOutcome run(const std::string& yaml) {
   const Model model = testing::model_from_text(yaml);
-  const DaeSystem system(model);
+  DaeSystem system(model);
   auto integrator = make_integrator(system, model.simulation);
   Quiet quiet;
   RunOutcome outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), quiet);
@@ -219,7 +219,7 @@ void for_every_mode(const std::string& type, const std::string& parameters, Plac
   for (const Ends ends : {Ends::GroundBody, Ends::BodyBody}) {
     INFO(type << (ends == Ends::GroundBody ? " ground-body" : " body-body"));
     const Model model = testing::model_from_text(general_yaml(type, parameters, ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     auto& element = dynamic_cast<Element&>(*model.elements().front());
     const int segments = element.law().segment_count();
     for (int k = 0; k <= segments; ++k) {
@@ -230,8 +230,8 @@ void for_every_mode(const std::string& type, const std::string& parameters, Plac
       const double x = inside(element.law(), broken ? 0 : k);
       place(element, y, x);
       const int nq = system.body_unknowns();
-      REQUIRE(element.measure_of(gather_state(element, y.data(), y.data() + nq)) == Approx(x).margin(1e-12));
-      element.set_mode(SegmentMode{broken ? 0 : k, broken});
+      REQUIRE(element.measure_of(gather_state(element, y.data(), y.data() + nq, nullptr)) == Approx(x).margin(1e-12));
+      system.modes().as<SegmentMode>(0) = SegmentMode{broken ? 0 : k, broken};
       check(system, element, y, k);
     }
   }
@@ -251,7 +251,7 @@ void check_force_is_energy_gradient(const DaeSystem& system, const Element& elem
   const std::vector<double> q(y.begin(), y.begin() + nq), v(y.begin() + nq, y.begin() + 2 * nq);
   std::vector<double> f(static_cast<std::size_t>(nq), 0.0);
   system.generalized_forces(0.0, q.data(), v.data(), f.data());
-  const auto energy = [&](const std::vector<double>& at) { return element.potential_energy(gather_state(element, at.data(), v.data())); };
+  const auto energy = [&](const std::vector<double>& at) { return element.potential_energy(gather_state(element, at.data(), v.data(), system.modes().of(0))); };
   double largest = 0.0;
   for (std::size_t k = 0; k < q.size(); ++k) {
     const double h = 1e-6;
@@ -270,7 +270,7 @@ void check_force_is_energy_gradient(const DaeSystem& system, const Element& elem
 template <class Spring>
 void place_spring(Spring& e, std::vector<double>& y, double x, double direction) {
   const int nq = static_cast<int>(y.size()) / 2;
-  const double now = e.measure_of(gather_state(e, y.data(), y.data() + nq));
+  const double now = e.measure_of(gather_state(e, y.data(), y.data() + nq, nullptr));  // x needs no mode
   e.free_length = *e.free_length + direction * (x - now);
 }
 
@@ -299,7 +299,7 @@ TEST_CASE("nonlinear element Jacobians match central differences in every mode",
           // All velocities zero but body a's translation, set along the line to give rate x.
           const int nq = static_cast<int>(y.size()) / 2;
           std::fill(y.begin() + nq, y.end(), 0.0);
-          const LineGeometry<double> g = line_geometry(e, gather_state(e, y.data(), y.data() + nq));
+          const LineGeometry<double> g = line_geometry(e, gather_state(e, y.data(), y.data() + nq, nullptr));
           const double ux = g.d.x / g.length, uy = g.d.y / g.length;
           const double sign = e.point(1).body == 0 ? 1.0 : -1.0;  // body a holds P2 (+) or P1 (-)
           y[static_cast<std::size_t>(nq)] = sign * x * ux;
@@ -347,7 +347,7 @@ TEST_CASE("nonlinear_spring force and energy follow both branches past both brea
       a.position = (flip ? -1.0 : 1.0) * (1.0 + p.deformation);
       a.simulation = ida(1.0);
       const Model model = testing::model_from_text(axial_yaml(a));
-      const DaeSystem system(model);
+      DaeSystem system(model);
       const std::vector<double> y = system.initial_state();
       std::vector<double> f(3, 0.0), out(2, 0.0);
       system.generalized_forces(0.0, y.data(), y.data() + 3, f.data());
@@ -358,7 +358,7 @@ TEST_CASE("nonlinear_spring force and energy follow both branches past both brea
       CHECK(f[0] == Approx((flip ? 1.0 : -1.0) * -(-p.tension)).epsilon(1e-12));
       CHECK(f[1] == Approx(0.0).margin(1e-12));
       const Element& e = *model.elements().front();
-      CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3)) == Approx(p.energy).epsilon(1e-12));
+      CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0))) == Approx(p.energy).epsilon(1e-12));
     }
   }
 }
@@ -372,7 +372,7 @@ TEST_CASE("nonlinear_dashpot force follows both branches past both switch veloci
     a.velocity = rate;  // body at +1 on x: its velocity is the rate of length
     a.simulation = ida(1.0);
     const Model model = testing::model_from_text(axial_yaml(a));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const std::vector<double> y = system.initial_state();
     std::vector<double> f(3, 0.0), out(2, 0.0);
     system.generalized_forces(0.0, y.data(), y.data() + 3, f.data());
@@ -381,7 +381,7 @@ TEST_CASE("nonlinear_dashpot force follows both branches past both switch veloci
     CHECK(out[1] == Approx(rate).epsilon(1e-12));
     CHECK(f[0] == Approx(-tension).epsilon(1e-12));
     const Element& e = *model.elements().front();
-    CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3)) == 0.0);
+    CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0))) == 0.0);
   }
 }
 
@@ -395,7 +395,7 @@ TEST_CASE("special_spring acts one way only: compression (kind 1) or tension (ki
       a.position = kind == 1 ? 1.0 - deflection : 1.0 + deflection;
       a.simulation = ida(1.0);
       const Model model = testing::model_from_text(axial_yaml(a));
-      const DaeSystem system(model);
+      DaeSystem system(model);
       const std::vector<double> y = system.initial_state();
       std::vector<double> f(3, 0.0), out(2, 0.0);
       system.generalized_forces(0.0, y.data(), y.data() + 3, f.data());
@@ -410,7 +410,7 @@ TEST_CASE("special_spring acts one way only: compression (kind 1) or tension (ki
                                 ? 5.0 * deflection + 1000.0 * deflection * deflection
                                 : 0.5 + 45.0 * (deflection - 0.02) + 10000.0 * std::pow(deflection - 0.02, 2);
       const Element& e = *model.elements().front();
-      CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3)) == Approx(energy).margin(1e-12));
+      CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0))) == Approx(energy).margin(1e-12));
     }
   }
 }
@@ -427,7 +427,7 @@ TEST_CASE("special_spring along an axis: force along the turned axis, lever arm 
       "elements:\n  - {name: e, type: special_spring, stiffness_1: 100, free_length: 1.0, axis: [1, 0], "
       "points: [{body: a, at: [0, 0]}, {body: b, at: [0, 0]}]}\n"
       "simulation: {t_end: 1}\n");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const std::vector<double> y = system.initial_state();
   std::vector<double> f(6, 0.0), out(2, 0.0);
   system.generalized_forces(0.0, y.data(), y.data() + 6, f.data());
@@ -440,7 +440,7 @@ TEST_CASE("special_spring along an axis: force along the turned axis, lever arm 
   CHECK(out[0] == Approx(20.0));
   CHECK(out[1] == Approx(0.2));
   const Element& e = *model.elements().front();
-  CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 6)) == Approx(2.0));
+  CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 6, system.modes().of(0))) == Approx(2.0));
 }
 
 TEST_CASE("a breakpoint that is no kink is merged: the report's symmetric dashpot and gap spring",

@@ -197,7 +197,7 @@ TEST_CASE("spring and dashpot DAE Jacobians match central differences inside the
     for (const Ends ends : kAllEnds) {
       INFO(type << " " << ends_name(ends) << "\n" << parameters);
       const Model model = testing::model_from_text(element_model(type, parameters, ends));
-      const DaeSystem system(model);
+      DaeSystem system(model);
       std::mt19937 rng(3);
       for (int trial = 0; trial < 4; ++trial) {
         INFO("trial " << trial);
@@ -216,7 +216,7 @@ TEST_CASE("linear_spring pulls with stiffness times stretch along the line", "[e
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("linear_spring", linear_spring_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     at_several_states(system, [&](const BodyState& s) {
       const double tension = kStiffness * (distance(s.q, l) - kFreeLength);
@@ -235,14 +235,14 @@ TEST_CASE("linear_spring on a rotated body: force and moment at a known configur
       "elements:\n  - name: e\n    type: linear_spring\n    stiffness: 100\n    free_length: 1.5\n"
       "    points: [{body: ground, at: [0, 0.5]}, {body: a, at: [0.5, 0]}]\n"
       "simulation: {t_end: 1.0}\n");
-  const DaeSystem system(model);
+  DaeSystem system(model);
   check_forces(forces(system, split(system, system.initial_state())), {-50.0, 0.0, 25.0});
 }
 
 TEST_CASE("linear_spring with zero free length pulls with stiffness times separation", "[elements]") {
   const Model model =
       testing::model_from_text(element_model("linear_spring", "    stiffness: 40\n    free_length: 0\n", Ends::BodyBody));
-  const DaeSystem system(model);
+  DaeSystem system(model);
   const Layout l = layout(Ends::BodyBody);
   at_several_states(system, [&](const BodyState& s) {
     const Vec p1 = position(s.q, l.p1), p2 = position(s.q, l.p2);
@@ -254,7 +254,7 @@ TEST_CASE("linear_dashpot resists with damping times the rate of length", "[elem
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("linear_dashpot", linear_dashpot_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     at_several_states(system, [&](const BodyState& s) {
       const double force = kDamping * length_rate(s.q, s.v, l);
@@ -270,7 +270,7 @@ TEST_CASE("torsional_spring applies opposite moments proportional to the relativ
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("torsional_spring", torsional_spring_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     at_several_states(system, [&](const BodyState& s) {
       const double moment = kTorsionalStiffness * (relative_angle(s.q, l) - kFreeAngle);
@@ -284,7 +284,7 @@ TEST_CASE("torsional_dashpot applies opposite moments proportional to the relati
     INFO(ends_name(ends));
     const Model model =
         testing::model_from_text(element_model("torsional_dashpot", torsional_dashpot_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     at_several_states(system, [&](const BodyState& s) {
       const double moment = kTorsionalDamping * relative_rate(s.v, l);
@@ -306,7 +306,7 @@ TEST_CASE("spring forces are minus the gradient of their potential energy", "[el
     for (const Ends ends : kAllEnds) {
       INFO(type << " " << ends_name(ends) << "\n" << parameters);
       const Model model = testing::model_from_text(element_model(type, parameters, ends));
-      const DaeSystem system(model);
+      DaeSystem system(model);
       const Element& element = *model.elements().front();
       const auto energy = [&](const std::vector<double>& q, const std::vector<double>& v) {
         return element.potential_energy(gather_state(element, q.data(), v.data()));
@@ -337,7 +337,7 @@ TEST_CASE("spring potential energy is half stiffness times deformation squared",
     const Model linear = testing::model_from_text(element_model("linear_spring", linear_spring_parameters(), ends));
     const Model torsional =
         testing::model_from_text(element_model("torsional_spring", torsional_spring_parameters(), ends));
-    const DaeSystem system(linear);  // both models have the same bodies: the states fit either
+    DaeSystem system(linear);  // both models have the same bodies: the states fit either
     at_several_states(system, [&](const BodyState& s) {
       const Element& spring = *linear.elements().front();
       const double stretch = distance(s.q, l) - kFreeLength;
@@ -357,7 +357,7 @@ TEST_CASE("linear_spring without free_length is unstressed in the initial config
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("linear_spring", "    stiffness: 40\n", ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     const BodyState start = split(system, system.initial_state());
     const auto& spring = dynamic_cast<const LinearSpring&>(*model.elements().front());
@@ -379,7 +379,7 @@ TEST_CASE("torsional_spring without free_angle is unstressed in the initial conf
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("torsional_spring", "    stiffness: 25\n", ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     const BodyState start = split(system, system.initial_state());
     const auto& spring = dynamic_cast<const TorsionalSpring&>(*model.elements().front());
@@ -421,7 +421,7 @@ TEST_CASE("linear_spring outputs tension-positive force and deformation", "[elem
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("linear_spring", linear_spring_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     CHECK(system.output_names() == std::vector<std::string>{"e.force", "e.deformation"});
     at_several_states(system, [&](const BodyState& s) {
@@ -443,7 +443,7 @@ TEST_CASE("linear_spring output force is positive when stretched and negative wh
         std::to_string(free_length) + "\n    points: [{body: ground}, {body: a}]\nsimulation: {t_end: 1.0}\n");
   };
   const Model stretched = spring_at(1.5), compressed = spring_at(2.5);
-  const DaeSystem stretched_system(stretched), compressed_system(compressed);
+  DaeSystem stretched_system(stretched), compressed_system(compressed);
   const std::vector<double> out_stretched = element_outputs(stretched_system, stretched_system.initial_state());
   const std::vector<double> out_compressed = element_outputs(compressed_system, compressed_system.initial_state());
   CHECK(out_stretched[0] == Approx(5.0));
@@ -458,7 +458,7 @@ TEST_CASE("linear_dashpot outputs force and rate of length", "[elements]") {
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("linear_dashpot", linear_dashpot_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     CHECK(system.output_names() == std::vector<std::string>{"e.force", "e.rate"});
     at_several_states(system, [&](const BodyState& s) {
@@ -474,7 +474,7 @@ TEST_CASE("torsional_spring outputs moment and rotation", "[elements]") {
   for (const Ends ends : kAllEnds) {
     INFO(ends_name(ends));
     const Model model = testing::model_from_text(element_model("torsional_spring", torsional_spring_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     CHECK(system.output_names() == std::vector<std::string>{"e.moment", "e.rotation"});
     at_several_states(system, [&](const BodyState& s) {
@@ -491,7 +491,7 @@ TEST_CASE("torsional_dashpot outputs moment and relative angular velocity", "[el
     INFO(ends_name(ends));
     const Model model =
         testing::model_from_text(element_model("torsional_dashpot", torsional_dashpot_parameters(), ends));
-    const DaeSystem system(model);
+    DaeSystem system(model);
     const Layout l = layout(ends);
     CHECK(system.output_names() == std::vector<std::string>{"e.moment", "e.rate"});
     at_several_states(system, [&](const BodyState& s) {

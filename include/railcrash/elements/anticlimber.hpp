@@ -226,16 +226,13 @@ class Anticlimber : public ForceElement<Anticlimber> {
     double override_time = -1.0;       // [time] of the override; < 0: none
     bool interlock_released = false;   // release: between horizontal unloading and reloading
   };
-  const State& state() const { return state_; }
-  /// Puts the element in a given mode (tests and tools; a run changes modes only by commit).
-  void set_state(const State& state) { state_ = state; }
+  RAILCRASH_ELEMENT_MODE(State, initial_state_)
 
-  bool overridden() const { return state_.contact == Contact::Overridden; }
-  double override_time() const { return state_.override_time; }
+  static bool overridden(const State& st) { return st.contact == Contact::Overridden; }
   /// Denominator of the report's response R2 [force].
   double vertical_yield_force() const { return vertical.yield_force(); }
   /// True while the vertical and torsional laws act (engaged and not released).
-  bool interlocked() const { return state_.contact == Contact::Engaged && !state_.interlock_released; }
+  static bool interlocked(const State& st) { return st.contact == Contact::Engaged && !st.interlock_released; }
 
   /// Geometry of the faces (see the header comment).
   template <class T>
@@ -266,13 +263,14 @@ class Anticlimber : public ForceElement<Anticlimber> {
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    if (state_.contact != Contact::Engaged) return;
+    const State& st = mode_as<State>(s);
+    if (st.contact != Contact::Engaged) return;
     const Kinematics<T> k = kinematics(s);
-    const T h = horizontal.force(state_.horizontal, k.horizontal);
+    const T h = horizontal.force(st.horizontal, k.horizontal);
     T v(0.0), m(0.0);
-    if (!state_.interlock_released) {
-      v = vertical.force(state_.vertical, k.vertical - state_.vertical_reference);
-      m = torsional.force(state_.torsional, k.rotation - state_.torsional_reference);
+    if (!st.interlock_released) {
+      v = vertical.force(st.vertical, k.vertical - st.vertical_reference);
+      m = torsional.force(st.torsional, k.rotation - st.torsional_reference);
     }
     const T push = h * (*facing);
     const Vec2<T> force{push * k.e1.x - v * k.n1.x, push * k.e1.y - v * k.n1.y};
@@ -297,9 +295,8 @@ class Anticlimber : public ForceElement<Anticlimber> {
   void initialize(const ElementState<double>& initial) override;
   int root_count() const override { return kRootCount; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void reset_modes() override { state_ = initial_state_; }
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override {
     return {"horizontal_force",      "vertical_force",         "moment",          "horizontal_deformation",
@@ -318,7 +315,7 @@ class Anticlimber : public ForceElement<Anticlimber> {
  private:
   std::size_t slot1() const { return static_cast<std::size_t>(point_slot(0)); }
   std::size_t slot2() const { return static_cast<std::size_t>(point_slot(1)); }
-  /// Deformations and their rates in the current state (vertical / torsional relative to the
+  /// Deformations and their rates at s in mode st (vertical / torsional relative to the
   /// engagement references).
   struct Deformations {
     double d[3];      // d_h, d_v, d_t
@@ -326,18 +323,17 @@ class Anticlimber : public ForceElement<Anticlimber> {
     double offset;    // v
     double rotation;  // phi
   };
-  Deformations deformations(const ElementState<double>& s) const;
-  void roots_of(const Deformations& k, double* g) const;
-  bool active(int index) const;
+  Deformations deformations(const State& st, const ElementState<double>& s) const;
+  void roots_of(const State& st, const Deformations& k, double* g) const;
+  bool active(const State& st, int index) const;
   /// Takes the current offset and rotation as the interlock's reference (fresh laws).
-  void seat_interlock(const Deformations& k);
-  /// Leaves the current mode through root `index`; appends what happened to `what`.
-  void transition(int index, double t, const Deformations& k, std::string& what);
+  void seat_interlock(State& st, const Deformations& k) const;
+  /// Leaves mode st through root `index`; appends what happened to `what`.
+  void transition(State& st, int index, double t, const Deformations& k, std::string& what) const;
   /// Applies every transition whose root is already negative.
-  void settle(double t, const ElementState<double>& s, std::string& what);
+  void settle(State& st, double t, const ElementState<double>& s, std::string& what) const;
 
-  State state_;
-  State initial_state_;
+  State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
 }  // namespace railcrash

@@ -126,9 +126,7 @@ class BeamElement : public ForceElement<BeamElement> {
     std::array<double, 3> offset{0, 0, 0};   // [length, rad, rad] stored plastic offsets p_k
     bool failed = false;
   };
-  const State& state() const { return state_; }
-  /// Puts the beam in a given mode (tests; restarting from a saved state).
-  void set_state(const State& state) { state_ = state; }
+  RAILCRASH_ELEMENT_MODE(State, State{})
 
   // Derived in initialize() from the section and the initial chord length L0.
   double initial_length() const { return length_; }          // [length] L0
@@ -166,12 +164,12 @@ class BeamElement : public ForceElement<BeamElement> {
     return k;
   }
 
-  /// Plastic offsets in the current mode: stored for elastic components, solved from the
-  /// yield conditions for plastic ones.
+  /// Plastic offsets in mode st: stored for elastic components, solved from the yield
+  /// conditions for plastic ones.
   template <class T>
-  std::array<T, 3> plastic_offsets(const std::array<T, 3>& x) const {
-    const std::array<int, 3>& sign = state_.sign;
-    std::array<T, 3> p{T(state_.offset[0]), T(state_.offset[1]), T(state_.offset[2])};
+  std::array<T, 3> plastic_offsets(const State& st, const std::array<T, 3>& x) const {
+    const std::array<int, 3>& sign = st.sign;
+    std::array<T, 3> p{T(st.offset[0]), T(st.offset[1]), T(st.offset[2])};
     if (sign[0] != 0) p[0] = (axial_stiffness_ * x[0] - sign[0] * yield_[0]) / (axial_stiffness_ + hardening_[0]);
     const double k11 = bending_stiffness_[0], k12 = bending_stiffness_[1], k22 = bending_stiffness_[2];
     const double d11 = k11 + hardening_[1], d22 = k22 + hardening_[2];
@@ -200,9 +198,10 @@ class BeamElement : public ForceElement<BeamElement> {
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    if (state_.failed) return;
+    const State& st = mode_as<State>(s);
+    if (st.failed) return;
     const Kinematics<T> k = kinematics(s);
-    const std::array<T, 3> r = resultants(k.strain, plastic_offsets(k.strain));
+    const std::array<T, 3> r = resultants(k.strain, plastic_offsets(st, k.strain));
     // force on P2 = -N d / L + (M_1 + M_2) perp(d) / L^2
     const T along = -r[0] / k.length;
     const T across = (r[1] + r[2]) / (k.length * k.length);
@@ -215,11 +214,10 @@ class BeamElement : public ForceElement<BeamElement> {
   bool applies_moment() const override { return true; }
   int root_count() const override { return 4; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void reset_modes() override { state_ = State{}; }
-  bool failed() const override { return state_.failed; }
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
+  bool failed(const void* mode) const override { return static_cast<const State*>(mode)->failed; }
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override;
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
@@ -236,7 +234,6 @@ class BeamElement : public ForceElement<BeamElement> {
   /// Largest of |N| / A_min, |M_i| / Z_i [force/length^2].
   double stress(const std::array<double, 3>& force) const;
 
-  State state_;
   double length_ = 0.0;                       // [length] L0
   std::array<double, 2> direction_{1.0, 0.0}; // u0, initial chord direction
   std::array<double, 2> initial_angle_{};     // [rad] theta of the body of P1, P2 at t = 0

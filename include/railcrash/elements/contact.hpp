@@ -58,7 +58,7 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
     Mode mode = Mode::Open;
     int segment = 0;  // contact: 0 below d_L, 1 above
   };
-  const State& state() const { return state_; }
+  RAILCRASH_ELEMENT_MODE(State, initial_state_)
 
   /// Penetration d and its rate d' at the point, and the unit normal / tangent there.
   template <class T>
@@ -98,9 +98,10 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    if (state_.mode != Mode::Contact) return;
+    const State& st = mode_as<State>(s);
+    if (st.mode != Mode::Contact) return;
     const Kinematics<T> k = kinematics(s);
-    const T normal = normal_force(k.penetration, k.rate, state_.segment);
+    const T normal = normal_force(k.penetration, k.rate, st.segment);
     const T tangential = friction > 0.0 ? -friction * normal * tanh(k.slip / friction_velocity) : T(0.0);
     const auto slot = static_cast<std::size_t>(point_slot(0));
     add_point_force(s.q[slot], point(0).sx, point(0).sy,
@@ -111,19 +112,17 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
   void initialize(const ElementState<double>& initial) override;
   int root_count() const override { return 3; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void reset_modes() override { state_ = initial_state_; }
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"normal_force", "friction_force", "penetration"}; }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  private:
-  void enter_mode(double penetration, double rate);
+  void enter_mode(State& st, double penetration, double rate) const;
 
-  State state_;
-  State initial_state_;
+  State initial_state_;  // the mode a run starts in (from the initial configuration)
   bool wheel_rail_;
 };
 

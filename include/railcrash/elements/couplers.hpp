@@ -343,23 +343,22 @@ class DraftGear : public ForceElement<DraftGear> {
     AxialHysteresis::State law;     // intact
     double solid_compression = 0.0;  // [length] sheared / solid: d at which it goes solid
   };
-  const State& state() const { return state_; }
-  /// Puts the element in a given mode (tests, tools); a run starts from initialize()'s.
-  void set_state(const State& st) { state_ = st; }
+  RAILCRASH_ELEMENT_MODE(State, initial_state_)
   const AxialHysteresis& law() const { return law_; }
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const State& st = mode_as<State>(s);
     const LineGeometry<T> g = line_geometry(*this, s);
-    const T scale = gear_force(*free_length - g.length) / g.length;  // force on P2 = F (r2 - r1) / L
+    const T scale = gear_force(st, *free_length - g.length) / g.length;  // force on P2 = F (r2 - r1) / L
     apply_line_force(*this, s, Vec2<T>{scale * g.d.x, scale * g.d.y}, f);
   }
-  /// Signed gear force F(d) in the current mode (> 0: compression pushes the points apart).
+  /// Signed gear force F(d) in mode st (> 0: compression pushes the points apart).
   template <class T>
-  T gear_force(const T& d) const {
-    switch (state_.stage) {
-      case Stage::Intact: return law_.force(state_.law, d);
-      case Stage::Solid: return stiffness_after_bottoming * (d - state_.solid_compression);
+  T gear_force(const State& st, const T& d) const {
+    switch (st.stage) {
+      case Stage::Intact: return law_.force(st.law, d);
+      case Stage::Solid: return stiffness_after_bottoming * (d - st.solid_compression);
       case Stage::Sheared:
       case Stage::Fractured: break;
     }
@@ -370,10 +369,9 @@ class DraftGear : public ForceElement<DraftGear> {
   static constexpr int kRoots = AxialHysteresis::kRoots + 2;  // + pin shear, fracture
   int root_count() const override { return kRoots; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
-  void reset_modes() override { state_ = initial_state_; }
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "compression"}; }
   /// In the crash load path, but not a coupler force: the force between coupler and car body.
@@ -387,12 +385,11 @@ class DraftGear : public ForceElement<DraftGear> {
     double d, rate;  // compression and its rate
   };
   Kinematics kinematics(const ElementState<double>& s) const;
-  void roots_at(const Kinematics& k, double* g) const;
-  void apply(int index, const Kinematics& k, Event& event);
+  void roots_at(const State& st, const Kinematics& k, double* g) const;
+  void apply(State& st, int index, const Kinematics& k, Event& event) const;
 
   AxialHysteresis law_;
-  State state_;
-  State initial_state_;
+  State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
 class CouplerEnd : public ForceElement<CouplerEnd> {
@@ -417,8 +414,7 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
     double peak = 0.0;        // [length] delta_max, largest buff penetration so far (restitution < 1)
     bool sheared = false;     // the faces have sheared off (terminal)
   };
-  const State& state() const { return state_; }
-  void set_state(const State& st) { state_ = st; }
+  RAILCRASH_ELEMENT_MODE(State, initial_state_)
   const DeadBand& faces() const { return faces_; }
   /// +1 when P2 lies in +x of P1 (faces meet along +x), -1 otherwise.
   double side() const { return side_; }
@@ -430,25 +426,26 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    if (!active()) return;
+    const State& st = mode_as<State>(s);
+    if (!active(st)) return;
     const PointOffset<T> o = point_offset(*this, s);
-    const T tension = face_tension(side_ * o.d.x);
+    const T tension = face_tension(st, side_ * o.d.x);
     Vec2<T> on_p2{-side_ * tension, T(0.0)};
     if (friction > 0.0) {
-      const T normal = state_.band == DeadBand::Mode::Below ? -tension : tension;
+      const T normal = st.band == DeadBand::Mode::Below ? -tension : tension;
       on_p2.y = -friction * normal * tanh(o.d_rate.y / friction_velocity);
     }
     apply_line_force(*this, s, on_p2, f);
   }
-  /// Tension T at spacing h in the current mode, if the faces are active (< 0: buff).
+  /// Tension T at spacing h in mode st, if the faces are active (< 0: buff).
   template <class T>
-  T face_tension(const T& h) const {
-    if (state_.band == DeadBand::Mode::Below && state_.unloading)
-      return unloading_stiffness() * (h - (faces_.lo - permanent_set(state_)));
-    return faces_.force(state_.band, h);
+  T face_tension(const State& st, const T& h) const {
+    if (st.band == DeadBand::Mode::Below && st.unloading)
+      return unloading_stiffness() * (h - (faces_.lo - permanent_set(st)));
+    return faces_.force(st.band, h);
   }
-  bool active() const {
-    return state_.overlapping && !state_.blocked && !state_.sheared && state_.band != DeadBand::Mode::Inside;
+  bool active(const State& st) const {
+    return st.overlapping && !st.blocked && !st.sheared && st.band != DeadBand::Mode::Inside;
   }
 
   void initialize(const ElementState<double>& initial) override;
@@ -457,10 +454,9 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   static constexpr int kRoots = DeadBand::kRoots + 2;  // + vertical overlap, face shear
   int root_count() const override { return kRoots; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
-  void reset_modes() override { state_ = initial_state_; }
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"normal_force", "friction_force", "gap"}; }
   /// The gap is no deformation: the report shows the force without a loop.
@@ -474,20 +470,19 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
     double h, h_rate, dy, dy_rate;  // spacing along the faces' normal, vertical offset, rates
   };
   Kinematics kinematics(const ElementState<double>& s) const;
-  void roots_at(const Kinematics& k, double* g) const;
+  void roots_at(const State& st, const Kinematics& k, double* g) const;
   /// Roots 0, 1 of the faces with restitution < 1 (buff only, with the permanent set).
-  void lossy_roots(const Kinematics& k, double* g) const;
-  void apply(int index, const Kinematics& k, Event& event);
-  void apply_lossy(int index, const Kinematics& k, Event& event);
+  void lossy_roots(const State& st, const Kinematics& k, double* g) const;
+  void apply(State& st, int index, const Kinematics& k, Event& event) const;
+  void apply_lossy(State& st, int index, const Kinematics& k, Event& event) const;
   /// Buff mode at the start or when the overlap is regained (restitution < 1).
-  DeadBand::Mode lossy_band(const Kinematics& k) const;
+  DeadBand::Mode lossy_band(const State& st, const Kinematics& k) const;
   double half_overlap() const { return 0.5 * (coupler_height[0] + coupler_height[1]); }
   bool lossy() const { return restitution < 1.0; }
 
   DeadBand faces_;
   double side_ = 1.0;
-  State state_;
-  State initial_state_;
+  State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
 class Coupling : public ForceElement<Coupling> {
@@ -507,20 +502,20 @@ class Coupling : public ForceElement<Coupling> {
     AxialHysteresis::State horizontal;
     DeadBand::Mode vertical = DeadBand::Mode::Inside;
   };
-  const State& state() const { return state_; }
-  void set_state(const State& st) { state_ = st; }
+  RAILCRASH_ELEMENT_MODE(State, initial_state_)
   const AxialHysteresis& horizontal_law() const { return law_; }
   const DeadBand& vertical_law() const { return vertical_; }
   double side() const { return side_; }
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
+    const State& st = mode_as<State>(s);
     const PointOffset<T> o = point_offset(*this, s);
     const T u = *free_length - side_ * o.d.x;
-    const T horizontal = law_.force(state_.horizontal, u);
-    Vec2<T> on_p2{side_ * horizontal, -vertical_.force(state_.vertical, o.d.y + misalignment)};
+    const T horizontal = law_.force(st.horizontal, u);
+    Vec2<T> on_p2{side_ * horizontal, -vertical_.force(st.vertical, o.d.y + misalignment)};
     if (friction > 0.0)
-      on_p2.y = on_p2.y - friction * law_.magnitude(state_.horizontal, u) * tanh(o.d_rate.y / friction_velocity);
+      on_p2.y = on_p2.y - friction * law_.magnitude(st.horizontal, u) * tanh(o.d_rate.y / friction_velocity);
     apply_line_force(*this, s, on_p2, f);
   }
 
@@ -528,10 +523,9 @@ class Coupling : public ForceElement<Coupling> {
   static constexpr int kRoots = AxialHysteresis::kRoots + DeadBand::kRoots;
   int root_count() const override { return kRoots; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
-  void reset_modes() override { state_ = initial_state_; }
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override {
     return {"horizontal_force", "deflection", "vertical_force", "vertical_offset", "friction_force"};
@@ -548,14 +542,13 @@ class Coupling : public ForceElement<Coupling> {
     double u, u_rate, w, w_rate;  // horizontal deflection, vertical head offset, rates
   };
   Kinematics kinematics(const ElementState<double>& s) const;
-  void roots_at(const Kinematics& k, double* g) const;
-  void apply(int index, const Kinematics& k, Event& event);
+  void roots_at(const State& st, const Kinematics& k, double* g) const;
+  void apply(State& st, int index, const Kinematics& k, Event& event) const;
 
   AxialHysteresis law_;
   DeadBand vertical_;
   double side_ = 1.0;
-  State state_;
-  State initial_state_;
+  State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
 }  // namespace railcrash

@@ -48,33 +48,17 @@ class CrushSpring : public ForceElement<CrushSpring> {
     double permanent_crush = 0.0;  // [length] d_p
     bool crushed = false;   // has ever been on the curve
   };
-  const State& state() const { return state_; }
+  RAILCRASH_ELEMENT_MODE(State, initial_state_)
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    const LineGeometry<T> g = line_geometry(*this, s);
-    const T crush = *free_length - g.length;
-    const T force = crush_force(crush);
-    // force on P2 = +P u = P d / L
-    const T scale = force / g.length;
-    apply_line_force(*this, s, Vec2<T>{scale * g.d.x, scale * g.d.y}, f);
+    line_force_law(s, mode_as<State>(s), unloading_stiffness, f);
   }
 
-  /// Crush force P(d) in the current mode.
+  /// Crush force P(d) in mode st.
   template <class T>
-  T crush_force(const T& crush) const {
-    switch (state_.mode) {
-      case Mode::Loading: {
-        const auto k = static_cast<std::size_t>(state_.segment);
-        return curve_force[k] + segment_slope(state_.segment) * (crush - curve_crush[k]);
-      }
-      case Mode::Elastic:
-        return unloading_stiffness * (crush - state_.permanent_crush);
-      case Mode::Open:
-        break;
-    }
-    if (tension_stiffness) return *tension_stiffness * (crush - state_.permanent_crush);
-    return T(0.0);
+  T crush_force(const State& st, const T& crush) const {
+    return crush_force(st, crush, unloading_stiffness);
   }
 
   /// Force on the loading curve at crush d (extrapolated with the last slope).
@@ -84,10 +68,9 @@ class CrushSpring : public ForceElement<CrushSpring> {
   void initialize(const ElementState<double>& initial) override;
   int root_count() const override { return 3; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Event& event) override;
-  void reset_modes() override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) override;
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Event& event) const override;
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "crush", "permanent_crush"}; }
   std::vector<RoleOfOutput> output_roles() const override {
@@ -96,13 +79,36 @@ class CrushSpring : public ForceElement<CrushSpring> {
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 
  private:
-  /// Mode for a state at crush d with crush rate rate, given the history.
-  void enter_mode_at(double crush, double rate);
+  /// The law with the elastic (unloading) stiffness given: force on P2 = +P u = P d / L.
+  template <class T>
+  void line_force_law(const ElementState<T>& s, const State& st, double elastic_stiffness, std::array<Pose<T>, 2>& f) const {
+    const LineGeometry<T> g = line_geometry(*this, s);
+    const T crush = *free_length - g.length;
+    const T force = crush_force(st, crush, elastic_stiffness);
+    const T scale = force / g.length;
+    apply_line_force(*this, s, Vec2<T>{scale * g.d.x, scale * g.d.y}, f);
+  }
+  template <class T>
+  T crush_force(const State& st, const T& crush, double elastic_stiffness) const {
+    switch (st.mode) {
+      case Mode::Loading: {
+        const auto k = static_cast<std::size_t>(st.segment);
+        return curve_force[k] + segment_slope(st.segment) * (crush - curve_crush[k]);
+      }
+      case Mode::Elastic:
+        return elastic_stiffness * (crush - st.permanent_crush);
+      case Mode::Open:
+        break;
+    }
+    if (tension_stiffness) return *tension_stiffness * (crush - st.permanent_crush);
+    return T(0.0);
+  }
+  /// Mode for a state at crush d with crush rate rate, given the history in st.
+  void enter_mode_at(State& st, double crush, double rate) const;
   double crush_of(const ElementState<double>& s) const;
   double crush_rate_of(const ElementState<double>& s) const;
 
-  State state_;
-  State initial_state_;
+  State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
 }  // namespace railcrash

@@ -159,21 +159,18 @@ class PiecewiseLineElement : public ForceElement<Derived> {
   std::optional<double> fracture_load;  // [force]; none: never breaks
 
   const PiecewiseLinearLaw& law() const { return law_; }
-  const SegmentMode& mode() const { return mode_; }
-  /// Puts the element in a mode (tests, restart tools). The next reset_modes() undoes it.
-  void set_mode(const SegmentMode& mode) { mode_ = mode; }
+  RAILCRASH_ELEMENT_MODE(SegmentMode, initial_mode_)
 
   int root_count() const override { return 2 + fracture_roots(); }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda,
-              Element::Event& event) override;
-  void reset_modes() override { mode_ = initial_mode_; }
+  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
+              Element::Event& event) const override;
   void initialize(const ElementState<double>& initial) override;
 
-  /// Law value f in the current mode (0 once broken).
+  /// Law value f in mode m (0 once broken).
   template <class T>
-  T law_value(const T& x) const {
-    return mode_.broken ? T(0.0) : law_.value(x, mode_.segment);
+  T law_value(const SegmentMode& m, const T& x) const {
+    return m.broken ? T(0.0) : law_.value(x, m.segment);
   }
   /// x of the state.
   double measure_of(const ElementState<double>& s) const { return static_cast<const Derived*>(this)->measure(s); }
@@ -193,8 +190,7 @@ class PiecewiseLineElement : public ForceElement<Derived> {
  private:
   PiecewiseLinearLaw law_;
   double root_band_ = 0.0;  // [unit of x] distance past a breakpoint at which a segment root fires
-  SegmentMode mode_;
-  SegmentMode initial_mode_;
+  SegmentMode initial_mode_;  // the mode a run starts in (from the initial configuration)
   int fracture_sides_ = 0;
 };
 
@@ -209,9 +205,10 @@ class NonlinearSpring : public PiecewiseLineElement<NonlinearSpring> {
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    if (mode().broken) return;
+    const SegmentMode& m = mode_as<SegmentMode>(s);
+    if (m.broken) return;
     const LineGeometry<T> g = line_geometry(*this, s);
-    const T tension = law_value(T(g.length - *free_length));
+    const T tension = law_value(m, T(g.length - *free_length));
     const T scale = tension / g.length;  // force on P2 = -T u = -(T / L) d
     apply_line_force(*this, s, Vec2<T>{-scale * g.d.x, -scale * g.d.y}, f);
   }
@@ -236,7 +233,7 @@ class NonlinearDashpot : public PiecewiseLineElement<NonlinearDashpot> {
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
     const LineGeometry<T> g = line_geometry(*this, s);
     const T rate = dot(g.d, g.d_rate) / g.length;
-    const T scale = law_value(rate) / g.length;
+    const T scale = law_value(mode_as<SegmentMode>(s), rate) / g.length;
     apply_line_force(*this, s, Vec2<T>{-scale * g.d.x, -scale * g.d.y}, f);
   }
 
@@ -262,12 +259,13 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
 
   template <class T>
   void force_law(double /*t*/, const ElementState<T>& s, std::array<Pose<T>, 2>& f) const {
-    if (mode().broken) return;
+    const SegmentMode& m = mode_as<SegmentMode>(s);
+    if (m.broken) return;
     if (axis) {
       // A point (P2) against a stop plane on body 1 with normal a: the force acts along a at r2
       // on both bodies, so it is the exact gradient of the energy (body 1 feels the lever arm r2 - c1).
       const AxisGeometry<T> g = axis_geometry(s);
-      const T force = direction() * law_value(T(direction() * (*free_length - g.along)));
+      const T force = direction() * law_value(m, T(direction() * (*free_length - g.along)));
       const Vec2<T> on_2{force * g.a.x, force * g.a.y};
       const PointRef& p2 = point(1);
       add_point_force(s.q[slot_of(1)], p2.sx, p2.sy, on_2, f[slot_of(1)]);
@@ -279,7 +277,7 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
       return;
     }
     const LineGeometry<T> g = line_geometry(*this, s);
-    const T force = law_value(T(direction() * (*free_length - g.length)));
+    const T force = law_value(m, T(direction() * (*free_length - g.length)));
     // kind 1: force on P2 = +P u; kind 2: -P u
     const T scale = direction() * force / g.length;
     apply_line_force(*this, s, Vec2<T>{scale * g.d.x, scale * g.d.y}, f);
