@@ -154,12 +154,15 @@ int report_command(const std::string& run_dir, double cfc) {
 }
 
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
-                const std::string& out_dir, bool with_report, bool quiet) {
+                const std::string& out_dir, bool with_report, bool quiet, railcrash::OutputFormat format) {
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
+  if (format == OutputFormat::Hdf5) require_hdf5();
+  if (format == OutputFormat::Hdf5 && with_report)
+    throw InputError("--report reads the CSV files: leave out --report with --format hdf5, or use --format csv");
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   catch_interrupts();
-  const RunReport report = run_model(model, out_dir, &g_stop, !quiet);
+  const RunReport report = run_model(model, out_dir, &g_stop, !quiet, /*keep_in_memory=*/false, format);
   const RunOutcome& o = report.outcome;
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
   std::printf("%s: %s with %s to t = %g in %.3g s (%ld steps, %ld residual evaluations)\n", model.name.c_str(),
@@ -194,7 +197,9 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
     }
     std::printf("\n");
   }
-  std::printf("results in %s/ (timeseries.csv, events.csv, summary.json, accelerations.csv, energy.csv, model.json)\n", out_dir.c_str());
+  std::printf("results in %s/ (%s, summary.json, model.json)\n", out_dir.c_str(),
+              format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
+                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv");
   if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;
 }
@@ -421,6 +426,11 @@ int main(int argc, char** argv) {
   run->add_option("--set", settings, "override a model key, e.g. --set simulation.t_end=0.5 --set elements.k1.stiffness=2e6");
   bool with_report = false;
   run->add_flag("--report", with_report, "also write DIR/report.html (as `railcrash report DIR`)");
+  std::string output_format = "csv";
+  run->add_option("--format", output_format,
+                  "csv, or hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Output\")")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"csv", "hdf5"}));
   bool quiet = false;
   run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
 
@@ -613,7 +623,8 @@ int main(int argc, char** argv) {
     if (*dt_option) overrides.dt = dt;
     if (*output_option) overrides.output_interval = output_interval;
     if (*max_steps_option) overrides.max_steps = max_steps;
-    return run_command(model_path, settings, overrides, out_dir, with_report, quiet);
+    return run_command(model_path, settings, overrides, out_dir, with_report, quiet,
+                       output_format == "hdf5" ? railcrash::OutputFormat::Hdf5 : railcrash::OutputFormat::Csv);
   } catch (const railcrash::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -146,15 +146,21 @@ std::vector<std::string> timeseries_columns(const DaeSystem& system) {
   return names;
 }
 
-ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory)
-    : system_(system), directory_(directory), last_flush_(std::chrono::steady_clock::now()), last_summary_(last_flush_) {
+ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory, OutputFormat format)
+    : system_(system), directory_(directory), format_(format), last_flush_(std::chrono::steady_clock::now()),
+      last_summary_(last_flush_) {
   const std::vector<std::string> names = timeseries_columns(system);
+  std::vector<std::string> acceleration_names{"t"};
+  for (const Body& b : system.model().bodies())
+    for (const char* q : {"ax", "ay", "alpha"}) acceleration_names.push_back(b.name + "." + q);
   if (!directory.empty()) {
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
+    if (format == OutputFormat::Hdf5) hdf5_ = std::make_unique<Hdf5File>(directory + "/timeseries.h5");  // (throws)
     for (auto [file, name] : {std::pair{&timeseries_, "timeseries.csv"}, {&events_, "events.csv"},
                               {&accelerations_file_, "accelerations.csv"}, {&energy_file_, "energy.csv"}}) {
+      if (hdf5_) break;
       *file = std::make_unique<BufferedFile>(directory + "/" + name);
       if (!(*file)->is_open())
         throw InputError("cannot write into the output folder '" + directory + "': " + name + ": " + std::strerror((*file)->error()));
@@ -162,14 +168,29 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     write_model_geometry(system, directory + "/model.json");  // (throws: before the folder is held open)
     folder_descriptor_ = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (folder_descriptor_ < 0) throw InputError("cannot open the output folder '" + directory + "': " + std::strerror(errno));
-    energy_ = std::make_unique<EnergyWriter>(system, *energy_file_);
-    accelerations_file_->character('t');
-    for (const Body& b : system.model().bodies())
-      for (const char* q : {"ax", "ay", "alpha"}) accelerations_file_->text("," + b.name + "." + q);
-    accelerations_file_->character('\n');
-    for (std::size_t k = 0; k < names.size(); ++k) timeseries_->text((k ? "," : "") + names[k]);
-    timeseries_->character('\n');
-    events_->text("t,element,event,value\n");
+    energy_ = std::make_unique<EnergyWriter>(system, energy_file_.get());
+    if (hdf5_) {
+      const Model& model = system.model();
+      const bool si = model.units == UnitSystem::SI;
+      hdf5_->attribute("railcrash_version", RAILCRASH_VERSION);
+      hdf5_->attribute("model", model.name);
+      hdf5_->attribute("model_file", model.file);
+      hdf5_->attribute("units", std::string(unit_system_name(model.units)) + ": length " + (si ? "m" : "in") +
+                                    ", time s, angle rad, force " + (si ? "N" : "lbf") + ", energy " + (si ? "J" : "in*lbf"));
+      const std::string length = si ? "m" : "in";
+      hdf5_tables_.timeseries = hdf5_->add_table("timeseries", names, "x, y: " + length + "; theta: rad; vx, vy: " + length +
+                                                                          "/s; omega: rad/s; element outputs: the file's units");
+      hdf5_tables_.accelerations = hdf5_->add_table("accelerations", acceleration_names, si ? "m/s^2, rad/s^2" : "in/s^2, rad/s^2");
+      hdf5_tables_.energy = hdf5_->add_table("energy", energy_->columns(), si ? "J" : "in*lbf");
+      hdf5_tables_.events = hdf5_->add_event_table("events");
+      if (!hdf5_->flush()) throw InputError(hdf5_->error());
+    } else {
+      for (std::size_t k = 0; k < acceleration_names.size(); ++k) accelerations_file_->text((k ? "," : "") + acceleration_names[k]);
+      accelerations_file_->character('\n');
+      for (std::size_t k = 0; k < names.size(); ++k) timeseries_->text((k ? "," : "") + names[k]);
+      timeseries_->character('\n');
+      events_->text("t,element,event,value\n");
+    }
   }
   if (keep_in_memory) columns_.resize(names.size());
   const std::size_t body_count = static_cast<std::size_t>(system.model().body_count());
@@ -208,15 +229,19 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     if (timeseries_) write_row_tail(*timeseries_, point_values_);
   }
   if (timeseries_) timeseries_->character('\n');
-  if (!columns_.empty()) {  // same order as the CSV columns
-    std::size_t column = 0;
-    columns_[column++].push_back(t);
+  if (!columns_.empty() || hdf5_) {  // the row, in the order of the CSV columns
+    row_.assign(1, t);
     for (int i = 0; i < n; ++i)
-      for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2})
-        columns_[column++].push_back(y[k]);
-    for (const double value : output_values_) columns_[column++].push_back(value);
-    if (!system_.model().output_points.empty())
-      for (const double value : point_values_) columns_[column++].push_back(value);
+      for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2}) row_.push_back(y[k]);
+    row_.insert(row_.end(), output_values_.begin(), output_values_.end());
+    if (!system_.model().output_points.empty()) row_.insert(row_.end(), point_values_.begin(), point_values_.end());
+    for (std::size_t column = 0; column < columns_.size(); ++column) columns_[column].push_back(row_[column]);
+    if (hdf5_) {
+      hdf5_->append(hdf5_tables_.timeseries, row_.data());
+      row_.assign(1, t);
+      row_.insert(row_.end(), acceleration_.begin(), acceleration_.end());
+      hdf5_->append(hdf5_tables_.accelerations, row_.data());
+    }
   }
   if (accelerations_file_) {
     accelerations_file_->number(t);
@@ -224,6 +249,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     accelerations_file_->character('\n');
   }
   if (energy_) energy_->sample(t, y, quadratures);
+  if (hdf5_) hdf5_->append(hdf5_tables_.energy, energy_->row().data());
   sample_times_.push_back(t);
   for (int i = 0; i < n; ++i) {
     const std::size_t b = static_cast<std::size_t>(i);
@@ -241,7 +267,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
   t_last_sample_ = t;
   // Keep what is on disk current without flushing every row; every write checked.
-  if (!timeseries_ || !failure_.empty()) return;
+  if (directory_.empty() || !failure_.empty()) return;
   const auto now = std::chrono::steady_clock::now();
   const bool flush = now - last_flush_ > std::chrono::milliseconds(500);
   check_files(flush);
@@ -289,6 +315,10 @@ void ResultWriter::check_files(bool flush) {
     if (flush) file->flush();
     if (file->error() != 0) fail("cannot write " + directory_ + "/" + name, file->error());
   }
+  if (hdf5_) {
+    if (flush) hdf5_->flush();
+    if (failure_.empty()) failure_ = hdf5_->error();
+  }
   // One fstat of the open folder per sample (no path lookup): a removed folder (no links left)
   // stops the run at its next sample.
   struct stat folder {};
@@ -328,6 +358,10 @@ bool ResultWriter::replace_summary(const std::string& text) {
 }
 
 void ResultWriter::event(const EventRecord& record, const double*) {
+  if (hdf5_) {
+    hdf5_->append_event(hdf5_tables_.events, record.t, record.element, record.what, record.value);
+    return;
+  }
   if (!events_) return;  // in memory, the events are the run outcome's
   std::string element = record.element, what = record.what;
   for (std::string* text : {&element, &what})
@@ -367,7 +401,7 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
 }
 
 std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json) {
-  if (timeseries_ && failure_.empty()) check_files(/*flush=*/true);
+  if (!directory_.empty() && failure_.empty()) check_files(/*flush=*/true);
   const std::string text = summary_text(outcome, outcome.ok ? "ok" : "failed", integrator, extra_json);
   if (!directory_.empty()) replace_summary(text);  // also after a failed CSV write: the summary may still fit
   return text;
@@ -386,6 +420,11 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"model\": " << json_string(model.name) << ",\n";
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
+  if (!directory_.empty())
+    j << "  \"output\": {\"format\": " << json_string(output_format_name(format_)) << ", \"files\": "
+      << (hdf5_ ? "[\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"
+                : "[\"timeseries.csv\", \"events.csv\", \"accelerations.csv\", \"energy.csv\"]")
+      << "},\n";
   j << "  \"units\": {\"system\": " << json_string(unit_system_name(model.units)) << ", \"length\": "
     << json_string(si ? "m" : "in") << ", \"time\": \"s\", \"force\": " << json_string(si ? "N" : "lbf")
     << ", \"mass\": " << json_string(si ? "kg" : "lbf*s^2/in") << ", \"angle\": \"rad\", \"energy\": "

@@ -161,7 +161,7 @@ std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationS
 }
 
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
-                    bool keep_in_memory) {
+                    bool keep_in_memory, OutputFormat format) {
   DaeSystem system(model);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;
@@ -169,7 +169,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   RunReport report;
   report.integrator = model.simulation.integrator == IntegratorKind::Euler ? "euler" : "ida";
   if (!out_dir.empty() || keep_in_memory) {
-    observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory)).get());
+    observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory, format)).get());
     writer->write_running_summary(report.integrator);
   }
   if (model.responses.defined())

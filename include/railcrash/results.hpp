@@ -20,6 +20,9 @@
 // change, mean deceleration; results/crash_pulse.hpp) as "collision". The filter needs a
 // sample rate of at least 2 x 2.0775 CFC; below 10 CFC the summary says the sampling is too coarse.
 // The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
+// With OutputFormat::Hdf5 the four per-row CSV files (timeseries, events, accelerations, energy)
+// are datasets of one file instead, DIR/timeseries.h5 (results/hdf5_file.hpp); summary.json's
+// "output" names the format and files.
 //
 // Car crush: a car is the set of bodies that declare it with `car: NAME` in the model file
 // (bodies without the key, such as a barrier or a track, belong to no car). A model where no
@@ -39,6 +42,7 @@
 
 #include "railcrash/integrator.hpp"
 #include "railcrash/results/crash_pulse.hpp"
+#include "railcrash/results/hdf5_file.hpp"
 
 namespace railcrash {
 
@@ -94,9 +98,10 @@ void write_row_tail(BufferedFile& file, const std::vector<double>& values);
 
 class ResultWriter : public RunObserver {
  public:
-  /// Creates DIR and the two CSV files with their headers (DIR empty: no files). With
+  /// Creates DIR and the CSV files with their headers, or timeseries.h5 (DIR empty: no files). With
   /// keep_in_memory, every sample is also kept as one value per timeseries column.
-  ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory = false);
+  ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory = false,
+               OutputFormat format = OutputFormat::Csv);
   ~ResultWriter() override;
   ResultWriter(const ResultWriter&) = delete;
   ResultWriter& operator=(const ResultWriter&) = delete;
@@ -143,6 +148,12 @@ class ResultWriter : public RunObserver {
   std::vector<CarCrush> cars_;
   std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
   std::unique_ptr<EnergyWriter> energy_;
+  OutputFormat format_ = OutputFormat::Csv;
+  std::unique_ptr<Hdf5File> hdf5_;  // --format hdf5: in place of the four CSV files
+  struct Hdf5Tables {
+    int timeseries = -1, accelerations = -1, energy = -1, events = -1;
+  } hdf5_tables_;
+  std::vector<double> row_;  // one timeseries (or accelerations) row, for memory and HDF5
   double cfc_ = 60.0;
   std::vector<double> sample_times_;                  // [time]
   // Per body, per sample, for the filtered peaks and collision pulses at the end; in single

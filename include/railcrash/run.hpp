@@ -53,10 +53,11 @@ struct RunReport {
   std::vector<FilteredAccelerations> filtered_accelerations;  // CFC 60 peaks, collision pulses
 };
 
-/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files);
+/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files;
+/// OutputFormat::Hdf5: timeseries.h5 in place of the per-row CSV files, results/hdf5_file.hpp);
 /// with keep_in_memory the same results also come back in the report.
 /// Input errors throw InputError before anything runs; solver failures come back with ok = false.
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
-                    bool show_progress = false, bool keep_in_memory = false);
+                    bool show_progress = false, bool keep_in_memory = false, OutputFormat format = OutputFormat::Csv);
 
 }  // namespace railcrash

@@ -62,7 +62,7 @@ void write_model_geometry(const DaeSystem& system, const std::string& path) {
   if (!out) throw InputError("cannot write " + path);
 }
 
-EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile& file) : system_(system), file_(file) {
+EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile* file) : system_(system), file_(file) {
   const Model& model = system.model();
   for (const auto& e : model.elements()) {
     auto it = std::find(types_.begin(), types_.end(), e->type());
@@ -71,9 +71,12 @@ EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile& file) : system
   }
   if (model.constraint_rows() > 0) types_.push_back("penalty");  // Euler's penalty joints (zero under IDA)
   dissipated_.assign(types_.size(), 0.0);
-  file_.text("t,kinetic,elastic,gravity,external_work,dissipated");
-  for (const std::string& type : types_) file_.text(",dissipated." + type);
-  file_.text(",balance_error\n");
+  columns_ = {"t", "kinetic", "elastic", "gravity", "external_work", "dissipated"};
+  for (const std::string& type : types_) columns_.push_back("dissipated." + type);
+  columns_.push_back("balance_error");
+  if (!file_) return;
+  for (std::size_t k = 0; k < columns_.size(); ++k) file_->text((k ? "," : "") + columns_[k]);
+  file_->character('\n');
 }
 
 void EnergyWriter::sample(double t, const double* y, const double* quadratures) {
@@ -101,15 +104,15 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   for (double d : dissipated_) dissipated += d;
   const double gravity = state.gravity - initial_gravity_;
   const double balance = state.kinetic + elastic + gravity + dissipated - initial_total_ - state.load_work;
-  file_.number(t);
-  for (const double value : {state.kinetic, elastic, gravity, state.load_work, dissipated}) {
-    file_.character(',');
-    file_.number(value);
+  row_.assign({t, state.kinetic, elastic, gravity, state.load_work, dissipated});
+  row_.insert(row_.end(), dissipated_.begin(), dissipated_.end());
+  row_.push_back(balance);
+  if (!file_) return;
+  for (std::size_t k = 0; k < row_.size(); ++k) {
+    if (k > 0) file_->character(',');
+    file_->number(row_[k]);
   }
-  write_row_tail(file_, dissipated_);
-  file_.character(',');
-  file_.number(balance);
-  file_.character('\n');
+  file_->character('\n');
 }
 
 }  // namespace railcrash

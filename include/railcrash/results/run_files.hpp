@@ -27,15 +27,21 @@ namespace railcrash {
 /// Writes DIR/model.json (see above). Throws InputError if it cannot be written.
 void write_model_geometry(const DaeSystem& system, const std::string& path);
 
-/// Writes energy.csv one row per sample.
+/// Computes energy.csv's row at every sample and writes it to file (with the header first), if any.
 class EnergyWriter {
  public:
-  EnergyWriter(const DaeSystem& system, BufferedFile& file);
+  EnergyWriter(const DaeSystem& system, BufferedFile* file);
   void sample(double t, const double* y, const double* quadratures);
+  /// energy.csv's column names.
+  const std::vector<std::string>& columns() const { return columns_; }
+  /// The last sample's row, one value per column.
+  const std::vector<double>& row() const { return row_; }
 
  private:
   const DaeSystem& system_;
-  BufferedFile& file_;
+  BufferedFile* file_;                   // null: rows in row() only
+  std::vector<std::string> columns_;
+  std::vector<double> row_;
   std::vector<std::string> types_;       // element types, in first-appearance order
   std::vector<int> type_of_element_;     // index into types_
   std::vector<double> initial_elastic_;  // per element [energy]

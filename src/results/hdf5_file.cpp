@@ -1,0 +1,291 @@
+// DIR/timeseries.h5 of `railcrash run --format hdf5` (see the header).
+#include "railcrash/results/hdf5_file.hpp"
+
+#include "railcrash/error.hpp"
+
+#ifdef RAILCRASH_HDF5
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <deque>
+#include <type_traits>
+
+#include "railcrash/results.hpp"
+#endif
+
+namespace railcrash {
+
+const char* output_format_name(OutputFormat format) { return format == OutputFormat::Hdf5 ? "hdf5" : "csv"; }
+
+void require_hdf5() {
+  if (!hdf5_available())
+    throw InputError("--format hdf5: this railcrash was built without HDF5; install Debian's libhdf5-dev "
+                     "(scripts/install-deps.sh does), configure and build again, or leave out --format hdf5 for the CSV files");
+}
+
+#ifndef RAILCRASH_HDF5
+
+bool hdf5_available() { return false; }
+
+struct Hdf5File::Table {};
+
+Hdf5File::Hdf5File(const std::string& path) : path_(path) { require_hdf5(); }
+Hdf5File::~Hdf5File() = default;
+void Hdf5File::attribute(const std::string&, const std::string&) {}
+int Hdf5File::add_table(const std::string&, const std::vector<std::string>&, const std::string&) { return -1; }
+int Hdf5File::add_event_table(const std::string&) { return -1; }
+void Hdf5File::append(int, const double*) {}
+void Hdf5File::append_event(int, double, const std::string&, const std::string&, double) {}
+bool Hdf5File::flush() { return false; }
+bool Hdf5File::compound(int) const { return false; }
+void Hdf5File::write_block(Table&) {}
+bool Hdf5File::fail(const std::string&) { return false; }
+
+#else
+
+static_assert(std::is_same_v<hid_t, std::int64_t>, "the header keeps hid_t as std::int64_t (HDF5 1.10 and later)");
+
+bool hdf5_available() { return true; }
+
+namespace {
+
+/// One row of the events table as HDF5 reads it from memory.
+struct EventRow {
+  double t;             // [time]
+  const char* element;  // UTF-8, owned by Table::texts until written
+  const char* event;
+  double value;
+};
+
+/// A variable-length UTF-8 string type (to close with H5Tclose), or a negative id.
+hid_t utf8_string_type() {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  if (type < 0) return type;
+  if (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0) {
+    H5Tclose(type);
+    return -1;
+  }
+  return type;
+}
+
+/// Closes an HDF5 identifier of any kind when it goes out of scope.
+class Handle {
+ public:
+  explicit Handle(hid_t id) : id_(id) {}
+  ~Handle() {
+    if (id_ >= 0) H5Idec_ref(id_);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+};
+
+/// HDF5's innermost error message (the first one walking up the stack).
+herr_t keep_innermost(unsigned depth, const H5E_error2_t* error, void* message) {
+  if (depth == 0 && error->desc) *static_cast<std::string*>(message) = error->desc;
+  return 0;
+}
+
+/// The reason in an HDF5 message: a failed write's "error message = '...'" (the OS's text), else all of it.
+std::string reason_in(const std::string& message) {
+  const std::string key = "error message = '";
+  const std::size_t start = message.find(key);
+  if (start == std::string::npos) return message.empty() ? "unknown HDF5 error" : message;
+  const std::size_t end = message.find('\'', start + key.size());
+  return message.substr(start + key.size(), end == std::string::npos ? std::string::npos : end - start - key.size());
+}
+
+/// A text attribute of an HDF5 object; false on failure.
+bool object_attribute(hid_t object, const char* name, const std::string& value) {
+  const Handle type(utf8_string_type());
+  const Handle space(H5Screate(H5S_SCALAR));
+  if (!type.valid() || !space.valid()) return false;
+  const Handle attribute(H5Acreate2(object, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT));
+  const std::string text = valid_utf8(value);
+  const char* data = text.c_str();
+  return attribute.valid() && H5Awrite(attribute.get(), type.get(), &data) >= 0;
+}
+
+/// A 1-D dataset of rows of file_type, empty, chunked by block_rows and extendible; extra_columns > 0
+/// makes it 2-D (rows x extra_columns). A negative id on failure.
+hid_t extendible_dataset(hid_t file, const std::string& name, hid_t file_type, hsize_t block_rows, hsize_t extra_columns) {
+  const int rank = extra_columns > 0 ? 2 : 1;
+  const hsize_t empty[2] = {0, extra_columns}, unlimited[2] = {H5S_UNLIMITED, extra_columns};
+  const hsize_t chunk[2] = {block_rows, extra_columns};
+  const Handle space(H5Screate_simple(rank, empty, unlimited));
+  const Handle properties(H5Pcreate(H5P_DATASET_CREATE));
+  if (!space.valid() || !properties.valid() || H5Pset_chunk(properties.get(), rank, chunk) < 0) return -1;
+  return H5Dcreate2(file, name.c_str(), file_type, space.get(), H5P_DEFAULT, properties.get(), H5P_DEFAULT);
+}
+
+}  // namespace
+
+struct Hdf5File::Table {
+  std::string name;
+  hid_t dataset = -1;
+  hid_t memory_type = -1;       // owned (closed with the table); H5T_NATIVE_DOUBLE for a matrix is not
+  bool owns_memory_type = true;
+  bool compound = true;         // false: a rows x columns matrix
+  std::size_t columns = 0;      // float64 values per row (0 for events)
+  hsize_t rows_written = 0;
+  std::size_t block_rows = 1;   // rows per chunk and per write
+  std::vector<double> pending;  // rows not written yet, one after another
+  std::vector<EventRow> pending_events;
+  std::deque<std::string> texts;  // the strings of pending_events (a deque keeps them in place)
+
+  std::size_t pending_rows() const { return columns > 0 ? pending.size() / columns : pending_events.size(); }
+};
+
+bool Hdf5File::fail(const std::string& what) {
+  std::string message;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, keep_innermost, &message);
+  H5Eclear2(H5E_DEFAULT);
+  if (error_.empty()) error_ = what + ": " + reason_in(message);
+  return false;
+}
+
+Hdf5File::Hdf5File(const std::string& path) : path_(path) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported through error(), not printed
+  // The 1.10 file format: its compact encoding of compound types fits about 1,200 named columns
+  // in the 64 KiB a type may take (the 1.8 format: about 700). Readable by HDF5 1.10 and later.
+  const Handle access(H5Pcreate(H5P_FILE_ACCESS));
+  if (access.valid() && H5Pset_libver_bounds(access.get(), H5F_LIBVER_V110, H5F_LIBVER_LATEST) >= 0)
+    file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get());
+  if (file_ < 0) {
+    fail("cannot create " + path);
+    throw InputError(error_);
+  }
+}
+
+Hdf5File::~Hdf5File() {
+  if (file_ < 0) return;
+  flush();
+  for (const auto& table : tables_) {
+    if (table->dataset >= 0) H5Dclose(table->dataset);
+    if (table->owns_memory_type && table->memory_type >= 0) H5Tclose(table->memory_type);
+  }
+  H5Fclose(file_);
+  H5Eclear2(H5E_DEFAULT);
+}
+
+void Hdf5File::attribute(const std::string& name, const std::string& value) {
+  if (error_.empty() && !object_attribute(file_, name.c_str(), value)) fail("cannot write the attribute " + name + " of " + path_);
+}
+
+int Hdf5File::add_table(const std::string& name, const std::vector<std::string>& columns, const std::string& units) {
+  auto table = std::make_unique<Table>();
+  table->name = name;
+  table->columns = columns.size();
+  const std::size_t row_bytes = sizeof(double) * columns.size();
+  table->block_rows = std::max<std::size_t>(1, kBlockBytes / row_bytes);
+  table->memory_type = H5Tcreate(H5T_COMPOUND, row_bytes);
+  bool ok = table->memory_type >= 0;
+  for (std::size_t k = 0; ok && k < columns.size(); ++k)
+    ok = H5Tinsert(table->memory_type, columns[k].c_str(), sizeof(double) * k, H5T_NATIVE_DOUBLE) >= 0;
+  if (ok) table->dataset = extendible_dataset(file_, name, table->memory_type, table->block_rows, 0);
+  if (table->dataset < 0) {  // too wide for one compound type (or a repeated name): a matrix
+    H5Eclear2(H5E_DEFAULT);
+    if (table->memory_type >= 0) H5Tclose(table->memory_type);
+    table->memory_type = H5T_NATIVE_DOUBLE;
+    table->owns_memory_type = false;
+    table->compound = false;
+    table->dataset = extendible_dataset(file_, name, H5T_IEEE_F64LE, table->block_rows, columns.size());
+    if (table->dataset >= 0) {
+      // The names as a dataset beside it: an attribute of that many strings can outgrow 64 KiB too.
+      const Handle type(utf8_string_type());
+      const hsize_t count = columns.size();
+      const Handle space(H5Screate_simple(1, &count, nullptr));
+      const Handle names(type.valid() && space.valid()
+                             ? H5Dcreate2(file_, (name + "_columns").c_str(), type.get(), space.get(), H5P_DEFAULT,
+                                          H5P_DEFAULT, H5P_DEFAULT)
+                             : -1);
+      std::vector<std::string> texts;
+      std::vector<const char*> pointers;
+      for (const std::string& column : columns) texts.push_back(valid_utf8(column));
+      for (const std::string& text : texts) pointers.push_back(text.c_str());
+      if (!names.valid() || H5Dwrite(names.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0 ||
+          !object_attribute(table->dataset, "columns", "the dataset " + name + "_columns"))
+        fail("cannot write the column names of " + path_ + ":/" + name);
+    }
+  }
+  if (table->dataset < 0) fail("cannot create the table " + name + " in " + path_);
+  if (table->dataset >= 0 && (!object_attribute(table->dataset, "layout", table->compound ? "compound" : "matrix") ||
+                              (!units.empty() && !object_attribute(table->dataset, "units", units))))
+    fail("cannot write the attributes of " + path_ + ":/" + name);
+  tables_.push_back(std::move(table));
+  return static_cast<int>(tables_.size()) - 1;
+}
+
+int Hdf5File::add_event_table(const std::string& name) {
+  auto table = std::make_unique<Table>();
+  table->name = name;
+  table->block_rows = 1024;
+  const Handle text(utf8_string_type());
+  table->memory_type = H5Tcreate(H5T_COMPOUND, sizeof(EventRow));
+  bool ok = text.valid() && table->memory_type >= 0;
+  ok = ok && H5Tinsert(table->memory_type, "t", offsetof(EventRow, t), H5T_NATIVE_DOUBLE) >= 0;
+  ok = ok && H5Tinsert(table->memory_type, "element", offsetof(EventRow, element), text.get()) >= 0;
+  ok = ok && H5Tinsert(table->memory_type, "event", offsetof(EventRow, event), text.get()) >= 0;
+  ok = ok && H5Tinsert(table->memory_type, "value", offsetof(EventRow, value), H5T_NATIVE_DOUBLE) >= 0;
+  if (ok) table->dataset = extendible_dataset(file_, name, table->memory_type, table->block_rows, 0);
+  if (table->dataset < 0 || !object_attribute(table->dataset, "layout", "compound"))
+    fail("cannot create the table " + name + " in " + path_);
+  tables_.push_back(std::move(table));
+  return static_cast<int>(tables_.size()) - 1;
+}
+
+bool Hdf5File::compound(int table) const { return tables_[static_cast<std::size_t>(table)]->compound; }
+
+void Hdf5File::append(int number, const double* values) {
+  Table& table = *tables_[static_cast<std::size_t>(number)];
+  table.pending.insert(table.pending.end(), values, values + table.columns);
+  if (table.pending_rows() >= table.block_rows) write_block(table);
+}
+
+void Hdf5File::append_event(int number, double t, const std::string& element, const std::string& event, double value) {
+  Table& table = *tables_[static_cast<std::size_t>(number)];
+  const char* element_text = table.texts.emplace_back(valid_utf8(element)).c_str();
+  const char* event_text = table.texts.emplace_back(valid_utf8(event)).c_str();
+  table.pending_events.push_back(EventRow{t, element_text, event_text, value});
+  if (table.pending_rows() >= table.block_rows) write_block(table);
+}
+
+void Hdf5File::write_block(Table& table) {
+  const hsize_t rows = table.pending_rows();
+  if (rows == 0 || !error_.empty() || table.dataset < 0) {  // nothing more after a failure
+    table.pending.clear();
+    table.pending_events.clear();
+    table.texts.clear();
+    return;
+  }
+  const int rank = table.compound ? 1 : 2;
+  const hsize_t start[2] = {table.rows_written, 0}, count[2] = {rows, table.columns};
+  const hsize_t extent[2] = {table.rows_written + rows, table.columns};
+  bool ok = H5Dset_extent(table.dataset, extent) >= 0;
+  const Handle file_space(ok ? H5Dget_space(table.dataset) : -1);
+  const Handle memory_space(H5Screate_simple(rank, count, nullptr));
+  ok = ok && file_space.valid() && memory_space.valid() &&
+       H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) >= 0;
+  const void* data = table.columns > 0 ? static_cast<const void*>(table.pending.data()) : table.pending_events.data();
+  ok = ok && H5Dwrite(table.dataset, table.memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT, data) >= 0;
+  if (ok) table.rows_written += rows;
+  else fail("cannot write " + path_);
+  table.pending.clear();
+  table.pending_events.clear();
+  table.texts.clear();
+}
+
+bool Hdf5File::flush() {
+  for (const auto& table : tables_) write_block(*table);
+  if (error_.empty() && H5Fflush(file_, H5F_SCOPE_LOCAL) < 0) fail("cannot write " + path_);
+  return error_.empty();
+}
+
+#endif
+
+}  // namespace railcrash
