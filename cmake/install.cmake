@@ -53,6 +53,9 @@ set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
 # sunlinsolklu target (libsuitesparse-dev).
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS
   "railcrash (= ${PROJECT_VERSION}), libsundials-dev (>= 6), libsuitesparse-dev, libyaml-cpp-dev, libeigen3-dev (>= 3.3), cmake (>= 3.18)")
+if(RAILCRASH_HDF5)  # the static library links the serial libhdf5.so by its path
+  string(APPEND CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS ", libhdf5-dev")
+endif()
 set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy")
 set(CPACK_COMPONENT_RUNTIME_DESCRIPTION "railcrash command-line program and shared library")
 set(CPACK_COMPONENT_DEVELOPMENT_DESCRIPTION "railcrash C++ headers, static library and CMake package")

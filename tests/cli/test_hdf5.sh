@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# `railcrash run --format hdf5` as a user meets it: the option's errors (exit 2), and
+# DIR/timeseries.h5 read with h5py and pandas (Debian's python3-h5py, python3-pandas) against
+# the CSV files of the same run; an interrupted run's file readable with the rows up to then.
+# Without HDF5 in the build: the input error that says how to get it.
+# Usage: test_hdf5.sh RAILCRASH_BINARY SOURCE_DIR
+set -u
+bin=$1
+src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+passes=0
+python=/usr/bin/python3
+
+expect_status() {  # description expected-status command...
+  local description=$1 expected=$2
+  shift 2
+  "$@" > "$tmp/stdout" 2> "$tmp/stderr"
+  local status=$?
+  if [ "$status" -ne "$expected" ]; then
+    echo "FAIL: $description: exit status $status, expected $expected"
+    sed 's/^/  | /' "$tmp/stderr" "$tmp/stdout" | head -20
+    failures=$((failures + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+
+expect_text() {  # description file pattern
+  if grep -q -- "$3" "$2"; then
+    passes=$((passes + 1))
+  else
+    echo "FAIL: $1: '$3' not found in $2"
+    sed 's/^/  | /' "$2" | head -20
+    failures=$((failures + 1))
+  fi
+}
+
+model=$src/models/report/final_two_car.yaml
+
+expect_status "an unknown format" 2 "$bin" run "$model" --format parquet --out "$tmp/bad"
+expect_text "the unknown format's message names the choices" "$tmp/stderr" "csv"
+expect_status "--report with hdf5" 2 "$bin" run "$model" --format hdf5 --report --out "$tmp/bad"
+
+"$bin" run "$model" --t-end 0.001 --format hdf5 --out "$tmp/probe" --quiet > "$tmp/stdout" 2> "$tmp/stderr"
+if grep -q "built without HDF5" "$tmp/stderr"; then
+  expect_status "hdf5 in a build without it" 2 "$bin" run "$model" --t-end 0.001 --format hdf5 --out "$tmp/probe"
+  expect_text "the message says how to get it" "$tmp/stderr" "install Debian's libhdf5-dev"
+  echo "$passes passed, $failures failed"
+  [ "$failures" -eq 0 ]
+  exit
+fi
+
+expect_status "run with csv" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --out "$tmp/csv" --quiet
+expect_status "run with hdf5" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 --out "$tmp/h5" --quiet
+expect_text "run names the file" "$tmp/stdout" "timeseries.h5"
+expect_text "summary.json names the format" "$tmp/h5/summary.json" '"format": "hdf5"'
+
+if ! "$python" -c "import h5py, pandas" 2> /dev/null; then
+  echo "h5py or pandas missing for $python (Debian: python3-h5py python3-pandas): the file is not read back here"
+else
+  # The README's recipe, table by table, against pandas.read_csv of the CSV run.
+  if "$python" - "$tmp/h5/timeseries.h5" "$tmp/csv" > "$tmp/compare" 2>&1 <<'EOF'
+import sys
+import h5py
+import pandas as pd
+path, csv_dir = sys.argv[1], sys.argv[2]
+with h5py.File(path, "r") as f:
+    assert f.attrs["railcrash_version"], "no version attribute"
+    for name in ["timeseries", "accelerations", "energy", "events"]:
+        table = pd.DataFrame(f[name][:])
+        if name == "events":
+            for column in ["element", "event"]:
+                table[column] = table[column].str.decode("utf-8")
+        csv = pd.read_csv(f"{csv_dir}/{name}.csv")
+        assert list(table.columns) == list(csv.columns), name
+        # The CSV holds 12 significant digits, the file every bit.
+        pd.testing.assert_frame_equal(table, csv, rtol=1e-11, atol=0, check_dtype=False)
+        print(name, table.shape)
+EOF
+  then
+    passes=$((passes + 1))
+  else
+    echo "FAIL: h5py + pandas read of timeseries.h5 differs from the CSV files"
+    sed 's/^/  | /' "$tmp/compare"
+    failures=$((failures + 1))
+  fi
+  expect_text "the timeseries table has the CSV's 21 rows and 390 columns" "$tmp/compare" "timeseries (21, 390)"
+
+  # SIGINT mid-run: exit 1, and the file closed with the rows up to the summary's t_reached.
+  "$bin" run "$model" --t-end 5 --format hdf5 --out "$tmp/stopped" --quiet > "$tmp/stdout" 2> "$tmp/stderr" &
+  pid=$!
+  for _ in $(seq 1 100); do  # until the first rows are on disk
+    [ -s "$tmp/stopped/timeseries.h5" ] && grep -q '"status": "running"' "$tmp/stopped/summary.json" 2> /dev/null && break
+    sleep 0.1
+  done
+  sleep 0.5
+  kill -INT "$pid"
+  wait "$pid"
+  status=$?
+  if [ "$status" -eq 1 ]; then passes=$((passes + 1)); else echo "FAIL: interrupted run: exit $status, expected 1"; failures=$((failures + 1)); fi
+  if "$python" - "$tmp/stopped" > "$tmp/compare" 2>&1 <<'EOF'
+import json, sys
+import h5py
+import pandas as pd
+folder = sys.argv[1]
+summary = json.load(open(f"{folder}/summary.json"))
+with h5py.File(f"{folder}/timeseries.h5", "r") as f:
+    table = pd.DataFrame(f["timeseries"][:])
+assert summary["status"] == "failed" and "interrupted" in summary["message"], summary["message"]
+assert len(table) > 1, len(table)
+assert abs(table["t"].iloc[-1] - summary["t_reached"]) < 1e-12, (table["t"].iloc[-1], summary["t_reached"])
+print("rows", len(table), "up to t =", summary["t_reached"])
+EOF
+  then
+    passes=$((passes + 1))
+  else
+    echo "FAIL: the interrupted run's timeseries.h5"
+    sed 's/^/  | /' "$tmp/compare"
+    failures=$((failures + 1))
+  fi
+fi
+
+echo "$passes passed, $failures failed"
+[ "$failures" -eq 0 ]
