@@ -301,6 +301,9 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv") || fs::exists(dir / "readings.csv") ||
                         fs::exists(dir / "runs.csv")))
     return write_study_report(dir);
+  if (!series.found && fs::exists(dir / "timeseries.h5"))
+    throw InputError("'" + run_dir + "' was written with --format hdf5 (timeseries.h5) and the report reads the CSV files: "
+                     "run again with --format csv (the default) for a report");
   if (!series.found)
     throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (write one with `railcrash run MODEL --out " +
                      run_dir + "`)");

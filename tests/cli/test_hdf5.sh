@@ -56,28 +56,46 @@ expect_status "run with csv" 0 "$bin" run "$model" --t-end 0.02 --output-interva
 expect_status "run with hdf5" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 --out "$tmp/h5" --quiet
 expect_text "run names the file" "$tmp/stdout" "timeseries.h5"
 expect_text "summary.json names the format" "$tmp/h5/summary.json" '"format": "hdf5"'
+expect_status "report of an hdf5 run folder" 2 "$bin" report "$tmp/h5"
+expect_text "the report says it reads the CSV files" "$tmp/stderr" "was written with --format hdf5"
+
+# A consist of 5 + 5 cars: its timeseries (some 1,900 columns) is too wide for one compound
+# type, so it is written as a matrix with its column names beside it.
+"$bin" consist "$model" --cars 5 --out "$tmp/consist.yaml" > /dev/null
+expect_status "consist with csv" 0 "$bin" run "$tmp/consist.yaml" --t-end 0.002 --output-interval 0.001 --out "$tmp/consist_csv" --quiet
+expect_status "consist with hdf5" 0 "$bin" run "$tmp/consist.yaml" --t-end 0.002 --output-interval 0.001 --format hdf5 \
+    --out "$tmp/consist_h5" --quiet
 
 if ! "$python" -c "import h5py, pandas" 2> /dev/null; then
   echo "h5py or pandas missing for $python (Debian: python3-h5py python3-pandas): the file is not read back here"
 else
   # The README's recipe, table by table, against pandas.read_csv of the CSV run.
-  if "$python" - "$tmp/h5/timeseries.h5" "$tmp/csv" > "$tmp/compare" 2>&1 <<'EOF'
+  if "$python" - "$tmp/h5" "$tmp/csv" "$tmp/consist_h5" "$tmp/consist_csv" > "$tmp/compare" 2>&1 <<'EOF'
 import sys
 import h5py
 import pandas as pd
-path, csv_dir = sys.argv[1], sys.argv[2]
-with h5py.File(path, "r") as f:
-    assert f.attrs["railcrash_version"], "no version attribute"
-    for name in ["timeseries", "accelerations", "energy", "events"]:
-        table = pd.DataFrame(f[name][:])
-        if name == "events":
-            for column in ["element", "event"]:
-                table[column] = table[column].str.decode("utf-8")
-        csv = pd.read_csv(f"{csv_dir}/{name}.csv")
-        assert list(table.columns) == list(csv.columns), name
-        # The CSV holds 12 significant digits, the file every bit.
-        pd.testing.assert_frame_equal(table, csv, rtol=1e-11, atol=0, check_dtype=False)
-        print(name, table.shape)
+
+
+def table(f, name):  # README "Binary output": a compound dataset, or a matrix and its names
+    d = f[name]
+    if d.attrs["layout"] == "matrix":
+        return pd.DataFrame(d[:], columns=f[name + "_columns"].asstr()[:])
+    return pd.DataFrame(d[:])
+
+
+for h5_dir, csv_dir in [(sys.argv[1], sys.argv[2]), (sys.argv[3], sys.argv[4])]:
+    with h5py.File(f"{h5_dir}/timeseries.h5", "r") as f:
+        assert f.attrs["railcrash_version"], "no version attribute"
+        for name in ["timeseries", "accelerations", "energy", "events"]:
+            frame = table(f, name)
+            if name == "events":
+                for column in ["element", "event"]:
+                    frame[column] = frame[column].str.decode("utf-8")
+            csv = pd.read_csv(f"{csv_dir}/{name}.csv")
+            assert list(frame.columns) == list(csv.columns), name
+            # The CSV holds 12 significant digits, the file every bit.
+            pd.testing.assert_frame_equal(frame, csv, rtol=1e-11, atol=0, check_dtype=False)
+            print(h5_dir, name, f[name].attrs["layout"], frame.shape)
 EOF
   then
     passes=$((passes + 1))
@@ -86,7 +104,8 @@ EOF
     sed 's/^/  | /' "$tmp/compare"
     failures=$((failures + 1))
   fi
-  expect_text "the timeseries table has the CSV's 21 rows and 390 columns" "$tmp/compare" "timeseries (21, 390)"
+  expect_text "the timeseries table has the CSV's 21 rows and 390 columns" "$tmp/compare" "h5 timeseries compound (21, 390)"
+  expect_text "the consist's timeseries is a matrix" "$tmp/compare" "consist_h5 timeseries matrix (3, "
 
   # SIGINT mid-run: exit 1, and the file closed with the rows up to the summary's t_reached.
   "$bin" run "$model" --t-end 5 --format hdf5 --out "$tmp/stopped" --quiet > "$tmp/stdout" 2> "$tmp/stderr" &

@@ -212,6 +212,7 @@ TEST_CASE("a table too wide for one compound type becomes a rows x columns matri
       for (std::size_t k = 0; k < row.size(); ++k) row[k] = r * 10000.0 + static_cast<double>(k);
       file.append(wide, row.data());
       file.append(small, row.data());
+      if (r == 32) CHECK(file.flush());  // a chunk written part-full, then again when full
     }
     CHECK(file.flush());
     CHECK(file.error().empty());
@@ -228,6 +229,8 @@ TEST_CASE("a table too wide for one compound type becomes a rows x columns matri
   REQUIRE(H5Dread(matrix.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0);
   CHECK(values[0] == 0.0);
   CHECK(values[2999] == 2999.0);
+  CHECK(values[32 * 3000 + 5] == 320005.0);
+  CHECK(values[34 * 3000 + 5] == 340005.0);
   CHECK(values[69 * 3000 + 17] == 690017.0);
   const Id column_names(H5Dopen2(file.id, "wide_columns", H5P_DEFAULT));
   CHECK(row_count(column_names.id) == names.size());
@@ -235,6 +238,7 @@ TEST_CASE("a table too wide for one compound type becomes a rows x columns matri
   CHECK(field_names(small.id) == narrow);
   const std::vector<double> small_values = read_doubles(small.id, narrow);
   CHECK(small_values.size() == 2 * rows);
+  for (int r = 0; r < rows; ++r) CHECK(small_values[2 * r] == r * 10000.0);
   CHECK(small_values[2 * 69 + 1] == 690001.0);
   std::filesystem::remove_all(dir);
 }
