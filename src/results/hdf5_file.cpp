@@ -151,8 +151,8 @@ bool Hdf5File::fail(const std::string& what) {
 
 Hdf5File::Hdf5File(const std::string& path) : path_(path) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported through error(), not printed
-  // The 1.10 file format: its compact encoding of compound types fits about 1,200 named columns
-  // in the 64 KiB a type may take (the 1.8 format: about 700). Readable by HDF5 1.10 and later.
+  // The 1.10 file format: its compact encoding of compound types fits more named columns in the
+  // 64 KiB a type may take than the 1.8 format's padded one. Readable by HDF5 1.10 and later.
   const Handle access(H5Pcreate(H5P_FILE_ACCESS));
   if (access.valid() && H5Pset_libver_bounds(access.get(), H5F_LIBVER_V110, H5F_LIBVER_LATEST) >= 0)
     file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get());

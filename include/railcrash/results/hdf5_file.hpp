@@ -9,9 +9,9 @@
 // A table is one compound dataset (one named field per column), so that h5py reads it as a
 // numpy record array and pandas.DataFrame(h5py.File(p)["timeseries"][:]) is the CSV's table.
 // HDF5 keeps a compound type's description in an object header message of at most 64 KiB
-// (some 1,200 columns of 30-character names): a wider table (a long consist) is written as a
-// 2-D float64 dataset instead (rows x columns), its column names in the attribute "columns";
-// the attribute "layout" of every table says which ("compound" or "matrix").
+// (some thousand columns of consist-length names): a wider table (a consist's timeseries) is
+// written as a 2-D float64 dataset instead (rows x columns), its column names in the dataset
+// "<table>_columns"; the attribute "layout" of every table says which ("compound" or "matrix").
 // File attributes: railcrash_version, model_file, model, units; each table's "units" attribute.
 //
 // Every HDF5 call's result is checked: the first failure (with HDF5's innermost message, which
