@@ -428,7 +428,7 @@ int main(int argc, char** argv) {
   run->add_flag("--report", with_report, "also write DIR/report.html (as `railcrash report DIR`)");
   std::string output_format = "csv";
   run->add_option("--format", output_format,
-                  "csv, or hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Output\")")
+                  "csv, or hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Binary output\")")
       ->capture_default_str()
       ->check(CLI::IsMember({"csv", "hdf5"}));
   bool quiet = false;

@@ -158,9 +158,12 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
     if (format == OutputFormat::Hdf5) hdf5_ = std::make_unique<Hdf5File>(directory + "/timeseries.h5");  // (throws)
-    for (auto [file, name] : {std::pair{&timeseries_, "timeseries.csv"}, {&events_, "events.csv"},
-                              {&accelerations_file_, "accelerations.csv"}, {&energy_file_, "energy.csv"}}) {
-      if (hdf5_) break;
+    using CsvFile = std::pair<std::unique_ptr<BufferedFile>*, const char*>;
+    const std::vector<CsvFile> csv_files =
+        hdf5_ ? std::vector<CsvFile>{}
+              : std::vector<CsvFile>{{&timeseries_, "timeseries.csv"}, {&events_, "events.csv"},
+                                     {&accelerations_file_, "accelerations.csv"}, {&energy_file_, "energy.csv"}};
+    for (auto [file, name] : csv_files) {
       *file = std::make_unique<BufferedFile>(directory + "/" + name);
       if (!(*file)->is_open())
         throw InputError("cannot write into the output folder '" + directory + "': " + name + ": " + std::strerror((*file)->error()));
@@ -420,11 +423,9 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"model\": " << json_string(model.name) << ",\n";
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
-  if (!directory_.empty())
-    j << "  \"output\": {\"format\": " << json_string(output_format_name(format_)) << ", \"files\": "
-      << (hdf5_ ? "[\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"
-                : "[\"timeseries.csv\", \"events.csv\", \"accelerations.csv\", \"energy.csv\"]")
-      << "},\n";
+  if (hdf5_)  // (the CSV files are the default: their summary is as it always was)
+    j << "  \"output\": {\"format\": " << json_string(output_format_name(format_))
+      << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]},\n";
   j << "  \"units\": {\"system\": " << json_string(unit_system_name(model.units)) << ", \"length\": "
     << json_string(si ? "m" : "in") << ", \"time\": \"s\", \"force\": " << json_string(si ? "N" : "lbf")
     << ", \"mass\": " << json_string(si ? "kg" : "lbf*s^2/in") << ", \"angle\": \"rad\", \"energy\": "

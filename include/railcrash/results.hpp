@@ -22,7 +22,7 @@
 // The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
 // With OutputFormat::Hdf5 the four per-row CSV files (timeseries, events, accelerations, energy)
 // are datasets of one file instead, DIR/timeseries.h5 (results/hdf5_file.hpp); summary.json's
-// "output" names the format and files.
+// "output" then names the format, file and datasets.
 //
 // Car crush: a car is the set of bodies that declare it with `car: NAME` in the model file
 // (bodies without the key, such as a barrier or a track, belong to no car). A model where no

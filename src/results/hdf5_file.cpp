@@ -150,6 +150,10 @@ bool Hdf5File::fail(const std::string& what) {
 }
 
 Hdf5File::Hdf5File(const std::string& path) : path_(path) {
+  // No HDF5 clean-up at exit: a file whose close failed (its last flush hit a full disk) stays
+  // open inside HDF5, and 1.10.8 crashes closing it again from its atexit handler. Every file
+  // that can be is closed by the destructor; the OS closes the rest. (A no-op once HDF5 runs.)
+  H5dont_atexit();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported through error(), not printed
   // The 1.10 file format: its compact encoding of compound types fits more named columns in the
   // 64 KiB a type may take than the 1.8 format's padded one. Readable by HDF5 1.10 and later.

@@ -59,6 +59,12 @@ expect_text "summary.json names the format" "$tmp/h5/summary.json" '"format": "h
 expect_status "report of an hdf5 run folder" 2 "$bin" report "$tmp/h5"
 expect_text "the report says it reads the CSV files" "$tmp/stderr" "was written with --format hdf5"
 
+# A write failing mid-run (files limited to 200 kB, SIGXFSZ ignored: the write fails with EFBIG):
+# exit 1 with the file and the reason, not a crash.
+expect_status "a write failing mid-run" 1 bash -c "trap '' XFSZ; ulimit -f 200; exec \"\$0\" \"\$@\"" \
+    "$bin" run "$model" --t-end 0.1 --output-interval 0.0001 --format hdf5 --out "$tmp/too_large" --quiet
+expect_text "it names the file and the reason" "$tmp/stdout" "cannot write $tmp/too_large/timeseries.h5: File too large"
+
 # A consist of 5 + 5 cars: its timeseries (some 1,900 columns) is too wide for one compound
 # type, so it is written as a matrix with its column names beside it.
 "$bin" consist "$model" --cars 5 --out "$tmp/consist.yaml" > /dev/null
