@@ -7,6 +7,7 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cstddef>
 #include <deque>
 #include <type_traits>
@@ -128,8 +129,7 @@ hid_t extendible_dataset(hid_t file, const std::string& name, hid_t file_type, h
 struct Hdf5File::Table {
   std::string name;
   hid_t dataset = -1;
-  hid_t memory_type = -1;       // owned (closed with the table); H5T_NATIVE_DOUBLE for a matrix is not
-  bool owns_memory_type = true;
+  hid_t event_type = -1;        // events: the row type in memory (numeric chunks go in as they are)
   bool compound = true;         // false: a rows x columns matrix
   std::size_t columns = 0;      // float64 values per row (0 for events)
   hsize_t first_pending_row = 0;  // events: rows written; numeric: first row of the chunk being filled
@@ -171,7 +171,7 @@ Hdf5File::~Hdf5File() {
   flush();
   for (const auto& table : tables_) {
     if (table->dataset >= 0) H5Dclose(table->dataset);
-    if (table->owns_memory_type && table->memory_type >= 0) H5Tclose(table->memory_type);
+    if (table->event_type >= 0) H5Tclose(table->event_type);
   }
   H5Fclose(file_);
   H5Eclear2(H5E_DEFAULT);
@@ -182,21 +182,19 @@ void Hdf5File::attribute(const std::string& name, const std::string& value) {
 }
 
 int Hdf5File::add_table(const std::string& name, const std::vector<std::string>& columns, const std::string& units) {
+  assert(!columns.empty());
   auto table = std::make_unique<Table>();
   table->name = name;
   table->columns = columns.size();
   const std::size_t row_bytes = sizeof(double) * columns.size();
   table->block_rows = std::max<std::size_t>(1, kBlockBytes / row_bytes);
-  table->memory_type = H5Tcreate(H5T_COMPOUND, row_bytes);
-  bool ok = table->memory_type >= 0;
+  const Handle row_type(H5Tcreate(H5T_COMPOUND, row_bytes));
+  bool ok = row_type.valid();
   for (std::size_t k = 0; ok && k < columns.size(); ++k)
-    ok = H5Tinsert(table->memory_type, columns[k].c_str(), sizeof(double) * k, H5T_NATIVE_DOUBLE) >= 0;
-  if (ok) table->dataset = extendible_dataset(file_, name, table->memory_type, table->block_rows, 0);
+    ok = H5Tinsert(row_type.get(), columns[k].c_str(), sizeof(double) * k, H5T_NATIVE_DOUBLE) >= 0;
+  if (ok) table->dataset = extendible_dataset(file_, name, row_type.get(), table->block_rows, 0);
   if (table->dataset < 0) {  // too wide for one compound type (or a repeated name): a matrix
     H5Eclear2(H5E_DEFAULT);
-    if (table->memory_type >= 0) H5Tclose(table->memory_type);
-    table->memory_type = H5T_NATIVE_DOUBLE;
-    table->owns_memory_type = false;
     table->compound = false;
     table->dataset = extendible_dataset(file_, name, H5T_NATIVE_DOUBLE, table->block_rows, columns.size());
     if (table->dataset >= 0) {
@@ -230,13 +228,13 @@ int Hdf5File::add_event_table(const std::string& name) {
   table->name = name;
   table->block_rows = 1024;
   const Handle text(utf8_string_type());
-  table->memory_type = H5Tcreate(H5T_COMPOUND, sizeof(EventRow));
-  bool ok = text.valid() && table->memory_type >= 0;
-  ok = ok && H5Tinsert(table->memory_type, "t", offsetof(EventRow, t), H5T_NATIVE_DOUBLE) >= 0;
-  ok = ok && H5Tinsert(table->memory_type, "element", offsetof(EventRow, element), text.get()) >= 0;
-  ok = ok && H5Tinsert(table->memory_type, "event", offsetof(EventRow, event), text.get()) >= 0;
-  ok = ok && H5Tinsert(table->memory_type, "value", offsetof(EventRow, value), H5T_NATIVE_DOUBLE) >= 0;
-  if (ok) table->dataset = extendible_dataset(file_, name, table->memory_type, table->block_rows, 0);
+  table->event_type = H5Tcreate(H5T_COMPOUND, sizeof(EventRow));
+  bool ok = text.valid() && table->event_type >= 0;
+  ok = ok && H5Tinsert(table->event_type, "t", offsetof(EventRow, t), H5T_NATIVE_DOUBLE) >= 0;
+  ok = ok && H5Tinsert(table->event_type, "element", offsetof(EventRow, element), text.get()) >= 0;
+  ok = ok && H5Tinsert(table->event_type, "event", offsetof(EventRow, event), text.get()) >= 0;
+  ok = ok && H5Tinsert(table->event_type, "value", offsetof(EventRow, value), H5T_NATIVE_DOUBLE) >= 0;
+  if (ok) table->dataset = extendible_dataset(file_, name, table->event_type, table->block_rows, 0);
   if (table->dataset < 0 || !object_attribute(table->dataset, "layout", "compound"))
     fail("cannot create the table " + name + " in " + path_);
   tables_.push_back(std::move(table));
@@ -289,7 +287,7 @@ void Hdf5File::write_block(Table& table) {
     const Handle memory_space(H5Screate_simple(1, &rows, nullptr));
     ok = ok && file_space.valid() && memory_space.valid() &&
          H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &start, nullptr, &rows, nullptr) >= 0 &&
-         H5Dwrite(table.dataset, table.memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT,
+         H5Dwrite(table.dataset, table.event_type, memory_space.get(), file_space.get(), H5P_DEFAULT,
                   table.pending_events.data()) >= 0;
     if (ok) table.first_pending_row += rows;
     table.pending_events.clear();
