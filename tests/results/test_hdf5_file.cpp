@@ -31,26 +31,6 @@ std::string temporary_folder(const std::string& name) {
   return path.string();
 }
 
-/// A CSV file's lines split at commas (the names here have no quotes or commas).
-std::vector<std::vector<std::string>> csv_fields(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<std::vector<std::string>> rows;
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> fields;
-    std::stringstream split(line);
-    for (std::string field; std::getline(split, field, ',');) fields.push_back(field);
-    rows.push_back(fields);
-  }
-  return rows;
-}
-
-/// value as the CSV files write it (printf's "%.12g").
-std::string csv_text(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.12g", value);
-  return text;
-}
-
 Model two_car_model(double t_end) {
   Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
   RunOverrides overrides;
@@ -75,6 +55,26 @@ TEST_CASE("without HDF5, --format hdf5 is an input error that says how to get it
 #else
 
 namespace {
+
+/// A CSV file's lines split at commas (the names here have no quotes or commas).
+std::vector<std::vector<std::string>> csv_fields(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    for (std::string field; std::getline(split, field, ',');) fields.push_back(field);
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+/// value as the CSV files write it (printf's "%.12g").
+std::string csv_text(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.12g", value);
+  return text;
+}
 
 /// Opens an HDF5 object and closes it at the end of the scope.
 struct Id {
