@@ -66,6 +66,11 @@ char* format_general12(char* first, double value) {
   std::uint64_t digits = 0;
   int exponent = 0;
   const double magnitude = std::abs(value);
+  if (magnitude == 0.0) {  // a tenth of a slider-crank run's numbers (bodies at rest, idle friction)
+    if (std::signbit(value)) *first++ = '-';
+    *first++ = '0';
+    return first;
+  }
   if (!(magnitude >= 1e-33 && magnitude <= 1e33) || !twelve_digits(magnitude, digits, exponent))
     return std::to_chars(first, first + 32, value, std::chars_format::general, 12).ptr;
   char text[12];  // the twelve digits, most significant first

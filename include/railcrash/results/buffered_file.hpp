@@ -14,7 +14,7 @@ namespace railcrash {
 /// Writes value at first as printf's "%.12g" (at most 32 characters) and returns the end: twelve
 /// digits from one scaling by a power of ten where that decides the rounding for certain
 /// (faster than std::to_chars with a precision), std::to_chars elsewhere (near a rounding
-/// tie, beyond 1e+-33, zero, infinities and NaN).
+/// tie, beyond 1e+-33, infinities and NaN).
 char* format_general12(char* first, double value);
 
 class BufferedFile {
