@@ -352,6 +352,8 @@ void ResultWriter::event(const EventRecord& record, const double*) {
 }
 
 std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const {
+  // The final summary and run_model both ask at the end: filter the samples once.
+  if (!sample_times_.empty() && filtered_samples_ == sample_times_.size() && filtered_class_ == cfc_) return filtered_;
   std::vector<FilteredAccelerations> result(vx_.size());
   const double interval = cfc::typical_interval(sample_times_);
   const bool can_filter = sample_times_.size() >= 3 && interval > 0.0 && cfc::design_frequency(cfc_) * interval < 0.5;
@@ -371,6 +373,9 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
       if (magnitude > f.peaks.magnitude) { f.peaks.magnitude = magnitude; f.peaks.t_magnitude = t; }
     }
   }
+  filtered_ = result;
+  filtered_samples_ = sample_times_.size();
+  filtered_class_ = cfc_;
   return result;
 }
 

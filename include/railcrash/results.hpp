@@ -160,6 +160,10 @@ class ResultWriter : public RunObserver {
   // precision (7 digits are plenty for peaks) to halve the memory of long, large runs.
   std::vector<std::vector<float>> vx_, ax_, ay_;
   std::vector<double> point_values_;                  // output points' columns at the last sample
+  // filtered_accelerations() as last computed, over how many samples, with which CFC
+  mutable std::vector<FilteredAccelerations> filtered_;
+  mutable std::size_t filtered_samples_ = 0;
+  mutable double filtered_class_ = 0.0;
   std::chrono::steady_clock::time_point last_flush_;
   std::chrono::steady_clock::time_point last_summary_;  // last running summary.json
   std::chrono::steady_clock::duration folder_check_interval_ = std::chrono::milliseconds(250);
