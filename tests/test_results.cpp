@@ -166,6 +166,7 @@ TEST_CASE("summary.json says running while the run goes and a vanished folder st
   const Model model = testing::model_from_text(spring_mass_text(10.0));
   DaeSystem system(model);
   ResultWriter writer(dir, system);
+  writer.set_folder_check_interval(std::chrono::steady_clock::duration::zero());  // look at every sample
   writer.write_running_summary("ida");
   FolderRemover observer;
   observer.writer = &writer;
@@ -176,12 +177,36 @@ TEST_CASE("summary.json says running while the run goes and a vanished folder st
   CHECK_THAT(observer.summary_mid_run, Catch::Contains("\"status\": \"running\"") && Catch::Contains("\"integrator\": \"ida\""));
   CHECK_FALSE(outcome.ok);
   CHECK_THAT(outcome.message, Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
-  // The check runs at every sample: the run stops at the first one after the removal and
-  // ends at the last sample written whole.
+  // Looking at every sample, the run stops at the first one after the removal and ends at
+  // the last sample written whole.
   CHECK(outcome.t_reached == Approx(0.099).margin(1e-9));
   CHECK(observer.samples == 101);
   // The final summary cannot be written; the writer says why instead of throwing.
   CHECK_THAT(writer.write_summary(outcome, "ida"), Catch::Contains("\"status\": \"failed\""));
+  CHECK_FALSE(std::filesystem::exists(dir));
+}
+
+TEST_CASE("with the default folder check a vanished folder stops the run or fails its summary", "[results][faults]") {
+  // The folder is looked at every 250 ms of wall time and at the end: a run shorter than that
+  // (10,000 samples of a spring-mass take some 0.1 s) finishes its steps, and the final
+  // summary finds the folder gone.
+  const std::string dir = temporary_folder("vanishing_later");
+  const Model model = testing::model_from_text(spring_mass_text(10.0));
+  DaeSystem system(model);
+  ResultWriter writer(dir, system);
+  FolderRemover observer;
+  observer.writer = &writer;
+  observer.folder = dir;
+  observer.look_at = 3;
+  observer.remove_at = 100;
+  const RunOutcome outcome = make_integrator(system, model.simulation)->run(10.0, 0.001, observer);
+  const std::string summary = writer.write_summary(outcome, "ida");
+  CHECK_THAT(writer.failure(), Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
+  if (!outcome.ok) {  // the periodic check came first (a slow machine)
+    CHECK_THAT(outcome.message, Catch::Contains("is gone"));
+  } else {
+    CHECK(observer.samples == 10001);
+  }
   CHECK_FALSE(std::filesystem::exists(dir));
 }
 

@@ -46,8 +46,15 @@
 
 namespace railcrash {
 
+/// Work space of body_accelerations, kept from one sample to the next (no allocation per row).
+struct AccelerationScratch {
+  std::vector<double> phi;                      // constraint values
+  std::vector<DaeSystem::Triplet> gradient;     // constraint gradient entries
+};
+
 /// Body accelerations v' (3 per body: x'', y'', theta'') at a sample state y.
-void body_accelerations(const DaeSystem& system, double t, const double* y, const double* lambda, double* acceleration);
+void body_accelerations(const DaeSystem& system, double t, const double* y, const double* lambda, double* acceleration,
+                        AccelerationScratch& scratch);
 
 /// Standard gravity in the model's units [length/time^2].
 double standard_gravity(const Model& model);
@@ -131,6 +138,9 @@ class ResultWriter : public RunObserver {
   /// Channel frequency class of the summary's filtered accelerations (default 60).
   void set_filter_class(double cfc) { cfc_ = cfc; }
   double filter_class() const { return cfc_; }
+  /// How often, at most, a sample looks whether the output folder still exists (default
+  /// 250 ms of wall time; the first sample and the final summary always look). Zero: at every sample.
+  void set_folder_check_interval(std::chrono::steady_clock::duration interval) { folder_check_interval_ = interval; }
   /// CFC-filtered peaks and collision pulses per body over the samples so far.
   std::vector<FilteredAccelerations> filtered_accelerations() const;
 
@@ -144,6 +154,7 @@ class ResultWriter : public RunObserver {
   std::vector<double> peak_output_;  // largest |value| of each element output
   std::vector<double> peak_time_;
   std::vector<double> acceleration_;  // 3 per body at the last sample
+  AccelerationScratch acceleration_scratch_;
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
   std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
@@ -160,8 +171,15 @@ class ResultWriter : public RunObserver {
   // precision (7 digits are plenty for peaks) to halve the memory of long, large runs.
   std::vector<std::vector<float>> vx_, ax_, ay_;
   std::vector<double> point_values_;                  // output points' columns at the last sample
+  // filtered_accelerations() as last computed, over how many samples, with which CFC
+  mutable std::vector<FilteredAccelerations> filtered_;
+  mutable std::size_t filtered_samples_ = 0;
+  mutable double filtered_class_ = 0.0;
   std::chrono::steady_clock::time_point last_flush_;
   std::chrono::steady_clock::time_point last_summary_;  // last running summary.json
+  std::chrono::steady_clock::duration folder_check_interval_ = std::chrono::milliseconds(250);
+  std::chrono::steady_clock::time_point last_folder_check_;
+  bool folder_checked_ = false;                          // by a sample
   std::string integrator_;                               // for the running summary
   double t_last_sample_ = 0.0;                           // [time]
   std::string failure_;                                  // first failed write, with the OS's reason
@@ -172,8 +190,9 @@ class ResultWriter : public RunObserver {
                            const std::string& extra_json) const;
   /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.
   bool replace_summary(const std::string& text);
-  /// Checks the CSV files' error flags (and flushes them with `flush`) and that the folder still exists.
-  void check_files(bool flush);
+  /// Checks the CSV files' error flags (and flushes them with `flush`) and, with
+  /// `look_at_folder`, that the folder still exists.
+  void check_files(bool flush, bool look_at_folder);
   void fail(const std::string& what, int error_number);
 };
 

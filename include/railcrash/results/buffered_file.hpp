@@ -1,6 +1,6 @@
 // A text file written through a large buffer by write(2), without iostreams or stdio: the run
 // folder's CSV files (timeseries, events, accelerations). Numbers are formatted by
-// std::to_chars exactly as printf's "%.12g" (the files stay byte-identical to the stdio ones).
+// format_general12 exactly as printf's "%.12g" (the files stay byte-identical to the stdio ones).
 // Every write is checked: the first failure's errno (ENOSPC, EIO, ...) is kept and reported
 // by error(); after it nothing more is written.
 #pragma once
@@ -10,6 +10,12 @@
 #include <string_view>
 
 namespace railcrash {
+
+/// Writes value at first as printf's "%.12g" (at most 32 characters) and returns the end: twelve
+/// digits from one scaling by a power of ten where that decides the rounding for certain
+/// (faster than std::to_chars with a precision), std::to_chars elsewhere (near a rounding
+/// tie, beyond 1e+-33, infinities and NaN).
+char* format_general12(char* first, double value);
 
 class BufferedFile {
  public:
