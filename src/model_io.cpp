@@ -3,10 +3,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#ifdef __GLIBC__
-#include <malloc.h>  // malloc_trim
-#endif
-
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
@@ -907,7 +903,7 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
 
 namespace {
 
-Model parse_and_build(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
   // The text is parsed on a thread of its own so that glibc puts the parse tree (about 60 times
   // the file's size: a 200 + 200-car consist's peaks near 300 MiB) in that thread's heap arena.
@@ -946,18 +942,6 @@ Model parse_and_build(const std::string& text, const std::string& path, const st
   } catch (const YAML::Exception& e) {  // a check above missed a case: still an input error with a line
     throw InputError(SourceLocation{file, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "cannot read the model: " + e.msg);
   }
-}
-
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
-                      const std::vector<OptionSetting>& options) {
-  Model model = parse_and_build(text, path, overrides, options);
-#ifdef __GLIBC__
-  // The parse tree's arena is not the one the run allocates from: its freed pages go back to
-  // the system here, or they would stay resident beside the run's (peak memory per car 1.3 MiB
-  // instead of 0.76 at 10-100 cars, `bench/run.sh consist`).
-  malloc_trim(0);
-#endif
-  return model;
 }
 
 }  // namespace
