@@ -10,7 +10,6 @@
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <thread>
 #include <unordered_set>
 
 #include "railcrash/element_registry.hpp"
@@ -905,25 +904,7 @@ namespace {
 
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
-  // The text is parsed on a thread of its own so that glibc puts the parse tree (about 60 times
-  // the file's size: a 200 + 200-car consist's peaks near 300 MiB) in that thread's heap arena.
-  // Sharing the main arena with it, the elements built below were allocated among its nodes,
-  // and a long train's sweeps paid for the scatter in cache misses (200 + 200 cars,
-  // `railcrash_bench kernels`, medians of 4 interleaved runs: residual 222 ns per unknown
-  // against 137 parsed apart, roots 214 against 112; bench/README.md).
-  YAML::Node root;
-  {
-    std::exception_ptr parse_error;
-    std::thread parser([&] {
-      try {
-        root = parse_model_yaml(text, path);
-      } catch (...) {
-        parse_error = std::current_exception();
-      }
-    });
-    parser.join();
-    if (parse_error) std::rethrow_exception(parse_error);
-  }
+  YAML::Node root = parse_model_yaml(text, path);
   std::string file = path;
   std::vector<VariantSetting> variant_settings;
   if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings);
