@@ -31,10 +31,11 @@ std::string flag_name(int flag) {
 /// Consistent rates at a (re)start, after committing the roots that sit exactly on a mode
 /// boundary and are about to leave it (IDA would leave them inactive). Each element changes
 /// mode at most once here, and not at all when it has just changed at this instant
-/// (`changed_elements`, flags per element; empty: none has): a mode it enters sits on its own
-/// boundary, where round-off alone would decide whether it flips back.
+/// (`changed_elements`, flags per element, empty: none has; the elements changed here are
+/// flagged too): a mode it enters sits on its own boundary, where round-off alone would decide
+/// whether it flips back.
 void restart_state(DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
-                   std::vector<EventRecord>& events, std::vector<char> changed_elements = {}) {
+                   std::vector<EventRecord>& events, std::vector<char>& changed_elements) {
   changed_elements.resize(system.model().elements().size(), 0);
   consistent_rates(system, t, y, yp);
   for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events, &changed_elements); ++pass)
@@ -251,6 +252,16 @@ struct IdaIntegrator::Impl {
     if (step > 0.0) stats.last_step = step;
   }
 
+  /// Restarts IDA at t from the state now in y, yp and quad (its counters are added to stats
+  /// first: IDAReInit clears them, and the stop time with them).
+  void reinitialize(double t, double t_end, RunStatistics& stats) {
+    accumulate(stats);
+    check(IDAReInit(ida, t, y, yp), "IDAReInit");
+    check(IDAQuadReInit(ida, quad), "IDAQuadReInit");
+    check(IDASetStopTime(ida, t_end), "IDASetStopTime");
+    ++stats.reinitializations;
+  }
+
   static void error_handler(int, const char* module, const char* function, char* message, void* user) {
     auto* self = static_cast<Impl*>(user);
     self->last_sundials_message = std::string(module) + "/" + function + ": " + message;
@@ -337,7 +348,8 @@ void IdaIntegrator::start(double t_end) {
     double* yp = N_VGetArrayPointer(impl.yp);
     std::vector<double> yp0;
     std::vector<EventRecord> start_events = settling_events;
-    restart_state(system_, 0.0, y0, yp0, start_events);
+    std::vector<char> changed_at_start;  // none yet
+    restart_state(system_, 0.0, y0, yp0, start_events, changed_at_start);
     std::copy(y0.begin(), y0.end(), y);
     std::copy(yp0.begin(), yp0.end(), yp);
     const std::vector<double> ids = system_.differential_ids();
@@ -388,6 +400,7 @@ void IdaIntegrator::start(double t_end) {
     impl.g_previous.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
     impl.g_now = impl.g_previous;
     impl.y_local.assign(static_cast<std::size_t>(n), 0.0);
+    impl.y_probe.assign(static_cast<std::size_t>(n), 0.0);
     impl.t_reached = 0.0;
     impl.at_start = true;
     report_events(start_events, y);
@@ -482,13 +495,6 @@ double IdaIntegrator::advance(double t_end) {
     return b;
   };
 
-  // The round-off level of root `local` of element e at state y_state: how much the root moves
-  // when each unknown it reads moves by its own rounding (|y_i| eps), summed over them, times a
-  // safety factor. A root of a mode just entered that is within this of zero sits on the
-  // mode's boundary because the commit put it there (e.g. a crush spring unloading at its
-  // largest crush, where "back on the curve" is zero by construction), not because the
-  // element is leaving the mode: committing it would flip the element back at the same
-  // instant, and round-off decides how often (once for one spring, 20 times for its mirror).
   std::vector<double>& y_probe = impl.y_probe;
   std::vector<double>& g_probe = impl.g_probe;
   std::vector<char>& on_boundary = impl.on_boundary;
@@ -503,11 +509,20 @@ double IdaIntegrator::advance(double t_end) {
       }
     }
   };
+  // The round-off level of root `local` of element e at state y_state: how much the root moves
+  // when each unknown it reads moves by its own rounding (|y_i| eps), summed over them, times a
+  // safety factor. Any root found below zero by no more than this is taken as resting on its
+  // mode's boundary, not leaving the mode, and carried as +0 (on_boundary) until clearly
+  // below: after a step (an element resting on a kink), and for a mode just entered, whose
+  // roots the commit may have put on the boundary by construction (a crush spring unloading at
+  // its largest crush, where "back on the curve" is zero): committing it would flip the element
+  // back at the same instant, as often as round-off decides.
   const auto root_noise = [&](int e, int local, double t, const double* y_state) {
     constexpr double kSafety = 64.0;
     const double eps = std::numeric_limits<double>::epsilon();
     const std::vector<int>& unknowns = system_.element_unknowns(e);
-    y_probe.assign(static_cast<std::size_t>(n), 0.0);
+    // Only the element's own unknowns are read (y_probe has the model's size, the rest unused):
+    // clearing the whole vector per call cost O(N) per crossing in a train.
     for (const int i : unknowns) y_probe[static_cast<std::size_t>(i)] = y_state[i];
     const int count = model.elements()[static_cast<std::size_t>(e)]->root_count();
     g_element.resize(static_cast<std::size_t>(count));
@@ -584,12 +599,8 @@ double IdaIntegrator::advance(double t_end) {
     std::copy(impl.retry.y.begin(), impl.retry.y.end(), N_VGetArrayPointer(impl.y));
     std::copy(impl.retry.yp.begin(), impl.retry.yp.end(), N_VGetArrayPointer(impl.yp));
     std::copy(impl.retry.quad.begin(), impl.retry.quad.end(), N_VGetArrayPointer(impl.quad));
-    impl.accumulate(stats());
-    impl.check(IDAReInit(impl.ida, impl.retry.t, impl.y, impl.yp), "IDAReInit");
-    impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
-    impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");
+    impl.reinitialize(impl.retry.t, t_end, stats());
     impl.check(IDASetInitStep(impl.ida, 0.1 * impl.retry.step_before), "IDASetInitStep");
-    ++stats().reinitializations;
     t_n = impl.t_reached = impl.retry.t;
     impl.last_sundials_message.clear();
     impl.non_finite_y.clear();
@@ -743,7 +754,6 @@ double IdaIntegrator::advance(double t_end) {
         std::copy(y_restart.begin(), y_restart.end(), y);
         std::copy(yp_restart.begin(), yp_restart.end(), yp);
         std::copy(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad, N_VGetArrayPointer(impl.quad));
-        impl.accumulate(stats());
         impl.retry.available = true;
         impl.retry.t = c.t;
         impl.check(IDAGetLastStep(impl.ida, &impl.retry.step_before), "IDAGetLastStep");
@@ -751,10 +761,7 @@ double IdaIntegrator::advance(double t_end) {
         impl.retry.y = y_restart;
         impl.retry.yp = yp_restart;
         impl.retry.quad.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + nquad);
-        impl.check(IDAReInit(impl.ida, c.t, impl.y, impl.yp), "IDAReInit");
-        impl.check(IDAQuadReInit(impl.ida, impl.quad), "IDAQuadReInit");
-        impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");  // IDAReInit clears it
-        ++stats().reinitializations;
+        impl.reinitialize(c.t, t_end, stats());
         system_.roots(c.t, y, g_previous.data());
         mark_boundary_roots(g_previous);
         impl.t_reached = c.t;

@@ -53,11 +53,13 @@ int Model::add_body(Body body) {
 
 Element& Model::add_element(std::unique_ptr<Element> element) {
   require_editable("add_element");
-  for (const auto& e : elements_)
-    if (e->name() == element->name())
-      throw InputError(element->where().prefix() + "element '" + element->name() +
-                       "' is defined twice (first at line " + std::to_string(e->where().line) +
-                       "); element names must be unique");
+  // A name index, not a walk over the elements added so far: that walk made loading a
+  // 200 + 200-car consist (12,000 elements) quadratic in its length.
+  const auto [it, added] = element_index_.emplace(element->name(), static_cast<int>(elements_.size()));
+  if (!added)
+    throw InputError(element->where().prefix() + "element '" + element->name() + "' is defined twice (first at line " +
+                     std::to_string(elements_[static_cast<std::size_t>(it->second)]->where().line) +
+                     "); element names must be unique");
   elements_.push_back(std::move(element));
   return *elements_.back();
 }

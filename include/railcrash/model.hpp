@@ -166,6 +166,7 @@ class Model {
   std::vector<std::unique_ptr<Element>> elements_;
   std::vector<Load> loads_;
   std::map<std::string, int> body_index_;
+  std::map<std::string, int> element_index_;  // element name -> index in elements_ (duplicate check)
   std::vector<int> constraint_offset_;
   int constraint_rows_ = 0;
   double length_scale_ = 1.0;
