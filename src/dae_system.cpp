@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -91,6 +92,8 @@ DaeSystem::DaeSystem(const Model& model) : model_(model), modes_(model) {
   RAILCRASH_DEMAND(model.finalized());
   const int n = model.body_count();
   mass_.resize(static_cast<std::size_t>(3 * n));
+  rotation_angle_.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+  rotation_.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     const Body& b = model.bodies()[static_cast<std::size_t>(i)];
     mass_[static_cast<std::size_t>(3 * i)] = b.mass;
@@ -185,8 +188,22 @@ void DaeSystem::load_forces(double t, const double* q, double* f) const {
   }
 }
 
+namespace {
+/// Power the bodies deliver to an element that applies the forces fe to them: -sum fe . v.
+double power_into(const std::array<Pose<double>, 2>& fe, const ElementState<double>& s) {
+  double power = 0.0;
+  for (std::size_t k = 0; k < 2; ++k) power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
+  return power;
+}
+}  // namespace
+
 void DaeSystem::generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty,
-                                   double* penalty_lambda, const double* lambda) const {
+                                   double* penalty_lambda, const double* lambda, const SweepExtras* extras) const {
+  double* powers = extras ? extras->powers : nullptr;
+  if (powers) {
+    body_quadrature_rates(t, q, v, powers);
+    powers[kPenaltyWork] = 0.0;
+  }
   const int n = model_.body_count();
   for (int i = 0; i < n; ++i) {
     f[3 * i] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
@@ -197,10 +214,18 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     const ElementState<double> s = local_state(e, q, v);
-    std::array<Pose<double>, 2> fe{};
     const int m = el.constraint_count();
+    if (extras && (extras->roots || extras->outputs)) {
+      const double* element_lambda = m > 0 ? extras->y_lambda + model_.constraint_offset(e) : nullptr;
+      if (extras->roots && el.root_count() > 0) el.roots(t, s, element_lambda, extras->roots + root_offset_[e]);
+      if (extras->outputs && output_offset_[e] < output_end(e)) el.outputs(s, element_lambda, extras->outputs + output_offset_[e]);
+    }
+    std::array<Pose<double>, 2> fe{};
+    double* element_power = powers ? powers + kFirstElementWork + static_cast<int>(e) : nullptr;
+    if (element_power) *element_power = 0.0;
     if (m == 0) {
       el.add_force(t, s, fe);
+      if (element_power) *element_power = power_into(fe, s);
     } else {
       const int offset = model_.constraint_offset(e);
       double reactions[kMaxConstraintRows] = {};  // multipliers the joint's friction sees
@@ -220,6 +245,7 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
             for (int c = 0; c < 3; ++c) rate += grad[r][3 * k + c] * component(s.v[static_cast<std::size_t>(k)], c);
           reactions[r] = penalty->stiffness[row] * phi[r] + penalty->damping[row] * rate;
           if (penalty_lambda) penalty_lambda[row] = reactions[r];
+          if (powers) powers[kPenaltyWork] += reactions[r] * rate;
           for (int k = 0; k < 2; ++k)
             for (int c = 0; c < 3; ++c) component(fe[static_cast<std::size_t>(k)], c) -= grad[r][3 * k + c] * reactions[r];
         }
@@ -228,7 +254,16 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
       } else {
         continue;
       }
-      if (el.has_joint_force() && !element_failed(e)) el.add_joint_force(t, s, reactions, fe);
+      if (el.has_joint_force() && !element_failed(e)) {
+        std::array<Pose<double>, 2> friction{};
+        el.add_joint_force(t, s, reactions, friction);
+        if (element_power) *element_power = power_into(friction, s);
+        for (std::size_t k = 0; k < 2; ++k) {
+          fe[k].x += friction[k].x;
+          fe[k].y += friction[k].y;
+          fe[k].theta += friction[k].theta;
+        }
+      }
     }
     for (int k = 0; k < 2; ++k) {
       const int b = el.slot_body(k);
@@ -599,10 +634,7 @@ double DaeSystem::gravity_potential(const double* q) const {
   return pe;
 }
 
-void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda) const {
-  const int nq = body_unknowns();
-  const double* q = y;
-  const double* v = y + nq;
+void DaeSystem::body_quadrature_rates(double t, const double* q, const double* v, double* rates) const {
   rates[kKineticIntegral] = kinetic_energy(v);
   // Power of the applied loads.
   double load_power = 0.0;
@@ -619,6 +651,13 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
     }
   }
   rates[kLoadWork] = load_power;
+}
+
+void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda) const {
+  const int nq = body_unknowns();
+  const double* q = y;
+  const double* v = y + nq;
+  body_quadrature_rates(t, q, v, rates);
   // Power delivered to each force element: -sum f_e . v over its bodies.
   double penalty_power = 0.0;
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
@@ -628,15 +667,13 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
     if (el.constraint_count() == 0) {
       std::array<Pose<double>, 2> fe{};
       el.add_force(t, s, fe);
-      for (std::size_t k = 0; k < 2; ++k)
-        power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
+      power = power_into(fe, s);
     } else if (el.has_joint_force() && !element_failed(e)) {
       // Friction of a joint: its reactions are the multipliers (ida) or penalty forces (euler).
       const double* reactions = (penalty_lambda ? penalty_lambda : y + 2 * nq) + model_.constraint_offset(e);
       std::array<Pose<double>, 2> fe{};
       el.add_joint_force(t, s, reactions, fe);
-      for (std::size_t k = 0; k < 2; ++k)
-        power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
+      power = power_into(fe, s);
     }
     if (el.constraint_count() > 0 && penalty_lambda) {
       // Penalty force -G^T lambda does power -lambda . (G v) on the bodies.
@@ -718,8 +755,7 @@ DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y)
   } else if (el.has_joint_force() && !element_failed(e)) {
     el.add_joint_force(t, s, y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)), load.force);
   }
-  for (std::size_t k = 0; k < 2; ++k)
-    load.power -= load.force[k].x * s.v[k].x + load.force[k].y * s.v[k].y + load.force[k].theta * s.v[k].theta;
+  load.power = power_into(load.force, s);
   return load;
 }
 
@@ -776,7 +812,22 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
 void DaeSystem::reset_modes() { modes_.reset(); }
 
 ElementState<double> DaeSystem::local_state(std::size_t e, const double* q, const double* v) const {
-  return gather_state(*model_.elements()[e], q, v, modes_.of(e));
+  return gather_state(*model_.elements()[e], q, v, modes_.of(e),
+                      [this](int b, double theta) -> const Rotation<double>& { return body_rotation(b, theta); });
+}
+
+const Rotation<double>& DaeSystem::body_rotation(int b, double theta) const {
+  const auto i = static_cast<std::size_t>(b);
+  // Exact comparison on purpose: a different angle, however close, gets its own cos and sin.
+  if (!(rotation_angle_[i] == theta)) {
+    rotation_[i] = rotation_of(theta);
+    rotation_angle_[i] = theta;
+  }
+  return rotation_[i];
+}
+
+int DaeSystem::output_end(std::size_t e) const {
+  return e + 1 < output_offset_.size() ? output_offset_[e + 1] : static_cast<int>(output_names_.size());
 }
 
 bool DaeSystem::element_failed(std::size_t e) const { return model_.elements()[e]->failed(modes_.of(e)); }
@@ -788,8 +839,7 @@ void DaeSystem::outputs(const double* y, const double* lambda, double* out) cons
 void DaeSystem::element_outputs(int e, const double* y, const double* lambda, double* out) const {
   const auto k = static_cast<std::size_t>(e);
   const int first = output_offset_[k];
-  const int end = k + 1 < output_offset_.size() ? output_offset_[k + 1] : static_cast<int>(output_names_.size());
-  if (first == end) return;
+  if (first == output_end(k)) return;
   const Element& el = *model_.elements()[k];
   const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(k) : nullptr;
   el.outputs(local_state(k, y, y + body_unknowns()), element_lambda, out + first);

@@ -73,16 +73,7 @@ void Element::add_force_jacobian(double, const ElementState<double>&, std::array
                                  ForceBlock&) const {}
 
 ElementState<double> gather_state(const Element& e, const double* q, const double* v, const void* mode) {
-  ElementState<double> s;
-  s.mode = mode;
-  for (int k = 0; k < 2; ++k) {
-    const int b = e.slot_body(k);
-    if (b == kGround) continue;
-    const auto ks = static_cast<std::size_t>(k);
-    s.q[ks] = {q[3 * b], q[3 * b + 1], q[3 * b + 2]};
-    s.v[ks] = {v[3 * b], v[3 * b + 1], v[3 * b + 2]};
-  }
-  return s;
+  return gather_state(e, q, v, mode, [](int, double theta) { return rotation_of(theta); });
 }
 
 ElementState<double> gather_state(const Element& e, const double* q, const double* v) {

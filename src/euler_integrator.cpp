@@ -211,8 +211,21 @@ void EulerIntegrator::start(double /*t_end*/) {
     }
     events_.clear();
     if (system_.commit_boundary_roots(0.0, y_.data(), yp.data(), events_)) report_events(events_, y_.data());
-    system_.roots(0.0, y_.data(), g_before_.data());
   }
+  outputs_.assign(system_.output_names().size(), 0.0);
+  sweep();
+  std::swap(g_before_, g_after_);
+}
+
+void EulerIntegrator::sweep() {
+  const int nq = system_.body_unknowns();
+  DaeSystem::SweepExtras extras;
+  extras.powers = rates_.data();
+  extras.roots = g_after_.data();
+  extras.outputs = outputs_.data();
+  extras.y_lambda = y_.data() + 2 * nq;  // the roots and outputs see y's multipliers, as roots(t, y) does
+  system_.generalized_forces(t_, y_.data(), y_.data() + nq, force_.data(), &penalty_, lambda_.data(), nullptr, &extras);
+  outputs_current_ = true;
 }
 
 // The loop runs on time: step k ends at k dt (no drift), the last one at t_end exactly.
@@ -225,8 +238,8 @@ double EulerIntegrator::advance(double t_end) {
   const bool last = static_cast<double>(step_) >= t_end / dt_ - 1e-9;
   const double t_next = last ? t_end : static_cast<double>(step_) * dt_;
   const double h = t_next - t_;
-  system_.generalized_forces(t_, q, v, force_.data(), &penalty_, lambda_.data());
-  system_.quadrature_rates(t_, y_.data(), rates_.data(), lambda_.data());
+  // force_, rates_ and lambda_ at (t_, y_) come from the last sweep (start() or the last step).
+  outputs_current_ = false;
   for (int k = 0; k < nquad; ++k) quadratures_[static_cast<std::size_t>(k)] += h * rates_[static_cast<std::size_t>(k)];
   for (int k = 0; k < nq; ++k) {
     v[k] += h * force_[static_cast<std::size_t>(k)] * inverse_mass_[static_cast<std::size_t>(k)];
@@ -236,8 +249,8 @@ double EulerIntegrator::advance(double t_end) {
   ++stats().steps;
   stats().residual_evaluations += 1;
   std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);
+  sweep();  // the next step's forces, this state's roots (into g_after_) and outputs
   if (!g_before_.empty()) {
-    system_.roots(t_, y_.data(), g_after_.data());
     bool fired = false;
     for (std::size_t k = 0; k < g_after_.size(); ++k) {
       const double before = g_before_[k], after = g_after_[k];
@@ -250,7 +263,7 @@ double EulerIntegrator::advance(double t_end) {
       events_.clear();
       if (system_.commit_roots(t_, y_.data(), direction_.data(), events_)) {
         ++stats().reinitializations;
-        system_.roots(t_, y_.data(), g_after_.data());
+        sweep();  // forces, roots and outputs in the new modes
       }
       report_events(events_, y_.data());
     }

@@ -113,6 +113,7 @@ void Model::finalize() {
       const Body& body = bodies_[static_cast<std::size_t>(b)];
       initial.q[static_cast<std::size_t>(k)] = {body.x, body.y, body.angle};
       initial.v[static_cast<std::size_t>(k)] = {body.vx, body.vy, body.angular_velocity};
+      initial.rotation[static_cast<std::size_t>(k)] = rotation_of(body.angle);
     }
     el.initialize(initial);
     constraint_offset_[e] = constraint_rows_;

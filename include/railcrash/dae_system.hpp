@@ -93,8 +93,17 @@ class DaeSystem {
   /// given, constraints add -G^T (k Phi + c G v) and penalty_lambda receives k Phi + c G v.
   /// Joint friction needs the reactions: the penalty forces, or else `lambda` (the DAE's
   /// multipliers; without either, joint friction is left out).
+  /// `extras` asks the same sweep over the elements for more (explicit Euler's one sweep per
+  /// step instead of four).
+  struct SweepExtras {
+    double* powers = nullptr;   // quadrature_count(): what quadrature_rates(t, y, powers, penalty_lambda) gives
+    double* roots = nullptr;    // root_count(): what roots(t, y, roots) gives for y = (q, v, y_lambda)
+    double* outputs = nullptr;  // output_names().size(): what outputs(y, y_lambda, outputs) gives
+    const double* y_lambda = nullptr;  // the multipliers in y that the roots and outputs read
+  };
   void generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty = nullptr,
-                          double* penalty_lambda = nullptr, const double* lambda = nullptr) const;
+                          double* penalty_lambda = nullptr, const double* lambda = nullptr,
+                          const SweepExtras* extras = nullptr) const;
   /// Triplets of df/dq and df/dv (same force definition as generalized_forces); with
   /// `stiffest`, each element in its stiffest mode (Euler's stability estimate).
   struct Triplet { int row, col; double value; };
@@ -130,6 +139,9 @@ class DaeSystem {
   //      work of applied loads, work done on each element (by the bodies), work on penalties ]
   int quadrature_count() const { return 3 + static_cast<int>(model_.elements().size()); }
   void quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda = nullptr) const;
+  /// The rates that do not come from elements (kinetic energy, loads' power); the rest is
+  /// written by quadrature_rates or by generalized_forces' `powers`.
+  void body_quadrature_rates(double t, const double* q, const double* v, double* rates) const;
   static constexpr int kKineticIntegral = 0;
   static constexpr int kLoadWork = 1;
   static constexpr int kPenaltyWork = 2;
@@ -201,9 +213,16 @@ class DaeSystem {
   template <class Sink>
   void assemble_jacobian(double t, double cj, const double* y, const double* yp, Sink& sink) const;
   double gravity_potential(const double* q) const;
-  /// Element e's local state at (q, v), with its mode.
+  /// Element e's local state at (q, v), with its mode; its slots' rotations come from
+  /// body_rotation().
   ElementState<double> local_state(std::size_t e, const double* q, const double* v) const;
+  /// cos and sin of body b's angle theta [rad], computed once per distinct angle: every
+  /// element on the body, and every sweep at the same state (Euler's forces, powers, roots and
+  /// outputs), reuse them. A cache keyed by the angle's value, so it is never stale.
+  const Rotation<double>& body_rotation(int b, double theta) const;
   void load_forces(double t, const double* q, double* f) const;
+  /// One past element e's last output in output_names().
+  int output_end(std::size_t e) const;
 
   const Model& model_;
   ElementStates modes_;  // the run's element modes and histories (the only state a DaeSystem changes)
@@ -218,6 +237,10 @@ class DaeSystem {
   std::vector<int> root_owner_;   // element of each root
   std::vector<std::vector<int>> element_unknowns_;  // y indices each element reads
   int root_count_ = 0;
+  // body_rotation()'s cache: the angle [rad] each rotation was computed for (NaN: none yet).
+  // Mutable scratch of const evaluations; a DaeSystem belongs to one run on one thread.
+  mutable std::vector<double> rotation_angle_;
+  mutable std::vector<Rotation<double>> rotation_;
 };
 
 }  // namespace railcrash

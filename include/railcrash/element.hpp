@@ -51,13 +51,15 @@ struct PointRef {
   double sy = 0.0;  // [length] body-fixed offset, body y axis
 };
 
-/// Local state of an element: pose and rate of its two slots (ground slots stay zero), and
+/// Local state of an element: pose and rate of its two slots (ground slots stay zero), the
+/// cos and sin of their angles, and
 /// its mode and history (read-only; its slot in the run's ElementStates, null for an element
 /// without modes).
 template <class T>
 struct ElementState {
   std::array<Pose<T>, 2> q{};
   std::array<Pose<T>, 2> v{};
+  std::array<Rotation<T>, 2> rotation{};  // cos and sin of q[k].theta, computed once per evaluation
   const void* mode = nullptr;
 };
 
@@ -238,6 +240,7 @@ ElementState<D> seeded_state(const ElementState<double>& s) {
     sd.q[ks] = {D(s.q[ks].x, 3 * k), D(s.q[ks].y, 3 * k + 1), D(s.q[ks].theta, 3 * k + 2)};
     sd.v[ks] = {D(s.v[ks].x, 6 + 3 * k), D(s.v[ks].y, 6 + 3 * k + 1), D(s.v[ks].theta, 6 + 3 * k + 2)};
   }
+  for (std::size_t k = 0; k < 2; ++k) sd.rotation[k] = rotation_of(sd.q[k].theta, s.rotation[k]);
   sd.mode = s.mode;
   return sd;
 }
@@ -359,7 +362,24 @@ class ConstraintElement : public Element {
 };
 
 /// Local state of element e gathered from the global q and v arrays (ground slots are zero);
-/// mode: its slot in the run's ElementStates (DaeSystem::modes()).
+/// mode: its slot in the run's ElementStates (DaeSystem::modes()); body_rotation(b, theta)
+/// gives a body's Rotation (a cache may serve it).
+template <class BodyRotation>
+ElementState<double> gather_state(const Element& e, const double* q, const double* v, const void* mode,
+                                  BodyRotation&& body_rotation) {
+  ElementState<double> s;
+  s.mode = mode;
+  for (int k = 0; k < 2; ++k) {
+    const int b = e.slot_body(k);
+    if (b == kGround) continue;
+    const auto ks = static_cast<std::size_t>(k);
+    s.q[ks] = {q[3 * b], q[3 * b + 1], q[3 * b + 2]};
+    s.v[ks] = {v[3 * b], v[3 * b + 1], v[3 * b + 2]};
+    s.rotation[ks] = body_rotation(b, q[3 * b + 2]);
+  }
+  return s;
+}
+/// The same, each rotation computed afresh.
 ElementState<double> gather_state(const Element& e, const double* q, const double* v, const void* mode);
 /// The same for an element without modes (mode_bytes() == 0; an internal error otherwise).
 ElementState<double> gather_state(const Element& e, const double* q, const double* v);

@@ -51,6 +51,10 @@ class EulerIntegrator : public Integrator {
   bool dense_output() const override { return false; }
   void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) override;
   const double* current_state() const override { return y_.data(); }
+  const double* current_outputs() const override { return outputs_current_ ? outputs_.data() : nullptr; }
+  /// One sweep over the elements at (t_, y_) in the present modes: the forces and power rates
+  /// of the next step, the root functions into g_after_, the element outputs.
+  void sweep();
   void final_state(std::vector<double>& y, std::vector<double>& quadratures) override { state_at(t_, y, quadratures); }
   EnergyState energy(const double* y, const double* quadratures) const override;
   std::string step_limit_advice(double t_end) const override;
@@ -74,6 +78,8 @@ class EulerIntegrator : public Integrator {
   std::vector<double> y_, quadratures_;
   std::vector<double> force_, rates_, lambda_, inverse_mass_;
   std::vector<double> g_before_, g_after_;  // root functions before and after a step
+  std::vector<double> outputs_;             // element outputs at y_ (sweep())
+  bool outputs_current_ = false;            // outputs_ belong to y_ and the present modes
   std::vector<int> direction_;
   std::vector<EventRecord> events_;
   double t_ = 0.0;  // [time]

@@ -27,34 +27,73 @@ struct Pose {
   T x{}, y{}, theta{};
 };
 
-/// R(theta) s: the body-fixed offset s expressed in global axes.
+/// cos and sin of a body's angle: an element evaluation computes them once per body slot
+/// (ElementState::rotation) and every point of the body uses them. Ground: the identity.
 template <class T>
-Vec2<T> rotate(const T& theta, double sx, double sy) {
-  const T c = cos(theta), s = sin(theta);
-  return {c * sx - s * sy, s * sx + c * sy};
+struct Rotation {
+  T cos = T(1.0), sin = T(0.0);
+};
+template <class T>
+Rotation<T> rotation_of(const T& theta) {
+  return {cos(theta), sin(theta)};
+}
+/// The same for a dual angle whose value's rotation r is known: d cos = -sin d theta,
+/// d sin = cos d theta (no second cos and sin of the value).
+template <int N>
+Rotation<Dual<double, N>> rotation_of(const Dual<double, N>& theta, const Rotation<double>& r) {
+  Rotation<Dual<double, N>> out;
+  out.cos.value = r.cos;
+  out.sin.value = r.sin;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(N); ++i) {
+    out.cos.grad[i] = -r.sin * theta.grad[i];
+    out.sin.grad[i] = r.cos * theta.grad[i];
+  }
+  return out;
 }
 
-/// Global position of the point with body-fixed offset (sx, sy).
+/// R(theta) s: the body-fixed offset s expressed in global axes.
+template <class T>
+Vec2<T> rotate(const Rotation<T>& r, double sx, double sy) {
+  return {r.cos * sx - r.sin * sy, r.sin * sx + r.cos * sy};
+}
+template <class T>
+Vec2<T> rotate(const T& theta, double sx, double sy) {
+  return rotate(rotation_of(theta), sx, sy);
+}
+
+/// Global position of the point with body-fixed offset (sx, sy); r: the body's rotation.
+template <class T>
+Vec2<T> point_position(const Pose<T>& q, const Rotation<T>& r, double sx, double sy) {
+  const Vec2<T> arm = rotate(r, sx, sy);
+  return {q.x + arm.x, q.y + arm.y};
+}
 template <class T>
 Vec2<T> point_position(const Pose<T>& q, double sx, double sy) {
-  const Vec2<T> arm = rotate(q.theta, sx, sy);
-  return {q.x + arm.x, q.y + arm.y};
+  return point_position(q, rotation_of(q.theta), sx, sy);
 }
 
 /// Global velocity of that point.
 template <class T>
-Vec2<T> point_velocity(const Pose<T>& q, const Pose<T>& v, double sx, double sy) {
-  const Vec2<T> arm = rotate(q.theta, sx, sy);
+Vec2<T> point_velocity(const Pose<T>& v, const Rotation<T>& r, double sx, double sy) {
+  const Vec2<T> arm = rotate(r, sx, sy);
   return {v.x - v.theta * arm.y, v.y + v.theta * arm.x};
+}
+template <class T>
+Vec2<T> point_velocity(const Pose<T>& q, const Pose<T>& v, double sx, double sy) {
+  return point_velocity(v, rotation_of(q.theta), sx, sy);
 }
 
 /// Adds the generalized force of a global force F applied at offset (sx, sy).
 template <class T>
-void add_point_force(const Pose<T>& q, double sx, double sy, const Vec2<T>& force, Pose<T>& generalized) {
-  const Vec2<T> arm = rotate(q.theta, sx, sy);
+void add_point_force(const Rotation<T>& r, double sx, double sy, const Vec2<T>& force, Pose<T>& generalized) {
+  const Vec2<T> arm = rotate(r, sx, sy);
   generalized.x += force.x;
   generalized.y += force.y;
   generalized.theta += cross(arm, force);
+}
+template <class T>
+void add_point_force(const Pose<T>& q, double sx, double sy, const Vec2<T>& force, Pose<T>& generalized) {
+  add_point_force(rotation_of(q.theta), sx, sy, force, generalized);
 }
 
 }  // namespace railcrash

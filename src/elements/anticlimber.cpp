@@ -136,8 +136,10 @@ Anticlimber::Deformations Anticlimber::deformations(const State& st, const Eleme
   const Pose<double>& q2 = s.q[slot2()];
   const Pose<double>& v1 = s.v[slot1()];
   const Pose<double>& v2 = s.v[slot2()];
-  const Vec2<double> d = point_position(q2, p2.sx, p2.sy) - point_position(q1, p1.sx, p1.sy);
-  const Vec2<double> d_rate = point_velocity(q2, v2, p2.sx, p2.sy) - point_velocity(q1, v1, p1.sx, p1.sy);
+  const Rotation<double>& rotation1 = s.rotation[slot1()];
+  const Rotation<double>& rotation2 = s.rotation[slot2()];
+  const Vec2<double> d = point_position(q2, rotation2, p2.sx, p2.sy) - point_position(q1, rotation1, p1.sx, p1.sy);
+  const Vec2<double> d_rate = point_velocity(v2, rotation2, p2.sx, p2.sy) - point_velocity(v1, rotation1, p1.sx, p1.sy);
   // e1' = omega1 n1, n1' = -omega1 e1.
   const double along_rate = dot(d_rate, k.e1) + v1.theta * dot(d, k.n1);
   const double across_rate = dot(d_rate, k.n1) - v1.theta * dot(d, k.e1);

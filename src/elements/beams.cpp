@@ -138,6 +138,10 @@ void BeamElement::initialize(const ElementState<double>& initial) {
                      "': its two points coincide in the initial configuration; a beam needs a length, move them apart");
   direction_ = {d.x / length_, d.y / length_};
   initial_angle_ = {initial.q[k1].theta, initial.q[k2].theta};
+  for (std::size_t k = 0; k < 2; ++k) {  // u0 in each end body's frame: R(-theta_k(0)) u0
+    const Vec2<double> u = rotate(-initial_angle_[k], direction_[0], direction_[1]);
+    body_direction_[k] = {u.x, u.y};
+  }
 
   const double e = material.elastic_modulus;
   axial_stiffness_ = e / (length_ * section_.axial_flexibility);
@@ -163,6 +167,7 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
       *out[c] = D(*q[c]);
       out[c]->grad[0] = *v[c];
     }
+    sd.rotation[k] = rotation_of(sd.q[k].theta, s.rotation[k]);
   }
   sd.mode = s.mode;
   const std::array<D, 3> x = kinematics(sd).strain;

@@ -61,7 +61,7 @@ SliderJoint::SliderJoint(ElementSpec& spec)
 
 void SliderJoint::outputs(const ElementState<double>& s, const double* lambda, double* out) const {
   const Vec2<double> d = Joint::separation(*this, s.q);
-  const Vec2<double> along = rotate(s.q[static_cast<std::size_t>(point_slot(0))].theta, axis_x, axis_y);
+  const Vec2<double> along = rotate(s.rotation[static_cast<std::size_t>(point_slot(0))], axis_x, axis_y);
   out[0] = -lambda[0];
   out[1] = -lambda[1];
   out[2] = dot(along, d);
@@ -75,7 +75,7 @@ SlidingPinJoint::SlidingPinJoint(ElementSpec& spec) : ConstraintElement(spec.nam
 
 void SlidingPinJoint::outputs(const ElementState<double>& s, const double* lambda, double* out) const {
   const Vec2<double> d = Joint::separation(*this, s.q);
-  const Vec2<double> along = rotate(s.q[static_cast<std::size_t>(point_slot(0))].theta, axis_x, axis_y);
+  const Vec2<double> along = rotate(s.rotation[static_cast<std::size_t>(point_slot(0))], axis_x, axis_y);
   out[0] = -lambda[0];
   out[1] = dot(along, d);
 }

@@ -293,9 +293,9 @@ int SpecialSpring::rate_sign(const ElementState<double>& s) const {
   const PointRef& p1 = point(0);
   const PointRef& p2 = point(1);
   const std::size_t k1 = slot_of(0), k2 = slot_of(1);
-  const Vec2<double> r1 = point_position(s.q[k1], p1.sx, p1.sy);
+  const Vec2<double> r1 = point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy);
   const Vec2<double> relative_rate =
-      point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy) - point_velocity(s.q[k1], s.v[k1], p1.sx, p1.sy);
+      point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy) - point_velocity(s.v[k1], s.rotation[k1], p1.sx, p1.sy);
   const Vec2<double> a_rate{-s.v[k1].theta * g.a.y, s.v[k1].theta * g.a.x};
   return sign_of(-direction() * (dot(relative_rate, g.a) + dot(g.r2 - r1, a_rate)));
 }

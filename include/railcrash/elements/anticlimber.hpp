@@ -249,11 +249,12 @@ class Anticlimber : public ForceElement<Anticlimber> {
     const PointRef& p2 = point(1);
     const Pose<T>& q1 = s.q[slot1()];
     const Pose<T>& q2 = s.q[slot2()];
+    const Rotation<T>& rotation1 = s.rotation[slot1()];
     Kinematics<T> k;
-    k.e1 = rotate(q1.theta, 1.0, 0.0);
-    k.n1 = rotate(q1.theta, 0.0, 1.0);
-    const Vec2<T> r2 = point_position(q2, p2.sx, p2.sy);
-    const Vec2<T> d = r2 - point_position(q1, p1.sx, p1.sy);
+    k.e1 = rotate(rotation1, 1.0, 0.0);
+    k.n1 = rotate(rotation1, 0.0, 1.0);
+    const Vec2<T> r2 = point_position(q2, s.rotation[slot2()], p2.sx, p2.sy);
+    const Vec2<T> d = r2 - point_position(q1, rotation1, p1.sx, p1.sy);
     k.arm1 = r2 - Vec2<T>{q1.x, q1.y};
     k.horizontal = -(*facing) * dot(d, k.e1);
     k.vertical = dot(d, k.n1) + initial_misalignment;
@@ -275,7 +276,7 @@ class Anticlimber : public ForceElement<Anticlimber> {
     const T push = h * (*facing);
     const Vec2<T> force{push * k.e1.x - v * k.n1.x, push * k.e1.y - v * k.n1.y};
     const PointRef& p2 = point(1);
-    add_point_force(s.q[slot2()], p2.sx, p2.sy, force, f[slot2()]);
+    add_point_force(s.rotation[slot2()], p2.sx, p2.sy, force, f[slot2()]);
     Pose<T>& f1 = f[slot1()];
     f1.x -= force.x;
     f1.y -= force.y;

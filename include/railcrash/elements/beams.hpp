@@ -154,11 +154,13 @@ class BeamElement : public ForceElement<BeamElement> {
     const PointRef& p1 = point(0);
     const PointRef& p2 = point(1);
     Kinematics<T> k;
-    k.d = point_position(s.q[k2], p2.sx, p2.sy) - point_position(s.q[k1], p1.sx, p1.sy);
+    k.d = point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy);
     k.length = sqrt(dot(k.d, k.d));
     k.strain[0] = k.length - length_;
-    const Vec2<T> t1 = rotate(T(s.q[k1].theta - initial_angle_[0]), direction_[0], direction_[1]);
-    const Vec2<T> t2 = rotate(T(s.q[k2].theta - initial_angle_[1]), direction_[0], direction_[1]);
+    // t_k = R(theta_k - theta_k(0)) u0, written R(theta_k) (R(-theta_k(0)) u0) so the end
+    // bodies' rotations serve (no further cos and sin per evaluation).
+    const Vec2<T> t1 = rotate(s.rotation[k1], body_direction_[0][0], body_direction_[0][1]);
+    const Vec2<T> t2 = rotate(s.rotation[k2], body_direction_[1][0], body_direction_[1][1]);
     k.strain[1] = atan2(cross(k.d, t1), dot(k.d, t1));
     k.strain[2] = atan2(cross(k.d, t2), dot(k.d, t2));
     return k;
@@ -237,6 +239,7 @@ class BeamElement : public ForceElement<BeamElement> {
   double length_ = 0.0;                       // [length] L0
   std::array<double, 2> direction_{1.0, 0.0}; // u0, initial chord direction
   std::array<double, 2> initial_angle_{};     // [rad] theta of the body of P1, P2 at t = 0
+  std::array<std::array<double, 2>, 2> body_direction_{};  // u0 in the frame of P1's, P2's body at t = 0
   double axial_stiffness_ = 0.0;              // [force/length]
   std::array<double, 3> bending_stiffness_{}; // [moment/rad] k11, k12, k22
   std::array<double, 3> yield_{};             // [force, moment, moment]

@@ -70,8 +70,8 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
   Kinematics<T> kinematics(const ElementState<T>& s) const {
     const auto k = static_cast<std::size_t>(point_slot(0));
     const PointRef& p = point(0);
-    const Vec2<T> r = point_position(s.q[k], p.sx, p.sy);
-    const Vec2<T> v = point_velocity(s.q[k], s.v[k], p.sx, p.sy);
+    const Vec2<T> r = point_position(s.q[k], s.rotation[k], p.sx, p.sy);
+    const Vec2<T> v = point_velocity(s.v[k], s.rotation[k], p.sx, p.sy);
     Kinematics<T> out;
     if (surface == Surface::Line) {
       out.normal = {T(nx), T(ny)};
@@ -104,7 +104,7 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
     const T normal = normal_force(k.penetration, k.rate, st.segment);
     const T tangential = friction > 0.0 ? -friction * normal * tanh(k.slip / friction_velocity) : T(0.0);
     const auto slot = static_cast<std::size_t>(point_slot(0));
-    add_point_force(s.q[slot], point(0).sx, point(0).sy,
+    add_point_force(s.rotation[slot], point(0).sx, point(0).sy,
                     Vec2<T>{normal * k.normal.x + tangential * k.tangent.x, normal * k.normal.y + tangential * k.tangent.y},
                     f[slot]);
   }

@@ -219,8 +219,8 @@ PointOffset<T> point_offset(const Element& e, const ElementState<T>& s) {
   const PointRef& p2 = e.point(1);
   const auto k1 = static_cast<std::size_t>(e.point_slot(0));
   const auto k2 = static_cast<std::size_t>(e.point_slot(1));
-  return {point_position(s.q[k2], p2.sx, p2.sy) - point_position(s.q[k1], p1.sx, p1.sy),
-          point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy) - point_velocity(s.q[k1], s.v[k1], p1.sx, p1.sy)};
+  return {point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy),
+          point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy) - point_velocity(s.v[k1], s.rotation[k1], p1.sx, p1.sy)};
 }
 
 /// Hysteretic force-deflection law along one axis (see the header comment).

@@ -113,18 +113,18 @@ class SliderJoint : public ConstraintElement<SliderJoint>, public AngleLockingJo
   void joint_force_law(double, const ElementState<T>& s, const T* lambda, std::array<Pose<T>, 2>& f) const {
     const auto k1 = static_cast<std::size_t>(point_slot(0)), k2 = static_cast<std::size_t>(point_slot(1));
     const PointRef& p2 = point(1);
-    const Vec2<T> r2 = point_position(s.q[k2], p2.sx, p2.sy);
-    const Vec2<T> v2 = point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy);
+    const Vec2<T> r2 = point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy);
+    const Vec2<T> v2 = point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy);
     // Velocity of the material point of body 1 under P2, and the axis in global axes.
     const Vec2<T> arm1{r2.x - s.q[k1].x, r2.y - s.q[k1].y};
     const Vec2<T> v1{s.v[k1].x - s.v[k1].theta * arm1.y, s.v[k1].y + s.v[k1].theta * arm1.x};
-    const Vec2<T> axis = rotate(s.q[k1].theta, axis_x, axis_y);
+    const Vec2<T> axis = rotate(s.rotation[k1], axis_x, axis_y);
     const T slip = dot(axis, v2 - v1);
     const T couple = 2.0 * lambda[1] / slider_length;
     const T normal = sqrt(lambda[0] * lambda[0] + couple * couple + 1e-30);
     const T magnitude = -friction * normal * tanh(slip / friction_velocity);
     const Vec2<T> force{magnitude * axis.x, magnitude * axis.y};
-    add_point_force(s.q[k2], p2.sx, p2.sy, force, f[k2]);
+    add_point_force(s.rotation[k2], p2.sx, p2.sy, force, f[k2]);
     f[k1].x -= force.x;
     f[k1].y -= force.y;
     f[k1].theta -= cross(arm1, force);

@@ -268,7 +268,7 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
       const T force = direction() * law_value(m, T(direction() * (*free_length - g.along)));
       const Vec2<T> on_2{force * g.a.x, force * g.a.y};
       const PointRef& p2 = point(1);
-      add_point_force(s.q[slot_of(1)], p2.sx, p2.sy, on_2, f[slot_of(1)]);
+      add_point_force(s.rotation[slot_of(1)], p2.sx, p2.sy, on_2, f[slot_of(1)]);
       Pose<T>& body_1 = f[slot_of(0)];
       const Vec2<T> arm = g.r2 - Vec2<T>{s.q[slot_of(0)].x, s.q[slot_of(0)].y};
       body_1.x -= on_2.x;
@@ -296,9 +296,9 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
     const PointRef& p1 = point(0);
     const PointRef& p2 = point(1);
     AxisGeometry<T> g;
-    const Vec2<T> r1 = point_position(s.q[slot_of(0)], p1.sx, p1.sy);
-    g.r2 = point_position(s.q[slot_of(1)], p2.sx, p2.sy);
-    g.a = rotate(s.q[slot_of(0)].theta, axis->x, axis->y);
+    const Vec2<T> r1 = point_position(s.q[slot_of(0)], s.rotation[slot_of(0)], p1.sx, p1.sy);
+    g.r2 = point_position(s.q[slot_of(1)], s.rotation[slot_of(1)], p2.sx, p2.sy);
+    g.a = rotate(s.rotation[slot_of(0)], axis->x, axis->y);
     g.along = dot(g.r2 - r1, g.a);
     return g;
   }

@@ -39,8 +39,8 @@ LineGeometry<T> line_geometry(const Element& e, const ElementState<T>& s) {
   const auto k1 = static_cast<std::size_t>(e.point_slot(0));
   const auto k2 = static_cast<std::size_t>(e.point_slot(1));
   LineGeometry<T> g;
-  g.d = point_position(s.q[k2], p2.sx, p2.sy) - point_position(s.q[k1], p1.sx, p1.sy);
-  g.d_rate = point_velocity(s.q[k2], s.v[k2], p2.sx, p2.sy) - point_velocity(s.q[k1], s.v[k1], p1.sx, p1.sy);
+  g.d = point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy);
+  g.d_rate = point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy) - point_velocity(s.v[k1], s.rotation[k1], p1.sx, p1.sy);
   g.length = sqrt(dot(g.d, g.d));
   return g;
 }
@@ -53,8 +53,8 @@ void apply_line_force(const Element& e, const ElementState<T>& s, const Vec2<T>&
   const PointRef& p2 = e.point(1);
   const auto k1 = static_cast<std::size_t>(e.point_slot(0));
   const auto k2 = static_cast<std::size_t>(e.point_slot(1));
-  add_point_force(s.q[k2], p2.sx, p2.sy, force_on_p2, f[k2]);
-  add_point_force(s.q[k1], p1.sx, p1.sy, Vec2<T>{-force_on_p2.x, -force_on_p2.y}, f[k1]);
+  add_point_force(s.rotation[k2], p2.sx, p2.sy, force_on_p2, f[k2]);
+  add_point_force(s.rotation[k1], p1.sx, p1.sy, Vec2<T>{-force_on_p2.x, -force_on_p2.y}, f[k1]);
 }
 
 class LinearSpring : public ForceElement<LinearSpring> {
