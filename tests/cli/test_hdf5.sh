@@ -13,29 +13,7 @@ failures=0
 passes=0
 python=/usr/bin/python3
 
-expect_status() {  # description expected-status command...
-  local description=$1 expected=$2
-  shift 2
-  "$@" > "$tmp/stdout" 2> "$tmp/stderr"
-  local status=$?
-  if [ "$status" -ne "$expected" ]; then
-    echo "FAIL: $description: exit status $status, expected $expected"
-    sed 's/^/  | /' "$tmp/stderr" "$tmp/stdout" | head -20
-    failures=$((failures + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
-
-expect_text() {  # description file pattern
-  if grep -q -- "$3" "$2"; then
-    passes=$((passes + 1))
-  else
-    echo "FAIL: $1: '$3' not found in $2"
-    sed 's/^/  | /' "$2" | head -20
-    failures=$((failures + 1))
-  fi
-}
+. "$(dirname "$0")/expect.sh"
 
 model=$src/models/report/final_two_car.yaml
 
