@@ -162,10 +162,7 @@ class Recorder : public RunObserver {
     run_.times.push_back(t);
     for (int k = 0; k < nq; ++k) run_.displacements.push_back(y[k] - start_[static_cast<std::size_t>(k)]);
     system_.outputs(y, lambda, outputs_.data());
-    for (std::size_t k = 0; k < outputs_.size(); ++k) {
-      run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs_[k]));
-      run_.peak_max[k] = std::max(run_.peak_max[k], outputs_[k]);
-    }
+    track_peaks(outputs_.data());
     if (responses_) responses_->sample(t, y, lambda, quadratures);
   }
 
@@ -173,7 +170,23 @@ class Recorder : public RunObserver {
     if (responses_) responses_->event(record, y);
   }
 
+  /// Peaks and responses from every accepted step and both sides of every event as well, as
+  /// `run`'s summary takes them: a peak must not depend on the output interval (a contact's
+  /// damper force peaks at the contact instant, which no output row need hit).
+  void step(double t, const double* y, const double* lambda, const double* outputs) override {
+    track_peaks(outputs);
+    if (responses_) responses_->step(t, y, lambda, outputs);
+  }
+  bool observes_steps() const override { return true; }
+
  private:
+  void track_peaks(const double* outputs) {
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs[k]));
+      run_.peak_max[k] = std::max(run_.peak_max[k], outputs[k]);
+    }
+  }
+
   const DaeSystem& system_;
   ConvergeRun& run_;
   ResponseTracker* responses_;
