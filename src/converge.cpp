@@ -15,6 +15,8 @@
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/plot.hpp"
+#include "railcrash/results.hpp"
+#include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/run.hpp"
 
 namespace railcrash {
@@ -36,7 +38,9 @@ std::string lower(std::string text) {
 
 const char* const kQuantityHelp =
     "max_crush, peak_anticlimber_force, peak_coupler_force, R1, R2, displacement_rms, "
-    "element.NAME.OUTPUT (peak |value| of an element output) or body.NAME.x|y|theta (displacement at the end)";
+    "element.NAME.OUTPUT (peak |value| of an element output), body.NAME.x|y|theta (displacement at the end), "
+    "event.NAME or event.NAME:TEXT (time of the element's first event, or of its first event whose description "
+    "contains TEXT) or acceleration.BODY (peak CFC-60 filtered acceleration magnitude of a body)";
 
 std::vector<int> role_columns(const DaeSystem& system, OutputRole role) {
   std::vector<int> columns;
@@ -137,6 +141,26 @@ ConvergeQuantity resolve_quantity(const std::string& requested, const DaeSystem&
     q.component = component == "x" ? 0 : component == "y" ? 1 : 2;
     q.description = rest + " displacement at the end [" + (q.component == 2 ? std::string("rad") : length_unit) +
                     "]; error: over the reference's largest absolute displacement";
+  } else if (key.rfind("event.", 0) == 0) {
+    q.kind = Kind::EventTime;
+    const std::string rest = requested.substr(6);
+    const auto colon = rest.find(':');
+    q.event_element = rest.substr(0, colon);
+    q.event_text = colon == std::string::npos ? "" : rest.substr(colon + 1);
+    const auto& elements = model.elements();
+    if (std::none_of(elements.begin(), elements.end(), [&](const auto& e) { return e->name() == q.event_element; }))
+      throw InputError("--quantities: the model has no element named '" + q.event_element + "' ('" + requested +
+                       "'); write event.NAME or event.NAME:TEXT, e.g. event.climb_limit:contact");
+    q.description = "time of the first " + (q.event_text.empty() ? std::string("event") : "'" + q.event_text + "' event") +
+                    " of " + q.event_element + " [s]; error: over the reference's time; a run without it: inf";
+  } else if (key.rfind("acceleration.", 0) == 0) {
+    q.kind = Kind::PeakAcceleration;
+    const std::string name = requested.substr(13);
+    const std::optional<int> body = model.find_body(name);
+    if (!body || *body == kGround)
+      throw InputError("--quantities: the model has no body named '" + name + "' ('" + requested + "'); write acceleration.BODY");
+    q.body = *body;
+    q.description = "peak CFC-60 filtered acceleration magnitude of " + name + " [g]";
   } else {
     throw InputError("--quantities: unknown quantity '" + requested + "'; use " + kQuantityHelp);
   }
@@ -150,8 +174,10 @@ std::string fmt(const char* format, double value);
 /// Keeps what the quantities are made of: sample times, body displacements, output peaks.
 class Recorder : public RunObserver {
  public:
-  Recorder(const DaeSystem& system, ConvergeRun& run, ResponseTracker* responses)
-      : system_(system), run_(run), responses_(responses), outputs_(system.output_names().size()) {
+  /// accelerations: an in-memory ResultWriter (no files) that filters the body accelerations
+  /// as `run`'s summary does, or null.
+  Recorder(const DaeSystem& system, ConvergeRun& run, ResponseTracker* responses, ResultWriter* accelerations)
+      : system_(system), run_(run), responses_(responses), accelerations_(accelerations), outputs_(system.output_names().size()) {
     run_.peak_abs.assign(outputs_.size(), 0.0);
     run_.peak_max.assign(outputs_.size(), -std::numeric_limits<double>::infinity());
   }
@@ -164,6 +190,7 @@ class Recorder : public RunObserver {
     system_.outputs(y, lambda, outputs_.data());
     track_peaks(outputs_.data());
     if (responses_) responses_->sample(t, y, lambda, quadratures);
+    if (accelerations_) accelerations_->sample(t, y, lambda, quadratures);
   }
 
   void event(const EventRecord& record, const double* y) override {
@@ -190,6 +217,7 @@ class Recorder : public RunObserver {
   const DaeSystem& system_;
   ConvergeRun& run_;
   ResponseTracker* responses_;
+  ResultWriter* accelerations_;
   std::vector<double> outputs_;
   std::vector<double> start_;
 };
@@ -235,7 +263,11 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
     DaeSystem system(model);
     std::unique_ptr<ResponseTracker> responses;
     if (model.responses.defined()) responses = std::make_unique<ResponseTracker>(system, model.responses);
-    Recorder recorder(system, run, responses.get());
+    std::unique_ptr<ResultWriter> accelerations;
+    if (std::any_of(plan.quantities.begin(), plan.quantities.end(),
+                    [](const ConvergeQuantity& q) { return q.kind == ConvergeQuantity::Kind::PeakAcceleration; }))
+      accelerations = std::make_unique<ResultWriter>("", system);
+    Recorder recorder(system, run, responses.get(), accelerations.get());
     const auto start = Clock::now();
     std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
     const RunOutcome outcome =
@@ -248,6 +280,12 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
       run.message = "stopped at t = " + fmt("%.6g", outcome.t_reached) + " after the run time limit of " +
                     fmt("%g", plan.options.run_time_limit) + " s (--run-timeout)";
     run.stats = outcome.stats;
+    run.events = outcome.events;
+    if (accelerations) {
+      const double g = standard_gravity(model);
+      for (const FilteredAccelerations& f : accelerations->filtered_accelerations())
+        run.peak_acceleration.push_back(f.filtered ? f.peaks.magnitude / g : kNaN);
+    }
     if (responses) {
       run.has_responses = true;
       run.responses = responses->result();
@@ -295,6 +333,13 @@ double scalar_value(const ConvergeQuantity& q, const ConvergeRun& run, const Res
                                static_cast<std::size_t>(q.component)];
     }
     case Kind::DisplacementRms: return kNaN;
+    case Kind::EventTime:
+      for (const EventRecord& e : run.events)
+        if (e.element == q.event_element && e.what.find(q.event_text) != std::string::npos) return e.t;
+      return kNaN;
+    case Kind::PeakAcceleration:
+      return static_cast<std::size_t>(q.body) < run.peak_acceleration.size() ? run.peak_acceleration[static_cast<std::size_t>(q.body)]
+                                                                            : kNaN;
   }
   return kNaN;
 }
@@ -363,6 +408,8 @@ void evaluate(ConvergeRun& run, const ConvergeRun& reference, const std::vector<
         q.kind == Kind::BodyDisplacement ? largest_displacement(reference, body_count, q.body, q.component) : std::abs(ref);
     if (std::isfinite(run.values[k]) && std::isfinite(ref))
       run.errors[k] = scale > 0.0 ? std::abs(run.values[k] - ref) / scale : (run.values[k] == ref ? 0.0 : kNaN);
+    else if (q.kind == Kind::EventTime && run.ok && std::isfinite(ref))
+      run.errors[k] = std::numeric_limits<double>::infinity();  // the reference's event did not happen in this run
   }
 }
 
@@ -544,6 +591,11 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   }
   if (!options.headline.empty() && plan.headline < 0)
     throw InputError("--headline: '" + options.headline + "' is not one of the study's quantities (--quantities)");
+  for (const ConvergeQuantity& q : plan.quantities)
+    if (q.kind == ConvergeQuantity::Kind::PeakAcceleration && !cfc::adequately_sampled(60.0, plan.output_interval))
+      throw InputError("--quantities: " + q.name + " is filtered at CFC 60, which needs at least 600 output rows per second; "
+                       "the study's output interval is " + format_number(plan.output_interval) +
+                       " s: give --output-interval 1e-3 or less");
 
   if (options.euler_runs == 0) return plan;
   // Euler's first step: a safety factor times the stability limit of the elements, as a whole

@@ -481,7 +481,9 @@ int main(int argc, char** argv) {
   converge->add_option("model", model_path, "model file (YAML)")->required();
   converge->add_option("--quantities", converge_options.quantities,
                        "comma list of max_crush, peak_anticlimber_force, peak_coupler_force, R1, R2, displacement_rms, "
-                       "element.NAME.OUTPUT (peak |value|), body.NAME.x|y|theta (displacement at the end); default: the first six")
+                       "element.NAME.OUTPUT (peak |value|), body.NAME.x|y|theta (displacement at the end), "
+                       "event.NAME[:TEXT] (time of the element's first event [whose description contains TEXT]), "
+                       "acceleration.BODY (peak CFC-60 acceleration magnitude); default: the first six")
       ->delimiter(',');
   converge->add_option("--euler-steps", converge_options.euler_runs, "number of Euler runs: dt_0 and its halvings (0: none)")
       ->capture_default_str();

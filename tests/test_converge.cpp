@@ -8,6 +8,7 @@
 
 #include "railcrash/converge.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/run.hpp"
 
 using namespace railcrash;
@@ -22,6 +23,7 @@ std::string case_path(const std::string& name) {
 /// over the samples and the accepted steps.
 struct Trace {
   std::vector<double> times, x, y;
+  std::vector<double> values;  // the output column at every sample
   double peak = -1e300;
 };
 
@@ -37,7 +39,10 @@ class TraceObserver : public RunObserver {
     trace_.x.push_back(y[0]);
     trace_.y.push_back(y[1]);
     system_.outputs(y, lambda, outputs_.data());
-    if (index_ < outputs_.size()) trace_.peak = std::max(trace_.peak, outputs_[index_]);
+    if (index_ < outputs_.size()) {
+      trace_.values.push_back(outputs_[index_]);
+      trace_.peak = std::max(trace_.peak, outputs_[index_]);
+    }
   }
   // The peak from every accepted step and both sides of every event as well (as `run` and
   // the study take it), so it does not depend on the output interval.
@@ -62,6 +67,19 @@ Trace run_by_hand(const std::string& path, const std::string& column, const std:
       make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval_of(model.simulation), observer);
   REQUIRE(outcome.ok);
   return trace;
+}
+
+/// The study on verification/cases/crush_impact.yaml over 0.1 s with 1e-4 s rows.
+ConvergeResult crush_impact_study(const std::vector<std::string>& quantities, double euler_first_step, int euler_runs,
+                                  double rtol) {
+  ConvergeOptions options;
+  options.quantities = quantities;
+  options.t_end = 0.1;
+  options.output_interval = 1e-4;
+  options.euler_first_step = euler_first_step;
+  options.euler_runs = euler_runs;
+  options.rtols = {rtol};
+  return run_convergence(plan_convergence(case_path("crush_impact"), options));
 }
 
 }  // namespace
@@ -129,15 +147,9 @@ TEST_CASE("convergence study: Euler first order and IDA errors falling with rtol
 TEST_CASE("convergence study: peak crush against the closed form and an Euler error by hand", "[converge]") {
   // 100 kg at 10 m/s into an elastic-perfectly-plastic crush structure: largest crush 0.055 m
   // (closed form in verification/cases/crush_impact.yaml), largest force F0 = 100 kN.
-  ConvergeOptions options;
-  options.quantities = {"max_crush", "element.crush.force", "peak_anticlimber_force"};
-  options.t_end = 0.1;
-  options.output_interval = 1e-4;
-  options.euler_first_step = 1e-4;
-  options.euler_runs = 2;
-  options.rtols = {1e-5};
   const std::string path = case_path("crush_impact");
-  const ConvergeResult result = run_convergence(plan_convergence(path, options));
+  const ConvergeResult result =
+      crush_impact_study({"max_crush", "element.crush.force", "peak_anticlimber_force"}, 1e-4, 2, 1e-5);
   REQUIRE(result.reference.ok);
   CHECK(result.reference.values[0] == Approx(0.055).epsilon(1e-4));
   CHECK(result.reference.values[1] == Approx(1e5).epsilon(1e-6));
@@ -154,6 +166,40 @@ TEST_CASE("convergence study: peak crush against the closed form and an Euler er
   CHECK(result.euler[1].errors[0] == Approx(std::abs(euler.peak - reference.peak) / reference.peak).epsilon(1e-6));
 }
 
+TEST_CASE("convergence study: event times and the CFC-60 acceleration against the closed form", "[converge]") {
+  // crush_impact: 100 kg at 10 m/s closes a 0.5 m gap (contact at 0.05 s), loads elastically
+  // (k = 1e7 N/m, w = sqrt(k / m)) to 10 mm, where x = (v0 / w) sin(w t1) gives
+  // t1 = asin(0.01 w / v0) / w and v1 = v0 cos(w t1), then crushes at F0 = 100 kN until it
+  // stops, t2 = m v1 / F0 later, and unloads. The crushing deceleration is F0 / m = 1000 m/s^2.
+  const std::string path = case_path("crush_impact");
+  const ConvergeResult result =
+      crush_impact_study({"event.crush:contact", "event.crush:unloading", "acceleration.mass"}, 1e-5, 1, 1e-4);
+  REQUIRE(result.reference.ok);
+  const double omega = std::sqrt(1e7 / 100.0), v0 = 10.0;
+  const double t1 = std::asin(0.01 * omega / v0) / omega, v1 = v0 * std::cos(omega * t1);
+  CHECK(result.reference.values[0] == Approx(0.05).margin(1e-9));
+  CHECK(result.reference.values[1] == Approx(0.05 + t1 + 100.0 * v1 / 1e5).margin(1e-8));
+  // The errors are over the reference's event time; both other runs have both events.
+  for (const ConvergeRun* run : {&result.euler[0], &result.ida[0]}) {
+    REQUIRE(run->ok);
+    CHECK(run->errors[1] == Approx(std::abs(run->values[1] - result.reference.values[1]) / result.reference.values[1]));
+    CHECK(run->errors[1] < 1e-2);
+  }
+
+  // The acceleration by hand: the crush force over the mass at every 1e-4 s sample (not the
+  // body accelerations the study filters), filtered at CFC 60, in g.
+  const Trace force =
+      run_by_hand(path, "crush.force", {"simulation.t_end=0.1", "simulation.output_interval=1e-4", "simulation.rtol=1e-9"});
+  std::vector<double> acceleration;  // [m/s^2]
+  for (double f : force.values) acceleration.push_back(f / 100.0);
+  double peak = 0.0;
+  for (double a : cfc::filter(acceleration, 1e-4, 60.0)) peak = std::max(peak, std::abs(a));
+  CHECK(result.reference.values[2] == Approx(peak / 9.80665).epsilon(1e-4));
+  // The filtered plateau is the crushing deceleration, 101.97 g, and a filter overshoot of a few %.
+  CHECK(result.reference.values[2] > 1000.0 / 9.80665);
+  CHECK(result.reference.values[2] < 1.06 * 1000.0 / 9.80665);
+}
+
 TEST_CASE("convergence study: unknown quantities are input errors that say what to write", "[converge]") {
   const std::string path = case_path("damped_spring_mass");
   ConvergeOptions options;
@@ -168,6 +214,14 @@ TEST_CASE("convergence study: unknown quantities are input errors that say what 
   CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("has no output 'torque'") && Catch::Contains("force"));
   options.quantities = {"body.mass.z"};
   CHECK_THROWS_AS(plan_convergence(path, options), InputError);
+  options.quantities = {"event.nope:contact"};
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("no element named 'nope'") && Catch::Contains("event.NAME:TEXT"));
+  options.quantities = {"acceleration.nope"};
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("no body named 'nope'"));
+  options.quantities = {"acceleration.mass"};
+  options.output_interval = 0.01;  // 100 rows per second: too few for CFC 60
+  CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("CFC 60") && Catch::Contains("--output-interval"));
+  options.output_interval.reset();
   options.quantities = {"R2", "displacement_rms"};
   options.headline = "R2";
   CHECK_THROWS_WITH(plan_convergence(path, options), Catch::Contains("does not apply"));

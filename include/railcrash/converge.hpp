@@ -85,7 +85,11 @@ struct ConvergeOptions {
 std::vector<std::string> default_quantities();
 
 struct ConvergeQuantity {
-  enum class Kind { MaxCrush, PeakAnticlimberForce, PeakCouplerForce, R1, R2, DisplacementRms, ElementPeak, BodyDisplacement };
+  enum class Kind {
+    MaxCrush, PeakAnticlimberForce, PeakCouplerForce, R1, R2, DisplacementRms, ElementPeak, BodyDisplacement,
+    EventTime,          // event.NAME[:TEXT]: time of the element's first event (whose description contains TEXT)
+    PeakAcceleration    // acceleration.BODY: peak CFC-60 filtered acceleration magnitude of the body
+  };
   std::string name;
   std::string description;     // what it measures, with its unit
   Kind kind = Kind::MaxCrush;
@@ -96,6 +100,8 @@ struct ConvergeQuantity {
   bool from_responses = false; // max_crush from the responses section
   int body = -1;               // body quantities: body index and component (0 x, 1 y, 2 theta)
   int component = 0;
+  std::string event_element;   // EventTime: the element's name and a text its event's description contains
+  std::string event_text;      // ("" = any event of the element)
 };
 
 /// One run of the study and its figures.
@@ -117,6 +123,9 @@ struct ConvergeRun {
   std::vector<double> peak_max;       // per element output column: largest value
   bool has_responses = false;
   Responses responses;
+  std::vector<EventRecord> events;           // every committed mode change, in order
+  std::vector<double> peak_acceleration;     // per body: peak CFC-60 acceleration magnitude [g]
+                                             // (filled when a PeakAcceleration quantity is asked for)
 };
 
 struct ConvergeFit {
