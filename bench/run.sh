@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|kernels|sensitivity|converge|compare|simbody|outcost|readings|python|sweep|formats|all] [extra options]
+#   bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|readings|python|sweep|formats|all] [extra options]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -16,6 +16,9 @@ case $what in
   # The two-car crash (IDA rtol 1e-3 and 1e-4, Euler at the model's dt) against an older
   # commit built side by side: bench/run.sh compare [COMMIT] (default cbce2b9) [--repeats 3]
   compare) /usr/bin/python3 bench/compare_commit.py "$@" ;;
+  # The same crash's engineering-quantity errors, both commits against their own rtol 1e-7 run:
+  # bench/run.sh accuracy-compare [COMMIT] [--rtols 1e-3,1e-4]
+  accuracy-compare) /usr/bin/python3 bench/compare_accuracy.py "$@" ;;
   # The slider-crank and Andrews' squeezer against Simbody 3.7 at equal accuracy (install-deps.sh --bench)
   simbody) /usr/bin/python3 bench/simbody/compare.py "$@" ;;
   # Share of a run's CPU that goes to output rows (slider-crank at 1 ms, Andrews at 10 us output)
@@ -42,5 +45,5 @@ case $what in
     $bench --commit "$commit" sensitivity
     build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
         --out bench/converge_final_two_car_0.5s ;;
-  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|compare|simbody|outcost|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
+  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
 esac
