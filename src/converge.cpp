@@ -151,22 +151,21 @@ std::string fmt(const char* format, double value);
 class Recorder : public RunObserver {
  public:
   Recorder(const DaeSystem& system, ConvergeRun& run, ResponseTracker* responses)
-      : system_(system), run_(run), responses_(responses), outputs_(system.output_names().size()) {
-    run_.peak_abs.assign(outputs_.size(), 0.0);
-    run_.peak_max.assign(outputs_.size(), -std::numeric_limits<double>::infinity());
+      : system_(system), run_(run), responses_(responses) {
+    run_.peak_abs.assign(system.output_names().size(), 0.0);
+    run_.peak_max.assign(system.output_names().size(), -std::numeric_limits<double>::infinity());
   }
 
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
     const int nq = system_.body_unknowns();
     if (start_.empty()) start_.assign(y, y + nq);
     run_.times.push_back(t);
     for (int k = 0; k < nq; ++k) run_.displacements.push_back(y[k] - start_[static_cast<std::size_t>(k)]);
-    system_.outputs(y, lambda, outputs_.data());
-    for (std::size_t k = 0; k < outputs_.size(); ++k) {
-      run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs_[k]));
-      run_.peak_max[k] = std::max(run_.peak_max[k], outputs_[k]);
+    for (std::size_t k = 0; k < run_.peak_abs.size(); ++k) {
+      run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs[k]));
+      run_.peak_max[k] = std::max(run_.peak_max[k], outputs[k]);
     }
-    if (responses_) responses_->sample(t, y, lambda, quadratures);
+    if (responses_) responses_->sample(t, y, lambda, quadratures, outputs);
   }
 
   void event(const EventRecord& record, const double* y) override {
@@ -177,13 +176,12 @@ class Recorder : public RunObserver {
   const DaeSystem& system_;
   ConvergeRun& run_;
   ResponseTracker* responses_;
-  std::vector<double> outputs_;
   std::vector<double> start_;
 };
 
 class NullObserver : public RunObserver {
  public:
-  void sample(double, const double*, const double*, const double*) override {}
+  void sample(double, const double*, const double*, const double*, const double*) override {}
 };
 
 std::string format_number(double value) {

@@ -540,7 +540,12 @@ void DaeSystem::constraint_acceleration_bias(const double* q, const double* v, d
 }
 
 double DaeSystem::constraint_residual(const double* q) const {
-  std::vector<double> phi(static_cast<std::size_t>(constraint_rows()), 0.0);
+  std::vector<double> phi;
+  return constraint_residual(q, phi);
+}
+
+double DaeSystem::constraint_residual(const double* q, std::vector<double>& phi) const {
+  phi.assign(static_cast<std::size_t>(constraint_rows()), 0.0);
   constraints(q, phi.data(), nullptr);
   double worst = 0.0;
   for (int row = 0; row < constraint_rows(); ++row) {

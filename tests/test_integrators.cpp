@@ -31,13 +31,13 @@ std::string oscillator(double k, double c, double t_end, const std::string& extr
 
 struct CountingObserver : RunObserver {
   std::vector<double> times;
-  void sample(double t, const double*, const double*, const double*) override { times.push_back(t); }
+  void sample(double t, const double*, const double*, const double*, const double*) override { times.push_back(t); }
 };
 
 struct StopAfter : RunObserver {
   std::atomic<bool>* stop;
   int samples = 0;
-  void sample(double, const double*, const double*, const double*) override {
+  void sample(double, const double*, const double*, const double*, const double*) override {
     if (++samples == 3) stop->store(true);
   }
 };
