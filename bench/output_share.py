@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Share of a run's CPU that goes to output rows (issue 14: "output <= 10 % of a run at 1 ms output").
 
-    bench/output_share.py [--repeats 7] [--executable build/railcrash] [--base OTHER_RAILCRASH]
+    bench/output_share.py [--repeats 7] [--executable build/railcrash] [--base OTHER_RAILCRASH] [--format csv|hdf5]
 
 The two mechanisms of bench/simbody/compare.py at their models' tolerances (slider-crank
 10 s, Andrews' squeezer 0.03 s), each run twice with every file written: with dense output
@@ -10,7 +10,8 @@ at t_end (one row). CPU of the whole process (start-up, run, files), medians of 
 interleaved pairs. Output share = (dense - end) / dense; per row = (dense - end) / rows.
 With --base (another build, e.g. of an older commit), its runs alternate with the
 executable's (dense and end of one, then of the other, REPEATS times) and both are printed:
-an A/B comparison in one run, with the same load on both.
+an A/B comparison in one run, with the same load on both. --format hdf5: the runs write
+timeseries.h5 in place of the four CSV files (railcrash run --format).
 """
 import argparse
 import os
@@ -36,11 +37,12 @@ def main():
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--executable", default=os.path.join(ROOT, "build", "railcrash"))
     parser.add_argument("--base", help="a second railcrash executable, run interleaved with --executable")
+    parser.add_argument("--format", choices=["csv", "hdf5"], default="csv", help="railcrash run --format")
     args = parser.parse_args()
     work = tempfile.mkdtemp(prefix="railcrash-output-share-")
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     executables = [args.executable] + ([args.base] if args.base else [])
-    print(f"railcrash {head} ({args.executable}{'; base ' + args.base if args.base else ''}); median CPU s of "
+    print(f"railcrash {head} ({args.executable}{'; base ' + args.base if args.base else ''}); --format {args.format}; median CPU s of "
           f"{args.repeats} interleaved pairs; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}\n")
     print("| model | executable | rows | CPU s, dense output | CPU s, output at t_end | output share | per row [us] |\n"
           "|---|---|---|---|---|---|---|")
@@ -49,7 +51,7 @@ def main():
         for _ in range(args.repeats):
             for exe, interval in times:
                 cpu, _ = run_timed([exe, "run", os.path.join(ROOT, model), "--rtol", repr(rtol), "--atol", repr(atol),
-                                    "--output-interval", repr(interval), "--out", os.path.join(work, "out"), "--quiet"])
+                                    "--output-interval", repr(interval), "--out", os.path.join(work, "out"), "--format", args.format, "--quiet"])
                 times[(exe, interval)].append(cpu)
         rows = round(t_end / dense)
         for exe in executables:
