@@ -1,13 +1,17 @@
 #!/usr/bin/env python3
 """Share of a run's CPU that goes to output rows (issue 14: "output <= 10 % of a run at 1 ms output").
 
-    bench/output_share.py [--repeats 7] [--executable build/railcrash]
+    bench/output_share.py [--repeats 7] [--executable build/railcrash] [--base OTHER_RAILCRASH] [--format csv|hdf5]
 
 The two mechanisms of bench/simbody/compare.py at their models' tolerances (slider-crank
 10 s, Andrews' squeezer 0.03 s), each run twice with every file written: with dense output
 (slider-crank every 1 ms, 10,000 rows; Andrews every 10 us, 3,000 rows) and with output only
 at t_end (one row). CPU of the whole process (start-up, run, files), medians of REPEATS
 interleaved pairs. Output share = (dense - end) / dense; per row = (dense - end) / rows.
+With --base (another build, e.g. of an older commit), its runs alternate with the
+executable's (dense and end of one, then of the other, REPEATS times) and both are printed:
+an A/B comparison in one run, with the same load on both. --format hdf5: the runs write
+timeseries.h5 in place of the four CSV files (railcrash run --format).
 """
 import argparse
 import os
@@ -32,23 +36,29 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--executable", default=os.path.join(ROOT, "build", "railcrash"))
+    parser.add_argument("--base", help="a second railcrash executable, run interleaved with --executable")
+    parser.add_argument("--format", choices=["csv", "hdf5"], default="csv", help="railcrash run --format")
     args = parser.parse_args()
     work = tempfile.mkdtemp(prefix="railcrash-output-share-")
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    print(f"railcrash {head} ({args.executable}); median CPU s of {args.repeats} interleaved pairs; "
-          f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}\n")
-    print("| model | rows | CPU s, dense output | CPU s, output at t_end | output share | per row [us] |\n|---|---|---|---|---|---|")
+    executables = [args.executable] + ([args.base] if args.base else [])
+    print(f"railcrash {head} ({args.executable}{'; base ' + args.base if args.base else ''}); --format {args.format}; median CPU s of "
+          f"{args.repeats} interleaved pairs; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}\n")
+    print("| model | executable | rows | CPU s, dense output | CPU s, output at t_end | output share | per row [us] |\n"
+          "|---|---|---|---|---|---|---|")
     for model, t_end, dense, rtol, atol in CASES:
-        times = {dense: [], t_end: []}
+        times = {(exe, interval): [] for exe in executables for interval in (dense, t_end)}
         for _ in range(args.repeats):
-            for interval in times:
-                cpu, _ = run_timed([args.executable, "run", os.path.join(ROOT, model), "--rtol", repr(rtol), "--atol", repr(atol),
-                                    "--output-interval", repr(interval), "--out", os.path.join(work, "out"), "--quiet"])
-                times[interval].append(cpu)
+            for exe, interval in times:
+                cpu, _ = run_timed([exe, "run", os.path.join(ROOT, model), "--rtol", repr(rtol), "--atol", repr(atol),
+                                    "--output-interval", repr(interval), "--out", os.path.join(work, "out"), "--format", args.format, "--quiet"])
+                times[(exe, interval)].append(cpu)
         rows = round(t_end / dense)
-        with_rows, without = statistics.median(times[dense]), statistics.median(times[t_end])
-        print(f"| {model} (every {dense:g} s) | {rows} | {with_rows:.4f} | {without:.4f} | "
-              f"{100 * (with_rows - without) / with_rows:.0f} % | {1e6 * (with_rows - without) / rows:.1f} |")
+        for exe in executables:
+            with_rows, without = statistics.median(times[(exe, dense)]), statistics.median(times[(exe, t_end)])
+            label = "base" if exe == args.base else "executable"
+            print(f"| {model} (every {dense:g} s) | {label} | {rows} | {with_rows:.4f} | {without:.4f} | "
+                  f"{100 * (with_rows - without) / with_rows:.0f} % | {1e6 * (with_rows - without) / rows:.1f} |")
         sys.stdout.flush()
     return 0
 

@@ -177,20 +177,19 @@ class Recorder : public RunObserver {
   /// accelerations: an in-memory ResultWriter (no files) that filters the body accelerations
   /// as `run`'s summary does, or null.
   Recorder(const DaeSystem& system, ConvergeRun& run, ResponseTracker* responses, ResultWriter* accelerations)
-      : system_(system), run_(run), responses_(responses), accelerations_(accelerations), outputs_(system.output_names().size()) {
-    run_.peak_abs.assign(outputs_.size(), 0.0);
-    run_.peak_max.assign(outputs_.size(), -std::numeric_limits<double>::infinity());
+      : system_(system), run_(run), responses_(responses), accelerations_(accelerations) {
+    run_.peak_abs.assign(system.output_names().size(), 0.0);
+    run_.peak_max.assign(system.output_names().size(), -std::numeric_limits<double>::infinity());
   }
 
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
     const int nq = system_.body_unknowns();
     if (start_.empty()) start_.assign(y, y + nq);
     run_.times.push_back(t);
     for (int k = 0; k < nq; ++k) run_.displacements.push_back(y[k] - start_[static_cast<std::size_t>(k)]);
-    system_.outputs(y, lambda, outputs_.data());
-    track_peaks(outputs_.data());
-    if (responses_) responses_->sample(t, y, lambda, quadratures);
-    if (accelerations_) accelerations_->sample(t, y, lambda, quadratures);
+    track_peaks(outputs);
+    if (responses_) responses_->sample(t, y, lambda, quadratures, outputs);
+    if (accelerations_) accelerations_->sample(t, y, lambda, quadratures, outputs);
   }
 
   void event(const EventRecord& record, const double* y) override {
@@ -208,7 +207,7 @@ class Recorder : public RunObserver {
 
  private:
   void track_peaks(const double* outputs) {
-    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+    for (std::size_t k = 0; k < run_.peak_abs.size(); ++k) {
       run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs[k]));
       run_.peak_max[k] = std::max(run_.peak_max[k], outputs[k]);
     }
@@ -218,13 +217,12 @@ class Recorder : public RunObserver {
   ConvergeRun& run_;
   ResponseTracker* responses_;
   ResultWriter* accelerations_;
-  std::vector<double> outputs_;
   std::vector<double> start_;
 };
 
 class NullObserver : public RunObserver {
  public:
-  void sample(double, const double*, const double*, const double*) override {}
+  void sample(double, const double*, const double*, const double*, const double*) override {}
 };
 
 std::string format_number(double value) {

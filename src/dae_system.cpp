@@ -540,8 +540,18 @@ void DaeSystem::constraint_acceleration_bias(const double* q, const double* v, d
 }
 
 double DaeSystem::constraint_residual(const double* q) const {
-  std::vector<double> phi(static_cast<std::size_t>(constraint_rows()), 0.0);
-  constraints(q, phi.data(), nullptr);
+  std::vector<double> phi;
+  return constraint_residual(q, phi);
+}
+
+double DaeSystem::constraint_residual(const double* q, std::vector<double>& phi) const {
+  phi.assign(static_cast<std::size_t>(constraint_rows()), 0.0);  // a failed element's rows stay 0
+  // The values alone (Element::constraint): constraints() would also differentiate every row.
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    if (el.constraint_count() == 0 || element_failed(e)) continue;
+    el.constraint(gather_poses(el, q), phi.data() + model_.constraint_offset(e));
+  }
   double worst = 0.0;
   for (int row = 0; row < constraint_rows(); ++row) {
     const double scale = constraint_row_is_rotational(row) ? model_.length_scale() : 1.0;

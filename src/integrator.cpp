@@ -55,7 +55,9 @@ void Integrator::deliver_sample(double t) {
     throw StepFailure(msg.str());
   }
   const int nq = system_.body_unknowns();
-  observer_->sample(t, sample_y_.data(), sample_y_.data() + 2 * nq, sample_quadratures_.data());
+  const double* lambda = sample_y_.data() + 2 * nq;
+  system_.outputs(sample_y_.data(), lambda, sample_outputs_.data());
+  observer_->sample(t, sample_y_.data(), lambda, sample_quadratures_.data(), sample_outputs_.data());
   const std::string observer_failure = observer_->failure();  // a failed write: stop at once
   if (!observer_failure.empty()) {
     std::ostringstream msg;
@@ -64,7 +66,8 @@ void Integrator::deliver_sample(double t) {
     else msg << ", the files hold the samples up to t = " << t_sampled_;
     throw StepFailure(msg.str());
   }
-  outcome_.max_constraint_residual = std::max(outcome_.max_constraint_residual, system_.constraint_residual(sample_y_.data()));
+  outcome_.max_constraint_residual =
+      std::max(outcome_.max_constraint_residual, system_.constraint_residual(sample_y_.data(), constraint_scratch_));
   t_sampled_ = t;
   last_sample_y_ = sample_y_;
   last_sample_quadratures_ = sample_quadratures_;
@@ -87,6 +90,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   observer_ = &observer;
   observe_steps_ = observer.observes_steps();
   step_outputs_.assign(system_.output_names().size(), 0.0);
+  sample_outputs_.assign(system_.output_names().size(), 0.0);
   t_end_ = t_end;
   output_interval_ = output_interval;
   output_index_ = 1;

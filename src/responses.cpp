@@ -10,7 +10,7 @@
 namespace railcrash {
 
 ResponseTracker::ResponseTracker(const DaeSystem& system, const ResponseSettings& settings)
-    : system_(system), settings_(settings), outputs_(system.output_names().size()) {
+    : system_(system), settings_(settings) {
   responses_.max_crush.assign(settings.crush_gauges.size(), 0.0);
   if (settings.anticlimber.empty()) return;
   const auto& elements = system.model().elements();
@@ -42,13 +42,12 @@ double ResponseTracker::gauge_length(const CrushGauge& gauge, const double* y) c
   return std::sqrt(dot(d, d));
 }
 
-void ResponseTracker::sample(double, const double* y, const double* lambda, const double*) {
+void ResponseTracker::sample(double, const double* y, const double*, const double*, const double* outputs) {
   if (!started_) {  // lengths at the start of the run (after any settling)
     for (const CrushGauge& g : settings_.crush_gauges) initial_length_.push_back(gauge_length(g, y));
     started_ = true;
   }
-  if (vertical_force_column_ >= 0) system_.outputs(y, lambda, outputs_.data());
-  track_extrema(y, outputs_.data());
+  track_extrema(y, outputs);
 }
 
 void ResponseTracker::step(double, const double* y, const double*, const double* outputs) {

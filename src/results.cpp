@@ -200,7 +200,6 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
   vx_.assign(body_count, {});
   ax_.assign(body_count, {});
   ay_.assign(body_count, {});
-  output_values_.assign(system.output_names().size(), 0.0);
   peak_output_.assign(system.output_names().size(), 0.0);
   peak_time_.assign(system.output_names().size(), 0.0);
   acceleration_.assign(static_cast<std::size_t>(system.body_unknowns()), 0.0);
@@ -212,7 +211,7 @@ ResultWriter::~ResultWriter() {
   if (folder_descriptor_ >= 0) ::close(folder_descriptor_);
 }
 
-void ResultWriter::sample(double t, const double* y, const double* lambda, const double* quadratures) {
+void ResultWriter::sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) {
   const int n = system_.model().body_count();
   const int nq = 3 * n;
   if (timeseries_) {
@@ -223,9 +222,9 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
         timeseries_->number(y[k]);
       }
   }
-  system_.outputs(y, lambda, output_values_.data());
-  if (timeseries_) write_row_tail(*timeseries_, output_values_);
-  track_extrema(t, output_values_.data());
+  const std::size_t output_count = system_.output_names().size();
+  if (timeseries_) write_row_tail(*timeseries_, outputs, output_count);
+  track_extrema(t, outputs);
   body_accelerations(system_, t, y, lambda, acceleration_.data(), acceleration_scratch_);
   if (!system_.model().output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
@@ -236,7 +235,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     row_.assign(1, t);
     for (int i = 0; i < n; ++i)
       for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2}) row_.push_back(y[k]);
-    row_.insert(row_.end(), output_values_.begin(), output_values_.end());
+    row_.insert(row_.end(), outputs, outputs + output_count);
     if (!system_.model().output_points.empty()) row_.insert(row_.end(), point_values_.begin(), point_values_.end());
     for (std::size_t column = 0; column < columns_.size(); ++column) columns_[column].push_back(row_[column]);
     if (hdf5_) {
@@ -302,12 +301,14 @@ void ResultWriter::track_extrema(double t, const double* outputs) {
   }
 }
 
-void write_row_tail(BufferedFile& file, const std::vector<double>& values) {
-  for (const double value : values) {
+void write_row_tail(BufferedFile& file, const double* values, std::size_t count) {
+  for (std::size_t k = 0; k < count; ++k) {
     file.character(',');
-    file.number(value);
+    file.number(values[k]);
   }
 }
+
+void write_row_tail(BufferedFile& file, const std::vector<double>& values) { write_row_tail(file, values.data(), values.size()); }
 
 void ResultWriter::fail(const std::string& what, int error_number) {
   if (failure_.empty()) failure_ = what + ": " + std::strerror(error_number);

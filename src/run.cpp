@@ -35,19 +35,15 @@ double checked_positive(double value, const char* option) {
 class ProgressObserver : public RunObserver {
  public:
   ProgressObserver(const DaeSystem& system, std::vector<RunObserver*> next, double t_end, bool show)
-      : system_(system), next_(std::move(next)), meter_(t_end, ProgressMeter::style_for(show, stderr)) {
-    for (const auto& el : system.model().elements())
-      for (const std::string& output : el->output_names()) output_owner_.push_back({el.get(), output});
-    output_values_.resize(output_owner_.size());
-  }
+      : system_(system), next_(std::move(next)), meter_(t_end, ProgressMeter::style_for(show, stderr)) {}
   /// From the first sample whose element outputs are not all finite on, nothing is passed on:
   /// the files end at the last good sample. The run itself goes on, so that an integrator that
   /// is diverging says so (Euler names the joint); run_model fails it in any case.
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
     meter_.update(t);
     t_last_ = t;
-    if (!non_finite_output_.empty() || !outputs_finite(t, y, lambda)) return;
-    for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures);
+    if (!non_finite_output_.empty() || !outputs_finite(t, outputs)) return;
+    for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures, outputs);
     t_passed_on_ = t;
   }
   /// Why the outputs were not all finite ("" when they were).
@@ -75,27 +71,33 @@ class ProgressObserver : public RunObserver {
   void finish() { meter_.finish(t_last_); }
 
  private:
-  /// Element outputs at the sample; the first non-finite one is recorded in non_finite_output_.
-  bool outputs_finite(double t, const double* y, const double* lambda) {
-    system_.outputs(y, lambda, output_values_.data());
-    for (std::size_t k = 0; k < output_values_.size(); ++k)
-      if (!std::isfinite(output_values_[k])) {
-        const Element& el = *output_owner_[k].first;
+  /// Whether the element outputs at the sample are all finite; the first non-finite one is
+  /// recorded in non_finite_output_ (its element found only then).
+  bool outputs_finite(double t, const double* outputs) {
+    const auto& names = system_.output_names();
+    const auto bad = std::find_if(outputs, outputs + names.size(), [](double value) { return !std::isfinite(value); });
+    if (bad == outputs + names.size()) return true;
+    const std::size_t column = static_cast<std::size_t>(bad - outputs);
+    std::size_t first_of_element = 0;  // column of the element's first output
+    for (const auto& el : system_.model().elements()) {
+      const std::vector<std::string> own = el->output_names();
+      if (column < first_of_element + own.size()) {
         std::ostringstream msg;
-        msg << el.where().prefix() << "element '" << el.name() << "' (" << el.type() << "): its output '"
-            << output_owner_[k].second << "' is " << output_values_[k] << " at t = " << t
+        msg << el->where().prefix() << "element '" << el->name() << "' (" << el->type() << "): its output '"
+            << own[column - first_of_element] << "' is " << *bad << " at t = " << t
             << "; check the element's numbers (a value too large or too small)";
         non_finite_output_ = msg.str();
         return false;
       }
-    return true;
+      first_of_element += own.size();
+    }
+    RAILCRASH_DEMAND(false);  // every output column belongs to an element
+    return false;
   }
 
   const DaeSystem& system_;
   std::vector<RunObserver*> next_;
   ProgressMeter meter_;
-  std::vector<std::pair<const Element*, std::string>> output_owner_;  // element and output of each value
-  std::vector<double> output_values_;
   std::string non_finite_output_;
   double t_last_ = 0.0;
   double t_passed_on_ = -1.0;

@@ -65,7 +65,7 @@ RunOutcome simulate(const Model& model, double output_interval) {
 RunOutcome simulate(DaeSystem& system, double output_interval) {
   const Model& model = system.model();
   struct Quiet : RunObserver {
-    void sample(double, const double*, const double*, const double*) override {}
+    void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
   RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval, observer);
   INFO(outcome.message);

@@ -30,30 +30,28 @@ struct Trace {
 class TraceObserver : public RunObserver {
  public:
   TraceObserver(const DaeSystem& system, const std::string& column, Trace& trace)
-      : system_(system), outputs_(system.output_names().size()), trace_(trace) {
+      : system_(system), trace_(trace) {
     const auto& names = system.output_names();
     index_ = static_cast<std::size_t>(std::find(names.begin(), names.end(), column) - names.begin());
   }
-  void sample(double t, const double* y, const double* lambda, const double*) override {
+  void sample(double t, const double* y, const double*, const double*, const double* outputs) override {
     trace_.times.push_back(t);
     trace_.x.push_back(y[0]);
     trace_.y.push_back(y[1]);
-    system_.outputs(y, lambda, outputs_.data());
-    if (index_ < outputs_.size()) {
-      trace_.values.push_back(outputs_[index_]);
-      trace_.peak = std::max(trace_.peak, outputs_[index_]);
+    if (index_ < system_.output_names().size()) {
+      trace_.values.push_back(outputs[index_]);
+      trace_.peak = std::max(trace_.peak, outputs[index_]);
     }
   }
   // The peak from every accepted step and both sides of every event as well (as `run` and
   // the study take it), so it does not depend on the output interval.
   void step(double, const double*, const double*, const double* outputs) override {
-    if (index_ < outputs_.size()) trace_.peak = std::max(trace_.peak, outputs[index_]);
+    if (index_ < system_.output_names().size()) trace_.peak = std::max(trace_.peak, outputs[index_]);
   }
   bool observes_steps() const override { return true; }
 
  private:
   const DaeSystem& system_;
-  std::vector<double> outputs_;
   Trace& trace_;
   std::size_t index_;
 };

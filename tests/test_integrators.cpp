@@ -31,13 +31,26 @@ std::string oscillator(double k, double c, double t_end, const std::string& extr
 
 struct CountingObserver : RunObserver {
   std::vector<double> times;
-  void sample(double t, const double*, const double*, const double*) override { times.push_back(t); }
+  void sample(double t, const double*, const double*, const double*, const double*) override { times.push_back(t); }
+};
+
+/// Checks the element outputs handed to sample() against the oscillator's sample state: spring
+/// force and deformation, damper rate (the mass moves along x, away from the origin).
+struct OscillatorOutputCheck : RunObserver {
+  int samples = 0;
+  void sample(double, const double* y, const double*, const double*, const double* outputs) override {
+    ++samples;
+    const double x = y[0], vx = y[3];             // [m], [m/s]
+    CHECK(outputs[0] == Approx(200.0 * (x - 1.0)).margin(1e-12));  // spring.force [N]
+    CHECK(outputs[1] == Approx(x - 1.0).margin(1e-14));            // spring.deformation [m]
+    CHECK(outputs[3] == Approx(vx).margin(1e-14));                 // damper.rate [m/s]
+  }
 };
 
 struct StopAfter : RunObserver {
   std::atomic<bool>* stop;
   int samples = 0;
-  void sample(double, const double*, const double*, const double*) override {
+  void sample(double, const double*, const double*, const double*, const double*) override {
     if (++samples == 3) stop->store(true);
   }
 };
@@ -116,6 +129,18 @@ TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "
   }
 }
 
+TEST_CASE("every sample hands the observer the element outputs of that sample's state", "[integrators]") {
+  for (const char* integrator : {"ida", "euler"}) {
+    Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    DaeSystem system(model);
+    REQUIRE(system.output_names() == std::vector<std::string>{"spring.force", "spring.deformation", "damper.force", "damper.rate"});
+    auto run = make_integrator(system, model.simulation);
+    OscillatorOutputCheck observer;
+    REQUIRE(run->run(1.0, 0.05, observer).ok);
+    CHECK(observer.samples == 21);
+  }
+}
+
 TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
     Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
@@ -174,7 +199,11 @@ TEST_CASE("a run whose element output is not finite fails naming the element", "
   // while the contact stays open (no force, so the motion itself stays finite).
   const Model model = testing::model_from_text(
       "railcrash: 1\nname: far\nunits: SI\ngravity: [0, 0]\nbodies:\n"
-      "  - {name: ball, mass: 2, inertia: 0.1, position: [1.0e308, 0], velocity: [1, 0]}\nelements:\n"
+      "  - {name: ball, mass: 2, inertia: 0.1, position: [1.0e308, 0], velocity: [1, 0]}\n"
+      "  - {name: anchor, mass: 1, inertia: 0.1, position: [2, 0]}\nelements:\n"
+      // an element with finite outputs before the contact: the bad column is not the first
+      "  - {name: tether, type: linear_spring, stiffness: 10, free_length: 2, "
+      "points: [{body: ground, at: [0, 0]}, {body: anchor, at: [0, 0]}]}\n"
       "  - {name: bump, type: contact, circle_center: [-1.7e308, 0], circle_radius: 1, stiffness: 1.0e6, "
       "points: [{body: ball, at: [0, 0]}]}\nsimulation: {t_end: 0.1, output_interval: 0.01}\n");
   const RunReport report = run_model(model, "", nullptr, false);

@@ -93,7 +93,7 @@ TEST_CASE("final two-car model, corrected variant: settled and without its impac
     std::vector<double> start;
     double largest_move = 0.0, largest_speed = 0.0;  // [in], [in/s]
     int nq = 0;
-    void sample(double, const double* y, const double*, const double*) override {
+    void sample(double, const double* y, const double*, const double*, const double*) override {
       if (start.empty()) start.assign(y, y + nq);
       for (int k = 0; k < nq; k += 3)
         for (int c = 0; c < 2; ++c) {

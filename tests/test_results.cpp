@@ -61,8 +61,8 @@ struct FolderRemover : RunObserver {
   int look_at, remove_at;
   int samples = 0;
   std::string summary_mid_run;
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override {
-    writer->sample(t, y, lambda, quadratures);
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
+    writer->sample(t, y, lambda, quadratures, outputs);
     if (++samples == look_at) summary_mid_run = file_text(folder + "/summary.json");
     if (samples == remove_at) std::filesystem::remove_all(folder);
   }

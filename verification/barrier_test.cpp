@@ -44,12 +44,10 @@ struct BarrierRun {
 class BarrierRecorder : public RunObserver {
  public:
   BarrierRecorder(const DaeSystem& system, BarrierRun& run) : system_(system), run_(run) {}
-  void sample(double t, const double* y, const double* lambda, const double*) override {
+  void sample(double t, const double* y, const double*, const double*, const double* outputs) override {
     run_.t.push_back(t);
     run_.y.emplace_back(y, y + system_.size());
-    std::vector<double> out(system_.output_names().size());
-    system_.outputs(y, lambda, out.data());
-    run_.outputs.push_back(std::move(out));
+    run_.outputs.emplace_back(outputs, outputs + system_.output_names().size());
   }
 
  private:

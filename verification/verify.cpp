@@ -36,7 +36,7 @@ struct Trajectory {
 class Recorder : public RunObserver {
  public:
   explicit Recorder(Trajectory& trajectory) : trajectory_(trajectory) {}
-  void sample(double t, const double* y, const double*, const double*) override {
+  void sample(double t, const double* y, const double*, const double*, const double*) override {
     trajectory_.t.push_back(t);
     trajectory_.y.emplace_back(y, y + size);
   }

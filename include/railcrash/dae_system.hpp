@@ -116,6 +116,8 @@ class DaeSystem {
   void constraint_acceleration_bias(const double* q, const double* v, double* gamma) const;
   /// Largest |Phi| over rows (lengths and angles*length_scale mixed: a quality figure).
   double constraint_residual(const double* q) const;
+  /// The same with phi as work space (no allocation per call: the run's every output sample).
+  double constraint_residual(const double* q, std::vector<double>& phi) const;
   /// Element owning constraint row `row`.
   const Element& constraint_owner(int row) const;
   /// Unknown k of y in the model's terms, with file:line: "model.yaml:7: body 'cab' vx",
@@ -148,6 +150,8 @@ class DaeSystem {
   static constexpr int kFirstElementWork = 3;
 
   double kinetic_energy(const double* v) const;
+  /// Potential of gravity, -sum m g . r [force*length].
+  double gravity_potential(const double* q) const;
   EnergyState energy(const double* y, const double* quadratures, const PenaltyRows* penalty = nullptr) const;
 
   // ---- modes and events ----
@@ -212,7 +216,6 @@ class DaeSystem {
  private:
   template <class Sink>
   void assemble_jacobian(double t, double cj, const double* y, const double* yp, Sink& sink) const;
-  double gravity_potential(const double* q) const;
   /// Element e's local state at (q, v), with its mode; its slots' rotations come from
   /// body_rotation().
   ElementState<double> local_state(std::size_t e, const double* q, const double* v) const;

@@ -33,8 +33,10 @@ struct RunStatistics {
 class RunObserver {
  public:
   virtual ~RunObserver() = default;
-  /// lambda: constraint multipliers (ida) or penalty forces (euler); quadratures as in DaeSystem.
-  virtual void sample(double t, const double* y, const double* lambda, const double* quadratures) = 0;
+  /// lambda: constraint multipliers (ida) or penalty forces (euler); quadratures as in DaeSystem;
+  /// outputs: the element outputs at the sample (DaeSystem::outputs), evaluated once for all
+  /// observers.
+  virtual void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) = 0;
   /// A committed mode change (contact, yield, rupture, ...); y is the state at that instant.
   virtual void event(const EventRecord& /*record*/, const double* /*y*/) {}
   /// The state at the end of every accepted step and on both sides of every committed mode
@@ -156,6 +158,8 @@ class Integrator {
   long output_index_ = 1;       // next output time: output_index_ * output_interval_
   double t_sampled_ = 0.0;      // last sample
   std::vector<double> sample_y_, sample_quadratures_;
+  std::vector<double> sample_outputs_;      // element outputs at the sample
+  std::vector<double> constraint_scratch_;  // work space of the per-sample constraint residual
   std::vector<double> last_sample_y_, last_sample_quadratures_;
   bool observe_steps_ = false;       // the observer wants step()
   std::vector<double> step_outputs_;  // element outputs at the last step

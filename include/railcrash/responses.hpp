@@ -44,7 +44,7 @@ struct Responses {
 class ResponseTracker : public RunObserver {
  public:
   ResponseTracker(const DaeSystem& system, const ResponseSettings& settings);
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override;
   void event(const EventRecord& record, const double* y) override;
   /// The largest crush and forces from every accepted step and both sides of every event.
   void step(double t, const double* y, const double* lambda, const double* outputs) override;
@@ -64,7 +64,6 @@ class ResponseTracker : public RunObserver {
   int vertical_force_column_ = -1; // index into DaeSystem::outputs
   int horizontal_deformation_column_ = -1;
   std::vector<double> initial_length_;
-  std::vector<double> outputs_;
   Responses responses_;
   bool started_ = false;
   bool vertical_window_closed_ = false;  // R2's window (ResponseSettings::vertical_force_window) has ended

@@ -101,6 +101,7 @@ class EnergyWriter;
 class BufferedFile;
 
 /// Writes ",value" for every value (as "%.12g") to a CSV row.
+void write_row_tail(BufferedFile& file, const double* values, std::size_t count);
 void write_row_tail(BufferedFile& file, const std::vector<double>& values);
 
 class ResultWriter : public RunObserver {
@@ -113,7 +114,7 @@ class ResultWriter : public RunObserver {
   ResultWriter(const ResultWriter&) = delete;
   ResultWriter& operator=(const ResultWriter&) = delete;
 
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override;
   void event(const EventRecord& record, const double* y) override;
   /// Element output peaks and car crush from every accepted step and both sides of every event.
   void step(double t, const double* y, const double* lambda, const double* outputs) override;
@@ -150,7 +151,6 @@ class ResultWriter : public RunObserver {
   std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
   int folder_descriptor_ = -1;                          // the open folder, to notice its removal
   std::vector<std::vector<double>> columns_;  // in memory, per timeseries column
-  std::vector<double> output_values_;
   std::vector<double> peak_output_;  // largest |value| of each element output
   std::vector<double> peak_time_;
   std::vector<double> acceleration_;  // 3 per body at the last sample

@@ -220,7 +220,7 @@ double largest_lift(const std::vector<double>& penetration) {
 }
 
 ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria& criteria)
-    : system_(system), criteria_(criteria), outputs_(system.output_names().size()) {
+    : system_(system), criteria_(criteria) {
   const Model& model = system.model();
   for (const std::string& b : criteria.passenger_bodies) passenger_index_.push_back(*model.find_body(b));
   for (const auto& g : criteria.survival_gauges) {
@@ -288,21 +288,20 @@ void ScenarioTracker::step(double, const double* y, const double*, const double*
     step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
 }
 
-void ScenarioTracker::sample(double t, const double* y, const double* lambda, const double*) {
+void ScenarioTracker::sample(double t, const double* y, const double*, const double*, const double* outputs) {
   times_.push_back(t);
   const double* velocities = y + system_.body_unknowns();
   for (std::size_t k = 0; k < passenger_index_.size(); ++k) vx_[k].push_back(velocities[3 * passenger_index_[k]]);
   for (std::size_t k = 0; k < front_index_.size(); ++k) lengths_[k].push_back(distance(y, front_index_[k], rear_index_[k]));
-  system_.outputs(y, lambda, outputs_.data());
-  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) car_crush_[k].push_back(car_crush_now(k, outputs_.data()));
+  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) car_crush_[k].push_back(car_crush_now(k, outputs));
   if (vertical_offset_column_ >= 0) {
-    vertical_offset_.push_back(outputs_[static_cast<std::size_t>(vertical_offset_column_)]);
-    overridden_ = overridden_ || outputs_[static_cast<std::size_t>(override_column_)] > 0.0;
+    vertical_offset_.push_back(outputs[vertical_offset_column_]);
+    overridden_ = overridden_ || outputs[override_column_] > 0.0;
   } else if (interface_upper_ >= 0) {
     vertical_offset_.push_back(y[3 * interface_upper_ + 1] - y[3 * interface_lower_ + 1]);
   }
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
-    penetration_[k].push_back(outputs_[static_cast<std::size_t>(wheel_columns_[k])]);
+    penetration_[k].push_back(outputs[wheel_columns_[k]]);
 }
 
 std::vector<CriterionResult> ScenarioTracker::results() const {

@@ -106,7 +106,7 @@ Anticlimber& anticlimber_of(const Model& model) { return dynamic_cast<Anticlimbe
 struct Samples : RunObserver {
   std::vector<double> t;
   std::vector<std::vector<double>> y;
-  void sample(double time, const double* state, const double*, const double*) override {
+  void sample(double time, const double* state, const double*, const double*, const double*) override {
     t.push_back(time);
     y.emplace_back(state, state + size);
   }

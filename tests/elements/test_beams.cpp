@@ -146,7 +146,7 @@ struct Run {
 
 class Quiet : public RunObserver {
  public:
-  void sample(double, const double*, const double*, const double*) override {}
+  void sample(double, const double*, const double*, const double*, const double*) override {}
 };
 
 Run simulate(const std::string& yaml) {

@@ -119,7 +119,7 @@ struct Run {
 Run run(DaeSystem& system) {
   const Model& model = system.model();
   struct Null : RunObserver {
-    void sample(double, const double*, const double*, const double*) override {}
+    void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
   Run r;
   r.outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, model.simulation.t_end / 4.0, observer);

@@ -182,7 +182,7 @@ TEST_CASE("Euler: a second run of one integrator starts from the same modes and 
   DaeSystem system(model);
   const std::unique_ptr<Integrator> euler = make_integrator(system, model.simulation);
   struct Quiet : RunObserver {
-    void sample(double, const double*, const double*, const double*) override {}
+    void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
   const RunOutcome first = euler->run(model.simulation.t_end, 0.01, observer);
   const RunOutcome second = euler->run(model.simulation.t_end, 0.01, observer);

@@ -78,7 +78,7 @@ std::string euler(double t_end, double dt) {
 }
 
 struct Quiet : RunObserver {
-  void sample(double, const double*, const double*, const double*) override {}
+  void sample(double, const double*, const double*, const double*, const double*) override {}
 };
 
 RunOutcome run(const std::string& yaml) {

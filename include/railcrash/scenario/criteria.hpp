@@ -120,7 +120,7 @@ double largest_lift(const std::vector<double>& penetration);
 class ScenarioTracker : public RunObserver {
  public:
   ScenarioTracker(const DaeSystem& system, const ScenarioCriteria& criteria);
-  void sample(double t, const double* y, const double* lambda, const double* quadratures) override;
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override;
   /// The extrema of the crush, gauge, interface and wheel criteria also from every accepted
   /// step and both sides of every event (the mean deceleration stays on the output rows: it
   /// filters a uniform record).
@@ -142,7 +142,7 @@ class ScenarioTracker : public RunObserver {
   int vertical_offset_column_ = -1, override_column_ = -1;
   int interface_lower_ = -1, interface_upper_ = -1;  // bodies of interface_bodies
   std::vector<int> wheel_columns_;
-  std::vector<double> outputs_, times_;
+  std::vector<double> times_;
   std::vector<std::vector<double>> vx_, lengths_, penetration_, car_crush_;
   std::vector<double> vertical_offset_;
   bool overridden_ = false;
