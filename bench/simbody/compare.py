@@ -2,6 +2,7 @@
 """railcrash against Simbody 3.7 on the slider-crank and Andrews' squeezer, at equal accuracy, output included.
 
     bench/simbody/compare.py [--repeats 3] [--targets 1e-4,1e-6] [--mechanisms slider_crank,andrews_squeezer]
+                             [--executable build/railcrash]
 
 The mechanisms are verification/cases/slider_crank.yaml (10 s) and
 verification/cases/andrews_squeezer.yaml (0.03 s); their Simbody twins are in
@@ -41,6 +42,7 @@ MECHANISMS = {
     "andrews_squeezer": (os.path.join(ROOT, "verification", "cases", "andrews_squeezer.yaml"), 0.03, 1e-3, 1e-5,
                          ["crank.theta", "rod.theta", "lever.theta"], ["crank.theta", "rod.theta", "lever.theta"], 1e-3),
 }
+RAILCRASH = [os.path.join(ROOT, "build", "railcrash")]  # --executable
 LEVELS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
 
 
@@ -67,7 +69,7 @@ def on_grid(rows, time_key, columns, grid):
 def railcrash_run(mechanism, level, interval, work):
     model, _, grid, _, columns, _, atol_ratio = MECHANISMS[mechanism]
     out = os.path.join(work, "railcrash")
-    cpu, _ = run_timed([os.path.join(ROOT, "build", "railcrash"), "run", model, "--rtol", repr(level), "--atol",
+    cpu, _ = run_timed([RAILCRASH[0], "run", model, "--rtol", repr(level), "--atol",
                         repr(level * atol_ratio), "--output-interval", repr(interval), "--out", out, "--quiet"])
     with open(os.path.join(out, "timeseries.csv")) as f:
         return cpu, on_grid(csv.DictReader(f), "t", columns, grid)
@@ -138,12 +140,14 @@ def main():
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--targets", default="1e-4,1e-6")
     parser.add_argument("--mechanisms", default=",".join(MECHANISMS))
+    parser.add_argument("--executable", default=RAILCRASH[0], help="the railcrash to run (another build's, say)")
     args = parser.parse_args()
+    RAILCRASH[0] = os.path.abspath(args.executable)
     targets = [float(x) for x in args.targets.split(",")]
     executable = harness()
     work = tempfile.mkdtemp(prefix="railcrash-simbody-")
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    print(f"railcrash {head} against Simbody 3.7 (Runge-Kutta-Merson); median CPU s of {args.repeats} interleaved runs "
+    print(f"railcrash {head} ({RAILCRASH[0]}) against Simbody 3.7 (Runge-Kutta-Merson); median CPU s of {args.repeats} interleaved runs "
           f"per setting, output included; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     for mechanism in args.mechanisms.split(","):
         compare(mechanism, executable, args, targets, work)
