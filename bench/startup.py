@@ -7,8 +7,8 @@ Runs `railcrash --version` and the slider-crank at its own 0.4 s output (the cas
 start-up dominates the Simbody comparison, bench/simbody/compare.py: rtol 1e-6 and 1e-8, atol
 a tenth of rtol), alternately with the base and this executable (the order swapped every
 repeat), and prints per case the median CPU time of the process (user + system) and the
-median wall time, both in ms, and the number of shared libraries each executable loads
-(`ldd`). Build the base once, e.g. `git archive 2f93f14 | tar -x -C /tmp/startup-base/src`,
+median wall time, both in ms, the number of shared libraries each executable loads (`ldd`)
+and, for scale, the cost of a process that does nothing (/bin/true). Build the base once, e.g. `git archive 2f93f14 | tar -x -C /tmp/startup-base/src`,
 configure /tmp/startup-base/build from it (Release) and build its target railcrash.
 """
 import argparse
@@ -56,7 +56,10 @@ def main():
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     print(f"railcrash start-up: {args.executable} (HEAD {head}) against {args.base}; medians of {args.repeats} "
           f"interleaved runs; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
-    print(f"shared libraries loaded (ldd): base {libraries(args.base)}, this {libraries(args.executable)}\n")
+    print(f"shared libraries loaded (ldd): base {libraries(args.base)}, this {libraries(args.executable)}")
+    floor = [timed("/bin/true", []) for _ in range(args.repeats)]
+    print(f"a process that does nothing (/bin/true, libc only): median CPU {statistics.median(s[0] for s in floor):.1f} ms, "
+          f"wall {statistics.median(s[1] for s in floor):.1f} ms\n")
     print("| case | base CPU ms | this CPU ms | this/base CPU | base wall ms | this wall ms | this/base wall |")
     print("|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory(prefix="railcrash-startup-") as work:
