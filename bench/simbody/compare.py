@@ -10,7 +10,7 @@ bench/simbody/mechanisms.cpp (built here into build/bench-simbody when missing; 
 libsimbody-dev: scripts/install-deps.sh --bench). Each tool runs a ladder of tolerances
 (railcrash IDA: --rtol R --atol R times the model file's atol/rtol; Simbody Runge-Kutta-Merson: accuracy A), whole
 processes timed by their CPU time (set-up, integration and the CSV output), medians of
-REPEATS interleaved runs.
+REPEATS interleaved runs (each repeat runs every level of both tools in turn).
 
 Error measure: the largest difference over the model's own output times (slider-crank:
 every 0.4 s, crank angle [rad] and slider position [m], both of order 1; Andrews: every
@@ -109,17 +109,18 @@ def compare(mechanism, executable, args, targets, work):
     print(f"reference: Simbody at accuracy 1e-12; railcrash at rtol 1e-10 differs from it by "
           f"{error(railcrash_tight, reference):.1e}")
     for interval in (grid, dense):
-        results = {"railcrash": {}, "simbody": {}}
-        for level in LEVELS:
-            times = {"railcrash": [], "simbody": []}
-            samples = {}
-            for _ in range(args.repeats):
-                cpu, samples["railcrash"] = railcrash_run(mechanism, level, interval, work)
-                times["railcrash"].append(cpu)
-                cpu, samples["simbody"] = simbody_run(executable, mechanism, level, interval, work)
-                times["simbody"].append(cpu)
-            for tool in results:
-                results[tool][level] = (statistics.median(times[tool]), error(samples[tool], reference))
+        # Every repeat runs every level of both tools, so that the settings a target pairs (two
+        # different levels) are timed over the same stretch of the machine's load.
+        times = {tool: {level: [] for level in LEVELS} for tool in ("railcrash", "simbody")}
+        samples = {tool: {} for tool in times}
+        for _ in range(args.repeats):
+            for level in LEVELS:
+                cpu, samples["railcrash"][level] = railcrash_run(mechanism, level, interval, work)
+                times["railcrash"][level].append(cpu)
+                cpu, samples["simbody"][level] = simbody_run(executable, mechanism, level, interval, work)
+                times["simbody"][level].append(cpu)
+        results = {tool: {level: (statistics.median(times[tool][level]), error(samples[tool][level], reference))
+                          for level in LEVELS} for tool in times}
         print(f"\noutput every {interval} s ({round(t_end / interval)} rows)\n")
         print("| tolerance | railcrash CPU s | railcrash error | Simbody CPU s | Simbody error |\n|---|---|---|---|---|")
         for level in LEVELS:
