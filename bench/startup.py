@@ -2,13 +2,15 @@
 """Start-up of the railcrash process: this build against a base build, interleaved (issue 14).
 
     bench/startup.py --base BASE_EXECUTABLE [--executable build/railcrash] [--repeats 21]
+                     [--base-python BASE/python [--python build/python]]
 
 Runs `railcrash --version` and the slider-crank at its own 0.4 s output (the case where
 start-up dominates the Simbody comparison, bench/simbody/compare.py: rtol 1e-6 and 1e-8, atol
 a tenth of rtol), alternately with the base and this executable (the order swapped every
 repeat), and prints per case the median CPU time of the process (user + system) and the
 median wall time, both in ms, the number of shared libraries each executable loads (`ldd`)
-and, for scale, the cost of a process that does nothing (/bin/true). Build the base once, e.g. `git archive 2f93f14 | tar -x -C /tmp/startup-base/src`,
+and, for scale, the cost of a process that does nothing (/bin/true). With --base-python, also
+`python3 -c "import railcrash"` with either build's module. Build the base once, e.g. `git archive 2f93f14 | tar -x -C /tmp/startup-base/src`,
 configure /tmp/startup-base/build from it (Release) and build its target railcrash.
 """
 import argparse
@@ -51,6 +53,8 @@ def main():
     parser.add_argument("--base", required=True, help="the base build's railcrash executable")
     parser.add_argument("--executable", default=os.path.join(ROOT, "build", "railcrash"))
     parser.add_argument("--repeats", type=int, default=21)
+    parser.add_argument("--base-python", help="the base build's python folder (BASE/python): also time `import railcrash`")
+    parser.add_argument("--python", default=os.path.join(ROOT, "build", "python"), help="this build's python folder")
     args = parser.parse_args()
     tools = {"base": args.base, "this": args.executable}
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
@@ -73,6 +77,17 @@ def main():
             print(f"| {name} | {cpu['base']:.1f} | {cpu['this']:.1f} | **{cpu['this'] / cpu['base']:.2f}** | "
                   f"{wall['base']:.1f} | {wall['this']:.1f} | {wall['this'] / wall['base']:.2f} |")
             sys.stdout.flush()
+    if args.base_python:  # `import railcrash`: the module links the library and its dependencies
+        folders = {"base": args.base_python, "this": args.python}
+        samples = {tool: [] for tool in folders}
+        for repeat in range(args.repeats):
+            for tool in (("base", "this") if repeat % 2 == 0 else ("this", "base")):
+                os.environ["PYTHONPATH"] = folders[tool]
+                samples[tool].append(timed("/usr/bin/python3", ["-c", "import railcrash"]))
+        cpu = {tool: statistics.median(s[0] for s in samples[tool]) for tool in folders}
+        wall = {tool: statistics.median(s[1] for s in samples[tool]) for tool in folders}
+        print(f"| python3 -c 'import railcrash' | {cpu['base']:.1f} | {cpu['this']:.1f} | **{cpu['this'] / cpu['base']:.2f}** | "
+              f"{wall['base']:.1f} | {wall['this']:.1f} | {wall['this'] / wall['base']:.2f} |")
     return 0
 
 
