@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|readings|python|sweep|formats|all] [extra options]
+#   bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -23,6 +23,8 @@ case $what in
   simbody) /usr/bin/python3 bench/simbody/compare.py "$@" ;;
   # Share of a run's CPU that goes to output rows (slider-crank at 1 ms, Andrews at 10 us output)
   outcost) /usr/bin/python3 bench/output_share.py "$@" ;;
+  # Start-up (--version, the slider-crank at 0.4 s output) against a base build: bench/run.sh startup --base BASE/railcrash
+  startup) /usr/bin/python3 bench/startup.py "$@" ;;
   python) PYTHONPATH=build/python /usr/bin/python3 bench/python_overhead.py "$@" ;;
   sweep) /usr/bin/python3 bench/sweep_bench.py "$@" ;;   # runs/s of `railcrash sweep`, 1 and 2 jobs, 2 MPI ranks
   formats) /usr/bin/python3 bench/output_format.py build/railcrash "$commit" "$@" ;;  # CPU and bytes, --format csv vs hdf5
@@ -45,5 +47,5 @@ case $what in
     $bench --commit "$commit" sensitivity
     build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
         --out bench/converge_final_two_car_0.5s ;;
-  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
+  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|startup|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
 esac

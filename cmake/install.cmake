@@ -1,7 +1,7 @@
 # `cmake --install build --prefix P` and `cpack` (run from build/): the command-line program,
 # the shared and static libraries with the public headers, and the CMake package that
 # find_package(railcrash) reads:
-#   P/bin/railcrash
+#   P/bin/railcrash (and railcrash-mpi, the MPI build it runs for a sweep under mpirun)
 #   P/lib/librailcrash.so.0.1, librailcrash.a
 #   P/include/railcrash/api.hpp, error.hpp
 #   P/lib/cmake/railcrash/railcrashConfig.cmake (targets railcrash::railcrash, railcrash::railcrash_static)
@@ -12,6 +12,9 @@ include(CMakePackageConfigHelpers)
 set(RAILCRASH_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/railcrash)
 
 install(TARGETS railcrash RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+if(TARGET railcrash_mpi)  # beside railcrash, which execs it for a sweep under mpirun
+  install(TARGETS railcrash_mpi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+endif()
 install(TARGETS railcrash_shared EXPORT railcrashTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT development)
 install(TARGETS railcrash_core EXPORT railcrashTargets
@@ -53,8 +56,8 @@ set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
 # sunlinsolklu target (libsuitesparse-dev).
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS
   "railcrash (= ${PROJECT_VERSION}), libsundials-dev (>= 6), libsuitesparse-dev, libyaml-cpp-dev, libeigen3-dev (>= 3.3), cmake (>= 3.18)")
-if(RAILCRASH_HDF5)  # the static library links the serial libhdf5.so by its path
-  string(APPEND CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS ", libhdf5-dev")
+if(RAILCRASH_HDF5)  # loaded by its soname for --format hdf5 (src/results/hdf5_library.cpp), so shlibdeps does not see it
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "libhdf5-103-1")
 endif()
 set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy")
 set(CPACK_COMPONENT_RUNTIME_DESCRIPTION "railcrash command-line program and shared library")

@@ -26,15 +26,18 @@
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
 #include "railcrash/sweep.hpp"
-#ifdef RAILCRASH_MPI
 #include "railcrash/sweep_mpi.hpp"
-#endif
 #include "railcrash/converge.hpp"
 #include "railcrash/report/report.hpp"
 #include "railcrash/version.hpp"
 
 #include <sstream>
 #include <thread>
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 namespace {
 
@@ -47,6 +50,21 @@ void catch_interrupts() {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
 }
+
+#ifdef RAILCRASH_MPI_PROGRAM
+/// `railcrash sweep` started by mpirun or srun: the same command line, run by the MPI build
+/// installed beside this executable (CMakeLists.txt: railcrash links no MPI, so that its other
+/// commands start without loading it). Returns only when that program cannot be started.
+[[noreturn]] void exec_mpi_program(char** argv) {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  const std::filesystem::path program = self.parent_path() / RAILCRASH_MPI_PROGRAM;
+  execv(program.c_str(), argv);
+  throw railcrash::InputError("sweep under an MPI launcher: cannot start " + program.string() + " (" + std::strerror(errno) +
+                              "), the MPI build of railcrash that is built and installed beside it when MPI is found; "
+                              "build and install railcrash again, or run the sweep without mpirun (--jobs)");
+}
+#endif
 
 int check_command(const std::string& path, const std::vector<std::string>& settings) {
   using namespace railcrash;
@@ -614,6 +632,9 @@ int main(int argc, char** argv) {
       converge_options.settings = settings;
       return converge_command(model_path, converge_options, converge_out);
     }
+#ifdef RAILCRASH_MPI_PROGRAM
+    if (*sweep && railcrash::launched_by_mpi()) exec_mpi_program(argv);
+#endif
     if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, out_dir);
     if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, out_dir);
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, out_dir);

@@ -139,12 +139,6 @@ void work(const SweepPlan& plan, const std::string& model_path, const std::strin
 
 }  // namespace
 
-bool launched_by_mpi() {
-  for (const char* variable : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"})
-    if (std::getenv(variable)) return true;
-  return false;
-}
-
 int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, const std::string& directory,
                    const SweepOptions& options) {
   int provided = 0;

@@ -2,6 +2,7 @@
 """railcrash against Simbody 3.7 on the slider-crank and Andrews' squeezer, at equal accuracy, output included.
 
     bench/simbody/compare.py [--repeats 3] [--targets 1e-4,1e-6] [--mechanisms slider_crank,andrews_squeezer]
+                             [--executable build/railcrash]
 
 The mechanisms are verification/cases/slider_crank.yaml (10 s) and
 verification/cases/andrews_squeezer.yaml (0.03 s); their Simbody twins are in
@@ -9,7 +10,7 @@ bench/simbody/mechanisms.cpp (built here into build/bench-simbody when missing; 
 libsimbody-dev: scripts/install-deps.sh --bench). Each tool runs a ladder of tolerances
 (railcrash IDA: --rtol R --atol R times the model file's atol/rtol; Simbody Runge-Kutta-Merson: accuracy A), whole
 processes timed by their CPU time (set-up, integration and the CSV output), medians of
-REPEATS interleaved runs.
+REPEATS interleaved runs (each repeat runs every level of both tools in turn).
 
 Error measure: the largest difference over the model's own output times (slider-crank:
 every 0.4 s, crank angle [rad] and slider position [m], both of order 1; Andrews: every
@@ -41,6 +42,7 @@ MECHANISMS = {
     "andrews_squeezer": (os.path.join(ROOT, "verification", "cases", "andrews_squeezer.yaml"), 0.03, 1e-3, 1e-5,
                          ["crank.theta", "rod.theta", "lever.theta"], ["crank.theta", "rod.theta", "lever.theta"], 1e-3),
 }
+RAILCRASH = [os.path.join(ROOT, "build", "railcrash")]  # --executable
 LEVELS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
 
 
@@ -67,7 +69,7 @@ def on_grid(rows, time_key, columns, grid):
 def railcrash_run(mechanism, level, interval, work):
     model, _, grid, _, columns, _, atol_ratio = MECHANISMS[mechanism]
     out = os.path.join(work, "railcrash")
-    cpu, _ = run_timed([os.path.join(ROOT, "build", "railcrash"), "run", model, "--rtol", repr(level), "--atol",
+    cpu, _ = run_timed([RAILCRASH[0], "run", model, "--rtol", repr(level), "--atol",
                         repr(level * atol_ratio), "--output-interval", repr(interval), "--out", out, "--quiet"])
     with open(os.path.join(out, "timeseries.csv")) as f:
         return cpu, on_grid(csv.DictReader(f), "t", columns, grid)
@@ -107,17 +109,18 @@ def compare(mechanism, executable, args, targets, work):
     print(f"reference: Simbody at accuracy 1e-12; railcrash at rtol 1e-10 differs from it by "
           f"{error(railcrash_tight, reference):.1e}")
     for interval in (grid, dense):
-        results = {"railcrash": {}, "simbody": {}}
-        for level in LEVELS:
-            times = {"railcrash": [], "simbody": []}
-            samples = {}
-            for _ in range(args.repeats):
-                cpu, samples["railcrash"] = railcrash_run(mechanism, level, interval, work)
-                times["railcrash"].append(cpu)
-                cpu, samples["simbody"] = simbody_run(executable, mechanism, level, interval, work)
-                times["simbody"].append(cpu)
-            for tool in results:
-                results[tool][level] = (statistics.median(times[tool]), error(samples[tool], reference))
+        # Every repeat runs every level of both tools, so that the settings a target pairs (two
+        # different levels) are timed over the same stretch of the machine's load.
+        times = {tool: {level: [] for level in LEVELS} for tool in ("railcrash", "simbody")}
+        samples = {tool: {} for tool in times}
+        for _ in range(args.repeats):
+            for level in LEVELS:
+                cpu, samples["railcrash"][level] = railcrash_run(mechanism, level, interval, work)
+                times["railcrash"][level].append(cpu)
+                cpu, samples["simbody"][level] = simbody_run(executable, mechanism, level, interval, work)
+                times["simbody"][level].append(cpu)
+        results = {tool: {level: (statistics.median(times[tool][level]), error(samples[tool][level], reference))
+                          for level in LEVELS} for tool in times}
         print(f"\noutput every {interval} s ({round(t_end / interval)} rows)\n")
         print("| tolerance | railcrash CPU s | railcrash error | Simbody CPU s | Simbody error |\n|---|---|---|---|---|")
         for level in LEVELS:
@@ -138,12 +141,14 @@ def main():
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--targets", default="1e-4,1e-6")
     parser.add_argument("--mechanisms", default=",".join(MECHANISMS))
+    parser.add_argument("--executable", default=RAILCRASH[0], help="the railcrash to run (another build's, say)")
     args = parser.parse_args()
+    RAILCRASH[0] = os.path.abspath(args.executable)
     targets = [float(x) for x in args.targets.split(",")]
     executable = harness()
     work = tempfile.mkdtemp(prefix="railcrash-simbody-")
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-    print(f"railcrash {head} against Simbody 3.7 (Runge-Kutta-Merson); median CPU s of {args.repeats} interleaved runs "
+    print(f"railcrash {head} ({RAILCRASH[0]}) against Simbody 3.7 (Runge-Kutta-Merson); median CPU s of {args.repeats} interleaved runs "
           f"per setting, output included; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     for mechanism in args.mechanisms.split(","):
         compare(mechanism, executable, args, targets, work)

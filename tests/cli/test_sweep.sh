@@ -119,6 +119,12 @@ if [ -n "$mpirun" ]; then
   status=$?
   if [ $status -eq 2 ] && [ "$(grep -c "bad_key.yaml:4:" "$tmp/stderr")" -eq 1 ]; then pass
   else fail "mpirun with a bad plan: status $status, $(cat "$tmp/stderr")"; fi
+  # railcrash links no MPI and runs railcrash-mpi beside it under a launcher: without it, exit 2 saying so.
+  mkdir "$tmp/alone" && cp "$bin" "$tmp/alone/railcrash"
+  PMIX_RANK=0 "$tmp/alone/railcrash" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --out "$tmp/alone/out" > /dev/null 2> "$tmp/stderr"
+  status=$?
+  if [ $status -eq 2 ] && grep -q "cannot start $tmp/alone/railcrash-mpi" "$tmp/stderr" && [ ! -e "$tmp/alone/out" ]; then pass
+  else fail "under a launcher without railcrash-mpi: status $status, $(cat "$tmp/stderr")"; fi
 fi
 
 echo "$passes passed, $failures failed"

@@ -28,6 +28,10 @@ contains() {  # contains PACKAGE-FILE PATTERN
 }
 contains "$runtime" "usr/bin/railcrash$"
 contains "$runtime" "usr/lib/.*librailcrash.so.0.1"
+if [ -x "$build/railcrash-mpi" ]; then contains "$runtime" "usr/bin/railcrash-mpi$"; fi  # what railcrash runs under mpirun
+if grep -q "^RAILCRASH_HDF5:BOOL=ON" "$build/CMakeCache.txt"; then  # loaded only for --format hdf5, so not a Depends
+  dpkg-deb -f "$runtime" Recommends | grep -q libhdf5 || { echo "$(basename "$runtime"): Recommends lacks libhdf5"; exit 1; }
+fi
 contains "$dev" "usr/include/railcrash/api.hpp"
 contains "$dev" "usr/lib/.*cmake/railcrash/railcrashConfig.cmake"
 contains "$dev" "usr/lib/.*librailcrash.a"
