@@ -8,6 +8,10 @@
 
 #include "railcrash/report/assets.hpp"
 
+#ifdef RAILCRASH_HDF5_LIBRARY
+#include <H5public.h>
+#endif
+
 #ifndef RAILCRASH_VERSION
 #define RAILCRASH_VERSION "unknown"
 #endif
@@ -22,6 +26,12 @@ std::string version_text() {
           number(SUITESPARSE_SUBSUB_VERSION) + " (KLU " + number(KLU_MAIN_VERSION) + "." + number(KLU_SUB_VERSION) + "." +
           number(KLU_SUBSUB_VERSION) + ")\n";
   text += "Eigen " + number(EIGEN_WORLD_VERSION) + "." + number(EIGEN_MAJOR_VERSION) + "." + number(EIGEN_MINOR_VERSION) + "\n";
+#ifdef RAILCRASH_HDF5_LIBRARY
+  text += "HDF5 " + number(H5_VERS_MAJOR) + "." + number(H5_VERS_MINOR) + "." + number(H5_VERS_RELEASE) +
+          " (--format hdf5; " RAILCRASH_HDF5_LIBRARY " loaded when first used)\n";
+#else
+  text += "HDF5: none (built without libhdf5-dev: no --format hdf5)\n";
+#endif
   text += std::string("report plots: ") + (report::assets::kHaveLibrary ? report::assets::kLibraryName : "none (built without npm)");
   return text;
 }

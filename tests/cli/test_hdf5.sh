@@ -30,6 +30,11 @@ if grep -q "built without HDF5" "$tmp/stderr"; then
   exit
 fi
 
+# --version names the HDF5 it was built with: the one h5py (Debian's, on the same library) reports.
+hdf5_version=$($python -c "import h5py; print(h5py.version.hdf5_version)")
+expect_status "--version" 0 "$bin" --version
+expect_text "it names HDF5 and its version" "$tmp/stdout" "^HDF5 $hdf5_version (--format hdf5"
+
 expect_status "run with csv" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --out "$tmp/csv" --quiet
 expect_status "run with hdf5" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 --out "$tmp/h5" --quiet
 expect_text "run names the file" "$tmp/stdout" "timeseries.h5"
