@@ -21,11 +21,13 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -181,7 +183,7 @@ int kernels_benchmark(const std::string& template_path, const std::vector<int>& 
   char line[256];
   std::snprintf(line, sizeof line,
                 "| cars per consist | unknowns | Jacobian nonzeros | residual ns per unknown | Jacobian ns per unknown | "
-                "roots ns per unknown |\n|---|---|---|---|---|---|\n");
+                "roots ns per unknown | elements | 4 KiB pages holding them |\n|---|---|---|---|---|---|---|---|\n");
   table << line;
   std::fputs(line, stdout);
   for (const int n : cars) {
@@ -217,8 +219,11 @@ int kernels_benchmark(const std::string& template_path, const std::vector<int>& 
     const double jacobian =
         time_per_unknown([&](const double* state) { system.jacobian(0.0, 1e4, state, yp.data(), values.data()); });
     const double roots = time_per_unknown([&](const double* state) { system.roots(0.0, state, g.data()); });
-    std::snprintf(line, sizeof line, "| %d | %d | %d | %.1f | %.1f | %.1f |\n", n, system.size(), system.pattern().nonzeros(),
-                  residual, jacobian, roots);
+    // How many memory pages a sweep over the element objects touches (their own bytes only).
+    std::set<std::uintptr_t> pages;
+    for (const auto& element : model.elements()) pages.insert(reinterpret_cast<std::uintptr_t>(element.get()) / 4096);
+    std::snprintf(line, sizeof line, "| %d | %d | %d | %.1f | %.1f | %.1f | %zu | %zu |\n", n, system.size(),
+                  system.pattern().nonzeros(), residual, jacobian, roots, model.elements().size(), pages.size());
     table << line;
     std::fputs(line, stdout);
     std::fflush(stdout);

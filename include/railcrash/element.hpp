@@ -111,6 +111,14 @@ class Element {
   virtual ~Element() = default;
   Element(const Element&) = delete;
   Element& operator=(const Element&) = delete;
+  /// Element objects live side by side in a pool of their own (element.cpp), not among the
+  /// loader's allocations: a sweep over a long train's elements then streams through a few
+  /// MiB instead of one page per element scattered over the heap the model file's parse left.
+  static void* operator new(std::size_t bytes);
+  static void operator delete(void* element, std::size_t bytes);
+  /// An over-aligned element type (none so far) takes the ordinary aligned heap.
+  static void* operator new(std::size_t bytes, std::align_val_t alignment);
+  static void operator delete(void* element, std::size_t bytes, std::align_val_t alignment);
 
   const std::string& name() const { return name_; }
   const std::string& type() const { return type_; }
