@@ -118,7 +118,9 @@ std::string Element::output_with_role(OutputRole role) const {
 }
 
 Element::Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where)
-    : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {}
+    : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {
+  for (std::size_t p = 0; p < points_.size() && p < near_points_.size(); ++p) near_points_[p] = points_[p];
+}
 
 void Element::bind_bodies() {
   // Slots in order of first appearance of a distinct body; ground always gets the slot
@@ -139,6 +141,7 @@ void Element::bind_bodies() {
       slot_body_[static_cast<std::size_t>(slot)] = body;
     }
     point_slot_[p] = slot;
+    if (p < near_point_slot_.size()) near_point_slot_[p] = slot;
   }
   // A joint whose points all lie on one body (or all on ground) constrains nothing: its
   // constraint rows are identically zero and the system would be singular.

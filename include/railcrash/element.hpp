@@ -128,9 +128,13 @@ class Element {
   /// Global body index of slot 0 / 1 (kGround for ground or an unused slot).
   int slot_body(int slot) const { return slot_body_[static_cast<std::size_t>(slot)]; }
   /// Slot holding the body of point p.
-  int point_slot(int p) const { return point_slot_[static_cast<std::size_t>(p)]; }
+  int point_slot(int p) const {
+    return p < kNearPoints ? near_point_slot_[static_cast<std::size_t>(p)] : point_slot_[static_cast<std::size_t>(p)];
+  }
   /// Offset of point p on its body.
-  const PointRef& point(int p) const { return points_[static_cast<std::size_t>(p)]; }
+  const PointRef& point(int p) const {
+    return p < kNearPoints ? near_points_[static_cast<std::size_t>(p)] : points_[static_cast<std::size_t>(p)];
+  }
 
   // ---- constraint elements ----
   virtual int constraint_count() const { return 0; }
@@ -236,6 +240,12 @@ class Element {
   SourceLocation where_;
   std::array<int, 2> slot_body_{kGround, kGround};
   std::vector<int> point_slot_;
+  // Copies of the first points and their slots inside the object, which the laws read at every
+  // evaluation: points_ and point_slot_ lie elsewhere on the heap (a line or page more per
+  // element and sweep in a long train).
+  static constexpr int kNearPoints = 2;
+  std::array<PointRef, kNearPoints> near_points_{};
+  std::array<int, kNearPoints> near_point_slot_{};
 };
 
 namespace ad {
