@@ -1,7 +1,13 @@
 #include "railcrash/element.hpp"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
 
 namespace railcrash {
 
@@ -22,6 +28,89 @@ const char* output_role_name(OutputRole role) {
   return "";
 }
 
+namespace {
+
+/// Memory for element objects: carved in order from large blocks, so the elements a model
+/// creates one after another sit next to each other; a freed object's bytes go to a list per
+/// size and serve the next element of that size. Blocks are kept for the process's life (a
+/// study's models reuse them). Thread-safe: a sweep loads its runs' models in parallel.
+class ElementPool {
+ public:
+  void* allocate(std::size_t bytes) {
+    bytes = rounded(bytes);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<void*>& reusable = freed_[bytes];
+    if (!reusable.empty()) {
+      void* element = reusable.back();
+      reusable.pop_back();
+      return element;
+    }
+    if (bytes > left_) {
+      const std::size_t block = std::max(kBlockBytes, bytes);
+      blocks_.push_back(std::make_unique<std::max_align_t[]>(block / sizeof(std::max_align_t)));
+      next_ = reinterpret_cast<char*>(blocks_.back().get());
+      left_ = block;
+    }
+    void* element = next_;
+    next_ += bytes;
+    left_ -= bytes;
+    return element;
+  }
+  void release(void* element, std::size_t bytes) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    freed_[rounded(bytes)].push_back(element);
+  }
+
+ private:
+  static constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
+  static std::size_t rounded(std::size_t bytes) {
+    constexpr std::size_t align = alignof(std::max_align_t);
+    return (bytes + align - 1) / align * align;
+  }
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<std::max_align_t[]>> blocks_;
+  char* next_ = nullptr;
+  std::size_t left_ = 0;
+  std::map<std::size_t, std::vector<void*>> freed_;  // by rounded size
+};
+
+/// Never destroyed: elements of static models may outlive other statics.
+ElementPool& element_pool() {
+  static ElementPool* pool = new ElementPool;
+  return *pool;
+}
+
+}  // namespace
+
+// Under AddressSanitizer the elements come from the ordinary heap, so that a use after free
+// of an element is still caught.
+#if defined(__SANITIZE_ADDRESS__)
+#define RAILCRASH_ELEMENT_POOL 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define RAILCRASH_ELEMENT_POOL 0
+#endif
+#endif
+#ifndef RAILCRASH_ELEMENT_POOL
+#define RAILCRASH_ELEMENT_POOL 1
+#endif
+
+void* Element::operator new(std::size_t bytes) {
+  return RAILCRASH_ELEMENT_POOL ? element_pool().allocate(bytes) : ::operator new(bytes);
+}
+
+void Element::operator delete(void* element, std::size_t bytes) {
+  if (!element) return;
+  if (RAILCRASH_ELEMENT_POOL) element_pool().release(element, bytes);
+  else ::operator delete(element, bytes);
+}
+
+void* Element::operator new(std::size_t bytes, std::align_val_t alignment) { return ::operator new(bytes, alignment); }
+
+void Element::operator delete(void* element, std::size_t bytes, std::align_val_t alignment) {
+  ::operator delete(element, bytes, alignment);
+}
+
 std::string Element::output_with_role(OutputRole role) const {
   for (const RoleOfOutput& r : output_roles())
     if (r.role == role) return r.output;
@@ -29,7 +118,9 @@ std::string Element::output_with_role(OutputRole role) const {
 }
 
 Element::Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where)
-    : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {}
+    : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {
+  for (std::size_t p = 0; p < points_.size() && p < near_points_.size(); ++p) near_points_[p] = points_[p];
+}
 
 void Element::bind_bodies() {
   // Slots in order of first appearance of a distinct body; ground always gets the slot
@@ -50,6 +141,7 @@ void Element::bind_bodies() {
       slot_body_[static_cast<std::size_t>(slot)] = body;
     }
     point_slot_[p] = slot;
+    if (p < near_point_slot_.size()) near_point_slot_[p] = slot;
   }
   // A joint whose points all lie on one body (or all on ground) constrains nothing: its
   // constraint rows are identically zero and the system would be singular.

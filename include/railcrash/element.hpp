@@ -111,6 +111,14 @@ class Element {
   virtual ~Element() = default;
   Element(const Element&) = delete;
   Element& operator=(const Element&) = delete;
+  /// Element objects live side by side in a pool of their own (element.cpp), not among the
+  /// loader's allocations: a sweep over a long train's elements then streams through a few
+  /// MiB instead of one page per element scattered over the heap the model file's parse left.
+  static void* operator new(std::size_t bytes);
+  static void operator delete(void* element, std::size_t bytes);
+  /// An over-aligned element type (none so far) takes the ordinary aligned heap.
+  static void* operator new(std::size_t bytes, std::align_val_t alignment);
+  static void operator delete(void* element, std::size_t bytes, std::align_val_t alignment);
 
   const std::string& name() const { return name_; }
   const std::string& type() const { return type_; }
@@ -120,9 +128,13 @@ class Element {
   /// Global body index of slot 0 / 1 (kGround for ground or an unused slot).
   int slot_body(int slot) const { return slot_body_[static_cast<std::size_t>(slot)]; }
   /// Slot holding the body of point p.
-  int point_slot(int p) const { return point_slot_[static_cast<std::size_t>(p)]; }
+  int point_slot(int p) const {
+    return p < kNearPoints ? near_point_slot_[static_cast<std::size_t>(p)] : point_slot_[static_cast<std::size_t>(p)];
+  }
   /// Offset of point p on its body.
-  const PointRef& point(int p) const { return points_[static_cast<std::size_t>(p)]; }
+  const PointRef& point(int p) const {
+    return p < kNearPoints ? near_points_[static_cast<std::size_t>(p)] : points_[static_cast<std::size_t>(p)];
+  }
 
   // ---- constraint elements ----
   virtual int constraint_count() const { return 0; }
@@ -228,6 +240,12 @@ class Element {
   SourceLocation where_;
   std::array<int, 2> slot_body_{kGround, kGround};
   std::vector<int> point_slot_;
+  // Copies of the first points and their slots inside the object, which the laws read at every
+  // evaluation: points_ and point_slot_ lie elsewhere on the heap (a line or page more per
+  // element and sweep in a long train).
+  static constexpr int kNearPoints = 2;
+  std::array<PointRef, kNearPoints> near_points_{};
+  std::array<int, kNearPoints> near_point_slot_{};
 };
 
 namespace ad {
