@@ -105,6 +105,8 @@ void Element::operator delete(void* element, std::size_t bytes) {
   else ::operator delete(element, bytes);
 }
 
+bool Element::allocated_from_pool() { return RAILCRASH_ELEMENT_POOL; }
+
 void* Element::operator new(std::size_t bytes, std::align_val_t alignment) { return ::operator new(bytes, alignment); }
 
 void Element::operator delete(void* element, std::size_t bytes, std::align_val_t alignment) {

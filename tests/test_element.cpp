@@ -81,23 +81,11 @@ TEST_CASE("the roles say which outputs are crush, contact, coupler and interlock
   CHECK(std::string(output_role_name(OutputRole::VerticalInterlockForce)) == "vertical_interlock_force");
 }
 
-// Under AddressSanitizer (GCC's or Clang's) elements come from the ordinary heap (element.cpp).
-#if defined(__SANITIZE_ADDRESS__)
-#define RAILCRASH_TEST_ELEMENT_POOL 0
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define RAILCRASH_TEST_ELEMENT_POOL 0
-#endif
-#endif
-#ifndef RAILCRASH_TEST_ELEMENT_POOL
-#define RAILCRASH_TEST_ELEMENT_POOL 1
-#endif
-
-#if RAILCRASH_TEST_ELEMENT_POOL
 TEST_CASE("a long train's elements lie side by side in memory, not one per page of the loader's heap", "[element][memory]") {
   // Loaded from a model file, each element object used to sit on its own 4 KiB page among the
   // parser's allocations (a median 2.9 KiB between consecutive elements; bench/README.md).
   // From the element pool (element.cpp) they fill the pages they occupy.
+  if (!Element::allocated_from_pool()) return;  // AddressSanitizer: the ordinary heap
   const Model model = load_model_text(make_consist_model(source_path("models/report/final_two_car.yaml"), 20), "consist.yaml");
   constexpr std::uintptr_t kPage = 4096;
   std::set<std::uintptr_t> pages;
@@ -108,4 +96,3 @@ TEST_CASE("a long train's elements lie side by side in memory, not one per page 
   // element on the heap. Allow for slots reused from models freed earlier in this process.
   CHECK(pages.size() < model.elements().size() / 4);
 }
-#endif

@@ -119,6 +119,9 @@ class Element {
   /// An over-aligned element type (none so far) takes the ordinary aligned heap.
   static void* operator new(std::size_t bytes, std::align_val_t alignment);
   static void operator delete(void* element, std::size_t bytes, std::align_val_t alignment);
+  /// False under AddressSanitizer, where elements come from the ordinary heap (so that a use
+  /// after free of an element is still caught).
+  static bool allocated_from_pool();
 
   const std::string& name() const { return name_; }
   const std::string& type() const { return type_; }
