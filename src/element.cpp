@@ -102,15 +102,15 @@ void* Element::operator new(std::size_t bytes) {
 void Element::operator delete(void* element, std::size_t bytes) {
   if (!element) return;
   if (RAILCRASH_ELEMENT_POOL) element_pool().release(element, bytes);
-  else ::operator delete(element, bytes);
+  else ::operator delete(element);  // (unsized: Clang declares the sized form only with -fsized-deallocation)
 }
 
 bool Element::allocated_from_pool() { return RAILCRASH_ELEMENT_POOL; }
 
 void* Element::operator new(std::size_t bytes, std::align_val_t alignment) { return ::operator new(bytes, alignment); }
 
-void Element::operator delete(void* element, std::size_t bytes, std::align_val_t alignment) {
-  ::operator delete(element, bytes, alignment);
+void Element::operator delete(void* element, std::size_t, std::align_val_t alignment) {
+  ::operator delete(element, alignment);
 }
 
 std::string Element::output_with_role(OutputRole role) const {
