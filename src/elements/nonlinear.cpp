@@ -12,39 +12,41 @@ namespace railcrash {
 PiecewiseLinearLaw::PiecewiseLinearLaw(const std::vector<double>& breakpoints, const std::vector<Segment>& segments) {
   RAILCRASH_DEMAND(segments.size() == breakpoints.size() + 1);
   const std::size_t n = breakpoints.size();
-  segments_.push_back(segments[0]);
+  append(segments[0], 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     RAILCRASH_DEMAND(i == 0 || breakpoints[i] >= breakpoints[i - 1]);
     // Segment i + 1 lies between breakpoints i and i + 1: empty when they coincide.
     if (i + 1 < n && breakpoints[i + 1] == breakpoints[i]) continue;
     const Segment& next = segments[i + 1];
-    Segment& last = segments_.back();
+    const int last = count_ - 1;
     const double b = breakpoints[i];
-    const double below = last.intercept + last.slope * b, above = next.intercept + next.slope * b;
-    if (next.slope == last.slope && std::abs(below - above) <= 1e-12 * (std::abs(below) + std::abs(above))) {
-      last.name += " / " + next.name;  // the same straight line: no kink here
+    const double below = value(b, last), above = next.intercept + next.slope * b;
+    if (next.slope == slope_[index(last)] && std::abs(below - above) <= 1e-12 * (std::abs(below) + std::abs(above))) {
+      names_.back() += " / " + next.name;  // the same straight line: no kink here
       continue;
     }
-    breakpoints_.push_back(b);
-    segments_.push_back(next);
+    append(next, b);
   }
   // Antiderivatives G_k(x) = C_k + a_k x + s_k x^2 / 2, with G(0) = 0 and G continuous.
-  const auto line_integral = [this](int k, double x) {
-    const Segment& s = segment(k);
-    return s.intercept * x + 0.5 * s.slope * x * x;
-  };
-  integral_constant_.assign(segments_.size(), 0.0);
+  const auto line_integral = [this](int k, double x) { return intercept_[index(k)] * x + 0.5 * slope_[index(k)] * x * x; };
   const int home = segment_at(0.0, 1);
   for (int k = home; k + 1 < segment_count(); ++k) {
     const double b = upper(k);
-    integral_constant_[static_cast<std::size_t>(k + 1)] =
-        integral_constant_[static_cast<std::size_t>(k)] + line_integral(k, b) - line_integral(k + 1, b);
+    integral_constant_[index(k + 1)] = integral_constant_[index(k)] + line_integral(k, b) - line_integral(k + 1, b);
   }
   for (int k = home; k > 0; --k) {
     const double b = lower(k);
-    integral_constant_[static_cast<std::size_t>(k - 1)] =
-        integral_constant_[static_cast<std::size_t>(k)] + line_integral(k, b) - line_integral(k - 1, b);
+    integral_constant_[index(k - 1)] = integral_constant_[index(k)] + line_integral(k, b) - line_integral(k - 1, b);
   }
+}
+
+void PiecewiseLinearLaw::append(const Segment& segment, double lower_breakpoint) {
+  RAILCRASH_DEMAND(count_ < kMaxSegments);
+  if (count_ > 0) breakpoints_[index(count_ - 1)] = lower_breakpoint;
+  intercept_[index(count_)] = segment.intercept;
+  slope_[index(count_)] = segment.slope;
+  names_.push_back(segment.name);
+  ++count_;
 }
 
 PiecewiseLinearLaw PiecewiseLinearLaw::two_branch(double value_at_zero, const Branch& negative,
@@ -71,8 +73,7 @@ PiecewiseLinearLaw PiecewiseLinearLaw::two_branch(double value_at_zero, const Br
 }
 
 double PiecewiseLinearLaw::integral(double x, int k) const {
-  const Segment& s = segment(k);
-  return integral_constant_[static_cast<std::size_t>(k)] + s.intercept * x + 0.5 * s.slope * x * x;
+  return integral_constant_[index(k)] + intercept_[index(k)] * x + 0.5 * slope_[index(k)] * x * x;
 }
 
 int PiecewiseLinearLaw::segment_at(double x, int direction) const {
@@ -230,7 +231,7 @@ void NonlinearSpring::prepare(const ElementState<double>& initial) {
   if (!free_length) free_length = line_geometry(*this, initial).length;
 }
 
-Element::Event NonlinearSpring::segment_event(int, int to, double x) const { return {law().segment(to).name, x}; }
+Element::Event NonlinearSpring::segment_event(int, int to, double x) const { return {law().segment_name(to), x}; }
 
 // ---- nonlinear_dashpot -------------------------------------------------------------------
 
@@ -246,7 +247,7 @@ double NonlinearDashpot::measure(const ElementState<double>& s) const { return l
 
 void NonlinearDashpot::prepare(const ElementState<double>& initial) { require_direction(*this, initial); }
 
-Element::Event NonlinearDashpot::segment_event(int, int to, double x) const { return {law().segment(to).name, x}; }
+Element::Event NonlinearDashpot::segment_event(int, int to, double x) const { return {law().segment_name(to), x}; }
 
 // ---- special_spring ----------------------------------------------------------------------
 
@@ -307,8 +308,8 @@ void SpecialSpring::prepare(const ElementState<double>& initial) {
 
 Element::Event SpecialSpring::segment_event(int from, int to, double x) const {
   if (to == 0) return {"opening", x};
-  if (from == 0) return {"closing (" + law().segment(to).name + ")", x};
-  return {law().segment(to).name, x};
+  if (from == 0) return {"closing (" + law().segment_name(to) + ")", x};
+  return {law().segment_name(to), x};
 }
 
 template class PiecewiseLineElement<NonlinearSpring>;

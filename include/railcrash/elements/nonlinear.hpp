@@ -75,6 +75,8 @@
 // sees an event at every velocity reversal.
 #pragma once
 
+#include <array>
+#include <cassert>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,8 +89,19 @@ namespace railcrash {
 
 /// f(x) = intercept_k + slope_k x on segment k, between breakpoints b_(k-1) and b_k
 /// (segment 0 extends to -infinity, the last one to +infinity).
+///
+/// The lines, breakpoints and integral constants are stored inside the object (at most
+/// kMaxSegments segments: the two-branch law has four, the special spring three): the element
+/// that holds the law comes from the elements' own pool (src/element.cpp), so the numbers read
+/// at every residual sit next to the element's other data. Held in std::vectors on the
+/// loader's heap they were one more scattered cache line per element and evaluation: in a
+/// 100 + 100-car consist the nonlinear springs' force law cost 34 times as much per car and
+/// step as in a 20 + 20-car one (bench/README.md, "Curves inside the element"). The segments'
+/// names, read only for events, stay on the heap.
 class PiecewiseLinearLaw {
  public:
+  static constexpr int kMaxSegments = 4;
+
   struct Segment {
     double intercept = 0.0;  // [f]
     double slope = 0.0;      // [f/x]
@@ -97,7 +110,8 @@ class PiecewiseLinearLaw {
 
   PiecewiseLinearLaw() = default;
   /// breakpoints non-decreasing (n values), segments n + 1. Neighbours on the same line
-  /// (equal slopes and equal values at their common breakpoint) are merged.
+  /// (equal slopes and equal values at their common breakpoint) are merged; at most
+  /// kMaxSegments remain.
   PiecewiseLinearLaw(const std::vector<double>& breakpoints, const std::vector<Segment>& segments);
 
   /// The usual two-branch law: f(0) = value_at_zero, slope_1 up to the breakpoint on
@@ -110,18 +124,21 @@ class PiecewiseLinearLaw {
   static PiecewiseLinearLaw two_branch(double value_at_zero, const Branch& negative, const std::string& negative_name,
                                        const Branch& positive, const std::string& positive_name);
 
-  int segment_count() const { return static_cast<int>(segments_.size()); }
-  const Segment& segment(int k) const { return segments_[static_cast<std::size_t>(k)]; }
+  int segment_count() const { return count_; }
+  /// Segment k's line and name (a copy: for events and tests, not for the force law).
+  Segment segment(int k) const { return {intercept_[index(k)], slope_[index(k)], names_[index(k)]}; }
+  const std::string& segment_name(int k) const { return names_[index(k)]; }
   bool has_lower(int k) const { return k > 0; }
   bool has_upper(int k) const { return k + 1 < segment_count(); }
-  double lower(int k) const { return breakpoints_[static_cast<std::size_t>(k - 1)]; }
-  double upper(int k) const { return breakpoints_[static_cast<std::size_t>(k)]; }
-  const std::vector<double>& breakpoints() const { return breakpoints_; }
+  double lower(int k) const { return breakpoints_[index(k - 1)]; }
+  double upper(int k) const { return breakpoints_[index(k)]; }
+  std::vector<double> breakpoints() const {
+    return {breakpoints_.begin(), breakpoints_.begin() + (count_ > 0 ? count_ - 1 : 0)};
+  }
 
   template <class T>
   T value(const T& x, int k) const {
-    const Segment& s = segment(k);
-    return s.intercept + s.slope * x;
+    return intercept_[index(k)] + slope_[index(k)] * x;
   }
   /// Integral of f from 0 to x along the law, using segment k's line at x.
   double integral(double x, int k) const;
@@ -129,9 +146,19 @@ class PiecewiseLinearLaw {
   int segment_at(double x, int direction) const;
 
  private:
-  std::vector<double> breakpoints_;
-  std::vector<Segment> segments_;
-  std::vector<double> integral_constant_;  // integral = constant_k + intercept_k x + slope_k x^2 / 2
+  static std::size_t index(int k) {
+    assert(k >= 0 && k < kMaxSegments);
+    return static_cast<std::size_t>(k);
+  }
+  /// Appends a segment (and the breakpoint below it, for all but the first).
+  void append(const Segment& segment, double lower_breakpoint);
+
+  int count_ = 0;
+  std::array<double, kMaxSegments> intercept_{};           // [f]
+  std::array<double, kMaxSegments> slope_{};               // [f/x]
+  std::array<double, kMaxSegments - 1> breakpoints_{};     // [x] between segments k and k + 1
+  std::array<double, kMaxSegments> integral_constant_{};   // integral = constant_k + intercept_k x + slope_k x^2 / 2
+  std::vector<std::string> names_;                         // events only
 };
 
 /// Mode of an element that follows a PiecewiseLinearLaw.
