@@ -2,6 +2,7 @@
 """Share of a run's CPU that goes to output rows (issue 14: "output <= 10 % of a run at 1 ms output").
 
     bench/output_share.py [--repeats 7] [--executable build/railcrash] [--base OTHER_RAILCRASH] [--format csv|hdf5]
+                          [--cases mechanisms|crash|all]
 
 The two mechanisms of bench/simbody/compare.py at their models' tolerances (slider-crank
 10 s, Andrews' squeezer 0.03 s), each run twice with every file written: with dense output
@@ -12,6 +13,10 @@ With --base (another build, e.g. of an older commit), its runs alternate with th
 executable's (dense and end of one, then of the other, REPEATS times) and both are printed:
 an A/B comparison in one run, with the same load on both. --format hdf5: the runs write
 timeseries.h5 in place of the four CSV files (railcrash run --format).
+
+--cases crash runs the two crash models instead, at their own rtol (1e-5) with 1 ms rows
+(the report's two-car crash over its 0.25 s, 250 rows; the barrier test over its 0.8 s,
+800 rows): what an output row costs in the runs railcrash is for. --cases all runs both sets.
 """
 import argparse
 import os
@@ -30,6 +35,11 @@ CASES = [
     ("verification/cases/slider_crank.yaml", 10.0, 1e-3, 1e-6, 1e-7),
     ("verification/cases/andrews_squeezer.yaml", 0.03, 1e-5, 1e-6, 1e-9),
 ]
+# the crash models at their own tolerances (no atol given: the run's scaled default)
+CRASH_CASES = [
+    ("models/report/final_two_car.yaml", 0.25, 1e-3, 1e-5, None),
+    ("models/barrier/two_car_barrier.yaml", 0.8, 1e-3, 1e-5, None),
+]
 
 
 def main():
@@ -38,7 +48,9 @@ def main():
     parser.add_argument("--executable", default=os.path.join(ROOT, "build", "railcrash"))
     parser.add_argument("--base", help="a second railcrash executable, run interleaved with --executable")
     parser.add_argument("--format", choices=["csv", "hdf5"], default="csv", help="railcrash run --format")
+    parser.add_argument("--cases", choices=["mechanisms", "crash", "all"], default="mechanisms")
     args = parser.parse_args()
+    cases = {"mechanisms": CASES, "crash": CRASH_CASES, "all": CASES + CRASH_CASES}[args.cases]
     work = tempfile.mkdtemp(prefix="railcrash-output-share-")
     head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     executables = [args.executable] + ([args.base] if args.base else [])
@@ -46,11 +58,12 @@ def main():
           f"{args.repeats} interleaved pairs; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}\n")
     print("| model | executable | rows | CPU s, dense output | CPU s, output at t_end | output share | per row [us] |\n"
           "|---|---|---|---|---|---|---|")
-    for model, t_end, dense, rtol, atol in CASES:
+    for model, t_end, dense, rtol, atol in cases:
         times = {(exe, interval): [] for exe in executables for interval in (dense, t_end)}
         for _ in range(args.repeats):
             for exe, interval in times:
-                cpu, _ = run_timed([exe, "run", os.path.join(ROOT, model), "--rtol", repr(rtol), "--atol", repr(atol),
+                tolerances = ["--rtol", repr(rtol)] + (["--atol", repr(atol)] if atol is not None else [])
+                cpu, _ = run_timed([exe, "run", os.path.join(ROOT, model)] + tolerances + [
                                     "--output-interval", repr(interval), "--out", os.path.join(work, "out"), "--format", args.format, "--quiet"])
                 times[(exe, interval)].append(cpu)
         rows = round(t_end / dense)

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
+#   bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -19,9 +19,13 @@ case $what in
   # The same crash's engineering-quantity errors, both commits against their own rtol 1e-7 run:
   # bench/run.sh accuracy-compare [COMMIT] [--rtols 1e-3,1e-4]
   accuracy-compare) /usr/bin/python3 bench/compare_accuracy.py "$@" ;;
+  # CPU at equal accuracy: both commits' work-precision lines over an rtol grid, the CPU
+  # ratio at equal error per quantity: bench/run.sh work-precision [COMMIT] [--repeats 3]
+  work-precision) /usr/bin/python3 bench/work_precision.py "$@" ;;
   # The slider-crank and Andrews' squeezer against Simbody 3.7 at equal accuracy (install-deps.sh --bench)
   simbody) /usr/bin/python3 bench/simbody/compare.py "$@" ;;
-  # Share of a run's CPU that goes to output rows (slider-crank at 1 ms, Andrews at 10 us output)
+  # Share of a run's CPU that goes to output rows (slider-crank at 1 ms, Andrews at 10 us output;
+  # --cases crash: the two crash models at 1 ms)
   outcost) /usr/bin/python3 bench/output_share.py "$@" ;;
   # Start-up (--version, the slider-crank at 0.4 s output) against a base build: bench/run.sh startup --base BASE/railcrash
   startup) /usr/bin/python3 bench/startup.py "$@" ;;
@@ -47,5 +51,5 @@ case $what in
     $bench --commit "$commit" sensitivity
     build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
         --out bench/converge_final_two_car_0.5s ;;
-  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|simbody|outcost|startup|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
+  *) echo "usage: bench/run.sh [consist|kernels|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
 esac

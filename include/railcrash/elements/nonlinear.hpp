@@ -94,10 +94,9 @@ namespace railcrash {
 /// kMaxSegments segments: the two-branch law has four, the special spring three): the element
 /// that holds the law comes from the elements' own pool (src/element.cpp), so the numbers read
 /// at every residual sit next to the element's other data. Held in std::vectors on the
-/// loader's heap they were one more scattered cache line per element and evaluation: in a
-/// 100 + 100-car consist the nonlinear springs' force law cost 34 times as much per car and
-/// step as in a 20 + 20-car one (bench/README.md, "Curves inside the element"). The segments'
-/// names, read only for events, stay on the heap.
+/// loader's heap they were one more scattered cache line per element and evaluation, and
+/// 100 + 100 and 200 + 200-car consists took about a fifth more CPU (bench/README.md,
+/// "Curves inside the element"). The segments' names, read only for events, stay on the heap.
 class PiecewiseLinearLaw {
  public:
   static constexpr int kMaxSegments = 4;
