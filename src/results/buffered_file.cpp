@@ -120,7 +120,7 @@ char* format_general12(char* first, double value) {
 BufferedFile::BufferedFile(const std::string& path) {
   descriptor_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (descriptor_ < 0) error_ = errno;
-  buffer_ = std::make_unique<char[]>(kCapacity);
+  buffer_.reset(new char[kCapacity]);  // not zeroed (std::make_unique would): only written bytes are read
 }
 
 BufferedFile::~BufferedFile() {
