@@ -129,8 +129,14 @@ class PiecewiseLinearLaw {
   const std::string& segment_name(int k) const { return names_[index(k)]; }
   bool has_lower(int k) const { return k > 0; }
   bool has_upper(int k) const { return k + 1 < segment_count(); }
-  double lower(int k) const { return breakpoints_[index(k - 1)]; }
-  double upper(int k) const { return breakpoints_[index(k)]; }
+  double lower(int k) const {
+    assert(has_lower(k));
+    return breakpoints_[index(k - 1)];
+  }
+  double upper(int k) const {
+    assert(has_upper(k));
+    return breakpoints_[index(k)];
+  }
   std::vector<double> breakpoints() const {
     return {breakpoints_.begin(), breakpoints_.begin() + (count_ > 0 ? count_ - 1 : 0)};
   }

@@ -73,7 +73,7 @@ class Hdf5File {
  private:
   struct Table;
   std::string path_;
-  std::int64_t file_ = -1;  // hid_t
+  [[maybe_unused]] std::int64_t file_ = -1;  // hid_t (a build without HDF5 never opens one)
   std::vector<std::unique_ptr<Table>> tables_;
   std::string error_;
 
