@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "railcrash/initial_conditions.hpp"
+#include "railcrash/serial_vector_ops.hpp"
 
 namespace railcrash {
 
@@ -338,10 +339,12 @@ void IdaIntegrator::start(double t_end) {
   {
     impl.check(SUNContext_Create(nullptr, &impl.context), "SUNContext_Create");
     impl.y = impl.created(N_VNew_Serial(n, impl.context), "N_VNew_Serial");
+    use_compiled_serial_ops(impl.y);  // before any clone: Debian's SUNDIALS is unoptimized
     impl.yp = impl.created(N_VClone(impl.y), "N_VClone");
     impl.ids = impl.created(N_VClone(impl.y), "N_VClone");
     impl.atol = impl.created(N_VClone(impl.y), "N_VClone");
     impl.quad = impl.created(N_VNew_Serial(nquad, impl.context), "N_VNew_Serial");
+    use_compiled_serial_ops(impl.quad);
     impl.quad_atol = impl.created(N_VClone(impl.quad), "N_VClone");
 
     double* y = N_VGetArrayPointer(impl.y);
