@@ -722,14 +722,18 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   return s;
 }
 
-void DaeSystem::roots(double t, const double* y, double* g) const {
+void DaeSystem::roots(double t, const double* y, double* g, double* outputs) const {
   const int nq = body_unknowns();
   const double* lambda = y + 2 * nq;
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
-    if (el.root_count() == 0) continue;
+    const bool has_roots = el.root_count() > 0;
+    const bool has_outputs = outputs != nullptr && output_offset_[e] < output_end(e);
+    if (!has_roots && !has_outputs) continue;
     const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-    el.roots(t, local_state(static_cast<std::size_t>(e), y, y + nq), element_lambda, g + root_offset_[e]);
+    const ElementState<double> s = local_state(e, y, y + nq);
+    if (has_roots) el.roots(t, s, element_lambda, g + root_offset_[e]);
+    if (has_outputs) el.outputs(s, element_lambda, outputs + output_offset_[e]);
   }
 }
 

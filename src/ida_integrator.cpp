@@ -401,6 +401,8 @@ void IdaIntegrator::start(double t_end) {
     impl.y_out = impl.created(N_VClone(impl.y), "N_VClone");
     impl.quad_out = impl.created(N_VClone(impl.quad), "N_VClone");
     impl.g_previous.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
+    outputs_.assign(system_.output_names().size(), 0.0);
+    outputs_current_ = false;
     impl.g_now = impl.g_previous;
     impl.y_local.assign(static_cast<std::size_t>(n), 0.0);
     impl.y_probe.assign(static_cast<std::size_t>(n), 0.0);
@@ -414,6 +416,7 @@ void IdaIntegrator::start(double t_end) {
 
 double IdaIntegrator::advance(double t_end) {
   Impl& impl = *impl_;
+  outputs_current_ = false;  // (until this step's sweep)
   const int n = system_.size();
   const int nq = system_.body_unknowns();
   const int nquad = system_.quadrature_count();
@@ -624,7 +627,10 @@ double IdaIntegrator::advance(double t_end) {
   bool restarted = false;
 
   if (root_count > 0) {
-    system_.roots(t_n, y, g_now.data());
+    // The step's element outputs come from the same sweep as its roots; they stand for the
+    // step's end only if no mode changes in it (below).
+    double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
+    system_.roots(t_n, y, g_now.data(), step_outputs);
     crossings.clear();
     for (int k = 0; k < root_count; ++k) {
       const auto kk = static_cast<std::size_t>(k);
@@ -644,6 +650,7 @@ double IdaIntegrator::advance(double t_end) {
       }
       crossings.push_back({t_n, owner, local, 0});
     }
+    outputs_current_ = step_outputs != nullptr && crossings.empty();
     if (!crossings.empty()) {
       load_taylor(t_n);
       double step = 0.0;

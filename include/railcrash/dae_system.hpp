@@ -156,8 +156,10 @@ class DaeSystem {
 
   // ---- modes and events ----
   int root_count() const { return root_count_; }
-  /// All elements' root functions at y, in element order.
-  void roots(double t, const double* y, double* g) const;
+  /// All elements' root functions at y, in element order. With `outputs`
+  /// (output_names().size()), every element's outputs at y as well, from the same evaluation of
+  /// its local state (IDA's one sweep after a step; outputs(y, y's multipliers) gives the same).
+  void roots(double t, const double* y, double* g, double* outputs = nullptr) const;
   /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
   /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
   /// any mode changed (Euler and the static settle; IDA commits element by element).

@@ -52,6 +52,7 @@ class IdaIntegrator : public Integrator {
   bool dense_output() const override { return true; }
   void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) override;
   const double* current_state() const override;
+  const double* current_outputs() const override { return outputs_current_ ? outputs_.data() : nullptr; }
   void final_state(std::vector<double>& y, std::vector<double>& quadratures) override;
   std::string step_limit_advice(double t_end) const override;
   std::string divergence_phrase() const override { return "IDA's solution is not finite"; }
@@ -68,6 +69,8 @@ class IdaIntegrator : public Integrator {
 
   IdaSettings settings_;
   std::unique_ptr<Impl> impl_;  // SUNDIALS' objects of the run in progress
+  std::vector<double> outputs_;  // element outputs at the step's end, from the roots' sweep
+  bool outputs_current_ = false;  // outputs_ belong to current_state() and the present modes
 };
 
 }  // namespace railcrash

@@ -139,6 +139,9 @@ class Integrator {
   /// Dense output: samples every output time up to t_limit not sampled yet.
   void sample_up_to(double t_limit);
   RunStatistics& stats() { return outcome_.stats; }
+  /// Whether the observer takes every step's element outputs (an integrator that can compute
+  /// them with other work hands them over through current_outputs()).
+  bool step_outputs_wanted() const { return observe_steps_; }
 
   DaeSystem& system_;
 
