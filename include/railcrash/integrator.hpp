@@ -124,7 +124,8 @@ class Integrator {
   /// Called once at the end of every run (also after a failure): counters into stats().
   virtual void finish() {}
   /// The element outputs at current_state() in the present modes when the integrator already
-  /// computed them (Euler's one sweep per step), else null: deliver_step evaluates them.
+  /// computed them (Euler's one sweep per step, IDA's sweep of the step's roots), else null:
+  /// deliver_step evaluates them.
   virtual const double* current_outputs() const { return nullptr; }
 
   // ---- for the integrators: what the run loop owns ----
