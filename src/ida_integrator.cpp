@@ -22,6 +22,11 @@ namespace railcrash {
 
 namespace {
 
+// IDA's first step after a restart: this fraction of the step that crossed the event, but no
+// more than kReachableMultiple times IDA's own first step (advance(), restart_first_step()).
+constexpr double kRestartStepFraction = 0.3;
+constexpr double kReachableMultiple = 1e4;
+
 std::string flag_name(int flag) {
   char* name = IDAGetReturnFlagName(flag);
   std::string out = name ? name : std::to_string(flag);
@@ -261,6 +266,32 @@ struct IdaIntegrator::Impl {
     check(IDAQuadReInit(ida, quad), "IDAQuadReInit");
     check(IDASetStopTime(ida, t_end), "IDASetStopTime");
     ++stats.reinitializations;
+  }
+
+  /// IDA's own first step from (t, y, y'), as IDASolve chooses it: 0.001 of the distance to
+  /// t_end, or less, so that the step moves the differential unknowns by half a tolerance
+  /// (0.5 / ||y'||, weighted RMS norm over all unknowns, the algebraic ones counted as zero).
+  double own_first_step(double t, double t_end) const {
+    const double* values = N_VGetArrayPointer(y);
+    const double* rates = N_VGetArrayPointer(yp);
+    const double* differential = N_VGetArrayPointer(ids);
+    const double* absolute = N_VGetArrayPointer(atol);
+    const sunindextype n = N_VGetLength(y);
+    double sum = 0.0;
+    for (sunindextype i = 0; i < n; ++i) {
+      if (!(differential[i] > 0.0)) continue;
+      const double weighted = rates[i] / (rtol * std::abs(values[i]) + absolute[i]);
+      sum += weighted * weighted;
+    }
+    const double norm = std::sqrt(sum / static_cast<double>(n));
+    const double step = 0.001 * std::abs(t_end - t);
+    return norm > 0.5 / step ? 0.5 / norm : step;
+  }
+
+  /// The first step after a restart at t from the state in y, yp (advance()).
+  double restart_first_step(double step_before, double t, double t_end) const {
+    const double own = own_first_step(t, t_end);
+    return std::max(own, std::min(kRestartStepFraction * step_before, kReachableMultiple * own));
   }
 
   static void error_handler(int, const char* module, const char* function, char* message, void* user) {
@@ -595,12 +626,12 @@ double IdaIntegrator::advance(double t_end) {
   int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
   impl.rethrow_callback_error();
   if ((flag == IDA_CONV_FAIL || flag == IDA_ERR_FAIL) && impl.retry.available) {
-    // The first step after a restart failed. IDA chose that step from the weighted norm of
-    // y', which at an impact is huge: it starts tiny, and the Newton matrix of the index-2
-    // multipliers worsens as 1/h^2, so it may never recover (two_car_barrier.yaml at rtol 1e-9
-    // failed at 0.15 s with h = 1e-16 after a damper's mode change). Once per restart: the same
-    // restart again with a first step a tenth of the step before the event, a scale the
-    // solution has just shown.
+    // The first step after a restart failed, after IDA's own cuts of it: each cut worsens the
+    // Newton matrix of the index-2 multipliers as 1/h^2, so a start far too large or far too
+    // small may never recover (IDA's own first step, 0.5 / ||y'||, used before every restart:
+    // two_car_barrier.yaml at rtol 1e-9 failed at 0.15 s with h = 1e-16 after a damper's mode
+    // change). Once per restart: the same restart again with a first step a tenth of the step
+    // before the event (a third of the first try, unless kReachableMultiple capped that).
     impl.retry.available = false;
     std::copy(impl.retry.y.begin(), impl.retry.y.end(), N_VGetArrayPointer(impl.y));
     std::copy(impl.retry.yp.begin(), impl.retry.yp.end(), N_VGetArrayPointer(impl.yp));
@@ -612,7 +643,6 @@ double IdaIntegrator::advance(double t_end) {
     impl.non_finite_y.clear();
     flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
     impl.rethrow_callback_error();
-    impl.check(IDASetInitStep(impl.ida, 0.0), "IDASetInitStep");  // IDA's own choice again
   }
   impl.retry.available = false;  // (a step was taken, or the run fails now)
   if (flag < 0) {
@@ -772,6 +802,19 @@ double IdaIntegrator::advance(double t_end) {
         impl.retry.yp = yp_restart;
         impl.retry.quad.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + nquad);
         impl.reinitialize(c.t, t_end, stats());
+        // IDA's own first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an
+        // impact, and it then climbs back at order 1, doubling per step, with a Jacobian at
+        // nearly every step (cj changes each time): 170 restarts in the 0.25 s two-car crash
+        // cost a tenth of its steps and half its Jacobians. It starts instead from a fraction
+        // of the step that crossed the event, a scale the solution has just shown; an impact
+        // faster than that is met by IDA's error test, which cuts the step. The fraction is
+        // measured (bench/README.md, "The first step after a restart"). The error test cuts
+        // at most 10 times, by 0.25 from the second cut on, so the start stays within
+        // kReachableMultiple of IDA's own: the step before a dropped ball touches a floor is its
+        // free flight's, 0.17 s, ten million times its first step in contact at rtol 1e-10
+        // (tests/elements/test_contact.cpp).
+        impl.check(IDASetInitStep(impl.ida, impl.retry.available ? impl.restart_first_step(impl.retry.step_before, c.t, t_end) : 0.0),
+                   "IDASetInitStep");
         system_.roots(c.t, y, g_previous.data());
         mark_boundary_roots(g_previous);
         impl.t_reached = c.t;

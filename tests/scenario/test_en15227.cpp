@@ -145,10 +145,16 @@ TEST_CASE("scenario: bad requests name what is missing", "[scenario]") {
 
 TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not move", "[scenario]") {
   // Until 9 ms: the coupler faces meet at 7.1 ms and the rail hangers and draft gears change mode,
-  // all in mirrored pairs (IDA locates them up to 9.5e-12 s apart, within 1e-9 here). At the
-  // anticlimber's contact (9.88 ms) the trains start to drift apart, 4.7e-7 of the closing speed
-  // at 10 ms and 1.19e-3 at 20 ms, at any rtol: the anticlimber measures its vertical offset in
-  // body 1's axes, which is not mirror-symmetric (models/scenarios/verify.sh prints it).
+  // all in mirrored pairs, which IDA locates up to 1e-13 s apart. Where the first of a pair
+  // restarts IDA, the second may change within the first step after it without a restart, its
+  // lag being within the local tolerance (IdaIntegrator::advance, lag_within_tolerance): the two
+  // trains then differ by a part of the local tolerance, rtol of the closing speed, not by
+  // round-off. Measured: 1.4e-7 of the closing speed (0.014 rtol) from the rail hangers'
+  // "extension segment 1" at 8.08 ms in this 9 ms run; 2.5e-12 up to 9.5 ms in verify.sh's
+  // 20 ms run, whose steps differ. At the anticlimber's contact (9.88 ms) the trains start to
+  // drift apart, 4.8e-7 of the closing speed at 10 ms and 1.19e-3 at 20 ms, at any rtol: the
+  // anticlimber measures its vertical offset in body 1's axes, which is not mirror-symmetric
+  // (models/scenarios/verify.sh prints it).
   ScenarioRequest q = report_car(1);
   q.offset = 0.0;
   q.t_end = 0.009;
@@ -166,8 +172,9 @@ TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not
       for (std::size_t k = 0; k < s.size(); ++k) largest = std::max(largest, std::abs(s[k] + t[k]));
     }
   }
-  CHECK(velocity_difference <= 1e-9 * closing_speed);
-  CHECK(position_difference <= 1e-9 * closing_speed * *q.t_end);
+  const double rtol = model.simulation.rtol;
+  CHECK(velocity_difference <= 0.1 * rtol * closing_speed);
+  CHECK(position_difference <= 0.1 * rtol * closing_speed * *q.t_end);
   // The collision did happen: the lead couplers have bounced back off each other.
   const auto& coupler_vx = run["s1_coupler.vx"];
   CHECK(*std::min_element(coupler_vx.begin(), coupler_vx.end()) < 0.0);
