@@ -22,6 +22,11 @@ The lines' slopes and their scatter (the root-mean-square distance of the points
 line, in decades of error) are printed with it; where either line's error falls by less than
 one decade per decade of CPU (R2 on this model: the rail hangers' bifurcation, bench/r2_jumps.py)
 no ratio is read off it. The points themselves are printed too.
+
+A second table reads the same runs as an engineer would: for an error target (1 % and 0.1 %)
+and quantity, each build's cheapest rtol of the grid at which that rtol and every tighter one
+meet the target (`railcrash converge`'s rule), and the ratio of their CPU. One unlucky point
+at a loose rtol moves it (the rule is strict); a line does not.
 """
 import argparse
 import math
@@ -40,6 +45,8 @@ DEFAULT_RTOLS = "1e-3,7e-4,5e-4,3e-4,2e-4,1e-4,7e-5,5e-5,3e-5,2e-5,1e-5"
 # A line whose error falls by less than this many decades per decade of CPU says little about
 # the cost of an error: a small shift of its points moves the cost read off it by decades.
 FLATTEST_SLOPE = 1.0
+# Error targets of the second table (issue 14's IDA-against-Euler table uses the same two).
+TARGETS = [1e-2, 1e-3]
 
 
 def run(executable, model, rtol, t_end, out):
@@ -129,6 +136,24 @@ def main():
         cost = {w: 10.0 ** ((target - lines[w][0]) / lines[w][1]) for w in lines}
         print(f"| {name} | {10.0 ** target:.2e} | {lines['old'][1]:.2f}, {lines['old'][2]:.2f} | "
               f"{lines['new'][1]:.2f}, {lines['new'][2]:.2f} | **{cost['old'] / cost['new']:.2f}** |")
+
+    # The engineer's reading: for an error target, the cheapest rtol of the grid at which this
+    # and every tighter rtol of the grid meet it (converge's rule), and its CPU.
+    print("\n| quantity | target | old: rtol, CPU s | new: rtol, CPU s | old CPU / new CPU |")
+    print("|---|---|---|---|---|")
+    loosest_first = sorted(rtols, key=float, reverse=True)
+    for target in TARGETS:
+        for name in NAMES:
+            cheapest = {}
+            for w in ("old", "new"):
+                cheapest[w] = None
+                for i, r in enumerate(loosest_first):
+                    if all(error(w, tighter, name) <= target for tighter in loosest_first[i:]):
+                        cheapest[w] = (r, statistics.median(cpu[(w, r)]))
+                        break
+            cells = [f"{c[0]}, {c[1]:.3f}" if c else "none in the grid" for c in (cheapest["old"], cheapest["new"])]
+            ratio = f"**{cheapest['old'][1] / cheapest['new'][1]:.2f}**" if cheapest["old"] and cheapest["new"] else "-"
+            print(f"| {name} | {target:g} | {cells[0]} | {cells[1]} | {ratio} |")
     print(f"\nruns' output in {work}")
     return 0
 
