@@ -663,7 +663,8 @@ void DaeSystem::body_quadrature_rates(double t, const double* q, const double* v
   rates[kLoadWork] = load_power;
 }
 
-void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda) const {
+void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda, double* g,
+                                 double* outputs) const {
   const int nq = body_unknowns();
   const double* q = y;
   const double* v = y + nq;
@@ -674,6 +675,11 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
     const Element& el = *model_.elements()[e];
     double power = 0.0;
     const ElementState<double> s = local_state(e, q, v);
+    if (g != nullptr || outputs != nullptr) {  // roots(): the same local state, the same laws
+      const double* element_lambda = el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(e) : nullptr;
+      if (g != nullptr && el.root_count() > 0) el.roots(t, s, element_lambda, g + root_offset_[e]);
+      if (outputs != nullptr && output_offset_[e] < output_end(e)) el.outputs(s, element_lambda, outputs + output_offset_[e]);
+    }
     if (el.constraint_count() == 0) {
       std::array<Pose<double>, 2> fe{};
       el.add_force(t, s, fe);

@@ -161,6 +161,15 @@ struct IdaIntegrator::Impl {
     double step_before = 0.0;  // [time] IDA's last step before the event
     std::vector<double> y, yp, quad;
   } retry;
+  // The root functions and element outputs from the quadratures' sweep (quadrature()): IDA
+  // evaluates the quadratures at the corrected state of each step it tries, so for the step it
+  // accepts they are the roots and outputs at its end, taken when t and y match bit for bit.
+  struct QuadratureSweep {
+    bool roots_wanted = false, outputs_wanted = false;  // set by advance() before each step
+    bool valid = false, has_outputs = false;
+    double t = 0.0;
+    std::vector<double> y, g, outputs;
+  } sweep;
   // The first trial state whose residual was not finite (cleared before every step).
   double non_finite_t = 0.0;
   std::vector<double> non_finite_y, non_finite_yp;
@@ -230,7 +239,18 @@ struct IdaIntegrator::Impl {
   static int quadrature(realtype t, N_Vector yy, N_Vector, N_Vector rates, void* user) {
     auto* self = static_cast<Impl*>(user);
     try {
-      self->system.quadrature_rates(t, N_VGetArrayPointer(yy), N_VGetArrayPointer(rates));
+      QuadratureSweep& sweep = self->sweep;
+      sweep.valid = false;
+      const double* y_now = N_VGetArrayPointer(yy);
+      double* g = sweep.roots_wanted ? sweep.g.data() : nullptr;
+      double* outputs = sweep.roots_wanted && sweep.outputs_wanted ? sweep.outputs.data() : nullptr;
+      self->system.quadrature_rates(t, y_now, N_VGetArrayPointer(rates), nullptr, g, outputs);
+      if (g != nullptr) {
+        sweep.t = t;
+        std::copy(y_now, y_now + sweep.y.size(), sweep.y.begin());
+        sweep.has_outputs = outputs != nullptr;
+        sweep.valid = true;
+      }
       return 0;
     } catch (...) {
       self->callback_error = std::current_exception();
@@ -437,6 +457,10 @@ void IdaIntegrator::start(double t_end) {
     impl.g_now = impl.g_previous;
     impl.y_local.assign(static_cast<std::size_t>(n), 0.0);
     impl.y_probe.assign(static_cast<std::size_t>(n), 0.0);
+    impl.sweep.y.assign(static_cast<std::size_t>(n), 0.0);
+    impl.sweep.g.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
+    impl.sweep.outputs.assign(system_.output_names().size(), 0.0);
+    impl.sweep.valid = false;
     impl.t_reached = 0.0;
     impl.at_start = true;
     report_events(start_events, y);
@@ -623,6 +647,9 @@ double IdaIntegrator::advance(double t_end) {
   double t_n = impl.t_reached;
   impl.last_sundials_message.clear();
   impl.non_finite_y.clear();
+  impl.sweep.roots_wanted = root_count > 0;
+  impl.sweep.outputs_wanted = step_outputs_wanted();
+  impl.sweep.valid = false;
   int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
   impl.rethrow_callback_error();
   if ((flag == IDA_CONV_FAIL || flag == IDA_ERR_FAIL) && impl.retry.available) {
@@ -660,7 +687,14 @@ double IdaIntegrator::advance(double t_end) {
     // The step's element outputs come from the same sweep as its roots; they stand for the
     // step's end only if no mode changes in it (below).
     double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
-    system_.roots(t_n, y, g_now.data(), step_outputs);
+    const Impl::QuadratureSweep& sweep = impl.sweep;
+    if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.has_outputs) &&
+        std::memcmp(sweep.y.data(), y, sizeof(double) * static_cast<std::size_t>(n)) == 0) {
+      std::copy(sweep.g.begin(), sweep.g.end(), g_now.begin());
+      if (step_outputs != nullptr) std::copy(sweep.outputs.begin(), sweep.outputs.end(), step_outputs);
+    } else {
+      system_.roots(t_n, y, g_now.data(), step_outputs);
+    }
     crossings.clear();
     for (int k = 0; k < root_count; ++k) {
       const auto kk = static_cast<std::size_t>(k);

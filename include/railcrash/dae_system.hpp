@@ -140,7 +140,13 @@ class DaeSystem {
   // ---- quadratures integrated alongside: [ integral of kinetic energy dt,
   //      work of applied loads, work done on each element (by the bodies), work on penalties ]
   int quadrature_count() const { return 3 + static_cast<int>(model_.elements().size()); }
-  void quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda = nullptr) const;
+  /// With `g` (root_count()) and `outputs` (output_names().size()), y holding the multipliers
+  /// as IDA's does, the root functions and the element outputs at (t, y) as well, from the same
+  /// sweep, equal bit for bit to roots(t, y, g, outputs): IDA evaluates the quadratures at the
+  /// corrected state of each step it tries, so the accepted step's roots and outputs need no
+  /// sweep of their own.
+  void quadrature_rates(double t, const double* y, double* rates, const double* penalty_lambda = nullptr,
+                        double* g = nullptr, double* outputs = nullptr) const;
   /// The rates that do not come from elements (kinetic energy, loads' power); the rest is
   /// written by quadrature_rates or by generalized_forces' `powers`.
   void body_quadrature_rates(double t, const double* q, const double* v, double* rates) const;
