@@ -1,6 +1,9 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -51,4 +54,31 @@ TEST_CASE("a non-finite law is traced to the element or body it comes from, with
   const std::vector<double> y_tame = tame_system.initial_state();
   const std::vector<double> yp_tame(y_tame.size(), 0.0);
   CHECK(tame_system.non_finite_source(0.0, y_tame.data(), yp_tame.data()).empty());
+}
+
+TEST_CASE("the quadratures' sweep gives the roots and outputs of roots() bit for bit, and the same rates", "[dae]") {
+  // IdaIntegrator takes a step's roots and outputs from this sweep (QuadratureSweep): any
+  // difference from roots() would change where events are found.
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  DaeSystem system(model);
+  REQUIRE(system.root_count() > 0);
+  REQUIRE(!system.output_names().empty());
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 5; ++trial) {
+    const std::vector<double> y = testing::random_state(system, rng, 0.05 * (trial + 1));
+    const double t = 0.01 * trial;
+    const auto nquad = static_cast<std::size_t>(system.quadrature_count());
+    std::vector<double> rates(nquad), rates_fused(nquad);
+    std::vector<double> g(static_cast<std::size_t>(system.root_count())), g_fused(g.size());
+    std::vector<double> outputs(system.output_names().size()), outputs_fused(outputs.size());
+    system.quadrature_rates(t, y.data(), rates.data());
+    system.roots(t, y.data(), g.data(), outputs.data());
+    system.quadrature_rates(t, y.data(), rates_fused.data(), nullptr, g_fused.data(), outputs_fused.data());
+    CHECK(std::memcmp(rates.data(), rates_fused.data(), sizeof(double) * nquad) == 0);
+    CHECK(std::memcmp(g.data(), g_fused.data(), sizeof(double) * g.size()) == 0);
+    CHECK(std::memcmp(outputs.data(), outputs_fused.data(), sizeof(double) * outputs.size()) == 0);
+    // Not a vacuous comparison: the state reaches the elements' roots and outputs.
+    CHECK(std::count_if(g.begin(), g.end(), [](double v) { return v != 0.0; }) > 0);
+    CHECK(std::count_if(outputs.begin(), outputs.end(), [](double v) { return v != 0.0; }) > 0);
+  }
 }
