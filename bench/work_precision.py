@@ -11,8 +11,9 @@ at the same rtol need not be equally accurate. Here both executables (this tree'
 build/railcrash, or --executable, and COMMIT's, built by compare_commit.py) run the same
 model (compare_commit.py's choice) at every rtol of a grid, interleaved, REPEATS times each;
 a run's cost is its process's median CPU (user + system), its errors those of
-compare_accuracy.py (max crush, peak coupler force, R2, CFC-60 car body, each against the
-same executable's own run at REFERENCE_RTOL).
+compare_accuracy.py (max crush, peak coupler force, R2, CFC-60 car body) and two event times
+(the struck car's draft-gear pin shear and the anticlimbers' first contact), each against the
+same executable's own run at REFERENCE_RTOL.
 
 For each quantity and build a straight line is fitted to log10(error) against log10(CPU)
 over the grid (least squares): the build's work-precision line. The figure is the ratio of
@@ -40,7 +41,21 @@ from child_cpu import run_timed
 from compare_accuracy import quantities
 from compare_commit import MODEL, ROOT, accepts, build_commit
 
-NAMES = ["max crush", "peak coupler force", "R2", "CFC-60 car body"]
+NAMES = ["max crush", "peak coupler force", "R2", "CFC-60 car body", "pin shear time", "anticlimber contact time"]
+# Event timing (issue 14's fifth quantity): the first occurrence of these (element, event) pairs
+# in events.csv, as in the IDA-against-Euler table of bench/README.md (the struck car's
+# draft-gear pin shear near 4.76 ms, the anticlimbers' first contact near 6.19 ms); relative
+# errors over those times.
+EVENTS = {"pin shear time": ("car2_draft_gear", "pin shear"), "anticlimber contact time": ("anticlimber", "contact")}
+
+
+def with_events(found):
+    """compare_accuracy's quantities with the event times of EVENTS added as quantities."""
+    for name, key in EVENTS.items():
+        found[name] = found["events"].get(key, math.nan)
+    return found
+
+
 DEFAULT_RTOLS = "1e-3,7e-4,5e-4,3e-4,2e-4,1e-4,7e-5,5e-5,3e-5,2e-5,1e-5"
 # A line whose error falls by less than this many decades per decade of CPU says little about
 # the cost of an error: a small shift of its points moves the cost read off it by decades.
@@ -55,7 +70,7 @@ def run(executable, model, rtol, t_end, out):
     quiet = ["--quiet"] if "--quiet" in usage else []
     cpu, _ = run_timed([executable, "run", model, "--integrator", "ida", "--rtol", rtol, "--t-end", str(t_end),
                         "--out", out] + quiet)
-    return cpu, quantities(out)
+    return cpu, with_events(quantities(out))
 
 
 def fit(points):

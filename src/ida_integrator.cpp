@@ -39,13 +39,14 @@ std::string flag_name(int flag) {
 /// mode at most once here, and not at all when it has just changed at this instant
 /// (`changed_elements`, flags per element, empty: none has; the elements changed here are
 /// flagged too): a mode it enters sits on its own boundary, where round-off alone would decide
-/// whether it flips back.
+/// whether it flips back. `rates_cache` keeps the consistent-rates solver's ordering between
+/// restarts of one run.
 void restart_state(DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
-                   std::vector<EventRecord>& events, std::vector<char>& changed_elements) {
+                   std::vector<EventRecord>& events, std::vector<char>& changed_elements, ConsistentRatesCache& rates_cache) {
   changed_elements.resize(system.model().elements().size(), 0);
-  consistent_rates(system, t, y, yp);
+  consistent_rates(system, t, y, yp, &rates_cache);
   for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events, &changed_elements); ++pass)
-    consistent_rates(system, t, y, yp);
+    consistent_rates(system, t, y, yp, &rates_cache);
 }
 
 /// SUNLinSol_KLU's initialize (called by IDA at the first solve after every IDAInit or
@@ -147,6 +148,7 @@ struct IdaIntegrator::Impl {
   int taylor_order = -1;
   double taylor_time = 0.0;
   std::vector<EventRecord> events;
+  ConsistentRatesCache rates_cache;  // the consistent-rates solver's ordering, kept between restarts
   struct Crossing {
     double t;
     int element, local;
@@ -403,7 +405,7 @@ void IdaIntegrator::start(double t_end) {
     std::vector<double> yp0;
     std::vector<EventRecord> start_events = settling_events;
     std::vector<char> changed_at_start;  // none yet
-    restart_state(system_, 0.0, y0, yp0, start_events, changed_at_start);
+    restart_state(system_, 0.0, y0, yp0, start_events, changed_at_start, impl.rates_cache);
     std::copy(y0.begin(), y0.end(), y);
     std::copy(yp0.begin(), yp0.end(), yp);
     const std::vector<double> ids = system_.differential_ids();
@@ -822,7 +824,7 @@ double IdaIntegrator::advance(double t_end) {
         std::vector<char> changed_now(model.elements().size(), 0);  // the elements that changed at c.t
         for (std::size_t k = 0; k < done.size(); ++k)
           if (change_times[k] == c.t) changed_now[static_cast<std::size_t>(done[k])] = 1;
-        restart_state(system_, c.t, y_restart, yp_restart, events, changed_now);
+        restart_state(system_, c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
         report_events(events, y_restart.data());
         impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
         std::copy(y_restart.begin(), y_restart.end(), y);

@@ -206,7 +206,20 @@ AssemblyReport assemble_initial_state(const DaeSystem& system, std::vector<doubl
   return report;
 }
 
-void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp) {
+struct ConsistentRatesCache::Impl {
+  Eigen::SparseLU<SparseMatrix> lu;
+  std::vector<SparseMatrix::StorageIndex> outer, inner;  // the pattern lu's ordering was made for
+  bool analysed = false;
+  long reused = 0, analyses = 0;
+};
+
+ConsistentRatesCache::ConsistentRatesCache() : impl_(std::make_unique<Impl>()) {}
+ConsistentRatesCache::~ConsistentRatesCache() = default;
+long ConsistentRatesCache::reused() const { return impl_->reused; }
+long ConsistentRatesCache::analysed() const { return impl_->analyses; }
+
+void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
+                      ConsistentRatesCache* cache) {
   const int nq = system.body_unknowns();
   const int m = system.constraint_rows();
   yp.assign(y.size(), 0.0);
@@ -233,8 +246,26 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
   SparseMatrix kkt(nq + m, nq + m);
   kkt.setFromTriplets(entries.begin(), entries.end());
   kkt.makeCompressed();
-  Eigen::SparseLU<SparseMatrix> lu;
-  lu.compute(kkt);
+  // SparseLU's analyzePattern (COLAMD ordering, elimination tree) reads the pattern alone, so
+  // a kept analysis of the same pattern gives the factorization compute() would.
+  Eigen::SparseLU<SparseMatrix> local_lu;
+  Eigen::SparseLU<SparseMatrix>& lu = cache ? cache->impl_->lu : local_lu;
+  const auto* outer = kkt.outerIndexPtr();
+  const auto* inner = kkt.innerIndexPtr();
+  const std::size_t columns = static_cast<std::size_t>(kkt.cols()) + 1, nonzeros = static_cast<std::size_t>(kkt.nonZeros());
+  if (cache && cache->impl_->analysed && cache->impl_->outer.size() == columns && cache->impl_->inner.size() == nonzeros &&
+      std::equal(outer, outer + columns, cache->impl_->outer.begin()) && std::equal(inner, inner + nonzeros, cache->impl_->inner.begin())) {
+    ++cache->impl_->reused;
+  } else {
+    lu.analyzePattern(kkt);
+    if (cache) {
+      cache->impl_->outer.assign(outer, outer + columns);
+      cache->impl_->inner.assign(inner, inner + nonzeros);
+      cache->impl_->analysed = true;
+      ++cache->impl_->analyses;
+    }
+  }
+  lu.factorize(kkt);
   if (lu.info() != Eigen::Success) {
     std::string zero;
     for (const Body& b : system.model().bodies())

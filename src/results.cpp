@@ -279,9 +279,14 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     last_folder_check_ = now;
     folder_checked_ = true;
   }
-  if (failure_.empty() && now - last_summary_ > std::chrono::seconds(2)) {
+  // The running summary.json every 2 s of wall time, or every 50 times what writing it took,
+  // whichever is longer: its text grows with the model (6 MB at 200 + 200 cars) and a run's
+  // length with it, so a fixed interval would cost in proportion to the square of the model.
+  if (failure_.empty() && now - last_summary_ > running_summary_interval_) {
     write_running_summary(integrator_);
-    last_summary_ = now;
+    const auto written = std::chrono::steady_clock::now();
+    running_summary_interval_ = std::max<std::chrono::steady_clock::duration>(std::chrono::seconds(2), 50 * (written - now));
+    last_summary_ = written;
   }
 }
 

@@ -8,6 +8,7 @@
 // (Newton does not converge) are input errors naming the elements involved.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "railcrash/dae_system.hpp"
@@ -30,7 +31,31 @@ AssemblyReport assemble_initial_state(const DaeSystem& system, std::vector<doubl
 /// G v = 0 do not involve the algebraic unknowns, so lambda is fixed only by this hidden
 /// constraint. Throws SolverError when the matrix is singular (a body with zero inertia
 /// that no joint holds).
-void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp);
+///
+/// With a `cache`, the fill-reducing ordering of the matrix (a function of its pattern only) is
+/// kept and reused while the pattern stays the same, as it does between most restarts of a
+/// run: the factors, and so the rates, are the same bit for bit as without one.
+class ConsistentRatesCache;
+void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
+                      ConsistentRatesCache* cache = nullptr);
+
+/// What consistent_rates keeps from one call to the next for one model: the sparse LU object
+/// with its ordering and work storage, and the pattern the ordering was made for.
+class ConsistentRatesCache {
+ public:
+  ConsistentRatesCache();
+  ~ConsistentRatesCache();
+  ConsistentRatesCache(const ConsistentRatesCache&) = delete;
+  ConsistentRatesCache& operator=(const ConsistentRatesCache&) = delete;
+  /// Calls that reused the ordering, and calls that made one (statistics for tests and benchmarks).
+  long reused() const;
+  long analysed() const;
+
+ private:
+  friend void consistent_rates(const DaeSystem&, double, std::vector<double>&, std::vector<double>&, ConsistentRatesCache*);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 struct EquilibriumReport {
   int steps = 0;                         // pseudo-time steps taken

@@ -177,6 +177,8 @@ class ResultWriter : public RunObserver {
   mutable double filtered_class_ = 0.0;
   std::chrono::steady_clock::time_point last_flush_;
   std::chrono::steady_clock::time_point last_summary_;  // last running summary.json
+  // At least 2 s, and 50 times what the last running summary.json took to write.
+  std::chrono::steady_clock::duration running_summary_interval_ = std::chrono::seconds(2);
   std::chrono::steady_clock::duration folder_check_interval_ = std::chrono::milliseconds(250);
   std::chrono::steady_clock::time_point last_folder_check_;
   bool folder_checked_ = false;                          // by a sample
