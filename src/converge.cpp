@@ -731,9 +731,14 @@ std::string convergence_markdown(const ConvergeResult& r) {
      << r.output_interval << " s; " << r.euler.size() << " Euler and " << r.ida.size() << " IDA runs against an IDA reference at rtol "
      << r.reference.rtol << "; " << r.jobs << " job" << (r.jobs > 1 ? "s (wall times under parallel load)" : "") << "; "
      << fmt("%.3g", r.total_seconds) << " s in all.";
-  if (r.element_stability_limit > 0.0)
-    md << " Euler stability limit of the elements " << fmt("%.4g", r.element_stability_limit) << " s";
-  if (r.stability_limit > 0.0) md << ", with the penalty joints at the first step " << fmt("%.4g", r.stability_limit) << " s.";
+  // Either limit may be unknown (with --euler-dt the elements' limit is not computed).
+  if (r.element_stability_limit > 0.0 && r.stability_limit > 0.0)
+    md << " Euler stability limit of the elements " << fmt("%.4g", r.element_stability_limit) << " s, with the penalty joints at the first step "
+       << fmt("%.4g", r.stability_limit) << " s.";
+  else if (r.element_stability_limit > 0.0)
+    md << " Euler stability limit of the elements " << fmt("%.4g", r.element_stability_limit) << " s.";
+  else if (r.stability_limit > 0.0)
+    md << " Euler stability limit with the penalty joints at the first step " << fmt("%.4g", r.stability_limit) << " s.";
   md << "\n\n";
   if (!r.reference_note.empty()) md << "Reference: " << r.reference_note << "\n\n";
   if (!r.reference.ok) md << "**The reference run failed** (" << r.reference.message << "): no errors can be computed.\n\n";
