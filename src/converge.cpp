@@ -187,7 +187,7 @@ class Recorder : public RunObserver {
     if (start_.empty()) start_.assign(y, y + nq);
     run_.times.push_back(t);
     for (int k = 0; k < nq; ++k) run_.displacements.push_back(y[k] - start_[static_cast<std::size_t>(k)]);
-    track_peaks(outputs);
+    track_peaks(outputs, FreshOutputs{});
     if (responses_) responses_->sample(t, y, lambda, quadratures, outputs);
     if (accelerations_) accelerations_->sample(t, y, lambda, quadratures, outputs);
   }
@@ -199,15 +199,16 @@ class Recorder : public RunObserver {
   /// Peaks and responses from every accepted step and both sides of every event as well, as
   /// `run`'s summary takes them: a peak must not depend on the output interval (a contact's
   /// damper force peaks at the contact instant, which no output row need hit).
-  void step(double t, const double* y, const double* lambda, const double* outputs) override {
-    track_peaks(outputs);
-    if (responses_) responses_->step(t, y, lambda, outputs);
+  void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override {
+    track_peaks(outputs, fresh);
+    if (responses_) responses_->step(t, y, lambda, outputs, fresh);
   }
   bool observes_steps() const override { return true; }
 
  private:
-  void track_peaks(const double* outputs) {
-    for (std::size_t k = 0; k < run_.peak_abs.size(); ++k) {
+  void track_peaks(const double* outputs, const FreshOutputs& fresh) {
+    const std::size_t end = std::min(run_.peak_abs.size(), static_cast<std::size_t>(fresh.end));
+    for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < end; ++k) {
       run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs[k]));
       run_.peak_max[k] = std::max(run_.peak_max[k], outputs[k]);
     }

@@ -47,20 +47,21 @@ void ResponseTracker::sample(double, const double* y, const double*, const doubl
     for (const CrushGauge& g : settings_.crush_gauges) initial_length_.push_back(gauge_length(g, y));
     started_ = true;
   }
-  track_extrema(y, outputs);
+  track_extrema(y, outputs, FreshOutputs{});
 }
 
-void ResponseTracker::step(double, const double* y, const double*, const double* outputs) {
-  if (started_) track_extrema(y, outputs);  // (events at the start come before the first sample)
+void ResponseTracker::step(double, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) {
+  if (started_) track_extrema(y, outputs, fresh);  // (events at the start come before the first sample)
 }
 
-void ResponseTracker::track_extrema(const double* y, const double* outputs) {
+void ResponseTracker::track_extrema(const double* y, const double* outputs, const FreshOutputs& fresh) {
   for (std::size_t k = 0; k < settings_.crush_gauges.size(); ++k)
     responses_.max_crush[k] = std::max(responses_.max_crush[k], initial_length_[k] - gauge_length(settings_.crush_gauges[k], y));
   if (vertical_force_column_ < 0) return;
-  if (!vertical_window_closed_)
+  if (!vertical_window_closed_ && fresh.has(vertical_force_column_))
     responses_.max_vertical_force = std::max(responses_.max_vertical_force, std::abs(outputs[vertical_force_column_]));
-  responses_.max_anticlimber_crush = std::max(responses_.max_anticlimber_crush, outputs[horizontal_deformation_column_]);
+  if (fresh.has(horizontal_deformation_column_))
+    responses_.max_anticlimber_crush = std::max(responses_.max_anticlimber_crush, outputs[horizontal_deformation_column_]);
 }
 
 void ResponseTracker::event(const EventRecord& record, const double* y) {

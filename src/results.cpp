@@ -224,7 +224,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
   const std::size_t output_count = system_.output_names().size();
   if (timeseries_) write_row_tail(*timeseries_, outputs, output_count);
-  track_extrema(t, outputs);
+  track_extrema(t, outputs, FreshOutputs{});
   body_accelerations(system_, t, y, lambda, acceleration_.data(), acceleration_scratch_);
   if (!system_.model().output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
@@ -290,15 +290,20 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
 }
 
-void ResultWriter::step(double t, const double*, const double*, const double* outputs) { track_extrema(t, outputs); }
+void ResultWriter::step(double t, const double*, const double*, const double* outputs, const FreshOutputs& fresh) {
+  track_extrema(t, outputs, fresh);
+}
 
-void ResultWriter::track_extrema(double t, const double* outputs) {
-  for (std::size_t k = 0; k < peak_output_.size(); ++k)
+void ResultWriter::track_extrema(double t, const double* outputs, const FreshOutputs& fresh) {
+  const std::size_t end = std::min(peak_output_.size(), static_cast<std::size_t>(fresh.end));
+  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < end; ++k)
     if (std::abs(outputs[k]) > peak_output_[k]) {
       peak_output_[k] = std::abs(outputs[k]);
       peak_time_[k] = t;
     }
+  // A car's crush sums several elements' outputs: only where all of them are fresh.
   for (CarCrush& car : cars_) {
+    if (!std::all_of(car.columns.begin(), car.columns.end(), [&](int column) { return fresh.has(column); })) continue;
     double crush = 0.0;  // [length]
     for (std::size_t k = 0; k < car.columns.size(); ++k)
       crush += car.shares[k] * std::max(0.0, outputs[car.columns[k]]);

@@ -55,9 +55,9 @@ class ProgressObserver : public RunObserver {
     for (RunObserver* o : next_) o->event(record, y);
   }
   /// Steps are passed on while the samples are (the extrema end where the files do).
-  void step(double t, const double* y, const double* lambda, const double* outputs) override {
+  void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override {
     if (non_finite_output_.empty())
-      for (RunObserver* o : next_) o->step(t, y, lambda, outputs);
+      for (RunObserver* o : next_) o->step(t, y, lambda, outputs, fresh);
   }
   bool observes_steps() const override {
     return std::any_of(next_.begin(), next_.end(), [](const RunObserver* o) { return o->observes_steps(); });

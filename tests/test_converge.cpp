@@ -47,8 +47,9 @@ class TraceObserver : public RunObserver {
   }
   // The peak from every accepted step and both sides of every event as well (as `run` and
   // the study take it), so it does not depend on the output interval.
-  void step(double, const double*, const double*, const double* outputs) override {
-    if (index_ < system_.output_names().size()) trace_.peak = std::max(trace_.peak, outputs[index_]);
+  void step(double, const double*, const double*, const double* outputs, const FreshOutputs& fresh) override {
+    if (index_ < system_.output_names().size() && fresh.has(static_cast<int>(index_)))
+      trace_.peak = std::max(trace_.peak, outputs[index_]);
   }
   bool observes_steps() const override { return true; }
 

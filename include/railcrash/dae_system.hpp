@@ -21,6 +21,7 @@
 
 #include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "railcrash/model.hpp"
@@ -217,6 +218,10 @@ class DaeSystem {
   void outputs(const double* y, const double* lambda, double* out) const;
   /// Element e's outputs only, into their places in the whole array `out` (as outputs() fills it).
   void element_outputs(int e, const double* y, const double* lambda, double* out) const;
+  /// Element e's columns of outputs(): first, one past the last.
+  std::pair<int, int> output_range(int e) const {
+    return {output_offset_[static_cast<std::size_t>(e)], output_end(static_cast<std::size_t>(e))};
+  }
 
   /// Mass-matrix diagonal entry of body unknown k (mass or inertia).
   double mass_diagonal(int k) const { return mass_[static_cast<std::size_t>(k)]; }

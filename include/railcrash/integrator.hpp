@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +30,17 @@ struct RunStatistics {
   double settling_displacement = 0.0;  // [length] static equilibrium: largest move
 };
 
+/// Which element outputs a RunObserver::step() call holds values of at its state: all of them
+/// (the end of an accepted step, a restart), or one element's alone (either side of that
+/// element's mode change located inside a step, where only its outputs are evaluated: every
+/// output at every such event made a train's cost grow as N^2). The other columns hold values
+/// from an earlier evaluation and must not be read.
+struct FreshOutputs {
+  int begin = 0;                               // first evaluated column of DaeSystem::outputs
+  int end = std::numeric_limits<int>::max();   // one past the last
+  bool has(int column) const { return column >= begin && column < end; }
+};
+
 /// Receives the state at every output time (t = 0 included).
 class RunObserver {
  public:
@@ -43,8 +55,11 @@ class RunObserver {
   /// change (before it: the old modes; after it: the new ones), whatever the output times:
   /// for extrema (peaks, crush, responses) that must not depend on the output interval.
   /// Nothing is written from it. lambda as in sample(); outputs: the element outputs there
-  /// (DaeSystem::outputs), evaluated once for all observers.
-  virtual void step(double /*t*/, const double* /*y*/, const double* /*lambda*/, const double* /*outputs*/) {}
+  /// (DaeSystem::outputs), evaluated once for all observers, but only the columns `fresh` has:
+  /// an extremum of a quantity computed from y, or from fresh columns alone, is taken here;
+  /// one that also needs other columns (a sum over several elements' outputs) is not.
+  virtual void step(double /*t*/, const double* /*y*/, const double* /*lambda*/, const double* /*outputs*/,
+                    const FreshOutputs& /*fresh*/) {}
   /// True when step() does something: only then does the run loop evaluate the outputs per step.
   virtual bool observes_steps() const { return false; }
   /// Why the observer cannot go on (a failed write: the OS's reason), "" while it can; the

@@ -47,7 +47,7 @@ class ResponseTracker : public RunObserver {
   void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override;
   void event(const EventRecord& record, const double* y) override;
   /// The largest crush and forces from every accepted step and both sides of every event.
-  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
   bool observes_steps() const override { return true; }
   Responses result() const;
   /// The responses as a JSON object (for summary.json).
@@ -55,8 +55,9 @@ class ResponseTracker : public RunObserver {
 
  private:
   double gauge_length(const CrushGauge& gauge, const double* y) const;
-  /// Updates the largest crush and forces with the state y and its element outputs.
-  void track_extrema(const double* y, const double* outputs);
+  /// Updates the largest crush and forces with the state y and its element outputs (those
+  /// `fresh` has).
+  void track_extrema(const double* y, const double* outputs, const FreshOutputs& fresh);
 
   const DaeSystem& system_;
   ResponseSettings settings_;

@@ -117,7 +117,7 @@ class ResultWriter : public RunObserver {
   void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override;
   void event(const EventRecord& record, const double* y) override;
   /// Element output peaks and car crush from every accepted step and both sides of every event.
-  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
   bool observes_steps() const override { return true; }
   /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.
   std::string failure() const override { return failure_; }
@@ -187,7 +187,7 @@ class ResultWriter : public RunObserver {
   std::string failure_;                                  // first failed write, with the OS's reason
 
   /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.
-  void track_extrema(double t, const double* outputs);
+  void track_extrema(double t, const double* outputs, const FreshOutputs& fresh);
   std::string summary_text(const RunOutcome& outcome, const std::string& status, const std::string& integrator,
                            const std::string& extra_json) const;
   /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.

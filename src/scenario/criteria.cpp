@@ -268,24 +268,30 @@ double ScenarioTracker::car_crush_now(std::size_t k, const double* outputs) cons
   return shared_crush(crush, car.shares);
 }
 
-void ScenarioTracker::step(double, const double* y, const double*, const double* outputs) {
+void ScenarioTracker::step(double, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) {
   if (times_.empty()) return;  // the references (L(0), the offset at 0) come from the first sample
   for (std::size_t k = 0; k < front_index_.size(); ++k)
     step_extremes_.shortening[k] =
         std::max(step_extremes_.shortening[k], lengths_[k].front() - distance(y, front_index_[k], rear_index_[k]));
-  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k)
-    step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], car_crush_now(k, outputs));
+  // A car's crush sums several elements' outputs: only where all of them are fresh.
+  for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
+    const std::vector<int>& columns = crush_of_cars_[k].columns;
+    if (std::all_of(columns.begin(), columns.end(), [&](int column) { return fresh.has(column); }))
+      step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], car_crush_now(k, outputs));
+  }
+  bool offset_known = true;
   double offset = 0.0;  // [length]
   if (vertical_offset_column_ >= 0) {
+    offset_known = fresh.has(vertical_offset_column_);
     offset = outputs[vertical_offset_column_];
-    overridden_ = overridden_ || outputs[override_column_] > 0.0;
+    if (fresh.has(override_column_)) overridden_ = overridden_ || outputs[override_column_] > 0.0;
   } else if (interface_upper_ >= 0) {
     offset = y[3 * interface_upper_ + 1] - y[3 * interface_lower_ + 1];
   }
-  if (!vertical_offset_.empty())
+  if (!vertical_offset_.empty() && offset_known)
     step_extremes_.offset_change = std::max(step_extremes_.offset_change, std::abs(offset - vertical_offset_.front()));
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
-    step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
+    if (fresh.has(wheel_columns_[k])) step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
 }
 
 void ScenarioTracker::sample(double t, const double* y, const double*, const double*, const double* outputs) {

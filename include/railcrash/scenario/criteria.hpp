@@ -124,7 +124,7 @@ class ScenarioTracker : public RunObserver {
   /// The extrema of the crush, gauge, interface and wheel criteria also from every accepted
   /// step and both sides of every event (the mean deceleration stays on the output rows: it
   /// filters a uniform record).
-  void step(double t, const double* y, const double* lambda, const double* outputs) override;
+  void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
   bool observes_steps() const override { return true; }
   std::vector<CriterionResult> results() const;
   /// The scenario and its criteria as a JSON object (summary.json's "scenario").
