@@ -207,8 +207,7 @@ class Recorder : public RunObserver {
 
  private:
   void track_peaks(const double* outputs, const FreshOutputs& fresh) {
-    const std::size_t end = std::min(run_.peak_abs.size(), static_cast<std::size_t>(fresh.end));
-    for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < end; ++k) {
+    for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(run_.peak_abs.size()); ++k) {
       run_.peak_abs[k] = std::max(run_.peak_abs[k], std::abs(outputs[k]));
       run_.peak_max[k] = std::max(run_.peak_max[k], outputs[k]);
     }

@@ -215,11 +215,8 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
     const Element& el = *model_.elements()[e];
     const ElementState<double> s = local_state(e, q, v);
     const int m = el.constraint_count();
-    if (extras && (extras->roots || extras->outputs)) {
-      const double* element_lambda = m > 0 ? extras->y_lambda + model_.constraint_offset(e) : nullptr;
-      if (extras->roots && el.root_count() > 0) el.roots(t, s, element_lambda, extras->roots + root_offset_[e]);
-      if (extras->outputs && output_offset_[e] < output_end(e)) el.outputs(s, element_lambda, extras->outputs + output_offset_[e]);
-    }
+    if (extras && (extras->roots || extras->outputs))
+      element_roots_and_outputs(e, t, s, extras->y_lambda, extras->roots, extras->outputs);
     std::array<Pose<double>, 2> fe{};
     double* element_power = powers ? powers + kFirstElementWork + static_cast<int>(e) : nullptr;
     if (element_power) *element_power = 0.0;
@@ -675,11 +672,7 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
     const Element& el = *model_.elements()[e];
     double power = 0.0;
     const ElementState<double> s = local_state(e, q, v);
-    if (g != nullptr || outputs != nullptr) {  // roots(): the same local state, the same laws
-      const double* element_lambda = el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(e) : nullptr;
-      if (g != nullptr && el.root_count() > 0) el.roots(t, s, element_lambda, g + root_offset_[e]);
-      if (outputs != nullptr && output_offset_[e] < output_end(e)) el.outputs(s, element_lambda, outputs + output_offset_[e]);
-    }
+    if (g != nullptr || outputs != nullptr) element_roots_and_outputs(e, t, s, y + 2 * nq, g, outputs);  // as roots()
     if (el.constraint_count() == 0) {
       std::array<Pose<double>, 2> fe{};
       el.add_force(t, s, fe);
@@ -736,11 +729,16 @@ void DaeSystem::roots(double t, const double* y, double* g, double* outputs) con
     const bool has_roots = el.root_count() > 0;
     const bool has_outputs = outputs != nullptr && output_offset_[e] < output_end(e);
     if (!has_roots && !has_outputs) continue;
-    const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-    const ElementState<double> s = local_state(e, y, y + nq);
-    if (has_roots) el.roots(t, s, element_lambda, g + root_offset_[e]);
-    if (has_outputs) el.outputs(s, element_lambda, outputs + output_offset_[e]);
+    element_roots_and_outputs(e, t, local_state(e, y, y + nq), lambda, g, outputs);
   }
+}
+
+void DaeSystem::element_roots_and_outputs(std::size_t e, double t, const ElementState<double>& s, const double* lambda,
+                                          double* g, double* outputs) const {
+  const Element& el = *model_.elements()[e];
+  const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
+  if (g != nullptr && el.root_count() > 0) el.roots(t, s, element_lambda, g + root_offset_[e]);
+  if (outputs != nullptr && output_offset_[e] < output_end(e)) el.outputs(s, element_lambda, outputs + output_offset_[e]);
 }
 
 void DaeSystem::element_roots(int e, double t, const double* y, double* g) const {

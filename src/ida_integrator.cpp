@@ -168,7 +168,7 @@ struct IdaIntegrator::Impl {
   // accepts they are the roots and outputs at its end, taken when t and y match bit for bit.
   struct QuadratureSweep {
     bool roots_wanted = false, outputs_wanted = false;  // set by advance() before each step
-    bool valid = false, has_outputs = false;
+    bool valid = false;
     double t = 0.0;
     std::vector<double> y, g, outputs;
   } sweep;
@@ -250,7 +250,6 @@ struct IdaIntegrator::Impl {
       if (g != nullptr) {
         sweep.t = t;
         std::copy(y_now, y_now + sweep.y.size(), sweep.y.begin());
-        sweep.has_outputs = outputs != nullptr;
         sweep.valid = true;
       }
       return 0;
@@ -690,7 +689,7 @@ double IdaIntegrator::advance(double t_end) {
     // step's end only if no mode changes in it (below).
     double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
     const Impl::QuadratureSweep& sweep = impl.sweep;
-    if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.has_outputs) &&
+    if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.outputs_wanted) &&
         std::memcmp(sweep.y.data(), y, sizeof(double) * static_cast<std::size_t>(n)) == 0) {
       std::copy(sweep.g.begin(), sweep.g.end(), g_now.begin());
       if (step_outputs != nullptr) std::copy(sweep.outputs.begin(), sweep.outputs.end(), step_outputs);

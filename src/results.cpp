@@ -295,15 +295,14 @@ void ResultWriter::step(double t, const double*, const double*, const double* ou
 }
 
 void ResultWriter::track_extrema(double t, const double* outputs, const FreshOutputs& fresh) {
-  const std::size_t end = std::min(peak_output_.size(), static_cast<std::size_t>(fresh.end));
-  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < end; ++k)
+  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(peak_output_.size()); ++k)
     if (std::abs(outputs[k]) > peak_output_[k]) {
       peak_output_[k] = std::abs(outputs[k]);
       peak_time_[k] = t;
     }
   // A car's crush sums several elements' outputs: only where all of them are fresh.
   for (CarCrush& car : cars_) {
-    if (!std::all_of(car.columns.begin(), car.columns.end(), [&](int column) { return fresh.has(column); })) continue;
+    if (!fresh.has_all(car.columns)) continue;
     double crush = 0.0;  // [length]
     for (std::size_t k = 0; k < car.columns.size(); ++k)
       crush += car.shares[k] * std::max(0.0, outputs[car.columns[k]]);

@@ -310,8 +310,8 @@ namespace {
 class CrushWitness : public RunObserver {
  public:
   CrushWitness(const DaeSystem& system, ResultWriter& writer)
-      : system_(system), writer_(writer), cars_(cars_of(system)), all_(system.output_names().size()),
-        every_instant_(cars_.size(), 0.0), full_instants_(cars_.size(), 0.0) {}
+      : cars_(cars_of(system)), every_instant_(cars_.size(), 0.0), full_instants_(cars_.size(), 0.0), system_(system),
+        writer_(writer), all_(system.output_names().size()) {}
   void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
     writer_.sample(t, y, lambda, quadratures, outputs);
     witness(y, lambda, outputs, FreshOutputs{});
@@ -341,8 +341,7 @@ class CrushWitness : public RunObserver {
       for (std::size_t k = 0; k < cars_[c].columns.size(); ++k)
         crush += cars_[c].shares[k] * std::max(0.0, all_[static_cast<std::size_t>(cars_[c].columns[k])]);
       every_instant_[c] = std::max(every_instant_[c], crush);
-      const bool whole = std::all_of(cars_[c].columns.begin(), cars_[c].columns.end(), [&](int k) { return fresh.has(k); });
-      if (whole) full_instants_[c] = std::max(full_instants_[c], crush);
+      if (fresh.has_all(cars_[c].columns)) full_instants_[c] = std::max(full_instants_[c], crush);
     }
   }
   const DaeSystem& system_;

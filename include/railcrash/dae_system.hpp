@@ -239,6 +239,11 @@ class DaeSystem {
   void load_forces(double t, const double* q, double* f) const;
   /// One past element e's last output in output_names().
   int output_end(std::size_t e) const;
+  /// Element e's roots into g and its outputs into `outputs` (their places in the whole arrays;
+  /// either may be null) at its local state s; lambda: all the multipliers (y + 2 nq). The one
+  /// place roots(), the quadratures' sweep and generalized_forces' extras evaluate them.
+  void element_roots_and_outputs(std::size_t e, double t, const ElementState<double>& s, const double* lambda, double* g,
+                                 double* outputs) const;
 
   const Model& model_;
   ElementStates modes_;  // the run's element modes and histories (the only state a DaeSystem changes)

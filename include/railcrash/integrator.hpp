@@ -2,7 +2,9 @@
 // and the outcome of a run. Integrators see a DaeSystem, never an element.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -39,6 +41,14 @@ struct FreshOutputs {
   int begin = 0;                               // first evaluated column of DaeSystem::outputs
   int end = std::numeric_limits<int>::max();   // one past the last
   bool has(int column) const { return column >= begin && column < end; }
+  /// Whether every column of a sum over several outputs is fresh.
+  bool has_all(const std::vector<int>& columns) const {
+    for (const int column : columns)
+      if (!has(column)) return false;
+    return true;
+  }
+  /// One past the last fresh column of an array of `count` columns.
+  std::size_t end_within(std::size_t count) const { return std::min(count, static_cast<std::size_t>(end)); }
 };
 
 /// Receives the state at every output time (t = 0 included).

@@ -275,8 +275,7 @@ void ScenarioTracker::step(double, const double* y, const double*, const double*
         std::max(step_extremes_.shortening[k], lengths_[k].front() - distance(y, front_index_[k], rear_index_[k]));
   // A car's crush sums several elements' outputs: only where all of them are fresh.
   for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
-    const std::vector<int>& columns = crush_of_cars_[k].columns;
-    if (std::all_of(columns.begin(), columns.end(), [&](int column) { return fresh.has(column); }))
+    if (fresh.has_all(crush_of_cars_[k].columns))
       step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], car_crush_now(k, outputs));
   }
   bool offset_known = true;
