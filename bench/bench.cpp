@@ -7,6 +7,9 @@
 //   railcrash_bench kernels [--cars 2,10,100]
 //       the cost per unknown of one residual, Jacobian and root-function evaluation of the
 //       consists at t = 0: whether the element kernels themselves scale linearly.
+//   railcrash_bench memory [--mib 0.25,0.5,1,2,4,8,16,32,64]
+//       this machine's read throughput against the size of the array read over and over:
+//       where its caches end (a consist's working set passes them as it grows).
 //   railcrash_bench sensitivity [--design FILE]
 //       the report's sensitivity study (base + first-order + second-order runs) with 1 and 2
 //       jobs: wall time and speed-up.
@@ -106,12 +109,13 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
   char line[512];
   std::snprintf(line, sizeof line,
                 "| cars per consist | bodies | unknowns | wall s | CPU s | CPU s per simulated s | steps | CPU ms per step | "
-                "residuals | events | located in a step | restarts | peak MiB | R1 |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                "residuals | events | located in a step | restarts | peak MiB | KLU factor entries | R1 |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   table << line;
   std::fputs(line, stdout);
   std::vector<double> fit_cars, fit_cost;
   std::vector<double> all_cars, all_cost, all_step_cost, all_peak;  // every size that finished
+  std::vector<std::array<double, kPhaseCount>> all_phases;           // their wall seconds by phase
   bool all_ok = true;
   for (const int n : cars) {
     Model model = load_consist(template_path, n);
@@ -121,15 +125,15 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
     apply_overrides(model, overrides);
     const double cpu_start = cpu_seconds();
     const auto wall_start = std::chrono::steady_clock::now();
-    const RunReport report = run_model(model, "");
+    const RunReport report = run_model(model, "", nullptr, false, false, OutputFormat::Csv, /*time_phases=*/true);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     const double cpu = cpu_seconds() - cpu_start;
     const RunStatistics& s = report.outcome.stats;
     const double peak_mib = peak_memory_mib();
-    std::snprintf(line, sizeof line, "| %d | %d | %d | %.2f | %.2f | %.1f | %ld | %.3f | %ld | %ld | %ld | %ld | %.0f | %.3f |%s\n", n,
+    std::snprintf(line, sizeof line, "| %d | %d | %d | %.2f | %.2f | %.1f | %ld | %.3f | %ld | %ld | %ld | %ld | %.0f | %ld | %.3f |%s\n", n,
                   model.body_count(), model.size(), wall, cpu, cpu / report.outcome.t_reached, s.steps,
                   1e3 * cpu / static_cast<double>(std::max<long>(s.steps, 1)), s.residual_evaluations, s.events,
-                  s.root_returns, s.reinitializations, peak_mib,
+                  s.root_returns, s.reinitializations, peak_mib, s.factor_nonzeros,
                   report.responses.r1, report.outcome.ok ? "" : (" FAILED: " + report.outcome.message).c_str());
     table << line;
     std::fputs(line, stdout);
@@ -140,6 +144,7 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
       all_cost.push_back(cpu / report.outcome.t_reached);
       all_step_cost.push_back(cpu / static_cast<double>(std::max<long>(s.steps, 1)));
       all_peak.push_back(peak_mib);
+      all_phases.push_back(s.phase_seconds);
     }
     if (n >= 10 && report.outcome.ok) {
       fit_cars.push_back(n);
@@ -162,6 +167,38 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
                     (all_peak[i] - all_peak[i - 1]) / (2.0 * (all_cars[i] - all_cars[i - 1])));
       table << line;
       std::fputs(line, stdout);
+    }
+  }
+  // Where each size's wall time went (summary.json's stats.seconds), and per segment the
+  // exponent of each phase: a phase whose calls are as many at both sizes but cost more than
+  // in proportion shows which work grows faster than the model.
+  if (!all_cars.empty()) {
+    std::string head = "\n| cars | wall s by phase:", rule = "|---|";
+    for (int p = 0; p < kPhaseCount; ++p) {
+      head += std::string(p == 0 ? " " : " | ") + phase_name(static_cast<Phase>(p));
+      rule += "---|";
+    }
+    table << head << " |\n" << rule << "\n";
+    std::printf("%s |\n%s\n", head.c_str(), rule.c_str());
+    const auto add_row = [&](const std::string& label, const auto& value) {
+      std::string row = "| " + label;
+      for (int p = 0; p < kPhaseCount; ++p) {
+        char cell[32];
+        std::snprintf(cell, sizeof cell, " | %.2f", value(static_cast<std::size_t>(p)));
+        row += cell;
+      }
+      table << row << " |\n";
+      std::printf("%s |\n", row.c_str());
+    };
+    for (std::size_t i = 0; i < all_cars.size(); ++i)
+      add_row(std::to_string(static_cast<int>(all_cars[i])), [&](std::size_t p) { return all_phases[i][p]; });
+    for (std::size_t i = 1; i < all_cars.size(); ++i) {
+      char label[64];
+      std::snprintf(label, sizeof label, "exponent %g -> %g", all_cars[i - 1], all_cars[i]);
+      add_row(label, [&](std::size_t p) {
+        const double a = all_phases[i - 1][p], b = all_phases[i][p];
+        return a > 0.0 && b > 0.0 ? std::log(b / a) / std::log(all_cars[i] / all_cars[i - 1]) : 0.0;
+      });
     }
   }
   if (fit_cars.size() >= 2) {
@@ -266,6 +303,49 @@ int sensitivity_benchmark(const std::string& model_path, const std::string& desi
   return 0;
 }
 
+/// Read throughput [GB/s] of summing an array of `mib` MiB over and over: the best of 5 rounds
+/// of at least 0.1 s each.
+int memory_benchmark(const std::vector<double>& sizes_mib, const std::string& results, const std::string& commit) {
+  std::ostringstream table;
+  table << "| array MiB | read GB/s | ns per double |\n|---|---|---|\n";
+  std::printf("| array MiB | read GB/s | ns per double |\n|---|---|---|\n");
+  double sink = 0.0;
+  for (const double mib : sizes_mib) {
+    const auto count = static_cast<std::size_t>(mib * 1024.0 * 1024.0 / sizeof(double));
+    std::vector<double> values(std::max<std::size_t>(count, 1));
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = 1e-9 * static_cast<double>(i % 1000);
+    double best = 0.0;  // [doubles per s]
+    for (int round = 0; round < 5; ++round) {
+      long passes = 0;
+      const auto start = std::chrono::steady_clock::now();
+      double elapsed = 0.0;
+      do {
+        double sum0 = 0.0, sum1 = 0.0, sum2 = 0.0, sum3 = 0.0;  // four chains: the loads, not the adds, limit
+        std::size_t i = 0;
+        for (; i + 4 <= values.size(); i += 4) {
+          sum0 += values[i];
+          sum1 += values[i + 1];
+          sum2 += values[i + 2];
+          sum3 += values[i + 3];
+        }
+        for (; i < values.size(); ++i) sum0 += values[i];
+        sink += sum0 + sum1 + sum2 + sum3;
+        ++passes;
+        elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      } while (elapsed < 0.1);
+      best = std::max(best, static_cast<double>(passes) * static_cast<double>(values.size()) / elapsed);
+    }
+    char line[128];
+    std::snprintf(line, sizeof line, "| %g | %.1f | %.3f |\n", mib, best * sizeof(double) * 1e-9, 1e9 / best);
+    table << line;
+    std::fputs(line, stdout);
+    std::fflush(stdout);
+  }
+  std::printf("(checksum %g)\n", sink);
+  append_results(results, "Read throughput against array size", table.str(), commit);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -288,6 +368,10 @@ int main(int argc, char** argv) {
   kernels->add_option("--template", template_path, "two-car model the consists are built from")->capture_default_str();
   kernels->add_option("--cars", kernel_cars, "cars per consist, comma-separated")->capture_default_str();
 
+  std::string memory_mib = "0.25,0.5,1,2,4,8,16,32,64";
+  CLI::App* memory = app.add_subcommand("memory", "read throughput against array size (where the caches end)");
+  memory->add_option("--mib", memory_mib, "array sizes [MiB], comma-separated")->capture_default_str();
+
   std::string design_path = source + "/models/report/sensitivity_design.yaml";
   CLI::App* sensitivity = app.add_subcommand("sensitivity", "the report's sensitivity study with 1 and 2 jobs");
   sensitivity->add_option("--design", design_path, "design file")->capture_default_str();
@@ -296,6 +380,12 @@ int main(int argc, char** argv) {
   try {
     if (*consist) return consist_benchmark(template_path, parse_list(cars_text), t_end, results, commit);
     if (*kernels) return kernels_benchmark(template_path, parse_list(kernel_cars), results, commit);
+    if (*memory) {
+      std::vector<double> sizes;
+      std::stringstream list(memory_mib);
+      for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stod(item));
+      return memory_benchmark(sizes, results, commit);
+    }
     if (*sensitivity) return sensitivity_benchmark(template_path, design_path, results, commit);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "railcrash_bench: %s\n", e.what());

@@ -224,6 +224,7 @@ void EulerIntegrator::sweep() {
   extras.roots = g_after_.data();
   extras.outputs = outputs_.data();
   extras.y_lambda = y_.data() + 2 * nq;  // the roots and outputs see y's multipliers, as roots(t, y) does
+  const PhaseClock::Scope timed(phase_clock(), Phase::Residual);
   system_.generalized_forces(t_, y_.data(), y_.data() + nq, force_.data(), &penalty_, lambda_.data(), nullptr, &extras);
   outputs_current_ = true;
 }
@@ -259,6 +260,7 @@ double EulerIntegrator::advance(double t_end) {
       fired = fired || direction_[k] != 0;
     }
     if (fired) {
+      const PhaseClock::Scope timed(phase_clock(), Phase::Events);
       observe_before_event(t_, y_.data());
       events_.clear();
       if (system_.commit_roots(t_, y_.data(), direction_.data(), events_)) {

@@ -72,6 +72,7 @@ int klu_initialize_keeping_symbolic(SUNLinearSolver solver) {
 /// the growth exceeds 1e8 or the refactorization fails.
 int klu_setup_reusing_pivots(SUNLinearSolver solver, SUNMatrix matrix) {
   auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
+  const PhaseClock::Scope timed(static_cast<PhaseClock*>(content->common.user_data), Phase::LinearSetup);
   if (content->first_factorize || content->symbolic == nullptr || content->numeric == nullptr)
     return SUNLinSolSetup_KLU(solver, matrix);  // analysis and first factorization
   sunindextype* columns = SUNSparseMatrix_IndexPointers(matrix);
@@ -92,6 +93,15 @@ int klu_setup_reusing_pivots(SUNLinearSolver solver, SUNMatrix matrix) {
   }
   content->last_flag = SUNLS_SUCCESS;
   return SUNLS_SUCCESS;
+}
+
+/// SUNLinSol_KLU's solve, timed as Phase::LinearSolve when the run is timed. The phase clock
+/// rides in KLU's Common.user_data, which KLU reads only for a user-supplied ordering (this
+/// solver uses AMD).
+int klu_solve_timed(SUNLinearSolver solver, SUNMatrix matrix, N_Vector x, N_Vector b, realtype tolerance) {
+  auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
+  const PhaseClock::Scope timed(static_cast<PhaseClock*>(content->common.user_data), Phase::LinearSolve);
+  return SUNLinSolSolve_KLU(solver, matrix, x, b, tolerance);
 }
 
 /// The length over which each body's angle counts, for its angular tolerances: an angle error
@@ -133,6 +143,7 @@ struct IdaIntegrator::Impl {
   void* ida = nullptr;
   std::exception_ptr callback_error;
   std::string last_sundials_message;
+  PhaseClock* phase_clock = nullptr;  // the run's, when it is timed by phase
 
   // The run in progress (IdaIntegrator::start sets them up, advance takes one step).
   double rtol = 0.0;
@@ -201,6 +212,7 @@ struct IdaIntegrator::Impl {
 
   static int residual(realtype t, N_Vector yy, N_Vector ypv, N_Vector rr, void* user) {
     auto* self = static_cast<Impl*>(user);
+    const PhaseClock::Scope timed(self->phase_clock, Phase::Residual);
     try {
       self->system.residual(t, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), N_VGetArrayPointer(rr));
       const double* r = N_VGetArrayPointer(rr);
@@ -223,6 +235,7 @@ struct IdaIntegrator::Impl {
   static int jacobian_values(realtype t, realtype cj, N_Vector yy, N_Vector ypv, N_Vector, SUNMatrix matrix, void* user,
                              N_Vector, N_Vector, N_Vector) {
     auto* self = static_cast<Impl*>(user);
+    const PhaseClock::Scope timed(self->phase_clock, Phase::Jacobian);
     try {
       const SparsePattern& p = self->system.pattern();
       // SUNMatZero also clears the index arrays of a sparse matrix: write them every time.
@@ -240,6 +253,7 @@ struct IdaIntegrator::Impl {
 
   static int quadrature(realtype t, N_Vector yy, N_Vector, N_Vector rates, void* user) {
     auto* self = static_cast<Impl*>(user);
+    const PhaseClock::Scope timed(self->phase_clock, Phase::StepSweep);
     try {
       QuadratureSweep& sweep = self->sweep;
       sweep.valid = false;
@@ -442,6 +456,9 @@ void IdaIntegrator::start(double t_end) {
     impl.linear_solver = impl.created(SUNLinSol_KLU(impl.y, impl.jacobian, impl.context), "SUNLinSol_KLU");
     impl.linear_solver->ops->initialize = &klu_initialize_keeping_symbolic;
     impl.linear_solver->ops->setup = &klu_setup_reusing_pivots;
+    impl.linear_solver->ops->solve = &klu_solve_timed;
+    impl.phase_clock = phase_clock();
+    static_cast<SUNLinearSolverContent_KLU>(impl.linear_solver->content)->common.user_data = impl.phase_clock;
     impl.check(IDASetLinearSolver(impl.ida, impl.linear_solver, impl.jacobian), "IDASetLinearSolver");
     impl.check(IDASetJacFn(impl.ida, &Impl::jacobian_values), "IDASetJacFn");
     impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");
@@ -661,11 +678,14 @@ double IdaIntegrator::advance(double t_end) {
     // change). Once per restart: the same restart again with a first step a tenth of the step
     // before the event (a third of the first try, unless kReachableMultiple capped that).
     impl.retry.available = false;
-    std::copy(impl.retry.y.begin(), impl.retry.y.end(), N_VGetArrayPointer(impl.y));
-    std::copy(impl.retry.yp.begin(), impl.retry.yp.end(), N_VGetArrayPointer(impl.yp));
-    std::copy(impl.retry.quad.begin(), impl.retry.quad.end(), N_VGetArrayPointer(impl.quad));
-    impl.reinitialize(impl.retry.t, t_end, stats());
-    impl.check(IDASetInitStep(impl.ida, 0.1 * impl.retry.step_before), "IDASetInitStep");
+    {
+      const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
+      std::copy(impl.retry.y.begin(), impl.retry.y.end(), N_VGetArrayPointer(impl.y));
+      std::copy(impl.retry.yp.begin(), impl.retry.yp.end(), N_VGetArrayPointer(impl.yp));
+      std::copy(impl.retry.quad.begin(), impl.retry.quad.end(), N_VGetArrayPointer(impl.quad));
+      impl.reinitialize(impl.retry.t, t_end, stats());
+      impl.check(IDASetInitStep(impl.ida, 0.1 * impl.retry.step_before), "IDASetInitStep");
+    }
     t_n = impl.t_reached = impl.retry.t;
     impl.last_sundials_message.clear();
     impl.non_finite_y.clear();
@@ -684,6 +704,7 @@ double IdaIntegrator::advance(double t_end) {
   const double t_step_start = impl.t_reached;
   bool restarted = false;
 
+  const PhaseClock::Scope events_timed(phase_clock(), Phase::Events);
   if (root_count > 0) {
     // The step's element outputs come from the same sweep as its roots; they stand for the
     // step's end only if no mode changes in it (below).
@@ -817,6 +838,7 @@ double IdaIntegrator::advance(double t_end) {
           continue;
         }
         restarted = true;
+        const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
         // Restart at the event: consistent rates for the new law (and roots that sit on
         // their boundary there), quadratures interpolated to it.
         std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
@@ -984,6 +1006,10 @@ void IdaIntegrator::finish() {
       impl_->accumulate(stats());
     } catch (const std::exception&) {  // counters are a report, not a result: keep the outcome
     }
+  }
+  if (impl_ && impl_->linear_solver) {
+    const auto* klu = static_cast<SUNLinearSolverContent_KLU>(impl_->linear_solver->content);
+    if (klu->numeric != nullptr) stats().factor_nonzeros = static_cast<long>(klu->numeric->lnz + klu->numeric->unz + klu->numeric->nzoff);
   }
   impl_.reset();
 }

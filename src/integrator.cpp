@@ -7,6 +7,45 @@
 
 namespace railcrash {
 
+const char* phase_name(Phase phase) {
+  switch (phase) {
+    case Phase::Other: return "other";
+    case Phase::Start: return "start";
+    case Phase::Residual: return "residual";
+    case Phase::Jacobian: return "jacobian";
+    case Phase::LinearSetup: return "linear_setup";
+    case Phase::LinearSolve: return "linear_solve";
+    case Phase::StepSweep: return "step_sweep";
+    case Phase::Events: return "events";
+    case Phase::Restarts: return "restarts";
+    case Phase::Output: return "output";
+    case Phase::kCount: break;
+  }
+  return "?";
+}
+
+void PhaseClock::start() {
+  on_ = true;
+  current_ = Phase::Other;
+  seconds_.fill(0.0);
+  since_ = std::chrono::steady_clock::now();
+}
+
+Phase PhaseClock::enter(Phase phase) {
+  const auto now = std::chrono::steady_clock::now();
+  seconds_[static_cast<std::size_t>(current_)] += std::chrono::duration<double>(now - since_).count();
+  since_ = now;
+  const Phase left = current_;
+  current_ = phase;
+  return left;
+}
+
+const std::array<double, kPhaseCount>& PhaseClock::stop() {
+  if (on_) enter(current_);
+  on_ = false;
+  return seconds_;
+}
+
 void Integrator::report_events(const std::vector<EventRecord>& events, const double* y, int element) {
   for (const EventRecord& record : events) observer_->event(record, y);
   if (!events.empty()) deliver_step(events.front().t, y, element);
@@ -20,6 +59,7 @@ void Integrator::observe_before_event(double t, const double* y, int element) {
 
 void Integrator::deliver_step(double t, const double* y, int element) {
   if (!observe_steps_) return;
+  const PhaseClock::Scope timed(phase_clock(), Phase::Output);
   const double* lambda = y + 2 * system_.body_unknowns();
   const double* ready = element < 0 && y == current_state() ? current_outputs() : nullptr;
   if (ready) {
@@ -53,6 +93,7 @@ std::string Integrator::non_finite_entry(const double* y) const {
 }
 
 void Integrator::deliver_sample(double t) {
+  const PhaseClock::Scope timed(phase_clock(), Phase::Output);
   state_at(t, sample_y_, sample_quadratures_);
   const std::string bad = non_finite_entry(sample_y_.data());
   if (!bad.empty()) {
@@ -91,8 +132,9 @@ void Integrator::sample_up_to(double t_limit) {
 }
 
 RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& observer, const std::atomic<bool>* stop) {
-  const auto wall_start = std::chrono::steady_clock::now();
   outcome_ = RunOutcome{};
+  if (time_phases_) phase_clock_.start();
+  const auto wall_start = std::chrono::steady_clock::now();
   observer_ = &observer;
   observe_steps_ = observer.observes_steps();
   step_outputs_.assign(system_.output_names().size(), 0.0);
@@ -105,7 +147,10 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   last_sample_quadratures_.clear();
   double t_reached = 0.0;
   try {
-    start(t_end);
+    {
+      const PhaseClock::Scope timed(phase_clock(), Phase::Start);
+      start(t_end);
+    }
     state_at(0.0, sample_y_, sample_quadratures_);
     outcome_.initial_energy = energy(sample_y_.data(), sample_quadratures_.data());
     outcome_.max_constraint_residual = 0.0;
@@ -142,6 +187,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
     }
   } catch (const InputError&) {
     finish();
+    phase_clock_.stop();
     throw;
   } catch (const std::exception& e) {
     outcome_.message = e.what();
@@ -159,6 +205,10 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   else outcome_.final_energy = outcome_.initial_energy;  // stopped before the first sample, at t = 0
   finish();
   outcome_.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (phase_clock_.on()) {
+    outcome_.stats.phase_seconds = phase_clock_.stop();
+    outcome_.stats.phases_timed = true;
+  }
   observer_ = nullptr;
   return std::move(outcome_);
 }

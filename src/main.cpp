@@ -172,7 +172,7 @@ int report_command(const std::string& run_dir, double cfc) {
 }
 
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
-                const std::string& out_dir, bool with_report, bool quiet, railcrash::OutputFormat format) {
+                const std::string& out_dir, bool with_report, bool quiet, railcrash::OutputFormat format, bool timings) {
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   if (format == OutputFormat::Hdf5) require_hdf5();
@@ -180,13 +180,23 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
     throw InputError("--report reads the CSV files: leave out --report with --format hdf5, or use --format csv");
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   catch_interrupts();
-  const RunReport report = run_model(model, out_dir, &g_stop, !quiet, /*keep_in_memory=*/false, format);
+  const RunReport report = run_model(model, out_dir, &g_stop, !quiet, /*keep_in_memory=*/false, format, timings);
   const RunOutcome& o = report.outcome;
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
   std::printf("%s: %s with %s to t = %g in %.3g s (%ld steps, %ld residual evaluations)\n", model.name.c_str(),
               o.ok ? "finished" : "FAILED", report.integrator.c_str(), o.t_reached, o.stats.wall_seconds, o.stats.steps,
               o.stats.residual_evaluations);
   if (!o.ok) std::printf("reason: %s\n", o.message.c_str());
+  if (o.stats.phases_timed) {
+    std::printf("wall time by phase [s]:");
+    for (int p = 0; p < kPhaseCount; ++p) {
+      const double seconds = o.stats.phase_seconds[static_cast<std::size_t>(p)];
+      if (seconds > 0.0)
+        std::printf(" %s %.3g (%.0f %%)", phase_name(static_cast<Phase>(p)), seconds,
+                    o.stats.wall_seconds > 0.0 ? 100.0 * seconds / o.stats.wall_seconds : 0.0);
+    }
+    std::printf("\n");
+  }
   if (o.stats.stability_limit > 0.0)
     std::printf("euler step %.4g, stability limit %.4g\n", o.stats.last_step, o.stats.stability_limit);
   std::printf("energy balance error %.3g (kinetic %.6g, elastic %.6g, gravity %.6g, dissipated %.6g, external work %.6g)\n",
@@ -451,6 +461,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"csv", "hdf5"}));
   bool quiet = false;
   run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
+  bool timings = false;
+  run->add_flag("--timings", timings,
+                "split the run's wall time by phase (residual, Jacobian, linear solver, events, restarts, output, ...): "
+                "printed, and summary.json's stats.seconds");
 
   std::string report_dir;
   double report_cfc = 60.0;
@@ -647,7 +661,7 @@ int main(int argc, char** argv) {
     if (*output_option) overrides.output_interval = output_interval;
     if (*max_steps_option) overrides.max_steps = max_steps;
     return run_command(model_path, settings, overrides, out_dir, with_report, quiet,
-                       output_format == "hdf5" ? railcrash::OutputFormat::Hdf5 : railcrash::OutputFormat::Csv);
+                       output_format == "hdf5" ? railcrash::OutputFormat::Hdf5 : railcrash::OutputFormat::Csv, timings);
   } catch (const railcrash::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

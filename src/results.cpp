@@ -461,7 +461,16 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     << ", \"last_step\": " << json_number(s.last_step) << ", \"stability_limit\": " << json_number(s.stability_limit)
     << ", \"assembly_correction\": " << json_number(s.assembly_correction)
     << ", \"settling_steps\": " << s.settling_steps << ", \"settling_displacement\": " << json_number(s.settling_displacement)
-    << ", \"unknowns\": " << system_.size() << ", \"jacobian_nonzeros\": " << system_.pattern().nonzeros() << "},\n";
+    << ", \"unknowns\": " << system_.size() << ", \"jacobian_nonzeros\": " << system_.pattern().nonzeros();
+  if (s.factor_nonzeros > 0) j << ", \"factor_nonzeros\": " << s.factor_nonzeros;
+  if (s.phases_timed) {  // (--timings) exclusive wall seconds per phase, adding up to wall_seconds
+    j << ", \"seconds\": {";
+    for (int p = 0; p < kPhaseCount; ++p)
+      j << (p > 0 ? ", " : "") << json_string(phase_name(static_cast<Phase>(p))) << ": "
+        << json_number(s.phase_seconds[static_cast<std::size_t>(p)]);
+    j << "}";
+  }
+  j << "},\n";
   j << "  \"constraint_residual_max\": " << json_number(outcome.max_constraint_residual) << ",\n";
   const double scale = std::max({std::abs(energy.initial_total), std::abs(energy.kinetic) + std::abs(energy.elastic) +
                                                                      std::abs(energy.gravity) + std::abs(energy.dissipated) +

@@ -163,7 +163,7 @@ std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationS
 }
 
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
-                    bool keep_in_memory, OutputFormat format) {
+                    bool keep_in_memory, OutputFormat format, bool time_phases) {
   DaeSystem system(model);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;
@@ -188,6 +188,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
       report.outcome.message = e.what();
     }
+    if (integrator) integrator->time_phases(time_phases);
     if (integrator)
       report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
   } catch (const InputError& e) {  // found at the start (a non-finite law, joints): the summary says so too

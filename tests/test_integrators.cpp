@@ -291,3 +291,53 @@ TEST_CASE("IDA at rtol 1e-9 runs the barrier crash through and agrees with rtol 
   const double work_a = a.quadratures[DaeSystem::kFirstElementWork], work_b = b.quadratures[DaeSystem::kFirstElementWork];
   CHECK(std::abs(work_a - work_b) <= 1e-5 * std::abs(work_b));  // measured 2.5e-6 (the wall contact's work)
 }
+
+TEST_CASE("a timed run's phases add up to its wall time, each where its work is", "[integrators]") {
+  // The barrier crash has every phase: IDA's Newton iterations, Jacobians, KLU, steps with
+  // roots, located mode changes and restarts (the wall contact, the dampers).
+  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_test_phases").string();
+  std::filesystem::remove_all(dir);
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
+                                 {"simulation.t_end=0.2"});
+  const RunReport timed = run_model(model, dir, nullptr, false, false, OutputFormat::Csv, /*time_phases=*/true);
+  REQUIRE(timed.outcome.ok);
+  const RunStatistics& s = timed.outcome.stats;
+  REQUIRE(s.phases_timed);
+  const auto seconds = [&](Phase p) { return s.phase_seconds[static_cast<std::size_t>(p)]; };
+  double sum = 0.0;
+  for (const double x : s.phase_seconds) {
+    CHECK(x >= 0.0);
+    sum += x;
+  }
+  INFO("phases " << sum << " s, wall " << s.wall_seconds << " s");
+  CHECK(std::abs(sum - s.wall_seconds) <= 1e-3 * s.wall_seconds + 1e-4);  // exclusive: nothing counted twice
+  for (const Phase p : {Phase::Start, Phase::Residual, Phase::Jacobian, Phase::LinearSetup, Phase::LinearSolve,
+                        Phase::StepSweep, Phase::Events, Phase::Output, Phase::Other})
+    CHECK(seconds(p) > 0.0);
+  REQUIRE(s.reinitializations > 0);
+  CHECK(seconds(Phase::Restarts) > 0.0);
+  CHECK(s.factor_nonzeros >= DaeSystem(model).pattern().nonzeros());  // L, U and the blocks off the diagonal hold at least A's entries
+  std::ifstream summary_file(dir + "/summary.json");
+  std::stringstream summary;
+  summary << summary_file.rdbuf();
+  CHECK_THAT(summary.str(), Catch::Contains("\"seconds\": {\"other\": ") && Catch::Contains("\"restarts\": ") &&
+                                Catch::Contains("\"factor_nonzeros\": " + std::to_string(s.factor_nonzeros)));
+
+  // Euler's phases: its force sweeps and mode changes; no Jacobian, no linear solver.
+  const Model euler = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
+                                 {"simulation.t_end=0.05", "simulation.integrator=euler"});
+  const RunReport explicit_run = run_model(euler, "", nullptr, false, false, OutputFormat::Csv, true);
+  REQUIRE(explicit_run.outcome.stats.phases_timed);
+  const auto& e = explicit_run.outcome.stats.phase_seconds;
+  CHECK(e[static_cast<std::size_t>(Phase::Residual)] > 0.0);
+  CHECK(e[static_cast<std::size_t>(Phase::Jacobian)] == 0.0);
+  CHECK(e[static_cast<std::size_t>(Phase::LinearSolve)] == 0.0);
+  CHECK(explicit_run.outcome.stats.factor_nonzeros == 0);
+
+  // Untimed (the default): no phase figures, none in summary.json.
+  const RunReport untimed = run_model(model, dir);
+  CHECK_FALSE(untimed.outcome.stats.phases_timed);
+  for (const double x : untimed.outcome.stats.phase_seconds) CHECK(x == 0.0);
+  CHECK_THAT(untimed.summary_json, !Catch::Contains("\"seconds\""));
+  std::filesystem::remove_all(dir);
+}

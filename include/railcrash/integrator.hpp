@@ -3,7 +3,9 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
@@ -13,6 +15,63 @@
 #include "railcrash/dae_system.hpp"
 
 namespace railcrash {
+
+/// The phases a run's wall time is split into when it is timed (`railcrash run --timings`;
+/// summary.json's stats.seconds). Each is exclusive: a phase entered inside another (a restart
+/// while events are handled, a sample written at an event, a residual of Euler's re-sweep after
+/// a mode change) counts for itself alone, so the phases add up to the run's wall time.
+enum class Phase : int {
+  Other,        // the integrator's own work: IDA's vector operations, error test, step and order
+                // choice, interpolation for events; Euler's update; the run loop's checks
+  Start,        // start(): initial conditions, static settle, integrator set-up
+  Residual,     // ida: IDA's residual calls; euler: the force sweep (forces, roots, outputs)
+  Jacobian,     // ida: Jacobian values
+  LinearSetup,  // ida: KLU factorizations
+  LinearSolve,  // ida: KLU solves
+  StepSweep,    // ida: each step's sweep of energy rates, roots and step outputs
+  Events,       // finding, locating and committing mode changes
+  Restarts,     // ida: consistent rates after a mode change and the integrator's restart
+  Output,       // output samples (interpolation, rows, files) and observers' per-step tracking
+  kCount
+};
+constexpr int kPhaseCount = static_cast<int>(Phase::kCount);
+/// summary.json's names of the phases, in Phase's order.
+const char* phase_name(Phase phase);
+
+/// Exclusive wall time per phase: enter() closes the running phase's interval and opens the
+/// next (one clock reading per change). Off unless start()ed, when Scope does nothing.
+class PhaseClock {
+ public:
+  void start();
+  bool on() const { return on_; }
+  /// Enters `phase`; returns the phase it leaves (for Scope to return to).
+  Phase enter(Phase phase);
+  /// Closes the running interval; the seconds per phase so far.
+  const std::array<double, kPhaseCount>& stop();
+
+  /// The scope's time counts for `phase` (nothing when clock is null or off).
+  class Scope {
+   public:
+    Scope(PhaseClock* clock, Phase phase) : clock_(clock != nullptr && clock->on() ? clock : nullptr) {
+      if (clock_ != nullptr) previous_ = clock_->enter(phase);
+    }
+    ~Scope() {
+      if (clock_ != nullptr) clock_->enter(previous_);
+    }
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+   private:
+    PhaseClock* clock_;
+    Phase previous_ = Phase::Other;
+  };
+
+ private:
+  bool on_ = false;
+  Phase current_ = Phase::Other;
+  std::chrono::steady_clock::time_point since_;
+  std::array<double, kPhaseCount> seconds_{};  // [s]
+};
 
 struct RunStatistics {
   long steps = 0;
@@ -30,6 +89,9 @@ struct RunStatistics {
   double assembly_correction = 0.0;  // [length] largest move of the initial position assembly
   long settling_steps = 0;           // static equilibrium: pseudo-time steps
   double settling_displacement = 0.0;  // [length] static equilibrium: largest move
+  long factor_nonzeros = 0;          // ida: entries KLU stores: L, U and the off-diagonal blocks (last factorization)
+  bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
+  std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
 };
 
 /// Which element outputs a RunObserver::step() call holds values of at its state: all of them
@@ -110,6 +172,10 @@ class Integrator {
   /// Integrates from 0 to t_end, sampling every output_interval; stops early (ok = false,
   /// message says why) on failure or when *stop becomes true. Input errors throw InputError.
   RunOutcome run(double t_end, double output_interval, RunObserver& observer, const std::atomic<bool>* stop = nullptr);
+  /// Whether run() splits its wall time by Phase (RunStatistics::phase_seconds). Off by
+  /// default: a clock reading per phase change costs about 30 ns, a few per cent of a small
+  /// mechanism's step.
+  void time_phases(bool on) { time_phases_ = on; }
 
  protected:
   /// A failure of the integration itself (not of the input): becomes the outcome's message.
@@ -165,6 +231,8 @@ class Integrator {
   /// Dense output: samples every output time up to t_limit not sampled yet.
   void sample_up_to(double t_limit);
   RunStatistics& stats() { return outcome_.stats; }
+  /// The run's phase clock when it is timed, else null (for PhaseClock::Scope).
+  PhaseClock* phase_clock() { return phase_clock_.on() ? &phase_clock_ : nullptr; }
   /// Whether the observer takes every step's element outputs (an integrator that can compute
   /// them with other work hands them over through current_outputs()).
   bool step_outputs_wanted() const { return observe_steps_; }
@@ -191,6 +259,8 @@ class Integrator {
   std::vector<double> constraint_scratch_;  // work space of the per-sample constraint residual
   std::vector<double> last_sample_y_, last_sample_quadratures_;
   bool observe_steps_ = false;       // the observer wants step()
+  bool time_phases_ = false;         // time_phases()
+  PhaseClock phase_clock_;
   std::vector<double> step_outputs_;  // element outputs at the last step
 };
 

@@ -57,7 +57,10 @@ struct RunReport {
 /// OutputFormat::Hdf5: timeseries.h5 in place of the per-row CSV files, results/hdf5_file.hpp);
 /// with keep_in_memory the same results also come back in the report.
 /// Input errors throw InputError before anything runs; solver failures come back with ok = false.
+/// time_phases: the run's wall time split by phase (RunStatistics::phase_seconds; summary.json's
+/// stats.seconds; `railcrash run --timings`).
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
-                    bool show_progress = false, bool keep_in_memory = false, OutputFormat format = OutputFormat::Csv);
+                    bool show_progress = false, bool keep_in_memory = false, OutputFormat format = OutputFormat::Csv,
+                    bool time_phases = false);
 
 }  // namespace railcrash

@@ -27,6 +27,11 @@ expect_status "euler run" 0 "$bin" run "$crank" --integrator euler --dt 1e-3 --t
 expect_text "euler prints its step and limit" "$tmp/stdout" "euler step 0.001, stability limit"
 expect_text "summary integrator" "$tmp/euler/summary.json" '"integrator": "euler"'
 
+expect_status "run --timings" 0 "$bin" run "$crank" --t-end 1 --timings --out "$tmp/timed"
+expect_text "--timings prints the phases" "$tmp/stdout" "^wall time by phase \[s\]: other [0-9.e-]* ([0-9]* %) start .* residual .* linear_solve .* output "
+expect_text "--timings: summary.json has them" "$tmp/timed/summary.json" '"seconds": {"other": [0-9.e-]*, "start": '
+if grep -q '"seconds"' "$tmp/crank/summary.json"; then echo "FAIL: an untimed run's summary has seconds"; failures=$((failures + 1)); else passes=$((passes + 1)); fi
+
 expect_status "--set changes a model key" 0 "$bin" run "$crank" --set simulation.t_end=0.25 --out "$tmp/set"
 expect_text "--set took effect" "$tmp/set/summary.json" '"t_reached": 0.25,'
 
