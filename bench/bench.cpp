@@ -30,6 +30,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -303,12 +304,15 @@ int sensitivity_benchmark(const std::string& model_path, const std::string& desi
   return 0;
 }
 
-/// Read throughput [GB/s] of summing an array of `mib` MiB over and over: the best of 5 rounds
-/// of at least 0.1 s each.
+/// Per array size of `mib` MiB: the read throughput [GB/s] of summing the array over and over
+/// (the hardware prefetches it), and the latency [ns] of a load whose address depends on the
+/// one before (a walk through the array's 64-byte lines in a random cycle: no prefetch helps,
+/// so each load waits for the level of the memory hierarchy the array fits in). Best of 5
+/// rounds of at least 0.1 s each.
 int memory_benchmark(const std::vector<double>& sizes_mib, const std::string& results, const std::string& commit) {
   std::ostringstream table;
-  table << "| array MiB | read GB/s | ns per double |\n|---|---|---|\n";
-  std::printf("| array MiB | read GB/s | ns per double |\n|---|---|---|\n");
+  table << "| array MiB | read GB/s | ns per double | ns per dependent load |\n|---|---|---|---|\n";
+  std::printf("| array MiB | read GB/s | ns per double | ns per dependent load |\n|---|---|---|---|\n");
   double sink = 0.0;
   for (const double mib : sizes_mib) {
     const auto count = static_cast<std::size_t>(mib * 1024.0 * 1024.0 / sizeof(double));
@@ -335,8 +339,32 @@ int memory_benchmark(const std::vector<double>& sizes_mib, const std::string& re
       } while (elapsed < 0.1);
       best = std::max(best, static_cast<double>(passes) * static_cast<double>(values.size()) / elapsed);
     }
+    // The random cycle over the lines: next[line] is the index (in doubles) of the next line.
+    constexpr std::size_t kLine = 64 / sizeof(double);
+    const std::size_t lines = std::max<std::size_t>(values.size() / kLine, 2);
+    std::vector<std::size_t> order(lines);
+    for (std::size_t i = 0; i < lines; ++i) order[i] = i;
+    std::mt19937_64 shuffle(12345);
+    std::shuffle(order.begin(), order.end(), shuffle);
+    std::vector<std::size_t> next(lines * kLine, 0);
+    for (std::size_t i = 0; i < lines; ++i) next[order[i] * kLine] = order[(i + 1) % lines] * kLine;
+    double best_latency = 1e300;  // [s per load]
+    std::size_t at = order[0] * kLine;
+    for (int round = 0; round < 5; ++round) {
+      long loads = 0;
+      const auto start = std::chrono::steady_clock::now();
+      double elapsed = 0.0;
+      do {
+        for (int k = 0; k < 100000; ++k) at = next[at];
+        loads += 100000;
+        elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      } while (elapsed < 0.1);
+      best_latency = std::min(best_latency, elapsed / static_cast<double>(loads));
+    }
+    sink += static_cast<double>(at);
     char line[128];
-    std::snprintf(line, sizeof line, "| %g | %.1f | %.3f |\n", mib, best * sizeof(double) * 1e-9, 1e9 / best);
+    std::snprintf(line, sizeof line, "| %g | %.1f | %.3f | %.1f |\n", mib, best * sizeof(double) * 1e-9, 1e9 / best,
+                  1e9 * best_latency);
     table << line;
     std::fputs(line, stdout);
     std::fflush(stdout);
