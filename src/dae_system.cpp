@@ -737,8 +737,9 @@ void DaeSystem::element_roots_and_outputs(std::size_t e, double t, const Element
                                           double* g, double* outputs) const {
   const Element& el = *model_.elements()[e];
   const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-  if (g != nullptr && el.root_count() > 0) el.roots(t, s, element_lambda, g + root_offset_[e]);
-  if (outputs != nullptr && output_offset_[e] < output_end(e)) el.outputs(s, element_lambda, outputs + output_offset_[e]);
+  double* element_g = g != nullptr && el.root_count() > 0 ? g + root_offset_[e] : nullptr;
+  double* element_outputs = outputs != nullptr && output_offset_[e] < output_end(e) ? outputs + output_offset_[e] : nullptr;
+  if (element_g != nullptr || element_outputs != nullptr) el.roots_and_outputs(t, s, element_lambda, element_g, element_outputs);
 }
 
 void DaeSystem::element_roots(int e, double t, const double* y, double* g) const {

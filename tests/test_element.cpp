@@ -3,10 +3,15 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
+#include <random>
 #include <set>
 #include <string>
 
 #include "railcrash/consist.hpp"
+#include "railcrash/dae_system.hpp"
+#include "railcrash/elements/beams.hpp"
+#include "railcrash/run.hpp"
 #include "railcrash/element_registry.hpp"
 #include "railcrash/model_io.hpp"
 #include "support.hpp"
@@ -95,4 +100,61 @@ TEST_CASE("a long train's elements lie side by side in memory, not one per page 
   // At about 440 bytes an element (the largest types about 1 KiB) nine share a page; a page per
   // element on the heap. Allow for slots reused from models freed earlier in this process.
   CHECK(pages.size() < model.elements().size() / 4);
+}
+
+TEST_CASE("every element's roots_and_outputs equals its roots and outputs, bit for bit", "[element]") {
+  // The step sweep asks for both at once (Element::roots_and_outputs); an element that
+  // evaluates its law once for both (the beams) must give what the two calls give, in every
+  // mode: the two-car crash is run first so its beams, springs and contacts hold the modes of
+  // a crash (plastic hinges among them), then every element is compared at random states.
+  std::vector<Model> models;
+  for (const char* file : {"models/report/final_two_car.yaml", "models/report/preliminary_car.yaml",
+                           "models/barrier/two_car_barrier.yaml", "models/examples/coupled_cars.yaml"})
+    models.push_back(load_model(source_path(file), {"simulation.t_end=0.15"}));
+  models.push_back(testing::model_from_text(kOtherTypes));
+  std::mt19937 rng(7);
+  int compared = 0, plastic_beams = 0, failed_beams = 0;
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    DaeSystem system(models[m]);
+    if (m == 0) REQUIRE(testing::simulate(system, 0.05).ok);  // the crash, to its t_end
+    const int nq = system.body_unknowns();
+    for (int sample = 0; sample < 3; ++sample) {
+      // A beam in each mode family: as the run left it, then plastic in all three components,
+      // then failed.
+      if (sample > 0)
+        for (std::size_t e = 0; e < system.model().elements().size(); ++e)
+          if (dynamic_cast<const BeamElement*>(system.model().elements()[e].get()) != nullptr) {
+            BeamElement::State st;
+            if (sample == 1) st = {{1, -1, 1}, {1e-3, 2e-3, -1e-3}, false};
+            else st.failed = true;
+            testing::set_mode(system, st, e);
+          }
+      for (int draw = 0; draw < 20; ++draw) {
+        const std::vector<double> y = testing::random_state(system, rng, 0.05);
+        for (std::size_t e = 0; e < system.model().elements().size(); ++e) {
+          const Element& el = *system.model().elements()[e];
+          INFO(el.type() << " '" << el.name() << "', sample " << sample);
+          const ElementState<double> s = gather_state(el, y.data(), y.data() + nq, system.modes().of(e));
+          const double* lambda = el.constraint_count() > 0 ? y.data() + 2 * nq + system.model().constraint_offset(e) : nullptr;
+          const auto roots = static_cast<std::size_t>(el.root_count());
+          const std::size_t outputs = el.output_names().size();
+          std::vector<double> g_apart(roots, -7.0), g_together(roots, -9.0), out_apart(outputs, -7.0), out_together(outputs, -9.0);
+          el.roots(0.1, s, lambda, g_apart.data());
+          el.outputs(s, lambda, out_apart.data());
+          el.roots_and_outputs(0.1, s, lambda, roots > 0 ? g_together.data() : nullptr, out_together.data());
+          CHECK(std::memcmp(g_apart.data(), g_together.data(), roots * sizeof(double)) == 0);
+          CHECK(std::memcmp(out_apart.data(), out_together.data(), outputs * sizeof(double)) == 0);
+          ++compared;
+          if (dynamic_cast<const BeamElement*>(&el) != nullptr) {
+            const auto& st = system.modes().as<BeamElement::State>(e);
+            if (st.failed) ++failed_beams;
+            else if (st.sign != std::array<int, 3>{0, 0, 0}) ++plastic_beams;
+          }
+        }
+      }
+    }
+  }
+  CHECK(compared > 1000);
+  CHECK(plastic_beams > 0);
+  CHECK(failed_beams > 0);
 }

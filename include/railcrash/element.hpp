@@ -218,6 +218,14 @@ class Element {
   std::string output_with_role(OutputRole role) const;
   /// Values of those quantities; lambda are the element's constraint multipliers (if any).
   virtual void outputs(const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*out*/) const {}
+  /// roots() into g and outputs() into out at one state, for the sweeps that want both (either
+  /// may be null: that one is skipped). An element whose roots and outputs share an expensive
+  /// evaluation overrides this to do it once; the values must equal the two calls', bit for bit.
+  virtual void roots_and_outputs(double t, const ElementState<double>& s, const double* lambda, double* g,
+                                 double* out) const {
+    if (g != nullptr) roots(t, s, lambda, g);
+    if (out != nullptr) outputs(s, lambda, out);
+  }
 
   // ---- penalty representation of a constraint (explicit Euler) ----
   struct PenaltyOverrides {

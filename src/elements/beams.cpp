@@ -155,7 +155,7 @@ void BeamElement::initialize(const ElementState<double>& initial) {
 }
 
 void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
-                           std::array<double, 3>* offset_rate) const {
+                           std::array<double, 3>* offset_rate, std::array<double, 3>* strain) const {
   // One pass with a single directional derivative along the velocities gives the rates.
   using D = Dual<double, 1>;
   ElementState<D> sd;
@@ -177,6 +177,7 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
     force[k] = r[k].value;
     offset[k] = p[k].value;
     if (offset_rate) (*offset_rate)[k] = p[k].grad[0];
+    if (strain) (*strain)[k] = x[k].value;
   }
 }
 
@@ -191,6 +192,11 @@ void BeamElement::roots(double, const ElementState<double>& s, const double*, do
   if (st.failed) return;
   std::array<double, 3> force{}, offset{}, rate{};
   evaluate(s, force, offset, &rate);
+  roots_from(st, force, offset, rate, g);
+}
+
+void BeamElement::roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
+                             const std::array<double, 3>& rate, double* g) const {
   for (std::size_t k = 0; k < 3; ++k) {
     const int sign = st.sign[k];
     g[k] = sign == 0 ? 1.0 + kYieldMargin - std::abs(force[k] - hardening_[k] * offset[k]) / yield_[k] : sign * rate[k];
@@ -252,10 +258,24 @@ std::vector<std::string> BeamElement::output_names() const {
 }
 
 void BeamElement::outputs(const ElementState<double>& s, const double*, double* out) const {
+  std::array<double, 3> force{}, offset{}, x{};
+  evaluate(s, force, offset, nullptr, &x);
+  outputs_from(mode_as<State>(s), force, offset, x, out);
+}
+
+void BeamElement::roots_and_outputs(double, const ElementState<double>& s, const double*, double* g, double* out) const {
   const State& st = mode_as<State>(s);
-  const std::array<double, 3> x = kinematics(s).strain;
-  std::array<double, 3> force{}, offset{};
-  evaluate(s, force, offset);
+  std::array<double, 3> force{}, offset{}, rate{}, x{};
+  evaluate(s, force, offset, &rate, &x);
+  if (g != nullptr) {
+    g[0] = g[1] = g[2] = g[3] = 1.0;
+    if (!st.failed) roots_from(st, force, offset, rate, g);
+  }
+  if (out != nullptr) outputs_from(st, force, offset, x, out);
+}
+
+void BeamElement::outputs_from(const State& st, std::array<double, 3> force, const std::array<double, 3>& offset,
+                               const std::array<double, 3>& x, double* out) const {
   if (st.failed) force = {0.0, 0.0, 0.0};
   for (std::size_t k = 0; k < 3; ++k) {
     out[k] = force[k];

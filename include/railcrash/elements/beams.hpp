@@ -223,6 +223,9 @@ class BeamElement : public ForceElement<BeamElement> {
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override;
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+  /// One evaluation of the law for both (the step sweep's): a third of the beam's work there.
+  void roots_and_outputs(double t, const ElementState<double>& s, const double* lambda, double* g,
+                         double* out) const override;
 
  protected:
   BeamElement(ElementSpec& spec, BeamMaterial beam_material);
@@ -230,9 +233,16 @@ class BeamElement : public ForceElement<BeamElement> {
   BeamSection section_;
 
  private:
-  /// Resultants F and offsets p at state s, and (when offset_rate is given) dp/dt along s.v.
+  /// Resultants F and offsets p at state s, and (when given) dp/dt along s.v and the
+  /// deformations x (stretch, end rotations).
   void evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
-                std::array<double, 3>* offset_rate = nullptr) const;
+                std::array<double, 3>* offset_rate = nullptr, std::array<double, 3>* strain = nullptr) const;
+  /// The roots in mode st (not failed) from an evaluation at the state.
+  void roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
+                  const std::array<double, 3>& offset_rate, double* g) const;
+  /// The outputs in mode st from an evaluation at the state.
+  void outputs_from(const State& st, std::array<double, 3> force, const std::array<double, 3>& offset,
+                    const std::array<double, 3>& strain, double* out) const;
   /// Largest of |N| / A_min, |M_i| / Z_i [force/length^2].
   double stress(const std::array<double, 3>& force) const;
 
