@@ -206,10 +206,10 @@ double largest_change(const std::vector<double>& values) {
   return largest;
 }
 
-double shared_crush(const std::vector<double>& crush, const std::vector<double>& shares) {
-  assert(crush.size() == shares.size());
+double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares) {
+  assert(columns.size() == shares.size());
   double total = 0.0;
-  for (std::size_t k = 0; k < crush.size(); ++k) total += shares[k] * std::max(0.0, crush[k]);
+  for (std::size_t k = 0; k < columns.size(); ++k) total += shares[k] * std::max(0.0, outputs[columns[k]]);
   return total;
 }
 
@@ -262,10 +262,7 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
 }
 
 double ScenarioTracker::car_crush_now(std::size_t k, const double* outputs) const {
-  const CarCrush& car = crush_of_cars_[k];
-  std::vector<double> crush(car.columns.size());
-  for (std::size_t e = 0; e < crush.size(); ++e) crush[e] = outputs[car.columns[e]];
-  return shared_crush(crush, car.shares);
+  return shared_crush(outputs, crush_of_cars_[k].columns, crush_of_cars_[k].shares);
 }
 
 void ScenarioTracker::step(double, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) {

@@ -98,8 +98,9 @@ TEST_CASE("scenario criteria: shortening, vertical change and wheel lift of hand
   CHECK(largest_lift({0.001, 0.0, -0.004, -0.002}) == Approx(0.004));
   CHECK(largest_lift({0.001, 0.002}) == 0.0);
   // A car's crush at one time: only the positive parts count, an element between two cars by half.
-  CHECK(shared_crush({0.2, -0.1, 0.6}, {1.0, 1.0, 0.5}) == Approx(0.2 + 0.0 + 0.3));
-  CHECK(shared_crush({}, {}) == 0.0);
+  const double outputs[] = {9.0, 0.6, 0.2, -0.1};  // the car's columns are 2, 3 and 1
+  CHECK(shared_crush(outputs, {2, 3, 1}, {1.0, 1.0, 0.5}) == Approx(0.2 + 0.0 + 0.3));
+  CHECK(shared_crush(outputs, {}, {}) == 0.0);
 }
 
 TEST_CASE("scenario criteria: survival-space cars, excluded elements and the interface are checked", "[scenario]") {

@@ -110,9 +110,9 @@ double filtered_mean_deceleration(const std::vector<double>& times, const std::v
 double largest_shortening(const std::vector<double>& lengths);
 /// Largest |v(t) - v(0)|.
 double largest_change(const std::vector<double>& values);
-/// Crush of a car at one time [length]: sum of share x max(0, crush) over its crush outputs
-/// (as results.hpp's car_crush: share 1, or 1/2 for an element between two cars).
-double shared_crush(const std::vector<double>& crush, const std::vector<double>& shares);
+/// Crush of a car at one time [length]: sum of share x max(0, outputs[column]) over its crush
+/// output columns (as results.hpp's car_crush: share 1, or 1/2 for an element between two cars).
+double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares);
 /// Largest lift max(0, -penetration) of a wheel [length].
 double largest_lift(const std::vector<double>& penetration);
 
