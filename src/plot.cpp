@@ -17,6 +17,8 @@ namespace {
 constexpr double kWidth = 800.0;   // [px]
 constexpr double kHeight = 500.0;  // [px]
 constexpr double kLeft = 90.0, kRight = 20.0, kTop = 40.0, kBottom = 60.0;  // [px] margins
+constexpr double kLegendSwatch = 50.0;     // [px] the legend column's gap, line sample and margins
+constexpr double kLegendCharacter = 7.0;   // [px] per character of a label (12 px sans-serif, generous)
 const char* const kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
                                 "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
 
@@ -53,10 +55,10 @@ struct Axis {
   /// Sets the range from data (axis space), padded, with a unit range when empty or flat.
   void fit(double data_low, double data_high) {
     if (!(data_low <= data_high)) data_low = 0.0, data_high = 1.0;
-    if (log) {
-      low = std::floor(data_low);
-      high = std::ceil(data_high);
-      if (high <= low) high = low + 1.0;
+    if (log) {  // a twentieth of the span (at least of a decade) beyond the data, as on a linear axis
+      const double pad = 0.05 * std::max(data_high - data_low, 1.0);
+      low = data_low - pad;
+      high = data_high + pad;
       return;
     }
     double span = data_high - data_low;
@@ -69,9 +71,18 @@ struct Axis {
   /// Tick positions (values, not axis space).
   std::vector<double> ticks() const {
     std::vector<double> values;
-    if (log) {
-      const int step = std::max(1, static_cast<int>(std::ceil((high - low) / 8.0)));
-      for (int e = static_cast<int>(low); e <= static_cast<int>(high); e += step) values.push_back(std::pow(10.0, e));
+    if (log) {  // the decades inside the range; 1, 2 and 5 times them where fewer than two are
+      const int first = static_cast<int>(std::ceil(low - 1e-9)), last = static_cast<int>(std::floor(high + 1e-9));
+      if (last - first >= 1) {
+        const int step = std::max(1, static_cast<int>(std::ceil((high - low) / 8.0)));
+        for (int e = first; e <= last; e += step) values.push_back(std::pow(10.0, e));
+        return values;
+      }
+      for (int e = first - 1; e <= last; ++e)
+        for (const double m : {1.0, 2.0, 5.0}) {
+          const double v = m * std::pow(10.0, e);
+          if (space(v) >= low - 1e-9 && space(v) <= high + 1e-9) values.push_back(v);
+        }
       return values;
     }
     const double raw = (high - low) / 6.0;
@@ -109,9 +120,14 @@ void write_svg(const Figure& figure, const std::filesystem::path& path) {
   Axis x_axis{figure.log_x, 0.0, 1.0, kLeft, kWidth - kRight};
   Axis y_axis{figure.log_y, 0.0, 1.0, kHeight - kBottom, kTop};
   fit_axes(figure, x_axis, y_axis);
+  // The legend stands right of the plot, never over a line: the figure widens by its column.
+  std::size_t longest_label = 0;
+  for (const Series& s : figure.series) longest_label = std::max(longest_label, s.label.size());
+  const double legend_width = longest_label > 0 ? kLegendSwatch + kLegendCharacter * static_cast<double>(longest_label) : 0.0;
+  const double width = kWidth + legend_width;
 
   std::ostringstream svg;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kWidth << "\" height=\"" << kHeight
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << kHeight
       << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
       << "<text x=\"" << kWidth / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">" << escape(figure.title)
@@ -168,10 +184,11 @@ void write_svg(const Figure& figure, const std::filesystem::path& path) {
           svg << "<circle cx=\"" << number(x_axis.pixel(s.x[i])) << "\" cy=\"" << number(y_axis.pixel(s.y[i]))
               << "\" r=\"3.5\" fill=\"" << colour << "\"/>\n";
     if (!s.label.empty()) {
-      const double ly = kTop + 16 + 16 * static_cast<double>(k);
-      svg << "<line x1=\"" << kWidth - kRight - 170 << "\" y1=\"" << ly - 4 << "\" x2=\"" << kWidth - kRight - 150
-          << "\" y2=\"" << ly - 4 << "\" stroke=\"" << colour << "\" stroke-width=\"2\"/>\n<text x=\""
-          << kWidth - kRight - 145 << "\" y=\"" << ly << "\">" << escape(s.label) << "</text>\n";
+      const double ly = kTop + 12 + 16 * static_cast<double>(k);
+      const double lx = kWidth - kRight + 12;
+      svg << "<line x1=\"" << lx << "\" y1=\"" << ly - 4 << "\" x2=\"" << lx + 20 << "\" y2=\"" << ly - 4 << "\" stroke=\""
+          << colour << "\" stroke-width=\"2\"" << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n<text x=\"" << lx + 25
+          << "\" y=\"" << ly << "\">" << escape(s.label) << "</text>\n";
     }
   }
   svg << "</svg>\n";

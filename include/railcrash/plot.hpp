@@ -26,8 +26,11 @@ struct Figure {
   std::vector<Series> series;
 };
 
-/// Writes the figure as an SVG file (800 x 500). Throws std::runtime_error when the file
-/// cannot be written. Empty figures are written with empty axes.
+/// Writes the figure as an SVG file: an 800 x 500 plot, widened on the right by the legend's
+/// column when a series has a label. Axes reach a twentieth of the data's span beyond it (log
+/// axes: at least a twentieth of a decade), so no point or level line lies on the frame.
+/// Throws std::runtime_error when the file cannot be written. Empty figures are written with
+/// empty axes.
 void write_svg(const Figure& figure, const std::filesystem::path& path);
 
 }  // namespace railcrash::plot
