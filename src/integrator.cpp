@@ -7,23 +7,6 @@
 
 namespace railcrash {
 
-const char* phase_name(Phase phase) {
-  switch (phase) {
-    case Phase::Other: return "other";
-    case Phase::Start: return "start";
-    case Phase::Residual: return "residual";
-    case Phase::Jacobian: return "jacobian";
-    case Phase::LinearSetup: return "linear_setup";
-    case Phase::LinearSolve: return "linear_solve";
-    case Phase::StepSweep: return "step_sweep";
-    case Phase::Events: return "events";
-    case Phase::Restarts: return "restarts";
-    case Phase::Output: return "output";
-    case Phase::kCount: break;
-  }
-  return "?";
-}
-
 void PhaseClock::start() {
   on_ = true;
   current_ = Phase::Other;

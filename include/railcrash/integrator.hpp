@@ -36,7 +36,12 @@ enum class Phase : int {
 };
 constexpr int kPhaseCount = static_cast<int>(Phase::kCount);
 /// summary.json's names of the phases, in Phase's order.
-const char* phase_name(Phase phase);
+constexpr const char* phase_name(Phase phase) {
+  constexpr const char* kNames[] = {"other",        "start",     "residual", "jacobian", "linear_setup",
+                                    "linear_solve", "step_sweep", "events",   "restarts", "output"};
+  static_assert(sizeof kNames / sizeof kNames[0] == static_cast<std::size_t>(Phase::kCount), "a name per phase");
+  return static_cast<int>(phase) >= 0 && phase < Phase::kCount ? kNames[static_cast<int>(phase)] : "?";
+}
 
 /// Exclusive wall time per phase: enter() closes the running phase's interval and opens the
 /// next (one clock reading per change). Off unless start()ed, when Scope does nothing.
