@@ -92,6 +92,26 @@ void append_results(const std::string& path, const std::string& heading, const s
   else std::printf("appended to %s\n", path.c_str());
 }
 
+/// The source tree's commit as bench/run.sh names it ("abc1234", "+changes" when tracked files
+/// differ from it), read with git; "unknown" outside a git checkout.
+std::string source_commit(const std::string& source) {
+  const auto run = [](const std::string& command) {
+    std::string out;
+    if (FILE* pipe = popen(command.c_str(), "r")) {
+      char buffer[256];
+      while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) out += buffer;
+      if (pclose(pipe) != 0) return std::string();
+    }
+    return out;
+  };
+  const std::string quoted = "'" + source + "'";  // (the source path is this build's, without quotes in it)
+  std::string commit = run("git -C " + quoted + " rev-parse --short HEAD 2>/dev/null");
+  while (!commit.empty() && (commit.back() == '\n' || commit.back() == '\r')) commit.pop_back();
+  if (commit.empty()) return "unknown";
+  if (!run("git -C " + quoted + " status --porcelain --untracked-files=no 2>/dev/null").empty()) commit += "+changes";
+  return commit;
+}
+
 /// The 2N-car consist built from the template, through a model file (so it is loaded like any other).
 Model load_consist(const std::string& template_path, int cars) {
   const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_consist_" + std::to_string(cars) + ".yaml");
@@ -381,7 +401,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string source = RAILCRASH_SOURCE_DIR;
   std::string commit = "unknown", results = source + "/bench/results.md";
-  app.add_option("--commit", commit, "commit id written with the figures");
+  app.add_option("--commit", commit, "commit id written with the figures (default: the source tree's, from git)");
   app.add_option("--results", results, "Markdown file the figures are appended to")->capture_default_str();
 
   std::string template_path = source + "/models/report/final_two_car.yaml", cars_text = "10,20,50,100,200";
@@ -405,6 +425,7 @@ int main(int argc, char** argv) {
   sensitivity->add_option("--design", design_path, "design file")->capture_default_str();
 
   CLI11_PARSE(app, argc, argv);
+  if (app.count("--commit") == 0) commit = source_commit(source);
   try {
     if (*consist) return consist_benchmark(template_path, parse_list(cars_text), t_end, results, commit);
     if (*kernels) return kernels_benchmark(template_path, parse_list(kernel_cars), results, commit);
