@@ -96,8 +96,8 @@ int klu_setup_reusing_pivots(SUNLinearSolver solver, SUNMatrix matrix) {
 }
 
 /// SUNLinSol_KLU's solve, timed as Phase::LinearSolve when the run is timed. The phase clock
-/// rides in KLU's Common.user_data, which KLU reads only for a user-supplied ordering (this
-/// solver uses AMD).
+/// rides in KLU's Common.user_data, which KLU passes only to a user-supplied ordering function
+/// (ordering 3; this solver keeps SUNDIALS' default, COLAMD).
 int klu_solve_timed(SUNLinearSolver solver, SUNMatrix matrix, N_Vector x, N_Vector b, realtype tolerance) {
   auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
   const PhaseClock::Scope timed(static_cast<PhaseClock*>(content->common.user_data), Phase::LinearSolve);

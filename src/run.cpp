@@ -188,9 +188,10 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
       report.outcome.message = e.what();
     }
-    if (integrator) integrator->time_phases(time_phases);
-    if (integrator)
+    if (integrator) {
+      integrator->time_phases(time_phases);
       report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+    }
   } catch (const InputError& e) {  // found at the start (a non-finite law, joints): the summary says so too
     if (writer) {
       report.outcome.message = e.what();
