@@ -170,7 +170,8 @@ PYBIND11_MODULE(_railcrash, m) {
       .def_readwrite("atol", &rc::RunSettings::atol)
       .def_readwrite("dt", &rc::RunSettings::dt)
       .def_readwrite("output_interval", &rc::RunSettings::output_interval)
-      .def_readwrite("force_dt", &rc::RunSettings::force_dt);
+      .def_readwrite("force_dt", &rc::RunSettings::force_dt)
+      .def_readwrite("timings", &rc::RunSettings::timings);
 
   py::class_<rc::Results, std::shared_ptr<rc::Results>>(m, "Results", "What a run gives, in memory.")
       .def_property_readonly("ok", &rc::Results::ok)

@@ -88,6 +88,7 @@ struct RunSettings {
   std::optional<double> dt;                   // euler: step [s]
   std::optional<double> output_interval;      // [s] time between samples
   bool force_dt = false;                      // euler: accept a step above the stability limit
+  bool timings = false;                       // the wall time split by phase: summary_json's stats.seconds
 };
 
 /// A committed mode change: contact, yield, unloading, rupture, override, ...

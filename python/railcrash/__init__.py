@@ -106,10 +106,13 @@ Model.with_settings = _with
 
 
 def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, output_interval=None, force_dt=False,
-        set=None):
+        set=None, timings=False):
     """Runs a model (a Model, or a model file's path) and returns its Results, in memory.
 
     Unset arguments keep the model's simulation section. integrator: "ida" or "euler".
+    timings: split the run's wall time by phase, as `railcrash run --timings`:
+    results.summary["stats"]["seconds"] (residual, jacobian, linear_solve, ..., adding up to
+    results.summary["stats"]["wall_seconds"]).
     """
     if isinstance(model, (str, _os.PathLike)):
         model = load(model, set)
@@ -130,6 +133,7 @@ def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, outpu
             raise TypeError(f"{name} must be a number, not {type(value).__name__}")
         setattr(settings, name, float(value))
     settings.force_dt = bool(force_dt)
+    settings.timings = bool(timings)
     return _railcrash._run(model, settings)
 
 

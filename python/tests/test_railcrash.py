@@ -221,6 +221,18 @@ class RunTest(unittest.TestCase):
         b = railcrash.run(valued, rtol=1e-5).series("anticlimber.horizontal_force")
         numpy.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-6)
 
+    def test_timings_split_the_wall_time_by_phase(self):
+        timed = railcrash.run(railcrash.from_yaml(ANTICLIMBER), timings=True)
+        self.assertTrue(timed.ok, timed.message)
+        stats = timed.summary["stats"]
+        seconds = stats["seconds"]
+        self.assertEqual(list(seconds), ["other", "start", "residual", "jacobian", "linear_setup", "linear_solve",
+                                         "step_sweep", "events", "restarts", "output"])
+        self.assertAlmostEqual(sum(seconds.values()), stats["wall_seconds"], delta=1e-3 * stats["wall_seconds"] + 1e-4)
+        self.assertGreater(seconds["residual"], 0.0)
+        self.assertGreater(seconds["linear_solve"], 0.0)
+        self.assertNotIn("seconds", railcrash.run(railcrash.from_yaml(ANTICLIMBER)).summary["stats"])
+
     @unittest.skipUnless(__import__("importlib").util.find_spec("pandas"), "pandas is not installed")
     def test_dataframe(self):
         result = railcrash.run(railcrash.from_yaml(OSCILLATOR), t_end=0.1)
