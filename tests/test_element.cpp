@@ -141,9 +141,10 @@ TEST_CASE("every element's roots_and_outputs equals its roots and outputs, bit f
           std::vector<double> g_apart(roots, -7.0), g_together(roots, -9.0), out_apart(outputs, -7.0), out_together(outputs, -9.0);
           el.roots(0.1, s, lambda, g_apart.data());
           el.outputs(s, lambda, out_apart.data());
-          el.roots_and_outputs(0.1, s, lambda, roots > 0 ? g_together.data() : nullptr, out_together.data());
-          CHECK(std::memcmp(g_apart.data(), g_together.data(), roots * sizeof(double)) == 0);
-          CHECK(std::memcmp(out_apart.data(), out_together.data(), outputs * sizeof(double)) == 0);
+          el.roots_and_outputs(0.1, s, lambda, roots > 0 ? g_together.data() : nullptr, outputs > 0 ? out_together.data() : nullptr);
+          // (memcmp of bits: NaN equals NaN; never on an empty vector's null data)
+          if (roots > 0) CHECK(std::memcmp(g_apart.data(), g_together.data(), roots * sizeof(double)) == 0);
+          if (outputs > 0) CHECK(std::memcmp(out_apart.data(), out_together.data(), outputs * sizeof(double)) == 0);
           ++compared;
           if (dynamic_cast<const BeamElement*>(&el) != nullptr) {
             const auto& st = system.modes().as<BeamElement::State>(e);
