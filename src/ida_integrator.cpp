@@ -3,7 +3,6 @@
 #include <idas/idas.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_klu.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include <limits>
 #include <sstream>
 
+#include "klu_solver.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/serial_vector_ops.hpp"
 
@@ -47,61 +47,6 @@ void restart_state(DaeSystem& system, double t, std::vector<double>& y, std::vec
   consistent_rates(system, t, y, yp, &rates_cache);
   for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events, &changed_elements); ++pass)
     consistent_rates(system, t, y, yp, &rates_cache);
-}
-
-/// SUNLinSol_KLU's initialize (called by IDA at the first solve after every IDAInit or
-/// IDAReInit) discards the symbolic analysis, so each restart would redo the ordering of a
-/// matrix whose pattern never changes. This replacement keeps a symbolic analysis once made;
-/// the next setup then refactors numerically (with the library's own fall-back to a full
-/// factorization when the pivots degrade).
-int klu_initialize_keeping_symbolic(SUNLinearSolver solver) {
-  auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
-  content->first_factorize = content->symbolic == nullptr ? 1 : 0;
-  content->last_flag = SUNLS_SUCCESS;
-  return SUNLS_SUCCESS;
-}
-
-/// SUNLinSol_KLU's setup refactors with the previous pivot order, then, when KLU's cheap
-/// reciprocal condition estimate is below eps^(2/3), computes the expensive condition
-/// estimate and, when that is large too, factors afresh. The GGL Jacobian of a crash model
-/// mixes masses, inertias and multiplier rows over many decades, so its condition estimate
-/// is always "large": every setup paid for three factorizations' worth of work (measured:
-/// klu_condest and a full klu_factor at every Jacobian update). This setup keeps the pivot
-/// order while it stays sound, judged by the pivot growth instead (KLU's reciprocal pivot
-/// growth, cheap: one pass over the matrix), and factors afresh with partial pivoting when
-/// the growth exceeds 1e8 or the refactorization fails.
-int klu_setup_reusing_pivots(SUNLinearSolver solver, SUNMatrix matrix) {
-  auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
-  const PhaseClock::Scope timed(static_cast<PhaseClock*>(content->common.user_data), Phase::LinearSetup);
-  if (content->first_factorize || content->symbolic == nullptr || content->numeric == nullptr)
-    return SUNLinSolSetup_KLU(solver, matrix);  // analysis and first factorization
-  sunindextype* columns = SUNSparseMatrix_IndexPointers(matrix);
-  sunindextype* rows = SUNSparseMatrix_IndexValues(matrix);
-  double* values = SUNSparseMatrix_Data(matrix);
-  constexpr double kSmallestReciprocalGrowth = 1e-8;
-  if (klu_l_refactor(columns, rows, values, content->symbolic, content->numeric, &content->common) &&
-      klu_l_rgrowth(columns, rows, values, content->symbolic, content->numeric, &content->common) &&
-      content->common.rgrowth > kSmallestReciprocalGrowth) {
-    content->last_flag = SUNLS_SUCCESS;
-    return SUNLS_SUCCESS;
-  }
-  klu_l_free_numeric(&content->numeric, &content->common);
-  content->numeric = klu_l_factor(columns, rows, values, content->symbolic, &content->common);
-  if (content->numeric == nullptr) {
-    content->last_flag = SUNLS_PACKAGE_FAIL_REC;  // singular: IDA cuts the step
-    return SUNLS_PACKAGE_FAIL_REC;
-  }
-  content->last_flag = SUNLS_SUCCESS;
-  return SUNLS_SUCCESS;
-}
-
-/// SUNLinSol_KLU's solve, timed as Phase::LinearSolve when the run is timed. The phase clock
-/// rides in KLU's Common.user_data, which KLU passes only to a user-supplied ordering function
-/// (ordering 3; this solver keeps SUNDIALS' default, COLAMD).
-int klu_solve_timed(SUNLinearSolver solver, SUNMatrix matrix, N_Vector x, N_Vector b, realtype tolerance) {
-  auto* content = static_cast<SUNLinearSolverContent_KLU>(solver->content);
-  const PhaseClock::Scope timed(static_cast<PhaseClock*>(content->common.user_data), Phase::LinearSolve);
-  return SUNLinSolSolve_KLU(solver, matrix, x, b, tolerance);
 }
 
 /// The length over which each body's angle counts, for its angular tolerances: an angle error
@@ -237,12 +182,8 @@ struct IdaIntegrator::Impl {
     auto* self = static_cast<Impl*>(user);
     const PhaseClock::Scope timed(self->phase_clock, Phase::Jacobian);
     try {
-      const SparsePattern& p = self->system.pattern();
-      // SUNMatZero also clears the index arrays of a sparse matrix: write them every time.
-      sunindextype* columns = SUNSparseMatrix_IndexPointers(matrix);
-      sunindextype* rows = SUNSparseMatrix_IndexValues(matrix);
-      for (std::size_t k = 0; k < p.column_start.size(); ++k) columns[k] = p.column_start[k];
-      for (std::size_t k = 0; k < p.row_index.size(); ++k) rows[k] = p.row_index[k];
+      // The matrix's pattern was written when it was made, and IDA's zeroing leaves it
+      // (make_klu_jacobian_matrix); the values are all written here.
       self->system.jacobian(t, cj, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), SUNSparseMatrix_Data(matrix));
       return 0;
     } catch (...) {
@@ -452,13 +393,10 @@ void IdaIntegrator::start(double t_end) {
     impl.check(IDASetMaxNumSteps(impl.ida, settings_.max_steps_per_output), "IDASetMaxNumSteps");
     impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");
     const SparsePattern& pattern = system_.pattern();
-    impl.jacobian = impl.created(SUNSparseMatrix(n, n, pattern.nonzeros(), CSC_MAT, impl.context), "SUNSparseMatrix");
-    impl.linear_solver = impl.created(SUNLinSol_KLU(impl.y, impl.jacobian, impl.context), "SUNLinSol_KLU");
-    impl.linear_solver->ops->initialize = &klu_initialize_keeping_symbolic;
-    impl.linear_solver->ops->setup = &klu_setup_reusing_pivots;
-    impl.linear_solver->ops->solve = &klu_solve_timed;
+    impl.jacobian = impl.created(make_klu_jacobian_matrix(impl.context, pattern.column_start, pattern.row_index), "SUNSparseMatrix");
     impl.phase_clock = phase_clock();
-    static_cast<SUNLinearSolverContent_KLU>(impl.linear_solver->content)->common.user_data = impl.phase_clock;
+    impl.linear_solver =
+        impl.created(make_klu_solver(impl.context, pattern.column_start, pattern.row_index, impl.phase_clock), "SUNLinSolNewEmpty");
     impl.check(IDASetLinearSolver(impl.ida, impl.linear_solver, impl.jacobian), "IDASetLinearSolver");
     impl.check(IDASetJacFn(impl.ida, &Impl::jacobian_values), "IDASetJacFn");
     impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");
@@ -1008,8 +946,8 @@ void IdaIntegrator::finish() {
     }
   }
   if (impl_ && impl_->linear_solver) {
-    const auto* klu = static_cast<SUNLinearSolverContent_KLU>(impl_->linear_solver->content);
-    if (klu->numeric != nullptr) stats().factor_nonzeros = static_cast<long>(klu->numeric->lnz + klu->numeric->unz + klu->numeric->nzoff);
+    const long entries = klu_factor_entries(impl_->linear_solver);
+    if (entries > 0) stats().factor_nonzeros = entries;
   }
   impl_.reset();
 }

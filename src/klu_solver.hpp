@@ -1,0 +1,52 @@
+#pragma once
+// IDA's linear solver: KLU (SuiteSparse) with 32-bit indices, as a SUNDIALS SUNLinearSolver.
+//
+// SUNDIALS' own KLU module (SUNLinSol_KLU) calls KLU's 64-bit-index interface (klu_l_*),
+// because Debian builds SUNDIALS with 64-bit sunindextype. Each stored entry of KLU's factors
+// then costs 16 bytes, index and value; with KLU's 32-bit interface (klu_*) it costs 12. The
+// algorithms are the same source compiled twice, so the factors, pivots and solutions are the
+// same bit for bit; only the memory a factorization and a solve stream through shrinks. On a
+// long consist that memory outgrows the cache (bench/README.md, "Where a long consist's time
+// goes, phase by phase"), where bytes are time.
+//
+// The solver also does what railcrash used to patch into SUNLinSol_KLU:
+//  - initialize keeps a symbolic analysis once made (a restart's IDAReInit would redo the
+//    ordering of a matrix whose pattern never changes);
+//  - setup refactors with the previous pivot order while KLU's reciprocal pivot growth stays
+//    above 1e-8, and factors afresh (partial pivoting) when it does not or the refactorization
+//    fails (SUNDIALS' module judges by condition estimates, which the GGL Jacobian of a crash
+//    model, mixing masses, inertias and multiplier rows over many decades, always fails: every
+//    setup paid for three factorizations);
+//  - setup and solve are timed as Phase::LinearSetup and Phase::LinearSolve when the run is.
+//
+// The matrix handed to setup and solve is IDA's SUNSparseMatrix (CSC): its values are read in
+// place; its pattern is the `column_start` / `row_index` given at creation, held here in 32-bit
+// indices, which is why the matrix's own index arrays are neither read nor rewritten
+// (make_klu_jacobian_matrix).
+
+#include <sundials/sundials_context.h>
+#include <sundials/sundials_linearsolver.h>
+#include <sundials/sundials_matrix.h>
+
+#include <vector>
+
+namespace railcrash {
+
+class PhaseClock;
+
+/// A KLU solver for n x n matrices of the given CSC pattern (column_start has n + 1 entries).
+/// `clock` (may be null) times setup and solve. The caller frees it with SUNLinSolFree.
+SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index,
+                                PhaseClock* clock);
+
+/// The entries KLU stores for the last factorization (L, U and the off-diagonal blocks of its
+/// block triangular form); 0 before the first.
+long klu_factor_entries(SUNLinearSolver solver);
+
+/// IDA's n x n CSC Jacobian matrix of the given pattern, with its index arrays written once.
+/// Its zero operation (called by IDA before every Jacobian evaluation) is replaced by one that
+/// leaves the matrix as it is: the Jacobian function overwrites every value, and the index
+/// arrays, which SUNDIALS' zero would clear, never change. The caller frees it with SUNMatDestroy.
+SUNMatrix make_klu_jacobian_matrix(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index);
+
+}  // namespace railcrash
