@@ -272,6 +272,51 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
   }
 }
 
+void DaeSystem::generalized_forces_at_reactions(double t, const double* q, const double* v, const double* lambda, double* f,
+                                                ForcesAtReactions& fixed) const {
+  const std::size_t count = model_.elements().size();
+  const int nq = body_unknowns();
+  if (!fixed.ready) {
+    fixed.base.assign(static_cast<std::size_t>(nq), 0.0);
+    for (int i = 0; i < model_.body_count(); ++i) {
+      fixed.base[static_cast<std::size_t>(3 * i)] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
+      fixed.base[static_cast<std::size_t>(3 * i + 1)] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_y;
+    }
+    load_forces(t, q, fixed.base.data());
+    fixed.elements.assign(count, std::array<Pose<double>, 2>{});
+    for (std::size_t e = 0; e < count; ++e) {
+      const Element& el = *model_.elements()[e];
+      if (el.constraint_count() == 0) el.add_force(t, local_state(e, q, v), fixed.elements[e]);
+    }
+    fixed.ready = true;
+  }
+  std::copy(fixed.base.begin(), fixed.base.end(), f);
+  for (std::size_t e = 0; e < count; ++e) {
+    const Element& el = *model_.elements()[e];
+    std::array<Pose<double>, 2> fe = fixed.elements[e];
+    const int m = el.constraint_count();
+    if (m > 0 && el.has_joint_force() && !element_failed(e)) {
+      const int offset = model_.constraint_offset(e);
+      double reactions[kMaxConstraintRows] = {};
+      for (int r = 0; r < m; ++r) reactions[r] = lambda[offset + r];
+      std::array<Pose<double>, 2> friction{};
+      el.add_joint_force(t, local_state(e, q, v), reactions, friction);
+      for (std::size_t k = 0; k < 2; ++k) {
+        fe[k].x += friction[k].x;
+        fe[k].y += friction[k].y;
+        fe[k].theta += friction[k].theta;
+      }
+    }
+    for (int k = 0; k < 2; ++k) {
+      const int b = el.slot_body(k);
+      if (b == kGround) continue;
+      f[3 * b] += fe[static_cast<std::size_t>(k)].x;
+      f[3 * b + 1] += fe[static_cast<std::size_t>(k)].y;
+      f[3 * b + 2] += fe[static_cast<std::size_t>(k)].theta;
+    }
+  }
+}
+
 void DaeSystem::residual(double t, const double* y, const double* yp, double* r) const {
   const int nq = body_unknowns();
   const double* q = y;

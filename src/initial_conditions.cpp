@@ -280,8 +280,9 @@ void consistent_rates(const DaeSystem& system, double t, std::vector<double>& y,
   std::vector<double> force(static_cast<std::size_t>(nq));
   Eigen::VectorXd rhs(nq + m), solution;
   Eigen::VectorXd previous = Eigen::VectorXd::Zero(m);
+  DaeSystem::ForcesAtReactions fixed_forces;  // the forces that do not change with the reactions, once
   for (int pass = 0; pass < (friction ? 50 : 1); ++pass) {
-    system.generalized_forces(t, y.data(), y.data() + nq, force.data(), nullptr, nullptr, y.data() + 2 * nq);
+    system.generalized_forces_at_reactions(t, y.data(), y.data() + nq, y.data() + 2 * nq, force.data(), fixed_forces);
     for (int k = 0; k < nq; ++k) rhs[k] = force[static_cast<std::size_t>(k)];
     rhs.tail(m) = constraint_rhs;
     solution = lu.solve(rhs);

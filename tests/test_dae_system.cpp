@@ -82,3 +82,33 @@ TEST_CASE("the quadratures' sweep gives the roots and outputs of roots() bit for
     CHECK(std::count_if(outputs.begin(), outputs.end(), [](double v) { return v != 0.0; }) > 0);
   }
 }
+
+TEST_CASE("the forces at new reactions equal generalized_forces bit for bit, with only the joints' friction evaluated again",
+          "[dae]") {
+  // consistent_rates iterates on the reactions that the joints' friction depends on; it keeps the
+  // forces that do not depend on them (DaeSystem::ForcesAtReactions). A restart's rates, and so
+  // every run with joint friction, must not move by a bit.
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  DaeSystem system(model);
+  const int nq = system.body_unknowns();
+  const int m = system.constraint_rows();
+  REQUIRE(m > 0);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> reaction(-2e5, 2e5);  // [force]
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<double> y = testing::random_state(system, rng, 0.05 * (trial + 1));
+    const double t = 0.01 * trial;
+    DaeSystem::ForcesAtReactions fixed;
+    std::vector<double> expected(static_cast<std::size_t>(nq)), got(expected.size()), without_friction(expected.size());
+    system.generalized_forces(t, y.data(), y.data() + nq, without_friction.data());
+    for (int pass = 0; pass < 4; ++pass) {
+      for (int r = 0; r < m; ++r) y[static_cast<std::size_t>(2 * nq + r)] = reaction(rng);
+      system.generalized_forces(t, y.data(), y.data() + nq, expected.data(), nullptr, nullptr, y.data() + 2 * nq);
+      system.generalized_forces_at_reactions(t, y.data(), y.data() + nq, y.data() + 2 * nq, got.data(), fixed);
+      CHECK(fixed.ready);
+      CHECK(std::memcmp(expected.data(), got.data(), sizeof(double) * expected.size()) == 0);
+      // Not vacuous: the reactions reach the friction of some joint.
+      CHECK(expected != without_friction);
+    }
+  }
+}

@@ -105,6 +105,19 @@ class DaeSystem {
   void generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty = nullptr,
                           double* penalty_lambda = nullptr, const double* lambda = nullptr,
                           const SweepExtras* extras = nullptr) const;
+  /// generalized_forces(t, q, v, f, nullptr, nullptr, lambda) for a run of calls at one t, q
+  /// and v in which only lambda changes (consistent_rates' iteration on the joints' friction).
+  /// The first call (`fixed.ready` false) keeps gravity and the loads, and each element's forces
+  /// that do not depend on lambda, in `fixed`; every call then evaluates only the joints'
+  /// friction and adds the elements' forces in generalized_forces' order, so f is the same bit
+  /// for bit as generalized_forces'.
+  struct ForcesAtReactions {
+    bool ready = false;
+    std::vector<double> base;                            // gravity and loads, per body unknown
+    std::vector<std::array<Pose<double>, 2>> elements;   // each element's forces without friction
+  };
+  void generalized_forces_at_reactions(double t, const double* q, const double* v, const double* lambda, double* f,
+                                       ForcesAtReactions& fixed) const;
   /// Triplets of df/dq and df/dv (same force definition as generalized_forces); with
   /// `stiffest`, each element in its stiffest mode (Euler's stability estimate).
   struct Triplet { int row, col; double value; };
