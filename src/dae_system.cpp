@@ -215,13 +215,16 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
     const Element& el = *model_.elements()[e];
     const ElementState<double> s = local_state(e, q, v);
     const int m = el.constraint_count();
-    if (extras && (extras->roots || extras->outputs))
-      element_roots_and_outputs(e, t, s, extras->y_lambda, extras->roots, extras->outputs);
+    const bool sweep = extras && (extras->roots || extras->outputs);
+    if (sweep && m > 0) element_roots_and_outputs(e, t, s, extras->y_lambda, extras->roots, extras->outputs);
     std::array<Pose<double>, 2> fe{};
     double* element_power = powers ? powers + kFirstElementWork + static_cast<int>(e) : nullptr;
     if (element_power) *element_power = 0.0;
     if (m == 0) {
-      el.add_force(t, s, fe);
+      if (sweep)
+        element_force_roots_and_outputs(e, t, s, extras->y_lambda, fe, extras->roots, extras->outputs);
+      else
+        el.add_force(t, s, fe);
       if (element_power) *element_power = power_into(fe, s);
     } else {
       const int offset = model_.constraint_offset(e);
@@ -717,10 +720,14 @@ void DaeSystem::quadrature_rates(double t, const double* y, double* rates, const
     const Element& el = *model_.elements()[e];
     double power = 0.0;
     const ElementState<double> s = local_state(e, q, v);
-    if (g != nullptr || outputs != nullptr) element_roots_and_outputs(e, t, s, y + 2 * nq, g, outputs);  // as roots()
+    const bool sweep = g != nullptr || outputs != nullptr;  // roots and outputs as roots() gives them
+    if (sweep && el.constraint_count() > 0) element_roots_and_outputs(e, t, s, y + 2 * nq, g, outputs);
     if (el.constraint_count() == 0) {
       std::array<Pose<double>, 2> fe{};
-      el.add_force(t, s, fe);
+      if (sweep)
+        element_force_roots_and_outputs(e, t, s, y + 2 * nq, fe, g, outputs);
+      else
+        el.add_force(t, s, fe);
       power = power_into(fe, s);
     } else if (el.has_joint_force() && !element_failed(e)) {
       // Friction of a joint: its reactions are the multipliers (ida) or penalty forces (euler).
@@ -778,13 +785,26 @@ void DaeSystem::roots(double t, const double* y, double* g, double* outputs) con
   }
 }
 
+DaeSystem::ElementSlices DaeSystem::element_slices(std::size_t e, const double* lambda, double* g, double* outputs) const {
+  const Element& el = *model_.elements()[e];
+  ElementSlices slices;
+  slices.lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
+  slices.g = g != nullptr && el.root_count() > 0 ? g + root_offset_[e] : nullptr;
+  slices.outputs = outputs != nullptr && output_offset_[e] < output_end(e) ? outputs + output_offset_[e] : nullptr;
+  return slices;
+}
+
 void DaeSystem::element_roots_and_outputs(std::size_t e, double t, const ElementState<double>& s, const double* lambda,
                                           double* g, double* outputs) const {
-  const Element& el = *model_.elements()[e];
-  const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-  double* element_g = g != nullptr && el.root_count() > 0 ? g + root_offset_[e] : nullptr;
-  double* element_outputs = outputs != nullptr && output_offset_[e] < output_end(e) ? outputs + output_offset_[e] : nullptr;
-  if (element_g != nullptr || element_outputs != nullptr) el.roots_and_outputs(t, s, element_lambda, element_g, element_outputs);
+  const ElementSlices slices = element_slices(e, lambda, g, outputs);
+  if (slices.g != nullptr || slices.outputs != nullptr)
+    model_.elements()[e]->roots_and_outputs(t, s, slices.lambda, slices.g, slices.outputs);
+}
+
+void DaeSystem::element_force_roots_and_outputs(std::size_t e, double t, const ElementState<double>& s, const double* lambda,
+                                                std::array<Pose<double>, 2>& f, double* g, double* outputs) const {
+  const ElementSlices slices = element_slices(e, lambda, g, outputs);
+  model_.elements()[e]->force_roots_and_outputs(t, s, slices.lambda, f, slices.g, slices.outputs);
 }
 
 void DaeSystem::element_roots(int e, double t, const double* y, double* g) const {

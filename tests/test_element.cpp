@@ -102,18 +102,19 @@ TEST_CASE("a long train's elements lie side by side in memory, not one per page 
   CHECK(pages.size() < model.elements().size() / 4);
 }
 
-TEST_CASE("every element's roots_and_outputs equals its roots and outputs, bit for bit", "[element]") {
-  // The step sweep asks for both at once (Element::roots_and_outputs); an element that
-  // evaluates its law once for both (the beams) must give what the two calls give, in every
-  // mode: the two-car crash is run first so its beams, springs and contacts hold the modes of
-  // a crash (plastic hinges among them), then every element is compared at random states.
+TEST_CASE("every element's roots_and_outputs and force_roots_and_outputs equal its separate calls, bit for bit", "[element]") {
+  // The step sweeps ask for roots and outputs at once (Element::roots_and_outputs), and for a
+  // force element its force with them (force_roots_and_outputs); an element that evaluates its
+  // law once for all (the beams) must give what the separate calls give, in every mode: the
+  // two-car crash is run first so its beams, springs and contacts hold the modes of a crash
+  // (plastic hinges among them), then every element is compared at random states.
   std::vector<Model> models;
   for (const char* file : {"models/report/final_two_car.yaml", "models/report/preliminary_car.yaml",
                            "models/barrier/two_car_barrier.yaml", "models/examples/coupled_cars.yaml"})
     models.push_back(load_model(source_path(file), {"simulation.t_end=0.15"}));
   models.push_back(testing::model_from_text(kOtherTypes));
   std::mt19937 rng(7);
-  int compared = 0, plastic_beams = 0, failed_beams = 0;
+  int compared = 0, compared_forces = 0, loaded_beams = 0, plastic_beams = 0, failed_beams = 0;
   for (std::size_t m = 0; m < models.size(); ++m) {
     DaeSystem system(models[m]);
     if (m == 0) REQUIRE(testing::simulate(system, 0.05).ok);  // the crash, to its t_end
@@ -145,6 +146,19 @@ TEST_CASE("every element's roots_and_outputs equals its roots and outputs, bit f
           // (memcmp of bits: NaN equals NaN; never on an empty vector's null data)
           if (roots > 0) CHECK(std::memcmp(g_apart.data(), g_together.data(), roots * sizeof(double)) == 0);
           if (outputs > 0) CHECK(std::memcmp(out_apart.data(), out_together.data(), outputs * sizeof(double)) == 0);
+          if (el.constraint_count() == 0) {
+            std::array<Pose<double>, 2> f_apart{}, f_together{};
+            el.add_force(0.1, s, f_apart);
+            std::vector<double> g_all(roots, -5.0), out_all(outputs, -5.0);
+            el.force_roots_and_outputs(0.1, s, lambda, f_together, roots > 0 ? g_all.data() : nullptr,
+                                       outputs > 0 ? out_all.data() : nullptr);
+            CHECK(std::memcmp(f_apart.data(), f_together.data(), sizeof(f_apart)) == 0);
+            if (roots > 0) CHECK(std::memcmp(g_apart.data(), g_all.data(), roots * sizeof(double)) == 0);
+            if (outputs > 0) CHECK(std::memcmp(out_apart.data(), out_all.data(), outputs * sizeof(double)) == 0);
+            ++compared_forces;
+            const bool loaded = f_apart[0].x != 0.0 || f_apart[0].theta != 0.0 || f_apart[1].y != 0.0;
+            if (dynamic_cast<const BeamElement*>(&el) != nullptr && loaded) ++loaded_beams;
+          }
           ++compared;
           if (dynamic_cast<const BeamElement*>(&el) != nullptr) {
             const auto& st = system.modes().as<BeamElement::State>(e);
@@ -156,6 +170,8 @@ TEST_CASE("every element's roots_and_outputs equals its roots and outputs, bit f
     }
   }
   CHECK(compared > 1000);
+  CHECK(compared_forces > 500);
+  CHECK(loaded_beams > 100);  // the beams' forces compared are not all zero
   CHECK(plastic_beams > 0);
   CHECK(failed_beams > 0);
 }

@@ -253,10 +253,23 @@ class DaeSystem {
   /// One past element e's last output in output_names().
   int output_end(std::size_t e) const;
   /// Element e's roots into g and its outputs into `outputs` (their places in the whole arrays;
-  /// either may be null) at its local state s; lambda: all the multipliers (y + 2 nq). The one
-  /// place roots(), the quadratures' sweep and generalized_forces' extras evaluate them.
+  /// either may be null) at its local state s; lambda: all the multipliers (y + 2 nq). With the
+  /// next one, the places roots(), the quadratures' sweep and generalized_forces' extras
+  /// evaluate them.
   void element_roots_and_outputs(std::size_t e, double t, const ElementState<double>& s, const double* lambda, double* g,
                                  double* outputs) const;
+  /// The same and force element e's force f (added to), from one evaluation where the element
+  /// shares it (Element::force_roots_and_outputs): the step sweeps'.
+  void element_force_roots_and_outputs(std::size_t e, double t, const ElementState<double>& s, const double* lambda,
+                                       std::array<Pose<double>, 2>& f, double* g, double* outputs) const;
+  /// Element e's multipliers, roots and outputs within the whole arrays (null where it has none
+  /// or the array is null).
+  struct ElementSlices {
+    const double* lambda = nullptr;
+    double* g = nullptr;
+    double* outputs = nullptr;
+  };
+  ElementSlices element_slices(std::size_t e, const double* lambda, double* g, double* outputs) const;
 
   const Model& model_;
   ElementStates modes_;  // the run's element modes and histories (the only state a DaeSystem changes)

@@ -227,6 +227,16 @@ class Element {
     if (out != nullptr) outputs(s, lambda, out);
   }
 
+  /// add_force(t, s, f) and roots_and_outputs(t, s, lambda, g, out) at one state, for the step
+  /// sweeps (the energy rates need the force; g and out may be null). An element whose force,
+  /// roots and outputs share an expensive evaluation overrides this to do it once; the values
+  /// must equal the separate calls', bit for bit.
+  virtual void force_roots_and_outputs(double t, const ElementState<double>& s, const double* lambda,
+                                       std::array<Pose<double>, 2>& f, double* g, double* out) const {
+    if (g != nullptr || out != nullptr) roots_and_outputs(t, s, lambda, g, out);
+    add_force(t, s, f);
+  }
+
   // ---- penalty representation of a constraint (explicit Euler) ----
   struct PenaltyOverrides {
     std::optional<double> stiffness;             // [force/length]

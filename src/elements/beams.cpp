@@ -155,7 +155,8 @@ void BeamElement::initialize(const ElementState<double>& initial) {
 }
 
 void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
-                           std::array<double, 3>* offset_rate, std::array<double, 3>* strain) const {
+                           std::array<double, 3>* offset_rate, std::array<double, 3>* strain,
+                           Kinematics<double>* chord) const {
   // One pass with a single directional derivative along the velocities gives the rates.
   using D = Dual<double, 1>;
   ElementState<D> sd;
@@ -170,7 +171,8 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
     sd.rotation[k] = rotation_of(sd.q[k].theta, s.rotation[k]);
   }
   sd.mode = s.mode;
-  const std::array<D, 3> x = kinematics(sd).strain;
+  const Kinematics<D> kd = kinematics(sd);
+  const std::array<D, 3>& x = kd.strain;
   const std::array<D, 3> p = plastic_offsets(mode_as<State>(s), x);
   const std::array<D, 3> r = resultants(x, p);
   for (std::size_t k = 0; k < 3; ++k) {
@@ -178,6 +180,11 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
     offset[k] = p[k].value;
     if (offset_rate) (*offset_rate)[k] = p[k].grad[0];
     if (strain) (*strain)[k] = x[k].value;
+  }
+  if (chord) {
+    chord->d = {kd.d.x.value, kd.d.y.value};
+    chord->length = kd.length.value;
+    for (std::size_t k = 0; k < 3; ++k) chord->strain[k] = x[k].value;
   }
 }
 
@@ -272,6 +279,28 @@ void BeamElement::roots_and_outputs(double, const ElementState<double>& s, const
     if (!st.failed) roots_from(st, force, offset, rate, g);
   }
   if (out != nullptr) outputs_from(st, force, offset, x, out);
+}
+
+void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& s, const double* lambda,
+                                          std::array<Pose<double>, 2>& f, double* g, double* out) const {
+  if (g == nullptr && out == nullptr) {
+    add_force(t, s, f);
+    return;
+  }
+  const State& st = mode_as<State>(s);
+  std::array<double, 3> force{}, offset{}, rate{};
+  Kinematics<double> chord;
+  evaluate(s, force, offset, &rate, nullptr, &chord);
+  if (g != nullptr) {
+    g[0] = g[1] = g[2] = g[3] = 1.0;
+    if (!st.failed) roots_from(st, force, offset, rate, g);
+  }
+  if (out != nullptr) outputs_from(st, force, offset, chord.strain, out);
+  // The dual pass's kinematics values are the double pass's, operation for operation. Its
+  // offsets and resultants are not (a dual divided by a number is multiplied by the inverse),
+  // so those few operations are redone in double: force_law's force, bit for bit.
+  if (!st.failed) apply_resultants(s, chord.d, chord.length, resultants(chord.strain, plastic_offsets(st, chord.strain)), f);
+  (void)lambda;
 }
 
 void BeamElement::outputs_from(const State& st, std::array<double, 3> force, const std::array<double, 3>& offset,

@@ -203,11 +203,17 @@ class BeamElement : public ForceElement<BeamElement> {
     const State& st = mode_as<State>(s);
     if (st.failed) return;
     const Kinematics<T> k = kinematics(s);
-    const std::array<T, 3> r = resultants(k.strain, plastic_offsets(st, k.strain));
+    apply_resultants(s, k.d, k.length, resultants(k.strain, plastic_offsets(st, k.strain)), f);
+  }
+
+  /// The generalized forces of resultants r = (N, M_1, M_2) on a chord d of length L.
+  template <class T>
+  void apply_resultants(const ElementState<T>& s, const Vec2<T>& d, const T& length, const std::array<T, 3>& r,
+                        std::array<Pose<T>, 2>& f) const {
     // force on P2 = -N d / L + (M_1 + M_2) perp(d) / L^2
-    const T along = -r[0] / k.length;
-    const T across = (r[1] + r[2]) / (k.length * k.length);
-    apply_line_force(*this, s, Vec2<T>{along * k.d.x - across * k.d.y, along * k.d.y + across * k.d.x}, f);
+    const T along = -r[0] / length;
+    const T across = (r[1] + r[2]) / (length * length);
+    apply_line_force(*this, s, Vec2<T>{along * d.x - across * d.y, along * d.y + across * d.x}, f);
     f[static_cast<std::size_t>(point_slot(0))].theta -= r[1];
     f[static_cast<std::size_t>(point_slot(1))].theta -= r[2];
   }
@@ -226,6 +232,9 @@ class BeamElement : public ForceElement<BeamElement> {
   /// One evaluation of the law for both (the step sweep's): a third of the beam's work there.
   void roots_and_outputs(double t, const ElementState<double>& s, const double* lambda, double* g,
                          double* out) const override;
+  /// The same evaluation gives the force too (the energy rates' and Euler's sweep).
+  void force_roots_and_outputs(double t, const ElementState<double>& s, const double* lambda,
+                               std::array<Pose<double>, 2>& f, double* g, double* out) const override;
 
  protected:
   BeamElement(ElementSpec& spec, BeamMaterial beam_material);
@@ -233,10 +242,11 @@ class BeamElement : public ForceElement<BeamElement> {
   BeamSection section_;
 
  private:
-  /// Resultants F and offsets p at state s, and (when given) dp/dt along s.v and the
-  /// deformations x (stretch, end rotations).
+  /// Resultants F and offsets p at state s, and (when given) dp/dt along s.v, the
+  /// deformations x (stretch, end rotations) and the chord (d, L; as kinematics() gives them).
   void evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
-                std::array<double, 3>* offset_rate = nullptr, std::array<double, 3>* strain = nullptr) const;
+                std::array<double, 3>* offset_rate = nullptr, std::array<double, 3>* strain = nullptr,
+                Kinematics<double>* chord = nullptr) const;
   /// The roots in mode st (not failed) from an evaluation at the state.
   void roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
                   const std::array<double, 3>& offset_rate, double* g) const;
