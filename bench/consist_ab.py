@@ -58,7 +58,7 @@ def main():
     for cars in [int(c) for c in args.cars.split(",")]:
         model = os.path.join(work, f"consist{cars}.yaml")
         subprocess.run([new, "consist", os.path.join(ROOT, "models/report/final_two_car.yaml"), "--cars", str(cars),
-                        "--out", model], check=True, stdout=subprocess.DEVNULL)
+                        "--out", model], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         cpu = {base: [], new: []}
         phases = {base: {p: [] for p in PHASES}, new: {p: [] for p in PHASES}}
         solver = {base: [], new: []}
