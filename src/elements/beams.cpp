@@ -281,7 +281,7 @@ void BeamElement::roots_and_outputs(double, const ElementState<double>& s, const
   if (out != nullptr) outputs_from(st, force, offset, x, out);
 }
 
-void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& s, const double* lambda,
+void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& s, const double*,
                                           std::array<Pose<double>, 2>& f, double* g, double* out) const {
   if (g == nullptr && out == nullptr) {
     add_force(t, s, f);
@@ -300,7 +300,6 @@ void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& 
   // offsets and resultants are not (a dual divided by a number is multiplied by the inverse),
   // so those few operations are redone in double: force_law's force, bit for bit.
   if (!st.failed) apply_resultants(s, chord.d, chord.length, resultants(chord.strain, plastic_offsets(st, chord.strain)), f);
-  (void)lambda;
 }
 
 void BeamElement::outputs_from(const State& st, std::array<double, 3> force, const std::array<double, 3>& offset,
