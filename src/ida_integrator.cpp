@@ -880,6 +880,10 @@ std::string IdaIntegrator::explain_failure(int flag) {
         system_.non_finite_source(impl.non_finite_t, impl.non_finite_y.data(), impl.non_finite_yp.data());
     why << "; the residual was not finite at t = " << impl.non_finite_t << (source.empty() ? "" : ": " + source);
   }
+  if (impl.linear_solver != nullptr) {
+    const std::string linear = klu_failure(impl.linear_solver);
+    if (!linear.empty()) why << "; " << linear;
+  }
   double t_good = 0.0, h = 0.0;
   if (IDAGetCurrentTime(impl.ida, &t_good) != IDA_SUCCESS || IDAGetCurrentStep(impl.ida, &h) != IDA_SUCCESS) return why.str();
   why << "; last good state at t = " << t_good << ", step h = " << h;

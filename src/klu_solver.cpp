@@ -5,6 +5,7 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
+#include <string>
 
 #include "railcrash/integrator.hpp"
 
@@ -41,6 +42,13 @@ int klu_initialize(SUNLinearSolver solver) {
   return klu.last_flag;
 }
 
+/// A failed KLU call's flag for IDA: a singular matrix is recoverable (IDA cuts its step); no
+/// memory, or factors past 32-bit indices, are not (IDA stops with IDA_LSETUP_FAIL and
+/// klu_failure says why).
+int failure_flag(const KluContent& klu) {
+  return klu.common.status == KLU_SINGULAR ? SUNLS_PACKAGE_FAIL_REC : SUNLS_PACKAGE_FAIL_UNREC;
+}
+
 /// Analysis and a factorization with partial pivoting, from scratch.
 int analyse_and_factor(KluContent& klu, double* values) {
   if (klu.symbolic == nullptr) {
@@ -49,8 +57,7 @@ int analyse_and_factor(KluContent& klu, double* values) {
   }
   if (klu.numeric != nullptr) klu_free_numeric(&klu.numeric, &klu.common);
   klu.numeric = klu_factor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, &klu.common);
-  // Singular (or too large for 32-bit KLU): IDA cuts the step, or stops with the flag.
-  return klu.numeric == nullptr ? SUNLS_PACKAGE_FAIL_REC : SUNLS_SUCCESS;
+  return klu.numeric == nullptr ? failure_flag(klu) : SUNLS_SUCCESS;
 }
 
 /// Refactors with the previous pivot order while it stays sound, judged by KLU's reciprocal
@@ -83,7 +90,7 @@ int klu_solve_vector(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, 
   const double* from = N_VGetArrayPointer(b);
   double* to = N_VGetArrayPointer(x);
   if (to != from) std::copy(from, from + klu.size, to);
-  klu.last_flag = klu_solve(klu.symbolic, klu.numeric, klu.size, 1, to, &klu.common) ? SUNLS_SUCCESS : SUNLS_PACKAGE_FAIL_REC;
+  klu.last_flag = klu_solve(klu.symbolic, klu.numeric, klu.size, 1, to, &klu.common) ? SUNLS_SUCCESS : failure_flag(klu);
   return klu.last_flag;
 }
 
@@ -133,6 +140,22 @@ SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& colu
 long klu_factor_entries(SUNLinearSolver solver) {
   const klu_numeric* numeric = content_of(solver).numeric;
   return numeric == nullptr ? 0 : static_cast<long>(numeric->lnz) + numeric->unz + numeric->nzoff;
+}
+
+std::string klu_failure(SUNLinearSolver solver) {
+  const KluContent& klu = content_of(solver);
+  if (klu.last_flag == SUNLS_SUCCESS) return "";
+  switch (klu.common.status) {
+    case KLU_SINGULAR:
+      return "KLU found the Newton matrix singular at its last factorization (a joint or a mass the motion "
+             "cannot determine at that state)";
+    case KLU_OUT_OF_MEMORY:
+      return "KLU ran out of memory factoring the Newton matrix";
+    case KLU_TOO_LARGE:
+      return "the Newton matrix's factors exceed KLU's 32-bit indices (2^31 entries): the model is too large";
+    default:
+      return "KLU failed (status " + std::to_string(klu.common.status) + ")";
+  }
 }
 
 SUNMatrix make_klu_jacobian_matrix(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index) {

@@ -28,6 +28,7 @@
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
 
+#include <string>
 #include <vector>
 
 namespace railcrash {
@@ -42,6 +43,9 @@ SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& colu
 /// The entries KLU stores for the last factorization (L, U and the off-diagonal blocks of its
 /// block triangular form); 0 before the first.
 long klu_factor_entries(SUNLinearSolver solver);
+
+/// Why the solver's last setup or solve failed, for a failure message ("" when it did not).
+std::string klu_failure(SUNLinearSolver solver);
 
 /// IDA's n x n CSC Jacobian matrix of the given pattern, with its index arrays written once.
 /// Its zero operation (called by IDA before every Jacobian evaluation) is replaced by one that

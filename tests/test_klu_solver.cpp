@@ -110,9 +110,11 @@ TEST_CASE("KLU with 32-bit indices solves, refactors, falls back to pivoting and
   s.set(singular);
   CHECK(SUNLinSolSetup(s.solver, s.matrix) == SUNLS_PACKAGE_FAIL_REC);
   CHECK(SUNLinSolLastFlag(s.solver) == SUNLS_PACKAGE_FAIL_REC);
+  CHECK_THAT(klu_failure(s.solver), Catch::Contains("singular"));
 
   // ... and the solver recovers when the values do.
   s.set(kValues);
   REQUIRE(SUNLinSolSetup(s.solver, s.matrix) == SUNLS_SUCCESS);
+  CHECK(klu_failure(s.solver).empty());
   CHECK(s.error_of_solve(kValues, flag) < 1e-14);
 }
