@@ -52,8 +52,8 @@ set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-railcrash)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
-# find_package(railcrash) finds these again (railcrashConfig.cmake); KLU comes with SUNDIALS's
-# sunlinsolklu target (libsuitesparse-dev).
+# find_package(railcrash) finds these again (railcrashConfig.cmake); KLU (libsuitesparse-dev)
+# through the SUNDIALS::KLU target that SUNDIALS' configuration defines.
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS
   "railcrash (= ${PROJECT_VERSION}), libsundials-dev (>= 6), libsuitesparse-dev, libyaml-cpp-dev, libeigen3-dev (>= 3.3), cmake (>= 3.18)")
 if(RAILCRASH_HDF5)  # loaded by its soname for --format hdf5 (src/results/hdf5_library.cpp), so shlibdeps does not see it

@@ -20,7 +20,7 @@ require() {  # require PACKAGE-FILE WORD...: the Depends field names every WORD
 }
 runtime=$(ls "$work"/railcrash_*.deb)
 dev=$(ls "$work"/railcrash-dev_*.deb)
-require "$runtime" libsundials-idas libsundials-sunlinsol libklu libyaml-cpp libstdc++6
+require "$runtime" libsundials-idas libklu libyaml-cpp libstdc++6  # KLU directly: railcrash's own linear solver
 require "$dev" "railcrash (=" libsundials-dev libsuitesparse-dev libyaml-cpp-dev libeigen3-dev
 contains() {  # contains PACKAGE-FILE PATTERN
   dpkg-deb -c "$1" > "$work/contents"
