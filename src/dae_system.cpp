@@ -171,6 +171,15 @@ std::vector<double> DaeSystem::differential_ids() const {
   return id;
 }
 
+void DaeSystem::gravity_and_load_forces(double t, const double* q, double* f) const {
+  for (int i = 0; i < model_.body_count(); ++i) {
+    f[3 * i] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
+    f[3 * i + 1] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_y;
+    f[3 * i + 2] = 0.0;
+  }
+  load_forces(t, q, f);
+}
+
 void DaeSystem::load_forces(double t, const double* q, double* f) const {
   for (const Load& load : model_.loads()) {
     const std::array<double, 2> value = load.value.at(t);
@@ -195,6 +204,26 @@ double power_into(const std::array<Pose<double>, 2>& fe, const ElementState<doub
   for (std::size_t k = 0; k < 2; ++k) power -= fe[k].x * s.v[k].x + fe[k].y * s.v[k].y + fe[k].theta * s.v[k].theta;
   return power;
 }
+
+/// fe += more, body by body.
+void add_poses(std::array<Pose<double>, 2>& fe, const std::array<Pose<double>, 2>& more) {
+  for (std::size_t k = 0; k < 2; ++k) {
+    fe[k].x += more[k].x;
+    fe[k].y += more[k].y;
+    fe[k].theta += more[k].theta;
+  }
+}
+
+/// An element's forces fe on its two bodies, added to the generalized forces f.
+void add_to_bodies(const Element& el, const std::array<Pose<double>, 2>& fe, double* f) {
+  for (int k = 0; k < 2; ++k) {
+    const int b = el.slot_body(k);
+    if (b == kGround) continue;
+    f[3 * b] += fe[static_cast<std::size_t>(k)].x;
+    f[3 * b + 1] += fe[static_cast<std::size_t>(k)].y;
+    f[3 * b + 2] += fe[static_cast<std::size_t>(k)].theta;
+  }
+}
 }  // namespace
 
 void DaeSystem::generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty,
@@ -204,13 +233,7 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
     body_quadrature_rates(t, q, v, powers);
     powers[kPenaltyWork] = 0.0;
   }
-  const int n = model_.body_count();
-  for (int i = 0; i < n; ++i) {
-    f[3 * i] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
-    f[3 * i + 1] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_y;
-    f[3 * i + 2] = 0.0;
-  }
-  load_forces(t, q, f);
+  gravity_and_load_forces(t, q, f);
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     const ElementState<double> s = local_state(e, q, v);
@@ -258,20 +281,10 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
         std::array<Pose<double>, 2> friction{};
         el.add_joint_force(t, s, reactions, friction);
         if (element_power) *element_power = power_into(friction, s);
-        for (std::size_t k = 0; k < 2; ++k) {
-          fe[k].x += friction[k].x;
-          fe[k].y += friction[k].y;
-          fe[k].theta += friction[k].theta;
-        }
+        add_poses(fe, friction);
       }
     }
-    for (int k = 0; k < 2; ++k) {
-      const int b = el.slot_body(k);
-      if (b == kGround) continue;
-      f[3 * b] += fe[static_cast<std::size_t>(k)].x;
-      f[3 * b + 1] += fe[static_cast<std::size_t>(k)].y;
-      f[3 * b + 2] += fe[static_cast<std::size_t>(k)].theta;
-    }
+    add_to_bodies(el, fe, f);
   }
 }
 
@@ -280,12 +293,8 @@ void DaeSystem::generalized_forces_at_reactions(double t, const double* q, const
   const std::size_t count = model_.elements().size();
   const int nq = body_unknowns();
   if (!fixed.ready) {
-    fixed.base.assign(static_cast<std::size_t>(nq), 0.0);
-    for (int i = 0; i < model_.body_count(); ++i) {
-      fixed.base[static_cast<std::size_t>(3 * i)] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_x;
-      fixed.base[static_cast<std::size_t>(3 * i + 1)] = mass_[static_cast<std::size_t>(3 * i)] * model_.gravity_y;
-    }
-    load_forces(t, q, fixed.base.data());
+    fixed.base.resize(static_cast<std::size_t>(nq));
+    gravity_and_load_forces(t, q, fixed.base.data());
     fixed.elements.assign(count, std::array<Pose<double>, 2>{});
     for (std::size_t e = 0; e < count; ++e) {
       const Element& el = *model_.elements()[e];
@@ -304,19 +313,9 @@ void DaeSystem::generalized_forces_at_reactions(double t, const double* q, const
       for (int r = 0; r < m; ++r) reactions[r] = lambda[offset + r];
       std::array<Pose<double>, 2> friction{};
       el.add_joint_force(t, local_state(e, q, v), reactions, friction);
-      for (std::size_t k = 0; k < 2; ++k) {
-        fe[k].x += friction[k].x;
-        fe[k].y += friction[k].y;
-        fe[k].theta += friction[k].theta;
-      }
+      add_poses(fe, friction);
     }
-    for (int k = 0; k < 2; ++k) {
-      const int b = el.slot_body(k);
-      if (b == kGround) continue;
-      f[3 * b] += fe[static_cast<std::size_t>(k)].x;
-      f[3 * b + 1] += fe[static_cast<std::size_t>(k)].y;
-      f[3 * b + 2] += fe[static_cast<std::size_t>(k)].theta;
-    }
+    add_to_bodies(el, fe, f);
   }
 }
 

@@ -250,6 +250,8 @@ class DaeSystem {
   /// outputs), reuse them. A cache keyed by the angle's value, so it is never stale.
   const Rotation<double>& body_rotation(int b, double theta) const;
   void load_forces(double t, const double* q, double* f) const;
+  /// f = gravity on every body, plus the loads: where the generalized forces start.
+  void gravity_and_load_forces(double t, const double* q, double* f) const;
   /// One past element e's last output in output_names().
   int output_end(std::size_t e) const;
   /// Element e's roots into g and its outputs into `outputs` (their places in the whole arrays;
