@@ -124,36 +124,40 @@ std::string Element::output_with_role(OutputRole role) const {
 }
 
 Element::Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where)
-    : name_(std::move(name)), type_(std::move(type)), points_(std::move(points)), where_(std::move(where)) {
-  for (std::size_t p = 0; p < points_.size() && p < near_points_.size(); ++p) near_points_[p] = points_[p];
+    : description_(std::make_unique<Description>(
+          Description{std::move(name), std::move(type), std::move(points), std::move(where), {}, {}})) {
+  const std::vector<PointRef>& all = description_->points;
+  for (std::size_t p = 0; p < all.size() && p < near_points_.size(); ++p) near_points_[p] = all[p];
 }
 
 void Element::bind_bodies() {
   // Slots in order of first appearance of a distinct body; ground always gets the slot
   // it first appears in too, so point p's slot is stable whatever the bodies are.
   slot_body_ = {kGround, kGround};
-  point_slot_.assign(points_.size(), 0);
+  const std::vector<PointRef>& all = description_->points;
+  std::vector<int>& point_slot = description_->point_slot;
+  point_slot.assign(all.size(), 0);
   int used = 0;
-  for (std::size_t p = 0; p < points_.size(); ++p) {
-    const int body = points_[p].body;
+  for (std::size_t p = 0; p < all.size(); ++p) {
+    const int body = all[p].body;
     int slot = -1;
     for (int k = 0; k < used; ++k)
       if (slot_body_[static_cast<std::size_t>(k)] == body) slot = k;
     if (slot < 0) {
       if (used == 2)
-        throw InputError(where_.prefix() + "element '" + name_ + "' (" + type_ +
+        throw InputError(where().prefix() + "element '" + name() + "' (" + type() +
                          ") connects more than two bodies; give its points on at most two bodies");
       slot = used++;
       slot_body_[static_cast<std::size_t>(slot)] = body;
     }
-    point_slot_[p] = slot;
+    point_slot[p] = slot;
     if (p < near_point_slot_.size()) near_point_slot_[p] = slot;
   }
   // A joint whose points all lie on one body (or all on ground) constrains nothing: its
   // constraint rows are identically zero and the system would be singular.
   if (constraint_count() > 0 && used < 2) {
     const std::string body = slot_body_[0] == kGround ? std::string("ground") : "one body";
-    throw InputError(where_.prefix() + "joint '" + name_ + "' (" + type_ + ") has all its points on " + body +
+    throw InputError(where().prefix() + "joint '" + name() + "' (" + type() + ") has all its points on " + body +
                      ", so it constrains nothing; give its points on two different bodies (or one body and ground)");
   }
 }

@@ -98,7 +98,7 @@ PenaltyRows EulerIntegrator::make_penalty(double dt) const {
     const Element& owner = system_.constraint_owner(r);
     const bool rotational = system_.constraint_row_is_rotational(r);
     const double effective_mass = 1.0 / inverse_effective_mass[row];
-    const auto& own = owner.penalty;
+    const auto& own = owner.penalty();
     const auto& global = settings_.penalty;
     const std::optional<double> k = rotational ? (own.rotational_stiffness ? own.rotational_stiffness : global.rotational_stiffness)
                                                : (own.stiffness ? own.stiffness : global.stiffness);

@@ -30,6 +30,7 @@
 #include <array>
 #include <cassert>
 #include <cstddef>
+#include <memory>
 #include <new>
 #include <optional>
 #include <type_traits>
@@ -123,20 +124,21 @@ class Element {
   /// after free of an element is still caught).
   static bool allocated_from_pool();
 
-  const std::string& name() const { return name_; }
-  const std::string& type() const { return type_; }
-  const SourceLocation& where() const { return where_; }
-  const std::vector<PointRef>& points() const { return points_; }
+  const std::string& name() const { return description_->name; }
+  const std::string& type() const { return description_->type; }
+  const SourceLocation& where() const { return description_->where; }
+  const std::vector<PointRef>& points() const { return description_->points; }
 
   /// Global body index of slot 0 / 1 (kGround for ground or an unused slot).
   int slot_body(int slot) const { return slot_body_[static_cast<std::size_t>(slot)]; }
   /// Slot holding the body of point p.
   int point_slot(int p) const {
-    return p < kNearPoints ? near_point_slot_[static_cast<std::size_t>(p)] : point_slot_[static_cast<std::size_t>(p)];
+    return p < kNearPoints ? near_point_slot_[static_cast<std::size_t>(p)]
+                           : description_->point_slot[static_cast<std::size_t>(p)];
   }
   /// Offset of point p on its body.
   const PointRef& point(int p) const {
-    return p < kNearPoints ? near_points_[static_cast<std::size_t>(p)] : points_[static_cast<std::size_t>(p)];
+    return p < kNearPoints ? near_points_[static_cast<std::size_t>(p)] : description_->points[static_cast<std::size_t>(p)];
   }
 
   // ---- constraint elements ----
@@ -244,7 +246,8 @@ class Element {
     std::optional<double> rotational_stiffness;  // [moment/rad]
     std::optional<double> rotational_damping;    // [moment*time/rad]
   };
-  PenaltyOverrides penalty;
+  PenaltyOverrides& penalty() { return description_->penalty; }
+  const PenaltyOverrides& penalty() const { return description_->penalty; }
 
   /// Called by Model::finalize with the global indices of the bodies of each point.
   void bind_bodies();
@@ -255,14 +258,24 @@ class Element {
   virtual bool applies_moment() const { return false; }
 
  protected:
-  std::string name_;
-  std::string type_;
-  std::vector<PointRef> points_;
-  SourceLocation where_;
+  /// What the sweeps never read: names, the model file's line, all points, penalty overrides.
+  /// It lives on the ordinary heap, not in the object, so that the element pool holds only what
+  /// a residual, Jacobian or step sweep reads. Those sweeps run through every element at every
+  /// evaluation, and their cost per element grows once a long train's elements pass this VM's
+  /// 7-8 MiB: 256 unused bytes added to each element made the 200 + 200-car consist's
+  /// residual calls 1.8x dearer (bench/README.md, "Elements without their description").
+  struct Description {
+    std::string name;
+    std::string type;
+    std::vector<PointRef> points;
+    SourceLocation where;
+    std::vector<int> point_slot;  // slot of each point (bind_bodies)
+    PenaltyOverrides penalty;
+  };
+  std::unique_ptr<Description> description_;
   std::array<int, 2> slot_body_{kGround, kGround};
-  std::vector<int> point_slot_;
   // Copies of the first points and their slots inside the object, which the laws read at every
-  // evaluation: points_ and point_slot_ lie elsewhere on the heap (a line or page more per
+  // evaluation: the description lies elsewhere on the heap (a line or page more per
   // element and sweep in a long train).
   static constexpr int kNearPoints = 2;
   std::array<PointRef, kNearPoints> near_points_{};

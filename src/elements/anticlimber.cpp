@@ -269,7 +269,7 @@ void Anticlimber::settle(State& st, double t, const ElementState<double>& s, std
 }
 
 void Anticlimber::initialize(const ElementState<double>& initial) {
-  const std::string who = where_.prefix() + "anticlimber '" + name_ + "'";
+  const std::string who = where().prefix() + "anticlimber '" + name() + "'";
   if (point_slot(0) == point_slot(1))
     throw InputError(who + ": both points are on the same body; put point 1 on one car end and point 2 on the other");
   if (!facing) {

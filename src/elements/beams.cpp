@@ -126,7 +126,7 @@ BeamElement::BeamElement(ElementSpec& spec, BeamMaterial beam_material)
 
 void BeamElement::initialize(const ElementState<double>& initial) {
   if (point_slot(0) == point_slot(1))
-    throw InputError(where_.prefix() + type_ + " '" + name_ +
+    throw InputError(where().prefix() + type() + " '" + name() +
                      "': both points are on the same body; a beam connects two bodies (or a body and ground)");
   const auto k1 = static_cast<std::size_t>(point_slot(0));
   const auto k2 = static_cast<std::size_t>(point_slot(1));
@@ -134,7 +134,7 @@ void BeamElement::initialize(const ElementState<double>& initial) {
                          point_position(initial.q[k1], point(0).sx, point(0).sy);
   length_ = std::sqrt(dot(d, d));
   if (!(length_ > 0.0))
-    throw InputError(where_.prefix() + type_ + " '" + name_ +
+    throw InputError(where().prefix() + type() + " '" + name() +
                      "': its two points coincide in the initial configuration; a beam needs a length, move them apart");
   direction_ = {d.x / length_, d.y / length_};
   initial_angle_ = {initial.q[k1].theta, initial.q[k2].theta};

@@ -413,7 +413,7 @@ DraftGear::Kinematics DraftGear::kinematics(const ElementState<double>& s) const
 void DraftGear::initialize(const ElementState<double>& initial) {
   const double length = line_geometry(*this, initial).length;
   if (length == 0.0)
-    throw InputError(where_.prefix() + "draft_gear '" + name_ +
+    throw InputError(where().prefix() + "draft_gear '" + name() +
                      "': its two points coincide in the initial configuration, so it has no direction; move them apart");
   if (!free_length) free_length = length;
   const Kinematics k = kinematics(initial);
@@ -423,7 +423,7 @@ void DraftGear::initialize(const ElementState<double>& initial) {
   const double force = std::abs(gear_force(st, k.d));
   const auto reject = [&](const char* what, double limit) {
     std::ostringstream msg;
-    msg << where_.prefix() << "draft_gear '" << name_ << "' starts with a force " << force << " at or above its " << what
+    msg << where().prefix() << "draft_gear '" << name() << "' starts with a force " << force << " at or above its " << what
         << " " << limit << "; start it closer to its free_length";
     throw InputError(msg.str());
   };
@@ -577,7 +577,7 @@ void CouplerEnd::initialize(const ElementState<double>& initial) {
   }
   if (shear_load && active(st) && st.band == DeadBand::Mode::Below && -face_tension(st, k.h) >= *shear_load) {
     std::ostringstream msg;
-    msg << where_.prefix() << "coupler_end '" << name_ << "' starts with a face force " << -face_tension(st, k.h)
+    msg << where().prefix() << "coupler_end '" << name() << "' starts with a face force " << -face_tension(st, k.h)
         << " at or above its shear_load " << *shear_load << "; start the faces closer to touching";
     throw InputError(msg.str());
   }

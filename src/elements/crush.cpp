@@ -60,13 +60,13 @@ void CrushSpring::enter_mode_at(State& st, double crush, double rate) const {
 void CrushSpring::initialize(const ElementState<double>& initial) {
   const double length = line_geometry(*this, initial).length;
   if (length == 0.0)
-    throw InputError(where_.prefix() + "crush_spring '" + name_ +
+    throw InputError(where().prefix() + "crush_spring '" + name() +
                      "': its two points coincide in the initial configuration, so it has no direction; move them apart");
   if (!free_length) free_length = length;
   initial_state_ = State{};
   enter_mode_at(initial_state_, crush_of(initial), crush_rate_of(initial));
   if (initial_state_.mode == Mode::Loading && crush_of(initial) > 0.0)
-    throw InputError(where_.prefix() + "crush_spring '" + name_ + "' starts crushed by " + std::to_string(crush_of(initial)) +
+    throw InputError(where().prefix() + "crush_spring '" + name() + "' starts crushed by " + std::to_string(crush_of(initial)) +
                      "; start it at or beyond its free_length (it has no crush history)");
 }
 

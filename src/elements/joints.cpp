@@ -18,10 +18,10 @@ std::array<double, 2> read_axis(ElementSpec& spec) {
 }
 
 void read_penalty(ElementSpec& spec, Element& e) {
-  e.penalty.stiffness = spec.parameters->number("penalty_stiffness");
-  e.penalty.damping = spec.parameters->number("penalty_damping");
-  e.penalty.rotational_stiffness = spec.parameters->number("penalty_rotational_stiffness");
-  e.penalty.rotational_damping = spec.parameters->number("penalty_rotational_damping");
+  e.penalty().stiffness = spec.parameters->number("penalty_stiffness");
+  e.penalty().damping = spec.parameters->number("penalty_damping");
+  e.penalty().rotational_stiffness = spec.parameters->number("penalty_rotational_stiffness");
+  e.penalty().rotational_damping = spec.parameters->number("penalty_rotational_damping");
 }
 
 template <class J>

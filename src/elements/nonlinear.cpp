@@ -115,7 +115,7 @@ void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initi
   if (fracture_roots() > 0) {
     const double f = law_.value(x, m.segment);
     if (f >= *fracture_load || (fracture_roots() > 1 && -f >= *fracture_load))
-      throw InputError(this->where_.prefix() + this->type_ + " '" + this->name_ + "' starts at a force of " +
+      throw InputError(this->where().prefix() + this->type() + " '" + this->name() + "' starts at a force of " +
                        std::to_string(f) + ", beyond its fracture_load " + std::to_string(*fracture_load) +
                        "; raise fracture_load or start it less deformed");
   }

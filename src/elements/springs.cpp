@@ -16,7 +16,7 @@ void LinearSpring::initialize(const ElementState<double>& initial) {
   const double length = line_geometry(*this, initial).length;
   if (!free_length) free_length = length;
   if (*free_length > 0.0 && length == 0.0)
-    throw InputError(where_.prefix() + "linear_spring '" + name_ +
+    throw InputError(where().prefix() + "linear_spring '" + name() +
                      "': its two points coincide in the initial configuration, so the spring has no direction; "
                      "move the points apart or set free_length: 0");
 }
