@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cassert>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -39,12 +40,14 @@ double standard_gravity(const Model& model) { return model.units == UnitSystem::
 std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole role) {
   std::vector<RoleColumn> columns;
   const auto& names = system.output_names();
-  for (const auto& e : system.model().elements()) {
-    const std::string output = e->output_with_role(role);
+  const auto& elements = system.model().elements();
+  for (std::size_t k = 0; k < elements.size(); ++k) {
+    const Element& e = *elements[k];
+    const std::string output = e.output_with_role(role);
     if (output.empty()) continue;
-    const auto it = std::find(names.begin(), names.end(), e->name() + "." + output);
+    const auto it = std::find(names.begin(), names.end(), e.name() + "." + output);
     RAILCRASH_DEMAND(it != names.end());  // a role names one of the element's outputs
-    columns.push_back(RoleColumn{e.get(), static_cast<int>(it - names.begin())});
+    columns.push_back(RoleColumn{&e, static_cast<int>(it - names.begin()), static_cast<int>(k)});
   }
   return columns;
 }
@@ -56,7 +59,7 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
   for (int i = 0; i < model.body_count(); ++i) {
     const std::string& name = model.bodies()[static_cast<std::size_t>(i)].car;
     auto car = std::find_if(cars.begin(), cars.end(), [&](const CarCrush& c) { return c.car == name; });
-    if (!name.empty() && car == cars.end()) car = cars.insert(cars.end(), CarCrush{name, {}, {}, {}, {}, 0.0, 0.0});
+    if (!name.empty() && car == cars.end()) car = cars.insert(cars.end(), CarCrush{name, {}, {}, {}, {}, {}, 0.0, 0.0});
     if (car != cars.end()) car->bodies.push_back(i);
     car_of_body.push_back(name.empty() ? -1 : static_cast<int>(car - cars.begin()));
   }
@@ -70,11 +73,37 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
     for (const int c : touched) {
       CarCrush& car = cars[static_cast<std::size_t>(c)];
       car.elements.push_back(crush.element->name());
+      car.element_indices.push_back(crush.element_index);
       car.columns.push_back(crush.column);
       car.shares.push_back(1.0 / static_cast<double>(touched.size()));
     }
   }
   return cars;
+}
+
+std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car, const double* y, const double* lambda,
+                                   const double* outputs, const FreshOutputs& fresh, std::vector<double>& scratch) {
+  bool any_fresh = false, all_fresh = true;
+  for (const int column : car.columns) {
+    any_fresh = any_fresh || fresh.has(column);
+    all_fresh = all_fresh && fresh.has(column);
+  }
+  if (!any_fresh) return std::nullopt;
+  if (all_fresh) return shared_crush(outputs, car.columns, car.shares);
+  scratch.resize(system.output_names().size());
+  for (std::size_t k = 0; k < car.columns.size(); ++k) {
+    const int column = car.columns[k];
+    if (fresh.has(column)) scratch[static_cast<std::size_t>(column)] = outputs[column];
+    else system.element_outputs(car.element_indices[k], y, lambda, scratch.data());  // at y, here
+  }
+  return shared_crush(scratch.data(), car.columns, car.shares);
+}
+
+double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares) {
+  assert(columns.size() == shares.size());
+  double total = 0.0;  // [length]
+  for (std::size_t k = 0; k < columns.size(); ++k) total += shares[k] * std::max(0.0, outputs[columns[k]]);
+  return total;
 }
 
 std::string valid_utf8(const std::string& text) {
@@ -224,7 +253,7 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
   const std::size_t output_count = system_.output_names().size();
   if (timeseries_) write_row_tail(*timeseries_, outputs, output_count);
-  track_extrema(t, outputs, FreshOutputs{});
+  track_extrema(t, y, lambda, outputs, FreshOutputs{});
   body_accelerations(system_, t, y, lambda, acceleration_.data(), acceleration_scratch_);
   if (!system_.model().output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
@@ -290,23 +319,24 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   }
 }
 
-void ResultWriter::step(double t, const double*, const double*, const double* outputs, const FreshOutputs& fresh) {
-  track_extrema(t, outputs, fresh);
+void ResultWriter::step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) {
+  track_extrema(t, y, lambda, outputs, fresh);
 }
 
-void ResultWriter::track_extrema(double t, const double* outputs, const FreshOutputs& fresh) {
+void ResultWriter::track_extrema(double t, const double* y, const double* lambda, const double* outputs,
+                                 const FreshOutputs& fresh) {
   for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(peak_output_.size()); ++k)
     if (std::abs(outputs[k]) > peak_output_[k]) {
       peak_output_[k] = std::abs(outputs[k]);
       peak_time_[k] = t;
     }
-  // A car's crush sums several elements' outputs: only where all of them are fresh.
+  // A car's crush sums several elements' outputs, all of one instant (car_crush_at).
   for (CarCrush& car : cars_) {
-    if (!fresh.has_all(car.columns)) continue;
-    double crush = 0.0;  // [length]
-    for (std::size_t k = 0; k < car.columns.size(); ++k)
-      crush += car.shares[k] * std::max(0.0, outputs[car.columns[k]]);
-    if (crush > car.max_crush) { car.max_crush = crush; car.t = t; }
+    const std::optional<double> crush = car_crush_at(system_, car, y, lambda, outputs, fresh, crush_scratch_);
+    if (crush && *crush > car.max_crush) {
+      car.max_crush = *crush;
+      car.t = t;
+    }
   }
 }
 

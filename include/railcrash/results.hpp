@@ -37,6 +37,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,7 @@ struct CarCrush {
   std::string car;
   std::vector<int> bodies;        // body indices, in model order
   std::vector<std::string> elements;
+  std::vector<int> element_indices;  // their indices in the model
   std::vector<int> columns;       // output columns of their crush deformations
   std::vector<double> shares;     // 1, or 0.5 for an element between two cars
   double max_crush = 0.0;         // [length]
@@ -87,10 +89,24 @@ struct CarCrush {
 /// Cars of a model (see above) in the order they are first declared, with their crush elements.
 std::vector<CarCrush> cars_of(const DaeSystem& system);
 
+/// Crush of a car at one time [length]: sum of share x max(0, outputs[column]) over its crush
+/// output columns (share 1, or 1/2 for an element between two cars).
+double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares);
+
+/// The car's crush [length] at state y, an instant at which only the `fresh` columns of
+/// `outputs` are y's: at a mode change located inside a step only the changed element's outputs
+/// are evaluated again. The car's crush elements whose columns are not fresh are evaluated at y
+/// here (into scratch, which is resized to the system's outputs), so that the sum is of one
+/// instant. nullopt when none of the car's columns is fresh: the instant is another element's
+/// event, and evaluating every car at every event would make a long train's cost grow as N^2.
+std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car, const double* y, const double* lambda,
+                                   const double* outputs, const FreshOutputs& fresh, std::vector<double>& scratch);
+
 /// An element output column (index into DaeSystem::output_names()) that plays a role.
 struct RoleColumn {
   const Element* element;
   int column;
+  int element_index;  // in the model
 };
 /// Every output playing `role`, in element order.
 std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole role);
@@ -157,6 +173,7 @@ class ResultWriter : public RunObserver {
   AccelerationScratch acceleration_scratch_;
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
+  std::vector<double> crush_scratch_;  // outputs of a car's crush elements evaluated at an event (car_crush_at)
   std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
   std::unique_ptr<EnergyWriter> energy_;
   OutputFormat format_ = OutputFormat::Csv;
@@ -187,7 +204,7 @@ class ResultWriter : public RunObserver {
   std::string failure_;                                  // first failed write, with the OS's reason
 
   /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.
-  void track_extrema(double t, const double* outputs, const FreshOutputs& fresh);
+  void track_extrema(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh);
   std::string summary_text(const RunOutcome& outcome, const std::string& status, const std::string& integrator,
                            const std::string& extra_json) const;
   /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.

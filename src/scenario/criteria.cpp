@@ -206,12 +206,6 @@ double largest_change(const std::vector<double>& values) {
   return largest;
 }
 
-double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares) {
-  assert(columns.size() == shares.size());
-  double total = 0.0;
-  for (std::size_t k = 0; k < columns.size(); ++k) total += shares[k] * std::max(0.0, outputs[columns[k]]);
-  return total;
-}
 
 double largest_lift(const std::vector<double>& penetration) {
   double largest = 0.0;
@@ -233,12 +227,14 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
     RAILCRASH_DEMAND(car != cars.end());  // the section reader checked that a body declares the car
     CarCrush kept = *car;  // without the excluded elements
     kept.elements.clear();
+    kept.element_indices.clear();
     kept.columns.clear();
     kept.shares.clear();
     for (std::size_t k = 0; k < car->elements.size(); ++k) {
       const auto& excluded = criteria.survival_excluded;
       if (std::find(excluded.begin(), excluded.end(), car->elements[k]) != excluded.end()) continue;
       kept.elements.push_back(car->elements[k]);
+      kept.element_indices.push_back(car->element_indices[k]);
       kept.columns.push_back(car->columns[k]);
       kept.shares.push_back(car->shares[k]);
     }
@@ -265,15 +261,15 @@ double ScenarioTracker::car_crush_now(std::size_t k, const double* outputs) cons
   return shared_crush(outputs, crush_of_cars_[k].columns, crush_of_cars_[k].shares);
 }
 
-void ScenarioTracker::step(double, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) {
+void ScenarioTracker::step(double, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) {
   if (times_.empty()) return;  // the references (L(0), the offset at 0) come from the first sample
   for (std::size_t k = 0; k < front_index_.size(); ++k)
     step_extremes_.shortening[k] =
         std::max(step_extremes_.shortening[k], lengths_[k].front() - distance(y, front_index_[k], rear_index_[k]));
-  // A car's crush sums several elements' outputs: only where all of them are fresh.
+  // A car's crush sums several elements' outputs, all of one instant (car_crush_at).
   for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
-    if (fresh.has_all(crush_of_cars_[k].columns))
-      step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], car_crush_now(k, outputs));
+    const std::optional<double> crush = car_crush_at(system_, crush_of_cars_[k], y, lambda, outputs, fresh, crush_scratch_);
+    if (crush) step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], *crush);
   }
   bool offset_known = true;
   double offset = 0.0;  // [length]

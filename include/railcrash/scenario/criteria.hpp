@@ -110,9 +110,6 @@ double filtered_mean_deceleration(const std::vector<double>& times, const std::v
 double largest_shortening(const std::vector<double>& lengths);
 /// Largest |v(t) - v(0)|.
 double largest_change(const std::vector<double>& values);
-/// Crush of a car at one time [length]: sum of share x max(0, outputs[column]) over its crush
-/// output columns (as results.hpp's car_crush: share 1, or 1/2 for an element between two cars).
-double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares);
 /// Largest lift max(0, -penetration) of a wheel [length].
 double largest_lift(const std::vector<double>& penetration);
 
@@ -139,6 +136,7 @@ class ScenarioTracker : public RunObserver {
 
   std::vector<int> passenger_index_, front_index_, rear_index_;
   std::vector<CarCrush> crush_of_cars_;                 // of survival_cars, in their order
+  std::vector<double> crush_scratch_;                   // their elements' outputs evaluated at an event (car_crush_at)
   int vertical_offset_column_ = -1, override_column_ = -1;
   int interface_lower_ = -1, interface_upper_ = -1;  // bodies of interface_bodies
   std::vector<int> wheel_columns_;
