@@ -177,7 +177,7 @@ std::vector<std::string> timeseries_columns(const DaeSystem& system) {
 
 ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory, OutputFormat format)
     : system_(system), directory_(directory), format_(format), last_flush_(std::chrono::steady_clock::now()),
-      last_summary_(last_flush_) {
+      running_summary_(last_flush_) {
   const std::vector<std::string> names = timeseries_columns(system);
   std::vector<std::string> acceleration_names{"t"};
   for (const Body& b : system.model().bodies())
@@ -308,14 +308,9 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
     last_folder_check_ = now;
     folder_checked_ = true;
   }
-  // The running summary.json every 2 s of wall time, or every 50 times what writing it took,
-  // whichever is longer: its text grows with the model (6 MB at 200 + 200 cars) and a run's
-  // length with it, so a fixed interval would cost in proportion to the square of the model.
-  if (failure_.empty() && now - last_summary_ > running_summary_interval_) {
+  if (failure_.empty() && running_summary_.due(now)) {
     write_running_summary(integrator_);
-    const auto written = std::chrono::steady_clock::now();
-    running_summary_interval_ = std::max<std::chrono::steady_clock::duration>(std::chrono::seconds(2), 50 * (written - now));
-    last_summary_ = written;
+    running_summary_.written(now, std::chrono::steady_clock::now());
   }
 }
 

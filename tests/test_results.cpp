@@ -394,3 +394,22 @@ TEST_CASE("a car's largest crush is a sum of its crush elements at one instant",
     if (std::string(scenario) == "scenario1_barrier_cars") CHECK(some_at_event);
   }
 }
+
+TEST_CASE("the running summary is written every 2 s, or every 50 times what the last one took", "[results]") {
+  using std::chrono::milliseconds;
+  const SummarySchedule::Clock::time_point start{};
+  SummarySchedule schedule(start);
+  CHECK_FALSE(schedule.due(start + milliseconds(1999)));
+  CHECK(schedule.due(start + milliseconds(2001)));
+  // A summary that took 100 ms: the next one 5 s after it ended, not 2 s.
+  schedule.written(start + milliseconds(2001), start + milliseconds(2101));
+  CHECK(schedule.interval() == milliseconds(5000));
+  CHECK_FALSE(schedule.due(start + milliseconds(4200)));
+  CHECK_FALSE(schedule.due(start + milliseconds(7100)));
+  CHECK(schedule.due(start + milliseconds(7102)));
+  // A quick one (10 ms): back to 2 s.
+  schedule.written(start + milliseconds(7102), start + milliseconds(7112));
+  CHECK(schedule.interval() == milliseconds(2000));
+  CHECK_FALSE(schedule.due(start + milliseconds(9100)));
+  CHECK(schedule.due(start + milliseconds(9113)));
+}

@@ -35,6 +35,7 @@
 // and its largest crush over the output samples and when.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -120,6 +121,30 @@ class BufferedFile;
 void write_row_tail(BufferedFile& file, const double* values, std::size_t count);
 void write_row_tail(BufferedFile& file, const std::vector<double>& values);
 
+/// When a run writes its running summary.json again: 2 s of wall time after the last one, or
+/// 50 times what writing the last one took, whichever is longer. Its text grows with the model
+/// (6 MB at 200 + 200 cars) and a run's length with it, so a fixed interval would cost in
+/// proportion to the square of the model; at 50 times, the summaries cost at most 2 % of a run.
+class SummarySchedule {
+ public:
+  using Clock = std::chrono::steady_clock;
+  static constexpr Clock::duration kShortestInterval = std::chrono::seconds(2);
+  static constexpr int kCostFactor = 50;  // interval / time to write, at least
+
+  explicit SummarySchedule(Clock::time_point start) : last_(start) {}
+  bool due(Clock::time_point now) const { return now - last_ > interval_; }
+  /// A summary was written, begun and ended at these times.
+  void written(Clock::time_point begun, Clock::time_point ended) {
+    interval_ = std::max<Clock::duration>(kShortestInterval, kCostFactor * (ended - begun));
+    last_ = ended;
+  }
+  Clock::duration interval() const { return interval_; }
+
+ private:
+  Clock::time_point last_;                    // end of the last summary (or the run's start)
+  Clock::duration interval_ = kShortestInterval;
+};
+
 class ResultWriter : public RunObserver {
  public:
   /// Creates DIR and the CSV files with their headers, or timeseries.h5 (DIR empty: no files). With
@@ -193,9 +218,7 @@ class ResultWriter : public RunObserver {
   mutable std::size_t filtered_samples_ = 0;
   mutable double filtered_class_ = 0.0;
   std::chrono::steady_clock::time_point last_flush_;
-  std::chrono::steady_clock::time_point last_summary_;  // last running summary.json
-  // At least 2 s, and 50 times what the last running summary.json took to write.
-  std::chrono::steady_clock::duration running_summary_interval_ = std::chrono::seconds(2);
+  SummarySchedule running_summary_;                     // the running summary.json's
   std::chrono::steady_clock::duration folder_check_interval_ = std::chrono::milliseconds(250);
   std::chrono::steady_clock::time_point last_folder_check_;
   bool folder_checked_ = false;                          // by a sample
