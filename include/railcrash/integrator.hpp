@@ -134,7 +134,8 @@ class RunObserver {
   /// Nothing is written from it. lambda as in sample(); outputs: the element outputs there
   /// (DaeSystem::outputs), evaluated once for all observers, but only the columns `fresh` has:
   /// an extremum of a quantity computed from y, or from fresh columns alone, is taken here;
-  /// one that also needs other columns (a sum over several elements' outputs) is not.
+  /// one that also needs other columns (a sum over several elements' outputs) evaluates them
+  /// at y itself (as car_crush_at in results.hpp does), or is not taken.
   virtual void step(double /*t*/, const double* /*y*/, const double* /*lambda*/, const double* /*outputs*/,
                     const FreshOutputs& /*fresh*/) {}
   /// True when step() does something: only then does the run loop evaluate the outputs per step.
