@@ -83,13 +83,9 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
 
 std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car, const double* y, const double* lambda,
                                    const double* outputs, const FreshOutputs& fresh, std::vector<double>& scratch) {
-  bool any_fresh = false, all_fresh = true;
-  for (const int column : car.columns) {
-    any_fresh = any_fresh || fresh.has(column);
-    all_fresh = all_fresh && fresh.has(column);
-  }
-  if (!any_fresh) return std::nullopt;
-  if (all_fresh) return shared_crush(outputs, car.columns, car.shares);
+  if (fresh.has_all(car.columns)) return shared_crush(outputs, car.columns, car.shares);
+  if (std::none_of(car.columns.begin(), car.columns.end(), [&](int column) { return fresh.has(column); }))
+    return std::nullopt;
   scratch.resize(system.output_names().size());
   for (std::size_t k = 0; k < car.columns.size(); ++k) {
     const int column = car.columns[k];
