@@ -759,7 +759,7 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   s.kinetic = kinetic_energy(y + nq);
   s.gravity = gravity_potential(y);
   for (std::size_t e = 0; e < model_.elements().size(); ++e)
-    s.elastic += model_.elements()[e]->potential_energy(local_state(e, y, y + nq));
+    s.elastic += element_potential_energy(e, y);
   if (penalty && constraint_rows() > 0) {
     std::vector<double> phi(static_cast<std::size_t>(constraint_rows()));
     constraints(y, phi.data(), nullptr);
@@ -770,6 +770,10 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   for (std::size_t e = 0; e < model_.elements().size(); ++e)
     s.element_work += quadratures[kFirstElementWork + static_cast<int>(e)];
   return s;
+}
+
+double DaeSystem::element_potential_energy(std::size_t e, const double* y) const {
+  return model_.elements()[e]->potential_energy(local_state(e, y, y + body_unknowns()));
 }
 
 void DaeSystem::roots(double t, const double* y, double* g, double* outputs) const {

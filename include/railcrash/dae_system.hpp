@@ -173,6 +173,9 @@ class DaeSystem {
   /// Potential of gravity, -sum m g . r [force*length].
   double gravity_potential(const double* q) const;
   EnergyState energy(const double* y, const double* quadratures, const PenaltyRows* penalty = nullptr) const;
+  /// Element e's stored elastic energy at the state y [force*length], its bodies' rotations from
+  /// the same cache as every sweep (an output row has computed them already).
+  double element_potential_energy(std::size_t e, const double* y) const;
 
   // ---- modes and events ----
   int root_count() const { return root_count_; }

@@ -90,8 +90,7 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   if (first_) initial_elastic_.assign(model.elements().size(), 0.0);
   double elastic = 0.0;
   for (std::size_t e = 0; e < model.elements().size(); ++e) {
-    const Element& el = *model.elements()[e];
-    const double stored = el.potential_energy(gather_state(el, y, y + nq, system_.modes().of(e)));
+    const double stored = system_.element_potential_energy(e, y);
     if (first_) initial_elastic_[e] = stored;
     elastic += stored;
     const double work = quadratures ? quadratures[DaeSystem::kFirstElementWork + static_cast<int>(e)] : 0.0;
