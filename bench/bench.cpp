@@ -10,6 +10,11 @@
 //   railcrash_bench memory [--mib 0.25,0.5,1,2,4,8,16,32,64]
 //       this machine's read throughput against the size of the array read over and over:
 //       where its caches end (a consist's working set passes them as it grows).
+//   railcrash_bench numbers [--model models/barrier/two_car_barrier.yaml]
+//       what an output row's numbers cost to format: the model's rows (body states, element
+//       outputs, body accelerations, at full precision) through format_general12 against
+//       snprintf's "%.12g" and std::to_chars(general, 12): ns per number and the ratios, and
+//       whether every text is printf's.
 //   railcrash_bench sensitivity [--design FILE]
 //       the report's sensitivity study (base + first-order + second-order runs) with 1 and 2
 //       jobs: wall time and speed-up.
@@ -30,6 +35,8 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <charconv>
+#include <cstring>
 #include <random>
 #include <set>
 #include <sstream>
@@ -37,7 +44,10 @@
 
 #include "railcrash/consist.hpp"
 #include "railcrash/dae_system.hpp"
+#include "railcrash/integrator.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/results.hpp"
+#include "railcrash/results/buffered_file.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/sensitivity.hpp"
 
@@ -394,6 +404,80 @@ int memory_benchmark(const std::vector<double>& sizes_mib, const std::string& re
   return 0;
 }
 
+/// The numbers a run's output rows print, unrounded: each row's body states, element outputs
+/// and body accelerations (timeseries.csv and accelerations.csv hold them to twelve digits).
+class RowNumbers : public RunObserver {
+ public:
+  explicit RowNumbers(const DaeSystem& system)
+      : system_(system), acceleration_(static_cast<std::size_t>(system.body_unknowns())) {}
+  void sample(double t, const double* y, const double* lambda, const double* /*quadratures*/, const double* outputs) override {
+    ++row_count;
+    numbers.push_back(t);
+    numbers.insert(numbers.end(), y, y + 2 * system_.body_unknowns());
+    numbers.insert(numbers.end(), outputs, outputs + system_.output_names().size());
+    body_accelerations(system_, t, y, lambda, acceleration_.data(), scratch_);
+    numbers.insert(numbers.end(), acceleration_.begin(), acceleration_.end());
+  }
+  std::vector<double> numbers;
+  std::size_t row_count = 0;
+
+ private:
+  const DaeSystem& system_;
+  std::vector<double> acceleration_;
+  AccelerationScratch scratch_;
+};
+
+int numbers_benchmark(const std::string& model_path, const std::string& results, const std::string& commit) {
+  Model model = load_model(model_path);
+  DaeSystem system(model);
+  RowNumbers rows(system);
+  const RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, model.simulation.output_interval, rows);
+  if (!outcome.ok) throw std::runtime_error("the run failed: " + outcome.message);
+  const std::vector<double>& numbers = rows.numbers;
+  std::vector<char> text(numbers.size() * 33);
+  // Every text against printf's, once.
+  std::size_t differ = 0;
+  for (const double x : numbers) {
+    char ours[40], printf_text[40];
+    *format_general12(ours, x) = '\0';
+    std::snprintf(printf_text, sizeof printf_text, "%.12g", x);
+    differ += std::strcmp(ours, printf_text) != 0 ? 1 : 0;
+  }
+  // The three formatters in turn, nine rounds; each one's fastest round [ns per number].
+  const auto time_one = [&](auto format) {
+    const auto start = std::chrono::steady_clock::now();
+    char* at = text.data();
+    for (const double x : numbers) {
+      at = format(at, x);
+      *at++ = ',';
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return 1e9 * seconds / static_cast<double>(numbers.size());
+  };
+  const auto ours = [](char* at, double x) { return format_general12(at, x); };
+  const auto with_snprintf = [](char* at, double x) { return at + std::snprintf(at, 33, "%.12g", x); };
+  const auto with_to_chars = [](char* at, double x) { return std::to_chars(at, at + 33, x, std::chars_format::general, 12).ptr; };
+  std::array<double, 3> best{1e300, 1e300, 1e300};
+  for (int round = 0; round < 9; ++round) {
+    best[0] = std::min(best[0], time_one(ours));
+    best[1] = std::min(best[1], time_one(with_snprintf));
+    best[2] = std::min(best[2], time_one(with_to_chars));
+  }
+  std::ostringstream table;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%s: %zu numbers from %zu rows (body states, element outputs, body accelerations), %zu of them "
+                "formatted otherwise than printf's \"%%.12g\"\n\n| formatter | ns per number (fastest of 9) | against "
+                "format_general12 |\n|---|---|---|\n| format_general12 | %.1f | 1 |\n| snprintf \"%%.12g\" | %.1f | %.2f |\n"
+                "| std::to_chars(general, 12) | %.1f | %.2f |\n",
+                model_path.c_str(), numbers.size(), rows.row_count, differ,
+                best[0], best[1], best[1] / best[0], best[2], best[2] / best[0]);
+  table << line;
+  std::fputs(line, stdout);
+  append_results(results, "Formatting an output row's numbers", table.str(), commit);
+  return differ == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -420,6 +504,10 @@ int main(int argc, char** argv) {
   CLI::App* memory = app.add_subcommand("memory", "read throughput against array size (where the caches end)");
   memory->add_option("--mib", memory_mib, "array sizes [MiB], comma-separated")->capture_default_str();
 
+  std::string numbers_model = source + "/models/barrier/two_car_barrier.yaml";
+  CLI::App* numbers = app.add_subcommand("numbers", "what formatting an output row's numbers costs");
+  numbers->add_option("--model", numbers_model, "model whose rows are formatted")->capture_default_str();
+
   std::string design_path = source + "/models/report/sensitivity_design.yaml";
   CLI::App* sensitivity = app.add_subcommand("sensitivity", "the report's sensitivity study with 1 and 2 jobs");
   sensitivity->add_option("--design", design_path, "design file")->capture_default_str();
@@ -435,6 +523,7 @@ int main(int argc, char** argv) {
       for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stod(item));
       return memory_benchmark(sizes, results, commit);
     }
+    if (*numbers) return numbers_benchmark(numbers_model, results, commit);
     if (*sensitivity) return sensitivity_benchmark(template_path, design_path, results, commit);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "railcrash_bench: %s\n", e.what());

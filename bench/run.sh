@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|consist-ab|kernels|memory|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
+#   bench/run.sh [consist|consist-ab|kernels|memory|numbers|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -12,7 +12,7 @@ commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 if [ -n "$(git status --porcelain 2>/dev/null | grep -v '^??' || true)" ]; then commit="$commit+changes"; fi
 bench=build/railcrash_bench
 case $what in
-  consist|sensitivity|kernels|memory) $bench --commit "$commit" "$what" "$@" ;;
+  consist|sensitivity|kernels|memory|numbers) $bench --commit "$commit" "$what" "$@" ;;
   # The two-car crash (IDA rtol 1e-3 and 1e-4, Euler at the model's dt) against an older
   # commit built side by side: bench/run.sh compare [COMMIT] (default cbce2b9) [--repeats 3]
   compare) /usr/bin/python3 bench/compare_commit.py "$@" ;;
@@ -54,5 +54,5 @@ case $what in
     $bench --commit "$commit" sensitivity
     build/railcrash converge models/report/final_two_car.yaml --t-end 0.5 --levels 1e-2,1e-3,1e-4 \
         --out bench/converge_final_two_car_0.5s ;;
-  *) echo "usage: bench/run.sh [consist|kernels|memory|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
+  *) echo "usage: bench/run.sh [consist|kernels|memory|numbers|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [options]" >&2; exit 2 ;;
 esac

@@ -32,10 +32,58 @@ double scaled_to_twelve_digits(double magnitude, int exponent) {
   return -1.0;
 }
 
+#if defined(__SIZEOF_INT128__)
+constexpr std::uint64_t kPowersOfFive[] = {1ULL,
+                                           5ULL,
+                                           25ULL,
+                                           125ULL,
+                                           625ULL,
+                                           3125ULL,
+                                           15625ULL,
+                                           78125ULL,
+                                           390625ULL,
+                                           1953125ULL,
+                                           9765625ULL,
+                                           48828125ULL,
+                                           244140625ULL,
+                                           1220703125ULL,
+                                           6103515625ULL,
+                                           30517578125ULL,
+                                           152587890625ULL,
+                                           762939453125ULL,
+                                           3814697265625ULL,
+                                           19073486328125ULL,
+                                           95367431640625ULL,
+                                           476837158203125ULL,
+                                           2384185791015625ULL};  // 5^0 .. 5^22 (< 2^52)
+
+/// The integer nearest to magnitude x 10^shift, decided from magnitude's bits without rounding:
+/// magnitude = mantissa 2^e, so magnitude 10^shift = (mantissa 5^shift) 2^(e + shift), and
+/// mantissa 5^shift < 2^105 for shift <= 22. False at an exact tie (printf's rule for those is
+/// std::to_chars' business), for shift outside 0..22, and where the product is an integer.
+bool nearest_integer_exactly(std::uint64_t bits, int shift, std::uint64_t& nearest) {
+  if (shift < 0 || shift > 22) return false;
+  const std::uint64_t mantissa = (bits & ((1ULL << 52) - 1)) | (1ULL << 52);  // a normal number
+  const int binary_exponent = static_cast<int>(bits >> 52) - 1075;            // magnitude = mantissa 2^that
+  const unsigned __int128 product = static_cast<unsigned __int128>(mantissa) * kPowersOfFive[shift];
+  const int fraction_bits = -(binary_exponent + shift);
+  if (fraction_bits <= 0 || fraction_bits >= 127) return false;
+  const unsigned __int128 whole = product >> fraction_bits;
+  const unsigned __int128 fraction = product - (whole << fraction_bits);
+  const unsigned __int128 half = static_cast<unsigned __int128>(1) << (fraction_bits - 1);
+  if (fraction == half) return false;
+  nearest = static_cast<std::uint64_t>(whole) + (fraction > half ? 1 : 0);  // whole < 1e13 here
+  return true;
+}
+#else
+bool nearest_integer_exactly(std::uint64_t, int, std::uint64_t&) { return false; }
+#endif
+
 /// The twelve significant digits of magnitude rounded to nearest and its decimal exponent, as
-/// printf's "%.12g" has them, when double arithmetic decides the rounding for certain: false
-/// when the scaled value lies within 1e-3 of a rounding tie (its error is below 2.5e-4 of a
-/// unit of the twelfth digit) or outside 1e-33..1e33.
+/// printf's "%.12g" has them: false outside 1e-33..1e33 and at exact rounding ties. Double
+/// arithmetic decides the rounding except within 1e-3 of a tie (the scaled value's error is
+/// below 2.5e-4 of a unit of the twelfth digit); there the exact product decides it
+/// (nearest_integer_exactly), where 10^shift has one (magnitudes from 1e-11 up to 1e12).
 bool twelve_digits(double magnitude, std::uint64_t& digits, int& exponent) {
   std::uint64_t bits = 0;
   std::memcpy(&bits, &magnitude, sizeof bits);
@@ -50,8 +98,8 @@ bool twelve_digits(double magnitude, std::uint64_t& digits, int& exponent) {
     if (scaled < 0.0 || scaled >= 1e13) return false;
     const auto whole = static_cast<std::uint64_t>(scaled);  // floor: scaled >= 0
     const double fraction = scaled - static_cast<double>(whole);  // exact: scaled < 2^53
-    if (std::abs(fraction - 0.5) < 1e-3) return false;
     digits = whole + (fraction > 0.5 ? 1 : 0);
+    if (std::abs(fraction - 0.5) < 1e-3 && !nearest_integer_exactly(bits, 11 - exponent, digits)) return false;
     if (digits >= 1000000000000ULL) {
       ++exponent;  // the estimate was one low, or the rounding carried into a thirteenth digit
     } else if (digits < 100000000000ULL) {

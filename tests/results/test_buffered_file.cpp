@@ -37,6 +37,14 @@ TEST_CASE("numbers are written as printf's %.12g, byte for byte", "[results]") {
     for (const double value : {std::pow(10.0, power), std::nextafter(std::pow(10.0, power), 0.0),
                                std::nextafter(std::pow(10.0, power), 1e300), 9.99999999999 * std::pow(10.0, power)})
       values.push_back(value);
+  // Near ties of the twelfth digit at every decade: within 1e-3 of a tie the exact product
+  // decides (nearest_integer_exactly, 1e-11 up to 1e12), elsewhere std::to_chars.
+  std::uniform_int_distribution<std::int64_t> twelve_digits(100000000000, 999999999999);
+  std::uniform_int_distribution<int> decade(-40, 40);
+  for (int k = 0; k < 20000; ++k) {
+    const double tie = (static_cast<double>(twelve_digits(random)) + 0.5) * std::pow(10.0, decade(random));
+    for (const double value : {tie, std::nextafter(tie, 0.0), std::nextafter(tie, 1e300), -tie}) values.push_back(value);
+  }
   for (int k = 0; k <= 3000; ++k) values.push_back(k * 1e-3);
   for (int k = 0; k <= 1000; ++k) values.push_back(static_cast<double>(k) * 1e-5 + 1e-5 * std::floor(k / 7));
   std::uniform_int_distribution<std::int64_t> integer(-10000000000000, 10000000000000);
