@@ -88,10 +88,9 @@ bool twelve_digits(double magnitude, std::uint64_t& digits, int& exponent) {
   std::uint64_t bits = 0;
   std::memcpy(&bits, &magnitude, sizeof bits);
   const int binary_exponent = static_cast<int>(bits >> 52) - 1023;  // magnitude in [2^b, 2^(b+1)): a normal number
-  // floor(log10(magnitude)) or one low: floor(b log10(2)) as (b 78913) >> 18, exact for |b| < 1650
-  // (78913 / 2^18 = 0.3010300...; >> of a negative int is arithmetic with GCC and Clang, and in
-  // C++20). The formula before this one was one low in nine of ten of a crash run's numbers, so
-  // most numbers took two attempts below.
+  // floor(log10(magnitude)) or one low (then a second attempt below): floor(b log10(2)) as
+  // (b 78913) >> 18, exact for |b| < 1650 (78913 / 2^18 = 0.3010300...; >> of a negative int is
+  // arithmetic with GCC and Clang, and in C++20).
   exponent = (binary_exponent * 78913) >> 18;
   for (int attempt = 0; attempt < 4; ++attempt) {
     const double scaled = scaled_to_twelve_digits(magnitude, exponent);
@@ -122,9 +121,9 @@ Characters16 pair_characters(std::uint32_t pair) {  // "00".."99"
   return characters;
 }
 
-/// The twelve digits as characters, then four '0's. Built in registers and written with whole
-/// 16-byte stores: written a byte at a time and read back as words, they stall the load that
-/// reads them (store forwarding), which was a fifth of the time.
+/// The twelve digits as characters, then four '0's, built in registers: written to memory a
+/// byte at a time and read back as words (the trailing-zero count, the 16-byte copies), they
+/// would stall the reads (no store forwarding from narrow stores to a wider load).
 Characters16 digit_characters(std::uint64_t digits) {
   const auto high = static_cast<std::uint32_t>(digits / 1000000), low = static_cast<std::uint32_t>(digits % 1000000);
   return pair_characters(high / 10000) | pair_characters(high / 100 % 100) << 16 | pair_characters(high % 100) << 32 |

@@ -11,10 +11,12 @@
 
 namespace railcrash {
 
-/// Writes value at first as printf's "%.12g" (at most 32 characters) and returns the end: twelve
-/// digits from one scaling by a power of ten where that decides the rounding for certain
-/// (faster than std::to_chars with a precision), std::to_chars elsewhere (near a rounding
-/// tie, beyond 1e+-33, infinities and NaN).
+/// Writes value at first as printf's "%.12g" and returns the end. first must have room for 32
+/// characters: the text is at most 32 long, and the bytes up to first + 32 may be written past
+/// the end returned. Twelve digits from one scaling by a power of ten where that decides the
+/// rounding for certain (faster than std::to_chars with a precision); near a rounding tie the
+/// exact product for magnitudes from 1e-11 up to 1e12; std::to_chars elsewhere (exact ties,
+/// near-ties outside that range, beyond 1e+-33, infinities and NaN).
 char* format_general12(char* first, double value);
 
 class BufferedFile {
