@@ -28,15 +28,15 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cstdint>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <charconv>
-#include <cstring>
 #include <random>
 #include <set>
 #include <sstream>

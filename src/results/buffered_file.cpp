@@ -10,9 +10,21 @@
 #include <cstdint>
 #include <cstring>
 
+// The fast path builds the twelve digits in a 128-bit integer whose lowest byte is the first
+// character: it needs unsigned __int128 and a little-endian machine. Elsewhere every number
+// goes through std::to_chars (the same text, slower).
+#if defined(__SIZEOF_INT128__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define RAILCRASH_FORMAT_FAST_PATH 1
+#else
+#define RAILCRASH_FORMAT_FAST_PATH 0
+#endif
+
 namespace railcrash {
 
 namespace {
+
+#if RAILCRASH_FORMAT_FAST_PATH
+__extension__ typedef unsigned __int128 Uint128;  // (__extension__: no -Wpedantic warning for it)
 
 constexpr double kPowersOfTen[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};  // exact
@@ -32,30 +44,11 @@ double scaled_to_twelve_digits(double magnitude, int exponent) {
   return -1.0;
 }
 
-#if defined(__SIZEOF_INT128__)
-constexpr std::uint64_t kPowersOfFive[] = {1ULL,
-                                           5ULL,
-                                           25ULL,
-                                           125ULL,
-                                           625ULL,
-                                           3125ULL,
-                                           15625ULL,
-                                           78125ULL,
-                                           390625ULL,
-                                           1953125ULL,
-                                           9765625ULL,
-                                           48828125ULL,
-                                           244140625ULL,
-                                           1220703125ULL,
-                                           6103515625ULL,
-                                           30517578125ULL,
-                                           152587890625ULL,
-                                           762939453125ULL,
-                                           3814697265625ULL,
-                                           19073486328125ULL,
-                                           95367431640625ULL,
-                                           476837158203125ULL,
-                                           2384185791015625ULL};  // 5^0 .. 5^22 (< 2^52)
+constexpr std::uint64_t kPowersOfFive[] = {  // 5^0 .. 5^22 (< 2^52)
+    1ULL,           5ULL,           25ULL,           125ULL,           625ULL,           3125ULL,
+    15625ULL,       78125ULL,       390625ULL,       1953125ULL,       9765625ULL,       48828125ULL,
+    244140625ULL,   1220703125ULL,  6103515625ULL,   30517578125ULL,   152587890625ULL,  762939453125ULL,
+    3814697265625ULL, 19073486328125ULL, 95367431640625ULL, 476837158203125ULL, 2384185791015625ULL};
 
 /// The integer nearest to magnitude x 10^shift, decided from magnitude's bits without rounding:
 /// magnitude = mantissa 2^e, so magnitude 10^shift = (mantissa 5^shift) 2^(e + shift), and
@@ -65,19 +58,16 @@ bool nearest_integer_exactly(std::uint64_t bits, int shift, std::uint64_t& neare
   if (shift < 0 || shift > 22) return false;
   const std::uint64_t mantissa = (bits & ((1ULL << 52) - 1)) | (1ULL << 52);  // a normal number
   const int binary_exponent = static_cast<int>(bits >> 52) - 1075;            // magnitude = mantissa 2^that
-  const unsigned __int128 product = static_cast<unsigned __int128>(mantissa) * kPowersOfFive[shift];
+  const Uint128 product = static_cast<Uint128>(mantissa) * kPowersOfFive[shift];
   const int fraction_bits = -(binary_exponent + shift);
   if (fraction_bits <= 0 || fraction_bits >= 127) return false;
-  const unsigned __int128 whole = product >> fraction_bits;
-  const unsigned __int128 fraction = product - (whole << fraction_bits);
-  const unsigned __int128 half = static_cast<unsigned __int128>(1) << (fraction_bits - 1);
+  const Uint128 whole = product >> fraction_bits;
+  const Uint128 fraction = product - (whole << fraction_bits);
+  const Uint128 half = static_cast<Uint128>(1) << (fraction_bits - 1);
   if (fraction == half) return false;
   nearest = static_cast<std::uint64_t>(whole) + (fraction > half ? 1 : 0);  // whole < 1e13 here
   return true;
 }
-#else
-bool nearest_integer_exactly(std::uint64_t, int, std::uint64_t&) { return false; }
-#endif
 
 /// The twelve significant digits of magnitude rounded to nearest and its decimal exponent, as
 /// printf's "%.12g" has them: false outside 1e-33..1e33 and at exact rounding ties. Double
@@ -110,10 +100,9 @@ bool twelve_digits(double magnitude, std::uint64_t& digits, int& exponent) {
   return false;
 }
 
-#if defined(__SIZEOF_INT128__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
 /// Sixteen characters in one integer, the first in the lowest byte (the order in which they lie
 /// in memory on this byte order).
-using Characters16 = unsigned __int128;
+using Characters16 = Uint128;
 
 Characters16 pair_characters(std::uint32_t pair) {  // "00".."99"
   std::uint16_t characters = 0;
@@ -140,60 +129,55 @@ int trailing_zeros(Characters16 characters) {
 }
 
 void store16(char* at, Characters16 characters) { std::memcpy(at, &characters, sizeof characters); }
-
-constexpr bool kFastPath = true;
-#else
-constexpr bool kFastPath = false;  // std::to_chars for every number
-#endif
+#endif  // RAILCRASH_FORMAT_FAST_PATH
 
 }  // namespace
 
 char* format_general12(char* first, double value) {
-  std::uint64_t digits = 0;
-  int exponent = 0;
   const double magnitude = std::abs(value);
   if (magnitude == 0.0) {  // a tenth of a slider-crank run's numbers (bodies at rest, idle friction)
     if (std::signbit(value)) *first++ = '-';
     *first++ = '0';
     return first;
   }
-  if (!kFastPath || !(magnitude >= 1e-33 && magnitude <= 1e33) || !twelve_digits(magnitude, digits, exponent))
-    return std::to_chars(first, first + 32, value, std::chars_format::general, 12).ptr;
-#if defined(__SIZEOF_INT128__) && defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-  // Each case writes whole 16-byte blocks (at most 30 bytes from first) and then moves the end
-  // to the last character it means: no loop whose length changes from one number to the next.
-  const Characters16 text = digit_characters(digits);
-  const int significant = 12 - trailing_zeros(text);
-  char* out = first;
-  *out = '-';
-  out += value < 0.0 ? 1 : 0;
-  if (exponent < -4 || exponent >= 12) {  // d.ddde+XX
-    *out++ = static_cast<char>(text);
-    if (significant > 1) {
-      *out++ = '.';
-      store16(out, text >> 8);
-      out += significant - 1;
+#if RAILCRASH_FORMAT_FAST_PATH
+  std::uint64_t digits = 0;
+  int exponent = 0;
+  if (magnitude >= 1e-33 && magnitude <= 1e33 && twelve_digits(magnitude, digits, exponent)) {
+    // Each case writes whole 16-byte blocks (at most 30 bytes from first) and then moves the end
+    // to the last character it means: no loop whose length changes from one number to the next.
+    const Characters16 text = digit_characters(digits);
+    const int significant = 12 - trailing_zeros(text);
+    char* out = first;
+    *out = '-';
+    out += value < 0.0 ? 1 : 0;
+    if (exponent < -4 || exponent >= 12) {  // d.ddde+XX
+      *out++ = static_cast<char>(text);
+      if (significant > 1) {
+        *out++ = '.';
+        store16(out, text >> 8);
+        out += significant - 1;
+      }
+      *out++ = 'e';
+      *out++ = exponent < 0 ? '-' : '+';
+      const int power = std::abs(exponent);  // <= 33
+      *out++ = static_cast<char>('0' + power / 10);
+      *out++ = static_cast<char>('0' + power % 10);
+    } else if (exponent >= 0) {  // ddd.ddd: exponent + 1 digits before the point
+      const int whole_digits = exponent + 1;
+      store16(out, text);
+      store16(out + whole_digits + 1, text >> (8 * whole_digits));  // the fraction, one place on
+      out[whole_digits] = '.';
+      out += significant > whole_digits ? significant + 1 : whole_digits;
+    } else {  // 0.000ddd: -exponent - 1 zeros after the point
+      std::memcpy(out, "0.000000", 8);
+      store16(out + 1 - exponent, text);
+      out += 1 - exponent + significant;
     }
-    *out++ = 'e';
-    *out++ = exponent < 0 ? '-' : '+';
-    const int power = std::abs(exponent);  // <= 33
-    *out++ = static_cast<char>('0' + power / 10);
-    *out++ = static_cast<char>('0' + power % 10);
-  } else if (exponent >= 0) {  // ddd.ddd: exponent + 1 digits before the point
-    const int whole_digits = exponent + 1;
-    store16(out, text);
-    store16(out + whole_digits + 1, text >> (8 * whole_digits));  // the fraction, one place on
-    out[whole_digits] = '.';
-    out += significant > whole_digits ? significant + 1 : whole_digits;
-  } else {  // 0.000ddd: -exponent - 1 zeros after the point
-    std::memcpy(out, "0.000000", 8);
-    store16(out + 1 - exponent, text);
-    out += 1 - exponent + significant;
+    return out;
   }
-  return out;
-#else
-  return first;  // not reached: kFastPath is false
 #endif
+  return std::to_chars(first, first + 32, value, std::chars_format::general, 12).ptr;
 }
 
 BufferedFile::BufferedFile(const std::string& path) {
