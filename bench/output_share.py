@@ -8,7 +8,10 @@ The two mechanisms of bench/simbody/compare.py at their models' tolerances (slid
 10 s, Andrews' squeezer 0.03 s), each run twice with every file written: with dense output
 (slider-crank every 1 ms, 10,000 rows; Andrews every 10 us, 3,000 rows) and with output only
 at t_end (one row). CPU of the whole process (start-up, run, files), medians of REPEATS
-interleaved pairs. Output share = (dense - end) / dense; per row = (dense - end) / rows.
+interleaved pairs. Output share = (dense - end) / dense of the medians; per row = (dense - end)
+/ rows. "Pairwise" is the median over the REPEATS pairs of each pair's own share, (dense - end)
+/ dense of one dense run and the end run right after it: a run disturbed by other work moves
+one pair's share, not the medians' balance (steadier when the VM's speed changes mid-run).
 With --base (another build, e.g. of an older commit), its runs alternate with the
 executable's (dense and end of one, then of the other, REPEATS times) and both are printed:
 an A/B comparison in one run, with the same load on both. --format hdf5: the runs write
@@ -56,8 +59,8 @@ def main():
     executables = [args.executable] + ([args.base] if args.base else [])
     print(f"railcrash {head} ({args.executable}{'; base ' + args.base if args.base else ''}); --format {args.format}; median CPU s of "
           f"{args.repeats} interleaved pairs; {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}\n")
-    print("| model | executable | rows | CPU s, dense output | CPU s, output at t_end | output share | per row [us] |\n"
-          "|---|---|---|---|---|---|---|")
+    print("| model | executable | rows | CPU s, dense output | CPU s, output at t_end | output share | pairwise | per row [us] |\n"
+          "|---|---|---|---|---|---|---|---|")
     for model, t_end, dense, rtol, atol in cases:
         times = {(exe, interval): [] for exe in executables for interval in (dense, t_end)}
         for _ in range(args.repeats):
@@ -69,9 +72,11 @@ def main():
         rows = round(t_end / dense)
         for exe in executables:
             with_rows, without = statistics.median(times[(exe, dense)]), statistics.median(times[(exe, t_end)])
+            pairwise = statistics.median((d - e) / d for d, e in zip(times[(exe, dense)], times[(exe, t_end)]))
             label = "base" if exe == args.base else "executable"
             print(f"| {model} (every {dense:g} s) | {label} | {rows} | {with_rows:.4f} | {without:.4f} | "
-                  f"{100 * (with_rows - without) / with_rows:.0f} % | {1e6 * (with_rows - without) / rows:.1f} |")
+                  f"{100 * (with_rows - without) / with_rows:.1f} % | {100 * pairwise:.1f} % | "
+                  f"{1e6 * (with_rows - without) / rows:.1f} |")
         sys.stdout.flush()
     return 0
 

@@ -86,8 +86,18 @@ void Integrator::deliver_sample(double t) {
   }
   const int nq = system_.body_unknowns();
   const double* lambda = sample_y_.data() + 2 * nq;
-  system_.outputs(sample_y_.data(), lambda, sample_outputs_.data());
-  observer_->sample(t, sample_y_.data(), lambda, sample_quadratures_.data(), sample_outputs_.data());
+  if (observe_sample_forces_) {  // the outputs and the forces from one sweep over the elements
+    DaeSystem::SweepExtras extras;
+    extras.outputs = sample_outputs_.data();
+    extras.y_lambda = lambda;
+    system_.generalized_forces(t, sample_y_.data(), sample_y_.data() + nq, sample_forces_.data(), nullptr, nullptr, lambda,
+                               &extras);
+    observer_->sample_with_forces(t, sample_y_.data(), lambda, sample_quadratures_.data(), sample_outputs_.data(),
+                                  sample_forces_.data());
+  } else {
+    system_.outputs(sample_y_.data(), lambda, sample_outputs_.data());
+    observer_->sample(t, sample_y_.data(), lambda, sample_quadratures_.data(), sample_outputs_.data());
+  }
   const std::string observer_failure = observer_->failure();  // a failed write: stop at once
   if (!observer_failure.empty()) {
     std::ostringstream msg;
@@ -122,6 +132,8 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   observe_steps_ = observer.observes_steps();
   step_outputs_.assign(system_.output_names().size(), 0.0);
   sample_outputs_.assign(system_.output_names().size(), 0.0);
+  observe_sample_forces_ = observer.wants_sample_forces();
+  sample_forces_.assign(observe_sample_forces_ ? static_cast<std::size_t>(system_.body_unknowns()) : 0, 0.0);
   t_end_ = t_end;
   output_interval_ = output_interval;
   output_index_ = 1;

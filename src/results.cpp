@@ -25,8 +25,14 @@ namespace railcrash {
 void body_accelerations(const DaeSystem& system, double t, const double* y, const double* lambda, double* acceleration,
                         AccelerationScratch& scratch) {
   const int nq = system.body_unknowns();
-  const int m = system.constraint_rows();
   system.generalized_forces(t, y, y + nq, acceleration, nullptr, nullptr, lambda);
+  accelerations_from_forces(system, y, lambda, acceleration, scratch);
+}
+
+void accelerations_from_forces(const DaeSystem& system, const double* y, const double* lambda, double* acceleration,
+                               AccelerationScratch& scratch) {
+  const int nq = system.body_unknowns();
+  const int m = system.constraint_rows();
   if (m > 0 && lambda != nullptr) {
     scratch.phi.resize(static_cast<std::size_t>(m));
     system.constraints(y, scratch.phi.data(), &scratch.gradient);
@@ -237,6 +243,19 @@ ResultWriter::~ResultWriter() {
 }
 
 void ResultWriter::sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) {
+  body_accelerations(system_, t, y, lambda, acceleration_.data(), acceleration_scratch_);
+  record_sample(t, y, lambda, quadratures, outputs);
+}
+
+void ResultWriter::sample_with_forces(double t, const double* y, const double* lambda, const double* quadratures,
+                                      const double* outputs, const double* forces) {
+  std::copy(forces, forces + acceleration_.size(), acceleration_.begin());
+  accelerations_from_forces(system_, y, lambda, acceleration_.data(), acceleration_scratch_);
+  record_sample(t, y, lambda, quadratures, outputs);
+}
+
+void ResultWriter::record_sample(double t, const double* y, const double* lambda, const double* quadratures,
+                                 const double* outputs) {
   const int n = system_.model().body_count();
   const int nq = 3 * n;
   if (timeseries_) {
@@ -250,7 +269,6 @@ void ResultWriter::sample(double t, const double* y, const double* lambda, const
   const std::size_t output_count = system_.output_names().size();
   if (timeseries_) write_row_tail(*timeseries_, outputs, output_count);
   track_extrema(t, y, lambda, outputs, FreshOutputs{});
-  body_accelerations(system_, t, y, lambda, acceleration_.data(), acceleration_scratch_);
   if (!system_.model().output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
     if (timeseries_) write_row_tail(*timeseries_, point_values_);

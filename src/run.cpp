@@ -40,11 +40,14 @@ class ProgressObserver : public RunObserver {
   /// the files end at the last good sample. The run itself goes on, so that an integrator that
   /// is diverging says so (Euler names the joint); run_model fails it in any case.
   void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
-    meter_.update(t);
-    t_last_ = t;
-    if (!non_finite_output_.empty() || !outputs_finite(t, outputs)) return;
-    for (RunObserver* o : next_) o->sample(t, y, lambda, quadratures, outputs);
-    t_passed_on_ = t;
+    pass_on(t, y, lambda, quadratures, outputs, nullptr);
+  }
+  bool wants_sample_forces() const override {
+    return std::any_of(next_.begin(), next_.end(), [](const RunObserver* o) { return o->wants_sample_forces(); });
+  }
+  void sample_with_forces(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs,
+                          const double* forces) override {
+    pass_on(t, y, lambda, quadratures, outputs, forces);
   }
   /// Why the outputs were not all finite ("" when they were).
   const std::string& non_finite_output() const { return non_finite_output_; }
@@ -71,6 +74,21 @@ class ProgressObserver : public RunObserver {
   void finish() { meter_.finish(t_last_); }
 
  private:
+  /// The sample to every observer (with the forces to those that want them, when given).
+  void pass_on(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs,
+               const double* forces) {
+    meter_.update(t);
+    t_last_ = t;
+    if (!non_finite_output_.empty() || !outputs_finite(t, outputs)) return;
+    for (RunObserver* o : next_) {
+      if (forces != nullptr && o->wants_sample_forces())
+        o->sample_with_forces(t, y, lambda, quadratures, outputs, forces);
+      else
+        o->sample(t, y, lambda, quadratures, outputs);
+    }
+    t_passed_on_ = t;
+  }
+
   /// Whether the element outputs at the sample are all finite; the first non-finite one is
   /// recorded in non_finite_output_ (its element found only then).
   bool outputs_finite(double t, const double* outputs) {

@@ -8,6 +8,7 @@
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/ida_integrator.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/results.hpp"
 #include "railcrash/run.hpp"
 #include "support.hpp"
 
@@ -52,6 +53,29 @@ struct StopAfter : RunObserver {
   int samples = 0;
   void sample(double, const double*, const double*, const double*, const double*) override {
     if (++samples == 3) stop->store(true);
+  }
+};
+
+/// An observer that wants the forces at each sample: checks them and the outputs against the
+/// system's own evaluation at the sample's state, bit for bit, and feeds two in-memory result
+/// writers, one with the run loop's forces and one through sample(), which evaluates its own.
+struct SampleForcesCheck : RunObserver {
+  explicit SampleForcesCheck(const DaeSystem& s) : system(s), with_forces("", s), without_forces("", s) {}
+  const DaeSystem& system;
+  ResultWriter with_forces, without_forces;
+  int samples = 0, samples_with_forces = 0, mismatches = 0;
+  bool wants_sample_forces() const override { return true; }
+  void sample(double, const double*, const double*, const double*, const double*) override { ++samples; }
+  void sample_with_forces(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs,
+                          const double* forces) override {
+    ++samples_with_forces;
+    const int nq = system.body_unknowns();
+    std::vector<double> f(static_cast<std::size_t>(nq)), out(system.output_names().size());
+    system.generalized_forces(t, y, y + nq, f.data(), nullptr, nullptr, lambda);
+    system.outputs(y, lambda, out.data());
+    if (!std::equal(f.begin(), f.end(), forces) || !std::equal(out.begin(), out.end(), outputs)) ++mismatches;
+    with_forces.sample_with_forces(t, y, lambda, quadratures, outputs, forces);
+    without_forces.sample(t, y, lambda, quadratures, outputs);
   }
 };
 
@@ -340,4 +364,48 @@ TEST_CASE("a timed run's phases add up to its wall time, each where its work is"
   for (const double x : untimed.outcome.stats.phase_seconds) CHECK(x == 0.0);
   CHECK_THAT(untimed.summary_json, !Catch::Contains("\"seconds\""));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("an observer that wants the forces gets them from the outputs' sweep, equal to generalized_forces", "[integrators]") {
+  // A block sliding on a slider with friction (its force needs the multipliers) under both
+  // integrators; the barrier crash's first 20 ms under IDA (contacts, crush springs, joints).
+  const std::string slider =
+      "railcrash: 1\nname: slide\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+      "  - {name: block, mass: 3.0, inertia: 0.2, position: [0, 0], velocity: [2, 0]}\n"
+      "elements:\n  - {name: guide, type: slider_joint, axis: [1, 0], friction: 0.4, slider_length: 0.5, "
+      "points: [{body: ground, at: [0, 0]}, {body: block, at: [0.1, 0]}]}\n"
+      "  - {name: pull, type: linear_spring, stiffness: 50, free_length: 1.0, "
+      "points: [{body: ground, at: [0, 0.5]}, {body: block, at: [0, 0]}]}\n"
+      "simulation: {t_end: 0.3, dt: 1e-4}\n";
+  const std::string barrier = std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml";
+  struct Case {
+    Model model;
+    IntegratorKind integrator;
+    double t_end, interval;
+  };
+  std::vector<Case> cases;
+  for (const IntegratorKind integrator : {IntegratorKind::Ida, IntegratorKind::Euler})
+    cases.push_back({testing::model_from_text(slider), integrator, 0.3, 0.01});
+  cases.push_back({load_model(barrier, {}), IntegratorKind::Ida, 0.02, 1e-3});
+  for (Case& c : cases) {
+    INFO(c.model.name << (c.integrator == IntegratorKind::Ida ? " under ida" : " under euler"));
+    c.model.simulation.integrator = c.integrator;
+    DaeSystem system(c.model);
+    auto run = make_integrator(system, c.model.simulation);
+    SampleForcesCheck observer(system);
+    REQUIRE(run->run(c.t_end, c.interval, observer).ok);
+    CHECK(observer.samples == 0);  // every sample came with the forces
+    CHECK(observer.samples_with_forces == static_cast<int>(std::lround(c.t_end / c.interval)) + 1);
+    CHECK(observer.mismatches == 0);
+    const auto& a = observer.with_forces.acceleration_peaks();
+    const auto& b = observer.without_forces.acceleration_peaks();
+    REQUIRE(a.size() == b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      CHECK(a[i].x == b[i].x);
+      CHECK(a[i].y == b[i].y);
+      CHECK(a[i].magnitude == b[i].magnitude);
+      CHECK(a[i].t_magnitude == b[i].t_magnitude);
+    }
+    CHECK(std::any_of(a.begin(), a.end(), [](const AccelerationPeaks& p) { return p.magnitude > 0.0; }));
+  }
 }

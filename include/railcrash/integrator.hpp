@@ -126,6 +126,17 @@ class RunObserver {
   /// outputs: the element outputs at the sample (DaeSystem::outputs), evaluated once for all
   /// observers.
   virtual void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) = 0;
+  /// True when the observer takes the generalized forces at each sample (sample_with_forces):
+  /// the run loop then evaluates them in the same sweep over the elements as the outputs.
+  virtual bool wants_sample_forces() const { return false; }
+  /// sample() with the generalized forces at the sample as well, for an observer that
+  /// wants_sample_forces(): `forces` (DaeSystem::body_unknowns()) is what
+  /// DaeSystem::generalized_forces(t, q, v, forces, nullptr, nullptr, lambda) gives (gravity,
+  /// loads, force elements, joint friction at lambda; no constraint reactions), bit for bit.
+  virtual void sample_with_forces(double t, const double* y, const double* lambda, const double* quadratures,
+                                  const double* outputs, const double* /*forces*/) {
+    sample(t, y, lambda, quadratures, outputs);
+  }
   /// A committed mode change (contact, yield, rupture, ...); y is the state at that instant.
   virtual void event(const EventRecord& /*record*/, const double* /*y*/) {}
   /// The state at the end of every accepted step and on both sides of every committed mode
@@ -261,6 +272,8 @@ class Integrator {
   double t_sampled_ = 0.0;      // last sample
   std::vector<double> sample_y_, sample_quadratures_;
   std::vector<double> sample_outputs_;      // element outputs at the sample
+  std::vector<double> sample_forces_;       // generalized forces at the sample, when the observer wants them
+  bool observe_sample_forces_ = false;      // the observer wants_sample_forces()
   std::vector<double> constraint_scratch_;  // work space of the per-sample constraint residual
   std::vector<double> last_sample_y_, last_sample_quadratures_;
   bool observe_steps_ = false;       // the observer wants step()

@@ -57,6 +57,11 @@ struct AccelerationScratch {
 /// Body accelerations v' (3 per body: x'', y'', theta'') at a sample state y.
 void body_accelerations(const DaeSystem& system, double t, const double* y, const double* lambda, double* acceleration,
                         AccelerationScratch& scratch);
+/// The same from the generalized forces at y, which `acceleration` holds on entry
+/// (DaeSystem::generalized_forces(t, q, v, f, nullptr, nullptr, lambda)): adds the constraint
+/// reactions -G^T lambda and divides by the masses, in place.
+void accelerations_from_forces(const DaeSystem& system, const double* y, const double* lambda, double* acceleration,
+                               AccelerationScratch& scratch);
 
 /// Standard gravity in the model's units [length/time^2].
 double standard_gravity(const Model& model);
@@ -156,6 +161,10 @@ class ResultWriter : public RunObserver {
   ResultWriter& operator=(const ResultWriter&) = delete;
 
   void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override;
+  /// The body accelerations from the run loop's forces (one sweep over the elements per row).
+  bool wants_sample_forces() const override { return true; }
+  void sample_with_forces(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs,
+                          const double* forces) override;
   void event(const EventRecord& record, const double* y) override;
   /// Element output peaks and car crush from every accepted step and both sides of every event.
   void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
@@ -187,6 +196,9 @@ class ResultWriter : public RunObserver {
   std::vector<FilteredAccelerations> filtered_accelerations() const;
 
  private:
+  /// What sample() does once acceleration_ holds the body accelerations at the sample.
+  void record_sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs);
+
   const DaeSystem& system_;
   std::string directory_;
   std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
