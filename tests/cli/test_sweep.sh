@@ -81,9 +81,11 @@ if [ "$(wc -l < "$tmp/one/runs.csv")" -eq 13 ] && ! grep -q ',failed,' "$tmp/one
 same_rows "2 jobs give the rows of 1 job" "$tmp/two/runs.csv" "$tmp/one/runs.csv"
 if grep -q "Main effects" "$tmp/one/summary.md"; then pass; else fail "summary.md has main effects"; fi
 
-# SIGTERM mid-sweep keeps the finished rows; --resume runs the rest. Longer runs (about 0.2 s
-# each, 40 of them) so that the signal comes mid-sweep.
-sed -e 's/^samples: 12/samples: 40/' -e 's/^seed: 3/seed: 3\nset: [simulation.output_interval=0.000003, simulation.rtol=1e-10]/' \
+# SIGTERM mid-sweep keeps the finished rows; --resume runs the rest. Longer runs, and 200 of
+# them, so that the signal comes mid-sweep: a run takes 0.02-0.03 s at 21b29fd (it took about
+# 0.2 s when this was written), and 40 of them under mpirun -np 2 finished in under 0.75 s,
+# before the loop below saw the third row.
+sed -e 's/^samples: 12/samples: 200/' -e 's/^seed: 3/seed: 3\nset: [simulation.output_interval=0.000003, simulation.rtol=1e-10]/' \
   "$tmp/plan.yaml" > "$tmp/slow.yaml"
 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --out "$tmp/whole" > /dev/null 2>&1
 interrupt_and_resume() {  # description folder command-prefix...: SIGTERM once 3 rows are written, then --resume
@@ -99,8 +101,8 @@ interrupt_and_resume() {  # description folder command-prefix...: SIGTERM once 3
   wait $pid
   local status=$?
   local rows=$(($(wc -l < "$folder/runs.csv") - 1))
-  if [ $status -ne 0 ] && [ $rows -ge 3 ] && [ $rows -lt 40 ]; then pass
-  else fail "$description: SIGTERM: status $status with $rows rows (expected failure with 3-39)"; fi
+  if [ $status -ne 0 ] && [ $rows -ge 3 ] && [ $rows -lt 200 ]; then pass
+  else fail "$description: SIGTERM: status $status with $rows rows (expected failure with 3-199)"; fi
   "$@" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/slow.yaml" --jobs 2 --resume --out "$folder" > "$folder.resume" 2>&1
   if grep -q "($rows resumed)" "$folder.resume"; then pass; else fail "$description: resume keeps the $rows rows: $(cat "$folder.resume")"; fi
   same_rows "$description: --resume after SIGTERM gives the uninterrupted file" "$folder/runs.csv" "$tmp/whole/runs.csv"
