@@ -74,14 +74,15 @@ class ProgressObserver : public RunObserver {
   void finish() { meter_.finish(t_last_); }
 
  private:
-  /// The sample to every observer (with the forces to those that want them, when given).
+  /// The sample to every observer, with the forces when given (an observer that does not want
+  /// them gets sample() through RunObserver::sample_with_forces' default).
   void pass_on(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs,
                const double* forces) {
     meter_.update(t);
     t_last_ = t;
     if (!non_finite_output_.empty() || !outputs_finite(t, outputs)) return;
     for (RunObserver* o : next_) {
-      if (forces != nullptr && o->wants_sample_forces())
+      if (forces != nullptr)
         o->sample_with_forces(t, y, lambda, quadratures, outputs, forces);
       else
         o->sample(t, y, lambda, quadratures, outputs);
