@@ -1,7 +1,7 @@
 #!/bin/sh
 # Builds railcrash (Release) and runs the benchmarks; figures are printed and appended to
 # bench/results.md with the core count and the commit. Usage:
-#   bench/run.sh [consist|consist-ab|kernels|memory|numbers|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
+#   bench/run.sh [ab|consist|consist-ab|kernels|memory|numbers|sensitivity|converge|compare|accuracy-compare|work-precision|simbody|outcost|startup|readings|python|sweep|formats|all] [extra options]
 # e.g. bench/run.sh consist --cars 2,5,10 --t-end 0.05
 set -eu
 cd "$(dirname "$0")/.."
@@ -25,6 +25,9 @@ case $what in
   # A consist against another build, interleaved size by size, phase by phase, and the change of
   # the cost exponent: bench/run.sh consist-ab BASE [--cars 10,20,50,100,200] [--repeats 5]
   consist-ab) /usr/bin/python3 bench/consist_ab.py "$@" ;;
+  # Whole runs of given models against another build's executable, interleaved, with a
+  # byte-for-byte comparison of the outputs: bench/run.sh ab BASE/railcrash [--models A,B] [--repeats 9]
+  ab) /usr/bin/python3 bench/ab_models.py "$@" ;;
   # The slider-crank and Andrews' squeezer against Simbody 3.7 at equal accuracy (install-deps.sh --bench)
   simbody) /usr/bin/python3 bench/simbody/compare.py "$@" ;;
   # Share of a run's CPU that goes to output rows (slider-crank at 1 ms, Andrews at 10 us output;

@@ -5,10 +5,8 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include <algorithm>
-#include <cassert>
 #include <string>
 
-#include "klu_pivot_growth.hpp"
 #include "railcrash/integrator.hpp"
 
 namespace railcrash {
@@ -20,7 +18,6 @@ struct KluContent {
   klu_common common;                // KLU's settings and statistics
   klu_symbolic* symbolic = nullptr;  // ordering and block triangular form, kept between restarts
   klu_numeric* numeric = nullptr;    // the last factorization
-  PivotGrowth pivot_growth;          // klu_rgrowth for refactorizations of `numeric`
   bool first_factorize = true;       // the next setup analyses and factors afresh
   int size = 0;                      // rows and columns
   std::vector<int> column_start;     // the matrix's pattern (CSC), 32-bit
@@ -58,16 +55,14 @@ int analyse_and_factor(KluContent& klu, double* values) {
     klu.symbolic = klu_analyze(klu.size, klu.column_start.data(), klu.row_index.data(), &klu.common);
     if (klu.symbolic == nullptr) return SUNLS_PACKAGE_FAIL_UNREC;
   }
-  klu.pivot_growth.clear();
   if (klu.numeric != nullptr) klu_free_numeric(&klu.numeric, &klu.common);
   klu.numeric = klu_factor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, &klu.common);
   return klu.numeric == nullptr ? failure_flag(klu) : SUNLS_SUCCESS;
 }
 
 /// Refactors with the previous pivot order while it stays sound, judged by KLU's reciprocal
-/// pivot growth (one pass over the matrix and U, by PivotGrowth's gathered lists: the value of
-/// klu_rgrowth, which debug builds check on every call); factors afresh when the growth exceeds
-/// 1e8 or the refactorization fails.
+/// pivot growth (one pass over the matrix); factors afresh when the growth exceeds 1e8 or the
+/// refactorization fails.
 int klu_setup(SUNLinearSolver solver, SUNMatrix matrix) {
   KluContent& klu = content_of(solver);
   const PhaseClock::Scope timed(klu.clock, Phase::LinearSetup);
@@ -78,16 +73,11 @@ int klu_setup(SUNLinearSolver solver, SUNMatrix matrix) {
     return klu.last_flag;
   }
   constexpr double kSmallestReciprocalGrowth = 1e-8;
-  if (klu_refactor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common)) {
-    if (!klu.pivot_growth.gathered())
-      klu.pivot_growth.gather(klu.column_start.data(), klu.row_index.data(), *klu.symbolic, *klu.numeric);
-    const double growth = klu.pivot_growth(values);  // klu_rgrowth's value (klu_pivot_growth.hpp)
-    assert(klu_rgrowth(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
-           klu.common.rgrowth == growth);
-    if (growth > kSmallestReciprocalGrowth) {
-      klu.last_flag = SUNLS_SUCCESS;
-      return klu.last_flag;
-    }
+  if (klu_refactor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
+      klu_rgrowth(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
+      klu.common.rgrowth > kSmallestReciprocalGrowth) {
+    klu.last_flag = SUNLS_SUCCESS;
+    return klu.last_flag;
   }
   klu.last_flag = analyse_and_factor(klu, values);
   return klu.last_flag;
@@ -110,7 +100,6 @@ int klu_free(SUNLinearSolver solver) {
   if (solver == nullptr) return SUNLS_SUCCESS;
   if (solver->content != nullptr) {
     KluContent* klu = &content_of(solver);
-    klu->pivot_growth.clear();
     if (klu->numeric != nullptr) klu_free_numeric(&klu->numeric, &klu->common);
     if (klu->symbolic != nullptr) klu_free_symbolic(&klu->symbolic, &klu->common);
     delete klu;

@@ -13,7 +13,7 @@
 //  - initialize keeps a symbolic analysis once made (a restart's IDAReInit would redo the
 //    ordering of a matrix whose pattern never changes);
 //  - setup refactors with the previous pivot order while KLU's reciprocal pivot growth stays
-//    above 1e-8 (klu_rgrowth's value, computed by PivotGrowth, klu_pivot_growth.hpp), and factors afresh (partial pivoting) when it does not or the refactorization
+//    above 1e-8, and factors afresh (partial pivoting) when it does not or the refactorization
 //    fails (SUNDIALS' module judges by condition estimates, which the GGL Jacobian of a crash
 //    model, mixing masses, inertias and multiplier rows over many decades, always fails: every
 //    setup paid for three factorizations);
