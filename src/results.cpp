@@ -163,9 +163,8 @@ std::string json_string(const std::string& text) {
 
 std::string json_number(double value) {
   if (!std::isfinite(value)) return "null";
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.12g", value);
-  return buffer;
+  char buffer[32];  // the room format_general12 may write into
+  return std::string(buffer, format_general12(buffer, value));  // printf's "%.12g", about 10x faster (buffered_file.hpp)
 }
 
 std::vector<std::string> timeseries_columns(const DaeSystem& system) {

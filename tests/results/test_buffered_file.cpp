@@ -1,5 +1,5 @@
-// The CSV writer (results/buffered_file.hpp): printf's "%.12g" text from format_general12, and a
-// failed write kept with the OS's reason.
+// The CSV writer (results/buffered_file.hpp): printf's "%.12g" text from format_general12 (also
+// summary.json's, json_number), and a failed write kept with the OS's reason.
 #include <catch2/catch.hpp>
 
 #include <cerrno>
@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "railcrash/results.hpp"
 #include "railcrash/results/buffered_file.hpp"
 
 using railcrash::BufferedFile;
@@ -59,6 +60,7 @@ TEST_CASE("numbers are written as printf's %.12g, byte for byte", "[results]") {
   }
   const std::string path = (std::filesystem::temp_directory_path() / "railcrash_test_buffered_file.csv").string();
   std::string expected;
+  int json_differs = 0;  // summary.json's numbers (json_number) are the same text, null where not finite
   {
     BufferedFile file(path);
     REQUIRE(file.is_open());
@@ -66,6 +68,7 @@ TEST_CASE("numbers are written as printf's %.12g, byte for byte", "[results]") {
       char text[40];
       std::snprintf(text, sizeof text, "%.12g", value);
       expected += std::string(text) + ",";
+      if (railcrash::json_number(value) != (std::isfinite(value) ? std::string(text) : "null")) ++json_differs;
       file.number(value);
       file.character(',');
     }
@@ -78,6 +81,7 @@ TEST_CASE("numbers are written as printf's %.12g, byte for byte", "[results]") {
   std::stringstream written;
   written << in.rdbuf();
   CHECK(written.str() == expected);  // also more than one buffer's worth
+  CHECK(json_differs == 0);
   CHECK(expected.size() > BufferedFile::kCapacity);
   std::filesystem::remove(path);
 }
