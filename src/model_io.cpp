@@ -833,9 +833,12 @@ Model build(const YAML::Node& root, const Reader& r) {
 
 namespace {
 
-YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
+/// parse(), which reads `text` as YAML, with its parse errors as InputErrors that say where
+/// (and which bracket was left open).
+template <class Parse>
+auto with_model_parse_errors(const std::string& text, const std::string& path, const Parse& parse) {
   try {
-    return load_yaml_text(text, path);
+    return parse();
   } catch (const YAML::ParserException& e) {
     const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
     // A ']' or '}' left out is noticed only where the next thing starts (often the next
@@ -849,6 +852,10 @@ YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
                        "' (the parser stopped at line " + std::to_string(line) + ": " + e.msg + ")");
     throw InputError(SourceLocation{path, line}.prefix() + "not valid YAML: " + e.msg);
   }
+}
+
+YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
+  return with_model_parse_errors(text, path, [&] { return load_yaml_text(text, path); });
 }
 
 /// A setting taken from a variant file: KEY=VALUE and how messages name it.
@@ -902,9 +909,9 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
 
 namespace {
 
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+/// The model of a parsed model file (`root`, read from `path`), with the settings applied.
+Model model_from_yaml(YAML::Node root, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
-  YAML::Node root = parse_model_yaml(text, path);
   std::string file = path;
   std::vector<VariantSetting> variant_settings;
   if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings);
@@ -925,7 +932,21 @@ Model load_model_text(const std::string& text, const std::string& path, const st
   }
 }
 
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+                      const std::vector<OptionSetting>& options) {
+  return model_from_yaml(parse_model_yaml(text, path), path, overrides, options);
+}
+
 }  // namespace
+
+CheckedYamlText check_model_text(std::string text, const std::string& path) {
+  return with_model_parse_errors(text, path, [&] { return CheckedYamlText(text, path); });
+}
+
+Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides) {
+  // Checked when it was read; a parse error here would have been found then.
+  return model_from_yaml(load_yaml_text(text), path, overrides, {});
+}
 
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
   return load_model_text(text, path, overrides, {});

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
 #include "railcrash/table_text.hpp"
 
 namespace railcrash {
@@ -51,7 +52,7 @@ std::string broadcast(std::string text) {
 
 /// One run on this rank (at most one per rank at a time): its runs.csv line, or nothing when
 /// the caller's stop flag interrupted it.
-std::string run_here(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+std::string run_here(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                      const std::string& directory, const SweepOptions& options, const SweepRunSpec& spec, std::size_t k) {
   BatchOptions batch;
   batch.run_time_limit = options.run_time_limit;
@@ -69,9 +70,9 @@ std::string run_here(const SweepPlan& plan, const std::string& model_path, const
 
 /// Rank 0: hands out the runs not done yet, one at a time, to the ranks that ask and to a
 /// thread of its own (rank 0 runs too), and writes the files.
-int coordinate(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+int coordinate(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                const std::string& directory, const SweepOptions& options, int ranks) {
-  SweepResult result = start_sweep(plan, model_text, directory, options.resume);
+  SweepResult result = start_sweep(plan, model_text.text(), directory, options.resume);
   std::vector<long> pending;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
     if (!result.lines[k]) pending.push_back(static_cast<long>(k));
@@ -123,9 +124,9 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const std::
 }
 
 /// Ranks above 0: ask for a run, run it, send its line, until told to stop.
-void work(const SweepPlan& plan, const std::string& model_path, const std::string& model_text, const std::string& directory,
+void work(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text, const std::string& directory,
           const SweepOptions& options) {
-  const std::vector<SweepRunSpec> specs = sweep_runs(plan, model_text);
+  const std::vector<SweepRunSpec> specs = sweep_runs(plan, model_text.text());
   std::string message = "-1\n";
   for (;;) {
     send_text(message);
@@ -171,10 +172,10 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
     if (ranks == 1) {
       const SweepResult result = run_sweep(model_path, plan, directory, options);
       status = result.done() == result.specs.size() && failed_sweep_runs(plan, result) == 0 ? 0 : 1;
-    } else if (rank == 0) {
-      status = coordinate(plan, model_path, model_text, directory, options, ranks);
     } else {
-      work(plan, model_path, model_text, directory, options);
+      const CheckedYamlText checked = check_model_text(model_text, model_path);  // once per rank, for all its runs
+      if (rank == 0) status = coordinate(plan, model_path, checked, directory, options, ranks);
+      else work(plan, model_path, checked, directory, options);
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <string>
+#include <vector>
 
 #include "railcrash/model_io.hpp"
 #include "railcrash/yaml_file.hpp"
@@ -98,4 +99,41 @@ TEST_CASE("a ',' at the start of a document is refused at once, not parsed witho
   CHECK_THAT(structure_error(",l"), StartsWith("in.yaml:1: not valid YAML: the parser makes no progress here"));
   CHECK_THAT(structure_error("\n\n,"), StartsWith("in.yaml:3: not valid YAML"));
   CHECK(structure_error("a:\nb:\nc: [, ]\n").find("no progress") == std::string::npos);
+}
+
+TEST_CASE("a model text checked once (a sweep's runs) is refused and read exactly as load_model_text", "[yaml_file]") {
+  const auto error_of = [](const auto& load) -> std::string {
+    try {
+      load();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  // Each refusal says what load_model_text says for the same text: an alias in its own
+  // anchor, nesting past the limit, a bracket left open (the bracket's own line), bad YAML.
+  for (const std::string& text :
+       {std::string("railcrash: 1\nname: x\nunits: SI\ndescription: &r [*r]\nbodies: []\n"),
+        "railcrash: 1\nname: " + std::string(kYamlMaxDepth, '[') + std::string(kYamlMaxDepth, ']') + "\n",
+        std::string("railcrash: 1\nbodies: [\n  {name: a, mass: 1}\nsimulation: {t_end: 1}\n"),
+        std::string("railcrash: 1\n  name: x\n bad")}) {
+    const std::string expected = error_of([&] { (void)load_model_text(text, "model.yaml"); });
+    REQUIRE_FALSE(expected.empty());
+    CHECK(error_of([&] { (void)check_model_text(text, "model.yaml"); }) == expected);
+  }
+  // A valid text: the same model, with and without --set settings; a setting's own mistakes
+  // are still checked (they are not part of the checked text).
+  const std::string valid = "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: bob, mass: 1, inertia: 1, position: [0, 0]}\n"
+                            "simulation: {t_end: 1}\n";
+  const CheckedYamlText checked = check_model_text(valid, "model.yaml");
+  CHECK(checked.text() == valid);
+  for (const std::vector<std::string>& settings : {std::vector<std::string>{}, std::vector<std::string>{"bodies.bob.mass=2.5"}}) {
+    const Model direct = load_model_text(valid, "model.yaml", settings);
+    const Model from_checked = load_model_text(checked, "model.yaml", settings);
+    CHECK(from_checked.bodies()[0].mass == direct.bodies()[0].mass);
+    CHECK(from_checked.simulation.t_end == direct.simulation.t_end);
+  }
+  CHECK(load_model_text(checked, "model.yaml", {"bodies.bob.mass=2.5"}).bodies()[0].mass == 2.5);
+  CHECK_THAT(error_of([&] { (void)load_model_text(checked, "model.yaml", {"description=&a [*a]"}); }),
+             StartsWith("model.yaml: --set 'description=&a [*a]'") && Contains("an alias refers to the node that contains it"));
 }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "railcrash/model.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -21,6 +22,11 @@ Model load_model(const std::string& path);
 /// applied before finalize (e.g. "simulation.t_end=0.5", "bodies.bob.mass=2").
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
 Model load_model(const std::string& path, const std::vector<std::string>& overrides);
+/// A model file's text, its YAML structure checked (InputError "path:line: ..." as load_model
+/// gives for the same text); the runs of a sweep then load it without walking it again.
+CheckedYamlText check_model_text(std::string text, const std::string& path);
+/// load_model_text of a checked text.
+Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides);
 
 /// A KEY=VALUE setting that goes through the same path as --set but is named in messages by
 /// the command-line option it came from (e.g. setting "simulation.t_end=-1", option "--t-end -1").

@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "railcrash/batch.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -115,8 +116,9 @@ struct SweepRow {
   std::string message;
 };
 
-/// Runs one specification (used by the thread pool and by MPI ranks).
-SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+/// Runs one specification (used by the thread pool and by MPI ranks); `model_text` is the model
+/// file's text, checked once (check_model_text) for all the runs.
+SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                         const SweepRunSpec& spec, const RunControl& control, const std::string& run_folder = "");
 
 /// runs.csv: header and one line per row (run number, hash, factors, status, responses, wall, message).
