@@ -940,6 +940,7 @@ Model load_model_text(const std::string& text, const std::string& path, const st
 }  // namespace
 
 CheckedYamlText check_model_text(std::string text, const std::string& path) {
+  // A copy goes into the checked text: a parse error's message reads `text` (the open bracket).
   return with_model_parse_errors(text, path, [&] { return CheckedYamlText(text, path); });
 }
 
