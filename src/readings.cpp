@@ -469,7 +469,7 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
   const std::vector<std::vector<int>> combinations = plan.combinations();
   // Every combination's runs are checked before the first run starts (the first combination's
   // run by run, the others with all their factors at once: check_sensitivity_inputs).
-  const std::string model_text = read_model_text(model_path);
+  const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
   std::vector<SensitivityDesign> designs;
   for (const std::vector<int>& combination : combinations) {
     designs.push_back(plan.design_for(combination, design));

@@ -252,7 +252,7 @@ std::vector<Job> study_jobs(const SensitivityDesign& design, const SensitivityOp
 
 /// The scale entry of a job's parameters that the model does not accept on its own, as
 /// "design.yaml:12: design parameter 'P7', scale key 'K' does not fit the model: ...", or "".
-std::string bad_scale_entry(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+std::string bad_scale_entry(const CheckedYamlText& model_text, const std::string& model_path, const SensitivityDesign& design,
                             const Job& job, const std::vector<std::string>& base_settings) {
   for (const auto& [name, value] : job.variation) {
     const SensitivityParameter* parameter = find_parameter(design, name);
@@ -281,7 +281,7 @@ void mark_interrupted(SensitivityRun& run) {
   if (run.message.empty()) run.message = "interrupted (SIGINT/SIGTERM)";
 }
 
-SensitivityRun run_one(const std::string& model_path, const std::string& model_text, const SensitivityDesign& design,
+SensitivityRun run_one(const std::string& model_path, const CheckedYamlText& model_text, const SensitivityDesign& design,
                        const Job& job, const std::vector<std::string>& base_settings, double time_limit,
                        const RunControl& control) {
   SensitivityRun run;
@@ -469,7 +469,7 @@ QuadraticFit fit_quadratic(const std::vector<SensitivityTerm>& terms, const std:
   return fit;
 }
 
-void check_sensitivity_inputs(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+void check_sensitivity_inputs(const CheckedYamlText& model_text, const std::string& model_path, const SensitivityDesign& design,
                               const SensitivityOptions& options, bool every_run) {
   std::size_t first_order_count = 0;
   const std::vector<Job> jobs = study_jobs(design, options, first_order_count);
@@ -504,7 +504,7 @@ void check_sensitivity_inputs(const std::string& model_text, const std::string& 
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
                                   const SensitivityOptions& options) {
-  const std::string model_text = read_model_text(model_path);
+  const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);  // once for every run
   check_sensitivity_inputs(model_text, model_path, design, options, true);
   SensitivityResult result;
   result.central = options.central_step > 0.0;

@@ -60,6 +60,7 @@
 
 #include "railcrash/error.hpp"
 #include "railcrash/responses.hpp"
+#include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
 
@@ -192,7 +193,7 @@ struct SensitivityOptions {
 /// study before its first run; the message names the design file's line of the scale entry.
 /// Without every_run, the model is first loaded once with every parameter's factors at once
 /// (what a reading study does for each of its many combinations), and run by run only if that fails.
-void check_sensitivity_inputs(const std::string& model_text, const std::string& model_path, const SensitivityDesign& design,
+void check_sensitivity_inputs(const CheckedYamlText& model_text, const std::string& model_path, const SensitivityDesign& design,
                               const SensitivityOptions& options, bool every_run);
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
