@@ -348,9 +348,10 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
   }
 
   // Every key and level against the model, before any run.
-  const std::string model_text = read_model_text(model_path);
-  (void)load_model_text(model_text, model_path);  // the model's own mistakes first, as they are
-  const YAML::Node model_root = load_yaml_text(model_text, model_path);
+  // Its YAML structure checked once for every load below (the same messages as load_model_text).
+  const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
+  (void)load_model_text(model_text, model_path, {});  // the model's own mistakes first, as they are
+  const YAML::Node model_root = load_yaml_text(model_text);
   const auto check = [&](const SweepFactor& factor, const std::string& level, int line) {
     std::vector<std::string> settings = plan.settings;
     try {
