@@ -29,6 +29,7 @@
 #include "railcrash/sweep_mpi.hpp"
 #include "railcrash/converge.hpp"
 #include "railcrash/report/report.hpp"
+#include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/version.hpp"
 
 #include <sstream>
@@ -212,18 +213,29 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   if (report.car_crush.empty()) std::printf("no per-car crush: no body declares a car (car: in the model file)\n");
   for (const CarCrush& car : report.car_crush) {
     std::printf("%-10s max crush %.4g at t = %.4g; peak acceleration (CFC 60, unfiltered) [g]:", car.car.c_str(), car.max_crush, car.t);
+    std::string at_end;  // the car-body masses whose filtered magnitude is larger within the end zone
     for (const int body : car.bodies) {
       const auto i = static_cast<std::size_t>(body);
       const std::string& name = model.bodies()[i].name;
       if (name.find("body") == std::string::npos && name.find("end") == std::string::npos) continue;
       const double g = standard_gravity(model);
-      if (i < report.filtered_accelerations.size() && report.filtered_accelerations[i].filtered)
-        std::printf(" %s %.3g (%.3g)", name.c_str(), report.filtered_accelerations[i].peaks.magnitude / g,
-                    report.acceleration_peaks[i].magnitude / g);
-      else
+      if (i < report.filtered_accelerations.size() && report.filtered_accelerations[i].filtered) {
+        const FilteredAccelerations& f = report.filtered_accelerations[i];
+        std::printf(" %s %.3g (%.3g)", name.c_str(), f.peaks.magnitude / g, report.acceleration_peaks[i].magnitude / g);
+        if (f.end_zone.magnitude > f.peaks.magnitude) {
+          char value[32];
+          std::snprintf(value, sizeof value, "%.3g", f.end_zone.magnitude / g);
+          at_end += " " + name + " " + value;
+        }
+      } else {
         std::printf(" %s %.3g (unfiltered)", name.c_str(), report.acceleration_peaks[i].magnitude / g);
+      }
     }
     std::printf("\n");
+    if (!at_end.empty())
+      std::printf("%-10s larger CFC 60 values within the record's last %.2g ms, where the filter follows the last row "
+                  "(lengthen t_end to see whether a pulse peaks there) [g]:%s\n",
+                  "", 1e3 * cfc::end_zone(60.0), at_end.c_str());
   }
   std::printf("results in %s/ (%s, summary.json, model.json)\n", out_dir.c_str(),
               format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"

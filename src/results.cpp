@@ -450,12 +450,17 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
     f.filtered = true;
     const std::vector<double> ax = cfc::filter(cfc::resample_uniform(sample_times_, widen(ax_[b]), interval), interval, cfc_);
     const std::vector<double> ay = cfc::filter(cfc::resample_uniform(sample_times_, widen(ay_[b]), interval), interval, cfc_);
+    // The end zone's samples go to their own peaks (results.hpp); a record no longer than the
+    // zone keeps all of its samples in `peaks`.
+    f.end_zone_start = std::max(sample_times_.front(), sample_times_.back() - cfc::end_zone(cfc_));
+    const bool split = f.end_zone_start > sample_times_.front();
     for (std::size_t k = 0; k < ax.size(); ++k) {
       const double t = sample_times_.front() + static_cast<double>(k) * interval;
       const double magnitude = std::hypot(ax[k], ay[k]);
-      if (std::abs(ax[k]) > f.peaks.x) { f.peaks.x = std::abs(ax[k]); f.peaks.t_x = t; }
-      if (std::abs(ay[k]) > f.peaks.y) { f.peaks.y = std::abs(ay[k]); f.peaks.t_y = t; }
-      if (magnitude > f.peaks.magnitude) { f.peaks.magnitude = magnitude; f.peaks.t_magnitude = t; }
+      AccelerationPeaks& peaks = split && t >= f.end_zone_start ? f.end_zone : f.peaks;
+      if (std::abs(ax[k]) > peaks.x) { peaks.x = std::abs(ax[k]); peaks.t_x = t; }
+      if (std::abs(ay[k]) > peaks.y) { peaks.y = std::abs(ay[k]); peaks.t_y = t; }
+      if (magnitude > peaks.magnitude) { peaks.magnitude = magnitude; peaks.t_magnitude = t; }
     }
   }
   filtered_ = result;
@@ -537,6 +542,13 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
                                        json_number(0.5 / cfc::design_frequency(cfc_)) + " s"
                    : adequate ? "x_cfc, y_cfc, magnitude_cfc: peaks of the filtered accelerations; unfiltered beside them"
                               : "sample rate below 10 x CFC: filtered peaks are rough, lower the output interval")
+    << ", \"end_zone\": " << json_number(cfc::end_zone(cfc_)) << ", \"end_zone_note\": "
+    << json_string(filtered_any && filtered.front().end_zone_start > sample_times_.front()
+                       ? "the filtered peaks are taken before the last end_zone seconds of the record, where the filter follows "
+                         "the record's last sample rather than the pulse; a larger filtered magnitude there is given as "
+                         "magnitude_cfc_end_zone (the run may have stopped mid-pulse: lengthen t_end to see it whole)"
+                       : "the record is no longer than the filter's end zone: its filtered peaks include the end, where the "
+                         "filter follows the record's last sample")
     << "}, \"bodies\": {";
   const auto peak_json = [&](double value, double t) {
     return "{\"abs_max\": " + json_number(value) + ", \"g\": " + json_number(value / g) + ", \"t\": " + json_number(t) + "}";
@@ -552,6 +564,8 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     if (f.filtered)
       j << ", \"x_cfc\": " << peak_json(f.peaks.x, f.peaks.t_x) << ", \"y_cfc\": " << peak_json(f.peaks.y, f.peaks.t_y)
         << ", \"magnitude_cfc\": " << peak_json(f.peaks.magnitude, f.peaks.t_magnitude);
+    if (f.filtered && f.end_zone.magnitude > f.peaks.magnitude)
+      j << ", \"magnitude_cfc_end_zone\": " << peak_json(f.end_zone.magnitude, f.end_zone.t_magnitude);
     const CollisionPulse& c = f.collision;
     if (c.found)
       j << ", \"collision\": {\"t_start\": " << json_number(c.t_start) << ", \"t_end\": " << json_number(c.t_end)

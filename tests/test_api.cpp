@@ -13,6 +13,7 @@
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 #include "support.hpp"
+#include <yaml-cpp/yaml.h>
 
 namespace rc = railcrash::api;
 
@@ -190,6 +191,53 @@ TEST_CASE("api: a built model with loads, tables and flags", "[api]") {
   const std::vector<double>& x = back.series("cart.x");
   CHECK(*std::max_element(x.begin(), x.end()) > 1.01);
   CHECK(x.back() == Approx(1.0).margin(1e-7));
+}
+
+TEST_CASE("api: CFC 60 peaks are taken before the filter's end zone; a larger value there is given apart", "[api][cfc]") {
+  // A free 1 kg body pushed by a table force: a 100 ms half-sine of 100 N from t = 0.1 s (all
+  // its energy below 10 Hz: it passes CFC 60 within 0.5 %), then, over the run's last 1 ms, a
+  // ramp to 1000 N (as a light body ringing at the last row). The filter's extension of the
+  // record passes the last sample through whole, so the peak over the whole record would be the
+  // 1000 m/s^2 end; before the end zone it is the pulse's 100.
+  rc::ModelBuilder b("pulse and end", "SI");
+  b.gravity(0.0, 0.0);
+  b.body({"cart", 1.0, 0.1, 0.0, 0.0});
+  std::vector<std::array<double, 3>> table;
+  for (int k = 0; k <= 100; ++k) table.push_back({0.1 + 1e-3 * k, 100.0 * std::sin(M_PI * k / 100.0), 0.0});
+  table.push_back({0.399, 0.0, 0.0});
+  table.push_back({0.4, 1000.0, 0.0});
+  b.force({"cart", 0.0, 0.0}, table);
+  rc::RunSettings s;
+  s.t_end = 0.4;
+  s.output_interval = 1e-3;
+  s.rtol = 1e-8;
+  b.simulation(s);
+  const rc::Results r = rc::run(b.build());
+  REQUIRE(r.ok());
+  const YAML::Node summary = YAML::Load(r.summary_json)["peak_accelerations"];
+  const double g = summary["standard_gravity"].as<double>();
+  CHECK(summary["filter"]["end_zone"].as<double>() == Approx(8.3155e-3).epsilon(1e-4));
+  const YAML::Node cart = summary["bodies"]["cart"];
+  CHECK(cart["magnitude_cfc"]["abs_max"].as<double>() == Approx(100.0).epsilon(5e-3));
+  CHECK(cart["magnitude_cfc"]["t"].as<double>() == Approx(0.15).margin(2e-3));
+  CHECK(cart["magnitude_cfc"]["g"].as<double>() == Approx(100.0 / g).epsilon(5e-3));
+  REQUIRE(cart["magnitude_cfc_end_zone"]);
+  CHECK(cart["magnitude_cfc_end_zone"]["abs_max"].as<double>() == Approx(1000.0).epsilon(1e-6));
+  CHECK(cart["magnitude_cfc_end_zone"]["t"].as<double>() == Approx(0.4).margin(1e-12));
+  // Unfiltered, the end is the peak: those are the samples themselves.
+  CHECK(cart["magnitude"]["max"].as<double>() == Approx(1000.0).epsilon(1e-6));
+
+  // Without the end ramp there is nothing larger at the end to give apart.
+  table.resize(table.size() - 2);
+  rc::ModelBuilder plain("pulse", "SI");
+  plain.gravity(0.0, 0.0);
+  plain.body({"cart", 1.0, 0.1, 0.0, 0.0});
+  plain.force({"cart", 0.0, 0.0}, table);
+  plain.simulation(s);
+  const rc::Results p = rc::run(plain.build());
+  const YAML::Node quiet = YAML::Load(p.summary_json)["peak_accelerations"]["bodies"]["cart"];
+  CHECK(quiet["magnitude_cfc"]["abs_max"].as<double>() == Approx(cart["magnitude_cfc"]["abs_max"].as<double>()).epsilon(1e-6));
+  CHECK_FALSE(quiet["magnitude_cfc_end_zone"]);
 }
 
 TEST_CASE("api: errors name the file and line, the element or the key", "[api]") {

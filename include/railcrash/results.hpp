@@ -16,7 +16,12 @@
 // Sampled at the output interval: a finer interval sees sharper peaks.
 // The same peaks of the accelerations filtered at a channel frequency class (CFC 60 unless
 // set_filter_class says otherwise; results/cfc_filter.hpp) are given beside them ("x_cfc",
-// "y_cfc", "magnitude_cfc"), and each body's collision pulse (first contact, end of its velocity
+// "y_cfc", "magnitude_cfc"), taken before the filter's end zone (the last cfc::end_zone
+// seconds of the record, 8.3 ms at CFC 60, where the filtered values follow the record's last
+// sample rather than its pulse; results/cfc_filter.hpp "Ends"). A larger filtered magnitude
+// within the end zone is given apart ("magnitude_cfc_end_zone"): the run may have stopped
+// mid-pulse, or a light body rings at the last row. A record no longer than the end zone has
+// no such split. Then each body's collision pulse (first contact, end of its velocity
 // change, mean deceleration; results/crash_pulse.hpp) as "collision". The filter needs a
 // sample rate of at least 2 x 2.0775 CFC; below 10 CFC the summary says the sampling is too coarse.
 // The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
@@ -76,7 +81,9 @@ struct AccelerationPeaks {
 /// Filtered peaks and the collision pulse of one body.
 struct FilteredAccelerations {
   bool filtered = false;      // false when the samples were too few or too coarse to filter
-  AccelerationPeaks peaks;    // of the CFC-filtered accelerations
+  AccelerationPeaks peaks;    // of the CFC-filtered accelerations before end_zone_start
+  double end_zone_start = 0.0;  // [time] the record's end minus cfc::end_zone; its start when the record is shorter
+  AccelerationPeaks end_zone;   // the filtered accelerations' peaks from end_zone_start on (zero when there is no split)
   CollisionPulse collision;   // from the body's x velocity
 };
 

@@ -32,6 +32,8 @@ void forward_pass(const Coefficients& c, std::vector<double>& x) {
 
 double design_frequency(double cfc) { return 2.0775 * cfc; }
 
+double end_zone(double cfc) { return std::sqrt(2.0) * std::log(100.0) / (2.0 * kPi * design_frequency(cfc)); }
+
 Coefficients coefficients(double cfc, double interval) {
   if (!(cfc > 0.0) || !std::isfinite(cfc)) throw std::invalid_argument("CFC class must be a positive number");
   if (!(interval > 0.0) || !std::isfinite(interval)) throw std::invalid_argument("sample interval must be positive");

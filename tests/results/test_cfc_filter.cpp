@@ -115,6 +115,31 @@ TEST_CASE("CFC filter on analytic inputs: constant, ramp, slow and short half-si
   CHECK(filtered_area == Approx(area).epsilon(1e-6));
 }
 
+TEST_CASE("CFC filter's end zone: a last-sample spike comes through whole, and is gone before the zone", "[cfc]") {
+  using namespace railcrash::cfc;
+  // end_zone = sqrt(2) ln(100) / (2 pi fd): 8.3155 ms at CFC 60, a third of that at CFC 180.
+  CHECK(end_zone(60.0) == Approx(std::sqrt(2.0) * std::log(100.0) / (2.0 * kPi * 2.0775 * 60.0)).epsilon(1e-15));
+  CHECK(end_zone(60.0) == Approx(8.3155e-3).epsilon(1e-4));
+  CHECK(end_zone(180.0) == Approx(end_zone(60.0) / 3.0).epsilon(1e-12));
+  for (const double interval : {1e-3, 5e-4, 1e-4, 1e-5}) {
+    // Zeros, then one sample of 1 at the record's end (a light body ringing at the last row):
+    // the point reflection extends it as a step of 2, and the filtered end is the spike.
+    std::vector<double> x(static_cast<std::size_t>(0.2 / interval), 0.0);
+    x.back() = 1.0;
+    const std::vector<double> y = filter(x, interval, 60.0);
+    INFO("interval " << interval);
+    CHECK(y.back() == Approx(1.0).epsilon(1e-9));
+    double before_zone = 0.0, in_last_quarter = 0.0;
+    for (std::size_t k = 0; k < y.size(); ++k) {
+      const double time_to_end = static_cast<double>(y.size() - 1 - k) * interval;
+      if (time_to_end > end_zone(60.0)) before_zone = std::max(before_zone, std::abs(y[k]));
+      if (time_to_end > 0.0 && time_to_end <= 0.25 * end_zone(60.0)) in_last_quarter = std::max(in_last_quarter, std::abs(y[k]));
+    }
+    CHECK(before_zone < 5e-3);  // under 0.5 % of the spike: the zone is long enough
+    if (interval < 1e-3) CHECK(in_last_quarter > 0.2);  // and not needlessly long
+  }
+}
+
 TEST_CASE("Uniform resampling and the typical interval", "[cfc]") {
   using namespace railcrash::cfc;
   const std::vector<double> t{0.0, 0.001, 0.002, 0.003, 0.0035}, v{0.0, 1.0, 2.0, 3.0, 3.5};

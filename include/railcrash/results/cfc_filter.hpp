@@ -21,6 +21,14 @@
 // slope and does not invent a step; the extension is as long as the filter's memory
 // (4 / (fd T) samples, or the record). The passes run over the extended record and the
 // extension is cut off.
+// That extension pins the filtered record to its last value: a single sample of height S at
+// the end comes through as S, and a light body's ringing (above the CFC's band) sampled at
+// the last row is reported as if it were the pulse. Before the end the extension's influence
+// dies out with the second-order section's envelope exp(-wd t / sqrt(2)); `end_zone` is the
+// time over which it falls to 1 % (sqrt(2) ln(100) / wd: 8.3 ms at CFC 60), after which a
+// last-sample spike moves the filtered value by less than 0.5 % of its height (the test).
+// Peaks within the end zone depend on how the record is extended, so results.hpp takes the
+// peaks before it and names a larger value within it apart.
 //
 // Sampling: the coefficients need fd T < 1/2; `filter` throws std::invalid_argument beyond.
 // Data acquisition practice asks for a sample rate of at least 10 CFC (600 Hz for CFC 60, as
@@ -43,6 +51,10 @@ double design_frequency(double cfc);
 /// Coefficients of one pass for the channel class `cfc` at sample interval `interval` [s].
 /// Throws std::invalid_argument when cfc <= 0, interval <= 0 or fd T >= 1/2.
 Coefficients coefficients(double cfc, double interval);
+
+/// Time before a record's end over which its extension still moves the filtered values by
+/// more than 1 % [s] (see Ends above): sqrt(2) ln(100) / (2 pi fd).
+double end_zone(double cfc);
 
 /// True when the sample rate is at least 10 CFC.
 bool adequately_sampled(double cfc, double interval);
