@@ -409,8 +409,17 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
       }
       const std::string what = std::string(axis) == "ax" ? "Longitudinal" : "Vertical";
       const std::string filter_name = can_filter ? "CFC " + number(options.cfc) : "unfiltered";
+      // The filtered curves' last cfc::end_zone seconds follow the record's last row
+      // (results/cfc_filter.hpp "Ends"); the summary's peaks leave them out, the plot says so.
+      std::string note = body_note;
+      if (can_filter) {
+        char zone_ms[32];
+        std::snprintf(zone_ms, sizeof zone_ms, "%.2g", 1e3 * cfc::end_zone(options.cfc));
+        note += std::string(note.empty() ? "" : "; ") + "the last " + zone_ms + " ms of each filtered curve follow the record's last row, not the pulse (the filter's end zone; "
+                "summary.json's CFC peaks leave it out)";
+      }
       plots.push_back(plot_json(std::string("acceleration_") + axis, what + " acceleration (" + filter_name + ")",
-                                g > 0.0 ? "g" : "length/time^2", uniform_t, list, options.max_plot_points, body_note));
+                                g > 0.0 ? "g" : "length/time^2", uniform_t, list, options.max_plot_points, note));
     }
   }
 

@@ -128,6 +128,8 @@ TEST_CASE("railcrash report: a good run, a truncated one, one without summary, a
   CHECK_THAT(page, Catch::Contains("\\u003cscript>document.title"));
   CHECK_THAT(page, !Catch::Contains("src=\"http") && !Catch::Contains("<link"));  // nothing fetched
   CHECK((page.find("uPlot") != std::string::npos) == railcrash::report::have_plotting_library());
+  // The acceleration plots say that their filtered curves' last 8.3 ms are the filter's end zone.
+  CHECK_THAT(page, Catch::Contains("the last 8.3 ms of each filtered curve follow the record's last row"));
 
   // A failed run: the failure comes first.
   {
