@@ -213,7 +213,8 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   if (report.car_crush.empty()) std::printf("no per-car crush: no body declares a car (car: in the model file)\n");
   for (const CarCrush& car : report.car_crush) {
     std::printf("%-10s max crush %.4g at t = %.4g; peak acceleration (CFC 60, unfiltered) [g]:", car.car.c_str(), car.max_crush, car.t);
-    std::string at_end;  // the car-body masses whose filtered magnitude is larger within the end zone
+    std::string at_end;   // the car-body masses whose filtered magnitude is larger within the end zone
+    std::string aliased;  // those whose CFC peak moves with the output interval (results.hpp)
     for (const int body : car.bodies) {
       const auto i = static_cast<std::size_t>(body);
       const std::string& name = model.bodies()[i].name;
@@ -222,10 +223,14 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
       if (i < report.filtered_accelerations.size() && report.filtered_accelerations[i].filtered) {
         const FilteredAccelerations& f = report.filtered_accelerations[i];
         std::printf(" %s %.3g (%.3g)", name.c_str(), f.peaks.magnitude / g, report.acceleration_peaks[i].magnitude / g);
+        char value[64];
         if (f.end_zone.magnitude > f.peaks.magnitude) {
-          char value[32];
           std::snprintf(value, sizeof value, "%.3g", f.end_zone.magnitude / g);
           at_end += " " + name + " " + value;
+        }
+        if (f.sampling_sensitive) {
+          std::snprintf(value, sizeof value, "%.3g against %.3g", f.peaks.magnitude / g, f.interval_mean_magnitude / g);
+          aliased += " " + name + " " + value;
         }
       } else {
         std::printf(" %s %.3g (unfiltered)", name.c_str(), report.acceleration_peaks[i].magnitude / g);
@@ -236,6 +241,10 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
       std::printf("%-10s larger CFC 60 values within the record's last %.2g ms, where the filter follows the last row "
                   "(lengthen t_end to see whether a pulse peaks there) [g]:%s\n",
                   "", 1e3 * cfc::end_zone(60.0), at_end.c_str());
+    if (!aliased.empty())
+      std::printf("%-10s CFC 60 peaks from the rows' accelerations against the output intervals' means, more than 5 %% apart "
+                  "(the acceleration has content above the rows' Nyquist frequency: lower the output interval) [g]:%s\n",
+                  "", aliased.c_str());
   }
   std::printf("results in %s/ (%s, summary.json, model.json)\n", out_dir.c_str(),
               format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
