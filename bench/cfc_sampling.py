@@ -9,7 +9,8 @@ zone (summary.json's magnitude_cfc) from
     filters),
   * the model's rows, the mean acceleration over each output interval (velocity differences
     of timeseries.csv, at the intervals' midpoints): an anti-alias box in front of the filter,
-each with its error against the reference. The filter is bench/cfc_end_zone.py's (SAE J211-1
+each with its error against the reference. summary.json gives the interval means' peak
+beside the rows' one (magnitude_cfc_interval_mean) where the two differ by more than 5 %. The filter is bench/cfc_end_zone.py's (SAE J211-1
 Appendix C, the end reflection of src/results/cfc_filter.cpp). Standard gravity 386.088 in/s^2
 (the crash models' units).
 
