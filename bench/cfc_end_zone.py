@@ -50,13 +50,19 @@ def cfc_filter(samples, interval, cfc=60.0):
     return x[pad:pad + n]
 
 
-def run(executable, model, rtol, t_end, out):
-    command = [executable, "run", model, "--rtol", rtol, "--out", out, "--quiet"]
-    if t_end is not None:
-        command += ["--set", f"simulation.t_end={t_end!r}"]
+def run(executable, model, rtol, out, extra=()):
+    """railcrash run MODEL at rtol into out, with extra options; its summary.json."""
+    command = [executable, "run", model, "--rtol", rtol, "--out", out, "--quiet", *extra]
     subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
     with open(os.path.join(out, "summary.json")) as f:
         return json.load(f)
+
+
+def table(path):
+    """A CSV file's header and its rows as numbers."""
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    return rows[0], [[float(v) for v in r] for r in rows[1:]]
 
 
 def main():
@@ -68,12 +74,10 @@ def main():
     parser.add_argument("--executable", default="build/railcrash")
     args = parser.parse_args()
     work = tempfile.mkdtemp(prefix="railcrash-cfc-end-")
-    short = run(args.executable, args.model, args.rtol, None, os.path.join(work, "short"))
+    short = run(args.executable, args.model, args.rtol, os.path.join(work, "short"))
     t_end = short["t_reached"]
-    run(args.executable, args.model, args.rtol, t_end + args.more, os.path.join(work, "long"))
-    with open(os.path.join(work, "long", "accelerations.csv")) as f:
-        rows = list(csv.reader(f))
-    head, data = rows[0], [[float(v) for v in r] for r in rows[1:]]
+    run(args.executable, args.model, args.rtol, os.path.join(work, "long"), ["--set", f"simulation.t_end={t_end + args.more!r}"])
+    head, data = table(os.path.join(work, "long", "accelerations.csv"))
     times = [r[0] for r in data]
     interval = times[1] - times[0]
     at_end = min(range(len(times)), key=lambda k: abs(times[k] - t_end))

@@ -18,32 +18,21 @@ Usage, from the repository root (about half a minute per model):
   /usr/bin/python3 bench/cfc_sampling.py MODEL [--rtol 1e-9] [--fine 1e-5] [--executable build/railcrash]
 """
 import argparse
-import csv
 import math
 import os
-import subprocess
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cfc_end_zone import cfc_filter  # noqa: E402
+from cfc_end_zone import cfc_filter, run, table  # noqa: E402
 
 G = 386.088
-END_ZONE = math.sqrt(2.0) * math.log(100.0) / (2.0 * math.pi * 2.0775 * 60.0)  # [s] cfc::end_zone(60)
 
 
-def table(path):
-    with open(path) as f:
-        rows = list(csv.reader(f))
-    return rows[0], [[float(v) for v in r] for r in rows[1:]]
-
-
-def run(executable, model, rtol, interval, out):
-    command = [executable, "run", model, "--rtol", rtol, "--out", out, "--quiet"]
-    if interval:
-        command += ["--output-interval", interval]
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
-    return table(os.path.join(out, "timeseries.csv")), table(os.path.join(out, "accelerations.csv"))
+def run_tables(executable, model, rtol, interval, out):
+    """The run's summary.json, timeseries.csv and accelerations.csv (rows every `interval`, or the model's)."""
+    summary = run(executable, model, rtol, out, ["--output-interval", interval] if interval else [])
+    return summary, table(os.path.join(out, "timeseries.csv")), table(os.path.join(out, "accelerations.csv"))
 
 
 def peak(times, ax, ay, interval, t_max):
@@ -52,7 +41,7 @@ def peak(times, ax, ay, interval, t_max):
 
 
 def peaks(series, body, t_max):
-    (th, ts), (ah, acc) = series
+    _, (th, ts), (ah, acc) = series
     times = [r[0] for r in acc]
     interval = times[1] - times[0]
     instantaneous = peak(times, [r[ah.index(body + ".ax")] for r in acc], [r[ah.index(body + ".ay")] for r in acc],
@@ -72,11 +61,12 @@ def main():
     parser.add_argument("--executable", default="build/railcrash")
     args = parser.parse_args()
     work = tempfile.mkdtemp(prefix="railcrash-cfc-sampling-")
-    own = run(args.executable, args.model, args.rtol, None, os.path.join(work, "own"))
-    fine = run(args.executable, args.model, args.rtol, args.fine, os.path.join(work, "fine"))
-    t_max = own[0][1][-1][0] - END_ZONE
-    bodies = [c[:-3] for c in own[1][0] if c.endswith(".ax")]
-    print(f"{args.model} at rtol {args.rtol}: own rows every {own[1][1][1][0] - own[1][1][0][0]:g} s against {args.fine} s rows; "
+    own = run_tables(args.executable, args.model, args.rtol, None, os.path.join(work, "own"))
+    fine = run_tables(args.executable, args.model, args.rtol, args.fine, os.path.join(work, "fine"))
+    summary, _, (acceleration_header, accelerations) = own
+    t_max = summary["t_reached"] - summary["peak_accelerations"]["filter"]["end_zone"]  # before the end zone
+    bodies = [c[:-3] for c in acceleration_header if c.endswith(".ax")]
+    print(f"{args.model} at rtol {args.rtol}: own rows every {accelerations[1][0] - accelerations[0][0]:g} s against {args.fine} s rows; "
           f"CFC-60 peaks of |a| before t = {t_max:g} s [g]\n")
     print("| body | fine rows | own rows, instantaneous | error | own rows, interval mean | error |\n|---|---|---|---|---|---|")
     errors = ([], [])

@@ -455,6 +455,12 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
   std::vector<FilteredAccelerations> result(vx_.size());
   const double interval = cfc::typical_interval(sample_times_);
   const bool can_filter = sample_times_.size() >= 3 && interval > 0.0 && cfc::design_frequency(cfc_) * interval < 0.5;
+  // The end zone's samples go to their own peaks (results.hpp); a record no longer than the
+  // zone keeps all of its samples in `peaks`.
+  const double end_zone_start =
+      sample_times_.empty() ? 0.0 : std::max(sample_times_.front(), sample_times_.back() - cfc::end_zone(cfc_));
+  const bool split = !sample_times_.empty() && end_zone_start > sample_times_.front();
+  const double sensitivity_floor = 0.01 * standard_gravity(system_.model());  // [length/time^2] 0.01 g
   for (std::size_t b = 0; b < vx_.size(); ++b) {
     FilteredAccelerations& f = result[b];
     const auto widen = [](const std::vector<float>& v) { return std::vector<double>(v.begin(), v.end()); };
@@ -463,10 +469,7 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
     f.filtered = true;
     const std::vector<double> ax = cfc::filter(cfc::resample_uniform(sample_times_, widen(ax_[b]), interval), interval, cfc_);
     const std::vector<double> ay = cfc::filter(cfc::resample_uniform(sample_times_, widen(ay_[b]), interval), interval, cfc_);
-    // The end zone's samples go to their own peaks (results.hpp); a record no longer than the
-    // zone keeps all of its samples in `peaks`.
-    f.end_zone_start = std::max(sample_times_.front(), sample_times_.back() - cfc::end_zone(cfc_));
-    const bool split = f.end_zone_start > sample_times_.front();
+    f.end_zone_start = end_zone_start;
     for (std::size_t k = 0; k < ax.size(); ++k) {
       const double t = sample_times_.front() + static_cast<double>(k) * interval;
       const double magnitude = std::hypot(ax[k], ay[k]);
@@ -485,9 +488,9 @@ std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const 
         const double magnitude = std::hypot(mx[k], my[k]);
         if (magnitude > f.interval_mean_magnitude) { f.interval_mean_magnitude = magnitude; f.t_interval_mean = t; }
       }
-      const double larger = std::max(f.peaks.magnitude, f.interval_mean_magnitude);
-      f.sampling_sensitive = std::abs(f.peaks.magnitude - f.interval_mean_magnitude) > kSamplingSensitivity * larger &&
-                             std::abs(f.peaks.magnitude - f.interval_mean_magnitude) > 0.01 * standard_gravity(system_.model());
+      const double difference = std::abs(f.peaks.magnitude - f.interval_mean_magnitude);
+      f.sampling_sensitive = difference > kSamplingSensitivity * std::max(f.peaks.magnitude, f.interval_mean_magnitude) &&
+                             difference > sensitivity_floor;
     }
   }
   filtered_ = result;

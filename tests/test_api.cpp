@@ -43,6 +43,21 @@ rc::ModelBuilder oscillator(double mass, double stiffness) {
   return b;
 }
 
+/// A free 1 kg body pushed along x by a table force (rows t, Fx, Fy) and run with 1 ms rows:
+/// its acceleration is the force, so its CFC peaks are those of the table.
+rc::Results pushed_cart(const std::vector<std::array<double, 3>>& force, double t_end, double rtol) {
+  rc::ModelBuilder b("pushed cart", "SI");
+  b.gravity(0.0, 0.0);
+  b.body({"cart", 1.0, 0.1, 0.0, 0.0});
+  b.force({"cart", 0.0, 0.0}, force);
+  rc::RunSettings s;
+  s.t_end = t_end;
+  s.output_interval = 1e-3;
+  s.rtol = rtol;
+  b.simulation(s);
+  return rc::run(b.build());
+}
+
 std::string read(const std::string& path) {
   std::ifstream in(path);
   std::stringstream text;
@@ -199,20 +214,11 @@ TEST_CASE("api: CFC 60 peaks are taken before the filter's end zone; a larger va
   // ramp to 1000 N (as a light body ringing at the last row). The filter's extension of the
   // record passes the last sample through whole, so the peak over the whole record would be the
   // 1000 m/s^2 end; before the end zone it is the pulse's 100.
-  rc::ModelBuilder b("pulse and end", "SI");
-  b.gravity(0.0, 0.0);
-  b.body({"cart", 1.0, 0.1, 0.0, 0.0});
   std::vector<std::array<double, 3>> table;
   for (int k = 0; k <= 100; ++k) table.push_back({0.1 + 1e-3 * k, 100.0 * std::sin(M_PI * k / 100.0), 0.0});
   table.push_back({0.399, 0.0, 0.0});
   table.push_back({0.4, 1000.0, 0.0});
-  b.force({"cart", 0.0, 0.0}, table);
-  rc::RunSettings s;
-  s.t_end = 0.4;
-  s.output_interval = 1e-3;
-  s.rtol = 1e-8;
-  b.simulation(s);
-  const rc::Results r = rc::run(b.build());
+  const rc::Results r = pushed_cart(table, 0.4, 1e-8);
   REQUIRE(r.ok());
   const YAML::Node summary = YAML::Load(r.summary_json)["peak_accelerations"];
   const double g = summary["standard_gravity"].as<double>();
@@ -229,12 +235,7 @@ TEST_CASE("api: CFC 60 peaks are taken before the filter's end zone; a larger va
 
   // Without the end ramp there is nothing larger at the end to give apart.
   table.resize(table.size() - 2);
-  rc::ModelBuilder plain("pulse", "SI");
-  plain.gravity(0.0, 0.0);
-  plain.body({"cart", 1.0, 0.1, 0.0, 0.0});
-  plain.force({"cart", 0.0, 0.0}, table);
-  plain.simulation(s);
-  const rc::Results p = rc::run(plain.build());
+  const rc::Results p = pushed_cart(table, 0.4, 1e-8);
   const YAML::Node quiet = YAML::Load(p.summary_json)["peak_accelerations"]["bodies"]["cart"];
   CHECK(quiet["magnitude_cfc"]["abs_max"].as<double>() == Approx(cart["magnitude_cfc"]["abs_max"].as<double>()).epsilon(1e-6));
   CHECK_FALSE(quiet["magnitude_cfc_end_zone"]);
@@ -247,22 +248,13 @@ TEST_CASE("api: a CFC 60 peak that aliases at the output rows is named, with the
   // rows' peak is about 100 + 500. Averaged over each 1 ms interval, the ringing keeps
   // sin(0.99 pi) / (0.99 pi) = 1.0 % of its amplitude, 5 N: the interval means' peak is the
   // pulse's 100 within 6 %.
-  rc::ModelBuilder b("pulse and ringing", "SI");
-  b.gravity(0.0, 0.0);
-  b.body({"cart", 1.0, 0.1, 0.0, 0.0});
   std::vector<std::array<double, 3>> table;
   const double t_end = 0.3, dt = 1.0 / (990.0 * 24.0);  // 24 table rows per period of the ringing
   for (double t = 0.0; t <= t_end + dt; t += dt) {
     const double pulse = t > 0.05 && t < 0.15 ? 100.0 * std::sin(M_PI * (t - 0.05) / 0.1) : 0.0;
     table.push_back({t, pulse + 500.0 * std::sin(2.0 * M_PI * 990.0 * t), 0.0});
   }
-  b.force({"cart", 0.0, 0.0}, table);
-  rc::RunSettings s;
-  s.t_end = t_end;
-  s.output_interval = 1e-3;
-  s.rtol = 1e-6;
-  b.simulation(s);
-  const rc::Results r = rc::run(b.build());
+  const rc::Results r = pushed_cart(table, t_end, 1e-6);
   REQUIRE(r.ok());
   const YAML::Node cart = YAML::Load(r.summary_json)["peak_accelerations"]["bodies"]["cart"];
   INFO(r.summary_json.substr(r.summary_json.find("\"cart\"")));
