@@ -208,7 +208,7 @@ TEST_CASE("api: a built model with loads, tables and flags", "[api]") {
   CHECK(x.back() == Approx(1.0).margin(1e-7));
 }
 
-TEST_CASE("api: CFC 60 peaks are taken before the filter's end zone; a larger value there is given apart", "[api][cfc]") {
+TEST_CASE("api: CFC 60 peaks are taken before the filter's end zone, a larger value there is given apart", "[api][cfc]") {
   // A free 1 kg body pushed by a table force: a 100 ms half-sine of 100 N from t = 0.1 s (all
   // its energy below 10 Hz: it passes CFC 60 within 0.5 %), then, over the run's last 1 ms, a
   // ramp to 1000 N (as a light body ringing at the last row). The filter's extension of the

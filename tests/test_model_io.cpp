@@ -698,7 +698,7 @@ TEST_CASE("NaN, infinite and non-numeric values are rejected", "[model_io]") {
   expect_error("list name", text, line_of(text, "[bob]"), {"body name must be a word"});
 }
 
-TEST_CASE("a body's car: is a name; bodies without one belong to no car", "[model_io]") {
+TEST_CASE("a body's car is a name, bodies without one belong to no car", "[model_io]") {
   const Model model = testing::model_from_text(edit(kBase, "    angular_velocity: 0.2\n", "    angular_velocity: 0.2\n    car: lead car\n"));
   CHECK(model.bodies()[0].car.empty());
   CHECK(model.bodies()[1].car == "lead car");

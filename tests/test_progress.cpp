@@ -20,7 +20,7 @@ TEST_CASE("Progress text: fraction, rate and time left", "[progress]") {
   CHECK_THAT(ProgressMeter::line_text(1.0, 1000.0, 60.0), Catch::EndsWith("about 16.6 h left"));
 }
 
-TEST_CASE("Progress lines when the output is not a terminal; nothing when off", "[progress]") {
+TEST_CASE("Progress lines when the output is not a terminal, nothing when off", "[progress]") {
   std::FILE* file = std::tmpfile();
   REQUIRE(file);
   CHECK(ProgressMeter::style_for(true, file) == ProgressMeter::Style::Lines);

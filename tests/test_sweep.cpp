@@ -157,7 +157,7 @@ TEST_CASE("sweep plans: an unknown key, a level of the wrong type and an empty d
              Catch::StartsWith(files.plan + ":5:") && Catch::Contains("a response is a name"));
 }
 
-TEST_CASE("sweep: R1 of each run against the closed-form crush; 1 and 2 jobs and a resume give the same rows", "[sweep]") {
+TEST_CASE("sweep: R1 of each run against the closed-form crush, and 1 and 2 jobs and a resume give the same rows", "[sweep]") {
   Files files;
   files.write_plan("sweep: 1\ndesign: full_factorial\nfactors:\n"
                    "  - {key: elements.ac.horizontal_yield_deflection, scale: true, levels: [0.8, 1.2]}\n"

@@ -451,7 +451,7 @@ TEST_CASE("draft_gear: the pin shears at the pin shear load, travels, goes solid
   }
 }
 
-TEST_CASE("draft_gear: in draft the pin does not shear; the gear fractures at the fracture load",
+TEST_CASE("draft_gear: in draft the pin does not shear, the gear fractures at the fracture load",
           "[elements][couplers]") {
   const double fracture = 1.0e5, v0 = 10.0;
   const std::string extra = "    pin_shear_load: 8.0e4\n    fracture_load: " + num(fracture) + "\n";
@@ -670,7 +670,7 @@ std::string coupler_end_yaml(const std::string& extra = "") {
 constexpr double kFaceStiffness = 1.8e5, kContact = 0.1;
 }  // namespace
 
-TEST_CASE("coupler_end: the gap closes at gap / speed; uncoupled faces never pull, coupled ones do after the slack",
+TEST_CASE("coupler_end: the gap closes at gap / speed, uncoupled faces never pull, coupled ones do after the slack",
           "[elements][couplers]") {
   const double m = 100.0, v = 2.0, gap = 0.03, slack = 0.05;
   const double half_period = kPi * std::sqrt(m / kFaceStiffness);
@@ -808,7 +808,7 @@ TEST_CASE("coupler_end: overlap regained with the faces past each other gives no
   CHECK_FALSE(system.modes().as<CouplerEnd::State>(0).overlapping);
 }
 
-TEST_CASE("coupler_end: faces touching at rest at the start; a load closes them, a pull does not", "[elements][couplers]") {
+TEST_CASE("coupler_end: faces touching at rest at the start: a load closes them, a pull does not", "[elements][couplers]") {
   // Exactly at the contact spacing, at rest. Pushed by P: h = c - (P / k)(1 - cos w t).
   // Pulled by P: no force from the faces, x = c + P t^2 / (2 m).
   const double m = 10.0, P = 1000.0, omega = std::sqrt(kFaceStiffness / m), T = 0.6 * kPi / omega;
@@ -990,7 +990,7 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   CHECK(push(0.01) == 0.0);
 }
 
-TEST_CASE("coupler_end restitution: loss of overlap while loading keeps the set; overlap regained past the set is blocked",
+TEST_CASE("coupler_end restitution: loss of overlap while loading keeps the set, overlap regained past the set is blocked",
           "[elements][couplers]") {
   const double e = 0.5, peak = 0.02, set = peak * (1.0 - e * e);
   const Model model =
@@ -1189,7 +1189,7 @@ TEST_CASE("coupling without slack, at rest at zero deflection: either direction 
   }
 }
 
-TEST_CASE("coupling vertical: slack, flexibility and misalignment; friction proportional to the horizontal force",
+TEST_CASE("coupling vertical: slack, flexibility and misalignment, with friction proportional to the horizontal force",
           "[elements][couplers]") {
   const double kv = 2.0e6, sv = 0.02, e = 0.004, mu = 0.25, vf = 0.01;
   const auto element = [&](double slack) {
