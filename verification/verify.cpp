@@ -3,7 +3,7 @@
 // integral, published SUNDIALS example), within a tolerance stated next to it. Every
 // comparison is also written as a Markdown table row to
 // <build>/verification/results/<case>.md (collected into verification/README.md).
-#define CATCH_CONFIG_MAIN
+
 #include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
