@@ -87,6 +87,7 @@ TEST_CASE("api: results in memory are the files railcrash run writes", "[api]") 
 
   std::ifstream csv(dir + "/timeseries.csv");
   std::string header;
+  std::getline(csv, header);  // the run's provenance (results/provenance.hpp)
   std::getline(csv, header);
   std::string joined;
   for (const std::string& c : memory.columns) joined += (joined.empty() ? "" : ",") + c;
@@ -109,6 +110,7 @@ TEST_CASE("api: results in memory are the files railcrash run writes", "[api]") 
   // Events: one row each, in order.
   std::ifstream events(dir + "/events.csv");
   std::string line;
+  std::getline(events, line);  // the run's provenance
   std::getline(events, line);
   std::size_t event_rows = 0;
   while (std::getline(events, line)) ++event_rows;
