@@ -10,9 +10,10 @@ if(GIT_FOUND)
                   OUTPUT_VARIABLE head RESULT_VARIABLE failed OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
   if(NOT failed AND head)
     set(commit "${head}")
-    execute_process(COMMAND ${GIT_EXECUTABLE} -C ${SOURCE_DIR} diff-index --quiet HEAD --
-                    RESULT_VARIABLE dirty OUTPUT_QUIET ERROR_QUIET)
-    if(dirty)
+    # (status, not diff-index: it refreshes the index, so a file touched but unchanged is clean)
+    execute_process(COMMAND ${GIT_EXECUTABLE} -C ${SOURCE_DIR} status --porcelain --untracked-files=no
+                    OUTPUT_VARIABLE changes RESULT_VARIABLE failed_status ERROR_QUIET)
+    if(NOT failed_status AND NOT changes STREQUAL "")
       set(commit "${commit}-dirty")
     endif()
   endif()
