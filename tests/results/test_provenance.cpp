@@ -24,8 +24,8 @@ using namespace railcrash;
 namespace {
 
 // Two cars of 40 t (a 4 t end frame and a 36 t body each), car 1 at 10 m/s into car 2: each
-// end frame on its body through a crush zone (crush_spring) and a draft gear, the cars' end
-// frames meeting at an anticlimber.
+// end frame 0.6 m ahead of its body on a crush zone (crush_spring) and a draft gear, the end
+// frames' anticlimbers 0.1 m apart at the start.
 const char* const kMultipleUnit = R"(railcrash: 1
 name: two 40 t multiple-unit cars, SI
 units: SI
@@ -40,15 +40,15 @@ elements:
      horizontal_yield_deflection: 0.002, vertical_elastic_stiffness: 5.0e8, vertical_plastic_stiffness: 1.0e6,
      vertical_yield_deflection: 0.002, torsional_elastic_stiffness: 1.0e8, torsional_plastic_stiffness: 1.0e6,
      torsional_yield_deflection: 0.002, face_height: 0.2,
-     points: [{body: car1_end, at: [0.4, 0]}, {body: car2_end, at: [-0.4, 0]}]}
+     points: [{body: car1_end, at: [0.45, 0]}, {body: car2_end, at: [-0.45, 0]}]}
   - {name: car1_crush_zone, type: crush_spring, curve: [[0, 0], [0.05, 1.5e6], [0.6, 1.8e6]], unloading_stiffness: 1.0e8,
-     points: [{body: car1_body, at: [10.5, 0]}, {body: car1_end, at: [-0.5, 0]}]}
+     points: [{body: car1_body, at: [10.0, 0]}, {body: car1_end, at: [-0.4, 0]}]}
   - {name: car1_draft_gear, type: draft_gear, initial_stiffness: 1.0e7, travel: 0.08, stiffness_after_bottoming: 1.0e9,
-     hysteresis_load: 2.0e5, points: [{body: car1_body, at: [10.5, 0.5]}, {body: car1_end, at: [-0.5, 0.5]}]}
+     hysteresis_load: 2.0e5, points: [{body: car1_body, at: [10.0, 0.5]}, {body: car1_end, at: [-0.4, 0.5]}]}
   - {name: car2_crush_zone, type: crush_spring, curve: [[0, 0], [0.05, 1.5e6], [0.6, 1.8e6]], unloading_stiffness: 1.0e8,
-     points: [{body: car2_end, at: [0.5, 0]}, {body: car2_body, at: [-10.5, 0]}]}
+     points: [{body: car2_end, at: [0.4, 0]}, {body: car2_body, at: [-10.0, 0]}]}
   - {name: car2_draft_gear, type: draft_gear, initial_stiffness: 1.0e7, travel: 0.08, stiffness_after_bottoming: 1.0e9,
-     hysteresis_load: 2.0e5, points: [{body: car2_end, at: [0.5, 0.5]}, {body: car2_body, at: [-10.5, 0.5]}]}
+     hysteresis_load: 2.0e5, points: [{body: car2_end, at: [0.4, 0.5]}, {body: car2_body, at: [-10.0, 0.5]}]}
 simulation: {t_end: 0.1, rtol: 1.0e-6, output_interval: 1.0e-3}
 )";
 
