@@ -8,8 +8,9 @@ Each model runs with BASE_EXECUTABLE and with build/railcrash in turn (base, new
 median CPU time of the process (user + system, the kernel's accounting of the child) and the
 ratio new / base of the medians, with the range of the per-pair ratios beside it. Each line
 also says whether the two builds' outputs were the same, byte for byte (every output file;
-summary.json without its wall time and phase seconds), so a change meant to leave results
-alone can be shown to.
+summary.json without its wall time and phase seconds; every file without the run's id and
+provenance, which name the run and the build), so a change meant to leave results alone can
+be shown to.
 
 Default models: the barrier test, the report's two-car crash and the slider-crank.
 """
@@ -36,6 +37,13 @@ def without_wall_time(path):
     return re.sub(r'"seconds": \{[^}]*\}', "", text)
 
 
+def without_provenance(text):
+    """The text without the run's id and provenance (results/provenance.hpp): a CSV file's first
+    line, model.json's and summary.json's "run_id" and "provenance" lines."""
+    return "".join(line for line in text.splitlines(keepends=True)
+                   if not line.startswith(("# railcrash provenance ", '  "run_id": ', '  "provenance": ')))
+
+
 def same_outputs(first, second):
     names = sorted(os.listdir(first))
     if names != sorted(os.listdir(second)):
@@ -43,8 +51,12 @@ def same_outputs(first, second):
     for name in names:
         a, b = os.path.join(first, name), os.path.join(second, name)
         if name == "summary.json":
-            if without_wall_time(a) != without_wall_time(b):
+            if without_provenance(without_wall_time(a)) != without_provenance(without_wall_time(b)):
                 return False
+        elif name.endswith((".csv", ".json")):
+            with open(a) as fa, open(b) as fb:
+                if without_provenance(fa.read()) != without_provenance(fb.read()):
+                    return False
         elif not filecmp.cmp(a, b, shallow=False):
             return False
     return True

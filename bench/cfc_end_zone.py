@@ -61,7 +61,7 @@ def run(executable, model, rtol, out, extra=()):
 def table(path):
     """A CSV file's header and its rows as numbers."""
     with open(path) as f:
-        rows = list(csv.reader(f))
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
     return rows[0], [[float(v) for v in r] for r in rows[1:]]
 
 

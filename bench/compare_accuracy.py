@@ -58,7 +58,7 @@ def quantities(out):
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
     with open(os.path.join(out, "timeseries.csv")) as f:
-        rows = list(csv.reader(f))
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
     times = [float(r[0]) for r in rows[1:]]
     interval = times[1] - times[0]
     body_peak = 0.0
@@ -69,7 +69,7 @@ def quantities(out):
         body_peak = max(body_peak, max(abs(a) for a in cfc_filter(acceleration, interval)))
     first = {}
     with open(os.path.join(out, "events.csv")) as f:
-        for event in csv.DictReader(f):
+        for event in csv.DictReader(line for line in f if not line.startswith("#")):
             first.setdefault((event["element"], event["event"]), float(event["t"]))
     def row_peak(column):
         k = rows[0].index(column)

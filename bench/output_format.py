@@ -47,8 +47,8 @@ def main():
                     cpu[fmt].append(seconds)
                     size[fmt] = folder_bytes(out, fmt)
             with open(os.path.join(work, "csv", "timeseries.csv")) as header:
-                columns = header.readline().count(",") + 1
-                rows = sum(1 for _ in header)
+                lines = [line for line in header if not line.startswith("#")]  # (the provenance line)
+                columns, rows = lines[0].count(",") + 1, len(lines) - 1
             csv_cpu, hdf5_cpu = statistics.median(cpu["csv"]), statistics.median(cpu["hdf5"])
             print(f"{title}: {rows} rows x {columns} timeseries columns; median of {args.repeats} CPU [s]: "
                   f"csv {csv_cpu:.2f}, hdf5 {hdf5_cpu:.2f} (hdf5/csv {hdf5_cpu / csv_cpu:.2f}); per-row files [MB]: "

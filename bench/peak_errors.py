@@ -34,7 +34,7 @@ def run(executable, model, rtol, interval, out):
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
     with open(os.path.join(out, "timeseries.csv")) as f:
-        rows = list(csv.reader(f))
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
     return summary, rows[0], rows[1:]
 
 

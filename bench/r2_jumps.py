@@ -30,11 +30,11 @@ def run(executable, rtol, out):
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
     with open(os.path.join(out, "timeseries.csv")) as f:
-        rows = list(csv.reader(f))
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
     column = rows[0].index(FORCE)
     force = [(float(r[0]), float(r[column])) for r in rows[1:]]
     with open(os.path.join(out, "events.csv")) as f:
-        crossings = [(float(e["t"]), e["element"], e["event"]) for e in csv.DictReader(f) if e["element"] in HANGERS]
+        crossings = [(float(e["t"]), e["element"], e["event"]) for e in csv.DictReader(line for line in f if not line.startswith("#")) if e["element"] in HANGERS]
     return summary["responses"]["R2"], force, crossings, rows
 
 

@@ -30,6 +30,8 @@
 #include "railcrash/converge.hpp"
 #include "railcrash/report/report.hpp"
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/provenance.hpp"
+#include "railcrash/results/run_files.hpp"
 #include "railcrash/version.hpp"
 
 #include <sstream>
@@ -180,6 +182,12 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   if (format == OutputFormat::Hdf5 && with_report)
     throw InputError("--report reads the CSV files: leave out --report with --format hdf5, or use --format csv");
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
+  // The folder is this run's: an earlier run's files go first (the writer would remove them too), said here.
+  if (const std::vector<std::string> removed = remove_earlier_run_files(out_dir); !removed.empty()) {
+    std::string names;
+    for (const std::string& name : removed) names += (names.empty() ? "" : ", ") + name;
+    std::printf("removed the files of an earlier run from %s/: %s\n", out_dir.c_str(), names.c_str());
+  }
   catch_interrupts();
   const RunReport report = run_model(model, out_dir, &g_stop, !quiet, /*keep_in_memory=*/false, format, timings);
   const RunOutcome& o = report.outcome;
@@ -246,9 +254,10 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
                   "(the acceleration has content above the rows' Nyquist frequency: lower the output interval) [g]:%s\n",
                   "", aliased.c_str());
   }
-  std::printf("results in %s/ (%s, summary.json, model.json)\n", out_dir.c_str(),
+  std::printf("results in %s/ (%s, summary.json, model.json), run id %s\n", out_dir.c_str(),
               format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
-                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv");
+                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv",
+              report.run_id.c_str());
   if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;
 }
@@ -448,6 +457,7 @@ std::vector<std::pair<double, double>> parse_curve(const std::string& text, cons
 }  // namespace
 
 int main(int argc, char** argv) {
+  railcrash::set_command_line(argc, argv);  // the runs' provenance
   CLI::App app{"railcrash: planar rail-vehicle crash dynamics (IDA + KLU, or explicit Euler)"};
   app.require_subcommand(1);
   app.set_version_flag("--version", railcrash::version_text());

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "railcrash/element_registry.hpp"
+#include "railcrash/sha256.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -868,7 +869,7 @@ struct VariantSetting {
 /// as --set. Returns the base document; `file` becomes the base file (its lines are the
 /// base's), `settings` the variant's changes, to be applied like --set before the user's own.
 YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, std::string& file,
-                           std::vector<VariantSetting>& settings) {
+                           std::vector<VariantSetting>& settings, std::vector<ModelSource>& sources) {
   const Reader reader(path);
   reader.check_keys(variant, kVariantKeys, "model variant");
   const YAML::Node version = reader.required(variant, "railcrash", "model variant (add 'railcrash: 1')");
@@ -885,6 +886,7 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
     reader.fail(base_node, "model variant: variant_of (relative to the variant's folder): " + std::string(e.what()));
   }
   file = base_path.string();
+  sources.push_back({file, sha256_hex(base_text)});
   YAML::Node base = parse_model_yaml(base_text, file);
   if (base.IsMap() && base["variant_of"])
     reader.fail(base_node, "model variant: '" + file + "' is itself a variant; name the model it is a variant of");
@@ -909,12 +911,13 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
 
 namespace {
 
-/// The model of a parsed model file (`root`, read from `path`), with the settings applied.
-Model model_from_yaml(YAML::Node root, const std::string& path, const std::vector<std::string>& overrides,
+/// The model of a parsed model file (`root`, the text `text` read from `path`), with the settings applied.
+Model model_from_yaml(YAML::Node root, const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
   std::string file = path;
   std::vector<VariantSetting> variant_settings;
-  if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings);
+  std::vector<ModelSource> sources{{path, sha256_hex(text)}};
+  if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings, sources);
   Reader reader(file);
   reader.index_empty_values(root);
   if (root.IsMap() || root.IsNull()) {  // otherwise build() says what the file should look like
@@ -925,6 +928,9 @@ Model model_from_yaml(YAML::Node root, const std::string& path, const std::vecto
   }
   try {
     Model model = build(root, reader);
+    model.sources = std::move(sources);
+    model.settings = overrides;
+    for (const OptionSetting& o : options) model.settings.push_back(o.setting);
     model.finalize();
     return model;
   } catch (const YAML::Exception& e) {  // a check above missed a case: still an input error with a line
@@ -934,7 +940,7 @@ Model model_from_yaml(YAML::Node root, const std::string& path, const std::vecto
 
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
-  return model_from_yaml(parse_model_yaml(text, path), path, overrides, options);
+  return model_from_yaml(parse_model_yaml(text, path), text, path, overrides, options);
 }
 
 }  // namespace
@@ -946,7 +952,7 @@ CheckedYamlText check_model_text(std::string text, const std::string& path) {
 
 Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides) {
   // Checked when it was read; a parse error here would have been found then.
-  return model_from_yaml(load_yaml_text(text), path, overrides, {});
+  return model_from_yaml(load_yaml_text(text), text.text(), path, overrides, {});
 }
 
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {

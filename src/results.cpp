@@ -18,6 +18,7 @@
 #include "railcrash/results/buffered_file.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/output_points.hpp"
+#include "railcrash/results/provenance.hpp"
 #include "railcrash/results/run_files.hpp"
 
 namespace railcrash {
@@ -177,8 +178,8 @@ std::vector<std::string> timeseries_columns(const DaeSystem& system) {
 }
 
 ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory, OutputFormat format)
-    : system_(system), directory_(directory), format_(format), last_flush_(std::chrono::steady_clock::now()),
-      running_summary_(last_flush_) {
+    : system_(system), directory_(directory), provenance_(run_provenance(system.model(), new_run_id())), format_(format),
+      last_flush_(std::chrono::steady_clock::now()), running_summary_(last_flush_) {
   const std::vector<std::string> names = timeseries_columns(system);
   std::vector<std::string> acceleration_names{"t"};
   for (const Body& b : system.model().bodies())
@@ -187,6 +188,7 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
+    removed_files_ = remove_earlier_run_files(directory);  // the folder holds this run's files only
     if (format == OutputFormat::Hdf5) hdf5_ = std::make_unique<Hdf5File>(directory + "/timeseries.h5");  // (throws)
     using CsvFile = std::pair<std::unique_ptr<BufferedFile>*, const char*>;
     const std::vector<CsvFile> csv_files =
@@ -197,15 +199,18 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
       *file = std::make_unique<BufferedFile>(directory + "/" + name);
       if (!(*file)->is_open())
         throw InputError("cannot write into the output folder '" + directory + "': " + name + ": " + std::strerror((*file)->error()));
+      (*file)->text(provenance_comment(provenance_));  // every CSV file's first line
     }
-    write_model_geometry(system, directory + "/model.json");  // (throws: before the folder is held open)
+    write_model_geometry(system, directory + "/model.json", provenance_.run_id);  // (throws: before the folder is held open)
     folder_descriptor_ = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (folder_descriptor_ < 0) throw InputError("cannot open the output folder '" + directory + "': " + std::strerror(errno));
     energy_ = std::make_unique<EnergyWriter>(system, energy_file_.get());
     if (hdf5_) {
       const Model& model = system.model();
       const bool si = model.units == UnitSystem::SI;
-      hdf5_->attribute("railcrash_version", RAILCRASH_VERSION);
+      hdf5_->attribute("railcrash_version", provenance_.version);
+      hdf5_->attribute("run_id", provenance_.run_id);
+      hdf5_->attribute("provenance", provenance_json(provenance_));
       hdf5_->attribute("model", model.name);
       hdf5_->attribute("model_file", model.file);
       hdf5_->attribute("units", std::string(unit_system_name(model.units)) + ": length " + (si ? "m" : "in") +
@@ -517,6 +522,8 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"status\": " << json_string(status) << ",\n";
   j << "  \"message\": " << json_string(outcome.message) << ",\n";
   j << "  \"model\": " << json_string(model.name) << ",\n";
+  j << "  \"run_id\": " << json_string(provenance_.run_id) << ",\n";
+  j << "  \"provenance\": " << provenance_json(provenance_) << ",\n";
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
   if (hdf5_)  // (the CSV files are the default: their summary is as it always was)

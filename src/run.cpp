@@ -244,6 +244,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
       report.outcome.ok = false;
       report.outcome.message = writer->failure();
     }
+    report.run_id = writer->provenance().run_id;
     report.acceleration_peaks = writer->acceleration_peaks();
     report.car_crush = writer->car_crush();
     report.filtered_accelerations = writer->filtered_accelerations();

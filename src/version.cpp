@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "build_commit.hpp"  // RAILCRASH_COMMIT (cmake/build_commit.cmake)
 #include "railcrash/report/assets.hpp"
 
 #ifdef RAILCRASH_HDF5_LIBRARY
@@ -18,9 +19,14 @@
 
 namespace railcrash {
 
+std::string version_number() { return RAILCRASH_VERSION; }
+
+std::string build_commit() { return RAILCRASH_COMMIT; }
+
 std::string version_text() {
   const auto number = [](int value) { return std::to_string(value); };
-  std::string text = "railcrash " RAILCRASH_VERSION "\n";
+  std::string text = "railcrash " RAILCRASH_VERSION;
+  text += build_commit().empty() ? "\n" : " (commit " + build_commit() + ")\n";
   text += "SUNDIALS " SUNDIALS_VERSION " (IDAS)\n";
   text += "SuiteSparse " + number(SUITESPARSE_MAIN_VERSION) + "." + number(SUITESPARSE_SUB_VERSION) + "." +
           number(SUITESPARSE_SUBSUB_VERSION) + " (KLU " + number(KLU_MAIN_VERSION) + "." + number(KLU_SUB_VERSION) + "." +

@@ -261,6 +261,7 @@ TEST_CASE("run_model writes timeseries, events and summary, also for a failed ru
   CHECK_FALSE(report.outcome.ok);
   std::ifstream csv(dir + "/timeseries.csv");
   std::string header;
+  std::getline(csv, header);  // the run's provenance (results/provenance.hpp)
   std::getline(csv, header);
   CHECK(header == "t,mass.x,mass.y,mass.theta,mass.vx,mass.vy,mass.omega,spring.force,spring.deformation");
   int rows = 0;
@@ -272,6 +273,7 @@ TEST_CASE("run_model writes timeseries, events and summary, also for a failed ru
   CHECK_THAT(summary.str(), Catch::Contains("\"status\": \"failed\"") && Catch::Contains("diverged") &&
                                 Catch::Contains("\"integrator\": \"euler\""));
   std::ifstream events(dir + "/events.csv");
+  std::getline(events, header);  // the run's provenance
   std::getline(events, header);
   CHECK(header == "t,element,event,value");
   std::filesystem::remove_all(dir);

@@ -71,8 +71,8 @@ def railcrash_run(mechanism, level, interval, work):
     out = os.path.join(work, "railcrash")
     cpu, _ = run_timed([RAILCRASH[0], "run", model, "--rtol", repr(level), "--atol",
                         repr(level * atol_ratio), "--output-interval", repr(interval), "--out", out, "--quiet"])
-    with open(os.path.join(out, "timeseries.csv")) as f:
-        return cpu, on_grid(csv.DictReader(f), "t", columns, grid)
+    with open(os.path.join(out, "timeseries.csv")) as f:  # (its first line: the run's provenance)
+        return cpu, on_grid(csv.DictReader(line for line in f if not line.startswith("#")), "t", columns, grid)
 
 
 def simbody_run(executable, mechanism, level, interval, work):

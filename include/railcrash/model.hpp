@@ -113,6 +113,12 @@ std::string output_rows_problem(const SimulationSettings& settings);
 
 struct ScenarioCriteria;  // scenario/criteria.hpp
 
+/// A model file read to build a model and the SHA-256 of the text read (a run's provenance).
+struct ModelSource {
+  std::string path;
+  std::string sha256;  // 64 hexadecimal digits
+};
+
 class Model {
  public:
   Model() = default;
@@ -121,6 +127,8 @@ class Model {
 
   std::string name;
   std::string file;  // model file the model came from ("" when built in code)
+  std::vector<ModelSource> sources;   // every model file read: the file given, then a variant's base
+  std::vector<std::string> settings;  // KEY=VALUE settings applied over the files (--set, then the run options)
   UnitSystem units = UnitSystem::SI;
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
   SimulationSettings simulation;

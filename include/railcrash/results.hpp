@@ -58,6 +58,7 @@
 #include "railcrash/integrator.hpp"
 #include "railcrash/results/crash_pulse.hpp"
 #include "railcrash/results/hdf5_file.hpp"
+#include "railcrash/results/provenance.hpp"
 
 namespace railcrash {
 
@@ -177,7 +178,9 @@ class SummarySchedule {
 
 class ResultWriter : public RunObserver {
  public:
-  /// Creates DIR and the CSV files with their headers, or timeseries.h5 (DIR empty: no files). With
+  /// Creates DIR, removes the files an earlier run left in it (run_files.hpp: removed_files()),
+  /// and creates the CSV files, each with its provenance line (results/provenance.hpp) and its
+  /// header, or timeseries.h5 (DIR empty: no files). With
   /// keep_in_memory, every sample is also kept as one value per timeseries column.
   ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory = false,
                OutputFormat format = OutputFormat::Csv);
@@ -205,6 +208,10 @@ class ResultWriter : public RunObserver {
   /// A failed write (also of an earlier CSV row) sets failure().
   std::string write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json = "");
   const std::string& directory() const { return directory_; }
+  /// This run's provenance (results/provenance.hpp): its id, program, model files and settings.
+  const Provenance& provenance() const { return provenance_; }
+  /// The files of an earlier run that the constructor removed from the folder (run_files.hpp).
+  const std::vector<std::string>& removed_files() const { return removed_files_; }
   /// The kept samples (keep_in_memory): columns[k] is timeseries column k over the samples.
   std::vector<std::vector<double>>& columns() { return columns_; }
   /// Peaks so far, per body in model order.
@@ -226,6 +233,8 @@ class ResultWriter : public RunObserver {
 
   const DaeSystem& system_;
   std::string directory_;
+  Provenance provenance_;
+  std::vector<std::string> removed_files_;  // of an earlier run, removed by the constructor
   std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
   int folder_descriptor_ = -1;                          // the open folder, to notice its removal
   std::vector<std::vector<double>> columns_;  // in memory, per timeseries column

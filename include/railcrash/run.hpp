@@ -47,6 +47,7 @@ struct RunReport {
   std::vector<AccelerationPeaks> acceleration_peaks;
   std::vector<CarCrush> car_crush;
   std::string summary_json;  // the text of summary.json (empty when neither a folder nor memory)
+  std::string run_id;        // the run's id in its files (results/provenance.hpp; empty when neither a folder nor memory)
   // keep_in_memory: timeseries.csv in memory, column by column (events: outcome.events).
   std::vector<std::string> columns;
   std::vector<std::vector<double>> series;

@@ -31,8 +31,13 @@ for integrator in ida euler; do
 done
 /usr/bin/python3 - "$out" <<'PY'
 import csv, json, pathlib, sys
+
+
+def rows_of(path):  # a run's CSV file without its first line, the run's provenance ("# railcrash provenance ...")
+    return [line for line in open(path) if not line.startswith("#")]
+
 out = pathlib.Path(sys.argv[1])
-rows = list(csv.DictReader(open(out / "symmetric/timeseries.csv")))
+rows = list(csv.DictReader(rows_of(out / "symmetric/timeseries.csv")))
 closing = json.loads((out / "symmetric/summary.json").read_text())["scenario"]["closing_speed"]
 print("scenario 1, zero offset: largest |vx_s + vx_t| / closing speed up to t")
 largest = 0.0
@@ -50,14 +55,14 @@ for r in rows:
 if first:
     t_first = float(first["t"])
     print("first sample above 1e-9: t = %.2f ms; events after the sample before it (%.2f ms):" % (1e3 * t_first, 1e3 * previous))
-    for e in csv.DictReader(open(out / "symmetric/events.csv")):
+    for e in csv.DictReader(rows_of(out / "symmetric/events.csv")):
         if previous < float(e["t"]) <= t_first:
             print("  t = %.5f ms  %s  %s" % (1e3 * float(e["t"]), e["element"], e["event"]))
     print("  there: front ends' heights differ by %.3g in, the anticlimber's vertical_offset is %.3g in, its vertical force %.3g"
           % (abs(float(first["s1_front_end.y"]) - float(first["t1_front_end.y"])), float(first["anticlimber.vertical_offset"]),
              float(first["anticlimber.vertical_force"])))
 events = {}
-for e in csv.DictReader(open(out / "symmetric/events.csv")):
+for e in csv.DictReader(rows_of(out / "symmetric/events.csv")):
     name = e["element"]
     key = (name[0], name[1:], e["event"]) if name[0] in "st" and name[1:2].isdigit() else None
     if key: events.setdefault(key[1:], {}).setdefault(key[0], []).append(float(e["t"]))
@@ -65,7 +70,7 @@ print("mirrored mode changes located apart (first of each pair):")
 for (element, event), times in sorted(events.items(), key=lambda kv: min(min(v) for v in kv[1].values())):
     if "s" in times and "t" in times:
         print("  %-28s %-40s t = %.5f s, apart %.2g s" % ("*" + element, event, times["s"][0], abs(times["s"][0] - times["t"][0])))
-tight = list(csv.DictReader(open(out / "symmetric_rtol_1e-9/timeseries.csv")))
+tight = list(csv.DictReader(rows_of(out / "symmetric_rtol_1e-9/timeseries.csv")))
 print("the same at rtol 1e-9: largest |vx_s + vx_t| / closing speed up to t")
 largest = 0.0
 for r in tight:
@@ -73,14 +78,14 @@ for r in tight:
     if 9.0 <= round(float(r["t"]) * 1e3, 1) <= 10.0:
         print("  t = %5.1f ms  %.3g" % (1e3 * float(r["t"]), largest))
 gear = {}
-for e in csv.DictReader(open(out / "symmetric_rtol_1e-9/events.csv")):
+for e in csv.DictReader(rows_of(out / "symmetric_rtol_1e-9/events.csv")):
     if e["element"] in ("s1_draft_gear", "t1_draft_gear") and e["event"] == "back on the loading curve (buff)":
         gear.setdefault(e["element"], float(e["t"]))
 if len(gear) == 2:
     print("  the draft gears' 'back on the loading curve' at %.5f ms, apart %.2g s" % (1e3 * min(gear.values()), abs(gear["s1_draft_gear"] - gear["t1_draft_gear"])))
 print("scenario 1 of the barrier cars, zero offset: largest |vx_s + vx_t| / closing speed up to t (IDA, Euler)")
 largest = {}
-series = {i: list(csv.DictReader(open(out / ("symmetric_barrier_%s/timeseries.csv" % i)))) for i in ("ida", "euler")}
+series = {i: list(csv.DictReader(rows_of(out / ("symmetric_barrier_%s/timeseries.csv" % i)))) for i in ("ida", "euler")}
 for k in range(len(series["ida"])):
     line = []
     for i in ("ida", "euler"):
@@ -91,7 +96,7 @@ for k in range(len(series["ida"])):
         print("  t = %5.1f ms  %s" % (1e3 * float(series["ida"][k]["t"]), "  ".join(line)))
 print("  IDA's mode changes of the mirrored lead_crush springs logged more than once at one time:")
 counts = {}
-for e in csv.DictReader(open(out / "symmetric_barrier_ida/events.csv")):
+for e in csv.DictReader(rows_of(out / "symmetric_barrier_ida/events.csv")):
     if e["element"] in ("s_lead_crush", "t_lead_crush"):
         counts.setdefault((e["t"], e["element"]), []).append(e["event"])
 for (t, element), logged in sorted(counts.items(), key=lambda kv: float(kv[0][0])):
@@ -102,7 +107,7 @@ for (t, element), logged in sorted(counts.items(), key=lambda kv: float(kv[0][0]
 for integrator in ("ida", "euler"):
     run = out / ("momentum_" + integrator)
     masses = {b["name"]: b["mass"] for b in json.loads((run / "model.json").read_text())["bodies"]}
-    rows = list(csv.DictReader(open(run / "timeseries.csv")))
+    rows = list(csv.DictReader(rows_of(run / "timeseries.csv")))
     momentum = [sum(m * float(r[b + ".vx"]) for b, m in masses.items()) for r in rows]
     change = max(abs(p - momentum[0]) for p in momentum) / abs(momentum[0])
     energy = json.loads((run / "summary.json").read_text())["energy"]["relative_balance_error"]

@@ -19,6 +19,7 @@
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/provenance.hpp"
 #include "railcrash/table_text.hpp"
 
 namespace railcrash::report {
@@ -71,7 +72,19 @@ struct NumericTable {
   std::map<std::string, int> index;  // column by name
   std::vector<std::vector<double>> data;  // per column
   std::size_t rows = 0;
+  std::string comment;  // the "# railcrash provenance {...}" line before the header ("" in older files)
 };
+
+/// Reads the lines before a CSV file's header that start with '#' (the provenance line,
+/// results/provenance.hpp) into `comment`, and the header into `line`; false at the end of the file.
+bool header_line(std::istream& in, std::string& line, std::string& comment, std::size_t& line_number) {
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty() || line[0] != '#') return true;
+    if (comment.empty()) comment = line;
+  }
+  return false;
+}
 
 NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& problems) {
   NumericTable table;
@@ -79,11 +92,11 @@ NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& pr
   if (!in) return table;
   table.found = true;
   std::string line;
-  if (!std::getline(in, line)) return table;
+  std::size_t line_number = 0;
+  if (!header_line(in, line, table.comment, line_number)) return table;
   table.columns = csv_fields(line);
   for (std::size_t k = 0; k < table.columns.size(); ++k) table.index.emplace(table.columns[k], static_cast<int>(k));
   table.data.assign(table.columns.size(), {});
-  std::size_t line_number = 1;
   while (std::getline(in, line)) {
     ++line_number;
     const bool ends_with_newline = !in.eof();  // getline stopped at a newline, not at the end
@@ -111,6 +124,37 @@ NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& pr
     ++table.rows;
   }
   return table;
+}
+
+/// Throws InputError when the run folder's files are not all of one run: the run id of
+/// summary.json (if there is one) and of every data file the report reads (timeseries.csv's
+/// provenance line, model.json's "run_id", accelerations.csv's, energy.csv's, events.csv's) must
+/// be the same; files without an id (an older railcrash) agree only with each other.
+void require_one_run(const fs::path& dir, const std::string& summary, bool summary_found, const std::string& timeseries_comment) {
+  struct FileRun {
+    std::string name, id;  // id "": the file carries none
+  };
+  std::vector<FileRun> files;
+  if (summary_found) files.push_back({"summary.json", run_id_in(summary).value_or("")});
+  files.push_back({"timeseries.csv", run_id_in(timeseries_comment).value_or("")});
+  for (const char* name : {"model.json", "accelerations.csv", "energy.csv", "events.csv"}) {
+    std::ifstream in(dir / name, std::ios::binary);
+    if (!in) continue;
+    std::string head(4096, '\0');  // the id is near the top: model.json's third line, a CSV file's first
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    const bool csv = std::string(name).find(".csv") != std::string::npos;
+    const std::string first_line = head.substr(0, head.find('\n'));
+    files.push_back({name, run_id_in(csv ? (first_line.rfind("#", 0) == 0 ? first_line : std::string()) : head).value_or("")});
+  }
+  const FileRun& reference = files.front();
+  const auto of_run = [](const std::string& id) { return id.empty() ? std::string("of no run id (written by an older railcrash)") : "of run " + id; };
+  for (const FileRun& file : files)
+    if (file.id != reference.id)
+      throw InputError("'" + (dir / file.name).string() + "' is " + of_run(file.id) + " but '" + (dir / reference.name).string() +
+                       "' is " + of_run(reference.id) + ": the folder holds the files of two runs, and the report would show "
+                       "one run's results under the other's; run the model again into this folder (a run removes the files of "
+                       "an earlier one) or into an empty folder");
 }
 
 int column_of(const NumericTable& table, const std::string& name) {
@@ -316,6 +360,7 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   const std::string summary = read_file(dir / "summary.json", &summary_found);
   if (!summary_found) problems.insert(problems.begin(), "no summary.json: the run did not finish (it was killed, crashed or is still running); "
                                                 "the report shows the rows written so far");
+  require_one_run(dir, summary, summary_found, series.comment);
   {  // A failed run says so first.
     std::smatch status, message, reached;
     if (std::regex_search(summary, status, std::regex(R"re("status": "failed")re"))) {
@@ -524,8 +569,9 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   {
     std::ifstream in(dir / "events.csv", std::ios::binary);
     if (!in) problems.push_back("no events.csv");
-    std::string line;
-    std::getline(in, line);
+    std::string line, comment;
+    std::size_t line_number = 0;
+    header_line(in, line, comment, line_number);
     std::size_t count = 0;
     while (std::getline(in, line) && count < 20000) {
       const std::vector<std::string> f = csv_fields(line);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -10,7 +11,30 @@
 
 namespace railcrash {
 
-void write_model_geometry(const DaeSystem& system, const std::string& path) {
+const std::vector<std::string>& run_folder_files() {
+  static const std::vector<std::string> names = {"timeseries.csv", "events.csv",   "accelerations.csv", "energy.csv",
+                                                 "timeseries.h5",  "summary.json", "summary.json.tmp",  "model.json",
+                                                 "report.html"};
+  return names;
+}
+
+std::vector<std::string> remove_earlier_run_files(const std::string& directory) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> removed;
+  for (const std::string& name : run_folder_files()) {
+    const fs::path path = fs::path(directory) / name;
+    std::error_code error;
+    if (!fs::is_regular_file(fs::symlink_status(path, error))) continue;
+    const bool removed_now = fs::remove(path, error);
+    if (error)
+      throw InputError("cannot remove " + path.string() + ", a file of an earlier run in the output folder: " + error.message() +
+                       "; remove it yourself or give another --out folder");
+    if (removed_now) removed.push_back(name);
+  }
+  return removed;
+}
+
+void write_model_geometry(const DaeSystem& system, const std::string& path, const std::string& run_id) {
   const Model& model = system.model();
   const bool si = model.units == UnitSystem::SI;
   // Connection points of each body, without repeats.
@@ -23,7 +47,9 @@ void write_model_geometry(const DaeSystem& system, const std::string& path) {
       if (std::find(list.begin(), list.end(), at) == list.end()) list.push_back(at);
     }
   std::ostringstream j;
-  j << "{\n  \"format\": 1,\n  \"name\": " << json_string(model.name) << ",\n  \"units\": {\"length\": "
+  j << "{\n  \"format\": 1,\n";
+  if (!run_id.empty()) j << "  \"run_id\": " << json_string(run_id) << ",\n";
+  j << "  \"name\": " << json_string(model.name) << ",\n  \"units\": {\"length\": "
     << json_string(si ? "m" : "in") << ", \"force\": " << json_string(si ? "N" : "lbf") << ", \"mass\": "
     << json_string(si ? "kg" : "lbf*s^2/in") << ", \"energy\": " << json_string(si ? "J" : "in*lbf")
     << ", \"standard_gravity\": " << json_number(standard_gravity(model)) << "},\n  \"bodies\": [";

@@ -118,7 +118,56 @@ expect_status "report of a truncated run folder" 0 "$bin" report "$tmp/two"
 expect_text "it lists the truncated row" "$tmp/stderr" "report: timeseries.csv line [0-9]*: .*the file ends mid-row"
 expect_text "and the missing summary" "$tmp/stderr" "report: no summary.json: the run did not finish"
 
+# A run owns its folder: it removes what an earlier run left (the names railcrash writes, no
+# others) and says so; every file carries the run's id and provenance (results/provenance.hpp).
+mkdir -p "$tmp/owned" && echo "my notes" > "$tmp/owned/notes.txt" && echo "stale" > "$tmp/owned/report.html"
+expect_status "a run into a folder with a report of an earlier run" 0 "$bin" run "$crank" --t-end 0.1 --out "$tmp/owned" --quiet
+expect_text "it says which files of an earlier run it removed" "$tmp/stdout" "^removed the files of an earlier run from $tmp/owned/: report.html$"
+[ -f "$tmp/owned/notes.txt" ] && [ ! -f "$tmp/owned/report.html" ] && passes=$((passes + 1)) ||
+  { echo "FAIL: the run removed notes.txt or kept report.html"; failures=$((failures + 1)); }
+cp "$tmp/owned/summary.json" "$tmp/first_summary.json"
+expect_status "a second run into the same folder" 0 "$bin" run "$crank" --t-end 0.2 --out "$tmp/owned" --quiet
+expect_text "it names the earlier run's files it removed" "$tmp/stdout" \
+  "^removed the files of an earlier run from $tmp/owned/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json$"
+run_id=$(sed -n 's/^  "run_id": "\([0-9a-f]*\)",$/\1/p' "$tmp/owned/summary.json")
+first_id=$(sed -n 's/^  "run_id": "\([0-9a-f]*\)",$/\1/p' "$tmp/first_summary.json")
+[ ${#run_id} -eq 32 ] && [ ${#first_id} -eq 32 ] && [ "$run_id" != "$first_id" ] && passes=$((passes + 1)) ||
+  { echo "FAIL: run ids '$first_id', '$run_id': not two different 32-digit ids"; failures=$((failures + 1)); }
+expect_text "stdout names the run id" "$tmp/stdout" "run id $run_id$"
+for name in timeseries events accelerations energy; do
+  expect_text "$name.csv's first line is the run's provenance" "$tmp/owned/$name.csv" \
+    "^# railcrash provenance {\"run_id\": \"$run_id\", \"version\": \"[0-9.]*\", \"commit\": "
+done
+expect_text "model.json carries the run id" "$tmp/owned/model.json" "^  \"run_id\": \"$run_id\",$"
+# The provenance in summary.json: the model's SHA-256 as sha256sum computes it, the command line, the settings.
+crank_sha=$(sha256sum "$crank" | cut -d' ' -f1)
+expect_text "summary.json has the model file's SHA-256" "$tmp/owned/summary.json" \
+  "\"model_files\": \[{\"path\": \"$crank\", \"sha256\": \"$crank_sha\"}\]"
+expect_text "and the command line" "$tmp/owned/summary.json" "\"command_line\": \"$bin run $crank --t-end 0.2 --out $tmp/owned --quiet\""
+expect_text "and the settings" "$tmp/owned/summary.json" \
+  '"settings": \["simulation.t_end=0.2"\], "simulation": {"integrator": "ida", "t_end": 0.2, "output_interval": 0.4, "max_steps": 10000000, "rtol": 1e-06, "atol": 1e-07,'
+expect_text "the timeseries' provenance line has them too" "$tmp/owned/timeseries.csv" "^# railcrash provenance .*\"sha256\": \"$crank_sha\""
+# A variant: both files read, each with its digest.
+variant=$src/models/report/final_two_car_corrected.yaml
+expect_status "a run of a model variant" 0 "$bin" run "$variant" --t-end 0.01 --set "simulation.rtol=1e-7" --out "$tmp/variant" --quiet
+expect_text "its provenance has the variant's and the base's SHA-256" "$tmp/variant/summary.json" \
+  "\"model_files\": \[{\"path\": \"$variant\", \"sha256\": \"$(sha256sum "$variant" | cut -d' ' -f1)\"}, {\"path\": \"$src/models/report/final_two_car.yaml\", \"sha256\": \"$(sha256sum "$src/models/report/final_two_car.yaml" | cut -d' ' -f1)\"}\]"
+expect_text "and the --set before the run options" "$tmp/variant/summary.json" '"settings": \["simulation.rtol=1e-7", "simulation.t_end=0.01"\]'
+# report refuses a folder whose files are of two runs, naming them.
+cp "$tmp/first_summary.json" "$tmp/owned/summary.json"
+expect_status "report of a folder with the summary.json of another run exits 2" 2 "$bin" report "$tmp/owned"
+expect_text "it names the two files and their runs" "$tmp/stderr" \
+  "'$tmp/owned/timeseries.csv' is of run $run_id but '$tmp/owned/summary.json' is of run $first_id: the folder holds the files of two runs"
+[ ! -f "$tmp/owned/report.html" ] && passes=$((passes + 1)) || { echo "FAIL: report wrote a page of two runs"; failures=$((failures + 1)); }
+expect_status "a run again" 0 "$bin" run "$crank" --t-end 0.1 --out "$tmp/owned" --quiet --report
+expect_text "its report carries the provenance" "$tmp/owned/report.html" "\"provenance\": {\"run_id\": \"$(sed -n 's/^  "run_id": "\([0-9a-f]*\)",$/\1/p' "$tmp/owned/summary.json")\""
+
 expect_status "--version" 0 "$bin" --version
+if git -C "$src" rev-parse HEAD > /dev/null 2>&1; then  # built from a checkout: a commit of it (the one built)
+  commit=$(sed -n 's/^railcrash [0-9.]* (commit \([0-9a-f]\{12\}\)\(-dirty\)\?)$/\1/p' "$tmp/stdout")
+  [ -n "$commit" ] && git -C "$src" cat-file -e "$commit^{commit}" 2> /dev/null && passes=$((passes + 1)) ||
+    { echo "FAIL: --version names no commit of $src: $(head -1 "$tmp/stdout")"; failures=$((failures + 1)); }
+fi
 expect_text "it names SUNDIALS" "$tmp/stdout" "^SUNDIALS 6"
 expect_text "and SuiteSparse" "$tmp/stdout" "^SuiteSparse [0-9.]* (KLU"
 expect_status "--quiet run" 0 "$bin" run "$src/tests/report/two_car.yaml" --quiet --out "$tmp/quiet"

@@ -42,6 +42,18 @@ expect_text "summary.json names the format" "$tmp/h5/summary.json" '"format": "h
 expect_status "report of an hdf5 run folder" 2 "$bin" report "$tmp/h5"
 expect_text "the report says it reads the CSV files" "$tmp/stderr" "was written with --format hdf5"
 
+# The issue's case: an HDF5 run into the folder of a CSV run. The run removes the CSV run's
+# files and says so; the report then refuses the folder as an HDF5 one, not with the old rows.
+cp -r "$tmp/csv" "$tmp/csv_then_h5"
+expect_status "an hdf5 run into a csv run's folder" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 \
+  --out "$tmp/csv_then_h5" --quiet
+expect_text "it says which files of the csv run it removed" "$tmp/stdout" \
+  "^removed the files of an earlier run from $tmp/csv_then_h5/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json$"
+left=$(ls "$tmp/csv_then_h5" | grep -c '\.csv$')
+[ "$left" -eq 0 ] && passes=$((passes + 1)) || { echo "FAIL: $left CSV files of the earlier run left"; failures=$((failures + 1)); }
+expect_status "report of that folder" 2 "$bin" report "$tmp/csv_then_h5"
+expect_text "it is an hdf5 run folder now" "$tmp/stderr" "was written with --format hdf5"
+
 # A write failing mid-run (files limited to 200 kB, SIGXFSZ ignored: the write fails with EFBIG):
 # exit 1 with the file and the reason, not a crash.
 expect_status "a write failing mid-run" 1 bash -c "trap '' XFSZ; ulimit -f 200; exec \"\$0\" \"\$@\"" \
@@ -60,6 +72,7 @@ if ! "$python" -c "import h5py, pandas" 2> /dev/null; then
 else
   # The README's recipe, table by table, against pandas.read_csv of the CSV run.
   if "$python" - "$tmp/h5" "$tmp/csv" "$tmp/consist_h5" "$tmp/consist_csv" > "$tmp/compare" 2>&1 <<'EOF'
+import json
 import sys
 import h5py
 import pandas as pd
@@ -75,12 +88,16 @@ def table(f, name):  # README "Binary output": a compound dataset, or a matrix a
 for h5_dir, csv_dir in [(sys.argv[1], sys.argv[2]), (sys.argv[3], sys.argv[4])]:
     with h5py.File(f"{h5_dir}/timeseries.h5", "r") as f:
         assert f.attrs["railcrash_version"], "no version attribute"
+        # The run's id and provenance, as summary.json has them.
+        summary = json.load(open(f"{h5_dir}/summary.json"))
+        assert f.attrs["run_id"] == summary["run_id"] and len(summary["run_id"]) == 32, (f.attrs["run_id"], summary["run_id"])
+        assert json.loads(f.attrs["provenance"]) == summary["provenance"], f.attrs["provenance"]
         for name in ["timeseries", "accelerations", "energy", "events"]:
             frame = table(f, name)
             if name == "events":
                 for column in ["element", "event"]:
                     frame[column] = frame[column].str.decode("utf-8")
-            csv = pd.read_csv(f"{csv_dir}/{name}.csv")
+            csv = pd.read_csv(f"{csv_dir}/{name}.csv", skiprows=1)  # README: the first line is the provenance
             assert list(frame.columns) == list(csv.columns), name
             # The CSV holds 12 significant digits, the file every bit.
             pd.testing.assert_frame_equal(frame, csv, rtol=1e-11, atol=0, check_dtype=False)

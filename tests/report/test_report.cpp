@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <regex>
 #include <sstream>
 
 #include <unistd.h>
@@ -86,12 +87,15 @@ TEST_CASE("Run folders hold model geometry, accelerations, energy and filtered p
   std::ifstream energy(dir / "energy.csv");
   std::string header, row, last;
   std::getline(energy, header);
+  CHECK(header.rfind("# railcrash provenance {\"run_id\": ", 0) == 0);
+  std::getline(energy, header);
   CHECK(header.rfind("t,kinetic,elastic,gravity,external_work,dissipated,dissipated.anticlimber", 0) == 0);
   while (std::getline(energy, row)) last = row;
   // The balance closes: the last column, relative to the initial kinetic energy (0.5 (500 + 5000) 25).
   const double balance = std::stod(last.substr(last.rfind(',') + 1));
   CHECK(std::abs(balance) < 1e-5 * 0.5 * 5500.0 * 25.0);
   std::ifstream accelerations(dir / "accelerations.csv");
+  std::getline(accelerations, header);  // the provenance
   std::getline(accelerations, header);
   CHECK(header == "t,car1_end.ax,car1_end.ay,car1_end.alpha,car1_body.ax,car1_body.ay,car1_body.alpha,car2_end.ax,car2_end.ay,"
                   "car2_end.alpha,car2_body.ax,car2_body.ay,car2_body.alpha");
@@ -234,4 +238,64 @@ TEST_CASE("Body and element names that would break CSV, JSON or HTML are refused
     CHECK_THROWS_WITH(railcrash::load_model_text(head + bad + tail, "names.yaml"), Catch::Contains("names.yaml:5") && Catch::Contains("body name"));
   }
   CHECK_NOTHROW(railcrash::load_model_text(head + "'front end (car 1)'" + tail, "names.yaml"));
+}
+
+namespace {
+
+/// The run id summary.json gives ("" when none).
+std::string summary_run_id(const fs::path& dir) {
+  std::smatch match;
+  const std::string summary = slurp(dir / "summary.json");
+  return std::regex_search(summary, match, std::regex("\n  \"run_id\": \"([0-9a-f]*)\",\n")) ? match[1].str() : "";
+}
+
+}  // namespace
+
+TEST_CASE("The report refuses a folder that holds the files of two runs, naming them", "[report]") {
+  const fs::path first = small_run("first_of_two"), second = small_run("second_of_two");
+  const std::string first_id = summary_run_id(first), second_id = summary_run_id(second);
+  REQUIRE(first_id.size() == 32);
+  REQUIRE(second_id.size() == 32);
+  REQUIRE(first_id != second_id);
+  // The summary of another run over this run's files.
+  fs::copy_file(second / "summary.json", first / "summary.json", fs::copy_options::overwrite_existing);
+  CHECK_THROWS_WITH(railcrash::report::write_report(first.string()),
+                    Catch::Contains("'" + (first / "timeseries.csv").string() + "' is of run " + first_id + " but '" +
+                                    (first / "summary.json").string() + "' is of run " + second_id +
+                                    ": the folder holds the files of two runs"));
+  CHECK_FALSE(fs::exists(first / "report.html"));
+  // A data file of another run under this run's summary.
+  fs::copy_file(second / "energy.csv", first / "energy.csv", fs::copy_options::overwrite_existing);
+  fs::copy_file(second / "summary.json", first / "summary.json", fs::copy_options::overwrite_existing);
+  fs::copy_file(second / "timeseries.csv", first / "timeseries.csv", fs::copy_options::overwrite_existing);
+  fs::copy_file(second / "model.json", first / "model.json", fs::copy_options::overwrite_existing);
+  CHECK_THROWS_WITH(railcrash::report::write_report(first.string()),
+                    Catch::Contains("'" + (first / "accelerations.csv").string() + "' is of run " + first_id + " but '" +
+                                    (first / "summary.json").string() + "' is of run " + second_id));
+  // A file without a run id (an older railcrash's) beside files with one.
+  const std::string accelerations = slurp(second / "accelerations.csv");
+  std::ofstream(first / "accelerations.csv", std::ios::binary) << accelerations.substr(accelerations.find('\n') + 1);
+  CHECK_THROWS_WITH(railcrash::report::write_report(first.string()),
+                    Catch::Contains("'" + (first / "accelerations.csv").string() +
+                                    "' is of no run id (written by an older railcrash) but '" + (first / "summary.json").string() +
+                                    "' is of run " + second_id));
+  // The second run's files, all of them: a report.
+  fs::copy_file(second / "accelerations.csv", first / "accelerations.csv", fs::copy_options::overwrite_existing);
+  fs::copy_file(second / "events.csv", first / "events.csv", fs::copy_options::overwrite_existing);
+  CHECK(railcrash::report::write_report(first.string()).problems.empty());
+  fs::remove_all(first);
+  fs::remove_all(second);
+}
+
+TEST_CASE("The report carries the run's provenance", "[report]") {
+  const fs::path dir = small_run("provenance");
+  const std::string id = summary_run_id(dir);
+  REQUIRE(id.size() == 32);
+  railcrash::report::write_report(dir.string());
+  const std::string page = slurp(dir / "report.html");
+  // summary.json's record, and the script that shows it as the page's provenance block.
+  CHECK_THAT(page, Catch::Contains("\"provenance\": {\"run_id\": \"" + id + "\", \"version\": ") &&
+                       Catch::Contains("/tests/report/two_car.yaml\", \"sha256\": \"") &&
+                       Catch::Contains("\"Provenance: run \" + pv.run_id"));
+  fs::remove_all(dir);
 }

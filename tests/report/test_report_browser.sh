@@ -26,7 +26,7 @@ if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; the
 timeout 120 "$chromium" "${flags[@]}" --window-size=1400,1300 --screenshot="$out/report_screenshot.png" "$url" > /dev/null 2>&1 ||
   fail "chromium --screenshot"
 
-"$node" - "$tmp/dom.html" <<'JS' || fail "self-check (above)"
+"$node" - "$tmp/dom.html" "$tmp/run/summary.json" <<'JS' || fail "self-check (above)"
 const fs = require("fs");
 const dom = fs.readFileSync(process.argv[2], "utf8");
 const m = dom.match(/<div id="self-check"[^>]*data-status="([a-z]+)"[^>]*>([^<]*)<\/div>/);
@@ -49,6 +49,13 @@ if (check.problems !== 0) problems.push(check.problems + " problems listed at th
 // The model name holds markup: it must be shown as text, never run.
 if (!dom.includes("two cars &lt;script&gt;document.title=\"injected\"&lt;/script&gt; &amp; \"quotes\", commas")) problems.push("the model name is not shown as text");
 if (/<title>[^<]*injected/.test(dom) && !/<title>railcrash report/.test(dom)) problems.push("the model name ran as a script");
+// The provenance block: the run id and the model file's SHA-256 of summary.json, shown.
+const provenance = JSON.parse(fs.readFileSync(process.argv[3], "utf8")).provenance;
+const block = dom.match(/<details class="provenance" id="provenance"[^>]*>([\s\S]*?)<\/details>/);
+if (!block) problems.push("no provenance block");
+else if (!block[1].includes("<summary>Provenance: run " + provenance.run_id + "</summary>") ||
+         !block[1].includes("sha256 " + provenance.model_files[0].sha256))
+  problems.push("the provenance block lacks the run id or the model's SHA-256: " + block[1].slice(0, 400));
 if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
 console.log("report ok: " + check.plots.length + " plots, " + check.frames.count + " frames");
 JS

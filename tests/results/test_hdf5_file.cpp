@@ -61,6 +61,7 @@ std::vector<std::vector<std::string>> csv_fields(const std::string& path) {
   std::ifstream in(path);
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) {
+    if (line.rfind("# railcrash provenance ", 0) == 0) continue;  // the run's provenance, before the header
     std::vector<std::string> fields;
     std::stringstream split(line);
     for (std::string field; std::getline(split, field, ',');) fields.push_back(field);

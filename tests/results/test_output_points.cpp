@@ -22,6 +22,7 @@ namespace {
 std::map<std::string, std::vector<double>> read_columns(const fs::path& path) {
   std::ifstream in(path);
   std::string line;
+  std::getline(in, line);  // the run's provenance
   std::getline(in, line);
   std::vector<std::string> names;
   std::stringstream header(line);

@@ -19,8 +19,11 @@
 // readings.csv, no timeseries.csv) gets a page of its Markdown summaries and CSV files as
 // tables, and the convergence chart (converge.svg).
 //
-// Bad folders: a missing folder, or one without timeseries.csv or without a single complete
-// row in it, throws InputError (exit 2). Anything else that is missing or broken (no
+// The header shows the run's provenance (results/provenance.hpp) from summary.json.
+//
+// Bad folders: a missing folder, one without timeseries.csv or without a single complete row in
+// it, or one whose files are of two runs (the run ids of summary.json, timeseries.csv,
+// model.json, accelerations.csv, energy.csv and events.csv differ), throws InputError (exit 2). Anything else that is missing or broken (no
 // summary.json, a failed run, a truncated CSV row, no model.json from an older railcrash) is
 // listed as a problem at the top of the page, and the page shows what there is.
 #pragma once

@@ -12,7 +12,8 @@
 // (some thousand columns of consist-length names): a wider table (a consist's timeseries) is
 // written as a 2-D float64 dataset instead (rows x columns), its column names in the dataset
 // "<table>_columns"; the attribute "layout" of every table says which ("compound" or "matrix").
-// File attributes: railcrash_version, model_file, model, units; each table's "units" attribute.
+// File attributes: railcrash_version, model_file, model, units, run_id and provenance (the
+// run's, results/provenance.hpp, as JSON); each table's "units" attribute.
 //
 // Every HDF5 call's result is checked: the first failure (with HDF5's innermost message, which
 // for a failed write names the OS's reason) is kept in error(), and after it nothing more is

@@ -24,8 +24,21 @@
 
 namespace railcrash {
 
-/// Writes DIR/model.json (see above). Throws InputError if it cannot be written.
-void write_model_geometry(const DaeSystem& system, const std::string& path);
+/// Writes DIR/model.json (see above), with the run's id (results/provenance.hpp) when given.
+/// Throws InputError if it cannot be written.
+void write_model_geometry(const DaeSystem& system, const std::string& path, const std::string& run_id = "");
+
+/// The files a run writes into its folder (either output format) and `railcrash report` adds:
+/// timeseries.csv, events.csv, accelerations.csv, energy.csv, timeseries.h5, summary.json (and
+/// its summary.json.tmp), model.json, report.html. A run owns them: it starts by removing those
+/// an earlier run left (remove_earlier_run_files), so that its folder never mixes two runs.
+const std::vector<std::string>& run_folder_files();
+
+/// Removes the run_folder_files() in `directory` that are regular files (nothing else: a
+/// user's other files stay, and so does a link or a device put in a file's place) and returns
+/// the names removed, in run_folder_files() order. Throws InputError naming the file when one
+/// cannot be removed.
+std::vector<std::string> remove_earlier_run_files(const std::string& directory);
 
 /// Computes energy.csv's row at every sample and writes it to file (with the header first), if any.
 class EnergyWriter {

@@ -176,6 +176,30 @@
       }
     }
     head.appendChild(table);
+    // Provenance (results/provenance.hpp): which program, model files and settings made the run.
+    var pv = summary && summary.provenance;
+    if (pv) {
+      var block = el("details", {"class": "provenance", "id": "provenance", "open": ""});
+      block.appendChild(el("summary", {}, "Provenance: run " + pv.run_id));
+      var list = el("table", {"class": "facts provenance-table"});
+      function line(name, value) {
+        var tr = el("tr");
+        tr.appendChild(el("th", {}, name));
+        tr.appendChild(el("td", {}, value));
+        list.appendChild(tr);
+      }
+      line("run id", pv.run_id);
+      line("program", "railcrash " + pv.version + (pv.commit ? " (commit " + pv.commit + ")" : " (not built from a git checkout)"));
+      line("command line", pv.command_line || "(not run from the command line)");
+      (pv.model_files || []).forEach(function (f, k) {
+        line(k === 0 ? "model file" : "variant's base", f.path + "  sha256 " + f.sha256);
+      });
+      line("settings", (pv.settings || []).length ? pv.settings.join(", ") : "none over the model file");
+      var sim = pv.simulation || {};
+      line("simulation", Object.keys(sim).map(function (k) { return k + " " + sim[k]; }).join(", "));
+      block.appendChild(list);
+      head.appendChild(block);
+    }
   })();
 
   // ---------------------------------------------------------------- animation
