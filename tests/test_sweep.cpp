@@ -372,7 +372,7 @@ TEST_CASE("sweep: --resume reruns the rows of an edited base model and --keep-ru
     CHECK(folders == 2);
     for (std::size_t k = 0; k < rows.size(); ++k) {
       INFO("run " << k);
-      char folder[16];
+      char folder[32];
       std::snprintf(folder, sizeof folder, "/runs/%04zu", k);
       const std::string summary = read(out + folder + "/summary.json");
       const std::size_t at = summary.find("\"R1\": ");
