@@ -401,6 +401,10 @@ int sweep_command(const std::string& path, const std::string& plan_path, int job
     std::fprintf(stderr, "[%zu/%zu] run %zu %s %.2f s%s%s\n", done, total, number, row.status.c_str(), row.wall_seconds,
                  row.message.empty() ? "" : ": ", row.message.c_str());
   };
+  options.note = [](const std::string& text) {
+    std::fputs(text.c_str(), stdout);
+    std::fflush(stdout);
+  };
   catch_interrupts();
 #ifdef RAILCRASH_MPI
   if (launched_by_mpi()) return sweep_with_mpi(path, plan_path, out_dir, options);

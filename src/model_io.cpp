@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <unordered_set>
@@ -78,8 +79,10 @@ class Reader {
   /// Each list or map is walked once: an alias (*name) is the anchored node itself, at the
   /// anchor's place in the text, so a document of aliases costs its text, not its expansion.
   void index_empty_values(const YAML::Node& node) {
-    if ((node.IsMap() || node.IsSequence()) && !node.Mark().is_null() && !walked_positions_.insert(node.Mark().pos).second)
+    if ((node.IsMap() || node.IsSequence()) && !node.Mark().is_null() && !walked_positions_.insert(node.Mark().pos).second) {
+      shared_positions_.insert(node.Mark().pos);  // met again: an alias
       return;
+    }
     if (node.IsMap()) {
       for (const auto& entry : node) {
         if (entry.second.IsNull() && !entry.first.Mark().is_null()) empty_values_.emplace_back(entry.second, entry.first.Mark().line + 1);
@@ -87,6 +90,30 @@ class Reader {
       }
     } else if (node.IsSequence()) {
       for (const auto& item : node) index_empty_values(item);
+    }
+  }
+
+  /// Whether the list or map `node` may be reached from more than one place of the document, so
+  /// that changing it in place would change those places too: a node an alias (*name) refers to
+  /// (index_empty_values met it twice), or an entry of a list or map that an edit copied (the
+  /// copy and the original both hold it). A node that lies inside such a node is reached through
+  /// it: the editor (put_value) copies everything below the first shared node of a path.
+  bool shared(const YAML::Node& node) const {
+    if (!node.IsMap() && !node.IsSequence()) return false;
+    if (!node.Mark().is_null() && shared_positions_.count(node.Mark().pos)) return true;
+    for (const YAML::Node& entry : copied_entries_)
+      if (entry.is(node)) return true;
+    return false;
+  }
+
+  /// Registers `copy`, a list or map an edit made from one of the document (one level deep),
+  /// as coming from `setting` (it has no line in the file), and its lists and maps as shared
+  /// with the original.
+  void add_copy(const YAML::Node& copy, const std::string& setting) {
+    overridden_.emplace_back(copy, setting);
+    for (const auto& entry : copy) {
+      const YAML::Node value = copy.IsMap() ? entry.second : YAML::Node(entry);
+      if (value.IsMap() || value.IsSequence()) copied_entries_.push_back(value);
     }
   }
 
@@ -212,6 +239,8 @@ class Reader {
   std::vector<std::pair<YAML::Node, std::string>> overridden_;
   std::vector<std::pair<YAML::Node, int>> empty_values_;
   std::unordered_set<int> walked_positions_;  // text positions of the lists and maps index_empty_values walked
+  std::unordered_set<int> shared_positions_;  // ... of those it met more than once (an alias refers to them)
+  std::vector<YAML::Node> copied_entries_;     // lists and maps held by an edit's copy and by the original
 };
 
 class YamlParameterReader : public ParameterReader {
@@ -261,18 +290,157 @@ class YamlParameterReader : public ParameterReader {
   std::string context_;
 };
 
-/// Marks the key that now holds `value` in `map` as coming from `setting` too (so an
-/// unknown key given with --set is reported against the setting).
-void mark_override_key(const YAML::Node& map, const YAML::Node& value, const std::string& setting, Reader& reader) {
-  for (const auto& entry : map)
-    if (entry.second.is(value)) reader.add_override(entry.first, setting);
+/// One step from a list or map of the document to one of its entries.
+struct DocumentStep {
+  std::string key;                   // a map's key (when index is empty)
+  std::optional<std::size_t> index;  // a list's entry, from 0
+};
+
+/// The node at the first `steps` steps of `path` below `root` (undefined when one is missing).
+YAML::Node node_at(const YAML::Node& root, const std::vector<DocumentStep>& path, std::size_t steps) {
+  YAML::Node node = root;
+  for (std::size_t k = 0; k < steps; ++k) {
+    const YAML::Node& holder = node;  // const: a missing key is not added
+    const YAML::Node entry = path[k].index ? holder[*path[k].index] : holder[path[k].key];
+    if (!entry.IsDefined()) return YAML::Node(YAML::NodeType::Undefined);
+    node.reset(entry);  // not =: assigning a node writes the entry into the node it was
+  }
+  return node;
 }
 
-/// Applies one KEY=VALUE override to the document: simulation.t_end=1, bodies.<name>.<key>=...,
-/// elements.<name>.<key>=..., gravity=[0,0], units=SI. The value is registered with the
-/// reader so that a bad value is reported against the setting rather than a file line.
-/// KEY*=FACTOR: multiplies an existing number of the model (a sensitivity run's +20 %).
-bool apply_scaling(YAML::Node& root, const std::string& setting, const std::string& where) {
+/// A copy of the list or map `container`, one level deep (its entries are the same nodes), with
+/// the entry at `step` replaced by `replacement` (or, in a map without it, added).
+YAML::Node copy_replacing(const YAML::Node& container, const DocumentStep& step, const YAML::Node& replacement) {
+  YAML::Node copy(container.IsSequence() ? YAML::NodeType::Sequence : YAML::NodeType::Map);
+  bool replaced = false;
+  if (container.IsSequence()) {
+    for (std::size_t i = 0; i < container.size(); ++i) {
+      replaced = replaced || i == *step.index;
+      copy.push_back(i == *step.index ? replacement : YAML::Node(container[i]));
+    }
+  } else {
+    for (const auto& entry : container) {
+      const bool edited = entry.first.IsScalar() && entry.first.Scalar() == step.key;
+      replaced = replaced || edited;
+      copy.force_insert(entry.first, edited ? replacement : entry.second);
+    }
+    if (!replaced) copy.force_insert(step.key, replacement);
+  }
+  copy.SetStyle(container.Style());
+  return copy;
+}
+
+/// Puts `value` at `path` in the document `root`, so that the place the path names changes and
+/// no other. yaml-cpp makes an alias (*name) the very node its anchor (&name) labels, and
+/// assigning to a node (node = value, node = "2") changes it wherever it appears. So a value is
+/// never assigned through the node it replaces: the map that holds it drops the old entry and
+/// takes the new one, and the lists and maps on the path from the first shared one down
+/// (Reader::shared) are copied one level deep, each copy taking the old one's place in the level
+/// above. A list's entry is replaced by copying the list. A copy has no line in the file:
+/// messages about it name `setting`. The key that names an edited value below the top level is
+/// marked as the setting's (an unknown key given with --set is reported against the setting).
+void put_value(const YAML::Node& root, const std::vector<DocumentStep>& path, const YAML::Node& value, Reader& reader,
+               const std::string& setting) {
+  std::vector<YAML::Node> containers;  // containers[k]: the list or map that step k goes into
+  for (std::size_t k = 0; k < path.size(); ++k) containers.push_back(node_at(root, path, k));
+  std::size_t first_copied = containers.size();
+  for (std::size_t k = 1; k < containers.size(); ++k)
+    if (reader.shared(containers[k])) {
+      first_copied = k;
+      break;
+    }
+  YAML::Node replacement = value;
+  for (std::size_t k = containers.size(); k-- > 0;) {
+    YAML::Node container = containers[k];
+    const DocumentStep& step = path[k];
+    if (k < first_copied && !step.index) {
+      const YAML::Node& map = container;
+      if (map.IsMap() && map[step.key]) container.remove(step.key);
+      container.force_insert(step.key, replacement);
+      if (k > 0 && k + 1 == containers.size())
+        for (const auto& entry : container)
+          if (entry.second.is(replacement)) reader.add_override(entry.first, setting);
+      return;
+    }
+    YAML::Node copy = copy_replacing(container, step, replacement);
+    reader.add_copy(copy, setting);
+    replacement.reset(copy);
+  }
+}
+
+/// The path a setting's KEY names (simulation.t_end, bodies.<name>.<key>, elements.<name>.<key>,
+/// a top-level key, each optionally followed by [INDEX] for an entry of a list: gravity[1],
+/// bodies.cart.velocity[0]). The lists and maps on the way must exist; the last key may be new
+/// (KEY=VALUE; `for_scaling` false), an index must be an entry of a list. `where` starts the
+/// messages.
+std::vector<DocumentStep> setting_path(YAML::Node& root, const std::string& key, bool for_scaling, const std::string& where) {
+  const auto bracket = key.find('[');
+  std::vector<std::size_t> indices;
+  for (std::size_t at = bracket; at != std::string::npos && at < key.size();) {
+    const std::size_t close = key.find(']', at);
+    const std::string digits = close == std::string::npos ? "" : key.substr(at + 1, close - at - 1);
+    if (key[at] != '[' || digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9)
+      throw InputError(where + "write an entry of a list as KEY[INDEX] (from 0), e.g. bodies.car1_center_body.velocity[0], "
+                               "not '" + key + "'");
+    indices.push_back(std::stoul(digits));
+    at = close + 1;
+  }
+  const std::string name = key.substr(0, bracket);
+  std::vector<std::string> parts;
+  std::stringstream stream(name);
+  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
+  const std::string no_number = "there is no number at '" + name +
+                                "' to scale (KEY is section.key, bodies.<name>.<key> or elements.<name>.<key>, "
+                                "optionally with [INDEX] for an entry of a list)";
+  const YAML::Node& document = root;  // const: looking a key up does not add it
+  std::vector<DocumentStep> path;
+  if (parts.size() == 1 && !name.empty()) {
+    path = {{parts[0], {}}};
+  } else if (parts.size() == 2) {
+    if (document[parts[0]] && !document[parts[0]].IsMap()) {
+      if (for_scaling) throw InputError(where + no_number);
+      if (parts[0] == "bodies" || parts[0] == "elements")
+        throw InputError(where + "'" + parts[0] + "' is a list; use " + parts[0] + ".<name>.<key>, e.g. " +
+                         (parts[0] == "bodies" ? "bodies.cart.mass=2" : "elements.spring.stiffness=200"));
+      throw InputError(where + "'" + parts[0] + "' is not a section of keys; give it whole, e.g. " + parts[0] + "=VALUE");
+    }
+    if (!document[parts[0]]) {
+      if (for_scaling || !indices.empty()) throw InputError(where + (for_scaling ? no_number : "the model has no '" + parts[0] + "' section"));
+      if (parts[0] != "simulation")
+        throw InputError(where + "'" + parts[0] + "' is not a section of keys; the section is simulation (e.g. simulation.t_end=0.5)");
+      root[parts[0]] = YAML::Node(YAML::NodeType::Map);
+    }
+    path = {{parts[0], {}}, {parts[1], {}}};
+  } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
+    const YAML::Node list = document[parts[0]];
+    if (list && list.IsSequence())
+      for (std::size_t i = 0; i < list.size() && path.empty(); ++i)
+        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == parts[1])
+          path = {{parts[0], {}}, {"", i}, {parts[2], {}}};
+    if (path.empty())
+      throw InputError(where + (for_scaling ? no_number : "the model has no " + std::string(parts[0] == "bodies" ? "body" : "element") +
+                                                              " named '" + parts[1] + "'"));
+  } else {
+    throw InputError(where + (for_scaling ? no_number : "KEY must be a top-level key, section.key (e.g. simulation.rtol), "
+                                                        "bodies.<name>.<key> or elements.<name>.<key>"));
+  }
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const YAML::Node list = node_at(root, path, path.size());
+    std::string list_key = name;
+    for (std::size_t j = 0; j < i; ++j) list_key += "[" + std::to_string(indices[j]) + "]";
+    if (!list.IsSequence())
+      throw InputError(where + "the model has no list at '" + list_key + "' (KEY[INDEX] names an entry of a list)");
+    if (indices[i] >= list.size())
+      throw InputError(where + "the list at '" + list_key + "' has " + std::to_string(list.size()) + " entries (index from 0)");
+    path.push_back({"", indices[i]});
+  }
+  return path;
+}
+
+/// KEY*=FACTOR: multiplies an existing number of the model (a sensitivity run's +20 %). `label`
+/// names the setting in messages; the scaled value is the setting's.
+bool apply_scaling(YAML::Node& root, const std::string& setting, Reader& reader, const std::string& label) {
+  const std::string where = label + ": ";
   const auto star = setting.find("*=");
   if (star == std::string::npos) return false;
   double factor = 0.0;
@@ -281,45 +449,39 @@ bool apply_scaling(YAML::Node& root, const std::string& setting, const std::stri
   } catch (const std::exception&) {
     throw InputError(where + "expected KEY*=FACTOR with a number, e.g. elements.spring.stiffness*=1.2");
   }
-  std::vector<std::string> parts;
-  std::stringstream stream(setting.substr(0, star));
-  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
-  // The map that holds the key (a section, or a named body / element).
-  YAML::Node holder;
-  std::string key;
-  if (parts.size() == 2 && root[parts[0]] && root[parts[0]].IsMap()) {
-    holder = root[parts[0]];
-    key = parts[1];
-  } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements") && root[parts[0]].IsSequence()) {
-    for (std::size_t i = 0; i < root[parts[0]].size(); ++i) {
-      const YAML::Node item = root[parts[0]][i];
-      if (item.IsMap() && item["name"] && item["name"].IsScalar() && item["name"].Scalar() == parts[1]) holder = item;
-    }
-    key = parts[2];
-  }
-  if (!holder || !holder.IsMap() || !holder[key] || !holder[key].IsScalar())
-    throw InputError(where + "there is no number at '" + setting.substr(0, star) +
-                     "' to scale (KEY is section.key, bodies.<name>.<key> or elements.<name>.<key>)");
+  const std::string key = setting.substr(0, star);
+  const std::vector<DocumentStep> path = setting_path(root, key, true, where);
+  const YAML::Node number = node_at(root, path, path.size());
+  if (!number || !number.IsScalar())
+    throw InputError(where + "there is no number at '" + key +
+                     "' to scale (KEY is section.key, bodies.<name>.<key> or elements.<name>.<key>, "
+                     "optionally with [INDEX] for an entry of a list)");
   double value = 0.0;
   try {
-    value = holder[key].as<double>();
+    value = number.as<double>();
   } catch (const YAML::Exception&) {
-    throw InputError(where + "'" + holder[key].Scalar() + "' is not a number");
+    throw InputError(where + "'" + number.Scalar() + "' is not a number");
   }
   if (value == 0.0 && factor != 1.0)
-    throw ZeroScaledError(where + "'" + setting.substr(0, star) + "' is 0 in the model, so a factor changes nothing; "
+    throw ZeroScaledError(where + "'" + key + "' is 0 in the model, so a factor changes nothing; "
                      "set a value with KEY=VALUE instead (or leave this parameter out)");
   char text[40];
   std::snprintf(text, sizeof text, "%.17g", value * factor);
-  holder[key] = std::string(text);
+  const YAML::Node scaled(std::string{text});
+  reader.add_override(scaled, label);
+  put_value(root, path, scaled, reader, label);
   return true;
 }
 
-/// `label`: how messages name the setting ("file: --set 'KEY=VALUE'" when empty).
+/// Applies one setting to the document: KEY=VALUE (simulation.t_end=1, bodies.<name>.<key>=...,
+/// elements.<name>.<key>=..., gravity=[0,0], units=SI, bodies.cart.velocity[0]=-2) or
+/// KEY*=FACTOR. The setting changes exactly the key it names (put_value). The value is
+/// registered with the reader so that a bad value is reported against the setting rather than
+/// a file line. `label`: how messages name the setting ("file: --set 'KEY=VALUE'" when empty).
 void apply_override(YAML::Node& root, const std::string& setting, Reader& reader, std::string label = {}) {
   if (label.empty()) label = SourceLocation{reader.file(), 0}.prefix() + "--set '" + setting + "'";
   const std::string where = label + ": ";
-  if (apply_scaling(root, setting, where)) return;
+  if (apply_scaling(root, setting, reader, label)) return;
   const auto equals = setting.find('=');
   if (equals == std::string::npos || equals == 0)
     throw InputError(where + "expected KEY=VALUE, e.g. simulation.t_end=0.5 or elements.spring.stiffness=200");
@@ -335,44 +497,7 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
     throw InputError(message.rfind(numbered, 0) == 0 ? where + message.substr(numbered.size()) : message);
   }
   reader.add_override(value, label);
-  std::vector<std::string> parts;
-  std::stringstream stream(key);
-  for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
-  if (parts.size() == 1) {
-    root[parts[0]] = value;
-    return;
-  }
-  if (parts.size() == 2) {
-    if (root[parts[0]] && !root[parts[0]].IsMap()) {
-      if (parts[0] == "bodies" || parts[0] == "elements")
-        throw InputError(where + "'" + parts[0] + "' is a list; use " + parts[0] + ".<name>.<key>, e.g. " +
-                         (parts[0] == "bodies" ? "bodies.cart.mass=2" : "elements.spring.stiffness=200"));
-      throw InputError(where + "'" + parts[0] + "' is not a section of keys; give it whole, e.g. " + parts[0] + "=VALUE");
-    }
-    if (!root[parts[0]]) {
-      if (parts[0] != "simulation")
-        throw InputError(where + "'" + parts[0] + "' is not a section of keys; the section is simulation (e.g. simulation.t_end=0.5)");
-      root[parts[0]] = YAML::Node(YAML::NodeType::Map);
-    }
-    YAML::Node section = root[parts[0]];
-    section[parts[1]] = value;
-    mark_override_key(section, value, label, reader);
-    return;
-  }
-  if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
-    YAML::Node list = root[parts[0]];
-    if (list && list.IsSequence())
-      for (std::size_t i = 0; i < list.size(); ++i)
-        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == parts[1]) {
-          YAML::Node item = list[i];
-          item[parts[2]] = value;
-          mark_override_key(item, value, label, reader);
-          return;
-        }
-    throw InputError(where + "the model has no " + (parts[0] == "bodies" ? "body" : "element") + " named '" + parts[1] + "'");
-  }
-  throw InputError(where + "KEY must be a top-level key, section.key (e.g. simulation.rtol), "
-                   "bodies.<name>.<key> or elements.<name>.<key>");
+  put_value(root, setting_path(root, key, false, where), value, reader, label);
 }
 
 const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
@@ -859,6 +984,12 @@ YAML::Node parse_model_yaml(const std::string& text, const std::string& path) {
   return with_model_parse_errors(text, path, [&] { return load_yaml_text(text, path); });
 }
 
+/// The base model a variant at `path` names (`variant_of`, relative to the variant's folder).
+std::filesystem::path variant_base_path(const std::string& path, const std::string& base_name) {
+  return std::filesystem::path(base_name).is_absolute() ? std::filesystem::path(base_name)
+                                                        : std::filesystem::path(path).parent_path() / base_name;
+}
+
 /// A setting taken from a variant file: KEY=VALUE and how messages name it.
 struct VariantSetting {
   std::string setting, label;
@@ -875,10 +1006,7 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
   const YAML::Node version = reader.required(variant, "railcrash", "model variant (add 'railcrash: 1')");
   if (!version.IsScalar() || version.Scalar() != "1") reader.fail(version, "model variant: 'railcrash' must be 1");
   const YAML::Node base_node = variant["variant_of"];
-  const std::string base_name = reader.text(base_node, "model variant: variant_of");
-  const std::filesystem::path base_path =
-      std::filesystem::path(base_name).is_absolute() ? std::filesystem::path(base_name)
-                                                     : std::filesystem::path(path).parent_path() / base_name;
+  const std::filesystem::path base_path = variant_base_path(path, reader.text(base_node, "model variant: variant_of"));
   std::string base_text;
   try {
     base_text = read_input_file(base_path.string(), "base model");
@@ -948,6 +1076,14 @@ Model load_model_text(const std::string& text, const std::string& path, const st
 CheckedYamlText check_model_text(std::string text, const std::string& path) {
   // A copy goes into the checked text: a parse error's message reads `text` (the open bracket).
   return with_model_parse_errors(text, path, [&] { return CheckedYamlText(text, path); });
+}
+
+std::vector<std::string> model_input_texts(const std::string& text, const std::string& path) {
+  std::vector<std::string> texts{text};
+  const YAML::Node root = parse_model_yaml(text, path);
+  if (root.IsMap() && root["variant_of"] && root["variant_of"].IsScalar())
+    texts.push_back(read_input_file(variant_base_path(path, root["variant_of"].Scalar()).string(), "base model"));
+  return texts;
 }
 
 Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides) {

@@ -12,6 +12,8 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
+#include <set>
 #include <sstream>
 
 #include "railcrash/batch.hpp"
@@ -19,6 +21,7 @@
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/table_text.hpp"
+#include "railcrash/version.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -89,69 +92,12 @@ SweepDistribution load_distribution(const std::string& path, const YAML::Node& n
   return d;
 }
 
-std::vector<std::string> split(const std::string& text, char separator) {
-  std::vector<std::string> parts;
-  std::stringstream stream(text);
-  for (std::string part; std::getline(stream, part, separator);) parts.push_back(part);
-  return parts;
-}
-
-/// The list a key ("gravity", "bodies.b.velocity") names in the model's YAML (an undefined node if none).
-YAML::Node model_list(const YAML::Node& root, const std::string& key) {
-  const std::vector<std::string> parts = split(key, '.');
-  YAML::Node holder;
-  std::string name;
-  if (parts.size() == 1) {
-    holder = root;
-    name = parts[0];
-  } else if (parts.size() == 2 && root[parts[0]] && root[parts[0]].IsMap()) {
-    holder = root[parts[0]];
-    name = parts[1];
-  } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements") && root[parts[0]].IsSequence()) {
-    for (const YAML::Node& item : root[parts[0]])
-      if (item.IsMap() && item["name"] && item["name"].IsScalar() && item["name"].Scalar() == parts[1]) holder = item;
-    name = parts[2];
-  }
-  if (!holder || !holder.IsMap() || !holder[name] || !holder[name].IsSequence()) return YAML::Node(YAML::NodeType::Undefined);
-  return holder[name];
-}
-
-/// The setting a factor at one level makes: KEY=LEVEL, KEY*=LEVEL, or for KEY[i] the whole
-/// list with entry i replaced (or scaled).
-std::string factor_setting(const SweepFactor& factor, const std::string& level, const YAML::Node& model_root) {
-  const auto bracket = factor.key.find('[');
-  if (bracket == std::string::npos) return factor.key + (factor.scale ? "*=" : "=") + level;
-  const std::string list_key = factor.key.substr(0, bracket);
-  const std::string where = "'" + factor.key + "'";
-  std::size_t index = 0;
-  try {
-    std::size_t used = 0;
-    index = std::stoul(factor.key.substr(bracket + 1), &used);
-    if (factor.key.substr(bracket + 1 + used) != "]") throw std::invalid_argument("trailing text");
-  } catch (const std::exception&) {
-    throw InputError(where + ": write an entry of a list as KEY[INDEX], e.g. bodies.car1_center_body.velocity[0]");
-  }
-  const YAML::Node list = model_list(model_root, list_key);
-  if (!list) throw InputError(where + ": the model has no list at '" + list_key + "' (a top-level key, section.key, bodies.<name>.<key> or elements.<name>.<key>)");
-  if (index >= list.size())
-    throw InputError(where + ": the list at '" + list_key + "' has " + std::to_string(list.size()) + " entries (index from 0)");
-  std::string text = list_key + "=[";
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    std::string entry = list[i].IsScalar() ? list[i].Scalar() : "";
-    if (i == index) {
-      if (!factor.scale) {
-        entry = level;
-      } else {
-        try {
-          entry = exact(list[i].as<double>() * std::stod(level));
-        } catch (const std::exception&) {
-          throw InputError(where + ": scaling needs a number in the model and a number as the level, not '" + level + "'");
-        }
-      }
-    }
-    text += (i ? ", " : "") + entry;
-  }
-  return text + "]";
+/// The setting a factor at one level makes: KEY=LEVEL or KEY*=LEVEL. KEY[i] (an entry of a
+/// list) is the model's own KEY[i] setting: each run starts from the model, takes the plan's
+/// settings and then each factor's in turn, so two entries of one list and a plan's setting of
+/// the list keep one another, and a scaled entry that is 0 is refused as a scaled key is.
+std::string factor_setting(const SweepFactor& factor, const std::string& level) {
+  return factor.key + (factor.scale ? "*=" : "=") + level;
 }
 
 std::uint64_t fnv1a(const std::string& text, std::uint64_t hash = 14695981039346656037ull) {
@@ -351,11 +297,10 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
   // Its YAML structure checked once for every load below (the same messages as load_model_text).
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
   (void)load_model_text(model_text, model_path, {});  // the model's own mistakes first, as they are
-  const YAML::Node model_root = load_yaml_text(model_text);
   const auto check = [&](const SweepFactor& factor, const std::string& level, int line) {
     std::vector<std::string> settings = plan.settings;
     try {
-      settings.push_back(factor_setting(factor, level, model_root));
+      settings.push_back(factor_setting(factor, level));
       const Model model = load_model_text(model_text, model_path, settings);
       (void)model;
     } catch (const InputError& e) {
@@ -384,7 +329,7 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
 
 // ---------------------------------------------------------------- runs
 
-std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_text) {
+std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text) {
   const std::size_t n = plan.factors.size();
   std::vector<std::vector<std::string>> levels;
   std::vector<std::size_t> counts;
@@ -417,14 +362,18 @@ std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& m
       levels = plan.runs;
       break;
   }
-  const YAML::Node model_root = load_yaml_text(model_text, "the model");
+  // What every run reads besides its settings: the program (with the libraries' versions) and
+  // every model file (a variant and its base), each text after its length.
+  std::uint64_t inputs = fnv1a(version_text());
+  for (const std::string& text : model_input_texts(model_text, model_path))
+    inputs = fnv1a(text, fnv1a(std::string(1, '\0') + std::to_string(text.size()) + std::string(1, '\0'), inputs));
   std::vector<SweepRunSpec> specs;
   for (auto& row : levels) {
     SweepRunSpec spec;
     spec.settings = plan.settings;
     for (std::size_t f = 0; f < n; ++f)
-      if (!row[f].empty()) spec.settings.push_back(factor_setting(plan.factors[f], row[f], model_root));
-    std::uint64_t hash = fnv1a(model_text);
+      if (!row[f].empty()) spec.settings.push_back(factor_setting(plan.factors[f], row[f]));
+    std::uint64_t hash = inputs;
     for (const std::string& s : spec.settings) hash = fnv1a(s, fnv1a(std::string(1, '\0'), hash));
     char text[17];
     std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
@@ -535,13 +484,58 @@ std::size_t SweepResult::done() const {
   return static_cast<std::size_t>(std::count_if(lines.begin(), lines.end(), [](const auto& l) { return l.has_value(); }));
 }
 
-SweepResult start_sweep(const SweepPlan& plan, const std::string& model_text, const std::string& directory, bool resume) {
+namespace {
+
+/// The run number a folder of DIR/runs is named by (NNNN), or nothing for any other name.
+std::optional<std::size_t> run_folder_number(const std::filesystem::path& folder) {
+  const std::string name = folder.filename().string();
+  if (name.empty() || name.size() > 12 || name.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  return static_cast<std::size_t>(std::stoull(name));
+}
+
+std::string run_folder_name(std::size_t number) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%04zu", number);
+  return name;
+}
+
+/// Makes DIR/runs/ match runs.csv: the folder of a resumed row (`kept`: old run number -> new)
+/// takes the row's new number, every other run folder is removed. Returns how many were removed.
+std::size_t match_run_folders(const std::string& directory, const std::map<std::size_t, std::size_t>& kept) {
+  namespace fs = std::filesystem;
+  const fs::path runs = fs::path(directory) / "runs";
+  std::error_code error;
+  if (!fs::is_directory(runs, error)) return 0;
+  std::size_t removed = 0;
+  std::vector<std::pair<fs::path, std::size_t>> moving;  // renamed aside first: new numbers may be old ones
+  for (const fs::directory_entry& entry : fs::directory_iterator(runs)) {
+    const std::optional<std::size_t> number = run_folder_number(entry.path());
+    if (!number || !entry.is_directory()) continue;
+    const auto it = kept.find(*number);
+    if (it == kept.end()) {
+      fs::remove_all(entry.path());
+      ++removed;
+    } else if (it->second != *number) {
+      const fs::path aside = runs / (".resumed-" + run_folder_name(*number));
+      fs::rename(entry.path(), aside);
+      moving.emplace_back(aside, it->second);
+    }
+  }
+  for (const auto& [aside, number] : moving) fs::rename(aside, runs / run_folder_name(number));
+  return removed;
+}
+
+}  // namespace
+
+SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+                        const std::string& directory, bool resume) {
   SweepResult result;
-  result.specs = sweep_runs(plan, model_text);
+  result.specs = sweep_runs(plan, model_path, model_text);
   result.lines.resize(result.specs.size());
   std::filesystem::create_directories(directory);
   const std::string csv_path = directory + "/runs.csv";
   const std::string header = sweep_csv_header(plan);
+  std::map<std::size_t, std::size_t> kept_folders;  // a resumed row's run number in the old runs.csv -> in the new
   if (resume && std::filesystem::exists(csv_path)) {
     std::ifstream in(csv_path);
     std::string line;
@@ -549,26 +543,49 @@ SweepResult start_sweep(const SweepPlan& plan, const std::string& model_text, co
     if (line != header)
       throw InputError(csv_path + ": its columns are not this plan's (" + line.substr(0, 80) +
                        "...); resume with the same plan, or write to another --out");
-    std::map<std::string, std::string> by_hash;  // hash -> the fields after the run's levels
+    struct OldRow {
+      std::string number, rest;  // rest: the fields after the hash
+    };
+    std::map<std::string, OldRow> by_hash;
+    std::vector<std::string> old_hashes;
     for (; std::getline(in, line);) {
       const std::vector<std::string> fields = csv_fields(line);
       // run, hash, factors..., status, ...: a line cut short by a kill is not a row.
       if (fields.size() != 2 + plan.factors.size() + 1 + plan.responses.size() + 2) continue;
       const std::size_t first = line.find(',');
-      by_hash[fields[1]] = line.substr(line.find(',', first + 1) + 1);
+      by_hash[fields[1]] = {fields[0], line.substr(line.find(',', first + 1) + 1)};
+      old_hashes.push_back(fields[1]);
     }
     for (std::size_t k = 0; k < result.specs.size(); ++k)
       if (const auto it = by_hash.find(result.specs[k].hash); it != by_hash.end()) {
-        result.lines[k] = std::to_string(k) + "," + result.specs[k].hash + "," + it->second;
+        result.lines[k] = std::to_string(k) + "," + result.specs[k].hash + "," + it->second.rest;
         ++result.resumed;
+        if (const std::optional<std::size_t> old = run_folder_number(it->second.number)) kept_folders[*old] = k;
       }
+    std::set<std::string> hashes;
+    for (const SweepRunSpec& spec : result.specs) hashes.insert(spec.hash);
+    result.stale_rows = static_cast<std::size_t>(
+        std::count_if(old_hashes.begin(), old_hashes.end(), [&](const std::string& hash) { return !hashes.count(hash); }));
   }
+  result.stale_folders = match_run_folders(directory, kept_folders);
   std::ofstream out(csv_path);
   out << header << '\n';
   for (const auto& line : result.lines)
     if (line) out << *line << '\n';
   if (!out) throw InputError(csv_path + ": cannot write (check the --out folder)");
   return result;
+}
+
+std::string sweep_start_note(const SweepResult& result, const std::string& directory) {
+  std::string note;
+  if (result.stale_rows > 0)
+    note += std::to_string(result.stale_rows) + " row" + (result.stale_rows == 1 ? "" : "s") + " of " + directory +
+            "/runs.csv ran with other inputs (a model file, the plan or railcrash changed since) or are no run of "
+            "this plan: dropped, and the plan's runs without a row run again\n";
+  if (result.stale_folders > 0)
+    note += std::to_string(result.stale_folders) + " folder" + (result.stale_folders == 1 ? "" : "s") + " of " + directory +
+            "/runs/ belonged to no row of runs.csv kept with these inputs: removed\n";
+  return note;
 }
 
 void append_sweep_line(const std::string& directory, const std::string& line) {
@@ -580,7 +597,8 @@ void append_sweep_line(const std::string& directory, const std::string& line) {
 SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, const std::string& directory,
                       const SweepOptions& options) {
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
-  SweepResult result = start_sweep(plan, model_text.text(), directory, options.resume);
+  SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
+  if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
   std::vector<std::size_t> pending;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
     if (!result.lines[k]) pending.push_back(k);

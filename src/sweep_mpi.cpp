@@ -72,7 +72,8 @@ std::string run_here(const SweepPlan& plan, const std::string& model_path, const
 /// thread of its own (rank 0 runs too), and writes the files.
 int coordinate(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                const std::string& directory, const SweepOptions& options, int ranks) {
-  SweepResult result = start_sweep(plan, model_text.text(), directory, options.resume);
+  SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
+  if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
   std::vector<long> pending;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
     if (!result.lines[k]) pending.push_back(static_cast<long>(k));
@@ -126,7 +127,7 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
 /// Ranks above 0: ask for a run, run it, send its line, until told to stop.
 void work(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text, const std::string& directory,
           const SweepOptions& options) {
-  const std::vector<SweepRunSpec> specs = sweep_runs(plan, model_text.text());
+  const std::vector<SweepRunSpec> specs = sweep_runs(plan, model_path, model_text.text());
   std::string message = "-1\n";
   for (;;) {
     send_text(message);

@@ -1,6 +1,7 @@
 // Model files: what a valid file gives, and that every bad input is an InputError whose
 // message names the file and line, the body / element / key at fault and what to change.
 #include <catch2/catch.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "railcrash/dae_system.hpp"
+#include "railcrash/elements/crush.hpp"
 #include "railcrash/elements/joints.hpp"
 #include "railcrash/elements/springs.hpp"
 #include "railcrash/initial_conditions.hpp"
@@ -992,3 +994,113 @@ simulation:
                             (Contains("'left_pin'") || Contains("'right_pin'")));
   }
 }
+
+namespace {
+
+// Two 40 t cars of a modern multiple unit, each driven at 5 m/s into its own crush zone on a
+// fixed barrier; the crush curve, the unloading stiffness and the velocity are written once
+// (&anchor) and used again (*alias), as PyYAML writes a list object a generator reuses.
+const std::string kSharedValuesModel = R"(railcrash: 1
+name: two cars on one crush zone definition
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: car_a, mass: 40000, inertia: 1.0e6, position: [1.0, 0], velocity: &speed [-5, 0]}
+  - {name: car_b, mass: 40000, inertia: 1.0e6, position: [1.0, 10], velocity: *speed}
+elements:
+  - name: crush_a
+    type: crush_spring
+    free_length: 1.0
+    curve: &zone [[0, 0], [0.01, 1.5e6], [0.6, 1.5e6]]
+    unloading_stiffness: &unloading 1.5e8
+    points: [{body: ground, at: [0, 0]}, {body: car_a, at: [0, 0]}]
+  - name: crush_b
+    type: crush_spring
+    free_length: 1.0
+    curve: *zone
+    unloading_stiffness: *unloading
+    points: [{body: ground, at: [0, 10]}, {body: car_b, at: [0, 0]}]
+simulation: {t_end: 0.4, rtol: 1.0e-8, output_interval: 0.0001}
+)";
+
+const CrushSpring& crush_spring(const Model& model, std::size_t index) {
+  const auto* spring = dynamic_cast<const CrushSpring*>(model.elements()[index].get());
+  REQUIRE(spring != nullptr);
+  return *spring;
+}
+
+}  // namespace
+
+TEST_CASE("an edit changes exactly the key it names, also where an alias shares the value", "[model_io]") {
+  const std::vector<double> soft{0.0, 1.5e6, 1.5e6}, stiff{0.0, 3.0e6, 3.0e6};
+  const Model as_written = load_model_text(kSharedValuesModel, "shared.yaml");
+  CHECK(crush_spring(as_written, 0).curve_force == soft);
+  CHECK(crush_spring(as_written, 1).curve_force == soft);
+  CHECK(as_written.bodies()[1].vx == -5.0);
+
+  SECTION("KEY=VALUE on a shared list") {
+    const Model model = load_model_text(kSharedValuesModel, "shared.yaml", {"elements.crush_a.curve=[[0, 0], [0.01, 3.0e6], [0.6, 3.0e6]]"});
+    CHECK(crush_spring(model, 0).curve_force == stiff);
+    CHECK(crush_spring(model, 1).curve_force == soft);
+  }
+  SECTION("KEY*=FACTOR on a shared number") {
+    const Model model = load_model_text(kSharedValuesModel, "shared.yaml", {"elements.crush_b.unloading_stiffness*=2"});
+    CHECK(crush_spring(model, 0).unloading_stiffness == 1.5e8);
+    CHECK(crush_spring(model, 1).unloading_stiffness == 3.0e8);
+  }
+  SECTION("KEY=VALUE and KEY[i] on a shared body velocity") {
+    const Model whole = load_model_text(kSharedValuesModel, "shared.yaml", {"bodies.car_a.velocity=[-6, 0]"});
+    CHECK(whole.bodies()[0].vx == -6.0);
+    CHECK(whole.bodies()[1].vx == -5.0);
+    const Model entry = load_model_text(kSharedValuesModel, "shared.yaml", {"bodies.car_b.velocity[0]=-4", "bodies.car_b.velocity[0]*=0.5"});
+    CHECK(entry.bodies()[0].vx == -5.0);
+    CHECK(entry.bodies()[1].vx == -2.0);
+    CHECK(entry.bodies()[1].vy == 0.0);
+  }
+  SECTION("an entry of a shared table, and a second edit below the first") {
+    const Model model = load_model_text(kSharedValuesModel, "shared.yaml",
+                                        {"elements.crush_a.curve[2]=[0.8, 1.5e6]", "elements.crush_a.curve[1][1]=2.0e6"});
+    CHECK(crush_spring(model, 0).curve_crush == std::vector<double>{0.0, 0.01, 0.8});
+    CHECK(crush_spring(model, 0).curve_force == std::vector<double>{0.0, 2.0e6, 1.5e6});
+    CHECK(crush_spring(model, 1).curve_crush == std::vector<double>{0.0, 0.01, 0.6});
+    CHECK(crush_spring(model, 1).curve_force == soft);
+  }
+  SECTION("a variant's set goes through the same path") {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("railcrash_alias_variant_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "base.yaml") << kSharedValuesModel;
+    std::ofstream(dir / "variant.yaml") << "railcrash: 1\nvariant_of: base.yaml\nset:\n  elements.crush_b.curve: [[0, 0], [0.01, 3.0e6], [0.6, 3.0e6]]\n";
+    const Model model = load_model((dir / "variant.yaml").string());
+    std::filesystem::remove_all(dir);
+    CHECK(crush_spring(model, 0).curve_force == soft);
+    CHECK(crush_spring(model, 1).curve_force == stiff);
+  }
+}
+
+TEST_CASE("KEY[i] settings name an entry of a list: each applies to the document as the settings before it left it", "[model_io]") {
+  const std::string model_text = kHeader + "gravity: [0, -9.81]\n" + kBodies + kElements + kLoads + kSimulation;
+  const Model model = load_model_text(model_text, "test.yaml", {"bodies.cart.velocity=[3, 0.5]", "bodies.cart.velocity[0]=2",
+                                                                "bodies.cart.velocity[1]*=4", "gravity[1]=-1.62"});
+  const auto cart = std::find_if(model.bodies().begin(), model.bodies().end(), [](const Body& b) { return b.name == "cart"; });
+  REQUIRE(cart != model.bodies().end());
+  CHECK(cart->vx == 2.0);
+  CHECK(cart->vy == 2.0);
+  CHECK(model.gravity_y == -1.62);
+  const auto error = [&](const std::string& setting) {
+    try {
+      (void)load_model_text(model_text, "test.yaml", {setting});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(error("bodies.cart.velocity[2]=1"), StartsWith("test.yaml: --set 'bodies.cart.velocity[2]=1': ") &&
+                                                     Contains("the list at 'bodies.cart.velocity' has 2 entries (index from 0)"));
+  CHECK_THAT(error("bodies.cart.mass[0]=1"), Contains("the model has no list at 'bodies.cart.mass'"));
+  CHECK_THAT(error("bodies.cart.velocity[x]=1"), Contains("write an entry of a list as KEY[INDEX]"));
+  CHECK_THAT(error("gravity[2]*=2"), Contains("the list at 'gravity' has 2 entries"));
+  // An entry that is 0 is refused a factor, as a key that is 0 is.
+  CHECK_THROWS_AS(load_model_text(model_text, "test.yaml", {"elements.slide.axis[1]*=2"}), ZeroScaledError);
+  CHECK_THAT(error("gravity[0]*=2"), Contains("'gravity[0]' is 0 in the model, so a factor changes nothing"));
+}
+

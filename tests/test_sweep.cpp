@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -201,4 +202,184 @@ TEST_CASE("sweep: R1 of each run against the closed-form crush, and 1 and 2 jobs
   CHECK(resumed.resumed == 2);
   CHECK(without_timing(read(files.dir + "/cut/runs.csv")) == reference);
   CHECK_THAT(read(files.dir + "/cut/summary.md"), Catch::Contains("| elements.ac.horizontal_yield_deflection* | 0.8: "));
+}
+
+namespace {
+
+/// The rows of runs.csv as maps column -> field.
+std::vector<std::map<std::string, std::string>> csv_rows(const std::string& path) {
+  std::istringstream in(read(path));
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = csv_fields(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> fields = csv_fields(line);
+    rows.emplace_back();
+    for (std::size_t k = 0; k < header.size() && k < fields.size(); ++k) rows.back()[header[k]] = fields[k];
+  }
+  return rows;
+}
+
+double number_in(const std::map<std::string, std::string>& row, const std::string& column) {
+  const auto it = row.find(column);
+  REQUIRE(it != row.end());
+  REQUIRE(!it->second.empty());
+  return std::stod(it->second);
+}
+
+/// Two 40 t cars of a modern multiple unit, each at 5 m/s into its own crush zone on a fixed
+/// barrier (SI). Both zones have one curve: written twice, or with `shared` written once (&zone)
+/// and used again (*zone), as PyYAML writes a list object a generator reuses.
+std::string two_zone_model(bool shared) {
+  const std::string zone = "[[0, 0], [0.01, 1.5e6], [0.6, 1.5e6]]";
+  return std::string("railcrash: 1\nname: two cars\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+         "  - {name: car_a, mass: 40000, inertia: 1.0e6, position: [1.0, 0], velocity: [-5, 0]}\n"
+         "  - {name: car_b, mass: 40000, inertia: 1.0e6, position: [1.0, 10], velocity: [-5, 0]}\n"
+         "elements:\n"
+         "  - {name: crush_a, type: crush_spring, free_length: 1.0, unloading_stiffness: 1.5e8, curve: ") +
+         (shared ? "&zone " : "") + zone + ",\n     points: [{body: ground, at: [0, 0]}, {body: car_a, at: [0, 0]}]}\n" +
+         "  - {name: crush_b, type: crush_spring, free_length: 1.0, unloading_stiffness: 1.5e8, curve: " +
+         (shared ? "*zone" : zone) + ",\n     points: [{body: ground, at: [0, 10]}, {body: car_b, at: [0, 0]}]}\n" +
+         "simulation: {t_end: 0.2, rtol: 1.0e-8, output_interval: 0.0001}\n";
+}
+
+/// Permanent crush of a zone [[0, 0], [0.01, F], [0.6, F]] that stops 40 t at 5 m/s (500 kJ):
+/// the largest crush d from F 0.01 / 2 + F (d - 0.01) = 500 kJ, less the elastic F / k_u that
+/// unloading at k_u = 1.5e8 N/m gives back.
+double zone_permanent_crush(double plateau_force) { return 500000.0 / plateau_force + 0.005 - plateau_force / 1.5e8; }
+
+}  // namespace
+
+TEST_CASE("sweep: factors on two elements that share a curve through an alias each change their own element", "[sweep]") {
+  Files files;
+  const std::string plan = "sweep: 1\ndesign: full_factorial\nfactors:\n"
+                           "  - {key: elements.crush_a.curve, levels: [[[0, 0], [0.01, 1.5e6], [0.6, 1.5e6]], [[0, 0], [0.01, 3.0e6], [0.6, 3.0e6]]]}\n"
+                           "  - {key: elements.crush_b.curve, levels: [[[0, 0], [0.01, 2.0e6], [0.6, 2.0e6]], [[0, 0], [0.01, 4.0e6], [0.6, 4.0e6]]]}\n"
+                           "responses: [peaks.crush_a.permanent_crush.abs_max, peaks.crush_b.permanent_crush.abs_max]\n";
+  files.write_plan(plan);
+  std::vector<std::vector<std::map<std::string, std::string>>> sweeps;
+  for (const bool shared : {true, false}) {
+    std::ofstream(files.model) << two_zone_model(shared);
+    const std::string out = files.dir + (shared ? "/shared" : "/written_out");
+    run_sweep(files.model, load_sweep_plan(files.plan, files.model), out, SweepOptions{});
+    sweeps.push_back(csv_rows(out + "/runs.csv"));
+  }
+  const std::vector<std::map<std::string, std::string>>& rows = sweeps[0];
+  REQUIRE(rows.size() == 4);
+  // Rows (a, b): (1.5, 2), (1.5, 4), (3, 2), (3, 4) MN plateaus.
+  const double force_a[] = {1.5e6, 1.5e6, 3.0e6, 3.0e6}, force_b[] = {2.0e6, 4.0e6, 2.0e6, 4.0e6};
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    INFO("run " << k);
+    CHECK(rows[k].at("status") == "ok");
+    CHECK(number_in(rows[k], "peaks.crush_a.permanent_crush.abs_max") == Approx(zone_permanent_crush(force_a[k])).epsilon(1e-4));
+    CHECK(number_in(rows[k], "peaks.crush_b.permanent_crush.abs_max") == Approx(zone_permanent_crush(force_b[k])).epsilon(1e-4));
+    CHECK(number_in(rows[k], "peaks.crush_a.permanent_crush.abs_max") == number_in(sweeps[1][k], "peaks.crush_a.permanent_crush.abs_max"));
+    CHECK(number_in(rows[k], "peaks.crush_b.permanent_crush.abs_max") == number_in(sweeps[1][k], "peaks.crush_b.permanent_crush.abs_max"));
+  }
+  // The main effect of crush_a's curve on crush_a: the two means differ by the analytic difference.
+  CHECK_THAT(read(files.dir + "/shared/summary.md"), Catch::Contains("| elements.crush_a.curve |"));
+  CHECK(number_in(rows[0], "peaks.crush_a.permanent_crush.abs_max") - number_in(rows[2], "peaks.crush_a.permanent_crush.abs_max") ==
+        Approx(zone_permanent_crush(1.5e6) - zone_permanent_crush(3.0e6)).epsilon(1e-3));
+}
+
+TEST_CASE("sweep: factors on entries of one list, a plan's set of the list and a scaled entry give each run its row's values", "[sweep]") {
+  Files files;
+  // The values each run used, read back from its time series at t = 0.
+  const std::string responses = "responses: [car.vx@0, car.vy@0]\n";
+  SECTION("two entries of one list") {
+    files.write_plan("sweep: 1\ndesign: full_factorial\nset: [simulation.t_end=0.01]\nfactors:\n"
+                     "  - {key: 'bodies.car.velocity[0]', levels: [-2.5, -1.5]}\n"
+                     "  - {key: 'bodies.car.velocity[1]', levels: [0.25, 0.5]}\n" + responses);
+    run_sweep(files.model, load_sweep_plan(files.plan, files.model), files.dir + "/out", SweepOptions{});
+    const auto rows = csv_rows(files.dir + "/out/runs.csv");
+    REQUIRE(rows.size() == 4);
+    for (const auto& row : rows) {
+      CHECK(number_in(row, "car.vx@0") == number_in(row, "bodies.car.velocity[0]"));
+      CHECK(number_in(row, "car.vy@0") == number_in(row, "bodies.car.velocity[1]"));
+    }
+  }
+  SECTION("the plan's set of the whole list, then an entry set and an entry scaled") {
+    files.write_plan("sweep: 1\ndesign: one_at_a_time\nset: [simulation.t_end=0.01, 'bodies.car.velocity=[-3, 0.25]']\nfactors:\n"
+                     "  - {key: 'bodies.car.velocity[0]', levels: [-2.5]}\n"
+                     "  - {key: 'bodies.car.velocity[1]', scale: true, levels: [2]}\n" + responses);
+    run_sweep(files.model, load_sweep_plan(files.plan, files.model), files.dir + "/out", SweepOptions{});
+    const auto rows = csv_rows(files.dir + "/out/runs.csv");
+    REQUIRE(rows.size() == 3);
+    const double vx[] = {-3.0, -2.5, -3.0}, vy[] = {0.25, 0.25, 0.5};
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      INFO("run " << k);
+      CHECK(number_in(rows[k], "car.vx@0") == vx[k]);
+      CHECK(number_in(rows[k], "car.vy@0") == vy[k]);
+    }
+  }
+  SECTION("a scaled factor on an entry that is 0 is refused, as on a key that is 0") {
+    const std::string message = files.error_of_plan("sweep: 1\ndesign: full_factorial\nfactors:\n"
+                                                    "  - {key: 'bodies.car.velocity[1]', scale: true, levels: [0.5, 2]}\n" + responses);
+    CHECK_THAT(message, Catch::StartsWith(files.plan + ":4: factor 'bodies.car.velocity[1]' at level '0.5': ") &&
+                            Catch::Contains("is 0 in the model, so a factor changes nothing"));
+  }
+}
+
+TEST_CASE("sweep: --resume reruns the rows of an edited base model and --keep-runs folders follow runs.csv", "[sweep]") {
+  Files files;
+  const std::string base = files.dir + "/base.yaml";
+  std::ofstream(base) << testing::anticlimber_r1_model_text(0.15);
+  std::ofstream(files.model) << "railcrash: 1\nvariant_of: base.yaml\nset:\n  name: r1 variant\n";
+  const auto plan_with = [&](const std::string& levels) {
+    files.write_plan("sweep: 1\ndesign: full_factorial\nfactors:\n"
+                     "  - {key: elements.ac.horizontal_yield_deflection, scale: true, levels: " + levels + "}\nresponses: [R1]\n");
+    return load_sweep_plan(files.plan, files.model);
+  };
+  const std::string out = files.dir + "/out";
+  SweepOptions options;
+  options.keep_runs = true;
+  std::string notes;
+  options.note = [&](const std::string& text) { notes += text; };
+  const SweepPlan first_plan = plan_with("[0.8, 1.2]");
+  run_sweep(files.model, first_plan, out, options);
+  REQUIRE(csv_rows(out + "/runs.csv").size() == 2);
+  CHECK(notes.empty());
+
+  SECTION("an edited base model: every row runs again") {
+    // The base's anticlimber 10 % stiffer: other crushes (R1 = crush / 0.02 m).
+    std::string text = testing::anticlimber_r1_model_text(0.15);
+    text.replace(text.find("horizontal_elastic_stiffness: 1.0e7"), 35, "horizontal_elastic_stiffness: 1.1e7");
+    std::ofstream(base) << text;
+    options.resume = true;
+    const SweepResult resumed = run_sweep(files.model, first_plan, out, options);
+    CHECK(resumed.resumed == 0);
+    CHECK(resumed.stale_rows == 2);
+    CHECK_THAT(notes, Catch::StartsWith("2 rows of " + out + "/runs.csv ran with other inputs"));
+    const auto rows = csv_rows(out + "/runs.csv");
+    REQUIRE(rows.size() == 2);
+    // The 0.8 run against the closed form with k = 1.1e7 N/m: k d_y^2 / 2 + F_y u + k_p u^2 / 2 = 2000 J.
+    const double k = 1.1e7, kp = 1e5, dy = 0.008, f = k * dy, rest = 2000.0 - 0.5 * k * dy * dy;
+    CHECK(number_in(rows[0], "R1") == Approx((dy + (-f + std::sqrt(f * f + 2.0 * kp * rest)) / kp) / 0.02).epsilon(1e-5));
+  }
+  SECTION("an edited plan: the kept rows' folders follow them, the others are removed") {
+    options.resume = true;
+    const SweepResult resumed = run_sweep(files.model, plan_with("[1.2, 1.0]"), out, options);
+    CHECK(resumed.resumed == 1);     // 1.2, run 1 before, run 0 now
+    CHECK(resumed.stale_rows == 1);  // 0.8
+    CHECK(resumed.stale_folders == 1);
+    CHECK_THAT(notes, Catch::Contains("1 row of " + out + "/runs.csv ran with other inputs") &&
+                          Catch::Contains("1 folder of " + out + "/runs/ belonged to no row of runs.csv"));
+    const auto rows = csv_rows(out + "/runs.csv");
+    REQUIRE(rows.size() == 2);
+    std::size_t folders = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(out + "/runs")) folders += entry.is_directory() ? 1 : 0;
+    CHECK(folders == 2);
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      INFO("run " << k);
+      char folder[32];
+      std::snprintf(folder, sizeof folder, "/runs/%04zu", k);
+      const std::string summary = read(out + folder + "/summary.json");
+      const std::size_t at = summary.find("\"R1\": ");
+      REQUIRE(at != std::string::npos);
+      CHECK(std::stod(summary.substr(at + 6)) == Approx(number_in(rows[k], "R1")).epsilon(1e-6));
+    }
+    CHECK(number_in(rows[0], "R1") == Approx(crush_for(0.012) / 0.02).epsilon(1e-5));
+    CHECK(number_in(rows[1], "R1") == Approx(crush_for(0.010) / 0.02).epsilon(1e-5));
+  }
 }

@@ -28,6 +28,10 @@ CheckedYamlText check_model_text(std::string text, const std::string& path);
 /// load_model_text of a checked text.
 Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides);
 
+/// The texts of the files a model reads, in order: `text` itself (the model file at `path`) and,
+/// for a variant (README "Model variants"), its base model's. A sweep's run hash covers them all.
+std::vector<std::string> model_input_texts(const std::string& text, const std::string& path);
+
 /// A KEY=VALUE setting that goes through the same path as --set but is named in messages by
 /// the command-line option it came from (e.g. setting "simulation.t_end=-1", option "--t-end -1").
 struct OptionSetting {

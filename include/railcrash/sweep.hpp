@@ -102,12 +102,15 @@ double normal_quantile(double probability);
 
 struct SweepRunSpec {
   std::vector<std::string> levels;     // per factor, YAML text ("" = the model's value)
-  std::vector<std::string> settings;   // what is applied to the model: the plan's, then the factors'
-  std::string hash;                    // 16 hex digits of FNV-1a over the model text and the settings
+  std::vector<std::string> settings;   // what is applied to the model: the plan's, then the factors' (KEY=LEVEL, KEY*=LEVEL)
+  std::string hash;                    // 16 hex digits of FNV-1a over everything the run reads (below)
 };
 
-/// The plan's runs, in order.
-std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_text);
+/// The plan's runs, in order. `model_text` is the text of the model file at `model_path`. A run's
+/// hash covers everything it reads: railcrash's and its libraries' versions (version_text), the
+/// text of every model file (the model and, for a variant, its base: model_input_texts) and the
+/// run's settings in order (the plan's `set`, then each factor's).
+std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text);
 
 struct SweepRow {
   std::string status;                  // "ok", "failed"
@@ -132,18 +135,27 @@ struct SweepOptions {
   bool resume = false;
   bool keep_runs = false;                   // per-run folders DIR/runs/NNNN
   std::function<void(std::size_t number, const SweepRow&, std::size_t done, std::size_t total)> progress;
+  std::function<void(const std::string& text)> note;  // sweep_start_note's lines, when there are any, before the runs
 };
 
 struct SweepResult {
   std::vector<SweepRunSpec> specs;
   std::vector<std::optional<std::string>> lines;  // runs.csv line per run; empty: not run (interrupted)
   std::size_t resumed = 0;                        // rows taken from an earlier runs.csv
+  std::size_t stale_rows = 0;     // rows of the earlier runs.csv (resuming) whose hash is no run of the plan: dropped
+  std::size_t stale_folders = 0;  // folders DIR/runs/NNNN of no row kept: removed
   std::size_t done() const;
 };
 
 /// Starts DIR/runs.csv (or, resuming, reads the rows it has whose hash matches a run): the
-/// result with the resumed lines set. InputError if a resumed file has other columns.
-SweepResult start_sweep(const SweepPlan& plan, const std::string& model_text, const std::string& directory, bool resume);
+/// result with the resumed lines set. The other rows of the earlier file are dropped (their runs
+/// read other inputs, or are no runs of this plan). DIR/runs/ is made to match the new file: the
+/// folder of a resumed row takes the row's new run number, every other run folder is removed.
+/// InputError if a resumed file has other columns.
+SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
+                        const std::string& directory, bool resume);
+/// Lines that say how many rows start_sweep dropped and folders it removed ("" when none).
+std::string sweep_start_note(const SweepResult& result, const std::string& directory);
 /// Appends one finished line to DIR/runs.csv (flushed: a killed sweep keeps it).
 void append_sweep_line(const std::string& directory, const std::string& line);
 

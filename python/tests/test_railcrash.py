@@ -260,6 +260,25 @@ class ErrorTest(unittest.TestCase):
         with self.assertRaisesRegex(railcrash.InputError, "cannot open the model file"):
             railcrash.load("/no/such/model.yaml")
 
+    def test_settings_change_exactly_the_key_they_name(self):
+        """set= goes through --set's path: a value two bodies share through a YAML alias (as PyYAML
+        writes a list a generator reuses) changes for the body named only, and KEY[i] is one entry."""
+        shared = """railcrash: 1
+name: two 40 t cars with one velocity
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: car_a, mass: 40000, inertia: 1.0e6, position: [0, 0], velocity: &speed [-5, 0]}
+  - {name: car_b, mass: 40000, inertia: 1.0e6, position: [0, 10], velocity: *speed}
+simulation: {t_end: 0.01, output_interval: 1.0e-3}
+"""
+        for settings, expected in (({"bodies.car_a.velocity": [-6, 0]}, (-6.0, -5.0)),
+                                   ({"bodies.car_b.velocity[0]": -4}, (-5.0, -4.0)),
+                                   ({"bodies.car_b.velocity[0]*": 0.5}, (-5.0, -2.5))):
+            result = railcrash.run(railcrash.from_yaml(shared, set=settings))
+            self.assertTrue(result.ok, result.message)
+            self.assertEqual((result.series("car_a.vx")[0], result.series("car_b.vx")[0]), expected, settings)
+
     def test_bad_settings(self):
         with self.assertRaisesRegex(railcrash.InputError, "no element named 'sprung'"):
             railcrash.from_yaml(OSCILLATOR, set={"elements.sprung.stiffness": 1.0})

@@ -109,6 +109,23 @@ interrupt_and_resume() {  # description folder command-prefix...: SIGTERM once 3
 }
 interrupt_and_resume "threads" "$tmp/cut"
 
+# A variant whose base model is edited between two sweeps: --resume runs every row again and says how many.
+mkdir "$tmp/variant"
+cp "$tmp/model.yaml" "$tmp/variant/base.yaml"
+printf 'railcrash: 1\nvariant_of: base.yaml\nset:\n  name: r1 variant\n' > "$tmp/variant/model.yaml"
+"$bin" sweep "$tmp/variant/model.yaml" --plan "$tmp/plan.yaml" --jobs 2 --out "$tmp/variant/out" > /dev/null 2>&1
+sed -i 's/horizontal_elastic_stiffness: 1.0e7/horizontal_elastic_stiffness: 1.1e7/' "$tmp/variant/base.yaml"
+"$bin" sweep "$tmp/variant/model.yaml" --plan "$tmp/plan.yaml" --jobs 2 --resume --out "$tmp/variant/out" > "$tmp/variant.out" 2>&1
+if grep -q "^12 rows of $tmp/variant/out/runs.csv ran with other inputs" "$tmp/variant.out" && grep -q "(0 resumed)" "$tmp/variant.out"; then pass
+else fail "--resume after an edit of the base model runs every row again: $(cat "$tmp/variant.out")"; fi
+
+# An edited plan (6 other samples) with --keep-runs: the 12 old folders are removed, with a count.
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --jobs 2 --keep-runs --out "$tmp/keep" > /dev/null 2>&1
+sed -e 's/^samples: 12/samples: 6/' "$tmp/plan.yaml" > "$tmp/six.yaml"
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/six.yaml" --jobs 2 --keep-runs --resume --out "$tmp/keep" > "$tmp/keep.out" 2>&1
+if grep -q "^12 folders of $tmp/keep/runs/ belonged to no row of runs.csv" "$tmp/keep.out" && [ "$(ls "$tmp/keep/runs" | wc -l)" -eq 6 ]; then pass
+else fail "an edited plan's --keep-runs folders: $(cat "$tmp/keep.out"; ls "$tmp/keep/runs")"; fi
+
 if [ -n "$mpirun" ]; then
   # CI runs as root on 2 cores: allow root, oversubscribe, and yield when idle.
   # OpenMPI keeps some allocations to the end of the process: no leak report in a sanitizer build.
