@@ -17,6 +17,10 @@
 //                         leaves when d > d_p (contact again: elastic, or loading if the
 //                         structure has never been crushed)
 // Roots are written positive inside their mode (element.hpp's convention).
+// The loader refuses an unloading_stiffness below the curve's steepest segment slope: from a
+// crush on such a segment the unloading line would rise above the loading curve (more force
+// unloading than crushing, more energy stored than the work done). Equal to it (within 1e-9 of
+// it, for unit conversions' round-off) is accepted.
 // Elastic energy is P^2 / (2 unloading_stiffness) (what unloading would give back); the
 // rest of the work done on the element is dissipated in crushing.
 #pragma once
