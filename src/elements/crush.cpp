@@ -34,7 +34,8 @@ CrushSpring::CrushSpring(ElementSpec& spec)
   for (int k = 1; k + 1 < static_cast<int>(curve_crush.size()); ++k)
     if (segment_slope(k) > segment_slope(steepest)) steepest = k;
   const double steepest_slope = segment_slope(steepest);
-  if (unloading_stiffness < steepest_slope * (1.0 - 1e-9)) {
+  unloading_above_curve = *spec.parameters->flag("unloading_above_curve");
+  if (unloading_stiffness < steepest_slope * (1.0 - 1e-9) && !unloading_above_curve) {
     std::ostringstream what;
     what.precision(6);
     what << "'unloading_stiffness' " << unloading_stiffness << " is below the slope " << steepest_slope
@@ -201,6 +202,11 @@ void register_crush_elements(ElementRegistry& registry) {
                   "loading curve [[crush, force], ...], crush strictly increasing, at least two points", Shape::Table},
                  {"unloading_stiffness", Unit::ForcePerLength, required, Range::Positive,
                   "slope of elastic unloading and reloading, at least the curve's steepest slope"},
+                 {"unloading_above_curve", Unit::Choice, default_flag(false), Range::Any,
+                  "true: accept an unloading_stiffness below the curve's steepest slope (unloading from those "
+                  "segments rises above the curve and stores more than the work done on it: a negative "
+                  "dissipation); for a model that says so, never by default",
+                  Shape::Flag},
                  {"tension_stiffness", Unit::ForcePerLength, optional("no force in tension"), Range::Positive,
                   "slope in tension beyond the permanent crush"},
                  {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::Positive,

@@ -180,6 +180,8 @@ TEST_CASE("crush spring: an unloading stiffness below the curve's steepest slope
   // round-off (the EN 15227 scenario's buffers: 6214924.1632110123 against 6214924.163211023).
   CHECK_NOTHROW(load(steep, "1.99999999999e7"));
   CHECK_THROWS(load(steep, "1.9999999e7"));
+  // A model that says, at the element, that it accepts it (models/barrier: reading 6).
+  CHECK_NOTHROW(load(steep, "1.0e7\n    unloading_above_curve: true"));
   // A softening curve (peak, then a falling force): the rising slope 1e7 is the steepest; a
   // falling segment never asks for more.
   CHECK_NOTHROW(load("[[0, 0], [0.01, 1.0e5], [0.05, 0.5e5], [1.0, 0.5e5]]", "1.0e7"));
