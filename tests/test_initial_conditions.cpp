@@ -193,18 +193,19 @@ TEST_CASE("a settle that fails names the body, the direction, the value and what
 
 TEST_CASE("a settle ends at the round-off of the forces that meet at a body, not of its weight", "[initial]") {
   // A 1 kg bob (weight 9.8 N) between two springs in tension, 1e12 N/m stretched 0.5 m from the
-  // left and 2e12 N/m stretched 0.25 m from the right: 5e11 N each way in x, and a 1e-7 N load
-  // in x. The x row sums two forces of 5e11 N, whose round-off (1e-4 N) is far above 1e-10 of the
-  // weight: the settle cannot bring it below that, and used to fail ("no static equilibrium").
-  // Within 1e-10 of the forces that meet there it is balanced. Equilibrium: x shifts by
-  // 1e-7 / (1e12 + 2e12) (3e-20 m, nothing), y sags by W / (T1 / L1 + T2 / L2) = 9.80665 / 1e12.
+  // left and 2e12 N/m stretched 0.25 m from the right (5e11 N each way in x), and a weak spring
+  // pulling 1.3e-5 N to the right. Lengths near 1 m move in steps of 2.2e-16 m, so the two
+  // strong forces change in steps of about 2e-4 N: the x row cannot come closer to zero than
+  // some 1e-5 N, far above 1e-10 of the weight (1e-9 N). The settle used to fail there ("no
+  // static equilibrium"); within 1e-10 of the forces that meet at that row it is balanced.
+  // Equilibrium: x moves by 1.3e-5 / 3e12 m (nothing), y sags by W / (T1 / L1 + T2 / L2) =
+  // 9.80665 / 1e12 m.
   const Model model = testing::model_from_text(
       "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: bob, mass: 1, inertia: 1, position: [0, 0]}\n"
       "elements:\n"
       "  - {name: left, type: linear_spring, stiffness: 1.0e12, free_length: 0.5, points: [{body: ground, at: [-1, 0]}, {body: bob, at: [0, 0]}]}\n"
       "  - {name: right, type: linear_spring, stiffness: 2.0e12, free_length: 0.75, points: [{body: ground, at: [1, 0]}, {body: bob, at: [0, 0]}]}\n"
-      "loads:\n"
-      "  - {type: force, body: bob, at: [0, 0], value: [1.0e-7, 0]}\n"
+      "  - {name: weak, type: linear_spring, stiffness: 1.0e-5, free_length: 3.7, points: [{body: ground, at: [5, 0]}, {body: bob, at: [0, 0]}]}\n"
       "simulation: {t_end: 1, static_equilibrium: true}\n");
   DaeSystem system(model);
   std::vector<double> y;
