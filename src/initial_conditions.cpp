@@ -349,66 +349,81 @@ struct ForceShare {
   double value;
 };
 
-/// What pushes on body unknown k (3 body + component) at the static state y: gravity, each
-/// load, each force element, each joint's reaction (-G^T lambda) and friction. Their sum is
-/// minus the residual's force row there.
-std::vector<ForceShare> forces_on(const DaeSystem& system, const std::vector<double>& y, int k) {
+/// What pushes on every body unknown k (3 body + component) at the static state y: gravity,
+/// each load, each element on the body (its forces, a joint's reaction -G^T lambda and its
+/// friction). Row k's sum is minus the residual's force row k.
+std::vector<std::vector<ForceShare>> forces_on_every_row(const DaeSystem& system, const std::vector<double>& y) {
   const Model& model = system.model();
-  const int body = k / 3, component = k % 3, nq = system.body_unknowns();
-  const auto line_of = [](const SourceLocation& where) {
-    return where.line > 0 ? ", line " + std::to_string(where.line) : std::string();
+  const int nq = system.body_unknowns();
+  const std::size_t count = model.elements().size();
+  std::vector<std::vector<ForceShare>> shares(static_cast<std::size_t>(nq));
+  const auto row_of = [&](int body, int component) -> std::vector<ForceShare>& {
+    return shares[static_cast<std::size_t>(3 * body + component)];
   };
-  std::vector<ForceShare> shares;
-  if (component < 2) {
-    const double g = component == 0 ? model.gravity_x : model.gravity_y;
-    shares.push_back({"gravity", model.bodies()[static_cast<std::size_t>(body)].mass * g});
+  for (int b = 0; b < model.body_count(); ++b) {
+    const double mass = model.bodies()[static_cast<std::size_t>(b)].mass;
+    row_of(b, 0).push_back({"gravity", mass * model.gravity_x});
+    row_of(b, 1).push_back({"gravity", mass * model.gravity_y});
   }
   for (const Load& load : model.loads()) {
-    if (load.body != body) continue;
+    const int b = load.body;
     const std::array<double, 2> value = load.value.at(0.0);
     Pose<double> generalized{};
     if (load.kind == Load::Kind::Moment) {
       generalized.theta = value[0];
     } else {
-      const Pose<double> pose{y[static_cast<std::size_t>(3 * body)], y[static_cast<std::size_t>(3 * body + 1)],
-                              y[static_cast<std::size_t>(3 * body + 2)]};
+      const Pose<double> pose{y[static_cast<std::size_t>(3 * b)], y[static_cast<std::size_t>(3 * b + 1)],
+                              y[static_cast<std::size_t>(3 * b + 2)]};
       add_point_force(pose, load.sx, load.sy, Vec2<double>{value[0], value[1]}, generalized);
     }
-    const double v = component == 0 ? generalized.x : component == 1 ? generalized.y : generalized.theta;
-    shares.push_back({std::string(load.kind == Load::Kind::Moment ? "moment load" : "load") +
-                          (load.where.line > 0 ? " (line " + std::to_string(load.where.line) + ")" : ""),
-                      v});
+    const std::string who = std::string(load.kind == Load::Kind::Moment ? "moment load" : "load") +
+                            (load.where.line > 0 ? " (line " + std::to_string(load.where.line) + ")" : "");
+    row_of(b, 0).push_back({who, generalized.x});
+    row_of(b, 1).push_back({who, generalized.y});
+    row_of(b, 2).push_back({who, generalized.theta});
   }
-  std::vector<double> element_share(model.elements().size(), 0.0);
-  for (std::size_t e = 0; e < model.elements().size(); ++e) {
-    const DaeSystem::ElementLoad load = system.element_load(static_cast<int>(e), 0.0, y.data());
-    for (std::size_t slot = 0; slot < 2; ++slot)
-      if (load.body[slot] == body)
-        element_share[e] += component == 0 ? load.force[slot].x : component == 1 ? load.force[slot].y : load.force[slot].theta;
-  }
+  // Each element's generalized forces on its slots' bodies, then the joints' reactions.
+  std::vector<std::array<Pose<double>, 2>> on_slots(count);
+  for (std::size_t e = 0; e < count; ++e) on_slots[e] = system.element_load(static_cast<int>(e), 0.0, y.data()).force;
+  std::vector<int> owner_of_row(static_cast<std::size_t>(system.constraint_rows()), -1);
+  for (std::size_t e = 0; e < count; ++e)
+    for (int r = 0; r < model.elements()[e]->constraint_count(); ++r)
+      owner_of_row[static_cast<std::size_t>(model.constraint_offset(e) + r)] = static_cast<int>(e);
   if (system.constraint_rows() > 0) {
     std::vector<double> phi(static_cast<std::size_t>(system.constraint_rows()));
     std::vector<DaeSystem::Triplet> gradient;
     system.constraints(y.data(), phi.data(), &gradient);
     for (const DaeSystem::Triplet& g : gradient) {
-      if (g.col != k || !system.constraint_row_active(g.row)) continue;
-      const Element& owner = system.constraint_owner(g.row);
-      for (std::size_t e = 0; e < model.elements().size(); ++e)
-        if (model.elements()[e].get() == &owner)
-          element_share[e] -= g.value * y[static_cast<std::size_t>(2 * nq + g.row)];
+      if (!system.constraint_row_active(g.row)) continue;
+      const auto e = static_cast<std::size_t>(owner_of_row[static_cast<std::size_t>(g.row)]);
+      const Element& el = *model.elements()[e];
+      const int body = g.col / 3, component = g.col % 3;
+      const std::size_t slot = el.slot_body(0) == body ? 0 : 1;
+      const double reaction = -g.value * y[static_cast<std::size_t>(2 * nq + g.row)];
+      Pose<double>& f = on_slots[e][slot];
+      (component == 0 ? f.x : component == 1 ? f.y : f.theta) += reaction;
     }
   }
-  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+  for (std::size_t e = 0; e < count; ++e) {
     const Element& el = *model.elements()[e];
-    if (el.slot_body(0) != body && el.slot_body(1) != body) continue;
-    shares.push_back({"element '" + el.name() + "' (" + el.type() + line_of(el.where()) + ")", element_share[e]});
+    const std::string who = "element '" + el.name() + "' (" + el.type() +
+                            (el.where().line > 0 ? ", line " + std::to_string(el.where().line) : std::string()) + ")";
+    for (std::size_t slot = 0; slot < 2; ++slot) {
+      const int b = el.slot_body(static_cast<int>(slot));
+      if (b == kGround || (slot == 1 && el.slot_body(0) == b)) continue;  // (both slots on one body: once)
+      Pose<double> f = on_slots[e][slot];
+      if (slot == 0 && el.slot_body(1) == b) f = {f.x + on_slots[e][1].x, f.y + on_slots[e][1].y, f.theta + on_slots[e][1].theta};
+      row_of(b, 0).push_back({who, f.x});
+      row_of(b, 1).push_back({who, f.y});
+      row_of(b, 2).push_back({who, f.theta});
+    }
   }
   return shares;
 }
 
 /// Why the settle stopped short: the largest unbalance (a force row, in the model's terms:
 /// body, direction, value and what pushes there, largest first; or a joint's gap), instead of
-/// assuming gravity. r: the residual at the state; shares: forces_on each body row there.
+/// assuming gravity. r: the residual at the state; shares: forces_on_every_row there.
 std::string unsettled_message(const DaeSystem& system, const std::vector<double>& r,
                               const EquilibriumReport& report, double force_scale,
                               const std::vector<std::vector<ForceShare>>& shares) {
@@ -612,12 +627,11 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
     // zero than about 1e-16 of them. A force row within 1e-10 of its own sum of magnitudes
     // (the settle's relative tolerance, on the forces that meet there) is balanced.
     std::vector<double> unbalanced(static_cast<std::size_t>(nq)), magnitude(static_cast<std::size_t>(nq));
-    std::vector<std::vector<ForceShare>> shares(static_cast<std::size_t>(nq));
+    const std::vector<std::vector<ForceShare>> shares = forces_on_every_row(system, y);
     bool round_off = true;
     for (int k = 0; k < nq; ++k) {
       const auto kk = static_cast<std::size_t>(k);
       unbalanced[kk] = -r[static_cast<std::size_t>(nq + k)];
-      shares[kk] = forces_on(system, y, k);
       for (const ForceShare& s : shares[kk]) magnitude[kk] += std::abs(s.value);
       if (std::abs(unbalanced[kk]) > 1e-10 * std::max(magnitude[kk], force_scale * (k % 3 == 2 ? length : 1.0)))
         round_off = false;
