@@ -82,7 +82,16 @@ EnergyBalance EnergyBalance::between(const EnergyState& start, const EnergyState
   b.kinetic = now.kinetic;
   b.elastic = now.elastic;
   b.gravity = now.gravity - start.gravity;
-  b.dissipated = (now.element_work - start.element_work) - (now.elastic - start.elastic);
+  // Each element that can dissipate now: work done on it less the change of its stored energy.
+  // A conservative element (an elastic spring, a frictionless joint) adds nothing: the
+  // difference between its work quadrature and its stored energy is integration drift.
+  const auto at = [](const std::vector<double>& values, std::size_t e) { return e < values.size() ? values[e] : 0.0; };
+  double dissipated = (now.penalty_work - start.penalty_work) - (now.penalty_elastic - start.penalty_elastic);
+  for (std::size_t e = 0; e < now.element_dissipates.size(); ++e)
+    if (now.element_dissipates[e])
+      dissipated += (at(now.element_work_done, e) - at(start.element_work_done, e)) -
+                    (at(now.element_elastic, e) - at(start.element_elastic, e));
+  b.dissipated = dissipated;
   b.external_work = now.load_work - start.load_work;
   b.initial_total = start.kinetic + start.elastic;
   return b;
@@ -758,22 +767,39 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   EnergyState s;
   s.kinetic = kinetic_energy(y + nq);
   s.gravity = gravity_potential(y);
-  for (std::size_t e = 0; e < model_.elements().size(); ++e)
-    s.elastic += element_potential_energy(e, y);
+  const std::size_t count = model_.elements().size();
+  s.element_elastic.resize(count);
+  s.element_work_done.resize(count);
+  s.element_dissipates.resize(count);
+  for (std::size_t e = 0; e < count; ++e) {
+    const StoredEnergy stored = element_stored_energy(e, y);
+    s.element_elastic[e] = stored.stored;
+    s.element_dissipates[e] = stored.dissipates;
+    s.element_work_done[e] = quadratures[kFirstElementWork + static_cast<int>(e)];
+    s.elastic += stored.stored;
+  }
   if (penalty && constraint_rows() > 0) {
     std::vector<double> phi(static_cast<std::size_t>(constraint_rows()));
     constraints(y, phi.data(), nullptr);
-    for (std::size_t row = 0; row < phi.size(); ++row) s.elastic += 0.5 * penalty->stiffness[row] * phi[row] * phi[row];
+    for (std::size_t row = 0; row < phi.size(); ++row)
+      s.penalty_elastic += 0.5 * penalty->stiffness[row] * phi[row] * phi[row];
+    s.elastic += s.penalty_elastic;
   }
   s.load_work = quadratures[kLoadWork];
-  s.element_work = quadratures[kPenaltyWork];
-  for (std::size_t e = 0; e < model_.elements().size(); ++e)
-    s.element_work += quadratures[kFirstElementWork + static_cast<int>(e)];
+  s.penalty_work = quadratures[kPenaltyWork];
+  s.element_work = s.penalty_work;
+  for (std::size_t e = 0; e < count; ++e) s.element_work += s.element_work_done[e];
   return s;
 }
 
 double DaeSystem::element_potential_energy(std::size_t e, const double* y) const {
   return model_.elements()[e]->potential_energy(local_state(e, y, y + body_unknowns()));
+}
+
+DaeSystem::StoredEnergy DaeSystem::element_stored_energy(std::size_t e, const double* y) const {
+  const Element& el = *model_.elements()[e];
+  const ElementState<double> s = local_state(e, y, y + body_unknowns());
+  return {el.potential_energy(s), !el.conservative(s)};
 }
 
 void DaeSystem::roots(double t, const double* y, double* g, double* outputs) const {

@@ -343,6 +343,143 @@ bool project_positions(const DaeSystem& system, std::vector<double>& y) {
   return false;
 }
 
+/// One thing that pushes on a body's component in a static state [force] or [force*length].
+struct ForceShare {
+  std::string who;  // "element 'front' (crush_spring, line 12)", "gravity", "load (line 20)"
+  double value;
+};
+
+/// What pushes on every body unknown k (3 body + component) at the static state y: gravity,
+/// each load, each element on the body (its forces, a joint's reaction -G^T lambda and its
+/// friction). Row k's sum is minus the residual's force row k.
+std::vector<std::vector<ForceShare>> forces_on_every_row(const DaeSystem& system, const std::vector<double>& y) {
+  const Model& model = system.model();
+  const int nq = system.body_unknowns();
+  const std::size_t count = model.elements().size();
+  std::vector<std::vector<ForceShare>> shares(static_cast<std::size_t>(nq));
+  const auto row_of = [&](int body, int component) -> std::vector<ForceShare>& {
+    return shares[static_cast<std::size_t>(3 * body + component)];
+  };
+  for (int b = 0; b < model.body_count(); ++b) {
+    const double mass = model.bodies()[static_cast<std::size_t>(b)].mass;
+    row_of(b, 0).push_back({"gravity", mass * model.gravity_x});
+    row_of(b, 1).push_back({"gravity", mass * model.gravity_y});
+  }
+  for (const Load& load : model.loads()) {
+    const int b = load.body;
+    const std::array<double, 2> value = load.value.at(0.0);
+    Pose<double> generalized{};
+    if (load.kind == Load::Kind::Moment) {
+      generalized.theta = value[0];
+    } else {
+      const Pose<double> pose{y[static_cast<std::size_t>(3 * b)], y[static_cast<std::size_t>(3 * b + 1)],
+                              y[static_cast<std::size_t>(3 * b + 2)]};
+      add_point_force(pose, load.sx, load.sy, Vec2<double>{value[0], value[1]}, generalized);
+    }
+    const std::string who = std::string(load.kind == Load::Kind::Moment ? "moment load" : "load") +
+                            (load.where.line > 0 ? " (line " + std::to_string(load.where.line) + ")" : "");
+    row_of(b, 0).push_back({who, generalized.x});
+    row_of(b, 1).push_back({who, generalized.y});
+    row_of(b, 2).push_back({who, generalized.theta});
+  }
+  // Each element's generalized forces on its slots' bodies, then the joints' reactions.
+  std::vector<std::array<Pose<double>, 2>> on_slots(count);
+  for (std::size_t e = 0; e < count; ++e) on_slots[e] = system.element_load(static_cast<int>(e), 0.0, y.data()).force;
+  std::vector<int> owner_of_row(static_cast<std::size_t>(system.constraint_rows()), -1);
+  for (std::size_t e = 0; e < count; ++e)
+    for (int r = 0; r < model.elements()[e]->constraint_count(); ++r)
+      owner_of_row[static_cast<std::size_t>(model.constraint_offset(e) + r)] = static_cast<int>(e);
+  if (system.constraint_rows() > 0) {
+    std::vector<double> phi(static_cast<std::size_t>(system.constraint_rows()));
+    std::vector<DaeSystem::Triplet> gradient;
+    system.constraints(y.data(), phi.data(), &gradient);
+    for (const DaeSystem::Triplet& g : gradient) {
+      if (!system.constraint_row_active(g.row)) continue;
+      const auto e = static_cast<std::size_t>(owner_of_row[static_cast<std::size_t>(g.row)]);
+      const Element& el = *model.elements()[e];
+      const int body = g.col / 3, component = g.col % 3;
+      const std::size_t slot = el.slot_body(0) == body ? 0 : 1;
+      const double reaction = -g.value * y[static_cast<std::size_t>(2 * nq + g.row)];
+      Pose<double>& f = on_slots[e][slot];
+      (component == 0 ? f.x : component == 1 ? f.y : f.theta) += reaction;
+    }
+  }
+  for (std::size_t e = 0; e < count; ++e) {
+    const Element& el = *model.elements()[e];
+    const std::string who = "element '" + el.name() + "' (" + el.type() +
+                            (el.where().line > 0 ? ", line " + std::to_string(el.where().line) : std::string()) + ")";
+    for (std::size_t slot = 0; slot < 2; ++slot) {
+      const int b = el.slot_body(static_cast<int>(slot));
+      if (b == kGround || (slot == 1 && el.slot_body(0) == b)) continue;  // (both slots on one body: once)
+      Pose<double> f = on_slots[e][slot];
+      if (slot == 0 && el.slot_body(1) == b) f = {f.x + on_slots[e][1].x, f.y + on_slots[e][1].y, f.theta + on_slots[e][1].theta};
+      row_of(b, 0).push_back({who, f.x});
+      row_of(b, 1).push_back({who, f.y});
+      row_of(b, 2).push_back({who, f.theta});
+    }
+  }
+  return shares;
+}
+
+/// Why the settle stopped short: the largest unbalance (a force row, in the model's terms:
+/// body, direction, value and what pushes there, largest first; or a joint's gap), instead of
+/// assuming gravity. r: the residual at the state; shares: forces_on_every_row there.
+std::string unsettled_message(const DaeSystem& system, const std::vector<double>& r,
+                              const EquilibriumReport& report, double force_scale,
+                              const std::vector<std::vector<ForceShare>>& shares) {
+  const Model& model = system.model();
+  const int nq = system.body_unknowns(), m = system.constraint_rows();
+  const double length = model.length_scale();
+  // Largest part of the unbalance measure: a force row over the force scale (moments over
+  // length times it), or a joint row over the length scale.
+  int worst = 0;
+  double worst_measure = -1.0;
+  for (int k = 0; k < nq + m; ++k) {
+    const double value = std::abs(r[static_cast<std::size_t>(nq + k)]);
+    const double measure = k < nq ? value / (force_scale * (k % 3 == 2 ? length : 1.0)) : value / length;
+    if (measure > worst_measure) worst = k, worst_measure = measure;
+  }
+  std::ostringstream msg;
+  msg << "no static equilibrium found: after " << report.steps << " steps ";
+  if (worst >= nq) {
+    const int row = worst - nq;
+    const Element& joint = system.constraint_owner(row);
+    int first_row = 0;  // the joint's first constraint row
+    for (std::size_t e = 0; e < model.elements().size(); ++e)
+      if (model.elements()[e].get() == &joint) first_row = model.constraint_offset(e);
+    msg << "the largest unbalance is a gap: " << joint.where().prefix() << "joint '" << joint.name() << "' ("
+        << joint.type() << ") is open by " << r[static_cast<std::size_t>(2 * nq + row)] << " in its constraint row "
+        << row - first_row + 1 << "; check that its points can meet with the other joints closed, or set "
+        << "static_equilibrium: false to start from the given positions";
+    return msg.str();
+  }
+  const Body& body = model.bodies()[static_cast<std::size_t>(worst / 3)];
+  static const char* const kDirection[3] = {"x", "y", "theta"};
+  const char* direction = kDirection[worst % 3];
+  const double unbalanced = -r[static_cast<std::size_t>(nq + worst)];
+  msg << "the largest unbalanced " << (worst % 3 == 2 ? "moment" : "force") << " is " << unbalanced << " in " << direction
+      << " on " << body.where.prefix() << "body '" << body.name << "' (the settle's force scale is " << force_scale
+      << ", its tolerance 1e-10 of that). On that body in " << direction << ":";
+  std::vector<ForceShare> list = shares[static_cast<std::size_t>(worst)];
+  std::stable_sort(list.begin(), list.end(),
+                   [](const ForceShare& a, const ForceShare& b) { return std::abs(a.value) > std::abs(b.value); });
+  std::size_t shown = 0;
+  for (const ForceShare& s : list) {
+    if (s.value == 0.0 || shown == 5) continue;
+    msg << (shown++ ? ", " : " ") << s.who << " " << s.value;
+  }
+  if (shown == 0) msg << " nothing";
+  if (shown < list.size()) {
+    std::size_t rest = 0;
+    for (const ForceShare& s : list) rest += s.value != 0.0;
+    if (rest > shown) msg << " and " << rest - shown << " more";
+  }
+  msg << ". Nothing in the model balances these in " << direction
+      << " (a missing spring, joint, contact or wheel in that direction has no equilibrium; so has a load no element "
+         "resists); set static_equilibrium: false to start from the given positions";
+  return msg.str();
+}
+
 }  // namespace
 
 EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<double>& y,
@@ -484,18 +621,24 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
   }
   current = unbalance(y, &report.residual_force);
   if (current > tolerance) {
-    int worst = 0;
-    for (int k = 0; k < nq; ++k)
-      if (std::abs(r[static_cast<std::size_t>(nq + k)]) * (k % 3 == 2 ? 1.0 / length : 1.0) >
-          std::abs(r[static_cast<std::size_t>(nq + worst)]) * (worst % 3 == 2 ? 1.0 / length : 1.0))
-        worst = k;
-    std::ostringstream msg;
-    msg << "no static equilibrium found: after " << report.steps << " steps the largest unbalanced force is "
-        << report.residual_force << ", on body '" << system.model().bodies()[static_cast<std::size_t>(worst / 3)].name << "' ("
-        << (worst % 3 == 0 ? "x" : worst % 3 == 1 ? "y" : "moment / length scale") << "; the weights total " << force_scale
-        << "). A body with nothing to hold it against gravity (a missing wheel, spring or joint) "
-        << "has no equilibrium; set static_equilibrium: false to start from the given positions";
-    throw SolverError(msg.str());
+    // Is what is left round-off? Each force row is a sum of what gravity, the loads, the
+    // elements and the joints' reactions put on one body component; where those are large
+    // (preloaded springs, stiff contacts pressed together), that sum cannot come out closer to
+    // zero than about 1e-16 of them. A force row within 1e-10 of its own sum of magnitudes
+    // (the settle's relative tolerance, on the forces that meet there) is balanced.
+    std::vector<double> unbalanced(static_cast<std::size_t>(nq)), magnitude(static_cast<std::size_t>(nq));
+    const std::vector<std::vector<ForceShare>> shares = forces_on_every_row(system, y);
+    bool round_off = true;
+    for (int k = 0; k < nq; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      unbalanced[kk] = -r[static_cast<std::size_t>(nq + k)];
+      for (const ForceShare& s : shares[kk]) magnitude[kk] += std::abs(s.value);
+      if (std::abs(unbalanced[kk]) > 1e-10 * std::max(magnitude[kk], force_scale * (k % 3 == 2 ? length : 1.0)))
+        round_off = false;
+    }
+    for (int row = 0; row < m; ++row)
+      if (std::abs(r[static_cast<std::size_t>(2 * nq + row)]) > tolerance * length) round_off = false;
+    if (!round_off) throw SolverError(unsettled_message(system, r, report, force_scale, shares));
   }
   for (int k = 0; k < nq; ++k)
     report.largest_position_change = std::max(report.largest_position_change,

@@ -208,8 +208,10 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   }
   if (o.stats.stability_limit > 0.0)
     std::printf("euler step %.4g, stability limit %.4g\n", o.stats.last_step, o.stats.stability_limit);
-  std::printf("energy balance error %.3g (kinetic %.6g, elastic %.6g, gravity %.6g, dissipated %.6g, external work %.6g)\n",
-              energy.error(), energy.kinetic, energy.elastic, energy.gravity, energy.dissipated, energy.external_work);
+  std::printf("energy: kinetic %.6g, elastic %.6g, gravity %.6g, dissipated %.6g, external work %.6g; integration drift "
+              "%.3g of the initial %.6g (energy the integration lost, no element's)\n",
+              energy.kinetic, energy.elastic, energy.gravity, energy.dissipated, energy.external_work,
+              energy.integration_drift(), energy.initial_total);
   std::printf("largest constraint residual %.3g\n", o.max_constraint_residual);
   if (report.has_responses) {
     const Responses& r = report.responses;

@@ -558,7 +558,8 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"energy\": {\"kinetic\": " << json_number(energy.kinetic) << ", \"elastic\": " << json_number(energy.elastic)
     << ", \"gravity\": " << json_number(energy.gravity) << ", \"dissipated\": " << json_number(energy.dissipated)
     << ", \"external_work\": " << json_number(energy.external_work) << ", \"initial_total\": "
-    << json_number(energy.initial_total) << ", \"balance_error\": " << json_number(energy.error())
+    << json_number(energy.initial_total) << ", \"integration_drift\": " << json_number(energy.integration_drift())
+    << ", \"balance_error\": " << json_number(energy.error())
     << ", \"relative_balance_error\": " << json_number(scale > 0.0 ? energy.error() / scale : 0.0) << "},\n";
   const double ke_integral = outcome.quadratures.empty() ? 0.0 : outcome.quadratures[DaeSystem::kKineticIntegral];
   j << "  \"kinetic_energy_integral\": " << json_number(ke_integral) << ",\n";

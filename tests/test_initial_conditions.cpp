@@ -160,6 +160,74 @@ TEST_CASE("static equilibrium reports a body that nothing holds", "[initial]") {
   CHECK_THROWS_WITH(prepare_start(system, y, events), Catch::Contains("no static equilibrium"));
 }
 
+TEST_CASE("a settle that fails names the body, the direction, the value and what pushes there, not gravity",
+          "[initial]") {
+  // A 100 kg block on a frictionless slider joint along x (the joint carries its weight, 981 N)
+  // and a constant 50 N load along x that nothing resists: no equilibrium. The message must
+  // name the x row of 'block' (line 5), its value, the load (line 9), and must not blame gravity
+  // (it has no x component); the joint, which pushes 0 in x, is not listed among the pushes.
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: s\nunits: SI\nbodies:\n"
+      "  - {name: block, mass: 100, inertia: 1, position: [0, 1]}\n"
+      "elements:\n"
+      "  - {name: rail, type: slider_joint, axis: [1, 0], points: [{body: ground, at: [0, 1]}, {body: block, at: [0, 0]}]}\n"
+      "loads:\n"
+      "  - {type: force, body: block, at: [0, 0], value: [50, 0]}\n"
+      "simulation: {t_end: 1, static_equilibrium: true}\n");
+  DaeSystem system(model);
+  std::vector<double> y;
+  std::vector<EventRecord> events;
+  std::string message = "no error";
+  try {
+    prepare_start(system, y, events);
+  } catch (const SolverError& e) {
+    message = e.what();
+  }
+  INFO(message);
+  CHECK_THAT(message, Catch::Contains("no static equilibrium found") &&
+                          Catch::Contains("the largest unbalanced force is 50 in x on test.yaml:5: body 'block'") &&
+                          Catch::Contains("On that body in x: load (line 9) 50.") &&
+                          Catch::Contains("Nothing in the model balances these in x"));
+  CHECK_THAT(message, !Catch::Contains("gravity"));
+}
+
+TEST_CASE("a settle ends at the round-off of the forces that meet at a body, not of its weight", "[initial]") {
+  // A 1 kg bob (weight 9.8 N) between two springs in tension, 1e12 N/m stretched 0.5 m from the
+  // left and 2e12 N/m stretched 0.25 m from the right (5e11 N each way in x), and a weak spring
+  // pulling 1.3e-5 N to the right. Lengths near 1 m move in steps of 2.2e-16 m, so the two
+  // strong forces change in steps of about 2e-4 N: the x row cannot come closer to zero than
+  // some 1e-5 N, far above 1e-10 of the weight (1e-9 N). The settle used to fail there ("no
+  // static equilibrium"); within 1e-10 of the forces that meet at that row it is balanced.
+  // Equilibrium: x moves by 1.3e-5 / 3e12 m (nothing), y sags by W / (T1 / L1 + T2 / L2) =
+  // 9.80665 / 1e12 m.
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: bob, mass: 1, inertia: 1, position: [0, 0]}\n"
+      "elements:\n"
+      "  - {name: left, type: linear_spring, stiffness: 1.0e12, free_length: 0.5, points: [{body: ground, at: [-1, 0]}, {body: bob, at: [0, 0]}]}\n"
+      "  - {name: right, type: linear_spring, stiffness: 2.0e12, free_length: 0.75, points: [{body: ground, at: [1, 0]}, {body: bob, at: [0, 0]}]}\n"
+      "  - {name: weak, type: linear_spring, stiffness: 1.0e-5, free_length: 3.7, points: [{body: ground, at: [5, 0]}, {body: bob, at: [0, 0]}]}\n"
+      "simulation: {t_end: 1, static_equilibrium: true}\n");
+  DaeSystem system(model);
+  std::vector<double> y;
+  std::vector<EventRecord> events;
+  REQUIRE_NOTHROW(prepare_start(system, y, events));
+  CHECK(std::abs(y[0]) < 1e-15);
+  CHECK(y[1] == Approx(-9.80665 / 1.0e12).epsilon(1e-6));
+}
+
+TEST_CASE("a settle that fails in y lists gravity among what pushes there", "[initial]") {
+  // A free 2 kg stone: gravity (-19.6133 N in y) is the one push, and the message says so.
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: stone, mass: 2, inertia: 1, position: [0, 1]}\n"
+      "simulation: {t_end: 1, static_equilibrium: true}\n");
+  DaeSystem system(model);
+  std::vector<double> y;
+  std::vector<EventRecord> events;
+  CHECK_THROWS_WITH(prepare_start(system, y, events),
+                    Catch::Contains("the largest unbalanced force is -19.6133 in y on test.yaml:5: body 'stone'") &&
+                        Catch::Contains("On that body in y: gravity -19.6133."));
+}
+
 TEST_CASE("static equilibrium settles onto the kink of a stop spring", "[initial]") {
   // A 100 kg block on a linear spring "adjusted for load": free length 1 + W / k, so the
   // spring alone carries the weight W = 981 N at length 1.0, exactly where a stop spring

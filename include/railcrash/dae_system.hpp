@@ -57,9 +57,18 @@ struct EnergyState {
   double gravity = 0.0;       // potential of gravity, -sum m g . r
   double element_work = 0.0;  // work done on elements (and penalties) by the bodies
   double load_work = 0.0;     // work done by applied loads
+  // Per element: stored energy, work done on it (its quadrature), and whether it can dissipate
+  // in the state's mode (not Element::conservative); then the same for Euler's penalty joints.
+  std::vector<double> element_elastic, element_work_done;
+  std::vector<char> element_dissipates;
+  double penalty_elastic = 0.0, penalty_work = 0.0;
 };
 
 /// Energy balance between a start state and now [force*length].
+/// dissipated sums, over the elements that can dissipate (Element::conservative false at
+/// `now`) and Euler's penalty joints, the work done on them less the change of their stored
+/// energy; a conservative element dissipates nothing by construction. What the balance then
+/// leaves over is the integration's error, not any element's: integration_drift().
 struct EnergyBalance {
   double kinetic = 0.0;
   double elastic = 0.0;       // stored in elements (and penalty springs)
@@ -67,7 +76,12 @@ struct EnergyBalance {
   double dissipated = 0.0;    // by elements (and penalty dampers)
   double external_work = 0.0; // done by applied loads
   double initial_total = 0.0;
-  double error() const { return kinetic + elastic + gravity + dissipated - initial_total - external_work; }
+  /// Energy the integration lost: initial_total + external_work - (kinetic + elastic + gravity
+  /// + dissipated) [force*length]; zero for an exact solution, positive when the numerical
+  /// solution lost energy. For a model of conservative elements, initial - final total energy.
+  double integration_drift() const { return initial_total + external_work - (kinetic + elastic + gravity + dissipated); }
+  /// The same with the opposite sign (energy gained), as summary.json's balance_error.
+  double error() const { return -integration_drift(); }
   static EnergyBalance between(const EnergyState& start, const EnergyState& now);
 };
 
@@ -176,6 +190,13 @@ class DaeSystem {
   /// Element e's stored elastic energy at the state y [force*length], its bodies' rotations from
   /// the same cache as every sweep (an output row has computed them already).
   double element_potential_energy(std::size_t e, const double* y) const;
+  /// The same and whether the element can dissipate in its current mode (not
+  /// Element::conservative), from one local state.
+  struct StoredEnergy {
+    double stored = 0.0;      // [force*length]
+    bool dissipates = true;
+  };
+  StoredEnergy element_stored_energy(std::size_t e, const double* y) const;
 
   // ---- modes and events ----
   int root_count() const { return root_count_; }

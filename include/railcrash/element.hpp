@@ -212,6 +212,14 @@ class Element {
   // ---- energy and output ----
   /// Energy stored in the element [force*length].
   virtual double potential_energy(const ElementState<double>& /*s*/) const { return 0.0; }
+  /// True when the element, in the state's mode, dissipates nothing by construction: its
+  /// forces are minus the gradient of potential_energy (an elastic spring, a joint without
+  /// friction), so the work done on it and the change of its stored energy differ only by the
+  /// integration's error. Its dissipation is then zero and that difference is reported as the
+  /// run's integration drift (EnergyBalance). The default, false, is for elements that can
+  /// dissipate (dampers, friction, crush, plasticity, fracture): their dissipation is the work
+  /// done on them less the change of their stored energy.
+  virtual bool conservative(const ElementState<double>& /*s*/) const { return false; }
   /// Names of the quantities this element adds to timeseries.csv (without the element prefix).
   virtual std::vector<std::string> output_names() const { return {}; }
   /// Which of those outputs play which role (OutputRole); most elements have none.
@@ -358,6 +366,8 @@ class ConstraintElement : public Element {
                        std::array<Pose<double>, 2>& f) const override {
     static_cast<const Derived*>(this)->joint_force_law(t, s, lambda, f);
   }
+  /// A joint's reactions do no work on an assembled state; only its friction dissipates.
+  bool conservative(const ElementState<double>& /*s*/) const override { return !has_joint_force(); }
 
   void add_joint_force_jacobian(double t, const ElementState<double>& s, const double* lambda,
                                 std::array<Pose<double>, 2>& f, ForceBlock& df_dq, ForceBlock& df_dv,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 namespace railcrash {
@@ -19,6 +20,31 @@ CrushSpring::CrushSpring(ElementSpec& spec)
       spec.parameters->fail("curve", "'curve' point " + std::to_string(k + 1) + ": crush values must increase strictly");
     curve_crush.push_back(crush);
     curve_force.push_back(force);
+  }
+  // Unloading from a crush d_max on a segment of slope s follows the line of slope
+  // unloading_stiffness k_u through (d_max, F(d_max)); just below d_max that line lies above the
+  // curve exactly when k_u < s (F(d_max) - k_u e > F(d_max) - s e for a small e > 0), and when
+  // k_u >= every slope it never rises above the curve (F(d_max) - F(d) <= k_u (d_max - d)). Every
+  // segment can be reached (the last one continues without end), so the rule is k_u >= the
+  // steepest slope; otherwise unloading would carry more force than crushing did and store more
+  // energy than the work done on the element (a negative dissipation). Within 1e-9 of the
+  // slope counts as equal (a curve and stiffness converted between units round differently; the
+  // scenario generator's check, src/scenario/en15227.cpp, allows the same).
+  int steepest = 0;
+  for (int k = 1; k + 1 < static_cast<int>(curve_crush.size()); ++k)
+    if (segment_slope(k) > segment_slope(steepest)) steepest = k;
+  const double steepest_slope = segment_slope(steepest);
+  unloading_above_curve = *spec.parameters->flag("unloading_above_curve");
+  if (unloading_stiffness < steepest_slope * (1.0 - 1e-9) && !unloading_above_curve) {
+    std::ostringstream what;
+    what.precision(6);
+    what << "'unloading_stiffness' " << unloading_stiffness << " is below the slope " << steepest_slope
+         << " of its curve between points " << steepest + 1 << " and " << steepest + 2 << " (crush "
+         << curve_crush[static_cast<std::size_t>(steepest)] << " to " << curve_crush[static_cast<std::size_t>(steepest + 1)]
+         << "): unloading from that segment would rise above the loading curve. The unloading stiffness must be at least "
+            "the curve's steepest slope: give unloading_stiffness >= "
+         << steepest_slope << ", or make the curve less steep there";
+    spec.parameters->fail("unloading_stiffness", what.str());
   }
 }
 
@@ -175,7 +201,12 @@ void register_crush_elements(ElementRegistry& registry) {
                 {{"curve", Unit::LengthForceCurve, required, Range::NonNegative,
                   "loading curve [[crush, force], ...], crush strictly increasing, at least two points", Shape::Table},
                  {"unloading_stiffness", Unit::ForcePerLength, required, Range::Positive,
-                  "slope of elastic unloading and reloading"},
+                  "slope of elastic unloading and reloading, at least the curve's steepest slope"},
+                 {"unloading_above_curve", Unit::Choice, default_flag(false), Range::Any,
+                  "true: accept an unloading_stiffness below the curve's steepest slope (unloading from those "
+                  "segments rises above the curve and stores more than the work done on it: a negative "
+                  "dissipation); for a model that says so, never by default",
+                  Shape::Flag},
                  {"tension_stiffness", Unit::ForcePerLength, optional("no force in tension"), Range::Positive,
                   "slope in tension beyond the permanent crush"},
                  {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::Positive,

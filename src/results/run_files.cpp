@@ -99,7 +99,7 @@ EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile* file) : system
   dissipated_.assign(types_.size(), 0.0);
   columns_ = {"t", "kinetic", "elastic", "gravity", "external_work", "dissipated"};
   for (const std::string& type : types_) columns_.push_back("dissipated." + type);
-  columns_.push_back("balance_error");
+  columns_.push_back("integration_drift");
   if (!file_) return;
   for (std::size_t k = 0; k < columns_.size(); ++k) file_->text((k ? "," : "") + columns_[k]);
   file_->character('\n');
@@ -116,11 +116,12 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   if (first_) initial_elastic_.assign(model.elements().size(), 0.0);
   double elastic = 0.0;
   for (std::size_t e = 0; e < model.elements().size(); ++e) {
-    const double stored = system_.element_potential_energy(e, y);
-    if (first_) initial_elastic_[e] = stored;
-    elastic += stored;
+    const DaeSystem::StoredEnergy energy = system_.element_stored_energy(e, y);
+    if (first_) initial_elastic_[e] = energy.stored;
+    elastic += energy.stored;
+    if (!energy.dissipates) continue;  // conservative: its work less its stored energy is drift
     const double work = quadratures ? quadratures[DaeSystem::kFirstElementWork + static_cast<int>(e)] : 0.0;
-    dissipated_[static_cast<std::size_t>(type_of_element_[e])] += work - (stored - initial_elastic_[e]);
+    dissipated_[static_cast<std::size_t>(type_of_element_[e])] += work - (energy.stored - initial_elastic_[e]);
   }
   if (model.constraint_rows() > 0 && quadratures) dissipated_.back() += quadratures[DaeSystem::kPenaltyWork];
   if (first_) {
@@ -131,10 +132,10 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   double dissipated = 0.0;
   for (double d : dissipated_) dissipated += d;
   const double gravity = gravity_potential - initial_gravity_;
-  const double balance = kinetic + elastic + gravity + dissipated - initial_total_ - load_work;
+  const double drift = initial_total_ + load_work - (kinetic + elastic + gravity + dissipated);
   row_.assign({t, kinetic, elastic, gravity, load_work, dissipated});
   row_.insert(row_.end(), dissipated_.begin(), dissipated_.end());
-  row_.push_back(balance);
+  row_.push_back(drift);
   if (!file_) return;
   for (std::size_t k = 0; k < row_.size(); ++k) {
     if (k > 0) file_->character(',');

@@ -149,6 +149,48 @@ TEST_CASE("crush spring input errors name the problem", "[elements][crush]") {
   CHECK_THAT(message("[[0, 0, 1], [1, 2, 3]]"), Catch::Contains("test.yaml:") && Catch::Contains("curve"));
 }
 
+TEST_CASE("crush spring: an unloading stiffness below the curve's steepest slope is refused with the slope needed",
+          "[elements][crush]") {
+  // impact()'s unloading_stiffness 1e7 N/m sits on line 12 of test.yaml. Curve slopes: 1e7, then
+  // 2e7 between points 2 and 3 (crush 0.01 to 0.02), then 0: unloading from a crush between 0.01
+  // and 0.02 along 1e7 N/m would rise above the curve (at d_max - e the line gives
+  // F(d_max) - 1e7 e, the curve F(d_max) - 2e7 e).
+  const auto load = [](const std::string& curve, const std::string& unloading) {
+    std::string text = impact(10.0, 0.5, "ida");
+    const std::string good = "[[0, 0], [0.01, 1.0e5], [1.0, 1.0e5]]";
+    text.replace(text.find(good), good.size(), curve);
+    const std::string stiffness = "unloading_stiffness: 1.0e7";
+    text.replace(text.find(stiffness), stiffness.size(), "unloading_stiffness: " + unloading);
+    return testing::model_from_text(text);
+  };
+  const std::string steep = "[[0, 0], [0.01, 1.0e5], [0.02, 3.0e5], [1.0, 3.0e5]]";
+  std::string message = "no error";
+  try {
+    load(steep, "1.0e7");
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  CHECK_THAT(message, Catch::Contains("test.yaml:12:") && Catch::Contains("'crush'") &&
+                          Catch::Contains("'unloading_stiffness' 1e+07 is below the slope 2e+07 of its curve between "
+                                          "points 2 and 3 (crush 0.01 to 0.02)") &&
+                          Catch::Contains("give unloading_stiffness >= 2e+07"));
+  // Equal to the steepest slope: the line runs along that segment, never above the curve.
+  CHECK_NOTHROW(load(steep, "2.0e7"));
+  // Within 1e-9 of it counts as equal: a curve and a stiffness converted between units differ by
+  // round-off (the EN 15227 scenario's buffers: 6214924.1632110123 against 6214924.163211023).
+  CHECK_NOTHROW(load(steep, "1.99999999999e7"));
+  CHECK_THROWS(load(steep, "1.9999999e7"));
+  // A model that says, at the element, that it accepts it (models/barrier: reading 6).
+  CHECK_NOTHROW(load(steep, "1.0e7\n    unloading_above_curve: true"));
+  // A softening curve (peak, then a falling force): the rising slope 1e7 is the steepest; a
+  // falling segment never asks for more.
+  CHECK_NOTHROW(load("[[0, 0], [0.01, 1.0e5], [0.05, 0.5e5], [1.0, 0.5e5]]", "1.0e7"));
+  // The last segment continues without end, so its slope counts as well.
+  CHECK_THROWS_WITH(load("[[0, 0], [0.01, 0.5e5], [0.02, 1.5e5]]", "8.0e6"),
+                    Catch::Contains("below the slope 1e+07 of its curve between points 2 and 3") &&
+                        Catch::Contains("give unloading_stiffness >= 1e+07"));
+}
+
 TEST_CASE("the run's element states: a snapshot restored undoes a commit and its history", "[elements][crush]") {
   const Model model = testing::model_from_text(impact(10.0, 0.0, "ida"));
   DaeSystem system(model);

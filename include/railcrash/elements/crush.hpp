@@ -17,6 +17,12 @@
 //                         leaves when d > d_p (contact again: elastic, or loading if the
 //                         structure has never been crushed)
 // Roots are written positive inside their mode (element.hpp's convention).
+// The loader refuses an unloading_stiffness below the curve's steepest segment slope: from a
+// crush on such a segment the unloading line would rise above the loading curve (more force
+// unloading than crushing, more energy stored than the work done). Equal to it (within 1e-9 of
+// it, for unit conversions' round-off) is accepted. A model that sets unloading_above_curve:
+// true is accepted all the same: it says so where the element is written (energy.csv then
+// shows the crush springs' negative dissipation while they unload from those segments).
 // Elastic energy is P^2 / (2 unloading_stiffness) (what unloading would give back); the
 // rest of the work done on the element is dissipated in crushing.
 #pragma once
@@ -39,6 +45,7 @@ class CrushSpring : public ForceElement<CrushSpring> {
   double unloading_stiffness;           // [force/length]
   std::optional<double> tension_stiffness;  // [force/length]; none: no tension
   std::optional<double> free_length;    // [length]; default: initial length
+  bool unloading_above_curve = false;   // accept unloading_stiffness below the steepest slope (see above)
 
   enum class Mode { Loading, Elastic, Open };
   struct State {

@@ -251,6 +251,8 @@ class NonlinearSpring : public PiecewiseLineElement<NonlinearSpring> {
   Event segment_event(int from, int to, double x) const;
 
   double potential_energy(const ElementState<double>& s) const override { return law_integral(s); }
+  /// Elastic until it breaks; breaking releases (dissipates) the energy it held.
+  bool conservative(const ElementState<double>& s) const override { return !mode_as<SegmentMode>(s).broken; }
   std::vector<std::string> output_names() const override { return {"force", "deformation"}; }  // tension positive
 };
 
@@ -343,6 +345,8 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
   Event segment_event(int from, int to, double x) const;
 
   double potential_energy(const ElementState<double>& s) const override { return law_integral(s); }
+  /// Elastic until it breaks; breaking releases (dissipates) the energy it held.
+  bool conservative(const ElementState<double>& s) const override { return !mode_as<SegmentMode>(s).broken; }
   // force >= 0 in the working direction (kind 1: compression, kind 2: tension)
   std::vector<std::string> output_names() const override { return {"force", "deflection"}; }
 

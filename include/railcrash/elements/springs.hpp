@@ -72,6 +72,7 @@ class LinearSpring : public ForceElement<LinearSpring> {
   }
   void initialize(const ElementState<double>& initial) override;
   double potential_energy(const ElementState<double>& s) const override;
+  bool conservative(const ElementState<double>& /*s*/) const override { return true; }
   std::vector<std::string> output_names() const override { return {"force", "deformation"}; }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 };
@@ -111,6 +112,7 @@ class TorsionalSpring : public ForceElement<TorsionalSpring> {
   bool applies_moment() const override { return true; }
   void initialize(const ElementState<double>& initial) override;
   double potential_energy(const ElementState<double>& s) const override;
+  bool conservative(const ElementState<double>& /*s*/) const override { return true; }
   std::vector<std::string> output_names() const override { return {"moment", "rotation"}; }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 };

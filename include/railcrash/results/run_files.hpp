@@ -10,10 +10,14 @@
 //                          accelerations v' of results.hpp, unfiltered, at every output row.
 //   DIR/energy.csv         t, kinetic, elastic, gravity (change from t = 0), external_work,
 //                          dissipated, then dissipated.<element type> for each type present,
-//                          then balance_error = kinetic + elastic + gravity + dissipated -
-//                          (initial kinetic + elastic) - external_work [energy]. The dissipation of
-//                          an element is the work done on it less the change of its stored
-//                          energy; under Euler the penalty joints are one more class, `penalty`.
+//                          then integration_drift = (initial kinetic + elastic) + external_work
+//                          - (kinetic + elastic + gravity + dissipated) [energy]: what the
+//                          integration lost, attributed to no element. The dissipation of an
+//                          element that can dissipate (Element::conservative false) is the work
+//                          done on it less the change of its stored energy; a conservative one
+//                          (elastic springs, frictionless joints) dissipates exactly zero. Under
+//                          Euler the penalty joints are one more class, `penalty` (their work:
+//                          their springs' stored energy is not in `elastic` here).
 #pragma once
 
 #include <string>

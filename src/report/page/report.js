@@ -134,7 +134,7 @@
       row("t reached", fmt(summary.t_reached) + " s");
       row("wall time, steps, events", fmt(s.wall_seconds, 3) + " s, " + s.steps + " steps, " + s.events + " events");
       var e = summary.energy || {};
-      row("energy balance error", fmt(e.balance_error, 3) + " " + energyUnit + " (" + fmt(100 * (e.relative_balance_error || 0), 3) + " % of the energy turned over)");
+      row("integration drift (energy lost)", fmt(e.integration_drift !== undefined ? e.integration_drift : -e.balance_error, 3) + " " + energyUnit + " (" + fmt(-100 * (e.relative_balance_error || 0), 3) + " % of the energy turned over; no element's dissipation)");
       var r = summary.responses;
       if (r) {
         row("R1 (crush), R2 (override), R3", fmt(r.R1) + ", " + fmt(r.R2) + ", " + fmt(r.R3));
@@ -561,7 +561,7 @@
   else (function energyPlot() {
     // Stacked areas: kinetic, elastic, gravity change, dissipated by element type; lines:
     // initial energy + external work (the top of the stack when the balance closes) and the
-    // balance error on its own axis.
+    // integration drift (energy the integration lost, attributed to no element) on its own axis.
     var spec = data.energy;
     var byName = {};
     spec.series.forEach(function (s) { byName[s.name] = s.values; });
@@ -591,13 +591,13 @@
       if (k > 0) bands.push({series: [k + 1, k], fill: fills[k % fills.length]});
     });
     if (supply) { columns.push(supply); series.push({label: "initial + external work", stroke: "#555", width: 1.5, dash: [8, 4]}); }
-    if (byName.balance_error) { columns.push(byName.balance_error); series.push({label: "balance error (right axis)", stroke: "#000", width: 1, dash: [2, 2], scale: "error"}); }
+    if (byName.integration_drift) { columns.push(byName.integration_drift); series.push({label: "integration drift (right axis)", stroke: "#000", width: 1, dash: [2, 2], scale: "error"}); }
     var box = el("div", {"class": "plot"});
     energyBox.appendChild(box);
     var u = new uPlot({
       title: "Energy partition [" + energyUnit + "] (stacked areas)", width: 900, height: 380,
       scales: {x: {time: false}, y: {range: function (u, min, max) { return [Math.min(0, min), max + 0.02 * Math.abs(max - Math.min(0, min))]; }}, error: {}},
-      axes: [{label: "t [s]"}, {label: energyUnit, size: 80}, {scale: "error", side: 1, label: "balance error", size: 80, grid: {show: false}}],
+      axes: [{label: "t [s]"}, {label: energyUnit, size: 80}, {scale: "error", side: 1, label: "integration drift", size: 80, grid: {show: false}}],
       series: series, bands: bands, legend: {live: true},
       cursor: {sync: {key: "railcrash-time"}}, hooks: {draw: [timeMarker]}
     }, columns, box);
