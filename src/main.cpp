@@ -31,6 +31,7 @@
 #include "railcrash/report/report.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/version.hpp"
+#include "railcrash/whole_file.hpp"
 
 #include <sstream>
 #include <thread>
@@ -282,13 +283,11 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   std::string table = write_sensitivity(result, design, out_dir);
   if (design.reference && !result.central && result.base.ok) {
     const std::string comparison = comparison_markdown(result, design);
-    std::ofstream file(std::filesystem::path(out_dir) / "comparison.md");
-    file << "# The study against the design's published results\n\n";
+    std::string text = "# The study against the design's published results\n\n";
     if (result.interrupted)
-      file << "**Interrupted after " << result.runs_finished << " of " << result.runs_total
-           << " runs**: the runs not finished have no results here.\n\n";
-    file << comparison;
-    if (!file) throw std::runtime_error("cannot write " + (std::filesystem::path(out_dir) / "comparison.md").string());
+      text += "**Interrupted after " + std::to_string(result.runs_finished) + " of " + std::to_string(result.runs_total) +
+              " runs**: the runs not finished have no results here.\n\n";
+    write_whole_file((std::filesystem::path(out_dir) / "comparison.md").string(), text + comparison);
     table += "\n" + comparison;
   }
   std::fputs(table.c_str(), stdout);
@@ -336,7 +335,7 @@ int readings_command(const std::string& path, const std::string& design_option, 
               results.size(), results.empty() ? 0 : 1 + results.front().study.runs.size() + results.front().study.second_order_runs.size(),
               options.study.jobs, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed,
               out_dir.c_str());
-  const std::size_t planned = plan.combinations().size();
+  const std::size_t planned = plan.combination_count().value_or(0);
   const std::size_t complete = static_cast<std::size_t>(
       std::count_if(results.begin(), results.end(), [](const ReadingsCombinationResult& r) { return !r.study.interrupted; }));
   if (complete < planned)
@@ -415,9 +414,7 @@ int write_generated_model(const std::string& text, const std::string& out_path, 
     std::fputs(text.c_str(), stdout);
     return 0;
   }
-  std::ofstream file(out_path);
-  file << text;
-  if (!file) throw railcrash::InputError("cannot write " + out_path + "; check that its folder exists");
+  railcrash::write_whole_file(out_path, text);
   std::fprintf(stderr, "%s written to %s\n", what.c_str(), out_path.c_str());
   return 0;
 }
