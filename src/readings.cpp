@@ -495,7 +495,7 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
   const std::optional<std::size_t> combination_count = plan.combination_count();
   const std::size_t runs_each = sensitivity_run_count(design, options.study);
   require_run_count(multiply_counts(combination_count, runs_each), options.study.max_runs,
-                    plan.path + ": " + (combination_count ? std::to_string(*combination_count) : std::string("too many")) +
+                    plan.path + ": " + (combination_count ? std::to_string(*combination_count) : "more than " + std::to_string(std::numeric_limits<std::size_t>::max())) +
                         " combinations of the readings x " + std::to_string(runs_each) + " runs each");
   const std::atomic<bool>* stop = options.study.stop;
   const auto stopped = [stop] { return stop && stop->load(); };
