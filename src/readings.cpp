@@ -100,7 +100,7 @@ double spearman_correlation(const std::vector<double>& a, const std::vector<doub
 std::optional<std::size_t> ReadingsPlan::combination_count() const {
   if (one_at_a_time) {
     std::optional<std::size_t> count = 1;
-    for (const Reading& r : readings) count = add_counts(count, r.levels.size() - 1);
+    for (const Reading& r : readings) count = add_counts(count, r.levels.empty() ? 0 : r.levels.size() - 1);
     return count;
   }
   std::vector<std::size_t> level_counts;
