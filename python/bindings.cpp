@@ -10,6 +10,9 @@
 #include <pybind11/stl.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
+#include <future>
 #include <map>
 #include <thread>
 #include <tuple>
@@ -47,18 +50,51 @@ py::dict sensitivity_run_dict(const railcrash::SensitivityRun& run) {
   return row;
 }
 
+/// Runs work() on a thread of its own while this thread, holding the GIL between waits, looks
+/// for Python's signals every 100 ms. On Ctrl-C (PyErr_CheckSignals raises KeyboardInterrupt) it
+/// raises `stop`, as the command line's SIGINT handler raises its flag: the runs in progress stop
+/// at their next step and no new run starts. It waits for work to end and raises the
+/// KeyboardInterrupt; the partial result is dropped.
+template <typename Work>
+auto until_interrupted(std::atomic<bool>& stop, Work work) -> decltype(work()) {
+  auto done = std::async(std::launch::async, std::move(work));
+  while (true) {
+    {
+      py::gil_scoped_release release;
+      if (done.wait_for(std::chrono::milliseconds(100)) == std::future_status::ready) break;
+    }
+    if (PyErr_CheckSignals() != 0) {
+      stop = true;
+      {
+        py::gil_scoped_release release;
+        done.wait();
+      }
+      try {
+        (void)done.get();
+      } catch (...) {  // the interruption is what the caller hears of
+      }
+      throw py::error_already_set();
+    }
+  }
+  return done.get();
+}
+
 /// `railcrash sweep`: (columns of runs.csv, each run's fields as text; runs not done left out).
 std::pair<std::vector<std::string>, std::vector<std::vector<std::string>>> sweep(const std::string& model_path,
                                                                                  const std::string& plan_path, int jobs,
                                                                                  const std::string& out_dir, bool resume,
                                                                                  double run_limit) {
-  py::gil_scoped_release release;
-  const railcrash::SweepPlan plan = railcrash::load_sweep_plan(plan_path, model_path);
-  railcrash::SweepOptions options;
-  options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  options.resume = resume;
-  options.run_time_limit = run_limit;
-  const railcrash::SweepResult result = railcrash::run_sweep(model_path, plan, out_dir, options);
+  std::atomic<bool> stop{false};
+  railcrash::SweepPlan plan;
+  const railcrash::SweepResult result = until_interrupted(stop, [&] {
+    plan = railcrash::load_sweep_plan(plan_path, model_path);
+    railcrash::SweepOptions options;
+    options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    options.resume = resume;
+    options.run_time_limit = run_limit;
+    options.stop = &stop;
+    return railcrash::run_sweep(model_path, plan, out_dir, options);
+  });
   std::vector<std::vector<std::string>> rows;
   for (const auto& line : result.lines)
     if (line) rows.push_back(railcrash::csv_fields(*line));
@@ -68,10 +104,9 @@ std::pair<std::vector<std::string>, std::vector<std::vector<std::string>>> sweep
 /// The first-order study of `railcrash sensitivity`: rows of runs and of fitted A_i.
 py::dict sensitivity(const std::string& model_path, const std::string& design, int jobs, const std::vector<std::string>& only,
                      bool second_order, double central, double run_limit) {
-  railcrash::SensitivityResult result;
   railcrash::SensitivityDesign loaded;
-  {
-    py::gil_scoped_release release;
+  std::atomic<bool> stop{false};
+  const railcrash::SensitivityResult result = until_interrupted(stop, [&] {
     const std::string path = design == "report" ? railcrash::default_design_path(model_path) : design;
     loaded = railcrash::load_design(path);
     railcrash::SensitivityOptions options;
@@ -80,8 +115,9 @@ py::dict sensitivity(const std::string& model_path, const std::string& design, i
     options.second_order = second_order;
     options.central_step = central;
     options.run_time_limit = run_limit;
-    result = railcrash::run_sensitivity(model_path, loaded, options);
-  }
+    options.stop = &stop;
+    return railcrash::run_sensitivity(model_path, loaded, options);
+  });
   py::list runs;
   runs.append(sensitivity_run_dict(result.base));
   for (const auto& r : result.runs) runs.append(sensitivity_run_dict(r));

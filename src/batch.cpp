@@ -10,6 +10,7 @@
 #include <sstream>
 #include <memory>
 #include <mutex>
+#include <system_error>
 #include <thread>
 
 #include "railcrash/error.hpp"
@@ -116,7 +117,14 @@ class BatchSupervisor {
  public:
   BatchSupervisor(std::vector<std::unique_ptr<RunControl>>& slots, const BatchOptions& options)
       : slots_(slots), options_(options) {
-    if (options.run_time_limit > 0.0 || options.stop) thread_ = std::thread([this] { watch(); });
+    if (options.run_time_limit > 0.0 || options.stop) {
+      try {
+        thread_ = std::thread([this] { watch(); });
+      } catch (const std::system_error& e) {  // not even one more thread: nothing could stop the runs
+        throw std::runtime_error("cannot start the thread that watches the runs' time limit and interrupts (" +
+                                 e.code().message() + "); lower --jobs, or raise the process limit (ulimit -u)");
+      }
+    }
   }
   ~BatchSupervisor() {
     {
@@ -197,8 +205,18 @@ std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void
       }
     }
   };
+  // The threads that can be had: past the process or memory limit (ulimit -u, -v) std::thread
+  // throws; the batch then runs on the threads it has (this one at least) and says so.
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker, std::ref(*slots[t]));
+  for (std::size_t t = 1; t < threads; ++t) {
+    try {
+      pool.emplace_back(worker, std::ref(*slots[t]));
+    } catch (const std::system_error& e) {
+      std::fprintf(stderr, "railcrash: --jobs %zu: only %zu thread%s could be started (%s); running the %zu runs with %zu\n",
+                   threads, t, t == 1 ? "" : "s", e.code().message().c_str(), count, t);
+      break;
+    }
+  }
   worker(*slots[0]);
   for (std::thread& t : pool) t.join();
   return states;

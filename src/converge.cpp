@@ -15,6 +15,7 @@
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/plot.hpp"
+#include "railcrash/whole_file.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/run.hpp"
@@ -816,7 +817,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
   std::error_code error;
   std::filesystem::create_directories(directory, error);
   if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
-  std::ofstream csv(directory + "/converge.csv");
+  std::ostringstream csv;
   csv << "method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events";
   for (const ConvergeQuantity& q : r.quantities) csv << "," << csv_field(q.name) << "," << csv_field(q.name + "_error");
   csv << ",message\n";
@@ -832,7 +833,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
   row(r.reference);
   for (const ConvergeRun& run : r.euler) row(run);
   for (const ConvergeRun& run : r.ida) row(run);
-  if (!csv) throw SolverError("could not write " + directory + "/converge.csv");
+  write_whole_file(directory + "/converge.csv", csv.str());
 
   plot::Figure figure;
   figure.log_x = figure.log_y = true;
@@ -870,7 +871,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
   }
   plot::write_svg(figure, directory + "/converge.svg");
   const std::string md = convergence_markdown(r);
-  std::ofstream(directory + "/converge.md") << md;
+  write_whole_file(directory + "/converge.md", md);
   return md;
 }
 

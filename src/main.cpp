@@ -6,6 +6,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -33,6 +35,7 @@
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/results/run_files.hpp"
 #include "railcrash/version.hpp"
+#include "railcrash/whole_file.hpp"
 
 #include <sstream>
 #include <thread>
@@ -68,6 +71,38 @@ void catch_interrupts() {
                               "build and install railcrash again, or run the sweep without mpirun (--jobs)");
 }
 #endif
+
+/// The one check of every numeric command-line option: a finite number within [low, high]
+/// (an open end excluded). The message names the value and the option's valid range, e.g.
+/// "--speed: 'inf' is not in range: give a finite number greater than 0 and at most 1000 [km/h]"
+/// (CLI11 puts the option's name first). Integer options are checked here for their range and
+/// by CLI11 for being whole.
+CLI::Validator finite_number(double low, double high, bool low_open, bool high_open, const std::string& unit = "") {
+  const auto limit = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return std::string(text);
+  };
+  std::string range = "a finite number";
+  if (std::isfinite(low)) range += (low_open ? " greater than " : " of at least ") + limit(low);
+  if (std::isfinite(high)) range += (std::isfinite(low) ? " and" : "") + std::string(high_open ? " less than " : " at most ") + limit(high);
+  if (!unit.empty()) range += " [" + unit + "]";
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        const char* first = text.c_str();
+        char* end = nullptr;
+        errno = 0;
+        const double value = std::strtod(first, &end);
+        if (end == first || *end != '\0') return "'" + text + "' is not a number: give " + range;
+        const bool inside = std::isfinite(value) && (low_open ? value > low : value >= low) && (high_open ? value < high : value <= high);
+        if (!inside) return "'" + text + "' is not in range: give " + range;
+        return "";
+      },
+      range.substr(2), "finite_number");
+}
+
+constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+constexpr double kMaxJobs = 65536;  // --jobs: threads asked for (batch.cpp runs with those it can have)
 
 int check_command(const std::string& path, const std::vector<std::string>& settings) {
   using namespace railcrash;
@@ -265,7 +300,8 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
 }
 
 int sensitivity_command(const std::string& path, const std::string& design_option, int jobs, double central,
-                        const std::string& only, bool first_order_only, double run_limit, const std::string& out_dir) {
+                        const std::string& only, bool first_order_only, double run_limit, std::size_t max_runs,
+                        const std::string& out_dir) {
   using namespace railcrash;
   check_output_folder(out_dir);
   // "report" (the default): the report's design for this model, sensitivity_design.yaml beside it.
@@ -276,6 +312,7 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   options.central_step = central;
   options.second_order = !first_order_only;
   options.run_time_limit = run_limit;
+  options.max_runs = max_runs;
   options.progress = [](const SensitivityRun& run, std::size_t number, std::size_t done, std::size_t total) {
     std::string varied = run.variation.empty() ? "base" : "";
     for (const auto& [name, value] : run.variation)
@@ -293,13 +330,11 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   std::string table = write_sensitivity(result, design, out_dir);
   if (design.reference && !result.central && result.base.ok) {
     const std::string comparison = comparison_markdown(result, design);
-    std::ofstream file(std::filesystem::path(out_dir) / "comparison.md");
-    file << "# The study against the design's published results\n\n";
+    std::string text = "# The study against the design's published results\n\n";
     if (result.interrupted)
-      file << "**Interrupted after " << result.runs_finished << " of " << result.runs_total
-           << " runs**: the runs not finished have no results here.\n\n";
-    file << comparison;
-    if (!file) throw std::runtime_error("cannot write " + (std::filesystem::path(out_dir) / "comparison.md").string());
+      text += "**Interrupted after " + std::to_string(result.runs_finished) + " of " + std::to_string(result.runs_total) +
+              " runs**: the runs not finished have no results here.\n\n";
+    write_whole_file((std::filesystem::path(out_dir) / "comparison.md").string(), text + comparison);
     table += "\n" + comparison;
   }
   std::fputs(table.c_str(), stdout);
@@ -318,7 +353,7 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
 }
 
 int readings_command(const std::string& path, const std::string& design_option, const std::string& readings_path, int jobs,
-                     bool first_order_only, double run_limit, const std::string& out_dir) {
+                     bool first_order_only, double run_limit, std::size_t max_runs, const std::string& out_dir) {
   using namespace railcrash;
   check_output_folder(out_dir);
   const std::string design_path = design_option == "report" ? default_design_path(path) : design_option;
@@ -328,6 +363,7 @@ int readings_command(const std::string& path, const std::string& design_option, 
   options.study.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options.study.second_order = !first_order_only;
   options.study.run_time_limit = run_limit;
+  options.study.max_runs = max_runs;
   options.progress = [&plan](const ReadingsCombinationResult& r, std::size_t number, std::size_t total) {
     const auto& a = r.agreement.responses;
     std::fprintf(stderr, "[%zu/%zu] %s: R1 %.3f R2 %.3f R3 %.3f; rho R1 %.2f R2 %.2f; goals %d/%d; %d failed; %.0f s\n",
@@ -347,7 +383,7 @@ int readings_command(const std::string& path, const std::string& design_option, 
               results.size(), results.empty() ? 0 : 1 + results.front().study.runs.size() + results.front().study.second_order_runs.size(),
               options.study.jobs, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), failed,
               out_dir.c_str());
-  const std::size_t planned = plan.combinations().size();
+  const std::size_t planned = plan.combination_count().value_or(0);
   const std::size_t complete = static_cast<std::size_t>(
       std::count_if(results.begin(), results.end(), [](const ReadingsCombinationResult& r) { return !r.study.interrupted; }));
   if (complete < planned)
@@ -430,9 +466,7 @@ int write_generated_model(const std::string& text, const std::string& out_path, 
     std::fputs(text.c_str(), stdout);
     return 0;
   }
-  std::ofstream file(out_path);
-  file << text;
-  if (!file) throw railcrash::InputError("cannot write " + out_path + "; check that its folder exists");
+  railcrash::write_whole_file(out_path, text);
   std::fprintf(stderr, "%s written to %s\n", what.c_str(), out_path.c_str());
   return 0;
 }
@@ -448,14 +482,19 @@ std::vector<std::pair<double, double>> parse_curve(const std::string& text, cons
   std::vector<std::pair<double, double>> points;
   std::stringstream items(text);
   std::string item;
+  // Each number whole and finite: a stroke from 0 to 10000 mm, a force from 0 to 1e6 kN.
+  const auto number = [](const std::string& field, double high, double& value) {
+    char* end = nullptr;
+    value = std::strtod(field.c_str(), &end);
+    return !field.empty() && *end == '\0' && std::isfinite(value) && value >= 0.0 && value <= high;
+  };
   while (std::getline(items, item, ',')) {
     const auto colon = item.find(':');
-    try {
-      if (colon == std::string::npos) throw std::invalid_argument(item);
-      points.emplace_back(std::stod(item.substr(0, colon)), std::stod(item.substr(colon + 1)));
-    } catch (const std::exception&) {
-      throw railcrash::InputError(option + ": '" + item + "' is not a point stroke:force (mm:kN), e.g. 0:0,75:600,105:1500");
-    }
+    double stroke = 0.0, force = 0.0;
+    if (colon == std::string::npos || !number(item.substr(0, colon), 10000.0, stroke) || !number(item.substr(colon + 1), 1e6, force))
+      throw railcrash::InputError(option + ": '" + item + "' is not a point stroke:force (mm:kN) with a stroke from 0 to 10000 mm " +
+                                  "and a force from 0 to 1e+06 kN, e.g. 0:0,75:600,105:1500");
+    points.emplace_back(stroke, force);
   }
   return points;
 }
@@ -465,6 +504,13 @@ std::vector<std::pair<double, double>> parse_curve(const std::string& text, cons
 int main(int argc, char** argv) {
   railcrash::set_command_line(argc, argv);  // the runs' provenance
   CLI::App app{"railcrash: planar rail-vehicle crash dynamics (IDA + KLU, or explicit Euler)"};
+  // The ranges of the numeric options (finite_number: every numeric option has one).
+  const CLI::Validator positive = finite_number(0, kUnbounded, true, false);
+  const CLI::Validator tolerance = finite_number(0, 1, true, true);
+  const CLI::Validator seconds = finite_number(0, kUnbounded, false, false, "s");
+  const CLI::Validator job_count = finite_number(0, kMaxJobs, false, false);
+  const CLI::Validator run_limit_count = finite_number(0, 1e18, false, false);
+  std::size_t max_runs = railcrash::kDefaultMaxRuns;
   app.require_subcommand(1);
   app.set_version_flag("--version", railcrash::version_text());
 
@@ -477,7 +523,9 @@ int main(int argc, char** argv) {
   run->add_option("model", model_path, "model file (YAML)")->required();
   run->add_option("--integrator", integrator, "ida or euler (default: the model's)")->check(CLI::IsMember({"ida", "euler"}));
   CLI::Option* t_end_option = run->add_option("--t-end", t_end, "end time");
-  CLI::Option* rtol_option = run->add_option("--rtol", rtol, "ida relative tolerance");
+  // --t-end, --atol, --dt, --output-interval and --max-steps go to the model's simulation keys,
+  // whose check refuses a non-finite or out-of-range value naming the model file (model_io.cpp).
+  CLI::Option* rtol_option = run->add_option("--rtol", rtol, "ida relative tolerance")->check(tolerance);
   CLI::Option* atol_option = run->add_option("--atol", atol, "ida absolute tolerance on lengths");
   CLI::Option* dt_option = run->add_option("--dt", dt, "euler step");
   CLI::Option* output_option = run->add_option("--output-interval", output_interval, "time between output rows");
@@ -508,7 +556,7 @@ int main(int argc, char** argv) {
   CLI::App* report = app.add_subcommand("report", "write RUN_DIR/report.html: header, animation, event log, plots (one self-contained file)");
   report->add_option("run_dir", report_dir, "run folder (the --out of `railcrash run`)")->required();
   report->add_option("--cfc", report_cfc, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000)")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()->check(finite_number(60, 1000, false, false, "Hz"));
 
   std::string design_path = "report", only;
   int jobs = 0;
@@ -521,12 +569,15 @@ int main(int argc, char** argv) {
                           "design file: parameters, what they scale, second-order runs and terms; 'report' = "
                           "sensitivity_design.yaml beside the model")
       ->capture_default_str();
-  sensitivity->add_option("--jobs", jobs, "runs in parallel (default: all cores)");
-  sensitivity->add_option("--central", central, "central differences at 1 +- H instead of the design's factor");
+  sensitivity->add_option("--jobs", jobs, "runs in parallel (default: all cores)")->check(job_count);
+  sensitivity->add_option("--central", central, "central differences at 1 +- H instead of the design's factor")
+      ->check(finite_number(0, 1, true, true));
   sensitivity->add_option("--only", only, "comma-separated parameter names to run");
   sensitivity->add_flag("--first-order", first_order_only, "skip the design's second-order runs and fit");
   sensitivity->add_option("--run-limit", run_limit, "stop a run after this many seconds and report it failed (default: no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(seconds);
+  sensitivity->add_option("--max-runs", max_runs, "refuse a study of more runs than this before it starts (0: no limit)")
+      ->capture_default_str()->check(run_limit_count);
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
 
   std::string readings_path;
@@ -537,10 +588,13 @@ int main(int argc, char** argv) {
   readings->add_option("--readings", readings_path, "readings file (YAML: reading_study: 1, readings: [{name, levels}])")->required();
   readings->add_option("--design", design_path, "design file with a 'reference' section; 'report' = sensitivity_design.yaml beside the model")
       ->capture_default_str();
-  readings->add_option("--jobs", jobs, "runs in parallel (default: all cores)");
+  readings->add_option("--jobs", jobs, "runs in parallel (default: all cores)")->check(job_count);
   readings->add_flag("--first-order", first_order_only, "skip the design's second-order runs");
   readings->add_option("--run-limit", run_limit, "stop a run after this many seconds and report it failed (default: no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(seconds);
+  readings->add_option("--max-runs", max_runs,
+                       "refuse a study of more runs (combinations x runs each) than this before it starts (0: no limit)")
+      ->capture_default_str()->check(run_limit_count);
   readings->add_option("--out", out_dir, "output folder")->capture_default_str();
 
   railcrash::ConvergeOptions converge_options;
@@ -555,23 +609,25 @@ int main(int argc, char** argv) {
                        "acceleration.BODY (peak CFC-60 acceleration magnitude); default: the first six")
       ->delimiter(',');
   converge->add_option("--euler-steps", converge_options.euler_runs, "number of Euler runs: dt_0 and its halvings (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()->check(finite_number(0, 60, false, false));
   converge->add_option("--euler-safety", converge_options.euler_safety, "dt_0 = this x the Euler stability limit")
-      ->capture_default_str();
-  converge->add_option("--euler-dt", converge_options.euler_first_step, "first Euler step instead (must be stable)");
-  converge->add_option("--rtols", converge_options.rtols, "comma list of IDA tolerances")->delimiter(',')->capture_default_str();
-  converge->add_option("--reference-rtol", converge_options.reference_rtol, "IDA reference tolerance")->capture_default_str();
-  CLI::Option* converge_t_end = converge->add_option("--t-end", t_end, "end time (default: the model's)");
-  CLI::Option* converge_output = converge->add_option("--output-interval", output_interval, "time between samples (default: the model's)");
+      ->capture_default_str()->check(finite_number(0, 1, true, true));
+  converge->add_option("--euler-dt", converge_options.euler_first_step, "first Euler step instead (must be stable)")->check(positive);
+  converge->add_option("--rtols", converge_options.rtols, "comma list of IDA tolerances")->delimiter(',')->capture_default_str()->check(tolerance);
+  converge->add_option("--reference-rtol", converge_options.reference_rtol, "IDA reference tolerance")->capture_default_str()->check(tolerance);
+  CLI::Option* converge_t_end = converge->add_option("--t-end", t_end, "end time (default: the model's)")->check(positive);
+  CLI::Option* converge_output =
+      converge->add_option("--output-interval", output_interval, "time between samples (default: the model's)")->check(positive);
   converge->add_option("--headline", converge_options.headline, "quantity for the cost ratio (default: the first applicable)");
   converge->add_option("--levels", converge_options.levels, "comma list of relative error levels for the cost ratio")
-      ->delimiter(',')->capture_default_str();
+      ->delimiter(',')->capture_default_str()->check(finite_number(0, 1, true, false));
   converge->add_option("--jobs", converge_options.jobs,
-                       "runs in parallel (default 1: parallel load makes the wall times noisier)")->capture_default_str();
+                       "runs in parallel (default 1: parallel load makes the wall times noisier)")->capture_default_str()
+      ->check(finite_number(1, kMaxJobs, false, false));
   converge->add_option("--run-timeout", converge_options.run_time_limit,
                        "stop a run after this many seconds of wall time and report it failed (0: no limit; IDA is stopped "
                        "at its next output time)")
-      ->capture_default_str();
+      ->capture_default_str()->check(seconds);
   converge->add_option("--out", converge_out, "output folder")->capture_default_str();
   converge->add_option("--set", settings, "override a model key (KEY=VALUE or KEY*=FACTOR)");
 
@@ -581,9 +637,9 @@ int main(int argc, char** argv) {
                                                 "run lists): DIR/runs.csv and summary.md; under mpirun the runs go to all ranks");
   sweep->add_option("model", model_path, "model file (YAML)")->required();
   sweep->add_option("--plan", plan_path, "plan file (YAML: sweep: 1, design, factors, responses; README \"Sweeps\")")->required();
-  sweep->add_option("--jobs", jobs, "runs in parallel on this machine (default: all cores)");
+  sweep->add_option("--jobs", jobs, "runs in parallel on this machine (default: all cores)")->check(job_count);
   sweep->add_option("--run-limit", run_limit, "stop a run after this many seconds and record it failed (default: no limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(seconds);
   sweep->add_flag("--resume", resume, "keep the rows of DIR/runs.csv whose run is in the plan (by hash) and run the rest");
   sweep->add_flag("--keep-runs", keep_runs, "also write each run's files to DIR/runs/NNNN/");
   sweep->add_option("--out", out_dir, "output folder")->capture_default_str();
@@ -593,7 +649,7 @@ int main(int argc, char** argv) {
   CLI::App* consist = app.add_subcommand("consist", "write a model of N coupled striking cars into N standing cars, "
                                                     "built from a two-car model (car1_* striking, car2_* standing)");
   consist->add_option("model", model_path, "two-car template, e.g. models/report/final_two_car.yaml")->required();
-  consist->add_option("--cars", consist_cars, "cars per consist")->capture_default_str()->check(CLI::Range(1, 100000));
+  consist->add_option("--cars", consist_cars, "cars per consist")->capture_default_str()->check(finite_number(1, 100000, false, false));
   consist->add_option("--out", consist_out, "model file to write (default: standard output)");
 
   railcrash::ScenarioRequest scenario_request;
@@ -601,10 +657,11 @@ int main(int argc, char** argv) {
   std::map<std::string, double> scenario_values;
   CLI::App* scenario = app.add_subcommand("scenario", "write a model of an EN 15227 design collision scenario (1, 2 or 3) "
                                                       "built from a car model, with the criteria evaluated after the run");
-  scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon, 3: deformable obstacle)")->required();
+  scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon, 3: deformable obstacle)")
+      ->required()->check(finite_number(1, 4, false, false));
   scenario->add_option("--train", scenario_request.train_path, "two-car template (car1_* striking, e.g. models/report/final_two_car.yaml) or a model whose bodies declare their cars (e.g. models/barrier/two_car_barrier.yaml)")
       ->required();
-  scenario->add_option("--cars", scenario_request.cars, "cars per train")->capture_default_str()->check(CLI::Range(1, 1000));
+  scenario->add_option("--cars", scenario_request.cars, "cars per train")->capture_default_str()->check(finite_number(1, 1000, false, false));
   scenario->add_option("--category", scenario_request.category, "C-I, C-II, C-III or C-IV")->capture_default_str();
   scenario->add_option("--passenger-bodies", scenario_request.passenger_bodies,
                        "comma list of the passenger-area bodies (template names without car1_), e.g. center_body")->delimiter(',');
@@ -613,24 +670,36 @@ int main(int argc, char** argv) {
   scenario->add_option("--crush-zones", scenario_request.crush_zones,
                        "comma list of crush elements whose crush is allowed (left out of the survival-space loss)")->delimiter(',');
   scenario->add_option("--buffer-curve", buffer_curve, "scenario 2: one side buffer's force-stroke curve mm:kN,mm:kN,...");
-  scenario->add_option("--wagon-mass", scenario_request.wagon_mass, "scenario 2: wagon mass [t]")->capture_default_str();
+  scenario->add_option("--wagon-mass", scenario_request.wagon_mass, "scenario 2: wagon mass [t]")->capture_default_str()
+      ->check(finite_number(0, 10000, true, false, "t"));
   scenario->add_option("--obstacle-curve", obstacle_curve, "scenario 3: the obstacle's force-crush curve mm:kN,mm:kN,... (required)");
-  scenario->add_option("--obstacle-mass", scenario_request.obstacle_mass, "scenario 3: obstacle mass [t]")->capture_default_str();
-  for (const auto& [option, help] : std::vector<std::pair<std::string, std::string>>{
-           {"--speed", "closing speed [km/h] (default 36 for C-I)"},
-           {"--offset", "scenario 1: vertical offset of the standing train [mm] (required)"},
-           {"--deceleration-limit", "mean longitudinal deceleration limit [g] (required)"},
-           {"--survival-space-limit", "largest allowed shortening of the survival space [mm] (required)"},
-           {"--override-limit", "largest allowed vertical relative displacement at the interface [mm] (required)"},
-           {"--wheel-lift-limit", "largest allowed wheel lift of the leading bogies [mm] (required)"},
-           {"--buffer-unloading-stiffness", "scenario 2: one buffer's unloading stiffness [kN/mm] (required)"},
-           {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)"},
-           {"--face-stiffness", "scenario 1 from a model declaring its cars: each front face's stiffness [kN/mm] (required)"},
-           {"--face-height", "scenario 1 from a model declaring its cars: each front face's height [mm] (required)"},
-           {"--obstacle-unloading-stiffness", "scenario 3: the obstacle's unloading stiffness [kN/mm] (required)"},
-           {"--obstacle-height", "scenario 3: height of the obstacle's contact point above the rail [mm] (required)"},
-           {"--t-end", "end time of the run [s] (default: the train model's)"}})
-    scenario->add_option(option, scenario_values[option], help);
+  scenario->add_option("--obstacle-mass", scenario_request.obstacle_mass, "scenario 3: obstacle mass [t]")->capture_default_str()
+      ->check(finite_number(0, 10000, true, false, "t"));
+  // Each value's valid range: speeds up to 1000 km/h, lengths within 10 m, decelerations up to
+  // 100 g, stiffnesses up to 1e6 kN/mm, run times up to 1000 s (EN 15227's collisions last a
+  // fraction of a second).
+  struct ScenarioValue {
+    const char* option;
+    const char* help;
+    CLI::Validator range;
+  };
+  const CLI::Validator length_mm = finite_number(0, 10000, false, false, "mm");
+  const CLI::Validator stiffness = finite_number(0, 1e6, true, false, "kN/mm");
+  for (const ScenarioValue& value : std::vector<ScenarioValue>{
+           {"--speed", "closing speed [km/h] (default 36 for C-I)", finite_number(0, 1000, true, false, "km/h")},
+           {"--offset", "scenario 1: vertical offset of the standing train [mm] (required)", length_mm},
+           {"--deceleration-limit", "mean longitudinal deceleration limit [g] (required)", finite_number(0, 100, true, false, "g")},
+           {"--survival-space-limit", "largest allowed shortening of the survival space [mm] (required)", finite_number(0, 10000, true, false, "mm")},
+           {"--override-limit", "largest allowed vertical relative displacement at the interface [mm] (required)", finite_number(0, 10000, true, false, "mm")},
+           {"--wheel-lift-limit", "largest allowed wheel lift of the leading bogies [mm] (required)", finite_number(0, 10000, true, false, "mm")},
+           {"--buffer-unloading-stiffness", "scenario 2: one buffer's unloading stiffness [kN/mm] (required)", stiffness},
+           {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)", length_mm},
+           {"--face-stiffness", "scenario 1 from a model declaring its cars: each front face's stiffness [kN/mm] (required)", stiffness},
+           {"--face-height", "scenario 1 from a model declaring its cars: each front face's height [mm] (required)", length_mm},
+           {"--obstacle-unloading-stiffness", "scenario 3: the obstacle's unloading stiffness [kN/mm] (required)", stiffness},
+           {"--obstacle-height", "scenario 3: height of the obstacle's contact point above the rail [mm] (required)", length_mm},
+           {"--t-end", "end time of the run [s] (default: the train model's)", finite_number(0, 1000, true, false, "s")}})
+    scenario->add_option(value.option, scenario_values[value.option], value.help)->check(value.range);
   scenario->add_option("--out", scenario_out, "model file to write (default: standard output)");
 
   CLI::App* check = app.add_subcommand("check", "validate a model and print a summary");
@@ -687,8 +756,8 @@ int main(int argc, char** argv) {
     if (*sweep && railcrash::launched_by_mpi()) exec_mpi_program(argv);
 #endif
     if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, out_dir);
-    if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, out_dir);
-    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, out_dir);
+    if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, max_runs, out_dir);
+    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
     if (*t_end_option) overrides.t_end = t_end;

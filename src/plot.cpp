@@ -3,6 +3,8 @@
 // a legend. Coordinates are computed here; the SVG is plain text.
 #include "railcrash/plot.hpp"
 
+#include "railcrash/whole_file.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -193,10 +195,7 @@ void write_svg(const Figure& figure, const std::filesystem::path& path) {
   }
   svg << "</svg>\n";
 
-  std::ofstream file(path);
-  if (!file) throw std::runtime_error("cannot write the plot " + path.string());
-  file << svg.str();
-  if (!file) throw std::runtime_error("writing the plot " + path.string() + " failed");
+  write_whole_file(path.string(), svg.str());
 }
 
 }  // namespace railcrash::plot

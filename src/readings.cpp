@@ -17,7 +17,9 @@
 #include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/run_count.hpp"
 #include "railcrash/table_text.hpp"
+#include "railcrash/whole_file.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -95,31 +97,46 @@ double spearman_correlation(const std::vector<double>& a, const std::vector<doub
   return sab / std::sqrt(saa * sbb);
 }
 
-std::vector<std::vector<int>> ReadingsPlan::combinations() const {
-  std::vector<std::vector<int>> list;
-  const std::vector<int> first(readings.size(), 0);
+std::optional<std::size_t> ReadingsPlan::combination_count() const {
   if (one_at_a_time) {
-    list.push_back(first);
-    for (std::size_t r = 0; r < readings.size(); ++r)
-      for (std::size_t l = 1; l < readings[r].levels.size(); ++l) {
-        std::vector<int> c = first;
-        c[r] = static_cast<int>(l);
-        list.push_back(c);
+    std::optional<std::size_t> count = 1;
+    for (const Reading& r : readings) count = add_counts(count, r.levels.empty() ? 0 : r.levels.size() - 1);
+    return count;
+  }
+  std::vector<std::size_t> level_counts;
+  for (const Reading& r : readings) level_counts.push_back(r.levels.size());
+  return readings.empty() ? std::optional<std::size_t>(1) : factorial_count(level_counts);
+}
+
+std::vector<int> ReadingsPlan::combination(std::size_t index) const {
+  std::vector<int> c(readings.size(), 0);
+  if (one_at_a_time) {
+    if (index == 0) return c;
+    std::size_t rest = index - 1;
+    for (std::size_t r = 0; r < readings.size(); ++r) {
+      const std::size_t others = readings[r].levels.size() - 1;  // the reading's levels after the first
+      if (rest < others) {
+        c[r] = static_cast<int>(rest + 1);
+        return c;
       }
-    return list;
-  }
-  std::vector<int> c = first;
-  while (true) {
-    list.push_back(c);
-    std::size_t r = readings.size();
-    while (r > 0) {  // odometer, last reading fastest
-      --r;
-      if (++c[r] < static_cast<int>(readings[r].levels.size())) break;
-      c[r] = 0;
-      if (r == 0) return list;
+      rest -= others;
     }
-    if (readings.empty()) return list;
+    RAILCRASH_DEMAND(false);  // index beyond combination_count()
   }
+  for (std::size_t r = readings.size(); r-- > 0;) {  // the last reading changes fastest
+    const std::size_t levels = readings[r].levels.size();
+    c[r] = static_cast<int>(index % levels);
+    index /= levels;
+  }
+  return c;
+}
+
+std::vector<std::vector<int>> ReadingsPlan::combinations() const {
+  const std::optional<std::size_t> count = combination_count();
+  RAILCRASH_DEMAND(count.has_value());
+  std::vector<std::vector<int>> list;
+  for (std::size_t k = 0; k < *count; ++k) list.push_back(combination(k));
+  return list;
 }
 
 std::vector<std::string> ReadingsPlan::settings(const std::vector<int>& combination) const {
@@ -236,10 +253,15 @@ ReadingsPlan load_readings(const std::string& path) {
   return plan;
 }
 
-void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
+bool check_readings(const ReadingsPlan& plan, const std::string& model_path, const std::atomic<bool>* stop) {
   const std::string text = read_model_text(model_path);
+  const auto stopped = [stop] { return stop && stop->load(); };
+  const std::optional<std::size_t> count = plan.combination_count();
+  // (run_readings holds the study to --max-runs first; here only a count beyond std::size_t is refused)
+  require_run_count(count, std::numeric_limits<std::size_t>::max(), plan.path + ": the readings' combinations");
   for (const Reading& reading : plan.readings)
     for (const ReadingLevel& level : reading.levels) {
+      if (stopped()) return false;
       try {
         (void)load_model_text(text, model_path, level.settings);
       } catch (const InputError& e) {
@@ -247,13 +269,16 @@ void check_readings(const ReadingsPlan& plan, const std::string& model_path) {
                          "' does not fit the model: " + e.what());
       }
     }
-  for (const std::vector<int>& combination : plan.combinations()) {
+  for (std::size_t k = 0; k < *count; ++k) {
+    if (stopped()) return false;
+    const std::vector<int> combination = plan.combination(k);
     try {
       (void)load_model_text(text, model_path, plan.settings(combination));
     } catch (const InputError& e) {
       throw InputError(plan.path + ": the combination " + plan.label(combination) + " does not fit the model: " + e.what());
     }
   }
+  return true;
 }
 
 namespace {
@@ -465,37 +490,48 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
   if (!design.reference)
     throw InputError("the design has no 'reference' section (the published results to score against); add one, as "
                      "models/report/sensitivity_design.yaml does");
-  check_readings(plan, model_path);
-  const std::vector<std::vector<int>> combinations = plan.combinations();
+  // The study's size before anything is generated: combinations x runs per combination (the
+  // combinations change the parameters' scalings, never their number).
+  const std::optional<std::size_t> combination_count = plan.combination_count();
+  const std::size_t runs_each = sensitivity_run_count(design, options.study);
+  require_run_count(multiply_counts(combination_count, runs_each), options.study.max_runs,
+                    plan.path + ": " + (combination_count ? std::to_string(*combination_count) : "more than " + std::to_string(std::numeric_limits<std::size_t>::max())) +
+                        " combinations of the readings x " + std::to_string(runs_each) + " runs each");
+  const std::atomic<bool>* stop = options.study.stop;
+  const auto stopped = [stop] { return stop && stop->load(); };
+  if (!check_readings(plan, model_path, stop)) return {};  // interrupted while checking: no run started
+  const std::size_t combinations = *combination_count;
   // Every combination's runs are checked before the first run starts (the first combination's
-  // run by run, the others with all their factors at once: check_sensitivity_inputs).
+  // run by run, the others with all their factors at once: check_sensitivity_inputs), and the
+  // checks stop when the study is interrupted.
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
-  std::vector<SensitivityDesign> designs;
-  for (const std::vector<int>& combination : combinations) {
-    designs.push_back(plan.design_for(combination, design));
+  for (std::size_t c = 0; c < combinations; ++c) {
+    if (stopped()) return {};
+    const std::vector<int> combination = plan.combination(c);
     SensitivityOptions study = options.study;
     study.settings = plan.settings(combination);
     try {
-      check_sensitivity_inputs(model_text, model_path, designs.back(), study, designs.size() == 1);
+      check_sensitivity_inputs(model_text, model_path, plan.design_for(combination, design), study, c == 0);
     } catch (const InputError& e) {
       throw InputError(e.what() + std::string(" (readings ") + plan.path + ", combination " + plan.label(combination) + ")");
     }
   }
   std::vector<ReadingsCombinationResult> results;
-  for (std::size_t c = 0; c < combinations.size(); ++c) {
-    if (options.study.stop && options.study.stop->load()) break;
+  for (std::size_t c = 0; c < combinations; ++c) {
+    if (stopped()) break;
     const auto start = std::chrono::steady_clock::now();
-    SensitivityOptions study = options.study;
-    study.settings = plan.settings(combinations[c]);
     ReadingsCombinationResult r;
-    r.levels = combinations[c];
-    r.study = run_sensitivity(model_path, designs[c], study);
-    r.agreement = score_agreement(r.study, designs[c]);
+    r.levels = plan.combination(c);
+    SensitivityOptions study = options.study;
+    study.settings = plan.settings(r.levels);
+    const SensitivityDesign combination_design = plan.design_for(r.levels, design);
+    r.study = run_sensitivity(model_path, combination_design, study);
+    r.agreement = score_agreement(r.study, combination_design);
     r.failed_runs = r.study.base.ok || r.study.base.interrupted ? 0 : 1;
     for (const auto& run : r.study.runs) r.failed_runs += run.ok || run.interrupted ? 0 : 1;
     for (const auto& run : r.study.second_order_runs) r.failed_runs += run.ok || run.interrupted ? 0 : 1;
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (options.progress) options.progress(r, c, combinations.size());
+    if (options.progress) options.progress(r, c, combinations);
     const bool interrupted = r.study.interrupted;
     results.push_back(std::move(r));
     if (interrupted) break;
@@ -519,7 +555,7 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     return std::string(folder);
   };
 
-  std::ofstream csv(std::filesystem::path(directory) / "readings.csv");
+  std::ostringstream csv;
   csv << "rank,combination";
   for (const Reading& r : plan.readings) csv << "," << csv_text(r.name);
   for (int k = 1; k <= 3; ++k)
@@ -542,11 +578,11 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     csv << "," << r.agreement.goals_met << "," << csv_field(r.agreement.score) << "," << r.failed_runs << ","
         << format(r.wall_seconds, "%.1f") << "\n";
   }
-  if (!csv) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.csv").string());
+  write_whole_file((std::filesystem::path(directory) / "readings.csv").string(), csv.str());
 
   std::ostringstream md;
   md << "# Reading study\n\n";
-  const std::size_t planned = plan.combinations().size();
+  const std::size_t planned = plan.combination_count().value_or(0);
   const std::size_t complete = static_cast<std::size_t>(std::count_if(
       results.begin(), results.end(), [](const ReadingsCombinationResult& r) { return !r.study.interrupted; }));
   if (complete < planned)
@@ -628,18 +664,15 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     md << (missed.empty() ? "none" : missed) << ".\n";
   }
   const std::string text = md.str();
-  std::ofstream out(std::filesystem::path(directory) / "readings.md");
-  out << text;
-  if (!out) throw std::runtime_error("cannot write " + (std::filesystem::path(directory) / "readings.md").string());
+  write_whole_file((std::filesystem::path(directory) / "readings.md").string(), text);
   for (std::size_t c = 0; c < results.size(); ++c) {
     const SensitivityDesign combination_design = plan.design_for(results[c].levels, design);
     const std::filesystem::path run_folder = std::filesystem::path(directory) / folder_of(c);
     write_sensitivity(results[c].study, combination_design, run_folder.string());
     if (!results[c].study.base.ok || results[c].study.central) continue;
-    std::ofstream comparison(run_folder / "comparison.md");
-    comparison << "# " << plan.label(results[c].levels) << ": the study against the published results\n\n"
-               << comparison_markdown(results[c].study, combination_design);
-    if (!comparison) throw std::runtime_error("cannot write " + (run_folder / "comparison.md").string());
+    write_whole_file((run_folder / "comparison.md").string(), "# " + plan.label(results[c].levels) +
+                                                                ": the study against the published results\n\n" +
+                                                                comparison_markdown(results[c].study, combination_design));
   }
   return text;
 }

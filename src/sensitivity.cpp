@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "railcrash/batch.hpp"
+#include "railcrash/run_count.hpp"
+#include "railcrash/whole_file.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
@@ -499,12 +501,21 @@ void check_sensitivity_inputs(const CheckedYamlText& model_text, const std::stri
   // Every run's model, as the run will load it: a scale key the model lacks, a bad value, or a
   // parameter whose model value is 0 (a factor would change nothing, and the study would call it
   // "no effect") stops the study before its first run.
-  for (const Job& job : jobs) check(job_settings(design, job, options.settings), job);
+  for (const Job& job : jobs) {
+    if (options.stop && options.stop->load()) return;  // interrupted: run_sensitivity starts no run
+    check(job_settings(design, job, options.settings), job);
+  }
+}
+
+std::size_t sensitivity_run_count(const SensitivityDesign& design, const SensitivityOptions& options) {
+  std::size_t first_order_count = 0;
+  return study_jobs(design, options, first_order_count).size();
 }
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
                                   const SensitivityOptions& options) {
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);  // once for every run
+  require_run_count(sensitivity_run_count(design, options), options.max_runs, "the sensitivity study");
   check_sensitivity_inputs(model_text, model_path, design, options, true);
   SensitivityResult result;
   result.central = options.central_step > 0.0;
@@ -634,7 +645,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
 
   // Runs: sensitivity.csv, and Table 11 / Tables 12-13 in the Markdown.
   {
-    std::ofstream csv(directory + "/sensitivity.csv");
+    std::ostringstream csv;
     csv << "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message\n";
     std::vector<const SensitivityRun*> all{&result.base};
     for (const SensitivityRun& r : result.runs) all.push_back(&r);
@@ -651,6 +662,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
           << csv_number(r.responses.r1) << ',' << csv_number(r.responses.r2) << ',' << csv_number(r.responses.r3) << ','
           << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << '\n';
     }
+    write_whole_file(directory + "/sensitivity.csv", csv.str());
   }
   md << "## Runs, first order (report Table 11)\n\n"
      << "| Run | Parameter varied | Factor | R1 | R2 | R3 | dR1 % | dR2 % | dR3 % |\n|---|---|---|---|---|---|---|---|---|\n";
@@ -695,12 +707,13 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
 
   // First-order coefficients: equations (1)-(3) and sensitivity_first_order.csv.
   {
-    std::ofstream csv(directory + "/sensitivity_first_order.csv");
+    std::ostringstream csv;
     csv << "term,description,R1,R2,R3\n1,constant A0," << csv_number(result.constant[0]) << ','
         << csv_number(result.constant[1]) << ',' << csv_number(result.constant[2]) << '\n';
     for (std::size_t i = 0; i < result.derivatives.size(); ++i)
       csv << parameter_of(i) << ',' << csv_text(description(parameter_of(i))) << ',' << csv_number(result.derivatives[i][0])
           << ',' << csv_number(result.derivatives[i][1]) << ',' << csv_number(result.derivatives[i][2]) << '\n';
+    write_whole_file(directory + "/sensitivity_first_order.csv", csv.str());
     md << "\n## First-order fit (report equations 1-3)\n\n"
        << (result.central ? "A_i = (R(1+h) - R(1-h)) / 2h" : "A_i = (R(run i) - R(run 0)) / (factor - 1)")
        << ", A0 = R(run 0) - sum A_i; terms that round to 0.000 are left out, as in the report.\n\n```\n";
@@ -720,12 +733,13 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
     return kNaN;
   };
   if (!fit.terms.empty()) {
-    std::ofstream csv(directory + "/sensitivity_second_order.csv");
+    std::ostringstream csv;
     csv << "term,R1,R2,R3\n1," << csv_number(fit.constant[0]) << ',' << csv_number(fit.constant[1]) << ','
         << csv_number(fit.constant[2]) << '\n';
     for (std::size_t k = 0; k < fit.terms.size(); ++k)
       csv << fit.terms[k].label() << ',' << csv_number(fit.coefficients[k][0]) << ',' << csv_number(fit.coefficients[k][1])
           << ',' << csv_number(fit.coefficients[k][2]) << '\n';
+    write_whole_file(directory + "/sensitivity_second_order.csv", csv.str());
     md << "\n## Second-order fit (report Section 4.4, reduced second-order form)\n\n";
     std::string term_list = "1";
     for (const SensitivityTerm& t : fit.terms) term_list += ", " + t.label();
@@ -750,7 +764,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
     }
     md << "```\n\n## Derivatives at the design point, all P = 1 (report Table 14)\n\n"
        << "| Derivative | R1 | R2 | R3 | first order: R1 | R2 | R3 |\n|---|---|---|---|---|---|---|\n";
-    std::ofstream derivatives_csv(directory + "/sensitivity_derivatives.csv");
+    std::ostringstream derivatives_csv;
     derivatives_csv << "derivative,R1,R2,R3,first_order_R1,first_order_R2,first_order_R3\n";
     for (const SensitivityDerivative& d : fit.derivatives) {
       std::array<double, 3> first_order{kNaN, kNaN, kNaN};
@@ -764,10 +778,11 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
                       << csv_number(d.value[2]) << ',' << csv_number(first_order[0]) << ',' << csv_number(first_order[1])
                       << ',' << csv_number(first_order[2]) << '\n';
     }
+    write_whole_file(directory + "/sensitivity_derivatives.csv", derivatives_csv.str());
   }
 
   // Rankings (Tables 15-17): by |first-order coefficient|, as the report ranks them.
-  std::ofstream ranking_csv(directory + "/sensitivity_ranking.csv");
+  std::ostringstream ranking_csv;
   ranking_csv << "response,rank,parameter,description,first_order,second_order_derivative\n";
   static const char* const kTitles[3] = {"Crush sensitivity (R1, report Table 15)", "Override sensitivity (R2, report Table 16)",
                                          "Crush with subsequent override sensitivity (R3, report Table 17)"};
@@ -804,7 +819,8 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
     if (!negligible.empty()) md << "\nNo effect at 3 decimals (|dR/dP| < 0.0005): " << negligible << ".\n";
     if (!failed.empty()) md << "\nNot available (a run failed): " << failed << ".\n";
   }
-  std::ofstream(directory + "/sensitivity.md") << md.str();
+  write_whole_file(directory + "/sensitivity_ranking.csv", ranking_csv.str());
+  write_whole_file(directory + "/sensitivity.md", md.str());
   return md.str();
 }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "railcrash/error.hpp"
 #include "railcrash/readings.hpp"
@@ -60,6 +61,31 @@ TEST_CASE("combinations: factorial odometer and one at a time", "[readings]") {
   REQUIRE(single.size() == 4);  // the first levels, then 1 + 2 other levels alone
   CHECK(single[1] == std::vector<int>{1, 0, 0});
   CHECK(single[3] == std::vector<int>{0, 2, 0});
+}
+
+TEST_CASE("combinations are counted without overflow and generated one at a time in the listed order", "[readings]") {
+  ReadingsPlan plan;
+  plan.readings.resize(3);
+  plan.readings[0].levels.resize(2);
+  plan.readings[1].levels.resize(3);
+  plan.readings[2].levels.resize(4);
+  REQUIRE(plan.combination_count() == std::optional<std::size_t>(24));  // 2 x 3 x 4
+  const auto listed = plan.combinations();
+  for (std::size_t k = 0; k < listed.size(); ++k) CHECK(plan.combination(k) == listed[k]);
+  CHECK(plan.combination(23) == std::vector<int>{1, 2, 3});
+  CHECK(plan.combination(5) == std::vector<int>{0, 1, 1});  // 5 = (0 x 3 + 1) x 4 + 1
+  plan.one_at_a_time = true;
+  REQUIRE(plan.combination_count() == std::optional<std::size_t>(7));  // 1 + 1 + 2 + 3
+  const auto single = plan.combinations();
+  for (std::size_t k = 0; k < single.size(); ++k) CHECK(plan.combination(k) == single[k]);
+  CHECK(plan.combination(6) == std::vector<int>{0, 0, 3});
+  // 64 readings of two levels: 2^64 combinations, one more than std::size_t holds.
+  plan.one_at_a_time = false;
+  plan.readings.assign(64, Reading{});
+  for (Reading& r : plan.readings) r.levels.resize(2);
+  CHECK_FALSE(plan.combination_count().has_value());
+  plan.readings.pop_back();  // 2^63 fits
+  CHECK(plan.combination_count() == std::optional<std::size_t>(std::size_t{1} << 63));
 }
 
 TEST_CASE("a study is scored against published results: errors, signs, rank correlation, top five", "[readings]") {

@@ -47,6 +47,8 @@
 
 #include <array>
 #include <functional>
+#include <atomic>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,8 +77,14 @@ struct ReadingsPlan {
   std::string path;
   std::vector<Reading> readings;
   bool one_at_a_time = false;
-  /// The combinations to run: each one level index per reading.
+  /// The combinations to run: each one level index per reading (all at once: for small plans;
+  /// the study generates them one at a time with combination()).
   std::vector<std::vector<int>> combinations() const;
+  /// How many combinations there are, or nullopt when the number does not fit in std::size_t
+  /// (a factorial over many readings): counted without generating them.
+  std::optional<std::size_t> combination_count() const;
+  /// Combination number `index` (0 <= index < combination_count()) in the order of combinations().
+  std::vector<int> combination(std::size_t index) const;
   /// The model changes of a combination, in reading order.
   std::vector<std::string> settings(const std::vector<int>& combination) const;
   /// "gravity=off, inertia=printed"
@@ -92,7 +100,8 @@ ReadingsPlan load_readings(const std::string& path);
 /// Loads the model with every level's changes (and with each combination's) without running it,
 /// so that a key the model does not have fails before any run starts, naming the readings
 /// file's line.
-void check_readings(const ReadingsPlan& plan, const std::string& model_path);
+/// The checks stop early, returning false, when `stop` rises (SIGINT/SIGTERM); true when all were made.
+bool check_readings(const ReadingsPlan& plan, const std::string& model_path, const std::atomic<bool>* stop = nullptr);
 
 struct ResponseAgreement {
   double value = 0.0, published = 0.0, relative_error = 0.0;  // run 0

@@ -58,6 +58,7 @@
 #include <utility>
 #include <vector>
 
+#include "railcrash/run_count.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/responses.hpp"
 #include "railcrash/yaml_file.hpp"
@@ -184,6 +185,7 @@ struct SensitivityOptions {
   bool second_order = true;          // run the design's second-order runs and fit
   double run_time_limit = 0.0;       // [s] wall time after which a run is stopped and reported failed (0: none)
   const std::atomic<bool>* stop = nullptr;  // raised (SIGINT/SIGTERM): runs in progress stop, no new run starts
+  std::size_t max_runs = kDefaultMaxRuns;  // a study with more runs is refused before it starts (--max-runs; 0: no limit)
   /// Called (one call at a time) as each run finishes: the run, its number (0 = base), runs done, runs in all.
   std::function<void(const SensitivityRun&, std::size_t, std::size_t, std::size_t)> progress;
 };
@@ -195,6 +197,10 @@ struct SensitivityOptions {
 /// (what a reading study does for each of its many combinations), and run by run only if that fails.
 void check_sensitivity_inputs(const CheckedYamlText& model_text, const std::string& model_path, const SensitivityDesign& design,
                               const SensitivityOptions& options, bool every_run);
+
+/// The number of runs the study makes with these options (the base run, the first-order runs,
+/// the second-order runs of the chosen parameters): the design's size, before any run.
+std::size_t sensitivity_run_count(const SensitivityDesign& design, const SensitivityOptions& options);
 
 SensitivityResult run_sensitivity(const std::string& model_path, const SensitivityDesign& design,
                                   const SensitivityOptions& options);

@@ -36,7 +36,7 @@ while IFS= read -r line; do
     read -r -a words <<< "$arguments"
     [[ "$arguments" == *"--out " ]] && words+=("")
   fi
-  output=$(timeout "$seconds_per_case" "$railcrash" "${words[@]}" 2>&1)
+  output=$(timeout -k 5 "$seconds_per_case" "$railcrash" "${words[@]}" 2>&1)
   status=$?
   problem=""
   if [[ $status -gt 2 ]]; then
