@@ -83,8 +83,20 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
     car_of_body.push_back(name.empty() ? -1 : static_cast<int>(car - cars.begin()));
   }
   const auto car_of = [&](int body) { return body == kGround ? -1 : car_of_body[static_cast<std::size_t>(body)]; };
-  // Each car's interface points: its points of crush elements whose other point is not its own.
-  std::vector<std::vector<CarEnd>> interface_points(cars.size());
+  std::vector<double> y0(static_cast<std::size_t>(3 * model.body_count()));  // the model file's positions
+  for (int i = 0; i < model.body_count(); ++i) {
+    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
+    y0[static_cast<std::size_t>(3 * i)] = b.x;
+    y0[static_cast<std::size_t>(3 * i + 1)] = b.y;
+    y0[static_cast<std::size_t>(3 * i + 2)] = b.angle;
+  }
+  // Each car's interface points: its points of crush elements whose other point is not its
+  // own, with the side (-1: towards -x, +1) on which the element's other point lies.
+  struct InterfacePoint {
+    CarEnd end;
+    double side;
+  };
+  std::vector<std::vector<InterfacePoint>> interface_points(cars.size());
   for (const RoleColumn& crush : columns_with_role(system, OutputRole::Crush)) {
     std::vector<int> touched;
     for (int slot = 0; slot < 2; ++slot) {
@@ -99,21 +111,21 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
       car.columns.push_back(crush.column);
       car.shares.push_back(1.0 / static_cast<double>(touched.size()));
       if (within_one_car) continue;
-      for (const PointRef& p : crush.element->points())
-        if (car_of(p.body) == c)
-          interface_points[static_cast<std::size_t>(c)].push_back(
-              CarEnd{p, crush.element->name(), crush.element_index, crush.column, 1.0 / static_cast<double>(touched.size())});
+      const std::vector<PointRef>& points = crush.element->points();
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        if (car_of(points[k].body) != c) continue;
+        double side = 0.0;  // towards the other points of the element (of another car, ground, ...)
+        for (std::size_t other = 0; other < points.size(); ++other)
+          if (car_of(points[other].body) != c) side += point_at(points[other], y0.data())[0] - point_at(points[k], y0.data())[0];
+        interface_points[static_cast<std::size_t>(c)].push_back(InterfacePoint{
+            CarEnd{points[k], crush.element->name(), crush.element_index, crush.column, 1.0 / static_cast<double>(touched.size())},
+            side});
+      }
     }
   }
-  // The ends: on each side of the car's mass centre the outermost interface point, or else the
-  // centre of gravity of the outermost body.
-  std::vector<double> y0(static_cast<std::size_t>(3 * model.body_count()));
-  for (int i = 0; i < model.body_count(); ++i) {
-    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
-    y0[static_cast<std::size_t>(3 * i)] = b.x;
-    y0[static_cast<std::size_t>(3 * i + 1)] = b.y;
-    y0[static_cast<std::size_t>(3 * i + 2)] = b.angle;
-  }
+  // The ends: on each side the outermost interface point facing that way, or else the centre
+  // of gravity of the car's outermost body. An interface point faces the element's other
+  // point; one level with it (a vertical contact) faces away from the car's mass centre.
   for (std::size_t c = 0; c < cars.size(); ++c) {
     CarCrush& car = cars[c];
     double mass = 0.0, moment = 0.0;  // [mass], [mass*length]
@@ -126,9 +138,10 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
       const double sign = side == 0 ? -1.0 : 1.0;  // outward along x
       const CarEnd* outermost = nullptr;
       double reach = 0.0;  // [length] how far out along x
-      for (const CarEnd& p : interface_points[c]) {
-        const double out = sign * (point_at(p.point, y0.data())[0] - centre);
-        if (out > 0.0 && (outermost == nullptr || out > reach)) outermost = &p, reach = out;
+      for (const InterfacePoint& p : interface_points[c]) {
+        const double out = sign * (point_at(p.end.point, y0.data())[0] - centre);
+        const double facing = p.side != 0.0 ? sign * p.side : out;
+        if (facing > 0.0 && (outermost == nullptr || out > reach)) outermost = &p.end, reach = out;
       }
       if (outermost != nullptr) {
         car.ends[static_cast<std::size_t>(side)] = *outermost;

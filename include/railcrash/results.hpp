@@ -47,11 +47,12 @@
 //   crush(t) = L(0) - L(t) + sum over its two ends of share x max(0, crush output(t))
 // L is the distance between the car's ends along the track (x; a pitch or sag of the car is
 // no crush), L(0) that of the run's first state (after any static settle).
-// Each end (towards -x, towards +x of the car's mass centre) is the outermost point at which
-// the car meets the rest of the model through a crush element (OutputRole::Crush: an
-// anticlimber's horizontal_deformation, a crush_spring's crush) whose other point lies on
-// ground, on a body of no car or on another car; an end with no such element is the centre of
-// gravity of the car's outermost body on that side. The car's crush elements within the car
+// Each end (towards -x, towards +x) is the outermost point at which the car meets the rest of
+// the model through a crush element (OutputRole::Crush: an anticlimber's
+// horizontal_deformation, a crush_spring's crush) whose other point lies on ground, on a body
+// of no car or on another car, and which faces that way (its other point lies further that
+// way; level with it, the point lies on that side of the car's mass centre); an end with no
+// such element is the centre of gravity of the car's outermost body on that side. The car's crush elements within the car
 // (both points on its bodies) and its body structure (beams, sills) shorten L and need no
 // term of their own. An interface element's deformation is not in L: the car takes all of an
 // element against ground or a body of no car (a barrier does not crush), and half of one
