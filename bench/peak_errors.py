@@ -62,7 +62,7 @@ def main():
     for name in args.columns.split(","):
         reference = column(ref_header, ref_rows, name)
         scale = max(abs(v) for v in reference)
-        peak = ref_summary["peaks"][name]
+        peak = largest_magnitude(ref_summary["peaks"][name])
         peak_row = min(range(len(ref_times)), key=lambda i: abs(ref_times[i] - peak["t"]))
         print(f"\n{args.model}: {name}; reference rtol {args.reference_rtol}: peak {peak['abs_max']:.9g} at "
               f"t = {peak['t']:.6f} s; output interval {interval}")
@@ -74,10 +74,17 @@ def main():
             values = column(header, rows, name)
             n = min(len(values), len(reference))
             errors = [abs(values[i] - reference[i]) / scale for i in range(n)]
-            p = summary["peaks"][name]
+            p = largest_magnitude(summary["peaks"][name])
             print(f"| {rtol} | {summary['stats']['steps']} | "
                   f"{(p['abs_max'] - peak['abs_max']) / peak['abs_max']:.2e} | {p['t']:.6f} | {max(errors):.2e} | "
                   f"{(sum(e * e for e in errors) / n) ** 0.5:.2e} | {(values[peak_row] - reference[peak_row]) / scale:.2e} |")
+
+
+def largest_magnitude(peak):
+    """The larger |value| of summary.json's signed peaks {max, t_max, min, t_min}, and when."""
+    if abs(peak["max"]) >= abs(peak["min"]):
+        return {"abs_max": abs(peak["max"]), "t": peak["t_max"]}
+    return {"abs_max": abs(peak["min"]), "t": peak["t_min"]}
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -59,6 +60,18 @@ std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole ro
   return columns;
 }
 
+namespace {
+
+/// Global position [length] of a body point at state y (the body's x, y, theta at 3 * body).
+std::array<double, 2> point_at(const PointRef& p, const double* y) {
+  if (p.body == kGround) return {p.sx, p.sy};
+  const double* q = y + 3 * p.body;
+  const double c = std::cos(q[2]), s = std::sin(q[2]);
+  return {q[0] + c * p.sx - s * p.sy, q[1] + s * p.sx + c * p.sy};
+}
+
+}  // namespace
+
 std::vector<CarCrush> cars_of(const DaeSystem& system) {
   const Model& model = system.model();
   std::vector<CarCrush> cars;
@@ -66,30 +79,119 @@ std::vector<CarCrush> cars_of(const DaeSystem& system) {
   for (int i = 0; i < model.body_count(); ++i) {
     const std::string& name = model.bodies()[static_cast<std::size_t>(i)].car;
     auto car = std::find_if(cars.begin(), cars.end(), [&](const CarCrush& c) { return c.car == name; });
-    if (!name.empty() && car == cars.end()) car = cars.insert(cars.end(), CarCrush{name, {}, {}, {}, {}, {}, 0.0, 0.0});
+    if (!name.empty() && car == cars.end()) car = cars.insert(cars.end(), CarCrush{name, {}, {}, {}, {}, {}, {}, 0.0, 0.0, 0.0});
     if (car != cars.end()) car->bodies.push_back(i);
     car_of_body.push_back(name.empty() ? -1 : static_cast<int>(car - cars.begin()));
   }
+  const auto car_of = [&](int body) { return body == kGround ? -1 : car_of_body[static_cast<std::size_t>(body)]; };
+  std::vector<double> y0(static_cast<std::size_t>(3 * model.body_count()));  // the model file's positions
+  for (int i = 0; i < model.body_count(); ++i) {
+    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
+    y0[static_cast<std::size_t>(3 * i)] = b.x;
+    y0[static_cast<std::size_t>(3 * i + 1)] = b.y;
+    y0[static_cast<std::size_t>(3 * i + 2)] = b.angle;
+  }
+  // Each car's interface points: its points of crush elements whose other point is not its
+  // own, with the side (-1: towards -x, +1) on which the element's other point lies.
+  struct InterfacePoint {
+    CarEnd end;
+    double side;
+  };
+  std::vector<std::vector<InterfacePoint>> interface_points(cars.size());
   for (const RoleColumn& crush : columns_with_role(system, OutputRole::Crush)) {
     std::vector<int> touched;
     for (int slot = 0; slot < 2; ++slot) {
-      const int body = crush.element->slot_body(slot);
-      const int car = body == kGround ? -1 : car_of_body[static_cast<std::size_t>(body)];
+      const int car = car_of(crush.element->slot_body(slot));
       if (car >= 0 && std::find(touched.begin(), touched.end(), car) == touched.end()) touched.push_back(car);
     }
+    const bool within_one_car = touched.size() == 1 && car_of(crush.element->slot_body(0)) == car_of(crush.element->slot_body(1));
     for (const int c : touched) {
       CarCrush& car = cars[static_cast<std::size_t>(c)];
       car.elements.push_back(crush.element->name());
       car.element_indices.push_back(crush.element_index);
       car.columns.push_back(crush.column);
       car.shares.push_back(1.0 / static_cast<double>(touched.size()));
+      if (within_one_car) continue;
+      const std::vector<PointRef>& points = crush.element->points();
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        if (car_of(points[k].body) != c) continue;
+        double side = 0.0;  // towards the other points of the element (of another car, ground, ...)
+        for (std::size_t other = 0; other < points.size(); ++other)
+          if (car_of(points[other].body) != c) side += point_at(points[other], y0.data())[0] - point_at(points[k], y0.data())[0];
+        interface_points[static_cast<std::size_t>(c)].push_back(InterfacePoint{
+            CarEnd{points[k], crush.element->name(), crush.element_index, crush.column, 1.0 / static_cast<double>(touched.size())},
+            side});
+      }
     }
+  }
+  // The ends: on each side the outermost interface point facing that way, or else the centre
+  // of gravity of the car's outermost body. An interface point faces the element's other
+  // point; one level with it (a vertical contact) faces away from the car's mass centre.
+  for (std::size_t c = 0; c < cars.size(); ++c) {
+    CarCrush& car = cars[c];
+    double mass = 0.0, moment = 0.0;  // [mass], [mass*length]
+    for (const int i : car.bodies) {
+      mass += model.bodies()[static_cast<std::size_t>(i)].mass;
+      moment += model.bodies()[static_cast<std::size_t>(i)].mass * model.bodies()[static_cast<std::size_t>(i)].x;
+    }
+    const double centre = mass > 0.0 ? moment / mass : model.bodies()[static_cast<std::size_t>(car.bodies.front())].x;
+    for (int side = 0; side < 2; ++side) {
+      const double sign = side == 0 ? -1.0 : 1.0;  // outward along x
+      const CarEnd* outermost = nullptr;
+      double reach = 0.0;  // [length] how far out along x
+      for (const InterfacePoint& p : interface_points[c]) {
+        const double out = sign * (point_at(p.end.point, y0.data())[0] - centre);
+        const double facing = p.side != 0.0 ? sign * p.side : out;
+        if (facing > 0.0 && (outermost == nullptr || out > reach)) outermost = &p.end, reach = out;
+      }
+      if (outermost != nullptr) {
+        car.ends[static_cast<std::size_t>(side)] = *outermost;
+        continue;
+      }
+      int body = car.bodies.front();
+      for (const int i : car.bodies)
+        if (sign * model.bodies()[static_cast<std::size_t>(i)].x > sign * model.bodies()[static_cast<std::size_t>(body)].x) body = i;
+      car.ends[static_cast<std::size_t>(side)] = CarEnd{PointRef{body, 0.0, 0.0}, "", -1, -1, 0.0};
+    }
+    car.initial_length = car_length(car, y0.data());
   }
   return cars;
 }
 
+double car_length(const CarCrush& car, const double* y) {
+  return point_at(car.ends[1].point, y)[0] - point_at(car.ends[0].point, y)[0];  // along the track (x)
+}
+
+double car_crush(const CarCrush& car, const double* y, const double* outputs) {
+  double crush = car.initial_length - car_length(car, y);  // [length]
+  for (const CarEnd& end : car.ends)
+    if (end.column >= 0) crush += end.share * std::max(0.0, outputs[end.column]);
+  return crush;
+}
+
 std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car, const double* y, const double* lambda,
                                    const double* outputs, const FreshOutputs& fresh, std::vector<double>& scratch) {
+  bool all_fresh = true, any_fresh = false, any_column = false;
+  for (const CarEnd& end : car.ends) {
+    if (end.column < 0) continue;
+    any_column = true;
+    all_fresh = all_fresh && fresh.has(end.column);
+    any_fresh = any_fresh || fresh.has(end.column);
+  }
+  if (all_fresh) return car_crush(car, y, outputs);
+  if (any_column && !any_fresh) return std::nullopt;
+  scratch.resize(system.output_names().size());
+  for (const CarEnd& end : car.ends) {
+    if (end.column < 0) continue;
+    if (fresh.has(end.column)) scratch[static_cast<std::size_t>(end.column)] = outputs[end.column];
+    else system.element_outputs(end.element_index, y, lambda, scratch.data());  // at y, here
+  }
+  return car_crush(car, y, scratch.data());
+}
+
+std::optional<double> car_elements_crush_at(const DaeSystem& system, const CarCrush& car, const double* y,
+                                            const double* lambda, const double* outputs, const FreshOutputs& fresh,
+                                            std::vector<double>& scratch) {
   if (fresh.has_all(car.columns)) return shared_crush(outputs, car.columns, car.shares);
   if (std::none_of(car.columns.begin(), car.columns.end(), [&](int column) { return fresh.has(column); }))
     return std::nullopt;
@@ -238,8 +340,10 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
   mean_ax_.assign(body_count, {});
   mean_ay_.assign(body_count, {});
   last_velocity_.assign(2 * body_count, 0.0);
-  peak_output_.assign(system.output_names().size(), 0.0);
-  peak_time_.assign(system.output_names().size(), 0.0);
+  output_max_.assign(system.output_names().size(), -std::numeric_limits<double>::infinity());
+  output_min_.assign(system.output_names().size(), std::numeric_limits<double>::infinity());
+  t_output_max_.assign(system.output_names().size(), 0.0);
+  t_output_min_.assign(system.output_names().size(), 0.0);
   acceleration_.assign(static_cast<std::size_t>(system.body_unknowns()), 0.0);
   acceleration_peaks_.assign(static_cast<std::size_t>(system.model().body_count()), AccelerationPeaks{});
   cars_ = cars_of(system);
@@ -351,12 +455,21 @@ void ResultWriter::step(double t, const double* y, const double* lambda, const d
 
 void ResultWriter::track_extrema(double t, const double* y, const double* lambda, const double* outputs,
                                  const FreshOutputs& fresh) {
-  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(peak_output_.size()); ++k)
-    if (std::abs(outputs[k]) > peak_output_[k]) {
-      peak_output_[k] = std::abs(outputs[k]);
-      peak_time_[k] = t;
+  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(output_max_.size()); ++k) {
+    if (outputs[k] > output_max_[k]) {
+      output_max_[k] = outputs[k];
+      t_output_max_[k] = t;
     }
-  // A car's crush sums several elements' outputs, all of one instant (car_crush_at).
+    if (outputs[k] < output_min_[k]) {
+      output_min_[k] = outputs[k];
+      t_output_min_[k] = t;
+    }
+  }
+  // L(0) from the run's first state, after any static settle or assembly (results.hpp "Car crush").
+  if (!car_lengths_measured_)
+    for (CarCrush& car : cars_) car.initial_length = car_length(car, y);
+  car_lengths_measured_ = true;
+  // A car's crush takes its ends' interface outputs of the state's own instant (car_crush_at).
   for (CarCrush& car : cars_) {
     const std::optional<double> crush = car_crush_at(system_, car, y, lambda, outputs, fresh, crush_scratch_);
     if (crush && *crush > car.max_crush) {
@@ -564,9 +677,10 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   const double ke_integral = outcome.quadratures.empty() ? 0.0 : outcome.quadratures[DaeSystem::kKineticIntegral];
   j << "  \"kinetic_energy_integral\": " << json_number(ke_integral) << ",\n";
   j << "  \"peaks\": {";
-  for (std::size_t k = 0; k < peak_output_.size(); ++k)
-    j << (k ? ", " : "") << json_string(system_.output_names()[k]) << ": {\"abs_max\": " << json_number(peak_output_[k])
-      << ", \"t\": " << json_number(peak_time_[k]) << "}";
+  for (std::size_t k = 0; k < output_max_.size(); ++k)
+    j << (k ? ", " : "") << json_string(system_.output_names()[k]) << ": {\"max\": " << json_number(output_max_[k])
+      << ", \"t_max\": " << json_number(t_output_max_[k]) << ", \"min\": " << json_number(output_min_[k])
+      << ", \"t_min\": " << json_number(t_output_min_[k]) << "}";
   j << "},\n";
   const double g = standard_gravity(model);
   const std::vector<FilteredAccelerations> filtered = filtered_accelerations();
@@ -622,11 +736,24 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "}},\n";
   if (cars_.empty())
     j << "  \"cars_note\": \"no body declares a car (the bodies' car: key in the model file): no per-car crush\",\n";
+  else
+    j << "  \"car_crush_note\": \"each car's shortening between its two ends (initial minus current length along the "
+         "line of the ends at the start), plus all of the crush of an end's crush element against ground or a body of no "
+         "car and half of one between two cars; an end is the car's outermost point on a crush element shared with "
+         "something outside the car, or else the centre of gravity of its outermost body (README, Car crush)\",\n";
   j << "  \"car_crush\": {";
   for (std::size_t c = 0; c < cars_.size(); ++c) {
     const CarCrush& car = cars_[c];
     j << (c ? ", " : "") << json_string(car.car) << ": {\"max_crush\": " << json_number(car.max_crush)
-      << ", \"t\": " << json_number(car.t) << ", \"bodies\": [";
+      << ", \"t\": " << json_number(car.t) << ", \"initial_length\": " << json_number(car.initial_length) << ", \"ends\": [";
+    for (std::size_t k = 0; k < car.ends.size(); ++k) {
+      const CarEnd& end = car.ends[k];
+      j << (k ? ", " : "") << "{\"body\": " << json_string(model.bodies()[static_cast<std::size_t>(end.point.body)].name)
+        << ", \"at\": [" << json_number(end.point.sx) << ", " << json_number(end.point.sy) << "]";
+      if (end.column >= 0) j << ", \"element\": " << json_string(end.element) << ", \"share\": " << json_number(end.share);
+      j << "}";
+    }
+    j << "], \"bodies\": [";
     for (std::size_t k = 0; k < car.bodies.size(); ++k)
       j << (k ? ", " : "") << json_string(model.bodies()[static_cast<std::size_t>(car.bodies[k])].name);
     j << "], \"elements\": [";

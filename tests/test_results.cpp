@@ -3,10 +3,13 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include <yaml-cpp/yaml.h>
 
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
@@ -85,6 +88,19 @@ TEST_CASE("cars are the bodies' car: keys and an element between two cars counts
   CHECK(cars[1].bodies == std::vector<int>{2, 3});
   CHECK(cars[1].elements == std::vector<std::string>{"between", "inside"});
   CHECK(cars[1].shares == std::vector<double>{0.5, 1.0});
+  // Ends: each car meets the other through `between` (half each); its other end is the centre
+  // of gravity of its outermost body. `inside` lies between the struck car's ends.
+  CHECK(cars[0].ends[0].point.body == 0);
+  CHECK(cars[0].ends[0].column < 0);
+  CHECK(cars[0].ends[1].point.body == 1);
+  CHECK(cars[0].ends[1].element == "between");
+  CHECK(cars[0].ends[1].share == 0.5);
+  CHECK(cars[1].ends[0].point.body == 2);
+  CHECK(cars[1].ends[0].element == "between");
+  CHECK(cars[1].ends[1].point.body == 3);
+  CHECK(cars[1].ends[1].column < 0);
+  CHECK(cars[0].initial_length == 2.0);
+  CHECK(cars[1].initial_length == 2.0);
 }
 
 TEST_CASE("a model whose bodies declare no car has no per-car crush, and its summary says why", "[results]") {
@@ -241,9 +257,9 @@ TEST_CASE("JSON strings stay valid UTF-8 and escaped whatever bytes a name or pa
 
 namespace {
 
-/// |value| of summary.json's "peaks" entry of one element output.
+/// Largest value of summary.json's "peaks" entry of one element output.
 double summary_peak(const std::string& summary, const std::string& output) {
-  const std::string key = "\"" + output + "\": {\"abs_max\": ";
+  const std::string key = "\"" + output + "\": {\"max\": ";
   const std::size_t at = summary.find(key, summary.find("\"peaks\""));
   REQUIRE(at != std::string::npos);
   return std::stod(summary.substr(at + key.size()));
@@ -305,9 +321,9 @@ TEST_CASE("the barrier model's crush-element peak is its force-crush curve's pea
 namespace {
 
 /// Passes every call on to a ResultWriter and, at each of them, evaluates every element output
-/// at the state itself: the cars' crush sums from one instant, over all the instants the
-/// writer is shown, over those where it is shown every output of the car's crush elements, and
-/// over those where it is shown at least one of them.
+/// at the state itself: the cars' crush (car_crush) from one instant, over all the instants the
+/// writer is shown, over those where it is shown every output of the car's end elements, and
+/// over those where it is shown at least one of them (every instant for a car without one).
 class CrushWitness : public RunObserver {
  public:
   CrushWitness(const DaeSystem& system, ResultWriter& writer)
@@ -338,35 +354,37 @@ class CrushWitness : public RunObserver {
       else if (outputs[k] != all_[k]) ++fresh_mismatches;  // a column said fresh must be this state's
     }
     partial_calls += full ? 0 : 1;
+    if (!lengths_measured_)  // L(0) from the first state, as the writer takes it
+      for (CarCrush& car : cars_) car.initial_length = car_length(car, y);
+    lengths_measured_ = true;
     for (std::size_t c = 0; c < cars_.size(); ++c) {
-      double crush = 0.0;  // [length]
-      for (std::size_t k = 0; k < cars_[c].columns.size(); ++k)
-        crush += cars_[c].shares[k] * std::max(0.0, all_[static_cast<std::size_t>(cars_[c].columns[k])]);
+      const double crush = car_crush(cars_[c], y, all_.data());  // [length]
+      std::vector<int> end_columns;
+      for (const CarEnd& end : cars_[c].ends)
+        if (end.column >= 0) end_columns.push_back(end.column);
       every_instant_[c] = std::max(every_instant_[c], crush);
-      if (fresh.has_all(cars_[c].columns)) full_instants_[c] = std::max(full_instants_[c], crush);
-      bool touched = false;
-      for (const int column : cars_[c].columns) touched = touched || fresh.has(column);
+      if (fresh.has_all(end_columns)) full_instants_[c] = std::max(full_instants_[c], crush);
+      bool touched = end_columns.empty();
+      for (const int column : end_columns) touched = touched || fresh.has(column);
       if (touched) touched_instants_[c] = std::max(touched_instants_[c], crush);
     }
   }
   const DaeSystem& system_;
   ResultWriter& writer_;
   std::vector<double> all_;
+  bool lengths_measured_ = false;
 };
 
 }  // namespace
 
-TEST_CASE("a car's largest crush is a sum of its crush elements at one instant", "[results]") {
+TEST_CASE("a car's largest crush is of one instant, its interface elements evaluated at located mode changes", "[results]") {
   // At a mode change located inside an IDA step only the changed element's outputs are
-  // evaluated (RunObserver::step's `fresh`). A car's crush sums several elements' outputs, so
-  // at such an instant the writer evaluates the car's other crush elements at that state
-  // (car_crush_at). Scenario 2 of the barrier cars: summing the changed element's new value
-  // with its neighbours' older ones gave the leading car 17.593 in at 0.1334 s, above the
-  // 17.557 in that any one instant of the run reaches. Skipping those instants instead loses
-  // the located ones, where a crush element's mode changes (its unloading starts at its
-  // largest crush).
-  // Scenario 1: the leading cars' largest crush (4.79360 in) is at a located mode change; the
-  // steps' whole sums reach 4.79359 in (0.0917 s).
+  // evaluated (RunObserver::step's `fresh`). A car's crush adds its ends' interface elements'
+  // outputs to its shortening, so at such an instant the writer evaluates them at that state
+  // (car_crush_at) and the crush is of one instant. Scenario 2 of the barrier cars: the
+  // leading car's front end is the wagon's buffers (a crush spring against a body of no car);
+  // scenario 1: the cars meet through coupler faces (coupler_end, no crush element), each car's crush is its
+  // length from the state alone, at every instant the writer is shown.
   for (const char* scenario : {"scenario2_barrier_cars", "scenario1_barrier_cars"}) {
     INFO(scenario);
     Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/" + scenario + ".yaml");
@@ -381,17 +399,15 @@ TEST_CASE("a car's largest crush is a sum of its crush elements at one instant",
     CHECK(witness.partial_calls > 100);  // located mode changes, each with one element's outputs
     const std::vector<CarCrush>& cars = writer.car_crush();
     REQUIRE(cars.size() == witness.cars_.size());
-    bool some_crush = false, some_at_event = false;
+    bool some_crush = false;
     for (std::size_t c = 0; c < cars.size(); ++c) {
       INFO("car " << cars[c].car);
       CHECK(cars[c].max_crush == witness.touched_instants_[c]);  // every instant with a fresh column, exactly
       CHECK(cars[c].max_crush >= witness.full_instants_[c]);     // the steps' whole sums among them
       CHECK(cars[c].max_crush <= witness.every_instant_[c]);     // never above what one instant reaches
       some_crush = some_crush || cars[c].max_crush > 4.0;
-      some_at_event = some_at_event || cars[c].max_crush > witness.full_instants_[c];
     }
-    CHECK(some_crush);  // the leading car crushes 17.6 in (scenario 2), 4.8 in (scenario 1)
-    if (std::string(scenario) == "scenario1_barrier_cars") CHECK(some_at_event);
+    CHECK(some_crush);  // the leading car crushes 17.5 in (scenario 2), 4.5 in (scenario 1)
   }
 }
 
@@ -412,4 +428,152 @@ TEST_CASE("the running summary is written every 2 s, or every 50 times what the 
   CHECK(schedule.interval() == milliseconds(2000));
   CHECK_FALSE(schedule.due(start + milliseconds(9100)));
   CHECK(schedule.due(start + milliseconds(9113)));
+}
+
+// ---- each car's own crush (results.hpp "Car crush") ----
+
+namespace {
+
+/// Timeseries column `name` of a run kept in memory.
+const std::vector<double>& series_of(const RunReport& report, const std::string& name) {
+  const auto it = std::find(report.columns.begin(), report.columns.end(), name);
+  REQUIRE(it != report.columns.end());
+  return report.series[static_cast<std::size_t>(it - report.columns.begin())];
+}
+
+/// x of a body point [length] at output row k, from the body's x and theta columns.
+double point_x(const RunReport& report, const std::string& body, double sx, double sy, std::size_t k) {
+  const double theta = series_of(report, body + ".theta")[k];
+  return series_of(report, body + ".x")[k] + std::cos(theta) * sx - std::sin(theta) * sy;
+}
+
+}  // namespace
+
+TEST_CASE("each car of the report's two-car model crushes by its own shortening, not half of the shared anticlimber", "[results]") {
+  // models/report/final_two_car.yaml: the anticlimber (one law for the two identical ends in
+  // series) is the only crush element and joins the cars; f654aee gave each car half of it,
+  // 19.55 in, at one instant. Each car's crush, computed here from the rows' body columns
+  // alone: the shortening along x between its anticlimber face (car1_front_end (42.375,
+  // -13.17), car2_front_end (-40.625, -11.90)) and its rear body's centre of gravity, plus half
+  // of the anticlimber's horizontal deformation. The writer takes every step and event, the
+  // rows every 0.5 ms: its maxima lie at or just above the rows'. Measured from the front end's
+  // centre of gravity instead of its face the two cars crush 20.79 and 20.59 in: the face, 13 in
+  // below that centre, moves back a little more as the front end pitches.
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+  REQUIRE(report.outcome.ok);
+  REQUIRE(report.car_crush.size() == 2);
+  const std::vector<double>& deformation = series_of(report, "anticlimber.horizontal_deformation");
+  struct Face {
+    const char* car;
+    const char* front;
+    double sx, sy;  // [in] the anticlimber point on the front end
+    const char* rear;
+    double outward;  // +1: the face is at the car's +x end
+  };
+  const Face faces[] = {{"car1", "car1_front_end", 42.375, -13.17, "car1_rear_body", 1.0},
+                        {"car2", "car2_front_end", -40.625, -11.90, "car2_rear_body", -1.0}};
+  double rows_max[2] = {0.0, 0.0};  // [in]
+  for (int c = 0; c < 2; ++c) {
+    const Face& f = faces[c];
+    const auto length = [&](std::size_t k) { return f.outward * (point_x(report, f.front, f.sx, f.sy, k) - series_of(report, f.rear + std::string(".x"))[k]); };
+    for (std::size_t k = 0; k < deformation.size(); ++k)
+      rows_max[c] = std::max(rows_max[c], length(0) - length(k) + 0.5 * std::max(0.0, deformation[k]));
+  }
+  INFO("writer: car1 " << report.car_crush[0].max_crush << " in at " << report.car_crush[0].t << " s, car2 "
+                       << report.car_crush[1].max_crush << " in at " << report.car_crush[1].t << " s; rows: "
+                       << rows_max[0] << ", " << rows_max[1]);
+  for (int c = 0; c < 2; ++c) {
+    CHECK(report.car_crush[static_cast<std::size_t>(c)].car == faces[c].car);
+    CHECK(report.car_crush[static_cast<std::size_t>(c)].max_crush >= rows_max[c] - 1e-9);
+    CHECK(report.car_crush[static_cast<std::size_t>(c)].max_crush == Approx(rows_max[c]).margin(0.01));  // [in]
+  }
+  CHECK(rows_max[0] == Approx(21.03).margin(0.01));
+  CHECK(rows_max[1] == Approx(20.66).margin(0.01));
+  CHECK(report.car_crush[0].max_crush - report.car_crush[1].max_crush > 0.3);  // [in] the loaded car crushes more
+  // R1 is the anticlimber's: unchanged.
+  CHECK(report.responses.max_anticlimber_crush == Approx(39.109).margin(0.001));
+}
+
+TEST_CASE("two SI cars whose crush zones differ in stiffness crush F / k each under the one force of the series", "[results]") {
+  // models/examples/crush_zone_cars.yaml: two 40 t cars, crush zones of 5e6 and 1e7 N/m, faces
+  // of 1e9 N/m between them, 5 m/s. The three springs are in series: at the largest
+  // compression F = v sqrt(mu k), 1 / k = 1 / 5e6 + 1 / 1e7 + 1 / 1e9, mu = 20,000 kg, and each
+  // car's crush is its zone's F / k_i plus half of the faces' F / 1e9. The zones as crush
+  // springs (crush elements within the car), and as linear springs (structure, as the
+  // report's sills: no crush element but the shared faces; f654aee gave each car half of the
+  // faces' 1.3 mm).
+  const double series_stiffness = 1.0 / (1.0 / 5.0e6 + 1.0 / 1.0e7 + 1.0 / 1.0e9);  // [N/m]
+  const double force = 5.0 * std::sqrt(20000.0 * series_stiffness);                    // [N] 1.289e6
+  const double expected[2] = {force / 5.0e6 + 0.5 * force / 1.0e9, force / 1.0e7 + 0.5 * force / 1.0e9};  // [m]
+  std::ifstream file(std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/crush_zone_cars.yaml");
+  std::stringstream read;
+  read << file.rdbuf();
+  const std::string crush_zones = read.str();
+  std::string structure = crush_zones;
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"type: crush_spring, curve: [[0, 0], [1, 5.0e6]], unloading_stiffness: 5.0e6",
+                                                                     "type: linear_spring, stiffness: 5.0e6"},
+                                 {"type: crush_spring, curve: [[0, 0], [1, 1.0e7]], unloading_stiffness: 1.0e7",
+                                  "type: linear_spring, stiffness: 1.0e7"}}) {
+    const std::size_t at = structure.find(from);
+    REQUIRE(at != std::string::npos);
+    structure.replace(at, from.size(), to);
+  }
+  for (const bool zones_are_crush_springs : {true, false}) {
+    INFO((zones_are_crush_springs ? "crush springs" : "linear springs"));
+    const RunReport report = run_model(testing::model_from_text(zones_are_crush_springs ? crush_zones : structure), "",
+                                       nullptr, false, /*keep_in_memory=*/true);
+    REQUIRE(report.outcome.ok);
+    REQUIRE(report.car_crush.size() == 2);
+    for (int c = 0; c < 2; ++c) {
+      INFO("car " << report.car_crush[static_cast<std::size_t>(c)].car);
+      CHECK(report.car_crush[static_cast<std::size_t>(c)].max_crush == Approx(expected[c]).epsilon(3e-3));
+    }
+  }
+}
+
+TEST_CASE("an output's peaks are its signed largest and smallest values with their times", "[results]") {
+  // 1000 kg at 2 m/s into a wall (contact, 3.673e6 N/m, no damping) that it touches at t = 0:
+  // the penetration is v0 sqrt(m/k) sin(w t), w = sqrt(k/m), largest 0.033 m at pi / (2 w) =
+  // 25.9 ms; the mass leaves at pi / w = 51.8 ms at 2 m/s, so the penetration at t_end = 0.36 s
+  // is -2 (0.36 - pi / w) = -0.616 m, its smallest. f654aee gave only the largest |value|, the
+  // gap's 0.616 m. Checked in summary.json and against timeseries.csv of the same run.
+  const double m = 1000.0, k = 3.673e6, v0 = 2.0;  // [kg], [N/m], [m/s]
+  const double w = std::sqrt(k / m);                // [rad/s]
+  const std::string text =
+      "railcrash: 1\nname: wall\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: car, car: car, mass: 1000, inertia: 100, position: [0, 0], velocity: [2, 0]}\nelements:\n"
+      "  - {name: wall, type: contact, stiffness: 3.673e6, line_point: [0, 0], line_normal: [-1, 0], points: [{body: car, at: [0, 0]}]}\n"
+      "simulation: {t_end: 0.36, output_interval: 0.001}\n";
+  const std::string folder = temporary_folder("signed_peaks");
+  const RunReport report = run_model(testing::model_from_text(text), folder);
+  REQUIRE(report.outcome.ok);
+  const YAML::Node peak = YAML::LoadFile(folder + "/summary.json")["peaks"]["wall.penetration"];
+  REQUIRE(peak);
+  // A smooth peak inside a step reads low by about (w h)^2 / 8 (README "What the maxima are taken over").
+  CHECK(peak["max"].as<double>() == Approx(v0 * std::sqrt(m / k)).epsilon(1e-4));
+  CHECK(peak["max"].as<double>() == Approx(0.033).epsilon(1e-3));
+  CHECK(peak["t_max"].as<double>() == Approx(0.5 * M_PI / w).margin(1e-3));  // [s] within an output interval
+  CHECK(peak["min"].as<double>() == Approx(-v0 * (0.36 - M_PI / w)).epsilon(1e-5));
+  CHECK(peak["t_min"].as<double>() == Approx(0.36).epsilon(1e-9));
+  CHECK_FALSE(peak["abs_max"]);
+  // timeseries.csv: the rows' extremes lie within what the run's steps saw.
+  std::ifstream rows(folder + "/timeseries.csv");
+  std::string line;
+  std::getline(rows, line);
+  std::vector<std::string> header;
+  for (std::stringstream names(line); std::getline(names, line, ',');) header.push_back(line);
+  const std::size_t column = static_cast<std::size_t>(std::find(header.begin(), header.end(), "wall.penetration") - header.begin());
+  REQUIRE(column < header.size());
+  double rows_max = -1.0, rows_min = 1.0;  // [m]
+  while (std::getline(rows, line)) {
+    std::stringstream fields(line);
+    std::string field;
+    for (std::size_t field_index = 0; field_index <= column; ++field_index) std::getline(fields, field, ',');
+    rows_max = std::max(rows_max, std::stod(field));
+    rows_min = std::min(rows_min, std::stod(field));
+  }
+  CHECK(rows_max <= peak["max"].as<double>());
+  CHECK(rows_max == Approx(peak["max"].as<double>()).epsilon(1e-3));
+  CHECK(rows_min == Approx(peak["min"].as<double>()).epsilon(1e-9));
 }

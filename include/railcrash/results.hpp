@@ -5,6 +5,9 @@
 //   DIR/events.csv      t,element,event,value
 //   DIR/summary.json    status, message, t_reached, integrator, units, stats, energy, peaks,
 //                       peak_accelerations, car_crush (and responses, when the model has them)
+// peaks: every element output's signed largest and smallest value over every accepted step,
+// both sides of every event and the output samples, with their times:
+// {"max", "t_max", "min", "t_min"} (a contact's penetration: max; its gap: min; README).
 // In memory (the library's runs, api.hpp): the timeseries.csv columns as vectors and the
 // summary.json text; no folder is needed.
 //
@@ -39,16 +42,30 @@
 //
 // Car crush: a car is the set of bodies that declare it with `car: NAME` in the model file
 // (bodies without the key, such as a barrier or a track, belong to no car). A model where no
-// body declares a car has no per-car crush: summary.json then says so under "cars_note". The
-// crush of a car is the sum of the outputs with the role OutputRole::Crush (positive part; an
-// anticlimber's horizontal_deformation, a crush_spring's crush) of the elements that act on
-// its bodies. An element between two cars gives half of its deformation to each (the
-// report's anticlimber carries the two identical ends in series); one between a car and
-// ground, a body of no car or within a car, all of it. The summary gives each car's bodies
-// and its largest crush over the output samples and when.
+// body declares a car has no per-car crush: summary.json then says so under "cars_note".
+// A car's crush is its own shortening, measured between its two ends:
+//   crush(t) = L(0) - L(t) + sum over its two ends of share x max(0, crush output(t))
+// L is the distance between the car's ends along the track (x; a pitch or sag of the car is
+// no crush), L(0) that of the run's first state (after any static settle).
+// Each end (towards -x, towards +x) is the outermost point at which the car meets the rest of
+// the model through a crush element (OutputRole::Crush: an anticlimber's
+// horizontal_deformation, a crush_spring's crush) whose other point lies on ground, on a body
+// of no car or on another car, and which faces that way (its other point lies further that
+// way; level with it, the point lies on that side of the car's mass centre); an end with no
+// such element is the centre of gravity of the car's outermost body on that side. The car's crush elements within the car
+// (both points on its bodies) and its body structure (beams, sills) shorten L and need no
+// term of their own. An interface element's deformation is not in L: the car takes all of an
+// element against ground or a body of no car (a barrier does not crush), and half of one
+// between two cars, whose two sides are one law in series (the report's anticlimber: the two
+// identical ends in series), so neither side's part can be told from the other: the plane of
+// contact is taken midway. The summary gives each car's ends, its largest crush over every
+// accepted step, both sides of every event and the output samples, and when.
+// The scenario's survival space (scenario/criteria.hpp) sums the crush elements' outputs
+// instead (CarCrush::elements, shares; car_elements_crush_at).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -106,33 +123,58 @@ struct FilteredAccelerations {
   CollisionPulse collision;   // from the body's x velocity
 };
 
-/// One car's crush elements and its largest crush [length] over the samples.
+/// One end of a car (results.hpp "Car crush"): a point of one of its bodies and, when the end
+/// is an interface crush element's point, that element's crush column and the car's share.
+struct CarEnd {
+  PointRef point;              // body and body-fixed offset [length]
+  std::string element;         // the interface crush element; "" for a body's centre of gravity
+  int element_index = -1;      // in the model
+  int column = -1;             // its crush output column; -1 for none
+  double share = 0.0;          // 1 against ground or a body of no car, 0.5 between two cars
+};
+
+/// One car's crush elements, its ends and its largest crush [length] over the run.
 struct CarCrush {
   std::string car;
   std::vector<int> bodies;        // body indices, in model order
+  // Every crush element acting on the car's bodies (summary.json lists them; the scenario's
+  // survival space sums them: car_elements_crush_at).
   std::vector<std::string> elements;
   std::vector<int> element_indices;  // their indices in the model
   std::vector<int> columns;       // output columns of their crush deformations
   std::vector<double> shares;     // 1, or 0.5 for an element between two cars
+  std::array<CarEnd, 2> ends;     // towards -x, towards +x of the car's mass centre
+  double initial_length = 0.0;    // [length] L(0): x of ends[1] minus x of ends[0] at the run's first state
   double max_crush = 0.0;         // [length]
   double t = 0.0;                 // [time]
 };
 
-/// Cars of a model (see above) in the order they are first declared, with their crush elements.
+/// Cars of a model (see above) in the order they are first declared, with their crush elements and ends.
 std::vector<CarCrush> cars_of(const DaeSystem& system);
 
 /// Crush of a car at one time [length]: sum of share x max(0, outputs[column]) over its crush
 /// output columns (share 1, or 1/2 for an element between two cars).
 double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares);
 
+/// The car's length L [length] between its ends at state y, along the track (x).
+double car_length(const CarCrush& car, const double* y);
+/// The car's crush [length] (results.hpp "Car crush") at state y with every output column of y.
+double car_crush(const CarCrush& car, const double* y, const double* outputs);
+
 /// The car's crush [length] at state y, an instant at which only the `fresh` columns of
 /// `outputs` are y's: at a mode change located inside a step only the changed element's outputs
-/// are evaluated again. The car's crush elements whose columns are not fresh are evaluated at y
-/// here (into scratch, which is resized to the system's outputs), so that the sum is of one
-/// instant. nullopt when none of the car's columns is fresh: the instant is another element's
-/// event, and evaluating every car at every event would make a long train's cost grow as N^2.
+/// are evaluated again. The car's interface elements whose columns are not fresh are evaluated at
+/// y here (into scratch, which is resized to the system's outputs), so that the crush is of one
+/// instant. nullopt when the car has interface elements and none of their columns is fresh: the
+/// instant is another element's event, and evaluating every car at every event would make a
+/// long train's cost grow as N^2.
 std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car, const double* y, const double* lambda,
                                    const double* outputs, const FreshOutputs& fresh, std::vector<double>& scratch);
+/// The sum of the car's crush elements' outputs (shared_crush over CarCrush::columns) at state
+/// y, with the same rule for the columns that are not fresh; the scenario's survival space.
+std::optional<double> car_elements_crush_at(const DaeSystem& system, const CarCrush& car, const double* y,
+                                            const double* lambda, const double* outputs, const FreshOutputs& fresh,
+                                            std::vector<double>& scratch);
 
 /// An element output column (index into DaeSystem::output_names()) that plays a role.
 struct RoleColumn {
@@ -238,12 +280,14 @@ class ResultWriter : public RunObserver {
   std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
   int folder_descriptor_ = -1;                          // the open folder, to notice its removal
   std::vector<std::vector<double>> columns_;  // in memory, per timeseries column
-  std::vector<double> peak_output_;  // largest |value| of each element output
-  std::vector<double> peak_time_;
+  // Signed largest and smallest value of each element output, and when [time].
+  std::vector<double> output_max_, output_min_;
+  std::vector<double> t_output_max_, t_output_min_;
   std::vector<double> acceleration_;  // 3 per body at the last sample
   AccelerationScratch acceleration_scratch_;
   std::vector<AccelerationPeaks> acceleration_peaks_;
   std::vector<CarCrush> cars_;
+  bool car_lengths_measured_ = false;  // each car's L(0) taken from the first state shown
   std::vector<double> crush_scratch_;  // outputs of a car's crush elements evaluated at an event (car_crush_at)
   std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
   std::unique_ptr<EnergyWriter> energy_;

@@ -266,9 +266,9 @@ void ScenarioTracker::step(double, const double* y, const double* lambda, const 
   for (std::size_t k = 0; k < front_index_.size(); ++k)
     step_extremes_.shortening[k] =
         std::max(step_extremes_.shortening[k], lengths_[k].front() - distance(y, front_index_[k], rear_index_[k]));
-  // A car's crush sums several elements' outputs, all of one instant (car_crush_at).
+  // A car's crush sums several elements' outputs, all of one instant (car_elements_crush_at).
   for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
-    const std::optional<double> crush = car_crush_at(system_, crush_of_cars_[k], y, lambda, outputs, fresh, crush_scratch_);
+    const std::optional<double> crush = car_elements_crush_at(system_, crush_of_cars_[k], y, lambda, outputs, fresh, crush_scratch_);
     if (crush) step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], *crush);
   }
   bool offset_known = true;

@@ -20,7 +20,7 @@
 //                      channel class `cfc` (results/cfc_filter.hpp), then the collision pulse
 //                      of results/crash_pulse.hpp: |velocity change| / duration of the collision.
 //   survival space     per car (`cars:`): the largest crush of the car over the run, the sum of
-//                      its crush outputs (OutputRole::Crush) as results' car_crush counts them
+//                      its crush outputs (OutputRole::Crush) as car_elements_crush_at sums them
 //                      (an element between two cars by half), without the `excluded:` elements
 //                      (crush zones, the struck wagon's buffers or obstacle);
 //   survival gauge     per gauge (`gauges:`, optional, beside): the largest shortening of the

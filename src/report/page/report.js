@@ -158,6 +158,23 @@
         });
         row(car, parts.join("; "));
       });
+      // Contacts and crush (summary.json "peaks": signed max and min, README "Peaks"): for a
+      // penetration, crush, compression or horizontal deformation the largest value (the deepest
+      // press; a negative smallest value is an opening); for a gap the smallest (the closest
+      // approach; negative: the faces pressed together).
+      var peaks = summary.peaks || {};
+      Object.keys(peaks).forEach(function (name) {
+        var quantity = name.slice(name.lastIndexOf(".") + 1);
+        var p = peaks[name];
+        if (p.max === null || p.min === null) return;
+        if (["penetration", "crush", "compression", "horizontal_deformation"].indexOf(quantity) >= 0) {
+          row(name, "largest " + fmt(p.max) + " " + lengthUnit + " at t = " + fmt(p.t_max) + " s" +
+              (p.min < 0 ? " (open by up to " + fmt(-p.min) + " " + lengthUnit + ", t = " + fmt(p.t_min) + " s)" : ""));
+        } else if (quantity === "gap") {
+          row(name, "smallest " + fmt(p.min) + " " + lengthUnit + " at t = " + fmt(p.t_min) + " s" +
+              " (largest " + fmt(p.max) + " " + lengthUnit + ", t = " + fmt(p.t_max) + " s)");
+        }
+      });
       var sc = summary.scenario;
       if (sc) {  // EN 15227 criteria (scenario/criteria.hpp): one row per criterion and subject
         row(sc.standard + " scenario " + sc.number + " (" + sc.category + ")",
