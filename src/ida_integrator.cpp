@@ -422,6 +422,16 @@ void IdaIntegrator::start(double t_end) {
     report_events(start_events, y);
     impl.on_boundary.assign(static_cast<std::size_t>(system_.root_count()), 0);
     if (system_.root_count() > 0) system_.roots(0.0, y, impl.g_previous.data());
+    // As after a restart (advance's mark_boundary_roots): a root at or below zero that
+    // restart_state did not commit starts on its boundary, carried as +0, so that its first
+    // fall below zero is a crossing. Taken as it was, a root at exactly 0 (a crush zone touching
+    // at rest, not pushed yet) was never "above zero before" and its contact went unseen until
+    // another element's restart.
+    for (std::size_t k = 0; k < impl.g_previous.size(); ++k)
+      if (impl.g_previous[k] <= 0.0) {
+        impl.g_previous[k] = std::numeric_limits<double>::min();
+        impl.on_boundary[k] = 1;
+      }
   }
 }
 

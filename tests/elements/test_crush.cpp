@@ -239,3 +239,46 @@ TEST_CASE("Euler: a second run of one integrator starts from the same modes and 
   CHECK(second.y == first.y);
   CHECK(first.y[3] == Approx(std::sqrt(10.0)).epsilon(1e-3));
 }
+
+TEST_CASE("crush spring: a zone touching at rest at the start crushes as soon as it is pushed", "[elements][crush]") {
+  // A 1000 kg car pushes a 100 kg end structure through a crush zone (5e6 N/m elastic, touching,
+  // no relative speed and no force at t = 0) into a wall (a 1e8 N/m crush spring, touching at
+  // t = 0, closing at 2 m/s). The zone's root sits exactly on its boundary at the start (crush 0,
+  // rate 0, acceleration 0): the zone must enter contact as soon as the wall pushes the end
+  // structure back, i.e. at t = 0+ with no crush, not later at the next restart with the faces
+  // already overlapping without force (IDA's start took its roots without the boundary marks its
+  // restarts use, so a crossing from exactly 0 was never seen).
+  const std::string text = R"(railcrash: 1
+name: touching zone
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: end, mass: 100, inertia: 10, position: [1, 0], velocity: [-2, 0]}
+  - {name: car, mass: 1000, inertia: 100, position: [3, 0], velocity: [-2, 0]}
+elements:
+  - {name: wall, type: crush_spring, curve: [[0, 0], [1, 1.0e8]], unloading_stiffness: 1.0e8,
+     points: [{body: ground, at: [0, 0]}, {body: end, at: [0, 0]}]}
+  - {name: zone, type: crush_spring, curve: [[0, 0], [1, 5.0e6]], unloading_stiffness: 5.0e6,
+     points: [{body: end, at: [0, 0]}, {body: car, at: [0, 0]}]}
+simulation: {t_end: 0.05, integrator: ida, rtol: 1e-9, output_interval: 0.001}
+)";
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    std::string model_text = text;
+    model_text.replace(model_text.find("integrator: ida"), 15, std::string("integrator: ") + integrator + ", dt: 1e-6");
+    const Model model = testing::model_from_text(model_text);
+    DaeSystem system(model);
+    const RunOutcome outcome = testing::simulate(system);
+    REQUIRE(outcome.ok);
+    const EventRecord* zone_contact = nullptr;
+    for (const EventRecord& e : outcome.events)
+      if (e.element == "zone") {
+        zone_contact = &e;
+        break;
+      }
+    REQUIRE(zone_contact != nullptr);
+    CHECK(zone_contact->what == "contact, crushing");
+    CHECK(zone_contact->t < 1e-5);            // f654aee (IDA): 0.0031 s, at the wall's separation
+    CHECK(std::abs(zone_contact->value) < 1e-6);  // crush at contact [m]; f654aee (IDA): 6.3 mm
+  }
+}
