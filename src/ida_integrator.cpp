@@ -26,6 +26,10 @@ namespace {
 // more than kReachableMultiple times IDA's own first step (advance(), restart_first_step()).
 constexpr double kRestartStepFraction = 0.3;
 constexpr double kReachableMultiple = 1e4;
+// A step predicted to cross a mode boundary ends this fraction of the predicted step past the
+// predicted crossing (advance(), "landing"); measured against 0.1 and against no landing in
+// bench/README.md, "Kinks are not jumps".
+constexpr double kLandingMargin = 0.02;
 
 std::string flag_name(int flag) {
   char* name = IDAGetReturnFlagName(flag);
@@ -112,6 +116,10 @@ struct IdaIntegrator::Impl {
   };
   std::vector<Crossing> crossings;
   bool at_start = true;  // no step taken since start()
+  // Landing on the next mode change (advance()): IDA's last step was a step of the run (not a
+  // restart), so its polynomial extrapolates over the next; the stop time was moved before it.
+  bool can_predict = false, stop_moved = false;
+  std::vector<double> y_ahead, g_ahead;  // the extrapolated state and its roots
   // The last restart, kept until IDA's first step after it succeeds (see advance()).
   struct RestartRetry {
     bool available = false;
@@ -567,28 +575,31 @@ double IdaIntegrator::advance(double t_end) {
   // t_event, counts half), the error of its work quadrature |change of its power|
   // (t_n - t_event); both must stay within the local tolerances. A constraint element that
   // failed always restarts: its equations changed.
+  // weight_at_event and weight_at_n weigh the two ends' force changes (the trapezoid: 0.5 and
+  // 0.5). A kink's continuity check takes the change at the event alone, held over the lag
+  // (1 and 0): the part of the lag a kink must not have.
   const auto lag_within_tolerance = [&](int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
                                         const double* y_at_event, double t_n, const double* y_n,
-                                        const double* quadratures) {
+                                        const double* quadratures, double weight_at_event = 0.5, double weight_at_n = 0.5) {
     const Element& el = *model.elements()[static_cast<std::size_t>(e)];
     if (el.constraint_count() > 0 && system_.element_failed(static_cast<std::size_t>(e))) return false;
     const double lag = t_n - t_event;
     const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
     const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);
     const int work = DaeSystem::kFirstElementWork + e;
-    const double power_change =
-        0.5 * (std::abs(after_event.power - before[0].power) + std::abs(after_n.power - before[1].power));
+    const double power_change = weight_at_event * std::abs(after_event.power - before[0].power) +
+                                weight_at_n * std::abs(after_n.power - before[1].power);
     if (power_change * lag > rtol * std::abs(quadratures[work]) + quad_atol[work]) return false;
     for (std::size_t slot = 0; slot < 2; ++slot) {
       const int b = after_event.body[slot];
       if (b == kGround) continue;
       const double changes[3] = {
-          0.5 * (std::abs(after_event.force[slot].x - before[0].force[slot].x) +
-                 std::abs(after_n.force[slot].x - before[1].force[slot].x)),
-          0.5 * (std::abs(after_event.force[slot].y - before[0].force[slot].y) +
-                 std::abs(after_n.force[slot].y - before[1].force[slot].y)),
-          0.5 * (std::abs(after_event.force[slot].theta - before[0].force[slot].theta) +
-                 std::abs(after_n.force[slot].theta - before[1].force[slot].theta))};
+          weight_at_event * std::abs(after_event.force[slot].x - before[0].force[slot].x) +
+              weight_at_n * std::abs(after_n.force[slot].x - before[1].force[slot].x),
+          weight_at_event * std::abs(after_event.force[slot].y - before[0].force[slot].y) +
+              weight_at_n * std::abs(after_n.force[slot].y - before[1].force[slot].y),
+          weight_at_event * std::abs(after_event.force[slot].theta - before[0].force[slot].theta) +
+              weight_at_n * std::abs(after_n.force[slot].theta - before[1].force[slot].theta)};
       for (int c = 0; c < 3; ++c) {
         if (changes[c] == 0.0) continue;
         const int k = 3 * b + c;
@@ -601,6 +612,53 @@ double IdaIntegrator::advance(double t_end) {
   };
 
   double t_n = impl.t_reached;
+  // ---- landing on the next mode change ----
+  // A mode change IDA steps across with its old law costs the lag between the event and the
+  // step's end (lag_within_tolerance), or a restart at order 1 from a short step. IDA's next
+  // step is predicted by extrapolating the polynomial of its last one: where an armed root is
+  // predicted to fall through zero within it, the step is made to end just past the predicted
+  // crossing (IDA's stop time), so the lag is a small fraction of a step and IDA keeps its
+  // order and history across a kink (bench/README.md, "Kinks are not jumps").
+  if (impl.stop_moved) {
+    impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");
+    impl.stop_moved = false;
+  }
+  if (root_count > 0 && impl.can_predict) {
+    double h_next = 0.0;
+    impl.check(IDAGetCurrentStep(impl.ida, &h_next), "IDAGetCurrentStep");
+    const double t_ahead = std::min(t_end, t_n + h_next);
+    if (h_next > 0.0 && t_ahead > t_n) {
+      load_taylor(t_n);
+      impl.y_ahead.resize(static_cast<std::size_t>(n));
+      impl.g_ahead.resize(static_cast<std::size_t>(root_count));
+      const double dt = t_ahead - t_n;
+      for (int i = 0; i < n; ++i) {
+        double value = taylor[static_cast<std::size_t>(taylor_order * n + i)];
+        for (int j = taylor_order - 1; j >= 0; --j) value = value * dt + taylor[static_cast<std::size_t>(j * n + i)];
+        impl.y_ahead[static_cast<std::size_t>(i)] = value;
+      }
+      system_.roots(t_ahead, impl.y_ahead.data(), impl.g_ahead.data());
+      const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), h_next);
+      double t_first = t_ahead;
+      bool predicted = false;
+      for (int k = 0; k < root_count; ++k) {
+        const auto kk = static_cast<std::size_t>(k);
+        if (on_boundary[kk] || !(g_previous[kk] > 0.0) || impl.g_ahead[kk] > 0.0) continue;
+        const int owner = system_.root_owner(k);
+        const double t_cross =
+            locate(owner, k - system_.root_offset(owner), t_n, g_previous[kk], t_ahead, impl.g_ahead[kk], tolerance);
+        t_first = std::min(t_first, t_cross);
+        predicted = true;
+      }
+      const double t_stop = t_first + kLandingMargin * h_next;
+      if (predicted && t_stop < t_ahead) {
+        impl.check(IDASetStopTime(impl.ida, t_stop), "IDASetStopTime");
+        impl.stop_moved = true;
+        ++stats().landings;
+      }
+    }
+  }
+  impl.can_predict = false;
   impl.last_sundials_message.clear();
   impl.non_finite_y.clear();
   impl.sweep.roots_wanted = root_count > 0;
@@ -639,6 +697,7 @@ double IdaIntegrator::advance(double t_end) {
     throw StepFailure(msg.str());
   }
   impl.at_start = false;
+  impl.can_predict = true;  // (until a restart below)
   const double t_step_start = impl.t_reached;
   bool restarted = false;
 
@@ -742,7 +801,13 @@ double IdaIntegrator::advance(double t_end) {
           change_times[static_cast<std::size_t>(seen - done.begin())] = c.t;
         }
         ++stats().root_returns;
-        if (!restarted && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
+        // A kink (the element says its force is continuous, and it is at the event state)
+        // needs no restart when the lag is within tolerance (the step landed just past it):
+        // IDA goes on with its order and history, and its error test sees the changed slope
+        // in the steps that follow. A jump always restarts (bench/README.md, "Kinks are not jumps").
+        const bool kink = !restarted && events.size() == 1 && events.front().kink &&
+                          lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n, 1.0, 0.0);
+        if (kink && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
           report_events(events, y_at_event, c.element);
           // The element's new mode may end within this step too: its roots that are at or
           // below zero at t_n are located in [t_event, t_n] (or committed at once when
@@ -797,6 +862,8 @@ double IdaIntegrator::advance(double t_end) {
         impl.retry.yp = yp_restart;
         impl.retry.quad.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + nquad);
         impl.reinitialize(c.t, t_end, stats());
+        impl.can_predict = false;
+        impl.stop_moved = false;  // (IDASetStopTime(t_end) by reinitialize)
         // IDA's own first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an
         // impact, and it then climbs back at order 1, doubling per step, with a Jacobian at
         // nearly every step (cj changes each time): 170 restarts in the 0.25 s two-car crash
