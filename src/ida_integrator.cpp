@@ -26,15 +26,6 @@ namespace {
 // more than kReachableMultiple times IDA's own first step (advance(), restart_first_step()).
 constexpr double kRestartStepFraction = 0.3;
 constexpr double kReachableMultiple = 1e4;
-// A step predicted to cross a mode boundary ends this fraction of the predicted step past the
-// predicted crossing (advance(), "landing"); measured against 0.1 and against no landing in
-// bench/README.md, "Kinks are not jumps".
-constexpr double kLandingMargin = 0.02;
-// No step is landed shorter than this fraction of the step IDA chose: a crossing predicted
-// early in the step is crossed as before (the lag test, or a restart). Without it, elements
-// resting on a boundary at the start of a 10 + 10-car consist made every step land at once
-// and the steps collapsed (IDA_CONV_FAIL, h 1.6e-22 at t = 4.9e-6 s).
-constexpr double kShortestLanding = 0.25;
 
 std::string flag_name(int flag) {
   char* name = IDAGetReturnFlagName(flag);
@@ -121,10 +112,6 @@ struct IdaIntegrator::Impl {
   };
   std::vector<Crossing> crossings;
   bool at_start = true;  // no step taken since start()
-  // Landing on the next mode change (advance()): IDA's last step was a step of the run (not a
-  // restart), so its polynomial extrapolates over the next; the stop time was moved before it.
-  bool can_predict = false, stop_moved = false;
-  std::vector<double> y_ahead, g_ahead;  // the extrapolated state and its roots
   // The last restart, kept until IDA's first step after it succeeds (see advance()).
   struct RestartRetry {
     bool available = false;
@@ -617,53 +604,6 @@ double IdaIntegrator::advance(double t_end) {
   };
 
   double t_n = impl.t_reached;
-  // ---- landing on the next mode change ----
-  // A mode change IDA steps across with its old law costs the lag between the event and the
-  // step's end (lag_within_tolerance), or a restart at order 1 from a short step. IDA's next
-  // step is predicted by extrapolating the polynomial of its last one: where an armed root is
-  // predicted to fall through zero within it, the step is made to end just past the predicted
-  // crossing (IDA's stop time), so the lag is a small fraction of a step and IDA keeps its
-  // order and history across a kink (bench/README.md, "Kinks are not jumps").
-  if (impl.stop_moved) {
-    impl.check(IDASetStopTime(impl.ida, t_end), "IDASetStopTime");
-    impl.stop_moved = false;
-  }
-  if (root_count > 0 && impl.can_predict) {
-    double h_next = 0.0;
-    impl.check(IDAGetCurrentStep(impl.ida, &h_next), "IDAGetCurrentStep");
-    const double t_ahead = std::min(t_end, t_n + h_next);
-    if (h_next > 0.0 && t_ahead > t_n) {
-      load_taylor(t_n);
-      impl.y_ahead.resize(static_cast<std::size_t>(n));
-      impl.g_ahead.resize(static_cast<std::size_t>(root_count));
-      const double dt = t_ahead - t_n;
-      for (int i = 0; i < n; ++i) {
-        double value = taylor[static_cast<std::size_t>(taylor_order * n + i)];
-        for (int j = taylor_order - 1; j >= 0; --j) value = value * dt + taylor[static_cast<std::size_t>(j * n + i)];
-        impl.y_ahead[static_cast<std::size_t>(i)] = value;
-      }
-      system_.roots(t_ahead, impl.y_ahead.data(), impl.g_ahead.data());
-      const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), h_next);
-      double t_first = t_ahead;
-      bool predicted = false;
-      for (int k = 0; k < root_count; ++k) {
-        const auto kk = static_cast<std::size_t>(k);
-        if (on_boundary[kk] || !(g_previous[kk] > 0.0) || impl.g_ahead[kk] > 0.0) continue;
-        const int owner = system_.root_owner(k);
-        const double t_cross =
-            locate(owner, k - system_.root_offset(owner), t_n, g_previous[kk], t_ahead, impl.g_ahead[kk], tolerance);
-        t_first = std::min(t_first, t_cross);
-        predicted = true;
-      }
-      const double t_stop = t_first + kLandingMargin * h_next;
-      if (predicted && t_stop < t_ahead && t_stop - t_n >= kShortestLanding * h_next) {
-        impl.check(IDASetStopTime(impl.ida, t_stop), "IDASetStopTime");
-        impl.stop_moved = true;
-        ++stats().landings;
-      }
-    }
-  }
-  impl.can_predict = false;
   impl.last_sundials_message.clear();
   impl.non_finite_y.clear();
   impl.sweep.roots_wanted = root_count > 0;
@@ -702,7 +642,6 @@ double IdaIntegrator::advance(double t_end) {
     throw StepFailure(msg.str());
   }
   impl.at_start = false;
-  impl.can_predict = true;  // (until a restart below)
   const double t_step_start = impl.t_reached;
   bool restarted = false;
 
@@ -807,9 +746,8 @@ double IdaIntegrator::advance(double t_end) {
         }
         ++stats().root_returns;
         // A kink (the element says its force is continuous, and it is at the event state)
-        // needs no restart when the lag is within tolerance (the step landed just past it):
-        // IDA goes on with its order and history, and its error test sees the changed slope
-        // in the steps that follow. A jump always restarts (bench/README.md, "Kinks are not jumps").
+        // needs no restart when the lag is within tolerance: IDA goes on with its order and
+        // history. A jump always restarts (bench/README.md, "Kinks are not jumps").
         const bool kink = !restarted && events.size() == 1 && events.front().kink &&
                           lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n, 1.0, 0.0);
         if (kink && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
@@ -867,8 +805,6 @@ double IdaIntegrator::advance(double t_end) {
         impl.retry.yp = yp_restart;
         impl.retry.quad.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + nquad);
         impl.reinitialize(c.t, t_end, stats());
-        impl.can_predict = false;
-        impl.stop_moved = false;  // (IDASetStopTime(t_end) by reinitialize)
         // IDA's own first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an
         // impact, and it then climbs back at order 1, doubling per step, with a Jacobian at
         // nearly every step (cj changes each time): 170 restarts in the 0.25 s two-car crash
