@@ -182,10 +182,11 @@ class Element {
   virtual void roots(double /*t*/, const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*g*/) const {}
   /// Whether the element's force stays continuous across a mode change. A kink (crush
   /// unloading or reloading, a curve segment change, contact whose force starts at zero)
-  /// changes only the force's slope: IDA goes on without a restart. A jump (fracture, shear,
-  /// preloaded contact, a friction reversal, override) changes the force itself: IDA restarts
-  /// from consistent values at the event. IDA checks a kink's continuity at the event (the
-  /// element's force before and after the commit) and restarts where it does not hold.
+  /// changes only the force's slope: IDA goes on without a restart where the lag of its step
+  /// allows. A jump (fracture, shear, preloaded contact, a friction reversal, override) changes
+  /// the force itself: IDA always restarts from consistent values at the event. IDA checks a
+  /// kink's continuity at the event (the element's force before and after the commit) and
+  /// restarts where it does not hold.
   enum class EventKind { Jump, Kink };
   /// What happened at an event, for events.csv.
   struct Event {

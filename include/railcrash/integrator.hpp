@@ -88,7 +88,6 @@ struct RunStatistics {
   long events = 0;
   long root_returns = 0;       // ida: mode changes located within a step (summary: located_mode_changes)
   long reinitializations = 0;  // ida: restarts (a mode change the step could not absorb); euler: mode changes
-  long landings = 0;  // ida: steps ended just past a predicted mode change (IdaIntegrator::advance)
   double wall_seconds = 0.0;
   double last_step = 0.0;          // [time]
   double stability_limit = 0.0;    // euler: [time] estimated largest stable step
