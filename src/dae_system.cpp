@@ -853,7 +853,7 @@ bool DaeSystem::commit_element_root(int e, int local, int direction, double t, c
   Element::Event event;
   const auto index = static_cast<std::size_t>(e);
   if (!el.commit(local, direction, t, local_state(index, y, y + nq), element_lambda, modes_.of(index), event)) return false;
-  events.push_back({t, el.name(), event.what, event.value});
+  events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
   return true;
 }
 
@@ -888,7 +888,7 @@ bool DaeSystem::commit_roots(double t, const double* y, const int* direction, st
       if (el.commit(k, d, t, local_state(e, y, y + nq), element_lambda, modes_.of(e), event)) {
         changed = true;
         if (changed_elements) (*changed_elements)[e] = 1;
-        events.push_back({t, el.name(), event.what, event.value});
+        events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
         break;  // the element's other roots belonged to the mode it just left
       }
     }

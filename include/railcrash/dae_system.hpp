@@ -42,6 +42,7 @@ struct EventRecord {
   std::string element;
   std::string what;
   double value = 0.0;
+  bool kink = false;  // the element's force is continuous across it (Element::EventKind::Kink)
 };
 
 /// Penalty stiffness and damping per constraint row (explicit Euler).

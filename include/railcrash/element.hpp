@@ -180,10 +180,19 @@ class Element {
   /// falls through zero (commit then gets direction -1). The integrators rely on it at a
   /// (re)start, where a root that is exactly zero and about to fall is committed at once.
   virtual void roots(double /*t*/, const ElementState<double>& /*s*/, const double* /*lambda*/, double* /*g*/) const {}
+  /// Whether the element's force stays continuous across a mode change. A kink (crush
+  /// unloading or reloading, a curve segment change, contact whose force starts at zero)
+  /// changes only the force's slope: IDA goes on without a restart where the lag of its step
+  /// allows. A jump (fracture, shear, preloaded contact, a friction reversal, override) changes
+  /// the force itself: IDA always restarts from consistent values at the event. IDA checks a
+  /// kink's continuity at the event (the element's force before and after the commit) and
+  /// restarts where it does not hold.
+  enum class EventKind { Jump, Kink };
   /// What happened at an event, for events.csv.
   struct Event {
     std::string what;   // e.g. "contact closed", "yield", "rupture"
     double value = 0.0; // the quantity that triggered it (deformation, force, ...)
+    EventKind kind = EventKind::Jump;  // a jump unless the element says its force is continuous
   };
   /// Root `index` changed sign (direction +1: increasing, -1: decreasing) at state s:
   /// commit the mode change into `mode` (the element's slot in the run's ElementStates, the

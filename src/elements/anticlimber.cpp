@@ -311,6 +311,7 @@ bool Anticlimber::commit(int index, int direction, double t, const ElementState<
   double g[kRootCount];
   roots_of(st, k, g);
   if (g[index] > 0.0) return false;  // an earlier commit at this instant already changed the mode
+  const State before = st;
   std::string what;
   transition(st, index, t, k, what);
   // The event's value: the offset v for an override (also faces missing each other at
@@ -319,7 +320,17 @@ bool Anticlimber::commit(int index, int direction, double t, const ElementState<
                            ? k.offset
                            : k.d[index == kContactRoot ? 0 : index / 3];
   settle(st, t, s, what);
-  event = {what, value};
+  // Contact seats the interlock at the faces' offset (every force starts at zero); yield,
+  // unloading and reloading change slopes only; separation releases the faces at zero
+  // horizontal force (IDA checks that the interlock's forces are zero there too). Override,
+  // crushing, shear or bending failure and the interlock's release or re-seating are jumps.
+  const auto ruptured = [](const State& x) {
+    using M = ElasticPlasticLaw::Mode;
+    return x.horizontal.mode == M::Failed || x.vertical.mode == M::Failed || x.torsional.mode == M::Failed;
+  };
+  const bool kink = (st.contact == Contact::Open || st.contact == Contact::Engaged) &&
+                    st.interlock_released == before.interlock_released && ruptured(st) == ruptured(before);
+  event = {what, value, kink ? EventKind::Kink : EventKind::Jump};
   return true;
 }
 

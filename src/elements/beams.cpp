@@ -227,13 +227,13 @@ bool BeamElement::commit(int index, int direction, double, const ElementState<do
   if (st.sign[k] == 0) {
     st.sign[k] = force[k] - hardening_[k] * offset[k] > 0.0 ? 1 : -1;
     if (k == 0)
-      event = {st.sign[k] > 0 ? "axial yield in tension" : "axial yield in compression", force[k]};
+      event = {st.sign[k] > 0 ? "axial yield in tension" : "axial yield in compression", force[k], EventKind::Kink};
     else
-      event = {"plastic hinge at " + component, force[k]};
+      event = {"plastic hinge at " + component, force[k], EventKind::Kink};
   } else {
     st.offset[k] = offset[k];
     st.sign[k] = 0;
-    event = {k == 0 ? std::string("axial unloading") : "hinge at " + component + " unloading", force[k]};
+    event = {k == 0 ? std::string("axial unloading") : "hinge at " + component + " unloading", force[k], EventKind::Kink};
   }
   return true;
 }

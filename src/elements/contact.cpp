@@ -98,28 +98,28 @@ bool SurfaceContact::commit(int index, int direction, double, const ElementState
       if (index != 0) return false;
       st.mode = Mode::Contact;
       st.segment = 0;
-      event = {wheel_rail_ ? "wheel contact" : "contact", k.rate};
+      event = {wheel_rail_ ? "wheel contact" : "contact", k.rate, EventKind::Kink};  // (with damping the force jumps: IDA finds that and restarts)
       return true;
     case Mode::Contact:
       if (index == 0) {
         st.mode = Mode::Open;
-        event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate};
+        event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate, EventKind::Kink};
       } else if (index == 1) {
         st.mode = Mode::Released;
-        event = {wheel_rail_ ? "wheel unloaded (damper would pull)" : "released (damper would pull)", k.penetration};
+        event = {wheel_rail_ ? "wheel unloaded (damper would pull)" : "released (damper would pull)", k.penetration, EventKind::Kink};
       } else {
         st.segment = 1 - st.segment;
-        event = {st.segment == 1 ? "above breakpoint" : "below breakpoint", k.penetration};
+        event = {st.segment == 1 ? "above breakpoint" : "below breakpoint", k.penetration, EventKind::Kink};
       }
       return true;
     case Mode::Released:
       if (index == 0) {
         st.mode = Mode::Open;
-        event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate};
+        event = {wheel_rail_ ? "wheel lift-off" : "separation", k.rate, EventKind::Kink};
       } else {
         st.mode = Mode::Contact;
         st.segment = k.penetration > breakpoint ? 1 : 0;
-        event = {wheel_rail_ ? "wheel contact" : "contact", k.penetration};
+        event = {wheel_rail_ ? "wheel contact" : "contact", k.penetration, EventKind::Kink};
       }
       return true;
   }

@@ -53,6 +53,7 @@ bool commit_crossing(int index, int direction, Roots roots, Apply apply, Element
     Element::Event more;
     apply(static_cast<int>(next - g.begin()), more);
     event.what += ", " + more.what;
+    if (more.kind == Element::EventKind::Jump) event.kind = Element::EventKind::Jump;  // a chain is a kink only if all are
   }
   return true;
 }
@@ -470,15 +471,17 @@ void DraftGear::apply(State& st, int index, const Kinematics& k, Event& event) c
         event = {"pin shear", force};
         return;
       }
-      event = {describe(law_.transition(st.law, index, k.d), st.law, law_, kGearSegments), k.d};
+      // The hysteresis law's transitions keep the force continuous (elastic lines join the
+      // loading and unloading lines); going solid and off solid start and end at zero force.
+      event = {describe(law_.transition(st.law, index, k.d), st.law, law_, kGearSegments), k.d, EventKind::Kink};
       return;
     case Stage::Sheared:
       st.stage = Stage::Solid;
-      event = {"solid", k.d};
+      event = {"solid", k.d, EventKind::Kink};
       return;
     case Stage::Solid:
       st.stage = Stage::Sheared;
-      event = {"off solid", k.d};
+      event = {"off solid", k.d, EventKind::Kink};
       return;
     case Stage::Fractured:
       return;
@@ -657,7 +660,7 @@ void CouplerEnd::apply(State& st, int index, const Kinematics& k, Event& event) 
   if (before == M::Inside) what = st.band == M::Below ? "contact" : "slack taken up (draft)";
   else if (before == M::Below) what = st.band == M::Inside ? "separation" : "buff to draft";
   else what = st.band == M::Inside ? "draft released" : "draft to buff";
-  event = {what, gap};
+  event = {what, gap, EventKind::Kink};  // the faces meet and part at zero force
 }
 
 void CouplerEnd::apply_lossy(State& st, int index, const Kinematics& k, Event& event) const {
@@ -665,22 +668,22 @@ void CouplerEnd::apply_lossy(State& st, int index, const Kinematics& k, Event& e
   if (st.blocked) {
     st.blocked = false;
     st.band = DeadBand::Mode::Inside;
-    event = {"faces clear", gap};
+    event = {"faces clear", gap, EventKind::Kink};
   } else if (st.band == DeadBand::Mode::Inside) {
     st.band = DeadBand::Mode::Below;
     st.unloading = st.peak > 0.0;  // a set face is reloaded along its unloading line
-    event = {"contact", gap};
+    event = {"contact", gap, EventKind::Kink};
   } else if (!st.unloading) {
     st.peak = std::max(st.peak, -gap);
     st.unloading = true;
-    event = {"unloading", gap};
+    event = {"unloading", gap, EventKind::Kink};
   } else if (index == 0) {
     st.band = DeadBand::Mode::Inside;
     st.unloading = false;
-    event = {"separation", gap};
+    event = {"separation", gap, EventKind::Kink};
   } else {
     st.unloading = false;
-    event = {"reloading", gap};
+    event = {"reloading", gap, EventKind::Kink};
   }
 }
 
@@ -830,7 +833,7 @@ void Coupling::roots(double, const ElementState<double>& s, const double*, doubl
 
 void Coupling::apply(State& st, int index, const Kinematics& k, Event& event) const {
   if (index < AxialHysteresis::kRoots) {
-    event = {describe(law_.transition(st.horizontal, index, k.u), st.horizontal, law_), k.u};
+    event = {describe(law_.transition(st.horizontal, index, k.u), st.horizontal, law_), k.u, EventKind::Kink};
     return;
   }
   using M = DeadBand::Mode;
@@ -838,7 +841,7 @@ void Coupling::apply(State& st, int index, const Kinematics& k, Event& event) co
   const char* what = st.vertical == M::Inside ? "vertical slack"
                      : st.vertical == M::Above ? "vertical slack taken up (head L above)"
                                                    : "vertical slack taken up (head L below)";
-  event = {what, k.w};
+  event = {what, k.w, EventKind::Kink};
 }
 
 bool Coupling::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,

@@ -145,13 +145,13 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
         st.max_crush = crush;
         st.permanent_crush = crush - curve_at(crush) / unloading_stiffness;
         st.mode = Mode::Elastic;
-        event = {"unloading", crush};
+        event = {"unloading", crush, EventKind::Kink};
       } else if (index == 1) {
         --st.segment;
-        event = {"curve segment " + std::to_string(st.segment + 1), crush};
+        event = {"curve segment " + std::to_string(st.segment + 1), crush, EventKind::Kink};
       } else {
         ++st.segment;
-        event = {"curve segment " + std::to_string(st.segment + 1), crush};
+        event = {"curve segment " + std::to_string(st.segment + 1), crush, EventKind::Kink};
       }
       return true;
     case Mode::Elastic:
@@ -161,16 +161,16 @@ bool CrushSpring::commit(int index, int direction, double, const ElementState<do
         // d_max (crush < d_max by round-off): the element reloads all the same, never a
         // "reloading" that leaves it elastic (which would fire again at once).
         enter_mode_at(st, std::max(crush, st.max_crush), 1.0);
-        event = {"reloading on the curve", crush};
+        event = {"reloading on the curve", crush, EventKind::Kink};
       } else {
         st.mode = Mode::Open;
-        event = {"separation", crush};
+        event = {"separation", crush, EventKind::Kink};
       }
       return true;
     case Mode::Open:
       if (direction > 0 || index != 0) return false;
       enter_mode_at(st, std::max(crush, st.permanent_crush), 1.0);  // contact (as above: never left open)
-      event = {st.mode == Mode::Loading ? "contact, crushing" : "contact", crush};
+      event = {st.mode == Mode::Loading ? "contact, crushing" : "contact", crush, EventKind::Kink};
       return true;
   }
   return false;

@@ -158,6 +158,9 @@ bool PiecewiseLineElement<Derived>::commit(int index, int direction, double, con
   const int from = m.segment;
   m.segment = to;
   event = static_cast<const Derived*>(this)->segment_event(from, to, x);
+  // The piecewise-linear laws are continuous across their breakpoints; a special spring that
+  // closes onto a preload is not, and the integrator finds that jump at the event and restarts.
+  event.kind = Element::EventKind::Kink;
   return true;
 }
 
