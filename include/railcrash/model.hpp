@@ -121,7 +121,8 @@ class Model {
 
   std::string name;
   std::string file;  // model file the model came from ("" when built in code)
-  UnitSystem units = UnitSystem::SI;
+  UnitSystem units = UnitSystem::SI;  // of the numbers held here
+  std::string file_units;             // the model file's `units` ("mm-t-s-N" is converted to SI when read)
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
   SimulationSettings simulation;
   ResponseSettings responses;
