@@ -20,8 +20,9 @@
 //       jobs: wall time and speed-up.
 //   railcrash_bench trains [--cars 200] [--model models/examples/emu3_wall.yaml]
 //       expanding car types and trains (train_expansion.hpp): the model's first train made N
-//       cars long (its car types in turn); the expansion alone, and loading the train model
-//       against loading its expanded flat text (fastest of 9 each) [ms].
+//       cars long (its car types in turn); parsing its text, the expansion alone (from the
+//       parsed document to the flat one), and loading the train model against loading its
+//       expanded flat text (fastest of 9 each) [ms].
 // "located in a step": mode changes located on IDA's interpolating polynomial (each one
 // O(1)); "restarts": mode changes the step could not absorb (IDAReInit).
 // Every benchmark prints a table and appends it, with the machine's core count, the commit
@@ -513,14 +514,17 @@ int trains_benchmark(const std::string& model_path, int cars, const std::string&
     return 1e3 * best;  // [ms]
   };
   std::size_t bodies = 0, elements = 0;
-  const double expand_ms = fastest([&] {
+  double expand_ms = 1e300;  // [ms] the expansion alone: from the parsed document to the flat one
+  for (int round = 0; round < 9; ++round) {
     YAML::Node document = YAML::Load(text);
     TrainExpansion expansion;
+    const auto start = std::chrono::steady_clock::now();
     expand_trains(document, file.string(), expansion, [](const YAML::Node&) -> const std::string* { return nullptr; },
                   [](const YAML::Node&, const std::string&) {});
+    expand_ms = std::min(expand_ms, 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     bodies = document["bodies"].size();
     elements = document["elements"].size();
-  });
+  }
   const double parse_ms = fastest([&] { YAML::Node document = YAML::Load(text); });
   const double load_train_ms = fastest([&] { load_model_text(text, file.string()); });
   const double load_flat_ms = fastest([&] { load_model_text(flat, "flat.yaml"); });
@@ -528,9 +532,9 @@ int trains_benchmark(const std::string& model_path, int cars, const std::string&
   char line[1024];
   std::snprintf(line, sizeof line,
                 "%d cars from %s's car types: %zu bodies, %zu elements\n\n| step | ms (fastest of 9) |\n|---|---|\n"
-                "| parse the train model's YAML | %.2f |\n| parse + expand | %.2f |\n| expansion alone (difference) | %.2f |\n"
+                "| parse the train model's YAML | %.2f |\n| expand the parsed document | %.2f |\n"
                 "| load the train model (parse, expand, build, finalize) | %.2f |\n| load the expanded flat model | %.2f |\n",
-                cars, model_path.c_str(), bodies, elements, parse_ms, expand_ms, expand_ms - parse_ms, load_train_ms, load_flat_ms);
+                cars, model_path.c_str(), bodies, elements, parse_ms, expand_ms, load_train_ms, load_flat_ms);
   std::fputs(line, stdout);
   append_results(results, "Expanding car types and trains", line, commit);
   return 0;

@@ -151,58 +151,69 @@ class Editor {
 
   const std::string* note = nullptr;  // the instance the copies belong to
 
+  /// A new, empty node (null until given a scalar, items or entries). Every node the expansion
+  /// makes lives in one yaml-cpp memory (the pool's): a node made on its own (YAML::Node(...))
+  /// has its own, and joining memories copies their sets of nodes, which for 200 cars cost
+  /// most of the expansion's time.
+  YAML::Node make(YAML::EmitterStyle::value style = YAML::EmitterStyle::Default) {
+    YAML::Node node = pool_[pooled_++];
+    node.SetStyle(style);  // (also makes it defined: the pool's next item needs that)
+    return node;
+  }
+  YAML::Node scalar(const std::string& text, int line) {
+    YAML::Node node = make();
+    node = text;
+    expansion_.add(node, line, note);
+    return node;
+  }
+
   YAML::Node copy(const YAML::Node& node, int fallback_line, bool inside_setting = false) {
     const int line = node.Mark().is_null() ? fallback_line : node.Mark().line + 1;
-    YAML::Node out;
+    YAML::Node out = make(node.Style());
     if (node.IsScalar()) {
-      out = YAML::Node(node.Scalar());
+      out = node.Scalar();
       if (!node.Tag().empty()) out.SetTag(node.Tag());
     } else if (node.IsSequence()) {
-      out = YAML::Node(YAML::NodeType::Sequence);
       for (const YAML::Node& item : node) out.push_back(copy(item, line, inside_setting || setting_of_(node)));
     } else if (node.IsMap()) {
-      out = YAML::Node(YAML::NodeType::Map);
       const bool set = inside_setting || setting_of_(node);
       for (const auto& entry : node) {
         const YAML::Node key = copy(entry.first, line, set);
         out.force_insert(key, copy(entry.second, line_of(entry.first) ? line_of(entry.first) : line, set));
       }
-    } else {
-      out = YAML::Node(YAML::NodeType::Null);
     }
-    out.SetStyle(node.Style());
     expansion_.add(out, line, note);
     if (!inside_setting)
       if (const std::string* setting = setting_of_(node)) mark_(out, *setting);
     return out;
   }
 
-  /// A new node holding `value`, at `line`.
+  /// A node the expansion made (the pool's), at `line`.
   YAML::Node fresh(const YAML::Node& value, int line) {
     expansion_.add(value, line, note);
     return value;
   }
   YAML::Node fresh_pair(double a, double b, int line) {
-    YAML::Node pair = flow_pair(a, b);
-    pair[0] = number_text(a);
-    pair[1] = number_text(b);
-    fresh(pair[0], line);
-    fresh(pair[1], line);
+    YAML::Node pair = make(YAML::EmitterStyle::Flow);
+    pair.push_back(scalar(number_text(a), line));
+    pair.push_back(scalar(number_text(b), line));
     return fresh(pair, line);
   }
+  /// Adds `key: value` to the map `map` (a copy without that key).
+  void insert(YAML::Node& map, const std::string& key, const YAML::Node& value, int line) { map.force_insert(scalar(key, line), value); }
 
   /// Sets the scalar `node` (a copy) to `text`, keeping its origin.
   void set(YAML::Node node, const std::string& text) {
     const TrainExpansion::Origin* origin = expansion_.origin(node);
     const TrainExpansion::Origin kept = origin ? *origin : TrainExpansion::Origin{0, note};
-    const bool from_setting = setting_of_(node) != nullptr;
-    if (from_setting) return;  // a setting's value stays as given (it is the user's number)
-    node = text;
+    node = text;  // (in place: a setting's label, kept by node, still names it)
     expansion_.add(node, kept.line, kept.note);
   }
   void set(YAML::Node node, double value) { set(node, number_text(value)); }
 
  private:
+  YAML::Node pool_{YAML::NodeType::Sequence};
+  std::size_t pooled_ = 0;
   TrainExpansion& expansion_;
   const SettingOf& setting_of_;
   const MarkSetting& mark_;
@@ -443,9 +454,9 @@ class Expander {
       }
       vx += facing * speed;
       if (b["velocity"]) edit_.set(body["velocity"][0], vx);
-      else if (vx != 0.0 || vy != 0.0) body["velocity"] = edit_.fresh_pair(vx, vy, line);
+      else if (vx != 0.0 || vy != 0.0) edit_.insert(body, "velocity", edit_.fresh_pair(vx, vy, line), line);
       if (b["car"]) edit_.set(body["car"], name);
-      else body["car"] = edit_.fresh(YAML::Node(name), line);
+      else edit_.insert(body, "car", edit_.scalar(name, line), line);
       bodies_.push_back(body);
       ++summary.bodies;
     }
@@ -495,7 +506,7 @@ class Expander {
                                     : std::array<double, 2>{0.0, 0.0};
         if (body == "ground") {  // a point fixed in the world: car coordinates placed
           if (point["at"]) edit_.set(copied["at"][0], p.x(at[0]));
-          else copied["at"] = edit_.fresh_pair(p.x(0.0), 0.0, line_of(point));
+          else edit_.insert(copied, "at", edit_.fresh_pair(p.x(0.0), 0.0, line_of(point)), line_of(point));
           continue;
         }
         if (std::find(type.body_names.begin(), type.body_names.end(), body) == type.body_names.end())
@@ -535,7 +546,7 @@ class Expander {
       edit_.set(element["name"], prefix + "." + element_name);
       const YAML::Node points = check_.required(e, "points", what);
       check_.list(points, what + ": points");
-      YAML::Node placed(YAML::NodeType::Sequence);
+      YAML::Node placed = edit_.make(YAML::EmitterStyle::Flow);
       for (std::size_t k = 0; k < points.size(); ++k) {
         const YAML::Node point = points[k];
         const std::string pw = what + ": point " + std::to_string(k + 1);
@@ -545,10 +556,9 @@ class Expander {
         if (end != "1" && end != "2") check_.fail(end_node, pw + ": end must be 1 (the end at smaller x) or 2");
         const CarEnd& at_end = end == "1" ? lower : upper;
         const auto offset = point["at"] ? check_.pair(point["at"], pw + ": at") : std::array<double, 2>{0.0, 0.0};
-        YAML::Node out(YAML::NodeType::Map);
-        out.SetStyle(YAML::EmitterStyle::Flow);
-        out["body"] = edit_.fresh(YAML::Node(at_end.body), line_of(end_node));
-        out["at"] = edit_.fresh_pair(at_end.sx + offset[0], at_end.sy + offset[1], line_of(point));
+        YAML::Node out = edit_.make(YAML::EmitterStyle::Flow);
+        edit_.insert(out, "body", edit_.scalar(at_end.body, line_of(end_node)), line_of(point));
+        edit_.insert(out, "at", edit_.fresh_pair(at_end.sx + offset[0], at_end.sy + offset[1], line_of(point)), line_of(point));
         placed.push_back(edit_.fresh(out, line_of(point)));
       }
       element["points"] = edit_.fresh(placed, line_of(points));
@@ -592,7 +602,7 @@ class Expander {
   std::map<std::string, int> interface_type_lines_;  // the line of each one's name
   std::set<std::string> trains_;
   std::map<std::string, CarInstance> cars_;
-  YAML::Node bodies_{YAML::NodeType::Sequence}, elements_{YAML::NodeType::Sequence};
+  YAML::Node bodies_ = edit_.make(), elements_ = edit_.make();  // the generated ones (the pool's)
 };
 
 /// KEY, the operator ("=" or "*=") and the text after it; InputError when there is none.
