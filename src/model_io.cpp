@@ -867,7 +867,7 @@ Model build(const YAML::Node& root, Reader& r) {
     model.units = UnitSystem::SI;
     r.set_scale({1.0e-3, 1.0e3, 1.0});
   } else {
-    r.fail(units, std::string("units must be SI, ") + kMillimetreTonne + " or in-lbf-s, not '" + unit_name + "'");
+    r.fail(units, "units must be SI or in-lbf-s, not '" + unit_name + "' (or " + kMillimetreTonne + ": mm, tonne, s, N)");
   }
   model.file_units = unit_name;
   const double g = standard_gravity(model.units);

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/consist.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
 #include "support.hpp"
@@ -343,4 +344,22 @@ TEST_CASE("two identical units meeting head on stay mirror images of each other"
   const auto body_a = static_cast<std::size_t>(*model.find_body("unitA.car1.body"));
   const auto front_a = static_cast<std::size_t>(*model.find_body("unitA.car1.front_end"));
   CHECK(y[3 * front_a] - y[3 * body_a] < 12.2 - 0.1);
+}
+
+TEST_CASE("consist makes a model's trains N cars long, repeating its cars in turn", "[trains][consist]") {
+  const std::string text = make_consist_model(YAML::Load(kTrainModel), "three.yaml", 5);
+  const Model model = load_model_text(text, "consist.yaml");
+  REQUIRE(model.body_count() == 10);
+  // Cars 1-3 as listed (the third reversed), then car4 = car1 and car5 = the named middle car,
+  // each 8.5 long over its ends with 0.2 between: car k's front at 10 - (k - 1) 8.7.
+  for (int k = 1; k <= 5; ++k) {
+    const bool reversed = k == 3;
+    const double front = 10.0 - (k - 1) * 8.7;
+    INFO("car " << k);
+    // the body's centre lies 4.0 behind the front interface; a reversed car leads with its
+    // rear interface, 4.5 behind it in the car's coordinates
+    CHECK(body(model, "unitA.car" + std::to_string(k) + ".body").x == Approx(reversed ? front - 4.5 : front - 4.0));
+  }
+  CHECK_THROWS_WITH(make_consist_model(YAML::Load("railcrash: 1\ntrains: {a: 1}\n"), "bad.yaml", 2),
+                    Contains("bad.yaml:2: consist: 'trains' must be a list of trains"));
 }
