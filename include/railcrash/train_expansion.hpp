@@ -40,7 +40,7 @@
 #include <functional>
 #include <memory>
 #include <string>
-#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace railcrash {
@@ -71,10 +71,11 @@ class TrainExpansion {
 
   // (the expansion's own)
   void add(const YAML::Node& node, int line, const std::string* note);
+  void seal();  // sorts the origins (after the last add)
   const std::string* note(std::string text);
 
  private:
-  std::unordered_map<const void*, Origin> origins_;
+  std::vector<std::pair<const void*, Origin>> origins_;  // by node, sorted once sealed
   std::vector<std::unique_ptr<std::string>> notes_;
 };
 
