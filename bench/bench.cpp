@@ -18,6 +18,11 @@
 //   railcrash_bench sensitivity [--design FILE]
 //       the report's sensitivity study (base + first-order + second-order runs) with 1 and 2
 //       jobs: wall time and speed-up.
+//   railcrash_bench trains [--cars 200] [--model models/examples/emu3_wall.yaml]
+//       expanding car types and trains (train_expansion.hpp): the model's first train made N
+//       cars long (its car types in turn); parsing its text, the expansion alone (from the
+//       parsed document to the flat one), and loading the train model against loading its
+//       expanded flat text (fastest of 9 each) [ms].
 // "located in a step": mode changes located on IDA's interpolating polynomial (each one
 // O(1)); "restarts": mode changes the step could not absorb (IDAReInit).
 // Every benchmark prints a table and appends it, with the machine's core count, the commit
@@ -46,6 +51,7 @@
 #include "railcrash/dae_system.hpp"
 #include "railcrash/integrator.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/train_expansion.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/buffered_file.hpp"
 #include "railcrash/run.hpp"
@@ -478,6 +484,62 @@ int numbers_benchmark(const std::string& model_path, const std::string& results,
   return differ == 0 ? 0 : 1;
 }
 
+/// Expansion time of an N-car train built from the car types of `model_path` (its first train's
+/// cars repeated in turn), and what loading it costs against loading the same model flat.
+int trains_benchmark(const std::string& model_path, int cars, const std::string& results, const std::string& commit) {
+  YAML::Node root = YAML::LoadFile(model_path);
+  const YAML::Node first = root["trains"][0];
+  YAML::Node long_cars(YAML::NodeType::Sequence);
+  for (int k = 0; k < cars; ++k) long_cars.push_back(YAML::Clone(first["cars"][k % first["cars"].size()]));
+  YAML::Node train = YAML::Clone(first);
+  train["cars"] = long_cars;
+  YAML::Node trains(YAML::NodeType::Sequence);
+  trains.push_back(train);
+  root["trains"] = trains;
+  root.remove("connections");
+  root.remove("elements");
+  YAML::Emitter emitter;
+  emitter << root;
+  const std::string text = emitter.c_str();
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "railcrash_bench_train.yaml";
+  std::ofstream(file) << text;
+  const std::string flat = expand_model_file(file.string(), {}).text;
+  const auto fastest = [](auto work) {
+    double best = 1e300;
+    for (int round = 0; round < 9; ++round) {
+      const auto start = std::chrono::steady_clock::now();
+      work();
+      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    return 1e3 * best;  // [ms]
+  };
+  std::size_t bodies = 0, elements = 0;
+  double expand_ms = 1e300;  // [ms] the expansion alone: from the parsed document to the flat one
+  for (int round = 0; round < 9; ++round) {
+    YAML::Node document = YAML::Load(text);
+    TrainExpansion expansion;
+    const auto start = std::chrono::steady_clock::now();
+    expand_trains(document, file.string(), expansion, [](const YAML::Node&) -> const std::string* { return nullptr; },
+                  [](const YAML::Node&, const std::string&) {});
+    expand_ms = std::min(expand_ms, 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    bodies = document["bodies"].size();
+    elements = document["elements"].size();
+  }
+  const double parse_ms = fastest([&] { YAML::Node document = YAML::Load(text); });
+  const double load_train_ms = fastest([&] { load_model_text(text, file.string()); });
+  const double load_flat_ms = fastest([&] { load_model_text(flat, "flat.yaml"); });
+  std::filesystem::remove(file);
+  char line[1024];
+  std::snprintf(line, sizeof line,
+                "%d cars from %s's car types: %zu bodies, %zu elements\n\n| step | ms (fastest of 9) |\n|---|---|\n"
+                "| parse the train model's YAML | %.2f |\n| expand the parsed document | %.2f |\n"
+                "| load the train model (parse, expand, build, finalize) | %.2f |\n| load the expanded flat model | %.2f |\n",
+                cars, model_path.c_str(), bodies, elements, parse_ms, expand_ms, load_train_ms, load_flat_ms);
+  std::fputs(line, stdout);
+  append_results(results, "Expanding car types and trains", line, commit);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -512,6 +574,12 @@ int main(int argc, char** argv) {
   CLI::App* sensitivity = app.add_subcommand("sensitivity", "the report's sensitivity study with 1 and 2 jobs");
   sensitivity->add_option("--design", design_path, "design file")->capture_default_str();
 
+  int train_cars = 200;
+  std::string train_model = source + "/models/examples/emu3_wall.yaml";
+  CLI::App* trains = app.add_subcommand("trains", "expansion time of an N-car train of car types");
+  trains->add_option("--cars", train_cars, "cars in the train")->capture_default_str();
+  trains->add_option("--model", train_model, "model whose car types and first train are used")->capture_default_str();
+
   CLI11_PARSE(app, argc, argv);
   if (app.count("--commit") == 0) commit = source_commit(source);
   try {
@@ -525,6 +593,7 @@ int main(int argc, char** argv) {
     }
     if (*numbers) return numbers_benchmark(numbers_model, results, commit);
     if (*sensitivity) return sensitivity_benchmark(template_path, design_path, results, commit);
+    if (*trains) return trains_benchmark(train_model, train_cars, results, commit);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "railcrash_bench: %s\n", e.what());
     return 2;

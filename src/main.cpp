@@ -143,7 +143,16 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
   int constraint_elements = 0;
   for (const auto& e : model.elements()) constraint_elements += e->constraint_count() > 0;
   std::printf("model      %s  (%s)\n", model.name.c_str(), path.c_str());
-  std::printf("units      %s, gravity [%g, %g]\n", unit_system_name(model.units), model.gravity_x, model.gravity_y);
+  std::printf("units      %s%s, gravity [%g, %g]\n", unit_system_name(model.units),
+              model.file_units == unit_system_name(model.units) ? "" : (" (the file's " + model.file_units + ", converted when read)").c_str(),
+              model.gravity_x, model.gravity_y);
+  const ExpandedModel expanded = expand_model_file(path, settings);  // the cars the file's trains placed
+  if (!expanded.cars.empty()) {
+    std::printf("cars       %zu placed from car types (railcrash expand writes the flat model)\n", expanded.cars.size());
+    for (const ExpandedCar& car : expanded.cars)
+      std::printf("  %-20s type %-14s%s leading end x %-10.6g trailing end x %-10.6g %zu bodies, %zu elements\n", car.name.c_str(),
+                  car.type.c_str(), car.reversed ? " reversed" : "         ", car.leading_x, car.trailing_x, car.bodies, car.elements);
+  }
   std::printf("bodies     %d\n", model.body_count());
   for (const Body& b : model.bodies())
     std::printf("  %-20s mass %-12.6g inertia %-12.6g at [%g, %g]\n", b.name.c_str(), b.mass, b.inertia, b.x, b.y);
@@ -471,6 +480,12 @@ int write_generated_model(const std::string& text, const std::string& out_path, 
   return 0;
 }
 
+int expand_command(const std::string& path, const std::vector<std::string>& settings, const std::string& out_path, bool out_given) {
+  if (out_given) railcrash::check_output_file(out_path);
+  const railcrash::ExpandedModel expanded = railcrash::expand_model_file(path, settings);
+  return write_generated_model(expanded.text, out_path, "the expanded model (" + std::to_string(expanded.cars.size()) + " cars)");
+}
+
 int consist_command(const std::string& template_path, int cars, const std::string& out_path, bool out_given) {
   if (out_given) railcrash::check_output_file(out_path);
   return write_generated_model(railcrash::make_consist_model(template_path, cars), out_path,
@@ -706,6 +721,12 @@ int main(int argc, char** argv) {
   check->add_option("model", model_path, "model file (YAML)")->required();
   check->add_option("--set", settings, "override a model key");
 
+  std::string expand_out;
+  CLI::App* expand = app.add_subcommand("expand", "write the model with its car types and trains expanded into flat bodies and elements");
+  expand->add_option("model", model_path, "model file (YAML)")->required();
+  expand->add_option("--set", settings, "override a model key");
+  expand->add_option("--out", expand_out, "model file to write (default: standard output)");
+
   std::string element_type_name;
   bool elements_markdown = false;
   CLI::App* elements = app.add_subcommand("elements", "element reference: the types, or one type's points and parameters");
@@ -719,6 +740,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*check) return check_command(model_path, settings);
+    if (*expand) return expand_command(model_path, settings, expand_out, expand->count("--out") > 0);
     if (*elements) return elements_command(element_type_name, elements_markdown);
     if (*report) return report_command(report_dir, report_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);

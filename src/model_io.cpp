@@ -15,6 +15,7 @@
 
 #include "railcrash/element_registry.hpp"
 #include "railcrash/sha256.hpp"
+#include "railcrash/train_expansion.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -122,6 +123,8 @@ class Reader {
 
   SourceLocation at(const YAML::Node& node) const {
     if (!node.IsDefined() || from_override(node)) return {file_, 0};
+    if (expansion_)
+      if (const TrainExpansion::Origin* origin = expansion_->origin(node)) return {file_, origin->line};
     if (node.IsNull())
       for (const auto& entry : empty_values_)
         if (entry.first.is(node)) return {file_, entry.second};
@@ -130,8 +133,37 @@ class Reader {
   }
   [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
     if (const std::string* setting = from_override(node)) throw InputError(*setting + ": " + message);
+    if (expansion_)  // a copy of a car type's text: its line, and the instance
+      if (const TrainExpansion::Origin* origin = expansion_->origin(node)) throw InputError(at(node).prefix() + message + *origin->note);
     throw InputError(at(node).prefix() + message);
   }
+
+  /// The setting (its label) `node` came from, or nullptr when it is from the file.
+  const std::string* setting_of(const YAML::Node& node) const { return from_override(node); }
+  /// The expansion of the file's car types and trains: where its generated nodes came from.
+  void set_expansion(const TrainExpansion* expansion) { expansion_ = expansion; }
+
+  /// Factors from the file's units to the model's (mm-t-s-N: to SI; otherwise 1).
+  struct UnitScale {
+    double length = 1.0, mass = 1.0, force = 1.0;
+    /// The factor of a parameter of unit kind `unit` (a curve's: of its length column).
+    double of(Unit unit) const {
+      const double l = length, f = force;
+      switch (unit) {
+        case Unit::Length: case Unit::Position: case Unit::Velocity: case Unit::LengthForceCurve: return l;
+        case Unit::Force: return f;
+        case Unit::Moment: case Unit::MomentPerAngle: case Unit::MomentTimePerAngle: return f * l;
+        case Unit::ForcePerLength: case Unit::ForceTimePerLength: return f / l;
+        case Unit::Stress: return f / (l * l);
+        case Unit::Area: return l * l;
+        case Unit::SectionModulus: return l * l * l;
+        case Unit::SecondMoment: return l * l * l * l;
+        default: return 1.0;  // dimensionless, angles, angular velocities, directions, choices
+      }
+    }
+  };
+  void set_scale(UnitScale scale) { scale_ = scale; }
+  const UnitScale& scale() const { return scale_; }
 
   void require_map(const YAML::Node& node, const std::string& what) const {
     if (!node.IsMap()) fail(node, what + " must be a map of keys (key: value)");
@@ -241,6 +273,8 @@ class Reader {
   std::unordered_set<int> walked_positions_;  // text positions of the lists and maps index_empty_values walked
   std::unordered_set<int> shared_positions_;  // ... of those it met more than once (an alias refers to them)
   std::vector<YAML::Node> copied_entries_;     // lists and maps held by an edit's copy and by the original
+  const TrainExpansion* expansion_ = nullptr;
+  UnitScale scale_;
 };
 
 class YamlParameterReader : public ParameterReader {
@@ -252,12 +286,14 @@ class YamlParameterReader : public ParameterReader {
   std::optional<double> given_number(const std::string& key) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
-    return reader_.number(node, context_ + ": '" + key + "'");
+    return reader_.number(node, context_ + ": '" + key + "'") * factor(key);
   }
   std::optional<std::vector<double>> given_vector(const std::string& key, std::size_t size) override {
     const YAML::Node node = element_[key];
     if (!node) return std::nullopt;
-    return reader_.numbers(node, size, context_ + ": '" + key + "'");
+    std::vector<double> values = reader_.numbers(node, size, context_ + ": '" + key + "'");
+    for (double& v : values) v *= factor(key);
+    return values;
   }
   std::optional<std::vector<std::vector<double>>> given_table(const std::string& key, std::size_t width) override {
     const YAML::Node node = element_[key];
@@ -265,8 +301,13 @@ class YamlParameterReader : public ParameterReader {
     if (!node.IsSequence() || node.size() == 0)
       reader_.fail(node, context_ + ": '" + key + "' must be a table of rows [[a, b], ...]");
     std::vector<std::vector<double>> rows;
-    for (std::size_t i = 0; i < node.size(); ++i)
+    const ParameterSpec* spec = type().find(key);
+    const bool curve = spec && spec->unit == Unit::LengthForceCurve;  // [[length, force], ...]
+    for (std::size_t i = 0; i < node.size(); ++i) {
       rows.push_back(reader_.numbers(node[i], width, context_ + ": '" + key + "' row " + std::to_string(i + 1)));
+      for (std::size_t k = 0; k < rows.back().size(); ++k)
+        rows.back()[k] *= curve && k > 0 ? reader_.scale().force : factor(key);
+    }
     return rows;
   }
   std::optional<bool> given_flag(const std::string& key) override {
@@ -285,6 +326,12 @@ class YamlParameterReader : public ParameterReader {
   }
 
  private:
+  /// From the file's units to the model's, for `key`'s unit kind.
+  double factor(const std::string& key) const {
+    const ParameterSpec* spec = type().find(key);
+    return spec ? reader_.scale().of(spec->unit) : 1.0;
+  }
+
   const Reader& reader_;
   YAML::Node element_;
   std::string context_;
@@ -500,6 +547,9 @@ void apply_override(YAML::Node& root, const std::string& setting, Reader& reader
   put_value(root, setting_path(root, key, false, where), value, reader, label);
 }
 
+/// The crash codes' unit system: mm, tonne, s, N (mass in t = 1000 kg, stiffness in N/mm, stress in MPa).
+constexpr const char* kMillimetreTonne = "mm-t-s-N";
+
 const std::vector<std::string> kTopKeys = {"railcrash", "name", "units", "gravity", "bodies", "elements", "loads", "simulation", "description", "outputs",
                                            "responses", "scenario"};
 const std::vector<std::string> kBodyKeys = {"name", "mass", "weight", "inertia", "position", "angle", "velocity", "angular_velocity",
@@ -527,7 +577,8 @@ Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double
   if (node["mass"] && node["weight"]) r.fail(node["weight"], context + ": give either mass or weight, not both");
   if (node["weight"]) {
     if (units != UnitSystem::InLbfS)
-      r.fail(node["weight"], context + ": 'weight' is for in-lbf-s models (weight in lbf); in SI give 'mass' in kg");
+      r.fail(node["weight"], context + ": 'weight' is for in-lbf-s models (weight in lbf); in " +
+                                 std::string(r.scale().mass != 1.0 ? "mm-t-s-N give 'mass' in t" : "SI give 'mass' in kg"));
     const double weight = r.number(node["weight"], context + ": weight");
     if (!(weight > 0.0)) r.fail(node["weight"], context + ": weight must be positive (lbf)");
     b.mass = weight / gravity_magnitude;  // [lbf*s^2/in] = lbf / (386.088 in/s^2)
@@ -535,18 +586,21 @@ Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double
     const YAML::Node mass = r.required(node, "mass", context + " (give mass" + std::string(units == UnitSystem::InLbfS ? " or weight" : "") + ")");
     b.mass = r.number(mass, context + ": mass");
     if (!(b.mass > 0.0)) r.fail(mass, context + ": mass must be positive");
+    b.mass *= r.scale().mass;
   }
   const YAML::Node inertia = r.required(node, "inertia", context);
   b.inertia = r.number(inertia, context + ": inertia");
   if (b.inertia < 0.0) r.fail(inertia, context + ": inertia must not be negative (0 = point mass)");
+  b.inertia *= r.scale().mass * r.scale().length * r.scale().length;
+  const double length = r.scale().length;
   const auto position = r.numbers(r.required(node, "position", context), 2, context + ": position");
-  b.x = position[0];
-  b.y = position[1];
+  b.x = position[0] * length;
+  b.y = position[1] * length;
   if (node["angle"]) b.angle = r.number(node["angle"], context + ": angle");
   if (node["velocity"]) {
     const auto v = r.numbers(node["velocity"], 2, context + ": velocity");
-    b.vx = v[0];
-    b.vy = v[1];
+    b.vx = v[0] * length;
+    b.vy = v[1] * length;
   }
   if (node["angular_velocity"]) b.angular_velocity = r.number(node["angular_velocity"], context + ": angular_velocity");
   if (node["car"]) {  // the car's name heads its rows in summary.json, the run output and the report
@@ -591,8 +645,8 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
     ref.body = *index;
     if (p["at"]) {
       const auto at = r.numbers(p["at"], 2, pc + ": at");
-      ref.sx = at[0];
-      ref.sy = at[1];
+      ref.sx = at[0] * r.scale().length;
+      ref.sy = at[1] * r.scale().length;
     }
     spec.points.push_back(ref);
   }
@@ -666,10 +720,13 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
   if (node["at"]) {
     if (load.kind == Load::Kind::Moment) r.fail(node["at"], context + ": a moment has no point; remove 'at'");
     const auto at = r.numbers(node["at"], 2, context + ": at");
-    load.sx = at[0];
-    load.sy = at[1];
+    load.sx = at[0] * r.scale().length;
+    load.sy = at[1] * r.scale().length;
   }
   load.value = read_load_value(r, r.required(node, "value", context), load.kind == Load::Kind::Force ? 2 : 1, context);
+  const double unit = load.kind == Load::Kind::Force ? r.scale().force : r.scale().force * r.scale().length;
+  for (auto& value : load.value.values)
+    for (double& component : value) component *= unit;
   return load;
 }
 
@@ -684,8 +741,8 @@ PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, co
   ref.body = *index;
   if (p["at"]) {
     const auto at = r.numbers(p["at"], 2, context + ": at");
-    ref.sx = at[0];
-    ref.sy = at[1];
+    ref.sx = at[0] * r.scale().length;
+    ref.sy = at[1] * r.scale().length;
   }
   return ref;
 }
@@ -714,8 +771,8 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
     output.point.body = *index;
     if (item["at"]) {
       const auto at = r.numbers(item["at"], 2, context + ": at");
-      output.point.sx = at[0];
-      output.point.sy = at[1];
+      output.point.sx = at[0] * r.scale().length;
+      output.point.sy = at[1] * r.scale().length;
     }
     if (item["name"]) {
       output.name = r.name(item["name"], context + ": name");
@@ -782,7 +839,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
   };
   if (!s.crush_gauges.empty() || s.crush_from_anticlimber) {
     if (!node["reference_crush"]) r.fail(node, "responses: crush gauges need 'reference_crush' (the maximum safe crush, R1 = crush / it)");
-    s.reference_crush = *positive("reference_crush");
+    s.reference_crush = *positive("reference_crush") * r.scale().length;
   }
   if (node["anticlimber"]) {
     s.anticlimber = r.text(node["anticlimber"], "responses: anticlimber");
@@ -791,6 +848,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     if (it == elements.end() || (*it)->type() != "anticlimber")
       r.fail(node["anticlimber"], "responses: 'anticlimber: " + s.anticlimber + "' must name an element of type anticlimber");
     s.vertical_yield_force = positive("vertical_yield_force");
+    if (s.vertical_yield_force) *s.vertical_yield_force *= r.scale().force;
     if (node["vertical_force_window"]) {
       using Window = ResponseSettings::VerticalForceWindow;
       const std::string window = r.text(node["vertical_force_window"], "responses: vertical_force_window");
@@ -803,7 +861,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     }
     if (!node["reference_velocity"])
       r.fail(node, "responses: an anticlimber needs 'reference_velocity' (the velocity that fails the collision post, for R2 after override)");
-    s.reference_velocity = *positive("reference_velocity");
+    s.reference_velocity = *positive("reference_velocity") * r.scale().length;
   }
 }
 
@@ -827,6 +885,8 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   };
   if (auto v = positive("rtol")) s.rtol = *v;
   s.atol = positive("atol");
+  const Reader::UnitScale& unit = r.scale();
+  if (s.atol) *s.atol *= unit.length;
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
   const std::string rows_problem = output_rows_problem(s);
@@ -844,10 +904,11 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   }
   if (node["static_equilibrium"])
     s.static_equilibrium = r.boolean(node["static_equilibrium"], "simulation: static_equilibrium");
-  s.penalty.stiffness = positive("penalty_stiffness");
-  s.penalty.damping = positive("penalty_damping");
-  s.penalty.rotational_stiffness = positive("penalty_rotational_stiffness");
-  s.penalty.rotational_damping = positive("penalty_rotational_damping");
+  const auto scaled = [](std::optional<double> value, double factor) { return value ? std::optional<double>(*value * factor) : value; };
+  s.penalty.stiffness = scaled(positive("penalty_stiffness"), unit.of(Unit::ForcePerLength));
+  s.penalty.damping = scaled(positive("penalty_damping"), unit.of(Unit::ForceTimePerLength));
+  s.penalty.rotational_stiffness = scaled(positive("penalty_rotational_stiffness"), unit.of(Unit::MomentPerAngle));
+  s.penalty.rotational_damping = scaled(positive("penalty_rotational_damping"), unit.of(Unit::MomentTimePerAngle));
 }
 
 /// The last '[' or '{' still open at offset `end` of `text` (line 0 when none). Skips
@@ -913,7 +974,7 @@ OpenBracket unclosed_bracket(const std::string& text, std::size_t end) {
   return open.empty() ? OpenBracket{} : open.back();
 }
 
-Model build(const YAML::Node& root, const Reader& r) {
+Model build(const YAML::Node& root, Reader& r) {
   if (!root.IsMap()) r.fail(root, "a model file must be a YAML map with keys railcrash, name, units, bodies, elements, simulation");
   r.check_keys(root, kTopKeys, "model");
   Model model;
@@ -924,16 +985,24 @@ Model build(const YAML::Node& root, const Reader& r) {
   model.name = r.text(r.required(root, "name", "model"), "name");
   const YAML::Node units = r.required(root, "units", "model");
   const std::string unit_name = r.text(units, "units");
-  if (unit_name == "SI") model.units = UnitSystem::SI;
-  else if (unit_name == "in-lbf-s") model.units = UnitSystem::InLbfS;
-  else r.fail(units, "units must be SI or in-lbf-s, not '" + unit_name + "'");
+  if (unit_name == "SI") {
+    model.units = UnitSystem::SI;
+  } else if (unit_name == "in-lbf-s") {
+    model.units = UnitSystem::InLbfS;
+  } else if (unit_name == kMillimetreTonne) {  // mm, t (1000 kg), s, N: converted to SI here, once
+    model.units = UnitSystem::SI;
+    r.set_scale({1.0e-3, 1.0e3, 1.0});
+  } else {
+    r.fail(units, "units must be SI or in-lbf-s, not '" + unit_name + "' (or " + kMillimetreTonne + ": mm, tonne, s, N)");
+  }
+  model.file_units = unit_name;
   const double g = standard_gravity(model.units);
   model.gravity_x = 0.0;
   model.gravity_y = -g;
   if (root["gravity"]) {
     const auto gravity = r.numbers(root["gravity"], 2, "gravity");
-    model.gravity_x = gravity[0];
-    model.gravity_y = gravity[1];
+    model.gravity_x = gravity[0] * r.scale().length;
+    model.gravity_y = gravity[1] * r.scale().length;
   }
   const YAML::Node bodies = r.required(root, "bodies", "model");
   r.require_list(bodies, "bodies");
@@ -949,8 +1018,16 @@ Model build(const YAML::Node& root, const Reader& r) {
   }
   if (root["responses"]) read_responses(r, root["responses"], model);
   if (root["outputs"]) read_outputs(r, root["outputs"], model);
-  if (root["scenario"])
+  if (root["scenario"]) {
     model.scenario = read_scenario_section(root["scenario"], model, [&r](const YAML::Node& node, const std::string& message) { r.fail(node, message); });
+    if (r.scale().length != 1.0) {  // its limits are lengths, speeds and decelerations
+      auto scaled = std::make_shared<ScenarioCriteria>(*model.scenario);
+      for (double* value : {&scaled->closing_speed, &scaled->deceleration_limit, &scaled->survival_limit, &scaled->override_limit,
+                            &scaled->wheel_lift_limit})
+        *value *= r.scale().length;
+      model.scenario = scaled;
+    }
+  }
   read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
   return model;
 }
@@ -1039,6 +1116,33 @@ YAML::Node resolve_variant(const YAML::Node& variant, const std::string& path, s
 
 namespace {
 
+/// The settings in the order they apply (the variant's, --set's, the options'), each with its
+/// label ("" for --set: apply_override names it).
+std::vector<VariantSetting> all_settings(const std::vector<VariantSetting>& variant_settings, const std::vector<std::string>& overrides,
+                                         const std::vector<OptionSetting>& options, const std::string& file) {
+  std::vector<VariantSetting> settings = variant_settings;
+  for (const auto& setting : overrides) settings.push_back({setting, ""});
+  for (const OptionSetting& o : options) settings.push_back({o.setting, SourceLocation{file, 0}.prefix() + o.option});
+  return settings;
+}
+
+/// Applies the settings to the document: those on car types and trains first, then the
+/// expansion into flat bodies and elements (train_expansion.hpp), then the others (on
+/// generated names too: unitA.car3.front_crush.stiffness=...).
+void apply_settings(YAML::Node& root, const std::vector<VariantSetting>& settings, Reader& reader, TrainExpansion& expansion) {
+  const MarkSetting mark = [&reader](const YAML::Node& node, const std::string& label) { reader.add_override(node, label); };
+  const auto label = [&reader](const VariantSetting& s) {
+    return s.label.empty() ? SourceLocation{reader.file(), 0}.prefix() + "--set '" + s.setting + "'" : s.label;
+  };
+  for (const VariantSetting& s : settings)
+    if (is_train_definition_setting(s.setting)) apply_train_definition_setting(root, s.setting, label(s), mark);
+  expand_trains(root, reader.file(), expansion, [&reader](const YAML::Node& node) { return reader.setting_of(node); }, mark);
+  reader.set_expansion(&expansion);
+  for (const VariantSetting& s : settings)
+    if (!is_train_definition_setting(s.setting) && !(expansion.expanded && apply_instance_setting(root, s.setting, label(s), mark)))
+      apply_override(root, s.setting, reader, s.label);
+}
+
 /// The model of a parsed model file (`root`, the text `text` read from `path`), with the settings applied.
 Model model_from_yaml(YAML::Node root, const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
@@ -1048,12 +1152,9 @@ Model model_from_yaml(YAML::Node root, const std::string& text, const std::strin
   if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings, sources);
   Reader reader(file);
   reader.index_empty_values(root);
-  if (root.IsMap() || root.IsNull()) {  // otherwise build() says what the file should look like
-    for (const VariantSetting& v : variant_settings) apply_override(root, v.setting, reader, v.label);
-    for (const auto& setting : overrides) apply_override(root, setting, reader);
-    for (const OptionSetting& o : options)
-      apply_override(root, o.setting, reader, SourceLocation{reader.file(), 0}.prefix() + o.option);
-  }
+  TrainExpansion expansion;
+  if (root.IsMap() || root.IsNull())  // otherwise build() says what the file should look like
+    apply_settings(root, all_settings(variant_settings, overrides, options, reader.file()), reader, expansion);
   try {
     Model model = build(root, reader);
     model.sources = std::move(sources);
@@ -1105,10 +1206,28 @@ Model load_model(const std::string& path, const std::vector<std::string>& overri
 
 Model load_model(const std::string& path) { return load_model(path, {}); }
 
+ExpandedModel expand_model_file(const std::string& path, const std::vector<std::string>& overrides) {
+  const std::string text = read_input_file(path, "model file");
+  YAML::Node root = parse_model_yaml(text, path);
+  std::string file = path;
+  std::vector<VariantSetting> variant_settings;
+  if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings);
+  Reader reader(file);
+  reader.index_empty_values(root);
+  TrainExpansion expansion;
+  if (root.IsMap()) apply_settings(root, all_settings(variant_settings, overrides, {}, reader.file()), reader, expansion);
+  ExpandedModel out;
+  out.cars = expansion.cars;
+  YAML::Emitter emitter;
+  emitter << root;
+  out.text = "# " + path + " with its car types and trains expanded (railcrash expand)\n" + std::string(emitter.c_str()) + "\n";
+  return out;
+}
+
 std::vector<std::string> model_file_keys() {
   std::vector<std::string> keys;
   for (const auto* list : {&kTopKeys, &kBodyKeys, &kLoadKeys, &kSimulationKeys, &kPointKeys, &kOutputKeys, &kResponseKeys,
-                           &kCrushGaugeKeys, &kVariantKeys})
+                           &kCrushGaugeKeys, &kVariantKeys, &train_expansion_keys()})
     for (const std::string& key : *list)
       if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
   return keys;

@@ -15,6 +15,8 @@
 //                              the car's rear face: a coupler_end with coupled: true, no slack,
 //                              faces touching (gap 0) at the start, the template's
 //                              coupler_faces stiffness, free lengths and heights.
+// A model with car types and trains (README "Car types and trains") is a template too: each of
+// its trains is made N cars long, its listed cars repeated in turn, and every other key kept.
 // L, the length over the coupler faces, follows from the template: the coupler faces meet
 // at x = 0 (the interface coupler_end's two points lie free_length behind their faces), and
 // the rear face is the front face mirrored about the centre body's centre of gravity,

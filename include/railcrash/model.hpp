@@ -129,7 +129,8 @@ class Model {
   std::string file;  // model file the model came from ("" when built in code)
   std::vector<ModelSource> sources;   // every model file read: the file given, then a variant's base
   std::vector<std::string> settings;  // KEY=VALUE settings applied over the files (--set, then the run options)
-  UnitSystem units = UnitSystem::SI;
+  UnitSystem units = UnitSystem::SI;  // of the numbers held here
+  std::string file_units;             // the model file's `units` ("mm-t-s-N" is converted to SI when read)
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
   SimulationSettings simulation;
   ResponseSettings responses;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "railcrash/model.hpp"
+#include "railcrash/train_expansion.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -40,6 +41,14 @@ struct OptionSetting {
 };
 /// load_model with the --set settings first, then the command-line options' settings.
 Model load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options);
+
+/// A model file with its car types and trains expanded into flat bodies and elements
+/// (README "Car types and trains"), the settings applied: what `railcrash expand` writes.
+struct ExpandedModel {
+  std::string text;               // YAML of the flat model (the file's units)
+  std::vector<ExpandedCar> cars;  // the cars placed, in train order (empty for a flat model)
+};
+ExpandedModel expand_model_file(const std::string& path, const std::vector<std::string>& overrides);
 
 /// Every key of the model file outside the element parameters (top-level sections, body, load,
 /// simulation, outputs, responses and variant keys; the scenario section's are its own), each
