@@ -12,7 +12,8 @@
 //   peak_absorbed  the largest absorbed over the samples [energy]
 //   capacity     the area under the declared loading curve from its first to its last point
 //                [energy]: crush_spring its `curve`; anticlimber its horizontal bilinear law
-//                up to horizontal_rupture_deflection (none without one); draft_gear
+//                up to horizontal_rupture_deflection (none without one: the curve has no
+//                last point, it is drawn but has no capacity); draft_gear
 //                initial_stiffness d + hysteresis_load up to `travel` (where it bottoms)
 // A car's absorbed energy is the sum of its zones' (a zone between two cars counts half for
 // each, as results.hpp's car crush counts it).
@@ -34,6 +35,8 @@ struct DeclaredCurve {
                                            // largest deformation reached (0: none)
   std::vector<double> lower_deformation, lower_force;  // draft gear: the unloading curve it slides
                                                        // down to (empty: none)
+  std::optional<double> open_end_slope;    // [force/length] a curve without a last point (an anticlimber
+                                           // without a rupture deflection) goes on at this slope: no capacity
 };
 
 /// Area under the piecewise-linear curve from its first point to its last [force*length].

@@ -479,6 +479,7 @@
 
   // ---------------------------------------------------------------- plots
   var haveLibrary = typeof window.uPlot === "function";
+  var drawnPlots = [];  // {id, u}: their tick labels go into the self-check
   var palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
   function timeMarker(u) {  // the animation's time as a vertical line
     if (!haveAnimation) return;
@@ -528,7 +529,7 @@
   window.railcrashTickLabels = tickLabels;  // (the browser test checks the labels)
   function readableAxis(label, unit, largest, extra) {  // a y axis with its unit scaled
     var s = scaledUnit(unit, largest);
-    var axis = {label: label + (s.unit ? " [" + s.unit + "]" : ""), size: 70, values: tickLabels(s.factor)};
+    var axis = {label: label ? label + (s.unit ? " [" + s.unit + "]" : "") : s.unit, size: 70, values: tickLabels(s.factor)};
     for (var k in extra || {}) axis[k] = extra[k];
     return axis;
   }
@@ -554,6 +555,7 @@
     if (extra) extra(options, columns);
     var u = new uPlot(options, columns, box);
     plotsToMark.push(u);
+    drawnPlots.push({id: spec.id, u: u});
     var notes = [];
     if (spec.note) notes.push(spec.note);
     if (spec.decimated) notes.push("decimated for drawing: every peak kept (min/max per bucket)");
@@ -595,6 +597,7 @@
     }, [null].concat(lines), box);
     if (design.length) box.appendChild(el("div", {"class": "note"}, "red: the run; black: the declared loading curve up to its last point; " +
                                                                     "grey dashed: unloading from the largest deformation reached"));
+    drawnPlots.push({id: "loop:" + loop.name, u: u});
     check.plots.push({id: "loop:" + loop.name, series: lines.length, points: loop.x.length, drawn: !!u.ctx, design: design.length});
   });
 
@@ -605,9 +608,10 @@
   function designCurveSeries(loop) {  // the declared loading curve and unloading line(s) of a loop's element
     var zone = zoneByName[loop.name];
     if (!zone || !zone.curve) return [];
-    var c = zone.curve, out = [{label: "declared loading curve", stroke: "#111", dash: undefined, data: [c.deformation, c.force]}];
+    var c = zone.curve, out = [{label: "declared loading curve", stroke: "#111", dash: undefined, data: [c.deformation.slice(), c.force.slice()]}];
     function onCurve(d) {  // the loading curve at d (its last slope beyond its last point)
       var x = c.deformation, y = c.force, n = x.length;
+      if (c.open_end_slope !== undefined && d > x[n - 1]) return y[n - 1] + c.open_end_slope * (d - x[n - 1]);
       if (n === 1) return y[0];
       var k = 0;
       while (k + 2 < n && d > x[k + 1]) ++k;
@@ -615,6 +619,12 @@
     }
     var reached = 0;
     loop.x.forEach(function (d) { if (d !== null && d > reached) reached = d; });
+    var last = c.deformation.length - 1;
+    if (c.open_end_slope !== undefined && reached > c.deformation[last]) {  // no last point: on to the deformation reached
+      out[0].data[0].push(reached);
+      out[0].data[1].push(c.force[last] + c.open_end_slope * (reached - c.deformation[last]));
+      out[0].label = "declared loading curve (no last point)";
+    }
     if (c.unloading_stiffness > 0 && reached > c.deformation[0]) {
       var top = onCurve(reached);
       var floor = 0;
@@ -754,7 +764,7 @@
     var box = el("div", {"class": "plot"});
     energyBox.appendChild(box);
     var u = new uPlot({
-      title: "Energy partition [" + energyUnit + "] (stacked areas)", width: 900, height: 380,
+      title: "Energy partition (stacked areas)", width: 900, height: 380,
       scales: {x: {time: false}, y: {range: function (u, min, max) { return [Math.min(0, min), max + 0.02 * Math.abs(max - Math.min(0, min))]; }}, error: {}},
       axes: [{label: "t [s]", values: tickLabels(1)}, readableAxis("", energyUnit, largestOf(columns.slice(1)), {size: 80}),
              {scale: "error", side: 1, label: "balance error [" + energyUnit + "]", size: 80, grid: {show: false}, values: tickLabels(1)}],
@@ -765,6 +775,7 @@
     var points = 0;
     columns.slice(1).forEach(function (c) { c.forEach(function (v) { if (v !== null) ++points; }); });
     check.plots.push({id: "energy", series: columns.length - 1, points: points, drawn: !!u.ctx});
+    drawnPlots.push({id: "energy", u: u});
   })();
 
   document.getElementById("footer").textContent = "railcrash report; plots by " + (data.library || "no plotting library") +
@@ -798,4 +809,16 @@
   check.ms = Math.round(performance.now());  // from navigation start to the page drawn, self-check included
   box.textContent = JSON.stringify(check);
   box.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  // The tick labels as uPlot drew them (axes[k]._values, after its first draw): no axis may
+  // show the same label twice ("0 0 0 0.001").
+  setTimeout(function () {
+    check.axes = drawnPlots.map(function (p) {
+      var labels = p.u.axes.map(function (a) { return (a._values || []).map(String); });
+      var repeated = labels.some(function (list) { return new Set(list).size !== list.length; });
+      return {id: p.id, labels: labels, distinct: !repeated, y_label: p.u.axes[1] && p.u.axes[1].label};
+    });
+    check.errors = window.railcrashErrors;
+    box.textContent = JSON.stringify(check);
+    box.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  }, 100);
 })();
