@@ -519,6 +519,8 @@
       var step = Infinity;
       for (var i = 1; i < splits.length; ++i) step = Math.min(step, Math.abs(splits[i] - splits[i - 1]) * factor);
       var decimals = isFinite(step) && step > 0 ? Math.max(0, Math.min(12, Math.ceil(-Math.log10(step) - 1e-9))) : 3;
+      while (decimals < 12 && isFinite(step) && step > 0 &&  // a spacing of 2.5 needs one decimal more than 2
+             Math.abs(step * Math.pow(10, decimals) - Math.round(step * Math.pow(10, decimals))) > 1e-6 * step * Math.pow(10, decimals)) ++decimals;
       return splits.map(function (v) {
         if (v === null || v === undefined) return "";
         var text = (v * factor).toFixed(decimals);
