@@ -480,6 +480,10 @@
   // ---------------------------------------------------------------- plots
   var haveLibrary = typeof window.uPlot === "function";
   var drawnPlots = [];  // {id, u}: their tick labels go into the self-check
+  // The crush zones of summary.json (results/crush_zones.hpp): their declared curves under the loops, their energies.
+  var crushZones = (summary && summary.crush_zones) || null;
+  var zoneByName = {};
+  ((crushZones && crushZones.zones) || []).forEach(function (z) { zoneByName[z.element] = z; });
   var palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
   function timeMarker(u) {  // the animation's time as a vertical line
     if (!haveAnimation) return;
@@ -604,9 +608,6 @@
   });
 
   // ---------------------------------------------------------------- crush zones: declared curves and absorbed energy
-  var crushZones = (summary && summary.crush_zones) || null;
-  var zoneByName = {};
-  ((crushZones && crushZones.zones) || []).forEach(function (z) { zoneByName[z.element] = z; });
   function designCurveSeries(loop) {  // the declared loading curve and unloading line(s) of a loop's element
     var zone = zoneByName[loop.name];
     if (!zone || !zone.curve) return [];
