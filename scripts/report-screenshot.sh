@@ -15,5 +15,5 @@ echo "docs/report.png: $(stat -c %s docs/report.png) bytes"
 
 build/railcrash run models/examples/emu_two_car_crush_zones.yaml --out "$out/emu" --report > /dev/null
 chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
-  --window-size=1280,1100 --screenshot="$PWD/docs/report_crush_zones.png" "file://$out/emu/report.html#loops-section" > /dev/null 2>&1
+  --window-size=1400,1550 --screenshot="$PWD/docs/report_crush_zones.png" "file://$out/emu/report.html#crush-zones" > /dev/null 2>&1
 echo "docs/report_crush_zones.png: $(stat -c %s docs/report_crush_zones.png) bytes"

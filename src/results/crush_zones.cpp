@@ -32,7 +32,10 @@ std::optional<DeclaredCurve> declared_curve(const Element& element) {
     const double yield = h.rupture_deflection ? std::min(h.yield_deflection, *h.rupture_deflection) : h.yield_deflection;
     curve.deformation = {0.0, yield};
     curve.force = {0.0, h.elastic_stiffness * yield};
-    if (!h.rupture_deflection) curve.open_end_slope = h.plastic_stiffness;  // no last point: the curve goes on
+    if (!h.rupture_deflection) {  // no last point: the curve goes on at the plastic slope
+      curve.open_ended = true;
+      curve.beyond_last_slope = h.plastic_stiffness;
+    }
     else if (*h.rupture_deflection > yield) {
       curve.deformation.push_back(*h.rupture_deflection);
       curve.force.push_back(h.yield_force() + h.plastic_stiffness * (*h.rupture_deflection - h.yield_deflection));
@@ -45,6 +48,7 @@ std::optional<DeclaredCurve> declared_curve(const Element& element) {
     curve.deformation = {0.0, travel};
     curve.force = {h, k * travel + h};
     curve.unloading_stiffness = gear->transition_stiffness;
+    curve.beyond_last_slope = gear->stiffness_after_bottoming;  // bottomed
     if (k * travel > h) {  // the unloading curve k d - H, from where it reaches zero force
       curve.lower_deformation = {h / k, travel};
       curve.lower_force = {0.0, k * travel - h};
@@ -76,7 +80,7 @@ CrushZoneTracker::CrushZoneTracker(const DaeSystem& system) : system_(system) {
     }
     zone.shares.assign(zone.cars.size(), zone.cars.empty() ? 0.0 : 1.0 / static_cast<double>(zone.cars.size()));
     zone.curve = declared_curve(element);
-    if (zone.curve && !zone.curve->open_end_slope) zone.capacity = area_under(*zone.curve);
+    if (zone.curve && !zone.curve->open_ended) zone.capacity = area_under(*zone.curve);
     zones_.push_back(zone);
   }
   for (const Body& body : model.bodies())  // cars in the order of their first body
@@ -154,7 +158,8 @@ std::string CrushZoneTracker::json(bool si) const {
       const DeclaredCurve& c = *zone.curve;
       j << ", \"curve\": {\"deformation\": " << numbers_json(c.deformation) << ", \"force\": " << numbers_json(c.force)
         << ", \"unloading_stiffness\": " << json_number(c.unloading_stiffness);
-      if (c.open_end_slope) j << ", \"open_end_slope\": " << json_number(*c.open_end_slope);
+      if (c.beyond_last_slope) j << ", \"beyond_last_slope\": " << json_number(*c.beyond_last_slope);
+      j << ", \"open_ended\": " << (c.open_ended ? "true" : "false");
       if (!c.lower_deformation.empty())
         j << ", \"lower_deformation\": " << numbers_json(c.lower_deformation) << ", \"lower_force\": " << numbers_json(c.lower_force);
       j << "}";

@@ -35,8 +35,9 @@ struct DeclaredCurve {
                                            // largest deformation reached (0: none)
   std::vector<double> lower_deformation, lower_force;  // draft gear: the unloading curve it slides
                                                        // down to (empty: none)
-  std::optional<double> open_end_slope;    // [force/length] a curve without a last point (an anticlimber
-                                           // without a rupture deflection) goes on at this slope: no capacity
+  std::optional<double> beyond_last_slope;  // [force/length] the loading slope beyond the last point (draft
+                                            // gear: after bottoming; none: the last segment's continues)
+  bool open_ended = false;  // no last point (an anticlimber without a rupture deflection): no capacity
 };
 
 /// Area under the piecewise-linear curve from its first point to its last [force*length].

@@ -599,9 +599,9 @@
       axes: [readableAxis(loop.x_label, lengthUnit, largestOf(xs), {size: 50}), readableAxis(loop.y_label, forceUnit, largestOf(ys))],
       series: [{}, {label: loop.name, stroke: "#d62728", width: 1.25, paths: uPlot.paths.linear(), points: {show: false}}].concat(
         design.map(function (d) { return {label: d.label, stroke: d.stroke, width: 1.5, dash: d.dash, paths: uPlot.paths.linear(), points: {show: false}}; })),
-      legend: {show: design.length > 0}
+      legend: {show: design.length > 0, live: false}
     }, [null].concat(lines), box);
-    if (design.length) box.appendChild(el("div", {"class": "note"}, "red: the run; black: the declared loading curve up to its last point; " +
+    if (design.length) box.appendChild(el("div", {"class": "note"}, "red: the run; black: the declared loading curve up to its last point (dotted: beyond it); " +
                                                                     "grey dashed: unloading from the largest deformation reached"));
     drawnPlots.push({id: "loop:" + loop.name, u: u});
     check.plots.push({id: "loop:" + loop.name, series: lines.length, points: loop.x.length, drawn: !!u.ctx, design: design.length});
@@ -614,7 +614,7 @@
     var c = zone.curve, out = [{label: "declared loading curve", stroke: "#111", dash: undefined, data: [c.deformation.slice(), c.force.slice()]}];
     function onCurve(d) {  // the loading curve at d (its last slope beyond its last point)
       var x = c.deformation, y = c.force, n = x.length;
-      if (c.open_end_slope !== undefined && d > x[n - 1]) return y[n - 1] + c.open_end_slope * (d - x[n - 1]);
+      if (c.beyond_last_slope !== undefined && d > x[n - 1]) return y[n - 1] + c.beyond_last_slope * (d - x[n - 1]);
       if (n === 1) return y[0];
       var k = 0;
       while (k + 2 < n && d > x[k + 1]) ++k;
@@ -623,18 +623,18 @@
     var reached = 0;
     loop.x.forEach(function (d) { if (d !== null && d > reached) reached = d; });
     var last = c.deformation.length - 1;
-    if (c.open_end_slope !== undefined && reached > c.deformation[last]) {  // no last point: on to the deformation reached
-      out[0].data[0].push(reached);
-      out[0].data[1].push(c.force[last] + c.open_end_slope * (reached - c.deformation[last]));
-      out[0].label = "declared loading curve (no last point)";
+    if (c.beyond_last_slope !== undefined && reached > c.deformation[last]) {  // on past its last point to the deformation reached
+      out.push({label: c.open_ended ? "declared loading curve (no last point)" : "beyond its last point", stroke: "#111", dash: [3, 3],
+                data: [[c.deformation[last], reached], [c.force[last], c.force[last] + c.beyond_last_slope * (reached - c.deformation[last])]]});
     }
     if (c.unloading_stiffness > 0 && reached > c.deformation[0]) {
       var top = onCurve(reached);
       var floor = 0;
       if (c.lower_deformation) {  // draft gear: down to its unloading curve
         var lx = c.lower_deformation, ly = c.lower_force;
-        var lower = ly[0] + (ly[1] - ly[0]) * (reached - lx[0]) / (lx[1] - lx[0]);
-        floor = Math.max(0, lower);
+        var lower = reached > lx[1] && c.beyond_last_slope !== undefined ? ly[1] + c.beyond_last_slope * (reached - lx[1])
+                                                                         : ly[0] + (ly[1] - ly[0]) * (reached - lx[0]) / (lx[1] - lx[0]);
+        floor = Math.max(0, Math.min(lower, top));
         out.push({label: "declared unloading curve", stroke: "#777", dash: [2, 3], data: [lx, ly]});
       }
       var back = reached - (top - floor) / c.unloading_stiffness;
@@ -805,6 +805,12 @@
     }
     setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
   }
+  // report.html#crush-zones: the loops and the energy per crush zone alone (docs' screenshot, printing).
+  if (location.hash === "#crush-zones")
+    ["problems", "provenance", "animation-section", "plots-section", "energy-section"].forEach(function (id) {
+      var node = document.getElementById(id);
+      if (node) node.hidden = true;
+    });
   var box = document.getElementById("self-check");
   check.library = haveLibrary;
   check.problems = problems.length;
