@@ -257,7 +257,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   }
   std::printf("results in %s/ (%s, summary.json, model.json), run id %s\n", out_dir.c_str(),
               format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
-                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv",
+                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv",
               report.run_id.c_str());
   if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;

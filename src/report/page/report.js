@@ -502,10 +502,12 @@
     return {length: lengthUnit, "length/time": lengthUnit ? lengthUnit + "/s" : "", force: forceUnit, energy: energyUnit, g: "g"}[label] || label;
   }
   // ---------------------------------------------------------------- readable axes
-  // SI prefixes (kN, MN, kJ, MJ, mm) chosen from the largest value shown; tick labels with as
+  // SI prefixes (kN, MN, kJ, MJ, mm; kip for lbf) chosen from the largest value shown; tick labels with as
   // many decimals as the tick spacing needs, so that no two ticks read the same.
   var siUnits = {N: true, J: true, "N*m": true, m: true, "m/s": true, Pa: true};
   function scaledUnit(unit, largest) {
+    if ((unit === "lbf" || unit === "in*lbf") && largest >= 1e4)  // US customary: kip = 1000 lbf
+      return {unit: unit === "lbf" ? "kip" : "kip*in", factor: 1e-3};
     if (!siUnits[unit] || !(largest > 0)) return {unit: unit, factor: 1};
     if (unit === "m" || unit === "m/s") return largest < 1 ? {unit: "m" + unit, factor: 1e3} : {unit: unit, factor: 1};
     if (largest >= 1e9) return {unit: "G" + unit, factor: 1e-9};
