@@ -195,9 +195,10 @@ int elements_command(const std::string& type_name, bool markdown) {
   return 0;
 }
 
-int report_command(const std::string& run_dir, double cfc) {
+int report_command(const std::string& run_dir, double cfc, double force_cfc = 60.0) {
   railcrash::report::ReportOptions options;
   options.cfc = cfc;
+  options.force_cfc = force_cfc;
   const railcrash::report::ReportResult result = railcrash::report::write_report(run_dir, options);
   for (const std::string& problem : result.problems) std::fprintf(stderr, "report: %s\n", problem.c_str());
   if (!result.study.empty()) {
@@ -293,7 +294,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   }
   std::printf("results in %s/ (%s, summary.json, model.json), run id %s\n", out_dir.c_str(),
               format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
-                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv",
+                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv",
               report.run_id.c_str());
   if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;
@@ -557,6 +558,10 @@ int main(int argc, char** argv) {
   report->add_option("run_dir", report_dir, "run folder (the --out of `railcrash run`)")->required();
   report->add_option("--cfc", report_cfc, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000)")
       ->capture_default_str()->check(finite_number(60, 1000, false, false, "Hz"));
+  double report_force_cfc = 60.0;
+  report->add_option("--force-cfc", report_force_cfc,
+                     "channel frequency class of the element force plot (SAE J211-1 lists CFC 60 for barrier face forces); 0: unfiltered")
+      ->capture_default_str()->check(finite_number(0, 1000, false, false, "Hz"));
 
   std::string design_path = "report", only;
   int jobs = 0;
@@ -720,7 +725,7 @@ int main(int argc, char** argv) {
   try {
     if (*check) return check_command(model_path, settings);
     if (*elements) return elements_command(element_type_name, elements_markdown);
-    if (*report) return report_command(report_dir, report_cfc);
+    if (*report) return report_command(report_dir, report_cfc, report_force_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
       if (scenario->count("--out") > 0) railcrash::check_output_file(scenario_out);
