@@ -276,7 +276,7 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   options.second_order = !first_order_only;
   options.run_time_limit = run_limit;
   options.branch_bisections = bisections;
-  options.branch_window = 1e-3 * branch_window_ms;
+  if (branch_window_ms >= 0.0) options.branch_window = 1e-3 * branch_window_ms;  // else the set of outcomes
   options.progress = [](const SensitivityRun& run, std::size_t number, std::size_t done, std::size_t total) {
     std::string varied = run.variation.empty() ? "base" : "";
     for (const auto& [name, value] : run.variation)
@@ -526,7 +526,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
   int bisections = 4;
-  double branch_window_ms = 1e3 * railcrash::kBranchWindow;
+  double branch_window_ms = -1.0;  // not given: runs compare by the set of outcomes
   sensitivity
       ->add_option("--bisect", bisections,
                    "halvings of the step of a first-order run whose discrete outcome differs from run 0's (one run "
@@ -535,8 +535,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 20));
   sensitivity
       ->add_option("--branch-window", branch_window_ms,
-                   "[ms] outcomes (fracture, shear, override, bottoming) this close form one group, compared as a set")
-      ->capture_default_str()
+                   "[ms] compare the order of the outcomes (fracture, shear, override, bottoming): those this close "
+                   "form one group, compared as a set (default: the set of outcomes, order aside)")
       ->check(CLI::NonNegativeNumber);
 
   std::string readings_path;

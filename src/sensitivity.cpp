@@ -718,8 +718,11 @@ void write_branch_changes(const SensitivityResult& result, const std::string& di
          "A_R1,A_R2,A_R3,within_R1,within_R2,within_R3,jump_R1,jump_R2,jump_R3,off_branch_outcomes,note\n";
   md << "\n## Discrete outcomes and branch changes\n\n"
      << "Run 0's outcome: `" << result.base.outcomes.text() << "` (branch `" << result.base.outcomes.order()
-     << "`; outcomes within " << number(1e3 * result.base.outcomes.window, "%g")
-     << " ms of each other form one group, compared as a set).\n\n";
+     << "`; " << (std::isinf(result.base.outcomes.window)
+                        ? std::string("runs are compared by the set of outcomes, order between elements aside")
+                        : "outcomes within " + number(1e3 * result.base.outcomes.window, "%g") +
+                              " ms of each other form one group, compared as a set, and the groups in order")
+     << ").\n\n";
   std::size_t changed = 0;
   for (const SensitivityRun& r : result.runs) changed += r.ok && !same_branch(r.outcomes, result.base.outcomes);
   std::size_t changed_second = 0;

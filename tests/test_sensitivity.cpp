@@ -460,10 +460,12 @@ TEST_CASE("outcome signature: outcomes only, first occurrence, near-simultaneous
       {0.017, "gear1", "bottomed (draft)", 0.0},            // second bottoming: not a new outcome
       {0.020, "ac", "horizontal unloading, override", 0.0}, // joined texts are split
       {0.021, "ac", "separation", 0.0}};
-  const OutcomeSignature s = outcome_signature(events);
+  const OutcomeSignature s = outcome_signature(events, 1e-4);  // order asked: groups within 0.1 ms
   REQUIRE(s.events.size() == 4);
   CHECK(s.text() == "gear1:bottomed@12.000ms>gear1:fracture@15.307ms>gear2:fracture@15.348ms>ac:override@20.000ms");
   CHECK(s.order() == "gear1:bottomed>gear1:fracture+gear2:fracture>ac:override");
+  // By default the set: order aside.
+  CHECK(outcome_signature(events).order() == "ac:override+gear1:bottomed+gear1:fracture+gear2:fracture");
   CHECK(outcome_of_event("horizontal unloading, override") == "override");
   CHECK(outcome_of_event("contact, crushing").empty());
   CHECK(outcome_of_event("pin shear") == "pin shear");
@@ -471,15 +473,24 @@ TEST_CASE("outcome signature: outcomes only, first occurrence, near-simultaneous
   std::vector<EventRecord> swapped = events;
   swapped[3].element = "gear2";
   swapped[4].element = "gear1";
-  CHECK(same_branch(outcome_signature(swapped), s));
+  CHECK(same_branch(outcome_signature(swapped, 1e-4), s));
+  CHECK(same_branch(outcome_signature(swapped), outcome_signature(events)));
   // A window below their distance makes the order count.
   CHECK_FALSE(same_branch(outcome_signature(swapped, 1e-5), outcome_signature(events, 1e-5)));
-  // One gear fractures only: another branch.
+  // The override before the fractures: another order, the same set.
+  std::vector<EventRecord> early = events;
+  early[7].t = 0.014;
+  std::stable_sort(early.begin(), early.end(), [](const EventRecord& a, const EventRecord& b) { return a.t < b.t; });
+  CHECK(same_branch(outcome_signature(early), outcome_signature(events)));
+  CHECK_FALSE(same_branch(outcome_signature(early, 1e-4), s));
+  // One gear fractures only: another branch, in either form.
   std::vector<EventRecord> one = events;
   one.erase(one.begin() + 4);
-  CHECK_FALSE(same_branch(outcome_signature(one), s));
+  CHECK_FALSE(same_branch(outcome_signature(one, 1e-4), s));
+  CHECK_FALSE(same_branch(outcome_signature(one), outcome_signature(events)));
   CHECK(outcome_signature({}).text() == "none");
   CHECK(s.json().find("\"branch\": \"gear1:bottomed>gear1:fracture+gear2:fracture>ac:override\"") != std::string::npos);
+  CHECK(outcome_signature(events).json().find("\"window\": null") != std::string::npos);  // no window: the set
 }
 
 namespace {
