@@ -31,6 +31,14 @@
 //   d2R/dP_i2      = 2 B_ii
 //   d2R/dP_i dP_j  = B_ij
 //
+// Branches (issue 40). Each run records its discrete outcome (outcomes.hpp: which elements
+// fractured, sheared, overrode or bottomed out, and when). A first-order run whose outcome
+// differs from run 0's crossed a jump, and its A_i is not a sensitivity: its step is halved
+// (branch_bisections times, one run each) to find the largest step on run 0's branch, and the
+// effect within the branch, the jump and the values of P around the change are reported apart
+// (BranchChange; sensitivity.md, sensitivity_branches.csv). A_i itself is left as the design
+// defines it (the report's printed method).
+//
 // A design file says what each nondimensional parameter scales in the model, and the
 // second-order study:
 //   sensitivity: 1
