@@ -302,7 +302,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
 
 int sensitivity_command(const std::string& path, const std::string& design_option, int jobs, double central,
                         const std::string& only, bool first_order_only, double run_limit, std::size_t max_runs,
-                        const std::string& out_dir) {
+                        const std::string& out_dir, int bisections, double branch_window_ms) {
   using namespace railcrash;
   check_output_folder(out_dir);
   // "report" (the default): the report's design for this model, sensitivity_design.yaml beside it.
@@ -314,6 +314,8 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   options.second_order = !first_order_only;
   options.run_time_limit = run_limit;
   options.max_runs = max_runs;
+  options.branch_bisections = bisections;
+  if (branch_window_ms >= 0.0) options.branch_window = 1e-3 * branch_window_ms;  // else the set of outcomes
   options.progress = [](const SensitivityRun& run, std::size_t number, std::size_t done, std::size_t total) {
     std::string varied = run.variation.empty() ? "base" : "";
     for (const auto& [name, value] : run.variation)
@@ -584,6 +586,19 @@ int main(int argc, char** argv) {
   sensitivity->add_option("--max-runs", max_runs, "refuse a study of more runs than this before it starts (0: no limit)")
       ->capture_default_str()->check(run_limit_count);
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
+  int bisections = 4;
+  double branch_window_ms = -1.0;  // not given: runs compare by the set of outcomes
+  sensitivity
+      ->add_option("--bisect", bisections,
+                   "halvings of the step of a first-order run whose discrete outcome differs from run 0's (one run "
+                   "each; 0: flag only)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 20));
+  sensitivity
+      ->add_option("--branch-window", branch_window_ms,
+                   "[ms] compare the order of the outcomes (fracture, shear, override, bottoming): those this close "
+                   "form one group, compared as a set (default: the set of outcomes, order aside)")
+      ->check(CLI::NonNegativeNumber);
 
   std::string readings_path;
   CLI::App* readings = app.add_subcommand(
@@ -762,7 +777,8 @@ int main(int argc, char** argv) {
 #endif
     if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, out_dir);
     if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, max_runs, out_dir);
-    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir);
+    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,
+                                                   bisections, branch_window_ms);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
     if (*t_end_option) overrides.t_end = t_end;
