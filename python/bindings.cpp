@@ -47,6 +47,27 @@ py::dict sensitivity_run_dict(const railcrash::SensitivityRun& run) {
   row["R2"] = run.responses.r2;
   row["R3"] = run.responses.r3;
   row["wall_seconds"] = run.wall_seconds;
+  row["outcomes"] = run.ok ? run.outcomes.text() : std::string();  // the discrete outcome (issue 40)
+  row["branch"] = run.ok ? run.outcomes.order() : std::string();    // order only: equal texts, one branch
+  return row;
+}
+
+/// A first-order run off run 0's branch, bisected (sensitivity.hpp's BranchChange).
+py::dict branch_change_dict(const railcrash::BranchChange& c) {
+  py::dict row;
+  row["parameter"] = c.parameter;
+  row["nominal_value"] = c.nominal_value;
+  row["on_branch_value"] = c.on_branch_value;
+  row["off_branch_value"] = c.off_branch_value;
+  row["off_branch_outcomes"] = c.off_branch_signature;
+  for (int k = 0; k < 3; ++k) {
+    const std::string r = "R" + std::to_string(k + 1);
+    row[py::str("A_" + r)] = c.nominal_derivative[static_cast<std::size_t>(k)];
+    row[py::str("within_" + r)] = c.within_branch[static_cast<std::size_t>(k)];
+    row[py::str("jump_" + r)] = c.jump[static_cast<std::size_t>(k)];
+  }
+  row["extra_runs"] = c.bisection_runs.size();
+  row["note"] = c.note;
   return row;
 }
 
@@ -103,7 +124,7 @@ std::pair<std::vector<std::string>, std::vector<std::vector<std::string>>> sweep
 
 /// The first-order study of `railcrash sensitivity`: rows of runs and of fitted A_i.
 py::dict sensitivity(const std::string& model_path, const std::string& design, int jobs, const std::vector<std::string>& only,
-                     bool second_order, double central, double run_limit) {
+                     bool second_order, double central, double run_limit, int bisections) {
   railcrash::SensitivityDesign loaded;
   std::atomic<bool> stop{false};
   const railcrash::SensitivityResult result = until_interrupted(stop, [&] {
@@ -115,6 +136,7 @@ py::dict sensitivity(const std::string& model_path, const std::string& design, i
     options.second_order = second_order;
     options.central_step = central;
     options.run_time_limit = run_limit;
+    options.branch_bisections = bisections;
     options.stop = &stop;
     return railcrash::run_sensitivity(model_path, loaded, options);
   });
@@ -141,6 +163,9 @@ py::dict sensitivity(const std::string& model_path, const std::string& design, i
   out["first_order"] = first_order;
   out["constant"] = py::make_tuple(result.constant[0], result.constant[1], result.constant[2]);
   out["central"] = result.central;
+  py::list changes;
+  for (const railcrash::BranchChange& c : result.branch_changes) changes.append(branch_change_dict(c));
+  out["branch_changes"] = changes;
   if (!result.fit.terms.empty()) {
     py::list terms;
     for (std::size_t k = 0; k < result.fit.terms.size(); ++k) {
@@ -259,5 +284,5 @@ PYBIND11_MODULE(_railcrash, m) {
   m.def("_sweep", &sweep, py::arg("model_path"), py::arg("plan_path"), py::arg("jobs"), py::arg("out_dir"), py::arg("resume"),
         py::arg("run_limit"));
   m.def("_sensitivity", &sensitivity, py::arg("model_path"), py::arg("design"), py::arg("jobs"), py::arg("only"),
-        py::arg("second_order"), py::arg("central"), py::arg("run_limit"));
+        py::arg("second_order"), py::arg("central"), py::arg("run_limit"), py::arg("bisections"));
 }

@@ -14,6 +14,7 @@
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/outcomes.hpp"
 #include "railcrash/plot.hpp"
 #include "railcrash/whole_file.hpp"
 #include "railcrash/results.hpp"
@@ -820,15 +821,20 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
   std::ostringstream csv;
   csv << "method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events";
   for (const ConvergeQuantity& q : r.quantities) csv << "," << csv_field(q.name) << "," << csv_field(q.name + "_error");
-  csv << ",message\n";
+  csv << ",message,outcomes,branch\n";
   const auto number = [](double v) { return std::isfinite(v) ? format_number(v) : std::string(); };
+  const OutcomeSignature reference_outcomes = outcome_signature(r.reference.events);
   const auto row = [&](const ConvergeRun& run) {
     csv << run.method << "," << (run.method == "euler" ? number(run.step) : "") << "," << (run.method == "euler" ? "" : number(run.rtol))
         << "," << (run.ok ? "ok" : "failed") << "," << number(run.wall_seconds) << "," << run.stats.steps << ","
         << run.stats.residual_evaluations << "," << run.stats.jacobian_evaluations << "," << run.stats.events;
     for (std::size_t q = 0; q < r.quantities.size(); ++q)
       csv << "," << (run.values.empty() ? "" : number(run.values[q])) << "," << (run.errors.empty() ? "" : number(run.errors[q]));
-    csv << "," << csv_field(run.message) << "\n";
+    // The run's discrete outcome (issue 40), and whether it is the reference's ("same") or not.
+    const OutcomeSignature outcomes = outcome_signature(run.events);
+    csv << "," << csv_field(run.message) << "," << csv_field(run.ok ? outcomes.text() : "") << ","
+        << (!run.ok || !r.reference.ok ? "" : &run == &r.reference ? "reference" : same_branch(outcomes, reference_outcomes) ? "same" : "changed")
+        << "\n";
   };
   row(r.reference);
   for (const ConvergeRun& run : r.euler) row(run);

@@ -204,9 +204,10 @@ int elements_command(const std::string& type_name, bool markdown) {
   return 0;
 }
 
-int report_command(const std::string& run_dir, double cfc) {
+int report_command(const std::string& run_dir, double cfc, double force_cfc = 60.0) {
   railcrash::report::ReportOptions options;
   options.cfc = cfc;
+  options.force_cfc = force_cfc;
   const railcrash::report::ReportResult result = railcrash::report::write_report(run_dir, options);
   for (const std::string& problem : result.problems) std::fprintf(stderr, "report: %s\n", problem.c_str());
   if (!result.study.empty()) {
@@ -302,7 +303,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   }
   std::printf("results in %s/ (%s, summary.json, model.json), run id %s\n", out_dir.c_str(),
               format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
-                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv",
+                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv",
               report.run_id.c_str());
   if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;
@@ -310,7 +311,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
 
 int sensitivity_command(const std::string& path, const std::string& design_option, int jobs, double central,
                         const std::string& only, bool first_order_only, double run_limit, std::size_t max_runs,
-                        const std::string& out_dir) {
+                        const std::string& out_dir, int bisections, double branch_window_ms) {
   using namespace railcrash;
   check_output_folder(out_dir);
   // "report" (the default): the report's design for this model, sensitivity_design.yaml beside it.
@@ -322,6 +323,8 @@ int sensitivity_command(const std::string& path, const std::string& design_optio
   options.second_order = !first_order_only;
   options.run_time_limit = run_limit;
   options.max_runs = max_runs;
+  options.branch_bisections = bisections;
+  if (branch_window_ms >= 0.0) options.branch_window = 1e-3 * branch_window_ms;  // else the set of outcomes
   options.progress = [](const SensitivityRun& run, std::size_t number, std::size_t done, std::size_t total) {
     std::string varied = run.variation.empty() ? "base" : "";
     for (const auto& [name, value] : run.variation)
@@ -572,6 +575,10 @@ int main(int argc, char** argv) {
   report->add_option("run_dir", report_dir, "run folder (the --out of `railcrash run`)")->required();
   report->add_option("--cfc", report_cfc, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000)")
       ->capture_default_str()->check(finite_number(60, 1000, false, false, "Hz"));
+  double report_force_cfc = 60.0;
+  report->add_option("--force-cfc", report_force_cfc,
+                     "channel frequency class of the element force plot (SAE J211-1 lists CFC 60 for barrier face forces); 0: unfiltered")
+      ->capture_default_str()->check(finite_number(0, 1000, false, false, "Hz"));
 
   std::string design_path = "report", only;
   int jobs = 0;
@@ -594,6 +601,19 @@ int main(int argc, char** argv) {
   sensitivity->add_option("--max-runs", max_runs, "refuse a study of more runs than this before it starts (0: no limit)")
       ->capture_default_str()->check(run_limit_count);
   sensitivity->add_option("--out", out_dir, "output folder")->capture_default_str();
+  int bisections = 4;
+  double branch_window_ms = -1.0;  // not given: runs compare by the set of outcomes
+  sensitivity
+      ->add_option("--bisect", bisections,
+                   "halvings of the step of a first-order run whose discrete outcome differs from run 0's (one run "
+                   "each; 0: flag only)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 20));
+  sensitivity
+      ->add_option("--branch-window", branch_window_ms,
+                   "[ms] compare the order of the outcomes (fracture, shear, override, bottoming): those this close "
+                   "form one group, compared as a set (default: the set of outcomes, order aside)")
+      ->check(CLI::NonNegativeNumber);
 
   std::string readings_path;
   CLI::App* readings = app.add_subcommand(
@@ -742,7 +762,7 @@ int main(int argc, char** argv) {
     if (*check) return check_command(model_path, settings);
     if (*expand) return expand_command(model_path, settings, expand_out, expand->count("--out") > 0);
     if (*elements) return elements_command(element_type_name, elements_markdown);
-    if (*report) return report_command(report_dir, report_cfc);
+    if (*report) return report_command(report_dir, report_cfc, report_force_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
       if (scenario->count("--out") > 0) railcrash::check_output_file(scenario_out);
@@ -779,7 +799,8 @@ int main(int argc, char** argv) {
 #endif
     if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, out_dir);
     if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, max_runs, out_dir);
-    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir);
+    if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,
+                                                   bisections, branch_window_ms);
     if (!integrator.empty())
       overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
     if (*t_end_option) overrides.t_end = t_end;

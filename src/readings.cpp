@@ -361,6 +361,68 @@ Agreement score_agreement(const SensitivityResult& result, const SensitivityDesi
   return agreement;
 }
 
+namespace {
+
+/// The first-order comparison split by branch (issue 40): the runs on run 0's branch, the runs
+/// across a change of the discrete outcome, and all of them with the effect within run 0's
+/// branch (from the bisection, scaled to the design's step) in place of the change across.
+std::string branch_comparison_markdown(const SensitivityResult& result, const SensitivityDesign& design) {
+  const PublishedResults& published = *design.reference;
+  if (result.central || !result.base.ok) return "";
+  const double step = design.factor - 1.0;
+  std::array<std::vector<double>, 3> on_ours, on_theirs, across_ours, across_theirs, within_ours, within_theirs;
+  std::string across_names;
+  for (std::size_t i = 0; i < result.runs.size(); ++i) {
+    const SensitivityRun& run = result.runs[i];
+    if (!run.ok) continue;
+    const std::array<double, 3>* theirs = nullptr;
+    for (const auto& [name, values] : published.first_order)
+      if (name == run.parameter) theirs = &values;
+    if (!theirs) continue;
+    const bool on = same_branch(run.outcomes, result.base.outcomes);
+    const BranchChange* change = nullptr;
+    for (const BranchChange& c : result.branch_changes)
+      if (c.run == i) change = &c;
+    if (!on) across_names += (across_names.empty() ? "" : ", ") + run.parameter;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double ours = response_of(run.responses, static_cast<int>(k)) - response_of(result.base.responses, static_cast<int>(k));
+      const double their = (*theirs)[k] - published.base[k];
+      (on ? on_ours : across_ours)[k].push_back(ours);
+      (on ? on_theirs : across_theirs)[k].push_back(their);
+      const double within = on ? ours : (change ? change->within_branch[k] * step : kNaN);
+      if (!std::isnan(within)) {
+        within_ours[k].push_back(within);
+        within_theirs[k].push_back(their);
+      }
+    }
+  }
+  std::ostringstream md;
+  md << "## By branch of the discrete outcome (issue 40)\n\n"
+     << "Run 0's outcome: `" << result.base.outcomes.text() << "`. First-order runs across a change of it: "
+     << (across_names.empty() ? std::string("none") : across_names) << " (" << across_ours[0].size() << " of "
+     << across_ours[0].size() + on_ours[0].size()
+     << " compared). The last rows put, for each run across a change, the effect within run 0's branch (the bisection's "
+        "dR/dP times the step " << format(step, "%g") << ") in place of its change.\n\n"
+     << "| | R1 | R2 | R3 |\n|---|---|---|---|\n";
+  const auto rows = [&](const std::string& label, const std::array<std::vector<double>, 3>& ours,
+                        const std::array<std::vector<double>, 3>& theirs) {
+    std::array<ChangeScores, 3> scores;
+    for (std::size_t k = 0; k < 3; ++k) scores[k] = score_changes(ours[k], theirs[k]);
+    md << "| " << label << ": published sign kept (change >= 0.005)";
+    for (const ChangeScores& c : scores) md << " | " << c.agree << " of " << c.significant;
+    md << " |\n| " << label << ": Spearman rho (" << ours[0].size() << " runs)";
+    for (const ChangeScores& c : scores) md << " | " << format(c.spearman, "%.2f");
+    md << " |\n";
+  };
+  rows("on run 0's branch", on_ours, on_theirs);
+  rows("across a change", across_ours, across_theirs);
+  rows("all, within-branch effect", within_ours, within_theirs);
+  md << "\n";
+  return md.str();
+}
+
+}  // namespace
+
 std::string comparison_markdown(const SensitivityResult& result, const SensitivityDesign& design) {
   RAILCRASH_DEMAND(design.reference.has_value());
   const PublishedResults& published = *design.reference;
@@ -396,6 +458,7 @@ std::string comparison_markdown(const SensitivityResult& result, const Sensitivi
   for (const auto& g : agreement.goals_missed) missed += (missed.empty() ? "" : "; ") + g;
   md << "\nGoals met: " << agreement.goals_met << " of " << Agreement::kGoals << (missed.empty() ? "" : " (missed: " + missed + ")")
      << ".\n\n";
+  md << branch_comparison_markdown(result, design);
 
   // Every run against the published one.
   md << "## Runs: ours against the published (changes against run 0)\n\n"
@@ -524,6 +587,7 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
     r.levels = plan.combination(c);
     SensitivityOptions study = options.study;
     study.settings = plan.settings(r.levels);
+    study.branch_bisections = 0;  // many studies: runs off run 0's branch are flagged, not bisected (issue 40)
     const SensitivityDesign combination_design = plan.design_for(r.levels, design);
     r.study = run_sensitivity(model_path, combination_design, study);
     r.agreement = score_agreement(r.study, combination_design);

@@ -347,6 +347,7 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
   acceleration_.assign(static_cast<std::size_t>(system.body_unknowns()), 0.0);
   acceleration_peaks_.assign(static_cast<std::size_t>(system.model().body_count()), AccelerationPeaks{});
   cars_ = cars_of(system);
+  crush_zones_ = std::make_unique<CrushZoneTracker>(system);
 }
 
 ResultWriter::~ResultWriter() {
@@ -405,6 +406,7 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
     accelerations_file_->character('\n');
   }
   if (energy_) energy_->sample(t, y, quadratures);
+  crush_zones_->sample(y, quadratures);
   if (hdf5_) hdf5_->append(hdf5_tables_.energy, energy_->row().data());
   // The mean over the interval since the last sample, from velocities in double precision.
   const double span = sample_times_.empty() ? 0.0 : t - sample_times_.back();
@@ -547,6 +549,14 @@ bool ResultWriter::replace_summary(const std::string& text) {
   return true;
 }
 
+void ResultWriter::write_energy_zones() {
+  const std::string path = directory_ + "/energy_zones.csv";
+  std::ofstream out(path, std::ios::binary);
+  out << provenance_comment(provenance_) << crush_zones_->csv();
+  out.flush();
+  if (!out) fail("cannot write " + path, errno);
+}
+
 void ResultWriter::event(const EventRecord& record, const double*) {
   if (hdf5_) {
     hdf5_->append_event(hdf5_tables_.events, record.t, record.element, record.what, record.value);
@@ -621,6 +631,7 @@ std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::st
   if (!directory_.empty() && failure_.empty()) check_files(/*flush=*/true, /*look_at_folder=*/true);
   const std::string text = summary_text(outcome, outcome.ok ? "ok" : "failed", integrator, extra_json);
   if (!directory_.empty()) replace_summary(text);  // also after a failed CSV write: the summary may still fit
+  if (!directory_.empty() && !hdf5_) write_energy_zones();
   return text;
 }
 
@@ -761,7 +772,8 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
       j << (k ? ", " : "") << "{\"element\": " << json_string(car.elements[k]) << ", \"share\": " << json_number(car.shares[k]) << "}";
     j << "]}";
   }
-  j << "}" << extra_json << "\n}\n";
+  j << "},\n  \"crush_zones\": " << crush_zones_->json(si);
+  j << extra_json << "\n}\n";
   return j.str();
 }
 

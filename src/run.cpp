@@ -235,11 +235,13 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     report.responses = responses->result();
     report.has_responses = true;
   }
+  report.outcomes = outcome_signature(report.outcome.events);
   if (writer) {
     report.summary_json =
         writer->write_summary(report.outcome, report.integrator,
                               (responses ? ",\n  \"responses\": " + responses->json() : "") +
-                                  (scenario ? ",\n  \"scenario\": " + scenario->json() : ""));
+                                  (scenario ? ",\n  \"scenario\": " + scenario->json() : "") +
+                                  ",\n  \"outcomes\": " + report.outcomes.json());
     if (report.outcome.ok && !writer->failure().empty()) {  // the last write failed
       report.outcome.ok = false;
       report.outcome.message = writer->failure();

@@ -192,6 +192,12 @@ std::string number_text(double value) {
   return text;
 }
 
+std::string parameter_value_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "P = %.6g", value);
+  return text;
+}
+
 struct Job {
   SensitivityPoint variation;
   std::string parameter;  // SensitivityRun::parameter
@@ -301,6 +307,7 @@ SensitivityRun run_one(const std::string& model_path, const CheckedYamlText& mod
                                         number_text(report.outcome.t_reached) + ")"
                                   : report.outcome.message;
     run.responses = report.responses;
+    run.outcomes = report.outcomes;
   } catch (const std::exception& e) {
     run.ok = false;
     run.message = e.what();
@@ -313,6 +320,59 @@ double response(const Responses& r, int k) { return k == 0 ? r.r1 : (k == 1 ? r.
 
 std::array<double, 3> responses_of(const SensitivityRun& run) {
   return {run.responses.r1, run.responses.r2, run.responses.r3};
+}
+
+/// Bisects the step of a first-order run that is off run 0's branch (issue 40): the step
+/// s = value - 1 is halved `levels` times, keeping the bracket [on, off] of the fractions of s
+/// at which the run is on run 0's branch and off it. Each level is one run (sequential: each
+/// depends on the last), so a flagged parameter costs `levels` extra runs.
+BranchChange bisect_branch(const std::string& model_path, const CheckedYamlText& model_text, const SensitivityDesign& design,
+                           const SensitivityOptions& options, const SensitivityRun& base, const SensitivityRun& flagged,
+                           std::size_t run_index, double nominal_step, const RunControl& control) {
+  BranchChange change;
+  change.run = run_index;
+  change.parameter = flagged.parameter;
+  change.nominal_value = flagged.factor;
+  const double step = flagged.factor - 1.0;
+  double on = 0.0, off = 1.0;  // fractions of the step
+  const SensitivityRun* on_run = &base;
+  const SensitivityRun* off_run = &flagged;
+  change.bisection_runs.reserve(static_cast<std::size_t>(std::max(0, options.branch_bisections)));
+  for (int level = 0; level < options.branch_bisections; ++level) {
+    if (options.stop && options.stop->load()) break;
+    const double middle = 0.5 * (on + off);
+    const double value = 1.0 + middle * step;
+    const Job job{{{flagged.parameter, value}}, flagged.parameter, value};
+    SensitivityRun run = run_one(model_path, model_text, design, job, options.settings, options.run_time_limit, control);
+    run.outcomes.window = options.branch_window;
+    change.bisection_runs.push_back(std::move(run));
+    const SensitivityRun& made = change.bisection_runs.back();
+    if (!made.ok) {
+      change.note = "bisection run at " + parameter_value_text(value) + " failed: " + made.message;
+      break;
+    }
+    if (same_branch(made.outcomes, base.outcomes)) {
+      on = middle;
+      on_run = &made;
+    } else {
+      off = middle;
+      off_run = &made;
+      if (made.outcomes.order() != flagged.outcomes.order() && change.note.empty())
+        change.note = "at " + parameter_value_text(value) + " a third branch (" + made.outcomes.order() + ")";
+    }
+  }
+  change.on_branch_value = 1.0 + on * step;
+  change.off_branch_value = 1.0 + off * step;
+  change.off_branch_signature = off_run->outcomes.text();
+  for (int k = 0; k < 3; ++k) {
+    const double r_base = response(base.responses, k), r_on = response(on_run->responses, k),
+                 r_off = response(off_run->responses, k), r_nominal = response(flagged.responses, k);
+    change.nominal_derivative[k] = (r_nominal - r_base) / nominal_step;
+    change.within_branch[k] = on > 0.0 ? (r_on - r_base) / (on * step) : kNaN;
+    const double trend = std::isnan(change.within_branch[k]) ? 0.0 : change.within_branch[k] * (off - on) * step;
+    change.jump[k] = r_off - r_on - trend;
+  }
+  return change;
 }
 
 std::string point_text(const SensitivityPoint& point, const char* separator = " ") {
@@ -536,6 +596,7 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
       jobs.size(),
       [&](std::size_t k, const RunControl& control) {
         runs[k] = run_one(model_path, model_text, design, jobs[k], options.settings, options.run_time_limit, control);
+        runs[k].outcomes.window = options.branch_window;
       },
       batch,
       [&](std::size_t k, BatchRunState state) {
@@ -580,6 +641,37 @@ SensitivityResult run_sensitivity(const std::string& model_path, const Sensitivi
     result.derivatives.push_back(d);
   }
 
+  // Branch changes (issue 40): every first-order run off run 0's branch, bisected towards 1.
+  if (result.base.ok && !result.interrupted) {
+    std::vector<std::size_t> flagged;
+    for (std::size_t i = 0; i < result.runs.size(); ++i)
+      if (result.runs[i].ok && !same_branch(result.runs[i].outcomes, result.base.outcomes)) flagged.push_back(i);
+    result.branch_changes.resize(flagged.size());
+    const std::vector<BatchRunState> bisected = run_batch(
+        flagged.size(),
+        [&](std::size_t k, const RunControl& control) {
+          const SensitivityRun& run = result.runs[flagged[k]];
+          const double nominal_step = result.central ? run.factor - 1.0 : design.factor - 1.0;
+          result.branch_changes[k] =
+              bisect_branch(model_path, model_text, design, options, result.base, run, flagged[k], nominal_step, control);
+        },
+        batch);
+    for (std::size_t k = 0; k < flagged.size(); ++k) {
+      if (bisected[k] == BatchRunState::finished) {
+        result.bisection_runs += result.branch_changes[k].bisection_runs.size();
+        continue;
+      }
+      BranchChange& change = result.branch_changes[k];  // interrupted: the run is flagged, not bisected
+      change = BranchChange{};
+      change.run = flagged[k];
+      change.parameter = result.runs[flagged[k]].parameter;
+      change.nominal_value = change.off_branch_value = result.runs[flagged[k]].factor;
+      change.off_branch_signature = result.runs[flagged[k]].outcomes.text();
+      change.within_branch = change.jump = change.nominal_derivative = {kNaN, kNaN, kNaN};
+      change.note = "not bisected: the study was interrupted";
+    }
+  }
+
   // Second order: every run that varies only parameters of the form.
   if (!terms.empty()) {
     std::vector<std::string> term_parameters;
@@ -621,6 +713,60 @@ std::string equation(int response_index, double constant, const std::vector<std:
   return text;
 }
 
+/// sensitivity.csv's branch column: "base" (run 0), "same" (run 0's branch), "changed", or ""
+/// (a failed run has no outcome to compare).
+std::string branch_label(const SensitivityRun& run, const SensitivityRun& base, bool is_base) {
+  if (is_base) return base.ok ? "base" : "";
+  if (!run.ok || !base.ok) return "";
+  return same_branch(run.outcomes, base.outcomes) ? "same" : "changed";
+}
+
+/// The branch changes (issue 40): the Markdown section and sensitivity_branches.csv.
+void write_branch_changes(const SensitivityResult& result, const std::string& directory, std::ostringstream& md) {
+  if (!result.base.ok) return;
+  std::ostringstream csv;  // sensitivity_branches.csv, written whole (whole_file.hpp)
+  csv << "run,parameter,nominal_value,on_branch_value,off_branch_value,extra_runs,"
+         "A_R1,A_R2,A_R3,within_R1,within_R2,within_R3,jump_R1,jump_R2,jump_R3,off_branch_outcomes,note\n";
+  md << "\n## Discrete outcomes and branch changes\n\n"
+     << "Run 0's outcome: `" << result.base.outcomes.text() << "` (branch `" << result.base.outcomes.order()
+     << "`; " << (std::isinf(result.base.outcomes.window)
+                        ? std::string("runs are compared by the set of outcomes, order between elements aside")
+                        : "outcomes within " + number(1e3 * result.base.outcomes.window, "%g") +
+                              " ms of each other form one group, compared as a set, and the groups in order")
+     << ").\n\n";
+  std::size_t changed = 0;
+  for (const SensitivityRun& r : result.runs) changed += r.ok && !same_branch(r.outcomes, result.base.outcomes);
+  std::size_t changed_second = 0;
+  for (const SensitivityRun& r : result.second_order_runs) changed_second += r.ok && !same_branch(r.outcomes, result.base.outcomes);
+  md << changed << " of " << result.runs.size() << " first-order runs";
+  if (!result.second_order_runs.empty()) md << " and " << changed_second << " of " << result.second_order_runs.size() << " second-order runs";
+  md << " end on another branch (sensitivity.csv, column branch). A finite difference across a branch change is not a "
+        "sensitivity: for each first-order run off run 0's branch, the step is halved until the run stays on it ("
+     << result.bisection_runs << " extra runs in all), and the effect within run 0's branch (dR/dP from run 0 to the "
+        "largest step on it) and the jump where the branch changes (R beyond the change minus R before it, less the "
+        "within-branch trend) are given apart. The change lies between the two values of P.\n\n";
+  if (result.branch_changes.empty()) {
+    write_whole_file(directory + "/sensitivity_branches.csv", csv.str());
+    return;
+  }
+  md << "| Run | Parameter | P on branch | P off branch | A (nominal) R1 | R2 | R3 | within R1 | R2 | R3 | jump R1 | R2 | R3 | "
+        "outcome off the branch |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const BranchChange& c : result.branch_changes) {
+    csv << c.run + 1 << ',' << c.parameter << ',' << csv_number(c.nominal_value) << ',' << csv_number(c.on_branch_value) << ','
+        << csv_number(c.off_branch_value) << ',' << c.bisection_runs.size();
+    md << "| " << c.run + 1 << " | " << c.parameter << " | " << number(c.on_branch_value, "%.4g") << " | "
+       << number(c.off_branch_value, "%.4g") << " |";
+    for (const auto* values : {&c.nominal_derivative, &c.within_branch, &c.jump})
+      for (int k = 0; k < 3; ++k) {
+        csv << ',' << csv_number((*values)[static_cast<std::size_t>(k)]);
+        md << ' ' << number((*values)[static_cast<std::size_t>(k)]) << " |";
+      }
+    csv << ',' << csv_text(c.off_branch_signature) << ',' << csv_text(c.note) << '\n';
+    md << " `" << c.off_branch_signature << "`" << (c.note.empty() ? "" : " (" + c.note + ")") << " |\n";
+  }
+  write_whole_file(directory + "/sensitivity_branches.csv", csv.str());
+}
+
 std::string power_label(const SensitivityTerm& t) {
   if (t.linear()) return t.first;
   if (t.square()) return t.first + "^2";
@@ -646,7 +792,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
   // Runs: sensitivity.csv, and Table 11 / Tables 12-13 in the Markdown.
   {
     std::ostringstream csv;
-    csv << "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message\n";
+    csv << "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message,branch,outcomes\n";
     std::vector<const SensitivityRun*> all{&result.base};
     for (const SensitivityRun& r : result.runs) all.push_back(&r);
     for (const SensitivityRun& r : result.second_order_runs) all.push_back(&r);
@@ -660,7 +806,8 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
       const int order = k == 0 ? 0 : (k <= result.runs.size() ? 1 : 2);
       csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : (r.interrupted ? "interrupted" : "failed")) << ','
           << csv_number(r.responses.r1) << ',' << csv_number(r.responses.r2) << ',' << csv_number(r.responses.r3) << ','
-          << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << '\n';
+          << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << ','
+          << branch_label(r, result.base, k == 0) << ',' << csv_text(r.ok ? r.outcomes.text() : "") << '\n';
     }
     write_whole_file(directory + "/sensitivity.csv", csv.str());
   }
@@ -704,6 +851,8 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
       md << ' ' << result_cells(r) << '\n';
     }
   }
+
+  write_branch_changes(result, directory, md);
 
   // First-order coefficients: equations (1)-(3) and sensitivity_first_order.csv.
   {

@@ -435,6 +435,8 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     const RunReport report = run_model(model, run_folder, control.stop_flag(), false, true);
     row.status = report.outcome.ok ? "ok" : "failed";
     row.message = report.outcome.message;
+    row.outcomes = report.outcomes.text();
+    row.branch = report.outcomes.order();
     if (!report.outcome.ok && control.timed_out()) row.message = "stopped at the run time limit (t = " + exact(report.outcome.t_reached) + ")";
     if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
     // railcrash's own summary, just written: YAML::Load without the structure check that
@@ -466,7 +468,7 @@ std::string sweep_csv_header(const SweepPlan& plan) {
   for (const SweepFactor& f : plan.factors) header += "," + csv_field(f.column());
   header += ",status";
   for (const std::string& r : plan.responses) header += "," + csv_field(r);
-  return header + ",wall_seconds,message";
+  return header + ",wall_seconds,message,outcomes,branch";
 }
 
 std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const SweepRunSpec& spec, const SweepRow& row) {
@@ -477,7 +479,7 @@ std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const Swee
   (void)plan;
   char wall[32];
   std::snprintf(wall, sizeof wall, "%.3f", row.wall_seconds);
-  return line + "," + wall + "," + csv_text(row.message);
+  return line + "," + wall + "," + csv_text(row.message) + "," + csv_text(row.outcomes) + "," + csv_text(row.branch);
 }
 
 std::size_t SweepResult::done() const {
@@ -551,7 +553,7 @@ SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, co
     for (; std::getline(in, line);) {
       const std::vector<std::string> fields = csv_fields(line);
       // run, hash, factors..., status, ...: a line cut short by a kill is not a row.
-      if (fields.size() != 2 + plan.factors.size() + 1 + plan.responses.size() + 2) continue;
+      if (fields.size() != 2 + plan.factors.size() + 1 + plan.responses.size() + 4) continue;
       const std::size_t first = line.find(',');
       by_hash[fields[1]] = {fields[0], line.substr(line.find(',', first + 1) + 1)};
       old_hashes.push_back(fields[1]);
@@ -663,6 +665,30 @@ const char* design_name(SweepDesignKind kind) {
 
 }  // namespace
 
+/// The runs whose discrete outcome differs from run 0's (issue 40): runs.csv's column branch.
+std::string sweep_branches_markdown(const SweepPlan& plan, const SweepResult& result) {
+  const std::size_t branch_field = 2 + plan.factors.size() + 1 + plan.responses.size() + 3;
+  std::vector<std::pair<std::size_t, std::string>> branches;  // run number, branch of ok runs
+  for (std::size_t k = 0; k < result.lines.size(); ++k) {
+    if (!result.lines[k]) continue;
+    const std::vector<std::string> fields = csv_fields(*result.lines[k]);
+    if (fields.size() > branch_field && fields[2 + plan.factors.size()] == "ok") branches.emplace_back(k, fields[branch_field]);
+  }
+  if (branches.empty() || branches.front().first != 0) return "";
+  std::ostringstream md;
+  std::string changed;
+  std::size_t count = 0;
+  for (const auto& [number, branch] : branches)
+    if (branch != branches.front().second) {
+      ++count;
+      if (count <= 20) changed += (changed.empty() ? "" : ", ") + std::to_string(number);
+    }
+  md << "\nDiscrete outcome of run 0 (runs.csv, column branch): `" << branches.front().second << "`; " << count << " of "
+     << branches.size() << " ok runs end on another branch" << (count ? " (runs " + changed + (count > 20 ? ", ..." : "") + ")" : "")
+     << ": a response may jump between them.\n";
+  return md.str();
+}
+
 std::size_t failed_sweep_runs(const SweepPlan& plan, const SweepResult& result) {
   std::size_t failed = 0;
   for (const auto& line : result.lines)
@@ -698,6 +724,7 @@ std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const 
   md << "# Sweep " << plan.path << "\n\n" << design_name(plan.design) << " design, " << result.specs.size() << " runs: "
      << result.done() << " done (" << result.resumed << " from an earlier runs.csv), " << failed << " failed, "
      << result.specs.size() - result.done() << " not run. Rows: runs.csv.\n";
+  md << sweep_branches_markdown(plan, result);
   const bool trend = sampled(plan.design);
   md << "\n## Main effects\n\n"
      << (trend ? "Each response's least-squares slope on each factor over the ok runs, the slope times the factor's "

@@ -94,8 +94,9 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
       const std::vector<std::string> fields = csv_fields(line);
       SweepRow row;
       row.status = fields[2 + plan.factors.size()];
-      row.wall_seconds = std::atof(fields[fields.size() - 2].c_str());
-      row.message = fields.back();
+      const std::size_t wall_field = 3 + plan.factors.size() + plan.responses.size();  // then message, outcomes, branch
+      row.wall_seconds = std::atof(fields[wall_field].c_str());
+      row.message = fields[wall_field + 1];
       options.progress(static_cast<std::size_t>(number), row, done, result.specs.size());
     }
   };

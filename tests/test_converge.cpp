@@ -271,7 +271,7 @@ TEST_CASE("convergence study: log-log slope and the files written", "[converge]"
   std::string header, line;
   std::getline(csv, header);
   CHECK(header == "method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events,"
-                  "displacement_rms,displacement_rms_error,message");
+                  "displacement_rms,displacement_rms_error,message,outcomes,branch");
   int rows = 0;
   while (std::getline(csv, line)) ++rows;
   CHECK(rows == 4);  // reference, two Euler, one IDA

@@ -85,7 +85,7 @@ TEST_CASE("first-order study: each run against the closed-form crush, derivative
   std::ifstream csv(files.dir + "/out/sensitivity.csv");
   std::string header;
   std::getline(csv, header);
-  CHECK(header == "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message");
+  CHECK(header == "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message,branch,outcomes");
   // A0 of the first-order form: the base response less the sum of the coefficients (report eq. 1-3).
   CHECK(result.constant[0] ==
         Approx(result.base.responses.r1 - result.derivatives[0][0] - result.derivatives[1][0]).epsilon(1e-12));
@@ -445,4 +445,138 @@ TEST_CASE("a run that exceeds the run time limit is stopped and reported failed"
   CHECK_THAT(result.base.message, Catch::Contains("stopped at the run time limit of 0.2 s"));
   CHECK(result.base.wall_seconds < 5.0);
   CHECK(std::isnan(result.derivatives[0][0]));
+}
+
+// ---- discrete outcomes and branch changes (issue 40) ----
+
+TEST_CASE("outcome signature: outcomes only, first occurrence, near-simultaneous outcomes as a set", "[sensitivity][branch]") {
+  const std::vector<EventRecord> events{
+      {0.010, "gear1", "sliding (buff)", 0.0},
+      {0.012, "gear1", "bottomed (buff)", 0.0},
+      {0.013, "ends", "contact", 0.0},
+      {0.015307, "gear1", "fracture", 0.0},
+      {0.015348, "gear2", "fracture", 0.0},
+      {0.016, "gear1", "off bottom (buff)", 0.0},
+      {0.017, "gear1", "bottomed (draft)", 0.0},            // second bottoming: not a new outcome
+      {0.020, "ac", "horizontal unloading, override", 0.0}, // joined texts are split
+      {0.021, "ac", "separation", 0.0}};
+  const OutcomeSignature s = outcome_signature(events, 1e-4);  // order asked: groups within 0.1 ms
+  REQUIRE(s.events.size() == 4);
+  CHECK(s.text() == "gear1:bottomed@12.000ms>gear1:fracture@15.307ms>gear2:fracture@15.348ms>ac:override@20.000ms");
+  CHECK(s.order() == "gear1:bottomed>gear1:fracture+gear2:fracture>ac:override");
+  // By default the set: order aside.
+  CHECK(outcome_signature(events).order() == "ac:override+gear1:bottomed+gear1:fracture+gear2:fracture");
+  CHECK(outcome_of_event("horizontal unloading, override") == "override");
+  CHECK(outcome_of_event("contact, crushing").empty());
+  CHECK(outcome_of_event("pin shear") == "pin shear");
+  // The two fractures 41 us apart in the other order: the same branch (one group, within 0.1 ms).
+  std::vector<EventRecord> swapped = events;
+  swapped[3].element = "gear2";
+  swapped[4].element = "gear1";
+  CHECK(same_branch(outcome_signature(swapped, 1e-4), s));
+  CHECK(same_branch(outcome_signature(swapped), outcome_signature(events)));
+  // A window below their distance makes the order count.
+  CHECK_FALSE(same_branch(outcome_signature(swapped, 1e-5), outcome_signature(events, 1e-5)));
+  // The override before the fractures: another order, the same set.
+  std::vector<EventRecord> early = events;
+  early[7].t = 0.014;
+  std::stable_sort(early.begin(), early.end(), [](const EventRecord& a, const EventRecord& b) { return a.t < b.t; });
+  CHECK(same_branch(outcome_signature(early), outcome_signature(events)));
+  CHECK_FALSE(same_branch(outcome_signature(early, 1e-4), s));
+  // One gear fractures only: another branch, in either form.
+  std::vector<EventRecord> one = events;
+  one.erase(one.begin() + 4);
+  CHECK_FALSE(same_branch(outcome_signature(one, 1e-4), s));
+  CHECK_FALSE(same_branch(outcome_signature(one), outcome_signature(events)));
+  CHECK(outcome_signature({}).text() == "none");
+  CHECK(s.json().find("\"branch\": \"gear1:bottomed>gear1:fracture+gear2:fracture>ac:override\"") != std::string::npos);
+  CHECK(outcome_signature(events).json().find("\"window\": null") != std::string::npos);  // no window: the set
+}
+
+namespace {
+
+// A 500 kg probe at 2 m/s into a draft gear fixed to the ground (k = 1e6 N/m, H = 2e4 N, stick
+// slope Kt = 2e7 N/m, travel 0.05 m, never reached): it sticks up to x1 = H / (Kt - k), then
+// loads on k x + H to the largest compression xm, where
+//   m v0^2 / 2 = Kt x1^2 / 2 + k (xm^2 - x1^2) / 2 + H (xm - x1),
+// so the peak gear force is k xm + H. The gear fractures when its fracture_load is below it.
+// Beside it, the R1 car of the other tests (responses need an anticlimber), which the gear does not touch.
+double gear_peak_force() {
+  const double m = 500.0, v0 = 2.0, k = 1e6, h = 2e4, kt = 2e7;
+  const double x1 = h / (kt - k);
+  const double rest = 0.5 * m * v0 * v0 - 0.5 * kt * x1 * x1 + 0.5 * k * x1 * x1 + h * x1;  // = k xm^2 / 2 + H xm
+  const double xm = (-h + std::sqrt(h * h + 2.0 * k * rest)) / k;
+  return k * xm + h;
+}
+
+std::string gear_fracture_model(double fracture_load) {
+  std::string text = testing::anticlimber_r1_model_text(0.15);
+  const auto elements = text.find("elements:\n");
+  text.insert(text.find("\n", text.find("bodies:\n") + 8) + 1,
+              "  - {name: probe, mass: 500, inertia: 1, position: [0, 5], velocity: [-2, 0]}\n");
+  char gear[512];
+  std::snprintf(gear, sizeof gear,
+                "  - name: gear\n    type: draft_gear\n    initial_stiffness: 1.0e6\n    travel: 0.05\n"
+                "    stiffness_after_bottoming: 2.0e7\n    hysteresis_load: 2.0e4\n    transition_stiffness: 2.0e7\n"
+                "    fracture_load: %.17g\n    points: [{body: ground, at: [-1, 5]}, {body: probe, at: [0, 0]}]\n",
+                fracture_load);
+  (void)elements;
+  text.insert(text.find("elements:\n") + 10, gear);
+  return text;
+}
+
+}  // namespace
+
+TEST_CASE("branch change: a gear that fractures at run 0 and not at +20 % is flagged and the threshold bracketed",
+          "[sensitivity][branch]") {
+  Files files;
+  const double peak = gear_peak_force(), nominal_load = 45000.0;
+  REQUIRE(peak > nominal_load);
+  REQUIRE(peak < 1.2 * nominal_load);
+  std::ofstream(files.model) << gear_fracture_model(nominal_load);
+  std::ofstream(files.design) << "sensitivity: 1\nfactor: 1.2\nparameters:\n"
+                                 "  - name: PF\n    description: gear fracture load\n"
+                                 "    scale: [{key: elements.gear.fracture_load, power: 1}]\n"
+                                 "  - name: P7\n    description: horizontal yield force\n"
+                                 "    scale: [{key: elements.ac.horizontal_yield_deflection, power: 1}]\n";
+  const SensitivityDesign design = load_design(files.design);
+  SensitivityOptions options;
+  options.jobs = 2;
+  const SensitivityResult result = run_sensitivity(files.model, design, options);
+  REQUIRE(result.base.ok);
+  REQUIRE(result.base.outcomes.events.size() == 1);
+  CHECK(result.base.outcomes.order() == "gear:fracture");
+  REQUIRE(result.runs.size() == 2);
+  CHECK(result.runs[0].outcomes.order() == "none");  // PF = 1.2: the load stays below it
+  CHECK(result.runs[1].outcomes.order() == "gear:fracture");  // P7 leaves the gear alone
+  REQUIRE(result.branch_changes.size() == 1);
+  const BranchChange& change = result.branch_changes[0];
+  CHECK(change.parameter == "PF");
+  CHECK(change.run == 0);
+  // 4 halvings of the step 0.2: the bracket is 0.2 / 16 wide and holds the threshold peak / load.
+  const double threshold = peak / nominal_load;
+  CHECK(change.bisection_runs.size() == 4);
+  CHECK(result.bisection_runs == 4);
+  CHECK(change.on_branch_value < threshold);
+  CHECK(change.off_branch_value > threshold);
+  CHECK(change.off_branch_value - change.on_branch_value == Approx(0.2 / 16).epsilon(1e-12));
+  CHECK(change.off_branch_signature == "none");
+  // R1 does not depend on the gear (only through the integrator's steps, which the probe shares):
+  // no effect within the branch, no jump.
+  CHECK(change.within_branch[0] == Approx(0.0).margin(1e-6));
+  CHECK(change.jump[0] == Approx(0.0).margin(1e-6));
+  CHECK(change.note.empty());
+  const std::string md = write_sensitivity(result, design, files.dir + "/out");
+  CHECK_THAT(md, Catch::Contains("Run 0's outcome: `gear:fracture@"));
+  CHECK_THAT(md, Catch::Contains("1 of 2 first-order runs end on another branch"));
+  std::ifstream csv(files.dir + "/out/sensitivity.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::getline(csv, line);
+  CHECK_THAT(line, Catch::Contains(",base,\"gear:fracture@"));
+  std::getline(csv, line);
+  CHECK_THAT(line, Catch::EndsWith(",changed,\"none\""));
+  std::getline(csv, line);
+  CHECK_THAT(line, Catch::Contains(",same,\"gear:fracture@"));
+  CHECK(std::filesystem::exists(files.dir + "/out/sensitivity_branches.csv"));
 }

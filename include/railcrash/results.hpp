@@ -74,6 +74,7 @@
 
 #include "railcrash/integrator.hpp"
 #include "railcrash/results/crash_pulse.hpp"
+#include "railcrash/results/crush_zones.hpp"
 #include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/provenance.hpp"
 
@@ -260,6 +261,8 @@ class ResultWriter : public RunObserver {
   const std::vector<AccelerationPeaks>& acceleration_peaks() const { return acceleration_peaks_; }
   /// Largest crush of each car so far.
   const std::vector<CarCrush>& car_crush() const { return cars_; }
+  /// Energy absorbed per crush zone and per car so far (results/crush_zones.hpp).
+  const CrushZoneTracker& crush_zones() const { return *crush_zones_; }
   /// Channel frequency class of the summary's filtered accelerations (default 60).
   void set_filter_class(double cfc) { cfc_ = cfc; }
   double filter_class() const { return cfc_; }
@@ -272,6 +275,8 @@ class ResultWriter : public RunObserver {
  private:
   /// What sample() does once acceleration_ holds the body accelerations at the sample.
   void record_sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs);
+  /// Writes DIR/energy_zones.csv: the provenance line, then CrushZoneTracker::csv().
+  void write_energy_zones();
 
   const DaeSystem& system_;
   std::string directory_;
@@ -291,6 +296,7 @@ class ResultWriter : public RunObserver {
   std::vector<double> crush_scratch_;  // outputs of a car's crush elements evaluated at an event (car_crush_at)
   std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
   std::unique_ptr<EnergyWriter> energy_;
+  std::unique_ptr<CrushZoneTracker> crush_zones_;  // energy per crush zone (summary.json, energy_zones.csv)
   OutputFormat format_ = OutputFormat::Csv;
   std::unique_ptr<Hdf5File> hdf5_;  // --format hdf5: in place of the four CSV files
   struct Hdf5Tables {

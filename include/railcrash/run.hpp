@@ -10,6 +10,7 @@
 #include "railcrash/integrator.hpp"
 #include "railcrash/model.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/outcomes.hpp"
 #include "railcrash/responses.hpp"
 #include "railcrash/results.hpp"
 
@@ -43,6 +44,7 @@ struct RunReport {
   std::string integrator;
   bool has_responses = false;  // the model has a responses section
   Responses responses;         // R1-R3 and what they are made of
+  OutcomeSignature outcomes;   // the run's discrete outcome (outcomes.hpp; summary.json's "outcomes")
   // From the result writer (empty when no output folder): per body, per car (results.hpp).
   std::vector<AccelerationPeaks> acceleration_peaks;
   std::vector<CarCrush> car_crush;

@@ -31,6 +31,14 @@
 //   d2R/dP_i2      = 2 B_ii
 //   d2R/dP_i dP_j  = B_ij
 //
+// Branches (issue 40). Each run records its discrete outcome (outcomes.hpp: which elements
+// fractured, sheared, overrode or bottomed out, and when). A first-order run whose outcome
+// differs from run 0's crossed a jump, and its A_i is not a sensitivity: its step is halved
+// (branch_bisections times, one run each) to find the largest step on run 0's branch, and the
+// effect within the branch, the jump and the values of P around the change are reported apart
+// (BranchChange; sensitivity.md, sensitivity_branches.csv). A_i itself is left as the design
+// defines it (the report's printed method).
+//
 // A design file says what each nondimensional parameter scales in the model, and the
 // second-order study:
 //   sensitivity: 1
@@ -60,6 +68,7 @@
 
 #include "railcrash/run_count.hpp"
 #include "railcrash/error.hpp"
+#include "railcrash/outcomes.hpp"
 #include "railcrash/responses.hpp"
 #include "railcrash/yaml_file.hpp"
 
@@ -131,6 +140,24 @@ struct SensitivityRun {
   Responses responses;
   double wall_seconds = 0.0;
   bool interrupted = false;    // stopped, or never started, because the study was interrupted
+  OutcomeSignature outcomes;   // the run's discrete outcome (outcomes.hpp)
+};
+
+/// A first-order run whose discrete outcome differs from run 0's (issue 40): the step is bisected
+/// towards 1 to find the largest step that stays on run 0's branch, so that the effect within the
+/// branch and the jump where the branch changes are reported apart. Step s = value - 1.
+struct BranchChange {
+  std::size_t run = 0;              // index in SensitivityResult::runs
+  std::string parameter;
+  double nominal_value = 1.0;       // the run's value (the design's factor, or 1 +- h)
+  double on_branch_value = 1.0;     // the value nearest nominal found on run 0's branch (1: none but run 0)
+  double off_branch_value = 1.0;    // the value nearest 1 found off it (the branch changes in between)
+  std::string off_branch_signature; // the outcome there (OutcomeSignature::text)
+  std::array<double, 3> nominal_derivative{};  // A_i from the nominal step (across the change)
+  std::array<double, 3> within_branch{};       // dR/dP from run 0 to on_branch_value (NaN: no step stayed on it)
+  std::array<double, 3> jump{};                // R(off) - R(on) - within_branch (off - on): the jump across the change
+  std::vector<SensitivityRun> bisection_runs;  // the extra runs, in the order they were made
+  std::string note;                            // a bisection run failed, or the branch returned to run 0's
 };
 
 /// One run's data for a fit.
@@ -174,6 +201,8 @@ struct SensitivityResult {
   std::size_t runs_total = 0;     // runs the study has (base, first order, second order)
   std::size_t runs_finished = 0;  // runs that ended by themselves (ok or failed); fewer if interrupted
   bool interrupted = false;       // the stop flag rose: runs not finished are failed "not run" / "interrupted"
+  std::vector<BranchChange> branch_changes;  // first-order runs off run 0's branch, bisected (issue 40)
+  std::size_t bisection_runs = 0;            // extra runs the bisections made
 };
 
 struct SensitivityOptions {
@@ -186,6 +215,8 @@ struct SensitivityOptions {
   double run_time_limit = 0.0;       // [s] wall time after which a run is stopped and reported failed (0: none)
   const std::atomic<bool>* stop = nullptr;  // raised (SIGINT/SIGTERM): runs in progress stop, no new run starts
   std::size_t max_runs = kDefaultMaxRuns;  // a study with more runs is refused before it starts (--max-runs; 0: no limit)
+  int branch_bisections = 4;         // halvings of the step of a first-order run off run 0's branch (0: flag only)
+  double branch_window = kBranchWindow;  // [s] outcomes this close form one group (outcomes.hpp)
   /// Called (one call at a time) as each run finishes: the run, its number (0 = base), runs done, runs in all.
   std::function<void(const SensitivityRun&, std::size_t, std::size_t, std::size_t)> progress;
 };

@@ -117,6 +117,8 @@ struct SweepRow {
   std::vector<double> responses;       // NaN where the run has no such value
   double wall_seconds = 0.0;
   std::string message;
+  std::string outcomes;                // the run's discrete outcome, with times (OutcomeSignature::text)
+  std::string branch;                  // the same, order only (OutcomeSignature::order): runs with equal ones are on one branch
 };
 
 /// Runs one specification (used by the thread pool and by MPI ranks); `model_text` is the model

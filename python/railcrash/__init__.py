@@ -155,22 +155,34 @@ def _dataframe(self):
     return frame
 
 
+def _outcomes(self):
+    """The run's discrete outcome (summary.json's "outcomes"): "signature" (fractures, shears,
+    overrides, bottoming with their times), "branch" (the order only; runs with equal ones are on
+    one branch) and "events" [{t, element, what}, ...]."""
+    return self.summary["outcomes"]
+
+
 Results.summary = property(_summary)
+Results.outcomes = property(_outcomes)
 Results.dataframe = _dataframe
 
 
-def sensitivity(model_path, design="report", jobs=0, only=None, second_order=True, central=0.0, run_limit=0.0):
+def sensitivity(model_path, design="report", jobs=0, only=None, second_order=True, central=0.0, run_limit=0.0,
+                bisect=4):
     """The report's parameter study of R1-R3 (`railcrash sensitivity`), returned as tables.
 
     design: a design file, or "report" for sensitivity_design.yaml beside the model.
-    Returns a dict: "runs" (one row per run: parameter, variation, factor, ok, R1-R3),
-    "first_order" (A_i per parameter), "constant" (A0 for R1-R3) and, with a second-order
-    design, "second_order" (fitted constants per term). Rows are dicts: pandas.DataFrame(rows)
-    makes a table of them.
+    Returns a dict: "runs" (one row per run: parameter, variation, factor, ok, R1-R3, and its
+    discrete outcome: "outcomes" with times, "branch" order only), "first_order" (A_i per
+    parameter), "constant" (A0 for R1-R3), "branch_changes" (each first-order run whose branch
+    differs from run 0's, its step bisected `bisect` times: the values of P on and off run 0's
+    branch, A_i, the effect within the branch and the jump) and, with a second-order design,
+    "second_order" (fitted constants per term). Rows are dicts: pandas.DataFrame(rows) makes a
+    table of them.
     """
     only = list(only) if only else []
     return _railcrash._sensitivity(str(model_path), str(design), int(jobs), only, bool(second_order), float(central),
-                                   float(run_limit))
+                                   float(run_limit), int(bisect))
 
 
 def _sweep_column(name, values):

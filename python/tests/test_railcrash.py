@@ -196,6 +196,32 @@ class RunTest(unittest.TestCase):
             self.assertIsInstance(t, float)
             self.assertTrue(0.0 <= t <= 0.15)
 
+    def test_discrete_outcome_of_a_gear_that_fractures_or_not(self):
+        # A 500 kg probe at 2 m/s into a draft gear: peak force sqrt(H^2 + 2 k (E - stick corner)),
+        # about 49.2 kN (tests/test_sensitivity.cpp gear_peak_force): a fracture load below it
+        # fractures, one above does not.
+        def gear(fracture_load):
+            return railcrash.from_yaml(
+                "railcrash: 1\nname: gear\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+                "  - {name: probe, mass: 500, inertia: 1, position: [0, 0], velocity: [-2, 0]}\nelements:\n"
+                "  - {name: gear, type: draft_gear, initial_stiffness: 1.0e6, travel: 0.05, stiffness_after_bottoming: 2.0e7,\n"
+                "     hysteresis_load: 2.0e4, transition_stiffness: 2.0e7, fracture_load: %g,\n"
+                "     points: [{body: ground, at: [-1, 0]}, {body: probe, at: [0, 0]}]}\n"
+                "simulation: {t_end: 0.06, rtol: 1e-8}\n" % fracture_load)
+        broken = railcrash.run(gear(45000.0))
+        self.assertTrue(broken.ok, broken.message)
+        self.assertEqual(broken.outcomes["branch"], "gear:fracture")
+        self.assertEqual(len(broken.outcomes["events"]), 1)
+        self.assertTrue(broken.outcomes["signature"].startswith("gear:fracture@"))
+        fracture_time = broken.outcomes["events"][0]["t"]
+        located = [t for t, element, event, _ in broken.events if (element, event) == ("gear", "fracture")]
+        self.assertEqual(len(located), 1)
+        self.assertAlmostEqual(fracture_time, located[0], delta=1e-9)  # summary.json keeps 12 digits
+        intact = railcrash.run(gear(54000.0))
+        self.assertTrue(intact.ok, intact.message)
+        self.assertEqual(intact.outcomes["branch"], "none")
+        self.assertEqual(intact.outcomes["events"], [])
+
     @unittest.skipUnless(TWO_CAR.exists(), "the report's two-car model")
     def test_report_model_from_file(self):
         model = railcrash.load(TWO_CAR, set={"elements.anticlimber.horizontal_yield_deflection*": 1.2,
@@ -419,6 +445,9 @@ class SensitivityTest(unittest.TestCase):
         expected = (crush_for(0.012) - crush_for(0.01)) / 0.02 / 0.2
         self.assertAlmostEqual(p7["A_R1"], expected, delta=1e-3 * abs(expected))
         self.assertLess(p7["A_R1"], 0.0)
+        # The anticlimber only yields: no discrete outcome, one branch, nothing to bisect.
+        self.assertEqual([r["branch"] for r in runs], ["none", "none"])
+        self.assertEqual(table["branch_changes"], [])
 
     def test_only_and_central(self):
         """--only and --central: the rows name the parameters that ran."""

@@ -14,7 +14,7 @@ namespace railcrash {
 const std::vector<std::string>& run_folder_files() {
   static const std::vector<std::string> names = {"timeseries.csv", "events.csv",   "accelerations.csv", "energy.csv",
                                                  "timeseries.h5",  "summary.json", "summary.json.tmp",  "model.json",
-                                                 "report.html"};
+                                                 "report.html",    "energy_zones.csv"};
   return names;
 }
 

@@ -128,7 +128,7 @@ expect_text "it says which files of an earlier run it removed" "$tmp/stdout" "^r
 cp "$tmp/owned/summary.json" "$tmp/first_summary.json"
 expect_status "a second run into the same folder" 0 "$bin" run "$crank" --t-end 0.2 --out "$tmp/owned" --quiet
 expect_text "it names the earlier run's files it removed" "$tmp/stdout" \
-  "^removed the files of an earlier run from $tmp/owned/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json$"
+  "^removed the files of an earlier run from $tmp/owned/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json, energy_zones.csv$"
 run_id=$(sed -n 's/^  "run_id": "\([0-9a-f]*\)",$/\1/p' "$tmp/owned/summary.json")
 first_id=$(sed -n 's/^  "run_id": "\([0-9a-f]*\)",$/\1/p' "$tmp/first_summary.json")
 [ ${#run_id} -eq 32 ] && [ ${#first_id} -eq 32 ] && [ "$run_id" != "$first_id" ] && passes=$((passes + 1)) ||

@@ -48,7 +48,7 @@ cp -r "$tmp/csv" "$tmp/csv_then_h5"
 expect_status "an hdf5 run into a csv run's folder" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 \
   --out "$tmp/csv_then_h5" --quiet
 expect_text "it says which files of the csv run it removed" "$tmp/stdout" \
-  "^removed the files of an earlier run from $tmp/csv_then_h5/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json$"
+  "^removed the files of an earlier run from $tmp/csv_then_h5/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json, energy_zones.csv$"
 left=$(ls "$tmp/csv_then_h5" | grep -c '\.csv$')
 [ "$left" -eq 0 ] && passes=$((passes + 1)) || { echo "FAIL: $left CSV files of the earlier run left"; failures=$((failures + 1)); }
 expect_status "report of that folder" 2 "$bin" report "$tmp/csv_then_h5"

@@ -299,3 +299,25 @@ TEST_CASE("The report carries the run's provenance", "[report]") {
                        Catch::Contains("\"Provenance: run \" + pv.run_id"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("railcrash report: the force plot at the channel class asked, the crush zones from summary.json", "[report]") {
+  using railcrash::report::write_report;
+  const fs::path dir = small_run("force_cfc");
+  const std::string summary = slurp(dir / "summary.json");
+  // The anticlimber is the crush zone; without a rupture deflection its curve has no last point:
+  // drawn on at its plastic slope (1e5 N/m), no capacity.
+  CHECK_THAT(summary, Catch::Contains("\"crush_zones\": {") &&
+                          Catch::Contains("{\"element\": \"anticlimber\", \"type\": \"anticlimber\", \"cars\": [{\"car\": \"car1\", \"share\": 0.5}, "
+                                          "{\"car\": \"car2\", \"share\": 0.5}]") &&
+                          Catch::Contains("\"capacity\": null") && Catch::Contains("\"beyond_last_slope\": 100000, \"open_ended\": true"));
+  CHECK(slurp(dir / "energy_zones.csv").find("zone,anticlimber,anticlimber,car1 car2,") != std::string::npos);
+  railcrash::report::ReportOptions options;  // default: CFC 60
+  CHECK_THAT(slurp(write_report(dir.string(), options).path), Catch::Contains("\"title\": \"Element forces (CFC 60; crash elements shown"));
+  options.force_cfc = 0.0;
+  CHECK_THAT(slurp(write_report(dir.string(), options).path), Catch::Contains("\"title\": \"Element forces (unfiltered; crash elements shown"));
+  options.force_cfc = 1.0e6;  // beyond what the output interval can carry: unfiltered, and says so
+  const railcrash::report::ReportResult coarse = write_report(dir.string(), options);
+  REQUIRE(coarse.problems.size() == 1);
+  CHECK_THAT(coarse.problems[0], Catch::Contains("too long for CFC 1e+06: the force plot is unfiltered"));
+  fs::remove_all(dir);
+}

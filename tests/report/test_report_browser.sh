@@ -36,12 +36,20 @@ const check = JSON.parse(m[2].replace(/&quot;/g, '"').replace(/&lt;/g, "<").repl
 if (m[1] !== "ran" || check.errors.length) problems.push("script errors: " + JSON.stringify(check.errors));
 if (!check.library) problems.push("the plotting library is missing");
 if (!check.frames || !check.frames.differ || check.frames.count < 100) problems.push("animation frames: " + JSON.stringify(check.frames));
-const expected = ["displacement", "velocity", "acceleration_ax", "acceleration_ay", "forces", "loop:anticlimber", "energy"];
+const expected = ["displacement", "velocity", "acceleration_ax", "acceleration_ay", "forces", "loop:anticlimber", "energy", "energy_zones"];
 for (const id of expected) {
   const p = check.plots.find((q) => q.id === id);
   if (!p) problems.push("plot " + id + " missing");
   else if (!(p.points > 0 && p.series > 0 && p.drawn)) problems.push("plot " + id + " has no data: " + JSON.stringify(p));
 }
+// The anticlimber's loop is drawn over its declared loading curve and unloading line.
+const loop = check.plots.find((q) => q.id === "loop:anticlimber");
+if (!loop || !(loop.design >= 2)) problems.push("the anticlimber's loop lacks its declared curve and unloading line: " + JSON.stringify(loop));
+// Axes: SI prefixes (the forces of this crash are some 100 kN) and no tick label twice on an axis.
+if (!check.axes || check.axes.length < 7) problems.push("no tick labels in the self-check: " + JSON.stringify(check.axes));
+for (const a of check.axes || []) if (!a.distinct) problems.push("plot " + a.id + " repeats a tick label: " + JSON.stringify(a.labels));
+const forceAxis = (check.axes || []).find((a) => a.id === "forces");
+if (!forceAxis || forceAxis.y_label !== "kN") problems.push("the force plot's axis is not in kN: " + JSON.stringify(forceAxis));
 const jump = check.event_jump;
 if (!jump || Math.abs(jump.frame_t - jump.event_t) > jump.spacing || jump.current !== "current")
   problems.push("a click on an event does not move the animation to it: " + JSON.stringify(jump));

@@ -158,9 +158,9 @@ TEST_CASE("A run removes the files an earlier run left in its folder and nothing
   const std::vector<std::string> expected =
       format == OutputFormat::Hdf5
           ? std::vector<std::string>{"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv", "summary.json", "model.json",
-                                     "report.html"}
+                                     "report.html", "energy_zones.csv"}
           : std::vector<std::string>{"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv", "timeseries.h5",
-                                     "summary.json", "model.json", "report.html"};
+                                     "summary.json", "model.json", "report.html", "energy_zones.csv"};
   CHECK(writer.removed_files() == expected);
   CHECK(slurp(dir / "notes.txt") == "the user's own file");
   CHECK(fs::is_symlink(dir / "summary.json.tmp"));

@@ -36,6 +36,7 @@ namespace railcrash::report {
 
 struct ReportOptions {
   double cfc = 60.0;                   // channel frequency class of the accelerations
+  double force_cfc = 60.0;             // channel frequency class of the element force plot (0: unfiltered)
   std::size_t max_plot_points = 4000;  // per series
   std::size_t max_frames = 1000;       // animation frames (fewer for very large models)
 };

@@ -59,7 +59,7 @@
     return t;
   }
   function studyReport() {
-    ["animation-section", "plots-section", "loops-section", "energy-section"].forEach(function (id) {
+    ["animation-section", "plots-section", "loops-section", "zones-section", "energy-section"].forEach(function (id) {
       document.getElementById(id).hidden = true;
     });
     var head = document.getElementById("header");
@@ -496,6 +496,11 @@
 
   // ---------------------------------------------------------------- plots
   var haveLibrary = typeof window.uPlot === "function";
+  var drawnPlots = [];  // {id, u}: their tick labels go into the self-check
+  // The crush zones of summary.json (results/crush_zones.hpp): their declared curves under the loops, their energies.
+  var crushZones = (summary && summary.crush_zones) || null;
+  var zoneByName = {};
+  ((crushZones && crushZones.zones) || []).forEach(function (z) { zoneByName[z.element] = z; });
   var palette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
   function timeMarker(u) {  // the animation's time as a vertical line
     if (!haveAnimation) return;
@@ -513,6 +518,47 @@
   function unitOf(label) {
     return {length: lengthUnit, "length/time": lengthUnit ? lengthUnit + "/s" : "", force: forceUnit, energy: energyUnit, g: "g"}[label] || label;
   }
+  // ---------------------------------------------------------------- readable axes
+  // SI prefixes (kN, MN, kJ, MJ, mm; kip for lbf) chosen from the largest value shown; tick labels with as
+  // many decimals as the tick spacing needs, so that no two ticks read the same.
+  var siUnits = {N: true, J: true, "N*m": true, m: true, "m/s": true, Pa: true};
+  function scaledUnit(unit, largest) {
+    if ((unit === "lbf" || unit === "in*lbf") && largest >= 1e4)  // US customary: kip = 1000 lbf
+      return {unit: unit === "lbf" ? "kip" : "kip*in", factor: 1e-3};
+    if (!siUnits[unit] || !(largest > 0)) return {unit: unit, factor: 1};
+    if (unit === "m" || unit === "m/s") return largest < 1 ? {unit: "m" + unit, factor: 1e3} : {unit: unit, factor: 1};
+    if (largest >= 1e9) return {unit: "G" + unit, factor: 1e-9};
+    if (largest >= 1e6) return {unit: "M" + unit, factor: 1e-6};
+    if (largest >= 1e3) return {unit: "k" + unit, factor: 1e-3};
+    return {unit: unit, factor: 1};
+  }
+  function largestOf(columns) {
+    var largest = 0;
+    columns.forEach(function (c) { (c || []).forEach(function (v) { if (v !== null && isFinite(v) && Math.abs(v) > largest) largest = Math.abs(v); }); });
+    return largest;
+  }
+  function tickLabels(factor) {  // uPlot axis `values`: distinct labels at the ticks' spacing
+    return function (u, splits) {
+      var step = Infinity;
+      for (var i = 1; i < splits.length; ++i) step = Math.min(step, Math.abs(splits[i] - splits[i - 1]) * factor);
+      var decimals = isFinite(step) && step > 0 ? Math.max(0, Math.min(12, Math.ceil(-Math.log10(step) - 1e-9))) : 3;
+      while (decimals < 12 && isFinite(step) && step > 0 &&  // a spacing of 2.5 needs one decimal more than 2
+             Math.abs(step * Math.pow(10, decimals) - Math.round(step * Math.pow(10, decimals))) > 1e-6 * step * Math.pow(10, decimals)) ++decimals;
+      return splits.map(function (v) {
+        if (v === null || v === undefined) return "";
+        var text = (v * factor).toFixed(decimals);
+        return /^-0(\.0*)?$/.test(text) ? text.slice(1) : text;
+      });
+    };
+  }
+  window.railcrashTickLabels = tickLabels;  // (the browser test checks the labels)
+  function readableAxis(label, unit, largest, extra) {  // a y axis with its unit scaled
+    var s = scaledUnit(unit, largest);
+    var axis = {label: label ? label + (s.unit ? " [" + s.unit + "]" : "") : s.unit, size: 70, values: tickLabels(s.factor)};
+    for (var k in extra || {}) axis[k] = extra[k];
+    return axis;
+  }
+
   function addTimePlot(container, spec, extra) {
     var box = el("div", {"class": "plot"});
     container.appendChild(box);
@@ -525,7 +571,7 @@
     var options = {
       title: spec.title, width: 560, height: 320,
       scales: {x: {time: false}},
-      axes: [{label: "t [s]"}, {label: unitOf(spec.y_label), size: 70}],
+      axes: [{label: "t [s]", values: tickLabels(1)}, readableAxis("", unitOf(spec.y_label), largestOf(columns.slice(1)))],
       series: series,
       legend: {live: true},
       cursor: {sync: {key: "railcrash-time"}},
@@ -534,6 +580,7 @@
     if (extra) extra(options, columns);
     var u = new uPlot(options, columns, box);
     plotsToMark.push(u);
+    drawnPlots.push({id: spec.id, u: u});
     var notes = [];
     if (spec.note) notes.push(spec.note);
     if (spec.decimated) notes.push("decimated for drawing: every peak kept (min/max per bucket)");
@@ -562,15 +609,142 @@
   else data.loops.forEach(function (loop) {
     var box = el("div", {"class": "plot"});
     loopsBox.appendChild(box);
+    var design = designCurveSeries(loop);
+    var lines = [[loop.x, loop.y]].concat(design.map(function (d) { return d.data; }));
+    var xs = lines.map(function (l) { return l[0]; }), ys = lines.map(function (l) { return l[1]; });
     var u = new uPlot({
       mode: 2, title: loop.name + " (" + loop.type + ")", width: 420, height: 320,
       scales: {x: {time: false}},
-      axes: [{label: loop.x_label + " [" + lengthUnit + "]"}, {label: loop.y_label + " [" + forceUnit + "]", size: 70}],
-      series: [{}, {label: loop.name, stroke: "#d62728", width: 1.25, paths: uPlot.paths.linear(), points: {show: false}}],
-      legend: {show: false}
-    }, [null, [loop.x, loop.y]], box);
-    check.plots.push({id: "loop:" + loop.name, series: 1, points: loop.x.length, drawn: !!u.ctx});
+      axes: [readableAxis(loop.x_label, lengthUnit, largestOf(xs), {size: 50}), readableAxis(loop.y_label, forceUnit, largestOf(ys))],
+      series: [{}, {label: loop.name, stroke: "#d62728", width: 1.25, paths: uPlot.paths.linear(), points: {show: false}}].concat(
+        design.map(function (d) { return {label: d.label, stroke: d.stroke, width: 1.5, dash: d.dash, paths: uPlot.paths.linear(), points: {show: false}}; })),
+      legend: {show: design.length > 0, live: false}
+    }, [null].concat(lines), box);
+    if (design.length) box.appendChild(el("div", {"class": "note"}, "red: the run; black: the declared loading curve up to its last point (dotted: beyond it); " +
+                                                                    "grey dashed: unloading from the largest deformation reached"));
+    drawnPlots.push({id: "loop:" + loop.name, u: u});
+    check.plots.push({id: "loop:" + loop.name, series: lines.length, points: loop.x.length, drawn: !!u.ctx, design: design.length});
   });
+
+  // ---------------------------------------------------------------- crush zones: declared curves and absorbed energy
+  function designCurveSeries(loop) {  // the declared loading curve and unloading line(s) of a loop's element
+    var zone = zoneByName[loop.name];
+    if (!zone || !zone.curve) return [];
+    var c = zone.curve, out = [{label: "declared loading curve", stroke: "#111", dash: undefined, data: [c.deformation.slice(), c.force.slice()]}];
+    function onCurve(d) {  // the loading curve at d (its last slope beyond its last point)
+      var x = c.deformation, y = c.force, n = x.length;
+      if (c.beyond_last_slope !== undefined && d > x[n - 1]) return y[n - 1] + c.beyond_last_slope * (d - x[n - 1]);
+      if (n === 1) return y[0];
+      var k = 0;
+      while (k + 2 < n && d > x[k + 1]) ++k;
+      return y[k] + (y[k + 1] - y[k]) * (d - x[k]) / (x[k + 1] - x[k]);
+    }
+    var reached = 0;
+    loop.x.forEach(function (d) { if (d !== null && d > reached) reached = d; });
+    var last = c.deformation.length - 1;
+    if (c.beyond_last_slope !== undefined && reached > c.deformation[last]) {  // on past its last point to the deformation reached
+      out.push({label: c.open_ended ? "declared loading curve (no last point)" : "beyond its last point", stroke: "#111", dash: [3, 3],
+                data: [[c.deformation[last], reached], [c.force[last], c.force[last] + c.beyond_last_slope * (reached - c.deformation[last])]]});
+    }
+    if (c.unloading_stiffness > 0 && reached > c.deformation[0]) {
+      var top = onCurve(reached);
+      var floor = 0;
+      if (c.lower_deformation) {  // draft gear: down to its unloading curve
+        var lx = c.lower_deformation, ly = c.lower_force;
+        var lower = reached > lx[1] && c.beyond_last_slope !== undefined ? ly[1] + c.beyond_last_slope * (reached - lx[1])
+                                                                         : ly[0] + (ly[1] - ly[0]) * (reached - lx[0]) / (lx[1] - lx[0]);
+        floor = Math.max(0, Math.min(lower, top));
+        out.push({label: "declared unloading curve", stroke: "#777", dash: [2, 3], data: [lx, ly]});
+      }
+      var back = reached - (top - floor) / c.unloading_stiffness;
+      out.push({label: "unloading line", stroke: "#777", dash: [6, 4], data: [[reached, back], [top, floor]]});
+    }
+    return out;
+  }
+  (function zonesChart() {
+    var box = document.getElementById("zones");
+    var zones = (crushZones && crushZones.zones) || [];
+    if (!crushZones) { box.appendChild(el("p", {}, "summary.json has no crush_zones (a run of an older railcrash, or no summary): no energy per crush zone.")); return; }
+    if (!zones.length) { box.appendChild(el("p", {}, "No crush zone (crush spring, anticlimber, draft gear) in this model.")); return; }
+    var total = crushZones.total_absorbed || 0;
+    var largest = 0;
+    zones.forEach(function (z) { largest = Math.max(largest, Math.abs(z.absorbed || 0), z.capacity || 0); });
+    var s = scaledUnit(energyUnit, largest);
+    var rowHeight = 26, left = 230, right = 330, width = 1100;
+    var canvasZones = el("canvas", {width: String(width), height: String(40 + rowHeight * zones.length + 30), id: "zones-canvas"});
+    box.appendChild(canvasZones);
+    var c = canvasZones.getContext("2d");
+    var plotWidth = width - left - right;
+    var scale = largest > 0 ? plotWidth / largest : 0;
+    c.font = "13px sans-serif";
+    c.fillStyle = "#222";
+    c.fillText("Energy absorbed [" + s.unit + "] (bar) against capacity (outline: area under the declared curve to its last point)", 10, 18);
+    // Gridlines at readable ticks.
+    var step = largest > 0 ? Math.pow(10, Math.floor(Math.log10(largest))) : 1;
+    if (largest / step < 2.5) step /= 5; else if (largest / step < 5) step /= 2;
+    var ticks = [];
+    for (var v = 0; v <= largest * 1.0001; v += step) ticks.push(v);
+    var labels = tickLabels(s.factor)(null, ticks);
+    var bottom = 36 + rowHeight * zones.length;
+    c.strokeStyle = "#e4e4e4";
+    c.fillStyle = "#555";
+    ticks.forEach(function (v, k) {
+      var x = left + v * scale;
+      c.beginPath(); c.moveTo(x, 30); c.lineTo(x, bottom); c.stroke();
+      c.fillText(labels[k], x - 8, bottom + 16);
+    });
+    zones.forEach(function (z, k) {
+      var y = 36 + k * rowHeight;
+      c.fillStyle = "#222";
+      var name = z.element.length > 30 ? z.element.slice(0, 29) + "…" : z.element;
+      c.fillText(name, 10, y + 15);
+      var absorbed = Math.max(0, z.absorbed || 0);
+      var used = z.capacity > 0 ? absorbed / z.capacity : null;
+      c.fillStyle = used !== null && used > 1 ? "#d62728" : "#1f77b4";
+      c.fillRect(left, y + 3, absorbed * scale, rowHeight - 8);
+      if (z.capacity > 0) {
+        c.strokeStyle = "#111";
+        c.lineWidth = 1.5;
+        c.strokeRect(left, y + 3, z.capacity * scale, rowHeight - 8);
+        c.lineWidth = 1;
+      }
+      c.fillStyle = "#222";
+      var text = fmt((z.absorbed || 0) * s.factor, 3) + " " + s.unit +
+                 (z.capacity > 0 ? " of " + fmt(z.capacity * s.factor, 3) + " (" + fmt(100 * used, 3) + " %)" : ", no declared capacity") +
+                 (total > 0 ? "; " + fmt(100 * z.share_of_total, 3) + " % of all" : "");
+      c.fillText(text, width - right + 10, y + 15);
+    });
+    // The numbers, per zone and per car.
+    var t = el("table", {"class": "facts zones", id: "zones-table"});
+    function row(cells, header) {
+      var tr = el("tr");
+      cells.forEach(function (cell, k) { tr.appendChild(el(header ? "th" : "td", k >= 3 ? {"class": "number"} : {}, cell)); });
+      t.appendChild(tr);
+    }
+    row(["crush zone", "type", "cars", "absorbed [" + s.unit + "]", "dissipated [" + s.unit + "]", "recoverable [" + s.unit + "]",
+         "capacity [" + s.unit + "]", "capacity used", "share of all zones"], true);
+    function value(v) { return v === null || v === undefined ? "-" : fmt(v * s.factor, 4); }
+    zones.forEach(function (z) {
+      row([z.element, z.type, (z.cars || []).map(function (c) { return c.car + (c.share < 1 ? " (" + fmt(c.share) + ")" : ""); }).join(", ") || "-",
+           value(z.absorbed), value(z.dissipated), value(z.recoverable), value(z.capacity),
+           z.capacity_used === null || z.capacity_used === undefined ? "-" : fmt(100 * z.capacity_used, 3) + " %",
+           z.share_of_total === null || z.share_of_total === undefined ? "-" : fmt(100 * z.share_of_total, 3) + " %"]);
+    });
+    var cars = crushZones.cars || {};
+    Object.keys(cars).forEach(function (name) {
+      var car = cars[name];
+      row(["car " + name, "", "", value(car.absorbed), "", "", value(car.capacity),
+           car.capacity > 0 ? fmt(100 * car.absorbed / car.capacity, 3) + " %" : "-",
+           car.share_of_total === null || car.share_of_total === undefined ? "-" : fmt(100 * car.share_of_total, 3) + " %"]);
+    });
+    var dissipatedAll = summary.energy && summary.energy.dissipated;
+    row(["all crush zones", "", "", value(total), "", "", "", "", "100 %"]);
+    box.appendChild(t);
+    box.appendChild(el("p", {"class": "hint"}, "absorbed: work done on the zone (dissipated + the change of its recoverable elastic energy); " +
+      "dissipated in all elements of the run: " + value(dissipatedAll) + " " + s.unit + "; per car, a zone between two cars counts half for each. " +
+      "The numbers are in summary.json (crush_zones) and energy_zones.csv."));
+    check.plots.push({id: "energy_zones", series: zones.length, points: zones.length, drawn: true, cars: Object.keys(cars).length});
+  })();
 
   var energyBox = document.getElementById("energy");
   if (!haveLibrary) noLibrary(energyBox);
@@ -612,9 +786,10 @@
     var box = el("div", {"class": "plot"});
     energyBox.appendChild(box);
     var u = new uPlot({
-      title: "Energy partition [" + energyUnit + "] (stacked areas)", width: 900, height: 380,
+      title: "Energy partition (stacked areas)", width: 900, height: 380,
       scales: {x: {time: false}, y: {range: function (u, min, max) { return [Math.min(0, min), max + 0.02 * Math.abs(max - Math.min(0, min))]; }}, error: {}},
-      axes: [{label: "t [s]"}, {label: energyUnit, size: 80}, {scale: "error", side: 1, label: "integration drift", size: 80, grid: {show: false}}],
+      axes: [{label: "t [s]", values: tickLabels(1)}, readableAxis("", energyUnit, largestOf(columns.slice(1)), {size: 80}),
+             {scale: "error", side: 1, label: "integration drift [" + energyUnit + "]", size: 80, grid: {show: false}, values: tickLabels(1)}],
       series: series, bands: bands, legend: {live: true},
       cursor: {sync: {key: "railcrash-time"}}, hooks: {draw: [timeMarker]}
     }, columns, box);
@@ -622,6 +797,7 @@
     var points = 0;
     columns.slice(1).forEach(function (c) { c.forEach(function (v) { if (v !== null) ++points; }); });
     check.plots.push({id: "energy", series: columns.length - 1, points: points, drawn: !!u.ctx});
+    drawnPlots.push({id: "energy", u: u});
   })();
 
   document.getElementById("footer").textContent = "railcrash report; plots by " + (data.library || "no plotting library") +
@@ -648,6 +824,12 @@
     }
     setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
   }
+  // report.html#crush-zones: the loops and the energy per crush zone alone (docs' screenshot, printing).
+  if (location.hash === "#crush-zones")
+    ["problems", "provenance", "animation-section", "plots-section", "energy-section"].forEach(function (id) {
+      var node = document.getElementById(id);
+      if (node) node.hidden = true;
+    });
   var box = document.getElementById("self-check");
   check.library = haveLibrary;
   check.problems = problems.length;
@@ -655,4 +837,16 @@
   check.ms = Math.round(performance.now());  // from navigation start to the page drawn, self-check included
   box.textContent = JSON.stringify(check);
   box.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  // The tick labels as uPlot drew them (axes[k]._values, after its first draw): no axis may
+  // show the same label twice ("0 0 0 0.001").
+  setTimeout(function () {
+    check.axes = drawnPlots.map(function (p) {
+      var labels = p.u.axes.map(function (a) { return (a._values || []).map(String); });
+      var repeated = labels.some(function (list) { return new Set(list).size !== list.length; });
+      return {id: p.id, labels: labels, distinct: !repeated, y_label: p.u.axes[1] && p.u.axes[1].label};
+    });
+    check.errors = window.railcrashErrors;
+    box.textContent = JSON.stringify(check);
+    box.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  }, 100);
 })();
