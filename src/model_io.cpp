@@ -1211,7 +1211,8 @@ ExpandedModel expand_model_file(const std::string& path, const std::vector<std::
   YAML::Node root = parse_model_yaml(text, path);
   std::string file = path;
   std::vector<VariantSetting> variant_settings;
-  if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings);
+  std::vector<ModelSource> sources;  // (not written out: the expanded text is the model itself)
+  if (root.IsMap() && root["variant_of"]) root = resolve_variant(root, path, file, variant_settings, sources);
   Reader reader(file);
   reader.index_empty_values(root);
   TrainExpansion expansion;

@@ -560,7 +560,7 @@ TEST_CASE("an output's peaks are its signed largest and smallest values with the
   // timeseries.csv: the rows' extremes lie within what the run's steps saw.
   std::ifstream rows(folder + "/timeseries.csv");
   std::string line;
-  std::getline(rows, line);
+  while (std::getline(rows, line) && line.rfind('#', 0) == 0) {}  // the run's provenance line first
   std::vector<std::string> header;
   for (std::stringstream names(line); std::getline(names, line, ',');) header.push_back(line);
   const std::size_t column = static_cast<std::size_t>(std::find(header.begin(), header.end(), "wall.penetration") - header.begin());
