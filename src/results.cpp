@@ -20,6 +20,7 @@
 #include "railcrash/results/output_points.hpp"
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/results/run_files.hpp"
+#include "railcrash/whole_file.hpp"
 
 namespace railcrash {
 
@@ -188,6 +189,7 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
+    folder_lock_ = std::make_unique<FolderLock>(directory);  // (throws: another process writes there)
     removed_files_ = remove_earlier_run_files(directory);  // the folder holds this run's files only
     if (format == OutputFormat::Hdf5) hdf5_ = std::make_unique<Hdf5File>(directory + "/timeseries.h5");  // (throws)
     using CsvFile = std::pair<std::unique_ptr<BufferedFile>*, const char*>;
@@ -412,23 +414,12 @@ void ResultWriter::write_running_summary(const std::string& integrator) {
 }
 
 bool ResultWriter::replace_summary(const std::string& text) {
-  const std::string path = directory_ + "/summary.json";
-  const std::string temporary = path + ".tmp";
-  std::FILE* file = std::fopen(temporary.c_str(), "w");
-  if (!file) {
-    fail("cannot write " + temporary, errno);
-    return false;
-  }
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size() && std::fflush(file) == 0;
-  const int write_error = errno;
-  if (std::fclose(file) != 0 || !written) {
-    fail("cannot write " + temporary, written ? errno : write_error);
-    std::remove(temporary.c_str());
-    return false;
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    fail("cannot rename " + temporary + " to summary.json", errno);
-    std::remove(temporary.c_str());
+  // A unique temporary name opened without following links, then a rename (whole_file.hpp): a
+  // planted summary.json.tmp or a link named summary.json is never written through.
+  try {
+    write_whole_file(directory_ + "/summary.json", text);
+  } catch (const FileWriteError& e) {
+    fail("cannot write " + e.path(), e.error_number());
     return false;
   }
   return true;

@@ -55,6 +55,7 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/folder_lock.hpp"
 #include "railcrash/integrator.hpp"
 #include "railcrash/results/crash_pulse.hpp"
 #include "railcrash/results/hdf5_file.hpp"
@@ -234,6 +235,7 @@ class ResultWriter : public RunObserver {
   const DaeSystem& system_;
   std::string directory_;
   Provenance provenance_;
+  std::unique_ptr<FolderLock> folder_lock_;  // the folder is this run's alone while it writes (null without a folder)
   std::vector<std::string> removed_files_;  // of an earlier run, removed by the constructor
   std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
   int folder_descriptor_ = -1;                          // the open folder, to notice its removal
