@@ -551,6 +551,10 @@ int main(int argc, char** argv) {
   bool quiet = false;
   run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
   bool timings = false;
+  double max_output_memory_gb = railcrash::output_memory_limit() / 1e9;
+  run->add_option("--max-output-memory", max_output_memory_gb,
+                  "refuse a run whose output would keep more memory than this [GB] until its end (0: no limit)")
+      ->check(finite_number(0, 1e6, false, false, "GB"));
   run->add_flag("--timings", timings,
                 "split the run's wall time by phase (residual, Jacobian, linear solver, events, restarts, output, ...): "
                 "printed, and summary.json's stats.seconds");
@@ -772,6 +776,7 @@ int main(int argc, char** argv) {
     if (*dt_option) overrides.dt = dt;
     if (*output_option) overrides.output_interval = output_interval;
     if (*max_steps_option) overrides.max_steps = max_steps;
+    railcrash::set_output_memory_limit(max_output_memory_gb * 1e9);
     return run_command(model_path, settings, overrides, out_dir, with_report, quiet,
                        output_format == "hdf5" ? railcrash::OutputFormat::Hdf5 : railcrash::OutputFormat::Csv, timings);
   } catch (const railcrash::InputError& e) {

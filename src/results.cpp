@@ -386,15 +386,29 @@ void ResultWriter::check_files(bool flush, bool look_at_folder) {
                                                          {events_.get(), "events.csv"},
                                                          {accelerations_file_.get(), "accelerations.csv"},
                                                          {energy_file_.get(), "energy.csv"}};
+  const bool failed_before = !failure_.empty();
+  bool all_written = true;
   for (const auto& [file, name] : files) {
     if (!file) continue;
     if (flush) file->flush();
-    if (file->error() != 0) fail("cannot write " + directory_ + "/" + name, file->error());
+    if (file->error() != 0) {
+      fail("cannot write " + directory_ + "/" + name, file->error());
+      all_written = false;
+    }
   }
   if (hdf5_) {
     if (flush) hdf5_->flush();
     if (failure_.empty()) failure_ = hdf5_->error();
+    all_written = all_written && hdf5_->error().empty();
   }
+  if (flush && all_written && failure_.empty()) {  // every row so far is in the files (the OS has it)
+    rows_on_disk_ = sample_times_.size();
+    t_on_disk_ = sample_times_.empty() ? -1.0 : sample_times_.back();
+  }
+  if (!failed_before && !failure_.empty() && !all_written)  // say what the files hold, not what was computed
+    failure_ += rows_on_disk_ == 0 ? std::string("; no output row reached the files")
+                                   : "; the files hold the first " + std::to_string(rows_on_disk_) + " rows whole, up to t = " +
+                                         json_number(t_on_disk_) + " (the rows after it were lost)";
   // One fstat of the open folder (no path lookup): a removed folder (no links left) stops the
   // run. Not at every sample: a system call per row was 11 % of a slider-crank run with 1 ms
   // output (perf, this VM); a file written into a removed folder is still written, so the
@@ -416,11 +430,18 @@ void ResultWriter::write_running_summary(const std::string& integrator) {
 bool ResultWriter::replace_summary(const std::string& text) {
   // A unique temporary name opened without following links, then a rename (whole_file.hpp): a
   // planted summary.json.tmp or a link named summary.json is never written through.
+  const std::string path = directory_ + "/summary.json";
   try {
-    write_whole_file(directory_ + "/summary.json", text);
+    write_whole_file(path, text);
   } catch (const FileWriteError& e) {
     fail("cannot write " + e.path(), e.error_number());
-    return false;
+    // A full disk: the new file has no room beside the old one, but may have in its place
+    // (the summary's size hardly changes). Rewritten in place, without following a link.
+    if (e.error_number() != ENOSPC && e.error_number() != EDQUOT) return false;
+    const int descriptor = ::open(path.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (descriptor < 0) return false;
+    const bool written = ::ftruncate(descriptor, 0) == 0 && write_all(descriptor, text.data(), text.size()) == 0;
+    return ::close(descriptor) == 0 && written;
   }
   return true;
 }
@@ -519,7 +540,11 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
   if (hdf5_)  // (the CSV files are the default: their summary is as it always was)
     j << "  \"output\": {\"format\": " << json_string(output_format_name(format_))
-      << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]},\n";
+      << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"
+      // The rows the file held whole at its last flush that succeeded (a kill after it leaves
+      // them readable; rows after them may be missing or zero).
+      << ", \"valid_rows\": " << rows_on_disk_ << ", \"valid_to_t\": " << json_number(t_on_disk_ < 0.0 ? 0.0 : t_on_disk_)
+      << "},\n";
   j << "  \"units\": {\"system\": " << json_string(unit_system_name(model.units)) << ", \"length\": "
     << json_string(si ? "m" : "in") << ", \"time\": \"s\", \"force\": " << json_string(si ? "N" : "lbf")
     << ", \"mass\": " << json_string(si ? "kg" : "lbf*s^2/in") << ", \"angle\": \"rad\", \"energy\": "

@@ -200,6 +200,8 @@ class ResultWriter : public RunObserver {
   bool observes_steps() const override { return true; }
   /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.
   std::string failure() const override { return failure_; }
+  /// The time of the last sample recorded (0 before the first) [time].
+  double last_sample_time() const { return t_last_sample_; }
   /// Writes summary.json with "status": "running" (t_reached and peaks so far; stats and
   /// energy come at the end); sample() replaces it every few seconds of wall time.
   void write_running_summary(const std::string& integrator);
@@ -277,6 +279,8 @@ class ResultWriter : public RunObserver {
   bool folder_checked_ = false;                          // by a sample
   std::string integrator_;                               // for the running summary
   double t_last_sample_ = 0.0;                           // [time]
+  std::size_t rows_on_disk_ = 0;                         // rows handed to the OS by the last flush that succeeded
+  double t_on_disk_ = -1.0;                              // [time] the last of them (-1: none)
   std::string failure_;                                  // first failed write, with the OS's reason
 
   /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.
