@@ -282,7 +282,10 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
     if (timeseries_) write_row_tail(*timeseries_, point_values_);
   }
-  if (timeseries_) timeseries_->character('\n');
+  if (timeseries_) {
+    timeseries_->character('\n');
+    row_ends_.emplace_back(timeseries_->appended(), t);
+  }
   if (!columns_.empty() || hdf5_) {  // the row, in the order of the CSV columns
     row_.assign(1, t);
     for (int i = 0; i < n; ++i)
@@ -401,14 +404,21 @@ void ResultWriter::check_files(bool flush, bool look_at_folder) {
     if (failure_.empty()) failure_ = hdf5_->error();
     all_written = all_written && hdf5_->error().empty();
   }
-  if (flush && all_written && failure_.empty()) {  // every row so far is in the files (the OS has it)
+  if (timeseries_) {  // the rows whose last byte the OS has
+    for (; !row_ends_.empty() && row_ends_.front().first <= timeseries_->written(); row_ends_.pop_front()) {
+      ++rows_on_disk_;
+      t_on_disk_ = row_ends_.front().second;
+    }
+  } else if (hdf5_ && flush && all_written && failure_.empty()) {  // every row so far is in the file
     rows_on_disk_ = sample_times_.size();
     t_on_disk_ = sample_times_.empty() ? -1.0 : sample_times_.back();
   }
-  if (!failed_before && !failure_.empty() && !all_written)  // say what the files hold, not what was computed
-    failure_ += rows_on_disk_ == 0 ? std::string("; no output row reached the files")
-                                   : "; the files hold the first " + std::to_string(rows_on_disk_) + " rows whole, up to t = " +
-                                         json_number(t_on_disk_) + " (the rows after it were lost)";
+  if (!failed_before && !failure_.empty() && !all_written) {  // say what the files hold, not what was computed
+    const std::string file = timeseries_ ? "timeseries.csv" : "timeseries.h5";
+    failure_ += rows_on_disk_ == 0 ? "; " + file + " holds no output row"
+                                   : "; " + file + " holds the first " + std::to_string(rows_on_disk_) +
+                                         " rows whole, up to t = " + json_number(t_on_disk_) + " (the rows after it were lost)";
+  }
   // One fstat of the open folder (no path lookup): a removed folder (no links left) stops the
   // run. Not at every sample: a system call per row was 11 % of a slider-crank run with 1 ms
   // output (perf, this VM); a file written into a removed folder is still written, so the

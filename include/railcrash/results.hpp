@@ -50,6 +50,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -279,8 +281,11 @@ class ResultWriter : public RunObserver {
   bool folder_checked_ = false;                          // by a sample
   std::string integrator_;                               // for the running summary
   double t_last_sample_ = 0.0;                           // [time]
-  std::size_t rows_on_disk_ = 0;                         // rows handed to the OS by the last flush that succeeded
+  // The rows the OS has whole: timeseries.csv's rows up to its bytes written; timeseries.h5's
+  // rows at its last flush that succeeded.
+  std::size_t rows_on_disk_ = 0;
   double t_on_disk_ = -1.0;                              // [time] the last of them (-1: none)
+  std::deque<std::pair<std::uint64_t, double>> row_ends_;  // timeseries.csv: byte after each row not yet written, its t
   std::string failure_;                                  // first failed write, with the OS's reason
 
   /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.

@@ -218,6 +218,7 @@ void BufferedFile::write_out() {
     return;
   }
   error_ = write_all(descriptor_, buffer_.get(), used_);  // (whole_file.hpp: the one checked write loop)
+  if (error_ == 0) written_ += used_;
   used_ = 0;
 }
 

@@ -254,7 +254,7 @@ expect_text "and the option that raises the limit" "$tmp/stderr" "--max-output-m
 # --- Full disk: a sweep's runs.csv, a CSV run's closing message, HDF5's summary.
 full2=$tmp/full2
 mkdir -p "$full2"
-if mount -t tmpfs -o size=256k tmpfs "$full2" 2> /dev/null; then
+if mount -t tmpfs -o size=1m tmpfs "$full2" 2> /dev/null; then
   # One free page: runs.csv's header and its first rows fit, the rest of the 64 rows does not.
   mkdir "$full2/sweep"
   dd if=/dev/zero of="$full2/reserve" bs=4096 count=1 2> /dev/null
@@ -271,7 +271,7 @@ if mount -t tmpfs -o size=256k tmpfs "$full2" 2> /dev/null; then
   # A CSV run on a disk with room for a few hundred rows: the message says what the files hold.
   dd if=/dev/zero of="$full2/filler" bs=4k count=40 2> /dev/null
   expect_status "a CSV run that fills the disk" 1 "$bin" run "$oscillator" --t-end 100 --output-interval 0.001 --quiet --out "$full2/csv"
-  expect_text "says what the files hold" "$tmp/stdout" "the files hold the first [0-9]* rows whole, up to t = "
+  expect_text "says what timeseries.csv holds" "$tmp/stdout" "timeseries.csv holds the first [0-9]* rows whole, up to t = "
   rows=$(grep -o 'the first [0-9]* rows' "$tmp/stdout" | grep -o '[0-9]*')
   t_held=$(grep -o 'rows whole, up to t = [0-9.e+-]*' "$tmp/stdout" | grep -o '[0-9.e+-]*$')
   # the provenance comment and the header, then at least that many whole rows, the last of them at t_held
