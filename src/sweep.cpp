@@ -694,7 +694,11 @@ SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, co
     content << in.rdbuf();
     if (in.bad()) throw InputError(csv_path + ": cannot read it to resume");
     std::vector<CsvRecord> records = csv_records(csv_path, content.str());
-    if (!records.empty() && !records.back().complete) {
+    // The last record is cut short when the file does not end with its line break, or (an
+    // editor may have added one) when it has fewer fields than a row.
+    const std::size_t row_fields = 2 + plan.factors.size() + 1 + plan.responses.size() + 2;
+    if (!records.empty() &&
+        (!records.back().complete || (records.size() > 1 && records.back().fields.size() < row_fields))) {
       result.torn_row_line = records.back().line;
       records.pop_back();
     }
