@@ -589,7 +589,6 @@ std::vector<CsvRecord> csv_records(const std::string& path, const std::string& t
       record.field_columns.push_back(column);
       std::string& field = record.fields.back();
       if (i < text.size() && text[i] == '"') {  // quoted
-        const std::size_t open_line = line, open_column = column;
         ++i, ++column;
         bool closed = false;
         while (i < text.size()) {
@@ -609,7 +608,6 @@ std::vector<CsvRecord> csv_records(const std::string& path, const std::string& t
           }
         }
         if (!closed) {  // the file ends inside the quotes: a record cut short
-          (void)open_line, (void)open_column;
           record.text = text.substr(record_start);
           records.push_back(std::move(record));
           return records;

@@ -215,12 +215,16 @@ expect_status "after the first is gone, the folder is free" 0 "$bin" run "$oscil
 
 # --- kill -9 during an HDF5 run: the file opens without h5clear and holds the rows summary.json
 # says are valid.
-if "$bin" run "$oscillator" --format hdf5 --out "$tmp/h5probe" > /dev/null 2>&1 && python3 -c 'import h5py' 2> /dev/null; then
+h5python=""
+for candidate in python3 /usr/bin/python3; do
+  if "$candidate" -c 'import h5py' 2> /dev/null; then h5python=$candidate; break; fi
+done
+if "$bin" run "$oscillator" --format hdf5 --out "$tmp/h5probe" > /dev/null 2>&1 && [ -n "$h5python" ]; then
   "$bin" run "$oscillator" --format hdf5 --t-end 100000 --output-interval 0.1 --quiet --out "$tmp/h5" > /dev/null 2>&1 &
   pid=$!
   for _ in $(seq 200); do grep -q '"valid_rows": [1-9]' "$tmp/h5/summary.json" 2> /dev/null && break; sleep 0.1; done
   kill -KILL "$pid"; wait "$pid" 2> /dev/null
-  same_value "a killed run's timeseries.h5 opens and holds its valid rows" "$(python3 -c '
+  same_value "a killed run's timeseries.h5 opens and holds its valid rows" "$("$h5python" -c '
 import h5py, json, sys
 summary = json.load(open(sys.argv[1] + "/summary.json"))
 valid, t = summary["output"]["valid_rows"], summary["output"]["valid_to_t"]
