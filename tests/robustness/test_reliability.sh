@@ -259,17 +259,24 @@ expect_text "and the option that raises the limit" "$tmp/stderr" "--max-output-m
 full2=$tmp/full2
 mkdir -p "$full2"
 if mount -t tmpfs -o size=1m tmpfs "$full2" 2> /dev/null; then
-  # One free page: runs.csv's header and its first rows fit, the rest of the 64 rows does not.
+  # Two free pages: the lock file's pid takes one, runs.csv's header and its first rows the
+  # other; the rest of the 160 rows (about 55 bytes each) does not fit.
+  printf 'sweep: 1\ndesign: full_factorial\nfactors:\n  - {key: elements.spring.stiffness, levels: [%s]}\n  - {key: bodies.bob.mass, levels: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}\nresponses: [bob.x@0.5]\n' \
+    "$(seq -s ', ' 100 10 250)" > "$tmp/sweep_160_runs.yaml"
   mkdir "$full2/sweep"
-  dd if=/dev/zero of="$full2/reserve" bs=4096 count=1 2> /dev/null
+  dd if=/dev/zero of="$full2/reserve" bs=4096 count=2 2> /dev/null
   dd if=/dev/zero of="$full2/filler" bs=4k 2> /dev/null
   dd if=/dev/zero of="$full2/filler_tail" bs=512 2> /dev/null
   rm "$full2/reserve"
-  expect_status "a sweep that fills the disk exits 1" 1 "$bin" sweep "$oscillator" --plan "$plan64" --jobs 2 --out "$full2/sweep"
+  expect_status "a sweep that fills the disk exits 1" 1 "$bin" sweep "$oscillator" --plan "$tmp/sweep_160_runs.yaml" --jobs 2 --out "$full2/sweep"
   expect_text "naming runs.csv and the reason" "$tmp/stderr" "cannot write '$full2/sweep/runs.csv': No space left on device"
+  rows_before=$(grep -c ',ok,' "$full2/sweep/runs.csv")
+  if [ "$rows_before" -ge 20 ] && [ "$rows_before" -lt 160 ]; then passes=$((passes + 1)); else
+    echo "FAIL: the rows appended before the disk was full: $rows_before, expected 20 to 159"; failures=$((failures + 1)); fi
   rm "$full2/filler"
-  expect_status "resumed with room again" 0 "$bin" sweep "$oscillator" --plan "$plan64" --jobs 2 --resume --out "$full2/sweep"
-  same_value "its runs.csv parses: 65 records, 64 ok" "$(count_csv_rows "$full2/sweep/runs.csv")" "65 64"
+  expect_status "resumed with room again" 0 "$bin" sweep "$oscillator" --plan "$tmp/sweep_160_runs.yaml" --jobs 2 --resume --out "$full2/sweep"
+  expect_text "every run done, the rows on disk resumed" "$tmp/stdout" "160 of 160 runs done ([0-9]* resumed), 0 failed"
+  same_value "its runs.csv parses: 161 records, 160 ok" "$(count_csv_rows "$full2/sweep/runs.csv")" "161 160"
   rm -rf "$full2/sweep"
 
   # A CSV run on a disk with room for a few hundred rows: the message says what the files hold.
