@@ -134,6 +134,8 @@ TEST_CASE("FolderLock refuses a second process naming the folder and its pid and
   const pid_t child = ::fork();
   REQUIRE(child >= 0);
   if (child == 0) {  // holds the folder until the parent closes its end of `release`
+    ::close(ready[0]);
+    ::close(release[1]);  // (else the read below never sees the end of the pipe)
     {
       const FolderLock held(folder);
       char byte = 1;
