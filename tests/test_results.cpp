@@ -147,7 +147,7 @@ TEST_CASE("the barrier model's two cars are summarised separately", "[results]")
   CHECK(cars[0].bodies.size() + cars[1].bodies.size() + 1 == static_cast<std::size_t>(model.body_count()));  // + coupler
 }
 
-TEST_CASE("a failed write stops the run at once with the OS reason and the rows on disk, and the summary says failed",
+TEST_CASE("a failed write stops the run at once with the OS reason and the rows on disk and the summary says failed",
           "[results][faults]") {
   // Files past 32 KiB cannot grow (RLIMIT_FSIZE: write(2) fails with EFBIG, as it fails with
   // ENOSPC on a full disk; SIGXFSZ ignored). A link to /dev/full would not do: result files
@@ -168,6 +168,7 @@ TEST_CASE("a failed write stops the run at once with the OS reason and the rows 
   CHECK_THAT(report.outcome.message, Catch::Contains("cannot write " + dir + "/timeseries.csv: File too large") &&
                                          Catch::Contains("the run stopped at t = "));
   // What is on disk: the rows whose last byte the OS took, the last of them named by its t.
+  INFO(report.outcome.message);
   const std::string key = "timeseries.csv holds the first ";
   const std::size_t at = report.outcome.message.find(key);
   REQUIRE(at != std::string::npos);

@@ -217,8 +217,9 @@ void BufferedFile::write_out() {
     used_ = 0;
     return;
   }
-  error_ = write_all(descriptor_, buffer_.get(), used_);  // (whole_file.hpp: the one checked write loop)
-  if (error_ == 0) written_ += used_;
+  std::size_t taken = 0;
+  error_ = write_all(descriptor_, buffer_.get(), used_, &taken);  // (whole_file.hpp: the one checked write loop)
+  written_ += taken;  // also the part of a failed write the OS took
   used_ = 0;
 }
 

@@ -45,7 +45,7 @@ class BufferedFile {
   bool flush();
   /// errno of the failed open or the first failed write, 0 while all went well.
   int error() const { return error_; }
-  /// Bytes handed to the OS whole (by writes that succeeded), from the start of the file.
+  /// Bytes the OS took, from the start of the file (also the part of a failed write it took).
   std::uint64_t written() const { return written_; }
   /// Bytes given to the file so far: written() and those still in the buffer.
   std::uint64_t appended() const { return written_ + used_; }
