@@ -101,9 +101,10 @@ void Integrator::deliver_sample(double t) {
   const std::string observer_failure = observer_->failure();  // a failed write: stop at once
   if (!observer_failure.empty()) {
     std::ostringstream msg;
+    // What the files hold is the writer's to say (its failure names the rows on disk): the
+    // samples computed are not all there after a failed write.
     msg << observer_failure << "; the run stopped at t = " << t;
-    if (last_sample_y_.empty()) msg << " before its first sample, the files hold no samples";
-    else msg << ", the files hold the samples up to t = " << t_sampled_;
+    if (last_sample_y_.empty()) msg << " before its first sample";
     throw StepFailure(msg.str());
   }
   outcome_.max_constraint_residual =

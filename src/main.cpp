@@ -27,6 +27,7 @@
 #include "railcrash/run.hpp"
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
+#include "railcrash/folder_lock.hpp"
 #include "railcrash/sweep.hpp"
 #include "railcrash/sweep_mpi.hpp"
 #include "railcrash/converge.hpp"
@@ -227,7 +228,9 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   if (format == OutputFormat::Hdf5 && with_report)
     throw InputError("--report reads the CSV files: leave out --report with --format hdf5, or use --format csv");
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
-  // The folder is this run's: an earlier run's files go first (the writer would remove them too), said here.
+  // The folder is this run's: locked against a second writer, then an earlier run's files go
+  // (the writer would remove them too), said here.
+  const FolderLock folder_lock(out_dir);
   if (const std::vector<std::string> removed = remove_earlier_run_files(out_dir); !removed.empty()) {
     std::string names;
     for (const std::string& name : removed) names += (names.empty() ? "" : ", ") + name;
@@ -439,13 +442,14 @@ int converge_command(const std::string& path, const railcrash::ConvergeOptions& 
 }
 
 int sweep_command(const std::string& path, const std::string& plan_path, int jobs, double run_limit, bool resume,
-                  bool keep_runs, const std::string& out_dir) {
+                  bool keep_runs, std::size_t max_runs, const std::string& out_dir) {
   using namespace railcrash;
   SweepOptions options;
   options.jobs = jobs > 0 ? jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options.run_time_limit = run_limit;
   options.resume = resume;
   options.keep_runs = keep_runs;
+  options.max_runs = max_runs;
   options.stop = &g_stop;
   options.progress = [](std::size_t number, const SweepRow& row, std::size_t done, std::size_t total) {
     std::fprintf(stderr, "[%zu/%zu] run %zu %s %.2f s%s%s\n", done, total, number, row.status.c_str(), row.wall_seconds,
@@ -565,6 +569,10 @@ int main(int argc, char** argv) {
   bool quiet = false;
   run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
   bool timings = false;
+  double max_output_memory_gb = railcrash::output_memory_limit() / 1e9;
+  run->add_option("--max-output-memory", max_output_memory_gb,
+                  "refuse a run whose output would keep more memory than this [GB] until its end (0: no limit)")
+      ->check(finite_number(0, 1e6, false, false, "GB"));
   run->add_flag("--timings", timings,
                 "split the run's wall time by phase (residual, Jacobian, linear solver, events, restarts, output, ...): "
                 "printed, and summary.json's stats.seconds");
@@ -677,6 +685,8 @@ int main(int argc, char** argv) {
       ->check(seconds);
   sweep->add_flag("--resume", resume, "keep the rows of DIR/runs.csv whose run is in the plan (by hash) and run the rest");
   sweep->add_flag("--keep-runs", keep_runs, "also write each run's files to DIR/runs/NNNN/");
+  sweep->add_option("--max-runs", max_runs, "refuse a plan of more runs than this before any is generated (0: no limit)")
+      ->capture_default_str()->check(run_limit_count);
   sweep->add_option("--out", out_dir, "output folder")->capture_default_str();
 
   std::string consist_out;
@@ -797,7 +807,7 @@ int main(int argc, char** argv) {
 #ifdef RAILCRASH_MPI_PROGRAM
     if (*sweep && railcrash::launched_by_mpi()) exec_mpi_program(argv);
 #endif
-    if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, out_dir);
+    if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, max_runs, out_dir);
     if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, max_runs, out_dir);
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,
                                                    bisections, branch_window_ms);
@@ -809,6 +819,7 @@ int main(int argc, char** argv) {
     if (*dt_option) overrides.dt = dt;
     if (*output_option) overrides.output_interval = output_interval;
     if (*max_steps_option) overrides.max_steps = max_steps;
+    railcrash::set_output_memory_limit(max_output_memory_gb * 1e9);
     return run_command(model_path, settings, overrides, out_dir, with_report, quiet,
                        output_format == "hdf5" ? railcrash::OutputFormat::Hdf5 : railcrash::OutputFormat::Csv, timings);
   } catch (const railcrash::InputError& e) {

@@ -21,6 +21,7 @@
 #include "railcrash/results/output_points.hpp"
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/results/run_files.hpp"
+#include "railcrash/whole_file.hpp"
 
 namespace railcrash {
 
@@ -290,6 +291,7 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
+    folder_lock_ = std::make_unique<FolderLock>(directory);  // (throws: another process writes there)
     removed_files_ = remove_earlier_run_files(directory);  // the folder holds this run's files only
     if (format == OutputFormat::Hdf5) hdf5_ = std::make_unique<Hdf5File>(directory + "/timeseries.h5");  // (throws)
     using CsvFile = std::pair<std::unique_ptr<BufferedFile>*, const char*>;
@@ -385,7 +387,10 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
     if (timeseries_) write_row_tail(*timeseries_, point_values_);
   }
-  if (timeseries_) timeseries_->character('\n');
+  if (timeseries_) {
+    timeseries_->character('\n');
+    row_ends_.emplace_back(timeseries_->appended(), t);
+  }
   if (!columns_.empty() || hdf5_) {  // the row, in the order of the CSV columns
     row_.assign(1, t);
     for (int i = 0; i < n; ++i)
@@ -499,14 +504,35 @@ void ResultWriter::check_files(bool flush, bool look_at_folder) {
                                                          {events_.get(), "events.csv"},
                                                          {accelerations_file_.get(), "accelerations.csv"},
                                                          {energy_file_.get(), "energy.csv"}};
+  const bool failed_before = !failure_.empty();
+  bool all_written = true;
   for (const auto& [file, name] : files) {
     if (!file) continue;
     if (flush) file->flush();
-    if (file->error() != 0) fail("cannot write " + directory_ + "/" + name, file->error());
+    if (file->error() != 0) {
+      fail("cannot write " + directory_ + "/" + name, file->error());
+      all_written = false;
+    }
   }
   if (hdf5_) {
     if (flush) hdf5_->flush();
     if (failure_.empty()) failure_ = hdf5_->error();
+    all_written = all_written && hdf5_->error().empty();
+  }
+  if (timeseries_) {  // the rows whose last byte the OS has
+    for (; !row_ends_.empty() && row_ends_.front().first <= timeseries_->written(); row_ends_.pop_front()) {
+      ++rows_on_disk_;
+      t_on_disk_ = row_ends_.front().second;
+    }
+  } else if (hdf5_ && flush && all_written && failure_.empty()) {  // every row so far is in the file
+    rows_on_disk_ = sample_times_.size();
+    t_on_disk_ = sample_times_.empty() ? -1.0 : sample_times_.back();
+  }
+  if (!failed_before && !failure_.empty() && !all_written) {  // say what the files hold, not what was computed
+    const std::string file = timeseries_ ? "timeseries.csv" : "timeseries.h5";
+    failure_ += rows_on_disk_ == 0 ? "; " + file + " holds no output row"
+                                   : "; " + file + " holds the first " + std::to_string(rows_on_disk_) +
+                                         " rows whole, up to t = " + json_number(t_on_disk_) + " (the rows after it were lost)";
   }
   // One fstat of the open folder (no path lookup): a removed folder (no links left) stops the
   // run. Not at every sample: a system call per row was 11 % of a slider-crank run with 1 ms
@@ -527,24 +553,20 @@ void ResultWriter::write_running_summary(const std::string& integrator) {
 }
 
 bool ResultWriter::replace_summary(const std::string& text) {
+  // A unique temporary name opened without following links, then a rename (whole_file.hpp): a
+  // planted summary.json.tmp or a link named summary.json is never written through.
   const std::string path = directory_ + "/summary.json";
-  const std::string temporary = path + ".tmp";
-  std::FILE* file = std::fopen(temporary.c_str(), "w");
-  if (!file) {
-    fail("cannot write " + temporary, errno);
-    return false;
-  }
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size() && std::fflush(file) == 0;
-  const int write_error = errno;
-  if (std::fclose(file) != 0 || !written) {
-    fail("cannot write " + temporary, written ? errno : write_error);
-    std::remove(temporary.c_str());
-    return false;
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    fail("cannot rename " + temporary + " to summary.json", errno);
-    std::remove(temporary.c_str());
-    return false;
+  try {
+    write_whole_file(path, text);
+  } catch (const FileWriteError& e) {
+    fail("cannot write " + e.path(), e.error_number());
+    // A full disk: the new file has no room beside the old one, but may have in its place
+    // (the summary's size hardly changes). Rewritten in place, without following a link.
+    if (e.error_number() != ENOSPC && e.error_number() != EDQUOT) return false;
+    const int descriptor = ::open(path.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (descriptor < 0) return false;
+    const bool written = ::ftruncate(descriptor, 0) == 0 && write_all(descriptor, text.data(), text.size()) == 0;
+    return ::close(descriptor) == 0 && written;
   }
   return true;
 }
@@ -652,7 +674,11 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
   if (hdf5_)  // (the CSV files are the default: their summary is as it always was)
     j << "  \"output\": {\"format\": " << json_string(output_format_name(format_))
-      << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]},\n";
+      << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"
+      // The rows the file held whole at its last flush that succeeded (a kill after it leaves
+      // them readable; rows after them may be missing or zero).
+      << ", \"valid_rows\": " << rows_on_disk_ << ", \"valid_to_t\": " << json_number(t_on_disk_ < 0.0 ? 0.0 : t_on_disk_)
+      << "},\n";
   j << "  \"units\": {\"system\": " << json_string(unit_system_name(model.units)) << ", \"length\": "
     << json_string(si ? "m" : "in") << ", \"time\": \"s\", \"force\": " << json_string(si ? "N" : "lbf")
     << ", \"mass\": " << json_string(si ? "kg" : "lbf*s^2/in") << ", \"angle\": \"rad\", \"energy\": "

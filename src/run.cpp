@@ -1,9 +1,11 @@
 #include "railcrash/run.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <new>
 #include <sstream>
 
 #include "railcrash/euler_integrator.hpp"
@@ -170,6 +172,42 @@ double output_interval_of(const SimulationSettings& settings) {
   return settings.output_interval > 0.0 ? settings.output_interval : settings.t_end / 500.0;
 }
 
+namespace {
+std::atomic<double> g_output_memory_limit{4.0 * 1024 * 1024 * 1024};  // [bytes]
+}  // namespace
+
+void set_output_memory_limit(double bytes) { g_output_memory_limit = bytes; }
+double output_memory_limit() { return g_output_memory_limit.load(); }
+
+double output_memory_estimate(const DaeSystem& system, bool keep_in_memory) {
+  const SimulationSettings& s = system.model().simulation;
+  const double rows = std::floor(s.t_end / output_interval_of(s)) + 2.0;                     // [rows]
+  double per_row = 20.0 * static_cast<double>(system.model().body_count()) + 16.0;            // [bytes]
+  if (keep_in_memory) per_row += 8.0 * static_cast<double>(timeseries_columns(system).size());
+  return rows * per_row;
+}
+
+namespace {
+
+/// InputError when the run's output would keep more memory than the limit: the estimate, its
+/// parts and what lowers it.
+void require_output_memory(const DaeSystem& system, bool keep_in_memory) {
+  const double limit = output_memory_limit(), estimate = output_memory_estimate(system, keep_in_memory);
+  if (!(limit > 0.0) || estimate <= limit) return;
+  const SimulationSettings& s = system.model().simulation;
+  const double rows = std::floor(s.t_end / output_interval_of(s)) + 2.0;
+  char text[640];
+  std::snprintf(text, sizeof text,
+                "the run's output would keep about %.3g GB in memory until its end (%d bodies x %.0f output rows x 20 B for "
+                "the CFC filter%s), more than the limit of %.3g GB: raise --output-interval (now %g; %g or more fits), "
+                "lower --t-end, or raise the limit with --max-output-memory GB (railcrash run)",
+                estimate / 1e9, system.model().body_count(), rows, keep_in_memory ? ", and the timeseries kept in memory" : "",
+                limit / 1e9, output_interval_of(s), output_interval_of(s) * estimate / limit);
+  throw InputError(SourceLocation{system.model().file, 0}.prefix() + text);
+}
+
+}  // namespace
+
 std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings) {
   if (settings.integrator == IntegratorKind::Euler)
     return std::make_unique<EulerIntegrator>(system,
@@ -190,6 +228,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   RunReport report;
   report.integrator = model.simulation.integrator == IntegratorKind::Euler ? "euler" : "ida";
   if (!out_dir.empty() || keep_in_memory) {
+    require_output_memory(system, keep_in_memory);  // before the writer starts
     observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory, format)).get());
     writer->write_running_summary(report.integrator);
   }
@@ -209,7 +248,14 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     }
     if (integrator) {
       integrator->time_phases(time_phases);
-      report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+      try {
+        report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+      } catch (const std::bad_alloc&) {  // the summary says why the run ended, not "running"
+        report.outcome.ok = false;
+        report.outcome.t_reached = writer ? writer->last_sample_time() : 0.0;
+        report.outcome.message = "out of memory (std::bad_alloc) after t = " + number_text(report.outcome.t_reached) +
+                                 "; raise --output-interval or run with fewer bodies";
+      }
     }
   } catch (const InputError& e) {  // found at the start (a non-finite law, joints): the summary says so too
     if (writer) {

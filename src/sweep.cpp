@@ -1,8 +1,12 @@
 #include "railcrash/sweep.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,10 +22,13 @@
 
 #include "railcrash/batch.hpp"
 #include "railcrash/error.hpp"
+#include "railcrash/folder_lock.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/run.hpp"
+#include "railcrash/run_count.hpp"
 #include "railcrash/table_text.hpp"
 #include "railcrash/version.hpp"
+#include "railcrash/whole_file.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -329,6 +336,27 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
 
 // ---------------------------------------------------------------- runs
 
+std::optional<std::size_t> sweep_run_count(const SweepPlan& plan) {
+  std::vector<std::size_t> counts;
+  for (const SweepFactor& f : plan.factors) counts.push_back(f.levels.size());
+  switch (plan.design) {
+    case SweepDesignKind::full_factorial: return factorial_count(counts);
+    case SweepDesignKind::one_at_a_time: {
+      std::optional<std::size_t> total = 1;  // the model's own run, then each level of each factor
+      for (std::size_t n : counts) total = add_counts(total, n);
+      return total;
+    }
+    case SweepDesignKind::latin_hypercube:
+    case SweepDesignKind::monte_carlo: return plan.samples;
+    case SweepDesignKind::runs: return plan.runs.size();
+  }
+  return std::nullopt;
+}
+
+void require_sweep_run_count(const SweepPlan& plan, std::size_t max_runs) {
+  require_run_count(sweep_run_count(plan), max_runs, plan.path + ": the sweep's plan");
+}
+
 std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text) {
   const std::size_t n = plan.factors.size();
   std::vector<std::vector<std::string>> levels;
@@ -463,6 +491,12 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
   return row;
 }
 
+/// Fields of a runs.csv row: run, hash, the factors, status, the responses, wall_seconds,
+/// message, outcomes, branch (sweep_csv_header's columns).
+namespace {
+std::size_t runs_csv_fields(const SweepPlan& plan) { return 2 + plan.factors.size() + 1 + plan.responses.size() + 4; }
+}  // namespace
+
 std::string sweep_csv_header(const SweepPlan& plan) {
   std::string header = "run,hash";
   for (const SweepFactor& f : plan.factors) header += "," + csv_field(f.column());
@@ -529,6 +563,125 @@ std::size_t match_run_folders(const std::string& directory, const std::map<std::
 
 }  // namespace
 
+namespace {
+
+/// One record of a CSV file: its fields, its raw text (without the line break that ends it) and
+/// where it starts (1-based line).
+struct CsvRecord {
+  std::vector<std::string> fields;
+  std::vector<std::size_t> field_columns;  // 1-based column of each field's first character
+  std::string text;
+  std::size_t line = 0;
+  bool complete = false;  // ended by a line break (a record cut short by a kill or a full disk is not)
+};
+
+[[noreturn]] void csv_error(const std::string& path, std::size_t line, std::size_t column, const std::string& what) {
+  throw InputError(path + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what +
+                   "; this is no runs.csv railcrash wrote: move it away, or write to another --out");
+}
+
+/// Splits text into CSV records (RFC 4180: a quoted field may hold commas, "" and line breaks).
+/// A quote inside an unquoted field, or text after a closing quote, is refused with its line
+/// and column. The last record is incomplete when the text does not end with a line break.
+std::vector<CsvRecord> csv_records(const std::string& path, const std::string& text) {
+  std::vector<CsvRecord> records;
+  std::size_t line = 1, column = 1;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    CsvRecord record;
+    record.line = line;
+    const std::size_t record_start = i;
+    bool end_of_record = false;
+    while (!end_of_record) {
+      record.fields.emplace_back();
+      record.field_columns.push_back(column);
+      std::string& field = record.fields.back();
+      if (i < text.size() && text[i] == '"') {  // quoted
+        ++i, ++column;
+        bool closed = false;
+        while (i < text.size()) {
+          const char c = text[i];
+          if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+            field += '"';
+            i += 2, column += 2;
+          } else if (c == '"') {
+            ++i, ++column;
+            closed = true;
+            break;
+          } else {
+            field += c;
+            ++i;
+            if (c == '\n') ++line, column = 1;
+            else ++column;
+          }
+        }
+        if (!closed) {  // the file ends inside the quotes: a record cut short
+          record.text = text.substr(record_start);
+          records.push_back(std::move(record));
+          return records;
+        }
+        if (i < text.size() && text[i] != ',' && text[i] != '\n')
+          csv_error(path, line, column, std::string("'") + text[i] + "' after a closing quote (a field is quoted whole)");
+      } else {
+        while (i < text.size() && text[i] != ',' && text[i] != '\n') {
+          if (text[i] == '"') csv_error(path, line, column, "a quote inside an unquoted field");
+          field += text[i];
+          ++i, ++column;
+        }
+      }
+      if (i >= text.size()) {
+        record.text = text.substr(record_start);
+        records.push_back(std::move(record));
+        return records;
+      }
+      if (text[i] == '\n') {
+        record.text = text.substr(record_start, i - record_start);
+        record.complete = true;
+        end_of_record = true;
+        ++line, column = 1;
+      } else {
+        ++column;
+      }
+      ++i;
+    }
+    records.push_back(std::move(record));
+  }
+  return records;
+}
+
+bool is_number(const std::string& text) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  (void)std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size();
+}
+
+/// Checks a complete row of an earlier runs.csv field by field: a run number, a 16-digit hash,
+/// ok or failed, numbers (or nothing) for the responses, a number for wall_seconds. InputError
+/// with the line and column of the first field that is not.
+void check_resumed_row(const std::string& path, const SweepPlan& plan, const CsvRecord& row) {
+  const std::size_t expected = runs_csv_fields(plan);
+  if (row.fields.size() != expected)
+    csv_error(path, row.line, 1, std::to_string(row.fields.size()) + " fields where the header has " + std::to_string(expected));
+  const auto at = [&](std::size_t k, const std::string& what) { csv_error(path, row.line, row.field_columns[k], what); };
+  if (row.fields[0].empty() || row.fields[0].size() > 12 || row.fields[0].find_first_not_of("0123456789") != std::string::npos)
+    at(0, "run '" + row.fields[0].substr(0, 40) + "' is not a run number");
+  if (row.fields[1].size() != 16 || row.fields[1].find_first_not_of("0123456789abcdef") != std::string::npos)
+    at(1, "hash '" + row.fields[1].substr(0, 40) + "' is not 16 hexadecimal digits");
+  const std::size_t status = 2 + plan.factors.size();
+  if (row.fields[status] != "ok" && row.fields[status] != "failed")
+    at(status, "status '" + row.fields[status].substr(0, 40) + "' is neither ok nor failed");
+  for (std::size_t r = 0; r < plan.responses.size(); ++r) {
+    const std::string& value = row.fields[status + 1 + r];
+    if (!value.empty() && !is_number(value))
+      at(status + 1 + r, plan.responses[r] + " '" + value.substr(0, 40) + "' is not a number (nor empty)");
+  }
+  const std::size_t wall = expected - 4;
+  if (!is_number(row.fields[wall])) at(wall, "wall_seconds '" + row.fields[wall].substr(0, 40) + "' is not a number");
+}
+
+}  // namespace
+
 SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
                         const std::string& directory, bool resume) {
   SweepResult result;
@@ -539,24 +692,36 @@ SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, co
   const std::string header = sweep_csv_header(plan);
   std::map<std::size_t, std::size_t> kept_folders;  // a resumed row's run number in the old runs.csv -> in the new
   if (resume && std::filesystem::exists(csv_path)) {
-    std::ifstream in(csv_path);
-    std::string line;
-    std::getline(in, line);
-    if (line != header)
-      throw InputError(csv_path + ": its columns are not this plan's (" + line.substr(0, 80) +
+    // The whole file is read and checked before any run: a row cut short at its end (a kill or
+    // a full disk while it was written) is dropped and its run runs again; anything else that
+    // is no row of this plan's runs.csv is refused with its line and column.
+    std::ifstream in(csv_path, std::ios::binary);
+    std::ostringstream content;
+    content << in.rdbuf();
+    if (in.bad()) throw InputError(csv_path + ": cannot read it to resume");
+    std::vector<CsvRecord> records = csv_records(csv_path, content.str());
+    // The last record is cut short when the file does not end with its line break, or (an
+    // editor may have added one) when it has fewer fields than a row.
+    const std::size_t row_fields = runs_csv_fields(plan);
+    if (!records.empty() &&
+        (!records.back().complete || (records.size() > 1 && records.back().fields.size() < row_fields))) {
+      result.torn_row_line = records.back().line;
+      records.pop_back();
+    }
+    if (!records.empty() && records.front().text != header)
+      throw InputError(csv_path + ": its columns are not this plan's (" + records.front().text.substr(0, 80) +
                        "...); resume with the same plan, or write to another --out");
     struct OldRow {
       std::string number, rest;  // rest: the fields after the hash
     };
     std::map<std::string, OldRow> by_hash;
     std::vector<std::string> old_hashes;
-    for (; std::getline(in, line);) {
-      const std::vector<std::string> fields = csv_fields(line);
-      // run, hash, factors..., status, ...: a line cut short by a kill is not a row.
-      if (fields.size() != 2 + plan.factors.size() + 1 + plan.responses.size() + 4) continue;
-      const std::size_t first = line.find(',');
-      by_hash[fields[1]] = {fields[0], line.substr(line.find(',', first + 1) + 1)};
-      old_hashes.push_back(fields[1]);
+    for (std::size_t r = 1; r < records.size(); ++r) {
+      const CsvRecord& row = records[r];
+      check_resumed_row(csv_path, plan, row);
+      const std::size_t first = row.text.find(',');
+      by_hash[row.fields[1]] = {row.fields[0], row.text.substr(row.text.find(',', first + 1) + 1)};
+      old_hashes.push_back(row.fields[1]);
     }
     for (std::size_t k = 0; k < result.specs.size(); ++k)
       if (const auto it = by_hash.find(result.specs[k].hash); it != by_hash.end()) {
@@ -570,11 +735,10 @@ SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, co
         std::count_if(old_hashes.begin(), old_hashes.end(), [&](const std::string& hash) { return !hashes.count(hash); }));
   }
   result.stale_folders = match_run_folders(directory, kept_folders);
-  std::ofstream out(csv_path);
-  out << header << '\n';
+  std::string text = header + '\n';
   for (const auto& line : result.lines)
-    if (line) out << *line << '\n';
-  if (!out) throw InputError(csv_path + ": cannot write (check the --out folder)");
+    if (line) text += *line + '\n';
+  write_whole_file(csv_path, text);  // (FileWriteError names the file)
   return result;
 }
 
@@ -584,6 +748,9 @@ std::string sweep_start_note(const SweepResult& result, const std::string& direc
     note += std::to_string(result.stale_rows) + " row" + (result.stale_rows == 1 ? "" : "s") + " of " + directory +
             "/runs.csv ran with other inputs (a model file, the plan or railcrash changed since) or are no run of "
             "this plan: dropped, and the plan's runs without a row run again\n";
+  if (result.torn_row_line > 0)
+    note += "the last row of " + directory + "/runs.csv (line " + std::to_string(result.torn_row_line) +
+            ") was cut short (the sweep was killed or the disk was full while it was written): dropped, its run runs again\n";
   if (result.stale_folders > 0)
     note += std::to_string(result.stale_folders) + " folder" + (result.stale_folders == 1 ? "" : "s") + " of " + directory +
             "/runs/ belonged to no row of runs.csv kept with these inputs: removed\n";
@@ -591,13 +758,20 @@ std::string sweep_start_note(const SweepResult& result, const std::string& direc
 }
 
 void append_sweep_line(const std::string& directory, const std::string& line) {
-  std::ofstream out(directory + "/runs.csv", std::ios::app);
-  out << line << '\n';
-  out.flush();
+  const std::string path = directory + "/runs.csv";
+  const int descriptor = ::open(path.c_str(), O_WRONLY | O_APPEND | O_NOFOLLOW | O_CLOEXEC);
+  if (descriptor < 0) throw FileWriteError(path, errno);
+  const std::string row = line + '\n';
+  const int error_number = write_all(descriptor, row.data(), row.size());
+  const int closed = ::close(descriptor);
+  if (error_number != 0) throw FileWriteError(path, error_number);
+  if (closed != 0 && errno != EINTR) throw FileWriteError(path, errno);
 }
 
 SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, const std::string& directory,
                       const SweepOptions& options) {
+  require_sweep_run_count(plan, options.max_runs);  // before a run is generated
+  const FolderLock folder_lock(directory);          // one sweep per folder (before anything there changes)
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
   SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
   if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
@@ -610,9 +784,14 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
   batch.run_time_limit = options.run_time_limit;
   batch.stop = options.stop;
   std::size_t done = result.done();
+  // A row that cannot be appended ends the sweep: no run starts after it, no row is appended
+  // after it (runs.csv ends at the failed row, which --resume drops), and the error is thrown.
+  std::optional<FileWriteError> write_failure;
+  std::atomic<bool> write_failed{false};
   run_batch(
       pending.size(),
       [&](std::size_t i, const RunControl& control) {
+        if (write_failed.load()) return;
         char folder[32];
         std::snprintf(folder, sizeof folder, "/runs/%04zu", pending[i]);
         rows[i] = run_sweep_spec(plan, model_path, model_text, result.specs[pending[i]], control,
@@ -620,12 +799,20 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
       },
       batch,
       [&](std::size_t i, BatchRunState state) {
-        if (state != BatchRunState::finished) return;  // an interrupted run is run again on --resume
+        if (state != BatchRunState::finished || write_failed.load()) return;  // an interrupted run is run again on --resume
         const std::size_t k = pending[i];
-        result.lines[k] = sweep_csv_line(plan, k, result.specs[k], rows[i]);
-        append_sweep_line(directory, *result.lines[k]);
+        const std::string line = sweep_csv_line(plan, k, result.specs[k], rows[i]);
+        try {
+          append_sweep_line(directory, line);
+        } catch (const FileWriteError& e) {
+          write_failure = e;
+          write_failed = true;
+          return;
+        }
+        result.lines[k] = line;
         if (options.progress) options.progress(k, rows[i], ++done, result.specs.size());
       });
+  if (write_failure) throw *write_failure;
   write_sweep(plan, result, directory);
   return result;
 }
@@ -667,7 +854,7 @@ const char* design_name(SweepDesignKind kind) {
 
 /// The runs whose discrete outcome differs from run 0's (issue 40): runs.csv's column branch.
 std::string sweep_branches_markdown(const SweepPlan& plan, const SweepResult& result) {
-  const std::size_t branch_field = 2 + plan.factors.size() + 1 + plan.responses.size() + 3;
+  const std::size_t branch_field = runs_csv_fields(plan) - 1;
   std::vector<std::pair<std::size_t, std::string>> branches;  // run number, branch of ok runs
   for (std::size_t k = 0; k < result.lines.size(); ++k) {
     if (!result.lines[k]) continue;
@@ -698,12 +885,10 @@ std::size_t failed_sweep_runs(const SweepPlan& plan, const SweepResult& result) 
 
 std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const std::string& directory) {
   std::filesystem::create_directories(directory);
-  {
-    std::ofstream csv(directory + "/runs.csv");
-    csv << sweep_csv_header(plan) << '\n';
-    for (const auto& line : result.lines)
-      if (line) csv << *line << '\n';
-  }
+  std::string csv = sweep_csv_header(plan) + '\n';
+  for (const auto& line : result.lines)
+    if (line) csv += *line + '\n';
+  write_whole_file(directory + "/runs.csv", csv);  // (FileWriteError names the file: the command fails)
   const std::size_t factor_count = plan.factors.size();
   // Per finished run: the levels and the responses of ok runs.
   std::vector<std::vector<std::string>> levels;
@@ -769,7 +954,7 @@ std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const 
       md << "| " << plan.factors[f].column() << " | " << cells << " | " << table_number(high - low, "%.4g") << " |\n";
     }
   }
-  std::ofstream(directory + "/summary.md") << md.str();
+  write_whole_file(directory + "/summary.md", md.str());
   return md.str();
 }
 

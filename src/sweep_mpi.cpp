@@ -6,12 +6,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
 #include "railcrash/error.hpp"
+#include "railcrash/folder_lock.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/table_text.hpp"
+#include "railcrash/whole_file.hpp"
 
 namespace railcrash {
 
@@ -72,8 +75,10 @@ std::string run_here(const SweepPlan& plan, const std::string& model_path, const
 /// thread of its own (rank 0 runs too), and writes the files.
 int coordinate(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                const std::string& directory, const SweepOptions& options, int ranks) {
+  const FolderLock folder_lock(directory);  // one sweep per folder
   SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
   if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
+  std::optional<FileWriteError> write_failure;  // a row that could not be appended: no more runs are handed out
   std::vector<long> pending;
   for (std::size_t k = 0; k < result.specs.size(); ++k)
     if (!result.lines[k]) pending.push_back(static_cast<long>(k));
@@ -81,14 +86,20 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
   std::size_t next = 0, done = result.done();
   const auto take = [&]() -> long {
     const std::lock_guard<std::mutex> lock(mutex);
-    if ((options.stop && options.stop->load()) || next >= pending.size()) return -1;
+    if ((options.stop && options.stop->load()) || write_failure || next >= pending.size()) return -1;
     return pending[next++];
   };
   const auto record = [&](long number, const std::string& line) {
     if (line.empty()) return;  // interrupted: run again on --resume
     const std::lock_guard<std::mutex> lock(mutex);
+    if (write_failure) return;
+    try {
+      append_sweep_line(directory, line);
+    } catch (const FileWriteError& e) {
+      write_failure = e;
+      return;
+    }
     result.lines[static_cast<std::size_t>(number)] = line;
-    append_sweep_line(directory, line);
     ++done;
     if (options.progress) {
       const std::vector<std::string> fields = csv_fields(line);
@@ -117,6 +128,7 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
     MPI_Send(&work, 1, MPI_LONG, source, kWorkTag, MPI_COMM_WORLD);
   }
   own.join();
+  if (write_failure) throw *write_failure;
   write_sweep(plan, result, directory);
   const std::size_t failed = failed_sweep_runs(plan, result);
   std::printf("%zu of %zu runs done (%zu resumed), %zu failed, on %d MPI ranks; results in %s/ (runs.csv, summary.md)\n",
@@ -158,6 +170,7 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
   try {
     if (rank == 0) check_output_folder(directory);  // only rank 0 writes there
     plan = load_sweep_plan(plan_path, model_path);
+    require_sweep_run_count(plan, options.max_runs);  // before a rank generates a run
     if (rank == 0) model_text = read_model_text(model_path);
   } catch (const InputError& e) {
     problem = e.what();
@@ -182,6 +195,9 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     MPI_Abort(MPI_COMM_WORLD, 2);
+  } catch (const FileWriteError& e) {  // runs.csv or summary.md could not be written (a full disk)
+    std::fprintf(stderr, "railcrash failed: %s\n", e.what());
+    MPI_Abort(MPI_COMM_WORLD, 1);
   }
   MPI_Bcast(&status, 1, MPI_INT, 0, MPI_COMM_WORLD);
   MPI_Finalize();

@@ -36,15 +36,20 @@ FileWriteError::FileWriteError(const std::string& path, int error_number, const 
       path_(path),
       error_number_(error_number) {}
 
-int write_all(int descriptor, const char* data, std::size_t size) {
+int write_all(int descriptor, const char* data, std::size_t size, std::size_t* written_out) {
   std::size_t written = 0;
+  int error_number = 0;
   while (written < size) {
     const ssize_t count = ::write(descriptor, data + written, size - written);
     if (count < 0 && errno == EINTR) continue;
-    if (count <= 0) return count < 0 ? errno : EIO;
+    if (count <= 0) {
+      error_number = count < 0 ? errno : EIO;
+      break;
+    }
     written += static_cast<std::size_t>(count);
   }
-  return 0;
+  if (written_out) *written_out = written;
+  return error_number;
 }
 
 void write_whole_file(const std::string& path, std::string_view text) {

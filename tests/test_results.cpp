@@ -2,8 +2,11 @@
 // results that survive faults (a full disk, a vanished folder).
 #include <catch2/catch.hpp>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -160,21 +163,60 @@ TEST_CASE("the barrier model's two cars are summarised separately", "[results]")
   CHECK(cars[0].bodies.size() + cars[1].bodies.size() + 1 == static_cast<std::size_t>(model.body_count()));  // + coupler
 }
 
-TEST_CASE("a full disk stops the run at once with the OS reason and the summary says failed", "[results][faults]") {
-  if (!std::filesystem::exists("/dev/full")) return;  // no device that is always full here
+TEST_CASE("a failed write stops the run at once with the OS reason and the rows on disk and the summary says failed",
+          "[results][faults]") {
+  // Files past 32 KiB cannot grow (RLIMIT_FSIZE: write(2) fails with EFBIG, as it fails with
+  // ENOSPC on a full disk; SIGXFSZ ignored). A link to /dev/full would not do: result files
+  // are opened without following links.
   const std::string dir = temporary_folder("full_disk");
   std::filesystem::create_directories(dir);
-  std::filesystem::create_symlink("/dev/full", dir + "/timeseries.csv");  // every write: ENOSPC
   const Model model = testing::model_from_text(spring_mass_text(10.0));
+  rlimit old_limit{};
+  REQUIRE(::getrlimit(RLIMIT_FSIZE, &old_limit) == 0);
+  rlimit small = old_limit;
+  small.rlim_cur = 32 * 1024;
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
   const RunReport report = run_model(model, dir);
+  ::setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
   CHECK_FALSE(report.outcome.ok);
-  CHECK_THAT(report.outcome.message, Catch::Contains("cannot write " + dir + "/timeseries.csv: No space left on device") &&
+  CHECK_THAT(report.outcome.message, Catch::Contains("cannot write " + dir + "/timeseries.csv: File too large") &&
                                          Catch::Contains("the run stopped at t = "));
-  // Stopped once the writer's 64 kB buffer (some 500 rows of 120 bytes) reached the device, not at t_end.
+  // What is on disk: the rows whose last byte the OS took, the last of them named by its t.
+  INFO(report.outcome.message);
+  const std::string key = "timeseries.csv holds the first ";
+  const std::size_t at = report.outcome.message.find(key);
+  REQUIRE(at != std::string::npos);
+  const std::size_t rows = std::stoul(report.outcome.message.substr(at + key.size()));
+  const std::string t_key = "rows whole, up to t = ";
+  const double t_held = std::stod(report.outcome.message.substr(report.outcome.message.find(t_key) + t_key.size()));
+  std::ifstream csv(dir + "/timeseries.csv");
+  std::string line, last_whole;
+  std::size_t data_rows = 0;
+  while (std::getline(csv, line))
+    if (!line.empty() && line[0] != '#' && line[0] != 't' && ++data_rows == rows) last_whole = line;
+  CHECK(data_rows >= rows);  // (a row after them may be there in part)
+  CHECK(rows > 100);
+  REQUIRE_FALSE(last_whole.empty());
+  CHECK(std::stod(last_whole.substr(0, last_whole.find(','))) == Approx(t_held).margin(1e-12));
+  // Stopped once the writer's 64 kB buffer (some 500 rows of 120 bytes) reached the file, not at t_end.
   CHECK(report.outcome.t_reached < 1.0);
   const std::string summary = file_text(dir + "/summary.json");
-  CHECK_THAT(summary, Catch::Contains("\"status\": \"failed\"") && Catch::Contains("No space left on device"));
+  CHECK_THAT(summary, Catch::Contains("\"status\": \"failed\"") && Catch::Contains("File too large"));
   CHECK_FALSE(std::filesystem::exists(dir + "/summary.json.tmp"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("a link planted under a result file's name is refused, not written through", "[results][faults]") {
+  const std::string dir = temporary_folder("planted_link");
+  std::filesystem::create_directories(dir);
+  { std::ofstream(dir + "/../planted_link_target.txt") << "precious\n"; }
+  std::filesystem::create_symlink("../planted_link_target.txt", dir + "/timeseries.csv");
+  const Model model = testing::model_from_text(spring_mass_text(0.05));
+  CHECK_THROWS_WITH(run_model(model, dir), Catch::Contains("timeseries.csv: Too many levels of symbolic links"));
+  CHECK(file_text(dir + "/../planted_link_target.txt") == "precious\n");
+  std::filesystem::remove(dir + "/../planted_link_target.txt");
   std::filesystem::remove_all(dir);
 }
 

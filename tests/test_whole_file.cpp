@@ -1,9 +1,10 @@
 // The shared whole-file writer (include/railcrash/whole_file.hpp) and the overflow-checked run
-// counting (include/railcrash/run_count.hpp).
+// counting (include/railcrash/run_count.hpp), and the output folder lock (folder_lock.hpp).
 #include <catch2/catch.hpp>
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,6 +16,7 @@
 #include <string>
 
 #include "railcrash/error.hpp"
+#include "railcrash/folder_lock.hpp"
 #include "railcrash/run_count.hpp"
 #include "railcrash/whole_file.hpp"
 
@@ -116,4 +118,43 @@ TEST_CASE("run counts: products and sums without overflow, and the limit's messa
                     Contains("plan.yaml: 1001 runs, more than the limit of 1000 (--max-runs)"));
   CHECK_THROWS_WITH(require_run_count(std::nullopt, 1000, "plan.yaml"),
                     Contains("plan.yaml: more than 18446744073709551615 runs"));
+}
+
+TEST_CASE("FolderLock refuses a second process naming the folder and its pid and nests within one process", "[whole_file]") {
+  const ScratchFolder scratch;
+  const std::string folder = (scratch.path / "out").string();
+  {
+    const FolderLock first(folder);  // creates the folder
+    const FolderLock again(folder);  // the same process: nested, not refused
+    CHECK(fs::exists(scratch.path / "out" / ".railcrash.lock"));
+  }
+  int ready[2], release[2];
+  REQUIRE(::pipe(ready) == 0);
+  REQUIRE(::pipe(release) == 0);
+  const pid_t child = ::fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {  // holds the folder until the parent closes its end of `release`
+    ::close(ready[0]);
+    ::close(release[1]);  // (else the read below never sees the end of the pipe)
+    {
+      const FolderLock held(folder);
+      char byte = 1;
+      (void)!::write(ready[1], &byte, 1);
+      (void)!::read(release[0], &byte, 1);
+    }
+    ::_exit(0);
+  }
+  ::close(ready[1]);
+  ::close(release[0]);
+  char byte = 0;
+  REQUIRE(::read(ready[0], &byte, 1) == 1);
+  CHECK_THROWS_WITH(FolderLock(folder), "the output folder '" + folder + "' is being written by another railcrash process (pid " +
+                                            std::to_string(child) +
+                                            "): wait until it ends, or give another --out (two writers would mix their files)");
+  ::close(release[1]);  // the child lets go and ends
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ::close(ready[0]);
+  CHECK(WIFEXITED(status));
+  CHECK_NOTHROW(FolderLock(folder));  // free again
 }

@@ -67,11 +67,14 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "railcrash/folder_lock.hpp"
 #include "railcrash/integrator.hpp"
 #include "railcrash/results/crash_pulse.hpp"
 #include "railcrash/results/crush_zones.hpp"
@@ -242,6 +245,8 @@ class ResultWriter : public RunObserver {
   bool observes_steps() const override { return true; }
   /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.
   std::string failure() const override { return failure_; }
+  /// The time of the last sample recorded (0 before the first) [time].
+  double last_sample_time() const { return t_last_sample_; }
   /// Writes summary.json with "status": "running" (t_reached and peaks so far; stats and
   /// energy come at the end); sample() replaces it every few seconds of wall time.
   void write_running_summary(const std::string& integrator);
@@ -281,6 +286,7 @@ class ResultWriter : public RunObserver {
   const DaeSystem& system_;
   std::string directory_;
   Provenance provenance_;
+  std::unique_ptr<FolderLock> folder_lock_;  // the folder is this run's alone while it writes (null without a folder)
   std::vector<std::string> removed_files_;  // of an earlier run, removed by the constructor
   std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
   int folder_descriptor_ = -1;                          // the open folder, to notice its removal
@@ -325,6 +331,11 @@ class ResultWriter : public RunObserver {
   bool folder_checked_ = false;                          // by a sample
   std::string integrator_;                               // for the running summary
   double t_last_sample_ = 0.0;                           // [time]
+  // The rows the OS has whole: timeseries.csv's rows up to its bytes written; timeseries.h5's
+  // rows at its last flush that succeeded.
+  std::size_t rows_on_disk_ = 0;
+  double t_on_disk_ = -1.0;                              // [time] the last of them (-1: none)
+  std::deque<std::pair<std::uint64_t, double>> row_ends_;  // timeseries.csv: byte after each row not yet written, its t
   std::string failure_;                                  // first failed write, with the OS's reason
 
   /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.

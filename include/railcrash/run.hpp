@@ -56,10 +56,22 @@ struct RunReport {
   std::vector<FilteredAccelerations> filtered_accelerations;  // CFC 60 peaks, collision pulses
 };
 
+/// The memory a run's output keeps until its end [bytes]: per row, 20 B per body (single-precision
+/// velocities and accelerations for the CFC filter and the collision pulses, results.hpp) and
+/// 16 B of times, and with keep_in_memory 8 B per timeseries column; rows = t_end /
+/// output_interval + 2. A vector that grows may briefly need half as much again.
+double output_memory_estimate(const DaeSystem& system, bool keep_in_memory);
+/// The limit run_model holds output_memory_estimate to [bytes] (default 4 GiB; 0: no limit).
+/// `railcrash run --max-output-memory GB` sets it for the process.
+void set_output_memory_limit(double bytes);
+double output_memory_limit();
+
 /// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files;
 /// OutputFormat::Hdf5: timeseries.h5 in place of the per-row CSV files, results/hdf5_file.hpp);
 /// with keep_in_memory the same results also come back in the report.
-/// Input errors throw InputError before anything runs; solver failures come back with ok = false.
+/// Input errors throw InputError before anything runs (also an output whose memory estimate is
+/// above output_memory_limit(), with the figures and what lowers it); solver failures come back
+/// with ok = false, and so does running out of memory (std::bad_alloc: summary.json "failed").
 /// time_phases: the run's wall time split by phase (RunStatistics::phase_seconds; summary.json's
 /// stats.seconds; `railcrash run --timings`).
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,

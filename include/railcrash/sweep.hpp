@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "railcrash/batch.hpp"
+#include "railcrash/run_count.hpp"
 #include "railcrash/yaml_file.hpp"
 
 namespace railcrash {
@@ -112,6 +113,13 @@ struct SweepRunSpec {
 /// run's settings in order (the plan's `set`, then each factor's).
 std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text);
 
+/// The number of runs the plan has, counted without generating them (nullopt: more than
+/// std::size_t holds): the product of the level counts (full factorial), 1 + their sum (one at
+/// a time), samples, or the runs listed.
+std::optional<std::size_t> sweep_run_count(const SweepPlan& plan);
+/// InputError unless the plan has at most max_runs runs (0: no limit; run_count.hpp).
+void require_sweep_run_count(const SweepPlan& plan, std::size_t max_runs);
+
 struct SweepRow {
   std::string status;                  // "ok", "failed"
   std::vector<double> responses;       // NaN where the run has no such value
@@ -136,6 +144,7 @@ struct SweepOptions {
   const std::atomic<bool>* stop = nullptr;
   bool resume = false;
   bool keep_runs = false;                   // per-run folders DIR/runs/NNNN
+  std::size_t max_runs = kDefaultMaxRuns;   // a plan of more runs is refused before any is generated (0: no limit)
   std::function<void(std::size_t number, const SweepRow&, std::size_t done, std::size_t total)> progress;
   std::function<void(const std::string& text)> note;  // sweep_start_note's lines, when there are any, before the runs
 };
@@ -146,6 +155,7 @@ struct SweepResult {
   std::size_t resumed = 0;                        // rows taken from an earlier runs.csv
   std::size_t stale_rows = 0;     // rows of the earlier runs.csv (resuming) whose hash is no run of the plan: dropped
   std::size_t stale_folders = 0;  // folders DIR/runs/NNNN of no row kept: removed
+  std::size_t torn_row_line = 0;  // resuming: the line of the earlier runs.csv's last row, cut short (dropped); 0: none
   std::size_t done() const;
 };
 
@@ -153,12 +163,15 @@ struct SweepResult {
 /// result with the resumed lines set. The other rows of the earlier file are dropped (their runs
 /// read other inputs, or are no runs of this plan). DIR/runs/ is made to match the new file: the
 /// folder of a resumed row takes the row's new run number, every other run folder is removed.
-/// InputError if a resumed file has other columns.
+/// InputError if a resumed file has other columns, or (with its line and column) anything that is
+/// no complete row of them but for a last row cut short, which is dropped (torn_row_line).
+/// The new runs.csv is written whole (write_whole_file); FileWriteError if it cannot be.
 SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
                         const std::string& directory, bool resume);
 /// Lines that say how many rows start_sweep dropped and folders it removed ("" when none).
 std::string sweep_start_note(const SweepResult& result, const std::string& directory);
-/// Appends one finished line to DIR/runs.csv (flushed: a killed sweep keeps it).
+/// Appends one finished line to DIR/runs.csv (by write(2), every byte checked: a killed sweep
+/// keeps it); FileWriteError naming the file when it cannot be written whole.
 void append_sweep_line(const std::string& directory, const std::string& line);
 
 /// The runs done whose status is not ok (runs.csv's status column).

@@ -32,7 +32,9 @@ class FileWriteError : public std::runtime_error {
 
 /// Writes all of data to descriptor, retrying short writes and EINTR: 0 when every byte was
 /// written, otherwise the errno of the failed write (EIO for a write that wrote nothing).
-int write_all(int descriptor, const char* data, std::size_t size);
+/// `written`, when given, receives the bytes the OS took (all of size on success, fewer after a
+/// short write and a failure).
+int write_all(int descriptor, const char* data, std::size_t size, std::size_t* written = nullptr);
 
 /// Replaces path with text as described above; FileWriteError on any failure.
 void write_whole_file(const std::string& path, std::string_view text);

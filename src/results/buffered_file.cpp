@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "railcrash/whole_file.hpp"
+
 // The fast path builds the twelve digits in a 128-bit integer whose lowest byte is the first
 // character: it needs unsigned __int128 and a little-endian machine. Elsewhere every number
 // goes through std::to_chars (the same text, slower).
@@ -181,7 +183,9 @@ char* format_general12(char* first, double value) {
 }
 
 BufferedFile::BufferedFile(const std::string& path) {
-  descriptor_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  // O_NOFOLLOW: a symbolic link planted under a result file's name is refused (ELOOP), not
+  // written through.
+  descriptor_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
   if (descriptor_ < 0) error_ = errno;
   buffer_.reset(new char[kCapacity]);  // not zeroed (std::make_unique would): only written bytes are read
 }
@@ -213,16 +217,9 @@ void BufferedFile::write_out() {
     used_ = 0;
     return;
   }
-  std::size_t written = 0;
-  while (written < used_) {
-    const ssize_t count = ::write(descriptor_, buffer_.get() + written, used_ - written);
-    if (count < 0 && errno == EINTR) continue;
-    if (count <= 0) {
-      error_ = count < 0 ? errno : EIO;
-      break;
-    }
-    written += static_cast<std::size_t>(count);
-  }
+  std::size_t taken = 0;
+  error_ = write_all(descriptor_, buffer_.get(), used_, &taken);  // (whole_file.hpp: the one checked write loop)
+  written_ += taken;  // also the part of a failed write the OS took
   used_ = 0;
 }
 

@@ -155,10 +155,13 @@ Hdf5File::Hdf5File(const std::string& path) : path_(path) {
   // that can be is closed by the destructor; the OS closes the rest. (A no-op once HDF5 runs.)
   H5dont_atexit();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported through error(), not printed
-  // The 1.10 file format: its compact encoding of compound types fits more named columns in the
-  // 64 KiB a type may take than the 1.8 format's padded one. Readable by HDF5 1.10 and later.
+  // The 1.8 file format at least: its compact encoding of compound types (datatype message
+  // version 3) fits more named columns in the 64 KiB a type may take than the older padded one.
+  // Not the 1.10 format: its superblock (version 3) marks the file open for writing, and after a
+  // kill -9 no reader opens it until `h5clear -s`; the 1.8 superblock has no such mark, so a
+  // killed run's file opens, with the rows of its last flush (summary.json's output.valid_rows).
   const Handle access(H5Pcreate(H5P_FILE_ACCESS));
-  if (access.valid() && H5Pset_libver_bounds(access.get(), H5F_LIBVER_V110, H5F_LIBVER_LATEST) >= 0)
+  if (access.valid() && H5Pset_libver_bounds(access.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) >= 0)
     file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get());
   if (file_ < 0) {
     fail("cannot create " + path);

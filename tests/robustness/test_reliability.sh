@@ -18,6 +18,7 @@ full=$tmp/full
 mounted=0
 cleanup() {
   [ "$mounted" = 1 ] && umount "$full"
+  mountpoint -q "$tmp/full2" 2> /dev/null && umount "$tmp/full2"
   rm -rf "$tmp"
 }
 trap cleanup EXIT
@@ -134,6 +135,163 @@ if [ "$(id -u)" = 0 ] && command -v setpriv > /dev/null; then
   expect_text "every run is done" "$tmp/stdout" "64 of 64 runs done (0 resumed), 0 failed"
 else
   skipped="$skipped thread-limit (needs root and setpriv)"
+fi
+
+# ============ issue 36, second part: the sweep's runs.csv, HDF5, the folder lock, planted links
+# in a run folder, a full-disk CSV run's closing message, the output memory estimate.
+plan64=$models/sweep_64_runs.yaml
+count_csv_rows() {  # file: the records a CSV reader finds (header included), or "unparsable"
+  python3 -c 'import csv,sys
+try:
+    rows=list(csv.reader(open(sys.argv[1], newline=""), strict=True))
+    print(len(rows), sum(1 for r in rows[1:] if len(r) == len(rows[0]) and r[4] == "ok"))
+except Exception as e:
+    print("unparsable", e)' "$1"
+}
+same_value() {  # description actual expected
+  if [ "$2" = "$3" ]; then passes=$((passes + 1)); else echo "FAIL: $1: '$2', expected '$3'"; failures=$((failures + 1)); fi
+}
+
+# --- A resumed runs.csv whose last row was cut inside its quoted message: the row is dropped
+# and its run runs again, and the file stays CSV.
+expect_status "a 64-run sweep" 0 "$bin" sweep "$oscillator" --plan "$plan64" --jobs 2 --out "$tmp/sweep"
+size=$(stat -c %s "$tmp/sweep/runs.csv")
+truncate -s $((size - 2)) "$tmp/sweep/runs.csv"  # the last row ends inside its message's quotes
+expect_status "resume after a torn last row" 0 "$bin" sweep "$oscillator" --plan "$plan64" --jobs 2 --resume --out "$tmp/sweep"
+expect_text "the torn row is named" "$tmp/stdout" "runs.csv (line 65) was cut short"
+expect_text "and run again" "$tmp/stdout" "64 of 64 runs done (63 resumed), 0 failed"
+same_value "runs.csv parses: 65 records, 64 ok" "$(count_csv_rows "$tmp/sweep/runs.csv")" "65 64"
+
+# --- Garbage in a resumed runs.csv: refused at the start with its line and column.
+sed -i '3s/^\([^,]*,[^,]*,[^,]*,[^,]*,ok,\)[^,]*/\1oops/' "$tmp/sweep/runs.csv"
+expect_status "resume with garbage in runs.csv" 2 "$bin" sweep "$oscillator" --plan "$plan64" --jobs 2 --resume --out "$tmp/sweep"
+expect_text "line and column named" "$tmp/stderr" "runs.csv:3:[0-9]*: bob.x@0.5 'oops' is not a number"
+
+# --- A sweep plan too big: counted without overflow and refused before a run is generated.
+python3 - "$tmp" << 'PY'
+import sys
+tmp = sys.argv[1]
+# full factorials of 2^65 and 2^21 runs over the stiffnesses of 65 springs on one body
+def plan(name, factors):
+    with open(f"{tmp}/{name}", "w") as f:
+        f.write("sweep: 1\ndesign: full_factorial\nfactors:\n")
+        for k in range(factors):
+            f.write(f"  - {{key: elements.s{k}.stiffness, levels: [100, 110]}}\n")
+        f.write("responses: [t_reached]\n")
+def model(name, springs):
+    with open(f"{tmp}/{name}", "w") as f:
+        f.write("railcrash: 1\nname: many springs\nunits: SI\ngravity: [0, 0]\nbodies:\n")
+        f.write("  - {name: bob, mass: 2, inertia: 0.1, position: [1.1, 0], angle: 0}\nelements:\n")
+        for k in range(springs):
+            f.write(f"  - {{name: s{k}, type: linear_spring, stiffness: 200, free_length: 1, points: [{{body: ground, at: [0, 0]}}, {{body: bob, at: [0, 0]}}]}}\n")
+        f.write("simulation: {t_end: 0.01, output_interval: 0.01}\n")
+model("springs.yaml", 65)
+plan("plan_2e64.yaml", 65)
+plan("plan_2e21.yaml", 21)
+# 300 bodies on springs: 1e6 output rows keep about 6 GB for the CFC filter
+with open(f"{tmp}/bodies_300.yaml", "w") as f:
+    f.write("railcrash: 1\nname: 300 oscillators\nunits: SI\ngravity: [0, 0]\nbodies:\n")
+    for k in range(300):
+        f.write(f"  - {{name: b{k}, mass: 2, inertia: 0.1, position: [1.1, {k}], angle: 0}}\n")
+    f.write("elements:\n")
+    for k in range(300):
+        f.write(f"  - {{name: s{k}, type: linear_spring, stiffness: 200, free_length: 1, points: [{{body: ground, at: [0, {k}]}}, {{body: b{k}, at: [0, 0]}}]}}\n")
+    f.write("simulation: {t_end: 1, output_interval: 1.0e-6}\n")
+PY
+expect_status "a 2^65-run sweep refused" 2 timeout -k 5 60 "$bin" sweep "$tmp/springs.yaml" --plan "$tmp/plan_2e64.yaml" --out "$tmp/huge"
+expect_text "as more than 2^64" "$tmp/stderr" "more than 18446744073709551615"
+expect_status "a 2^21-run sweep refused" 2 timeout -k 5 60 "$bin" sweep "$tmp/springs.yaml" --plan "$tmp/plan_2e21.yaml" --out "$tmp/huge"
+expect_text "with its count and the limit" "$tmp/stderr" "2097152 runs, more than the limit of 1000000 (--max-runs)"
+
+# --- Two writers, one folder: the second is refused, naming the folder and the first's pid.
+"$bin" run "$oscillator" --t-end 100000 --output-interval 0.1 --quiet --out "$tmp/busy" > /dev/null 2>&1 &
+first=$!
+for _ in $(seq 100); do [ -s "$tmp/busy/summary.json" ] && break; sleep 0.1; done
+expect_status "a second run into a busy folder" 2 "$bin" run "$oscillator" --out "$tmp/busy"
+expect_text "is refused with the folder and the pid" "$tmp/stderr" "the output folder '$tmp/busy' is being written by another railcrash process (pid $first)"
+expect_status "a sweep into it too" 2 "$bin" sweep "$oscillator" --plan "$plan64" --out "$tmp/busy"
+kill -KILL "$first"; wait "$first" 2> /dev/null
+expect_status "after the first is gone, the folder is free" 0 "$bin" run "$oscillator" --out "$tmp/busy"
+
+# --- kill -9 during an HDF5 run: the file opens without h5clear and holds the rows summary.json
+# says are valid.
+h5python=""
+for candidate in python3 /usr/bin/python3; do
+  if "$candidate" -c 'import h5py' 2> /dev/null; then h5python=$candidate; break; fi
+done
+if "$bin" run "$oscillator" --format hdf5 --out "$tmp/h5probe" > /dev/null 2>&1 && [ -n "$h5python" ]; then
+  "$bin" run "$oscillator" --format hdf5 --t-end 100000 --output-interval 0.1 --quiet --out "$tmp/h5" > /dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 200); do grep -q '"valid_rows": [1-9]' "$tmp/h5/summary.json" 2> /dev/null && break; sleep 0.1; done
+  kill -KILL "$pid"; wait "$pid" 2> /dev/null
+  same_value "a killed run's timeseries.h5 opens and holds its valid rows" "$("$h5python" -c '
+import h5py, json, sys
+summary = json.load(open(sys.argv[1] + "/summary.json"))
+valid, t = summary["output"]["valid_rows"], summary["output"]["valid_to_t"]
+with h5py.File(sys.argv[1] + "/timeseries.h5", "r") as f:
+    times = f["timeseries"]["t"][:valid]
+    ok = valid > 0 and len(times) == valid and all(b > a for a, b in zip(times, times[1:])) and abs(times[-1] - t) <= 1e-9 * max(1, abs(t))
+    print("ok" if ok else "rows %d, valid %d, last t %g, valid_to_t %g" % (len(times), valid, times[-1] if len(times) else -1, t))
+' "$tmp/h5" 2>&1 | tail -1)" "ok"
+else
+  skipped="$skipped hdf5-kill (no HDF5 in this build or no h5py)"
+fi
+
+# --- Planted links in a run folder: never written through.
+mkdir "$tmp/links"
+printf 'precious\n' > "$tmp/victim_csv"
+printf 'precious\n' > "$tmp/victim_tmp"
+ln -s "$tmp/victim_csv" "$tmp/links/timeseries.csv"
+ln -s "$tmp/victim_tmp" "$tmp/links/summary.json.tmp"
+"$bin" run "$oscillator" --out "$tmp/links" > /dev/null 2>&1
+same_text "a link named timeseries.csv is not followed" "$tmp/victim_csv" "precious"
+same_text "a link named summary.json.tmp is not followed" "$tmp/victim_tmp" "precious"
+rm "$tmp/links/timeseries.csv"
+expect_status "a run beside a planted summary.json.tmp link" 0 "$bin" run "$oscillator" --out "$tmp/links"
+same_text "whose target stays" "$tmp/victim_tmp" "precious"
+
+# --- Output memory: estimated at the start and refused above the limit, with the figures.
+expect_status "300 bodies x 1e6 rows refused" 2 timeout -k 5 60 "$bin" run "$tmp/bodies_300.yaml" --quiet --out "$tmp/memory"
+expect_text "with the estimate and what lowers it" "$tmp/stderr" "would keep about 6.0[0-9]* GB in memory until its end (300 bodies x 1000002 output rows x 20 B"
+expect_text "and the option that raises the limit" "$tmp/stderr" "--max-output-memory GB"
+
+# --- Full disk: a sweep's runs.csv, a CSV run's closing message, HDF5's summary.
+full2=$tmp/full2
+mkdir -p "$full2"
+if mount -t tmpfs -o size=1m tmpfs "$full2" 2> /dev/null; then
+  # Two free pages: the lock file's pid takes one, runs.csv's header and its first rows the
+  # other; the rest of the 160 rows (about 55 bytes each) does not fit.
+  printf 'sweep: 1\ndesign: full_factorial\nfactors:\n  - {key: elements.spring.stiffness, levels: [%s]}\n  - {key: bodies.bob.mass, levels: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]}\nresponses: [bob.x@0.5]\n' \
+    "$(seq -s ', ' 100 10 250)" > "$tmp/sweep_160_runs.yaml"
+  mkdir "$full2/sweep"
+  dd if=/dev/zero of="$full2/reserve" bs=4096 count=2 2> /dev/null
+  dd if=/dev/zero of="$full2/filler" bs=4k 2> /dev/null
+  dd if=/dev/zero of="$full2/filler_tail" bs=512 2> /dev/null
+  rm "$full2/reserve"
+  expect_status "a sweep that fills the disk exits 1" 1 "$bin" sweep "$oscillator" --plan "$tmp/sweep_160_runs.yaml" --jobs 2 --out "$full2/sweep"
+  expect_text "naming runs.csv and the reason" "$tmp/stderr" "cannot write '$full2/sweep/runs.csv': No space left on device"
+  rows_before=$(grep -c ',ok,' "$full2/sweep/runs.csv")
+  if [ "$rows_before" -ge 20 ] && [ "$rows_before" -lt 160 ]; then passes=$((passes + 1)); else
+    echo "FAIL: the rows appended before the disk was full: $rows_before, expected 20 to 159"; failures=$((failures + 1)); fi
+  rm "$full2/filler"
+  expect_status "resumed with room again" 0 "$bin" sweep "$oscillator" --plan "$tmp/sweep_160_runs.yaml" --jobs 2 --resume --out "$full2/sweep"
+  expect_text "every run done, the rows on disk resumed" "$tmp/stdout" "160 of 160 runs done ([0-9]* resumed), 0 failed"
+  same_value "its runs.csv parses: 161 records, 160 ok" "$(count_csv_rows "$full2/sweep/runs.csv")" "161 160"
+  rm -rf "$full2/sweep"
+
+  # A CSV run on a disk with room for a few hundred rows: the message says what the files hold.
+  dd if=/dev/zero of="$full2/filler" bs=4k count=40 2> /dev/null
+  expect_status "a CSV run that fills the disk" 1 "$bin" run "$oscillator" --t-end 100 --output-interval 0.001 --quiet --out "$full2/csv"
+  expect_text "says what timeseries.csv holds" "$tmp/stdout" "timeseries.csv holds the first [0-9]* rows whole, up to t = "
+  rows=$(grep -o 'the first [0-9]* rows' "$tmp/stdout" | grep -o '[0-9]*')
+  t_held=$(grep -o 'rows whole, up to t = [0-9.e+-]*' "$tmp/stdout" | grep -o '[0-9.e+-]*$')
+  # after the provenance comment and the header, at least that many whole rows, the last of them at t_held
+  row=$(grep -v '^#' "$full2/csv/timeseries.csv" | sed -n "$((rows + 1))p" | cut -d, -f1)
+  same_value "timeseries.csv's row $rows is at that t" "$(python3 -c "print(abs($row - $t_held) <= 1e-9 * max(1, abs($t_held)))")" "True"
+  expect_text "summary.json says failed even so" "$full2/csv/summary.json" '"status": "failed"'
+  umount "$full2"
+else
+  skipped="$skipped full-disk-2 (mount -t tmpfs is not permitted: not root)"
 fi
 
 echo "reliability: $passes checks passed, $failures failed${skipped:+; skipped:$skipped}"

@@ -5,6 +5,7 @@
 // by error(); after it nothing more is written.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -44,6 +45,10 @@ class BufferedFile {
   bool flush();
   /// errno of the failed open or the first failed write, 0 while all went well.
   int error() const { return error_; }
+  /// Bytes the OS took, from the start of the file (also the part of a failed write it took).
+  std::uint64_t written() const { return written_; }
+  /// Bytes given to the file so far: written() and those still in the buffer.
+  std::uint64_t appended() const { return written_ + used_; }
 
  private:
   void write_out();
@@ -52,6 +57,7 @@ class BufferedFile {
   std::unique_ptr<char[]> buffer_;  // kCapacity bytes
   std::size_t used_ = 0;            // bytes of buffer_ not written yet
   int error_ = 0;
+  std::uint64_t written_ = 0;
 };
 
 }  // namespace railcrash
