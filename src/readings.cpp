@@ -161,7 +161,7 @@ SensitivityDesign ReadingsPlan::design_for(const std::vector<int>& combination, 
     const ReadingLevel& level = readings[r].levels[static_cast<std::size_t>(combination[r])];
     for (const auto& [name, scales] : level.scales) {
       const auto it = std::find_if(changed.parameters.begin(), changed.parameters.end(),
-                                   [&](const SensitivityParameter& p) { return p.name == name; });
+                                   [&parameter = name](const SensitivityParameter& p) { return p.name == parameter; });
       if (it == changed.parameters.end())
         throw InputError(SourceLocation{path, level.line}.prefix() + "reading '" + readings[r].name + "', level '" + level.name +
                          "': the design has no parameter '" + name + "'");
