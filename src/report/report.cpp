@@ -7,20 +7,22 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <regex>
+#include <optional>
 #include <set>
-#include <sstream>
 #include <stdexcept>
+
+#include <nlohmann/json.hpp>
 
 #include "railcrash/error.hpp"
 #include "railcrash/report/assets.hpp"
 #include "railcrash/report/decimate.hpp"
+#include "railcrash/report/folder_file.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/table_text.hpp"
+#include "railcrash/whole_file.hpp"
 
 namespace railcrash::report {
 
@@ -56,13 +58,72 @@ std::string numbers(const std::vector<double>& values) {
   return out + "]";
 }
 
-std::string read_file(const fs::path& path, bool* found) {
-  std::ifstream in(path, std::ios::binary);
-  *found = static_cast<bool>(in);
-  std::stringstream text;
-  if (in) text << in.rdbuf();
-  return text.str();
+/// What to do about a file above the report's limit (folder_file.hpp), by its kind.
+const char* const kJsonAdvice =
+    "railcrash writes such files well under that; it is not a file of a railcrash run: move it away, or run the model "
+    "again into this folder";
+const char* const kTableAdvice =
+    "the report holds the file and its values in memory, and the limit is an eighth of this machine's memory; run again "
+    "with a longer --output-interval (fewer rows), or read the file with other tools";
+
+/// A JSON file of the folder (summary.json, model.json), size-limited; found false when there is none.
+std::string read_json_file(const fs::path& path, bool* found) {
+  FolderFile file = read_folder_file(path.string(), kMaxJsonBytes, kJsonAdvice);
+  *found = file.found;
+  return std::move(file.text);
 }
+
+/// A table or other file of the folder (CSV, Markdown, SVG), size-limited.
+std::string read_file(const fs::path& path, bool* found) {
+  FolderFile file = read_folder_file(path.string(), max_table_bytes(), kTableAdvice);
+  *found = file.found;
+  return std::move(file.text);
+}
+
+/// A JSON text parsed with nlohmann::json, which parses without recursion (the std::regex
+/// matching it replaces recursed once per character and overflowed the stack on a
+/// 100,000-character message, issue 36). Empty text: null. Text that is not JSON: null, and a
+/// problem saying where it breaks.
+nlohmann::json parse_json(const std::string& name, const std::string& text, std::vector<std::string>& problems) {
+  if (text.empty()) return nullptr;
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    std::string reason = e.what();  // "[json.exception.parse_error.101] parse error at line 3, column 7: ..."
+    const std::size_t tag_end = reason.find("] ");
+    if (reason.rfind("[json.exception.", 0) == 0 && tag_end != std::string::npos) reason = reason.substr(tag_end + 2);
+    problems.push_back(name + " is not valid JSON (" + reason.substr(0, 300) + "): the report shows what the other files hold");
+    return nullptr;
+  }
+}
+
+/// The string at key of a JSON object, "" when it is missing or not a string.
+std::string string_at(const nlohmann::json& object, const char* key) {
+  if (!object.is_object()) return "";
+  const auto it = object.find(key);
+  return it != object.end() && it->is_string() ? it->get<std::string>() : "";
+}
+
+/// The lines of a text, as std::getline reads them from a stream.
+class Lines {
+ public:
+  explicit Lines(const std::string& text) : text_(text) {}
+  /// The next line without its '\n'; false at the end. ended: whether a '\n' ended it.
+  bool next(std::string& line, bool* ended = nullptr) {
+    if (at_ >= text_.size()) return false;
+    const std::size_t end = text_.find('\n', at_);
+    const std::size_t stop = end == std::string::npos ? text_.size() : end;
+    line.assign(text_, at_, stop - at_);
+    at_ = end == std::string::npos ? text_.size() : end + 1;
+    if (ended) *ended = end != std::string::npos;
+    return true;
+  }
+  bool at_end() const { return at_ >= text_.size(); }
+
+ private:
+  const std::string& text_;
+  std::size_t at_ = 0;
+};
 
 
 /// A numeric CSV file: header and complete rows; stops at the first broken row.
@@ -77,8 +138,8 @@ struct NumericTable {
 
 /// Reads the lines before a CSV file's header that start with '#' (the provenance line,
 /// results/provenance.hpp) into `comment`, and the header into `line`; false at the end of the file.
-bool header_line(std::istream& in, std::string& line, std::string& comment, std::size_t& line_number) {
-  while (std::getline(in, line)) {
+bool header_line(Lines& in, std::string& line, std::string& comment, std::size_t& line_number) {
+  while (in.next(line)) {
     ++line_number;
     if (line.empty() || line[0] != '#') return true;
     if (comment.empty()) comment = line;
@@ -88,19 +149,19 @@ bool header_line(std::istream& in, std::string& line, std::string& comment, std:
 
 NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& problems) {
   NumericTable table;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return table;
-  table.found = true;
+  const std::string text = read_file(path, &table.found);
+  if (!table.found) return table;
+  Lines in(text);
   std::string line;
   std::size_t line_number = 0;
   if (!header_line(in, line, table.comment, line_number)) return table;
   table.columns = csv_fields(line);
   for (std::size_t k = 0; k < table.columns.size(); ++k) table.index.emplace(table.columns[k], static_cast<int>(k));
   table.data.assign(table.columns.size(), {});
-  while (std::getline(in, line)) {
+  bool ends_with_newline = false;  // the line stopped at a newline, not at the end
+  while (in.next(line, &ends_with_newline)) {
     ++line_number;
-    const bool ends_with_newline = !in.eof();  // getline stopped at a newline, not at the end
-    const bool last_line = !ends_with_newline || in.peek() == std::char_traits<char>::eof();
+    const bool last_line = !ends_with_newline || in.at_end();
     std::vector<double> row;
     std::string reason;
     const std::vector<std::string> fields = csv_fields(line);
@@ -138,11 +199,10 @@ void require_one_run(const fs::path& dir, const std::string& summary, bool summa
   if (summary_found) files.push_back({"summary.json", run_id_in(summary).value_or("")});
   files.push_back({"timeseries.csv", run_id_in(timeseries_comment).value_or("")});
   for (const char* name : {"model.json", "accelerations.csv", "energy.csv", "events.csv"}) {
-    std::ifstream in(dir / name, std::ios::binary);
-    if (!in) continue;
-    std::string head(4096, '\0');  // the id is near the top: model.json's third line, a CSV file's first
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
+    // The id is near the top: model.json's third line, a CSV file's first.
+    const FolderFile file = read_folder_file_head((dir / name).string(), 4096);
+    if (!file.found) continue;
+    const std::string& head = file.text;
     const bool csv = std::string(name).find(".csv") != std::string::npos;
     const std::string first_line = head.substr(0, head.find('\n'));
     files.push_back({name, run_id_in(csv ? (first_line.rfind("#", 0) == 0 ? first_line : std::string()) : head).value_or("")});
@@ -162,44 +222,49 @@ int column_of(const NumericTable& table, const std::string& name) {
   return it == table.index.end() ? -1 : it->second;
 }
 
-/// Element names and types from model.json (written one element per line by run_files.cpp).
-std::vector<std::pair<std::string, std::string>> element_types(const std::string& model_json) {
-  std::vector<std::pair<std::string, std::string>> out;
-  const std::regex pattern(R"re(\{"name": "((?:[^"\\]|\\.)*)", "type": "([A-Za-z0-9_]+)", "constraint")re");
-  std::stringstream lines(model_json);
-  for (std::string line; std::getline(lines, line);) {
-    std::smatch match;
-    if (!std::regex_search(line, match, pattern)) continue;
-    std::string name;  // undo json_string's escapes (names are plain text: model_io checks them)
-    const std::string raw = match[1].str();
-    for (std::size_t i = 0; i < raw.size(); ++i) name += (raw[i] == '\\' && i + 1 < raw.size()) ? raw[++i] : raw[i];
-    out.emplace_back(name, match[2].str());
-  }
+/// The elements of model.json (written by run_files.cpp), each an object with its name and type.
+std::vector<const nlohmann::json*> model_elements(const nlohmann::json& model) {
+  std::vector<const nlohmann::json*> out;
+  if (!model.is_object()) return out;
+  const auto elements = model.find("elements");
+  if (elements == model.end() || !elements->is_array()) return out;
+  for (const nlohmann::json& element : *elements)
+    if (!string_at(element, "name").empty() && !string_at(element, "type").empty()) out.push_back(&element);
   return out;
 }
 
-double standard_gravity_of(const std::string& model_json, const std::string& summary_json) {
-  const std::regex pattern(R"re("standard_gravity": ([0-9.eE+-]+))re");
-  std::smatch match;
-  if (std::regex_search(model_json, match, pattern) || std::regex_search(summary_json, match, pattern))
-    return std::strtod(match[1].str().c_str(), nullptr);
-  return 0.0;
+/// Element names and types from model.json.
+std::vector<std::pair<std::string, std::string>> element_types(const nlohmann::json& model) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const nlohmann::json* element : model_elements(model)) out.emplace_back(string_at(*element, "name"), string_at(*element, "type"));
+  return out;
+}
+
+/// The number at object[outer][inner], if there is one.
+std::optional<double> number_at(const nlohmann::json& object, const char* outer, const char* inner) {
+  if (!object.is_object()) return std::nullopt;
+  const auto a = object.find(outer);
+  if (a == object.end() || !a->is_object()) return std::nullopt;
+  const auto b = a->find(inner);
+  if (b == a->end() || !b->is_number()) return std::nullopt;
+  return b->get<double>();
+}
+
+/// The standard gravity of model.json's units, else of summary.json's peak accelerations, else 0.
+double standard_gravity_of(const nlohmann::json& model, const nlohmann::json& summary) {
+  if (const auto g = number_at(model, "units", "standard_gravity")) return *g;
+  return number_at(summary, "peak_accelerations", "standard_gravity").value_or(0.0);
 }
 
 /// Roles of the element outputs from model.json: element name -> role name -> output
-/// (element.hpp OutputRole; one element per line, its "roles" object last).
-std::map<std::string, std::map<std::string, std::string>> element_roles(const std::string& model_json) {
+/// (element.hpp OutputRole).
+std::map<std::string, std::map<std::string, std::string>> element_roles(const nlohmann::json& model) {
   std::map<std::string, std::map<std::string, std::string>> out;
-  const std::regex roles_pattern(R"re("roles": \{([^}]*)\}\})re");
-  const std::regex pair_pattern(R"re("([a-z_]+)": "([A-Za-z0-9_]+)")re");
-  std::stringstream lines(model_json);
-  for (std::string line; std::getline(lines, line);) {
-    const std::vector<std::pair<std::string, std::string>> element = element_types(line);
-    std::smatch roles;
-    if (element.size() != 1 || !std::regex_search(line, roles, roles_pattern)) continue;
-    const std::string text = roles[1].str();
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), pair_pattern); it != std::sregex_iterator(); ++it)
-      out[element.front().first][(*it)[1].str()] = (*it)[2].str();
+  for (const nlohmann::json* element : model_elements(model)) {
+    const auto roles = element->find("roles");
+    if (roles == element->end() || !roles->is_object()) continue;
+    for (const auto& [role, output] : roles->items())
+      if (output.is_string()) out[string_at(*element, "name")][role] = output.get<std::string>();
   }
   return out;
 }
@@ -323,10 +388,9 @@ std::string write_page(const fs::path& dir, const std::string& title, const std:
   fill(page, cursor, "{{DATA}}", script_safe(data));
   fill(page, cursor, "{{LIBRARY_SCRIPT}}", library);
   fill(page, cursor, "{{SCRIPT}}", script);
+  // Whole or not at all, never through a link or into a FIFO named report.html (whole_file.hpp).
   const std::string path = (dir / "report.html").string();
-  std::ofstream out(path, std::ios::binary);
-  out << page;
-  if (!out) throw InputError("cannot write " + path);
+  write_whole_file(path, page);
   return path;
 }
 
@@ -390,25 +454,23 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   result.rows = series.rows;
 
   bool found = false, summary_found = false;
-  const std::string summary = read_file(dir / "summary.json", &summary_found);
+  const std::string summary = read_json_file(dir / "summary.json", &summary_found);
   if (!summary_found) problems.insert(problems.begin(), "no summary.json: the run did not finish (it was killed, crashed or is still running); "
                                                 "the report shows the rows written so far");
   require_one_run(dir, summary, summary_found, series.comment);
-  {  // A failed run says so first.
-    std::smatch status, message, reached;
-    if (std::regex_search(summary, status, std::regex(R"re("status": "failed")re"))) {
-      std::regex_search(summary, message, std::regex(R"re("message": "((?:[^"\\]|\\.)*)")re"));
-      std::regex_search(summary, reached, std::regex(R"re("t_reached": ([0-9.eE+-]+))re"));
-      std::string text = message.empty() ? std::string() : message[1].str();
-      replace_all(text, "\\\"", "\"");
-      problems.insert(problems.begin(), "The run FAILED" + (reached.empty() ? std::string() : " at t = " + reached[1].str() + " s") +
-                                            ": " + text + "; the report shows the results up to then");
-    }
+  const nlohmann::json summary_value = parse_json("summary.json", summary, problems);
+  if (string_at(summary_value, "status") == "failed") {  // a failed run says so first
+    const auto reached = summary_value.find("t_reached");
+    const bool have_reached = reached != summary_value.end() && reached->is_number();
+    problems.insert(problems.begin(), "The run FAILED" +
+                                          (have_reached ? " at t = " + json_number(reached->get<double>()) + " s" : std::string()) +
+                                          ": " + string_at(summary_value, "message") + "; the report shows the results up to then");
   }
-  const std::string model_json = read_file(dir / "model.json", &found);
+  const std::string model_json = read_json_file(dir / "model.json", &found);
   if (!found) problems.push_back("no model.json (written by `railcrash run` since the report came in): no animation; run the model again");
-  const auto types = element_types(model_json);
-  const double g = standard_gravity_of(model_json, summary);
+  const nlohmann::json model_value = parse_json("model.json", model_json, problems);
+  const auto types = element_types(model_value);
+  const double g = standard_gravity_of(model_value, summary_value);
 
   // Bodies: groups of six columns <body>.x ... <body>.omega after t.
   std::vector<std::string> bodies;
@@ -509,7 +571,7 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   static const char* const kForceNames[] = {"horizontal_force", "force", "normal_force"};
   // Crash elements (an output with the crash_force role) come first and are shown, with a
   // force-deformation loop when they also have a crash_deformation; others are listed hidden.
-  const auto roles = element_roles(model_json);
+  const auto roles = element_roles(model_value);
   const auto role_column = [&](const std::string& name, const char* role) {
     const auto element = roles.find(name);
     if (element == roles.end()) return -1;
@@ -603,13 +665,15 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   // Events.
   std::string events = "[";
   {
-    std::ifstream in(dir / "events.csv", std::ios::binary);
-    if (!in) problems.push_back("no events.csv");
+    bool events_found = false;
+    const std::string text = read_file(dir / "events.csv", &events_found);
+    if (!events_found) problems.push_back("no events.csv");
+    Lines in(text);
     std::string line, comment;
     std::size_t line_number = 0;
     header_line(in, line, comment, line_number);
     std::size_t count = 0;
-    while (std::getline(in, line) && count < 20000) {
+    while (count < 20000 && in.next(line)) {
       const std::vector<std::string> f = csv_fields(line);
       if (f.size() != 4) continue;
       events += std::string(count++ ? ",\n" : "") + "[" + number(std::strtod(f[0].c_str(), nullptr)) + "," + js(f[1]) + "," +
@@ -634,8 +698,9 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
                            ",\n\"frames\": " + frames + ",\n\"plots\": " + plots_json + ",\n\"loops\": " + loops_json +
                            ",\n\"energy\": " + energy_json + ",\n\"events\": " + events + "}";
 
-  result.path = write_page(dir, "railcrash report: " + dir.filename().string(), summary.empty() ? "null" : summary,
-                           model_json.empty() ? "null" : model_json, data);
+  // A file that is not JSON goes into the page as null (the page parses these blocks).
+  result.path = write_page(dir, "railcrash report: " + dir.filename().string(), summary_value.is_null() ? "null" : summary,
+                           model_value.is_null() ? "null" : model_json, data);
   return result;
 }
 
