@@ -52,6 +52,18 @@ std::string suggestion(const std::string& word, const std::vector<std::string>& 
   return best.empty() ? "" : " (did you mean '" + best + "'?)";
 }
 
+std::string name_length_problem(const std::string& what, const std::string& name) {
+  std::size_t characters = 0;  // UTF-8 code points: every byte but the continuation bytes
+  for (const char c : name) characters += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  if (characters <= kMaxNameLength) return "";
+  constexpr std::size_t kShown = 40;
+  std::string head;
+  for (std::size_t i = 0; i < name.size() && i < kShown; ++i)  // bytes; anything but plain ASCII shown as '?'
+    head += static_cast<unsigned char>(name[i]) < 0x20 || static_cast<unsigned char>(name[i]) >= 0x7F ? '?' : name[i];
+  return what + " '" + head + "...' (its first " + std::to_string(kShown) + " characters) is " + std::to_string(characters) +
+         " characters long, more than the limit of " + std::to_string(kMaxNameLength) + " (model_io.hpp kMaxNameLength); shorten it";
+}
+
 namespace {
 
 /// Reads one model file, keeping the file name for every message.
@@ -228,6 +240,7 @@ class Reader {
   std::string name(const YAML::Node& node, const std::string& what) const {
     const std::string value = text(node, what);
     if (value.empty()) fail(node, what + " must not be empty");
+    if (const std::string problem = name_length_problem(what, value); !problem.empty()) fail(node, problem);
     for (std::size_t i = 0; i < value.size(); ++i) {
       const unsigned char c = static_cast<unsigned char>(value[i]);
       if (c < 0x20 || c == 0x7F || std::string(",\"'\\<>&").find(static_cast<char>(c)) != std::string::npos)
@@ -815,6 +828,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
       r.check_keys(g, kCrushGaugeKeys, context);
       CrushGauge gauge;
       gauge.name = r.text(r.required(g, "name", context), context + ": name");
+      if (const std::string problem = name_length_problem(context + ": name", gauge.name); !problem.empty()) r.fail(g["name"], problem);
       const YAML::Node points = r.required(g, "points", context);
       if (!points.IsSequence() || points.size() != 2) r.fail(points, context + ": points must be two points [{body, at}, {body, at}]");
       gauge.front = read_point(r, points[0], model, context + ": point 1");
@@ -983,6 +997,7 @@ Model build(const YAML::Node& root, Reader& r) {
   if (r.number(version, "railcrash (format version)") != 1.0)
     r.fail(version, "this railcrash reads model format 1; found railcrash: " + version.Scalar());
   model.name = r.text(r.required(root, "name", "model"), "name");
+  if (const std::string problem = name_length_problem("the model's name", model.name); !problem.empty()) r.fail(root["name"], problem);
   const YAML::Node units = r.required(root, "units", "model");
   const std::string unit_name = r.text(units, "units");
   if (unit_name == "SI") {

@@ -142,6 +142,7 @@ class Checker {
   }
   std::string word(const YAML::Node& node, const std::string& what) const {
     if (!node.IsScalar() || node.Scalar().empty()) fail(node, what + " must be a word");
+    if (const std::string problem = name_length_problem(what, node.Scalar()); !problem.empty()) fail(node, problem);
     return node.Scalar();
   }
   const std::string& file() const { return file_; }

@@ -1104,3 +1104,20 @@ TEST_CASE("KEY[i] settings name an entry of a list: each applies to the document
   CHECK_THAT(error("gravity[0]*=2"), Contains("'gravity[0]' is 0 in the model, so a factor changes nothing"));
 }
 
+
+TEST_CASE("a name longer than 256 characters is refused at load with its file, line, start, length and the limit", "[model_io]") {
+  const std::string long_name(20000, 'e');
+  const std::string start(40, 'e');
+  expect_error("element", edit(kBase, "- name: damper", "- name: " + long_name), line_of(kBase, "- name: damper"),
+               {"element name '" + start + "...'", "is 20000 characters long", "limit of 256", "shorten it"});
+  expect_error("body", edit(kBase, "- name: cart", "- name: c" + long_name), line_of(kBase, "- name: cart"),
+               {"body name 'c", "is 20001 characters long", "limit of 256"});
+  expect_error("model", edit(kBase, "name: io test model", "name: " + long_name), line_of(kBase, "name: io test model"),
+               {"the model's name", "20000 characters long"});
+  // Characters, not bytes: 256 two-byte letters are at the limit, one more is past it.
+  std::string umlauts;
+  for (int k = 0; k < 256; ++k) umlauts += "\xc3\xa4";
+  CHECK(name_length_problem("body name", umlauts).empty());
+  CHECK_THAT(name_length_problem("body name", umlauts + "x"), Contains("257 characters long"));
+  CHECK(name_length_problem("body name", std::string(kMaxNameLength, 'b')).empty());
+}

@@ -363,3 +363,15 @@ TEST_CASE("consist makes a model's trains N cars long, repeating its cars in tur
   CHECK_THROWS_WITH(make_consist_model(YAML::Load("railcrash: 1\ntrains: {a: 1}\n"), "bad.yaml", 2),
                     Contains("bad.yaml:2: consist: 'trains' must be a list of trains"));
 }
+
+TEST_CASE("train and car names longer than 256 characters are refused with file and line", "[trains]") {
+  const std::string long_name(300, 't');
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"- name: unitA", "- name: " + long_name},
+                                 {"{type: coach, name: mid}", "{type: coach, name: " + long_name + "}"},
+                                 {"  coach:\n", "  " + long_name + ":\n"}}) {
+    INFO("edit: " << from);
+    const std::string path = write_temp("railcrash_long_name_train.yaml", replaced(kTrainModel, from, to));
+    CHECK_THROWS_WITH(load_model(path), Contains("railcrash_long_name_train.yaml:") && Contains("is 300 characters long") &&
+                                            Contains("more than the limit of 256"));
+  }
+}

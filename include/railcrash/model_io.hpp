@@ -2,6 +2,7 @@
 // whose message starts with "file:line: " and says what to change.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -57,5 +58,18 @@ std::vector<std::string> model_file_keys();
 
 /// " (did you mean 'x'?)" when a word of `known` is close to `word` (edit distance < 3), else "".
 std::string suggestion(const std::string& word, const std::vector<std::string>& known);
+
+/// The longest name the loader takes, in characters (UTF-8 code points): of the model, a body,
+/// an element, an output point, a crush gauge, a car type, a car, a train, a connection. Names
+/// become CSV column headers (with ".quantity"), JSON keys and report labels, each repeated in
+/// every file of a run; 256 is far above any real name (the longest in models/ and examples/
+/// has 28 characters, a train's expanded "train.car.element" a few dozen) and keeps a header
+/// line and a message readable. A longer name is a mistake (pasted text, a generator's bug);
+/// 20,000 characters once crashed the report (issue 36).
+constexpr std::size_t kMaxNameLength = 256;
+
+/// "" when name has at most kMaxNameLength characters, else the reason to refuse it: "WHAT
+/// 'its first 40 characters...' is 20000 characters long, more than the limit of 256; shorten it".
+std::string name_length_problem(const std::string& what, const std::string& name);
 
 }  // namespace railcrash
