@@ -1,16 +1,20 @@
 #include "railcrash/folder_lock.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <utility>
+#include <vector>
 
 #include "railcrash/error.hpp"
 
@@ -33,7 +37,59 @@ std::map<std::pair<unsigned long long, unsigned long long>, HeldFolder>& held_fo
   return folders;
 }
 
+/// Whether name is one whole_file.cpp gives a temporary file, ".NAME.tmp-PID-N-T-A" (PID, N and
+/// A decimal, T hexadecimal), and if so its writer's process id.
+bool temporary_file_pid(const std::string& name, long* pid) {
+  const std::size_t tmp = name.rfind(".tmp-");
+  if (name.size() < 2 || name[0] != '.' || tmp == std::string::npos || tmp < 2) return false;
+  const std::string tail = name.substr(tmp + 5);  // PID-N-T-A
+  const auto field_ok = [](const std::string& field, bool hex) {
+    if (field.empty() || field.size() > 20) return false;
+    for (const char c : field)
+      if (!(c >= '0' && c <= '9') && !(hex && ((c >= 'a' && c <= 'f')))) return false;
+    return true;
+  };
+  std::size_t at = 0;
+  std::string fields[4];
+  for (int k = 0; k < 4; ++k) {
+    const std::size_t dash = k < 3 ? tail.find('-', at) : tail.size();
+    if (dash == std::string::npos) return false;
+    fields[k] = tail.substr(at, dash - at);
+    if (!field_ok(fields[k], k == 2)) return false;
+    at = dash + 1;
+  }
+  *pid = std::strtol(fields[0].c_str(), nullptr, 10);
+  return *pid > 0;
+}
+
+/// Removes the stale temporary files of folder (see the header); returns how many.
+std::size_t remove_stale_temporary_files(const std::string& folder) {
+  DIR* directory = ::opendir(folder.c_str());
+  if (!directory) return 0;
+  std::vector<std::string> stale;
+  while (const dirent* entry = ::readdir(directory)) {
+    const std::string name = entry->d_name;
+    long pid = 0;
+    if (!temporary_file_pid(name, &pid) || pid == static_cast<long>(::getpid())) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;  // running (or not ours to ask): keep
+    struct stat status {};
+    if (::fstatat(::dirfd(directory), entry->d_name, &status, AT_SYMLINK_NOFOLLOW) != 0) continue;
+    if (S_ISREG(status.st_mode) || S_ISLNK(status.st_mode)) stale.push_back(name);
+  }
+  std::size_t removed = 0;
+  for (const std::string& name : stale) removed += ::unlinkat(::dirfd(directory), name.c_str(), 0) == 0;
+  ::closedir(directory);
+  return removed;
+}
+
 }  // namespace
+
+std::string FolderLock::removal_note(const std::string& folder) const {
+  if (removed_temporary_files_ == 0) return "";
+  return "removed " + std::to_string(removed_temporary_files_) + " temporary file" + (removed_temporary_files_ == 1 ? "" : "s") +
+         " of an interrupted railcrash from " + folder + "/ (.NAME.tmp-PID-...: its writer was killed before it renamed " +
+         (removed_temporary_files_ == 1 ? "it" : "them") + ")";
+}
 
 FolderLock::FolderLock(const std::string& folder) {
   std::error_code error;
@@ -76,6 +132,7 @@ FolderLock::FolderLock(const std::string& folder) {
   if (::ftruncate(descriptor, 0) == 0) (void)!::pwrite(descriptor, pid.data(), pid.size(), 0);
   held.descriptor = descriptor;
   held.holders = 1;
+  removed_temporary_files_ = remove_stale_temporary_files(folder);  // (no other run or sweep writes here now)
 }
 
 FolderLock::~FolderLock() {

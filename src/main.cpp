@@ -231,6 +231,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   // The folder is this run's: locked against a second writer, then an earlier run's files go
   // (the writer would remove them too), said here.
   const FolderLock folder_lock(out_dir);
+  if (const std::string note = folder_lock.removal_note(out_dir); !note.empty()) std::printf("%s\n", note.c_str());
   if (const std::vector<std::string> removed = remove_earlier_run_files(out_dir); !removed.empty()) {
     std::string names;
     for (const std::string& name : removed) names += (names.empty() ? "" : ", ") + name;

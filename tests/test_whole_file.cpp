@@ -158,3 +158,37 @@ TEST_CASE("FolderLock refuses a second process naming the folder and its pid and
   CHECK(WIFEXITED(status));
   CHECK_NOTHROW(FolderLock(folder));  // free again
 }
+
+TEST_CASE("FolderLock removes the temporary files a killed writer left and nothing else", "[whole_file]") {
+  const ScratchFolder scratch;
+  const fs::path out = scratch.path / "out";
+  fs::create_directories(out);
+  const pid_t child = ::fork();  // a process that has ended: its pid names the dead writer's files
+  REQUIRE(child >= 0);
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  const std::string dead = std::to_string(child), alive = std::to_string(::getppid());
+  const auto touch = [&](const std::string& name) { std::ofstream(out / name) << "x"; };
+  touch(".summary.json.tmp-" + dead + "-0-1a2b3c-0");   // whole_file.cpp's names: removed
+  touch(".converge.csv.tmp-" + dead + "-12-ff-3");
+  touch(".runs.csv.tmp-" + alive + "-0-1a-0");           // a writer that still runs: kept
+  touch(".notes.tmp-" + dead + "-x-1-0");                // not the form: kept
+  touch("summary.json.tmp-" + dead + "-0-1-0");          // no leading dot: kept
+  touch(".tmp-" + dead + "-0-1-0");                      // no NAME: kept
+  fs::create_directory(out / (".folder.tmp-" + dead + "-0-1-0"));  // a folder: kept
+  {
+    const FolderLock lock(out.string());
+    CHECK(lock.removed_temporary_files() == 2);
+    CHECK(lock.removal_note("out") ==
+          "removed 2 temporary files of an interrupted railcrash from out/ (.NAME.tmp-PID-...: its writer was killed before it renamed them)");
+    const FolderLock nested(out.string());  // held already: removes nothing more, says nothing
+    CHECK(nested.removed_temporary_files() == 0);
+    CHECK(nested.removal_note("out").empty());
+  }
+  CHECK_FALSE(fs::exists(out / (".summary.json.tmp-" + dead + "-0-1a2b3c-0")));
+  CHECK_FALSE(fs::exists(out / (".converge.csv.tmp-" + dead + "-12-ff-3")));
+  for (const std::string& kept : {".runs.csv.tmp-" + alive + "-0-1a-0", ".notes.tmp-" + dead + "-x-1-0",
+                                  "summary.json.tmp-" + dead + "-0-1-0", ".tmp-" + dead + "-0-1-0", ".folder.tmp-" + dead + "-0-1-0"})
+    CHECK(fs::exists(out / kept));
+}
