@@ -772,7 +772,7 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
                       const SweepOptions& options) {
   require_sweep_run_count(plan, options.max_runs);  // before a run is generated
   const FolderLock folder_lock(directory);          // one sweep per folder (before anything there changes)
-  if (const std::string note = folder_lock.removal_note(directory); !note.empty() && options.note) options.note(note);
+  if (const std::string note = folder_lock.removal_note(directory); !note.empty() && options.note) options.note(note + "\n");
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
   SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
   if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);

@@ -76,7 +76,7 @@ std::string run_here(const SweepPlan& plan, const std::string& model_path, const
 int coordinate(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                const std::string& directory, const SweepOptions& options, int ranks) {
   const FolderLock folder_lock(directory);  // one sweep per folder
-  if (const std::string note = folder_lock.removal_note(directory); !note.empty() && options.note) options.note(note);
+  if (const std::string note = folder_lock.removal_note(directory); !note.empty() && options.note) options.note(note + "\n");
   SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
   if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
   std::optional<FileWriteError> write_failure;  // a row that could not be appended: no more runs are handed out

@@ -294,5 +294,77 @@ else
   skipped="$skipped full-disk-2 (mount -t tmpfs is not permitted: not root)"
 fi
 
+# ============ issue 36, third part: the report and hostile run folders, long names, stale
+# temporary files.
+
+# --- A 20,000-character element name: refused at load (check and run) with the file, the line,
+# the name's start, its length and the limit; nothing is run.
+long_name=$(head -c 20000 /dev/zero | tr '\0' 'e')
+sed "s/name: spring,/name: $long_name,/" "$oscillator" > "$tmp/long_name.yaml"
+for command in check "run --out $tmp/long_name"; do
+  expect_status "$command of a model with a 20000-character element name" 2 timeout -k 5 60 "$bin" $command "$tmp/long_name.yaml"
+  expect_text "is refused with file, line, start, length and limit" "$tmp/stderr" \
+    "long_name.yaml:8: element name 'eeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeeee...' (its first 40 characters) is 20000 characters long, more than the limit of 256"
+done
+
+# --- The report of a failed run whose summary.json holds a 100,000-character message, and whose
+# model.json names an element with 20,000 characters (std::regex recursion crashed both): the
+# report is written and leads with the message.
+"$bin" run "$oscillator" --quiet --out "$tmp/long_message" > /dev/null 2>&1
+python3 - "$tmp/long_message" <<'PY'
+import json, sys
+folder = sys.argv[1]
+summary = json.load(open(folder + "/summary.json"))
+summary["status"], summary["message"] = "failed", "m" * 100000 + ' "quoted" \\ end'
+json.dump(summary, open(folder + "/summary.json", "w"), indent=2)
+model = json.load(open(folder + "/model.json"))
+model["elements"][0]["name"] = "e" * 20000
+json.dump(model, open(folder + "/model.json", "w"), indent=2)
+PY
+expect_status "report with a 100k-character message and a 20k-character element name" 0 timeout -k 5 60 "$bin" report "$tmp/long_message"
+expect_text "leads with the failure and its whole message" "$tmp/stdout" "The run FAILED at t = 1 s: mmmmmmmmmm.*mmmm \"quoted\" \\\\ end"
+expect_text "and is written" "$tmp/stdout" "written to $tmp/long_message/report.html"
+
+# --- Files that are not regular in a run folder: refused at once (timeout: a hang fails), exit 2,
+# the message names the file and what it is.
+"$bin" run "$oscillator" --quiet --out "$tmp/hostile" > /dev/null 2>&1
+cp -r "$tmp/hostile" "$tmp/hostile_good"
+rm "$tmp/hostile/summary.json" && mkfifo "$tmp/hostile/summary.json"
+expect_status "report with summary.json a FIFO" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
+expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/summary.json' is a FIFO (named pipe), not a regular file"
+rm "$tmp/hostile/summary.json" && ln -s /dev/zero "$tmp/hostile/summary.json"
+expect_status "report with summary.json a link to /dev/zero" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
+expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/summary.json' is a symbolic link"
+cp "$tmp/hostile_good/summary.json" "$tmp/hostile/summary.json"
+rm "$tmp/hostile/timeseries.csv" && mkfifo "$tmp/hostile/timeseries.csv"
+expect_status "report with timeseries.csv a FIFO" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
+expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/timeseries.csv' is a FIFO (named pipe)"
+cp "$tmp/hostile_good/timeseries.csv" "$tmp/hostile/timeseries.csv"
+rm "$tmp/hostile/model.json" && ln -s /dev/zero "$tmp/hostile/model.json"
+expect_status "report with model.json a link to /dev/zero" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
+expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/model.json' is a symbolic link"
+rm "$tmp/hostile/model.json"
+head -c 70000000 /dev/zero | tr '\0' ' ' > "$tmp/hostile/summary.json"
+expect_status "report with a 70 MB summary.json" 2 timeout -k 2 30 "$bin" report "$tmp/hostile"
+expect_text "is refused with its size and the limit" "$tmp/stderr" "'$tmp/hostile/summary.json' is 70.0 MB (70000000 bytes), more than the report's limit of 67.1 MB"
+
+# --- Temporary files a killed writer left: the next run or sweep into the folder removes them
+# (only the names whole_file.cpp gives, whose writer no longer runs) and says how many.
+"$bin" run "$oscillator" --t-end 100000 --output-interval 0.1 --quiet --out "$tmp/killed" > /dev/null 2>&1 &
+victim=$!
+for _ in $(seq 100); do [ -s "$tmp/killed/summary.json" ] && break; sleep 0.1; done
+kill -KILL "$victim"; wait "$victim" 2> /dev/null
+# what a kill between a whole file's creation and its rename leaves (the victim's own names)
+touch "$tmp/killed/.summary.json.tmp-$victim-7-3fa2c1-0" "$tmp/killed/.converge.md.tmp-$victim-0-1b-0" "$tmp/killed/.notes.tmp-keep"
+expect_status "a run into the killed run's folder" 0 "$bin" run "$oscillator" --quiet --out "$tmp/killed"
+expect_text "says it removed the killed writer's 2 temporary files" "$tmp/stdout" \
+  "removed 2 temporary files of an interrupted railcrash from $tmp/killed/"
+same_value "and leaves other files" "$(ls -A "$tmp/killed" | grep -c 'tmp')" "1"
+mkdir -p "$tmp/killed_sweep"
+touch "$tmp/killed_sweep/.runs.csv.tmp-$victim-0-1b-0"
+expect_status "a sweep into a folder with a killed writer's temporary file" 0 "$bin" sweep "$oscillator" --plan "$plan64" --out "$tmp/killed_sweep"
+expect_text "says it removed it" "$tmp/stdout" "removed 1 temporary file of an interrupted railcrash from $tmp/killed_sweep/"
+no_temporary_files "the sweep's folder" "$tmp/killed_sweep"
+
 echo "reliability: $passes checks passed, $failures failed${skipped:+; skipped:$skipped}"
 [ "$failures" -eq 0 ]
