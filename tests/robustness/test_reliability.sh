@@ -322,7 +322,7 @@ model["elements"][0]["name"] = "e" * 20000
 json.dump(model, open(folder + "/model.json", "w"), indent=2)
 PY
 expect_status "report with a 100k-character message and a 20k-character element name" 0 timeout -k 5 60 "$bin" report "$tmp/long_message"
-expect_text "leads with the failure and its whole message" "$tmp/stdout" "The run FAILED at t = 1 s: mmmmmmmmmm.*mmmm \"quoted\" \\\\ end"
+expect_text "leads with the failure and its whole message" "$tmp/stderr" "The run FAILED at t = 1 s: mmmmmmmmmm.*mmmm \"quoted\" \\\\ end"
 expect_text "and is written" "$tmp/stdout" "written to $tmp/long_message/report.html"
 
 # --- Files that are not regular in a run folder: refused at once (timeout: a hang fails), exit 2,
@@ -335,11 +335,11 @@ expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/summary.json' i
 rm "$tmp/hostile/summary.json" && ln -s /dev/zero "$tmp/hostile/summary.json"
 expect_status "report with summary.json a link to /dev/zero" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
 expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/summary.json' is a symbolic link"
-cp "$tmp/hostile_good/summary.json" "$tmp/hostile/summary.json"
+rm "$tmp/hostile/summary.json" && cp "$tmp/hostile_good/summary.json" "$tmp/hostile/"  # (rm: cp writes through a link)
 rm "$tmp/hostile/timeseries.csv" && mkfifo "$tmp/hostile/timeseries.csv"
 expect_status "report with timeseries.csv a FIFO" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
 expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/timeseries.csv' is a FIFO (named pipe)"
-cp "$tmp/hostile_good/timeseries.csv" "$tmp/hostile/timeseries.csv"
+rm "$tmp/hostile/timeseries.csv" && cp "$tmp/hostile_good/timeseries.csv" "$tmp/hostile/"  # (rm: cp into a FIFO blocks)
 rm "$tmp/hostile/model.json" && ln -s /dev/zero "$tmp/hostile/model.json"
 expect_status "report with model.json a link to /dev/zero" 2 timeout -k 2 10 "$bin" report "$tmp/hostile"
 expect_text "is refused, naming it" "$tmp/stderr" "'$tmp/hostile/model.json' is a symbolic link"
