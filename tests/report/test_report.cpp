@@ -10,11 +10,13 @@
 #include <regex>
 #include <sstream>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/report/decimate.hpp"
+#include "railcrash/report/folder_file.hpp"
 #include "railcrash/report/report.hpp"
 #include "railcrash/run.hpp"
 
@@ -319,5 +321,37 @@ TEST_CASE("railcrash report: the force plot at the channel class asked, the crus
   const railcrash::report::ReportResult coarse = write_report(dir.string(), options);
   REQUIRE(coarse.problems.size() == 1);
   CHECK_THAT(coarse.problems[0], Catch::Contains("too long for CFC 1e+06: the force plot is unfiltered"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("The report reads regular files only, follows no link and keeps to its size limits", "[report]") {
+  using railcrash::report::read_folder_file;
+  const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_files_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "small.json") << "{\"a\": 1}";
+  CHECK(read_folder_file((dir / "small.json").string(), 100, "advice").text == "{\"a\": 1}");
+  CHECK_FALSE(read_folder_file((dir / "none.json").string(), 100, "advice").found);
+  CHECK_THROWS_WITH(read_folder_file((dir / "small.json").string(), 5, "move it away"),
+                    Catch::Contains("small.json' is 0.0 MB (8 bytes), more than the report's limit of 0.0 MB for this file: move it away"));
+  REQUIRE(::mkfifo((dir / "fifo.json").c_str(), 0600) == 0);  // would block a plain open for reading
+  CHECK_THROWS_WITH(read_folder_file((dir / "fifo.json").string(), 100, ""), Catch::Contains("fifo.json' is a FIFO (named pipe), not a regular file"));
+  fs::create_symlink("/dev/zero", dir / "zero.json");  // would be read until memory runs out
+  CHECK_THROWS_WITH(read_folder_file((dir / "zero.json").string(), 100, ""), Catch::Contains("zero.json' is a symbolic link"));
+  fs::create_symlink(dir / "small.json", dir / "link.json");
+  CHECK_THROWS_WITH(read_folder_file((dir / "link.json").string(), 100, ""), Catch::Contains("link.json' is a symbolic link"));
+  CHECK(railcrash::report::read_folder_file_head((dir / "small.json").string(), 3).text == "{\"a");
+  CHECK(railcrash::report::max_table_bytes() >= (std::uint64_t{64} << 20));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("railcrash report: a summary.json that is not JSON is a problem, and the page shows the rest", "[report]") {
+  const fs::path dir = small_run("not_json");
+  const std::string summary = slurp(dir / "summary.json");
+  std::ofstream(dir / "summary.json") << summary.substr(0, summary.size() / 2);  // cut short (its run id kept)
+  const railcrash::report::ReportResult result = railcrash::report::write_report(dir.string());
+  REQUIRE_FALSE(result.problems.empty());
+  CHECK_THAT(result.problems.front(), Catch::StartsWith("summary.json is not valid JSON (parse error at line "));
+  CHECK_THAT(slurp(result.path), Catch::Contains("<script type=\"application/json\" id=\"summary-json\">null</script>"));
   fs::remove_all(dir);
 }
