@@ -1105,7 +1105,7 @@ TEST_CASE("KEY[i] settings name an entry of a list: each applies to the document
 }
 
 
-TEST_CASE("a name longer than 256 characters is refused at load with its file, line, start, length and the limit", "[model_io]") {
+TEST_CASE("a name longer than 256 characters is refused at load with its file and line and start and length and the limit", "[model_io]") {
   const std::string long_name(20000, 'e');
   const std::string start(40, 'e');
   expect_error("element", edit(kBase, "- name: damper", "- name: " + long_name), line_of(kBase, "- name: damper"),

@@ -324,7 +324,7 @@ TEST_CASE("railcrash report: the force plot at the channel class asked, the crus
   fs::remove_all(dir);
 }
 
-TEST_CASE("The report reads regular files only, follows no link and keeps to its size limits", "[report]") {
+TEST_CASE("The report reads regular files only and follows no link and keeps to its size limits", "[report]") {
   using railcrash::report::read_folder_file;
   const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_files_" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -345,7 +345,7 @@ TEST_CASE("The report reads regular files only, follows no link and keeps to its
   fs::remove_all(dir);
 }
 
-TEST_CASE("railcrash report: a summary.json that is not JSON is a problem, and the page shows the rest", "[report]") {
+TEST_CASE("railcrash report: a summary.json that is not JSON is a problem and the page shows the rest", "[report]") {
   const fs::path dir = small_run("not_json");
   const std::string summary = slurp(dir / "summary.json");
   std::ofstream(dir / "summary.json") << summary.substr(0, summary.size() / 2);  // cut short (its run id kept)
