@@ -23,7 +23,10 @@
 //
 // Bad folders: a missing folder, one without timeseries.csv or without a single complete row in
 // it, or one whose files are of two runs (the run ids of summary.json, timeseries.csv,
-// model.json, accelerations.csv, energy.csv and events.csv differ), throws InputError (exit 2). Anything else that is missing or broken (no
+// model.json, accelerations.csv, energy.csv and events.csv differ), or one whose files are
+// not regular files, are links or are above the size limits (folder_file.hpp), throws
+// InputError (exit 2). summary.json and model.json are parsed as JSON (nlohmann-json; one that
+// is not JSON is a problem and reads as null). Anything else that is missing or broken (no
 // summary.json, a failed run, a truncated CSV row, no model.json from an older railcrash) is
 // listed as a problem at the top of the page, and the page shows what there is.
 #pragma once
