@@ -176,8 +176,7 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
     const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
-  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end,
-              model.simulation.integrator == IntegratorKind::Ida ? "ida" : "euler");
+  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end, integrator_name(model.simulation.integrator));
   return 0;
 }
 
@@ -244,6 +243,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
               o.ok ? "finished" : "FAILED", report.integrator.c_str(), o.t_reached, o.stats.wall_seconds, o.stats.steps,
               o.stats.residual_evaluations);
   if (!o.ok) std::printf("reason: %s\n", o.message.c_str());
+  if (!o.stats.hand_over_reason.empty()) std::printf("integrator auto: %s\n", o.stats.hand_over_reason.c_str());
   if (o.stats.phases_timed) {
     std::printf("wall time by phase [s]:");
     for (int p = 0; p < kPhaseCount; ++p) {
@@ -543,7 +543,8 @@ int main(int argc, char** argv) {
 
   CLI::App* run = app.add_subcommand("run", "run a model and write DIR/timeseries.csv, events.csv, summary.json");
   run->add_option("model", model_path, "model file (YAML)")->required();
-  run->add_option("--integrator", integrator, "ida or euler (default: the model's)")->check(CLI::IsMember({"ida", "euler"}));
+  run->add_option("--integrator", integrator, "auto, ida or euler (default: the model's; a model that names none: auto)")
+      ->check(CLI::IsMember({"auto", "ida", "euler"}));
   CLI::Option* t_end_option = run->add_option("--t-end", t_end, "end time");
   // --t-end, --atol, --dt, --output-interval and --max-steps go to the model's simulation keys,
   // whose check refuses a non-finite or out-of-range value naming the model file (model_io.cpp).
@@ -812,7 +813,7 @@ int main(int argc, char** argv) {
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,
                                                    bisections, branch_window_ms);
     if (!integrator.empty())
-      overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
+      overrides.integrator = railcrash::integrator_from_name(integrator);
     if (*t_end_option) overrides.t_end = t_end;
     if (*rtol_option) overrides.rtol = rtol;
     if (*atol_option) overrides.atol = atol;
