@@ -1,0 +1,220 @@
+"""The model file's JSON Schema (docs/railcrash-model.schema.json, README "Editor support").
+
+Usage: python3 test_model_schema.py MODE RAILCRASH_BINARY SOURCE_DIR, MODE one of
+  current   the committed schema equals what `railcrash schema` prints;
+  models    every model file under models/ and verification/ (a YAML map with a top-level
+            `railcrash` key; sweep plans, sensitivity designs and reading studies are other
+            formats) is valid against the schema;
+  agree     bad models (a misspelt parameter, a missing required one, a string for a number, an
+            unknown element type, ...) are rejected by the schema AND by `railcrash check`, and
+            their unbroken base by neither.
+
+YAML is read as YAML 1.2 reads numbers (what railcrash and VS Code's YAML extension do):
+PyYAML's YAML 1.1 rules read 1e6 (no dot) as a string. Anchors, aliases and merge keys are
+resolved by the YAML reader before validation, as in an editor.
+"""
+import copy
+import difflib
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import jsonschema
+import yaml
+
+
+class Yaml12Loader(yaml.SafeLoader):
+    """SafeLoader with YAML 1.2's floats (1e6, 2E-3 without a dot)."""
+
+
+Yaml12Loader.yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+Yaml12Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][-+]?[0-9]+)?$|^[-+]?\.(?:inf|Inf|INF)$|^\.(?:nan|NaN|NAN)$"),
+    list("-+0123456789."),
+)
+# An integer-looking scalar stays an integer (the int resolver is tried first for it).
+
+
+def load_yaml(path):
+    with open(path, encoding="utf-8") as f:
+        return yaml.load(f, Loader=Yaml12Loader)
+
+
+def schema_text(binary):
+    return subprocess.run([binary, "schema"], check=True, capture_output=True, text=True).stdout
+
+
+def validator(source_dir):
+    import json
+    with open(os.path.join(source_dir, "docs", "railcrash-model.schema.json"), encoding="utf-8") as f:
+        schema = json.load(f)
+    jsonschema.Draft7Validator.check_schema(schema)
+    return jsonschema.Draft7Validator(schema)
+
+
+def errors_of(v, document):
+    return sorted(v.iter_errors(document), key=lambda e: list(e.absolute_path))
+
+
+def describe(error):
+    # The deepest cause of an if/then failure says what is wrong.
+    path = "/".join(str(p) for p in error.absolute_path) or "(top)"
+    return f"{path}: {error.message[:300]}"
+
+
+def model_files(source_dir):
+    out = []
+    for top in ("models", "verification"):
+        for folder, _, files in os.walk(os.path.join(source_dir, top)):
+            for name in sorted(files):
+                if name.endswith((".yaml", ".yml")):
+                    path = os.path.join(folder, name)
+                    document = load_yaml(path)
+                    if isinstance(document, dict) and "railcrash" in document:
+                        out.append((path, document))
+    return sorted(out)
+
+
+def mode_current(binary, source_dir):
+    committed_path = os.path.join(source_dir, "docs", "railcrash-model.schema.json")
+    with open(committed_path, encoding="utf-8") as f:
+        committed = f.read()
+    generated = schema_text(binary)
+    if committed != generated:
+        sys.stdout.writelines(difflib.unified_diff(committed.splitlines(True), generated.splitlines(True),
+                                                   "docs/railcrash-model.schema.json (committed)", "railcrash schema"))
+        print("FAIL: docs/railcrash-model.schema.json differs from `railcrash schema` (- committed, + generated).")
+        print("Regenerate it from the source folder with: build/railcrash schema -o docs/railcrash-model.schema.json")
+        return 1
+    print("docs/railcrash-model.schema.json matches `railcrash schema`")
+    return 0
+
+
+def mode_models(binary, source_dir):
+    v = validator(source_dir)
+    files = model_files(source_dir)
+    failed = 0
+    for path, document in files:
+        errors = errors_of(v, document)
+        if errors:
+            failed += 1
+            print(f"FAIL: {os.path.relpath(path, source_dir)} is not valid against the schema:")
+            for e in errors[:10]:
+                print("   ", describe(e))
+    if len(files) < 20:
+        print(f"FAIL: only {len(files)} model files found under models/ and verification/")
+        return 1
+    print(f"{len(files) - failed} of {len(files)} model files valid against the schema")
+    return 1 if failed else 0
+
+
+def first_element(document, type_name):
+    for e in document["elements"]:
+        if e["type"] == type_name:
+            return e
+    raise AssertionError(f"no {type_name} element in the base model")
+
+
+def bad_models(source_dir):
+    """(what, base path, edit, what the loader's message must contain) for each case."""
+    spring_mass = os.path.join(source_dir, "verification", "cases", "spring_mass.yaml")
+    emu = os.path.join(source_dir, "models", "examples", "emu3_wall.yaml")
+    anticlimber = os.path.join(source_dir, "models", "report", "final_two_car.yaml")
+
+    def rename(key, new):
+        def edit(d):
+            e = first_element(d, "linear_spring")
+            e[new] = e.pop(key)
+        return edit
+
+    def spring(key, value):
+        def edit(d):
+            first_element(d, "linear_spring")[key] = value
+        return edit
+
+    def drop(key):
+        def edit(d):
+            del first_element(d, "linear_spring")[key]
+        return edit
+
+    def set_path(*path_and_value):
+        *path, value = path_and_value
+
+        def edit(d):
+            node = d
+            for step in path[:-1]:
+                node = node[step]
+            node[path[-1]] = value
+        return edit
+
+    def anticlimber_word(d):
+        first_element(d, "anticlimber")["interlock_while_unloading"] = "loosen"
+
+    return [
+        ("a misspelt parameter", spring_mass, rename("stiffness", "stifness"), "unknown key 'stifness'"),
+        ("a missing required parameter", spring_mass, drop("stiffness"), "missing required parameter 'stiffness'"),
+        ("a string where a number belongs", spring_mass, spring("stiffness", "stiff"), "must be a number"),
+        ("a list where a number belongs", spring_mass, spring("free_length", [1.0, 2.0]), "must be a number"),
+        ("a negative value where it must not be", spring_mass, spring("stiffness", -5.0), "must not be negative"),
+        ("an unknown element type", spring_mass, spring("type", "linear_sprung"), "unknown element type 'linear_sprung'"),
+        ("a misspelt body key", spring_mass, set_path("bodies", 0, "intertia", 0.1), "unknown key 'intertia'"),
+        ("an unknown integrator", spring_mass, set_path("simulation", "integrator", "rk4"), "integrator must be ida or euler"),
+        ("an unknown unit system", spring_mass, set_path("units", "furlongs"), "units must be"),
+        ("an unknown top-level key", spring_mass, set_path("simulaton", {"t_end": 1.0}), "unknown key 'simulaton'"),
+        ("a choice outside its values", anticlimber, anticlimber_word, "interlock_while_unloading"),
+        ("a misspelt key of a train's car", emu, set_path("trains", 0, "cars", 0, "reverse", True), "unknown key 'reverse'"),
+        ("a train facing neither way", emu, set_path("trains", 0, "facing", "up"), "facing must be +x or -x"),
+        ("a misspelt parameter in a car type", emu,
+         lambda d: next(iter(d["car_types"].values()))["elements"][0].update({"stifnes": 1.0}), "unknown key 'stifnes'"),
+    ]
+
+
+def railcrash_check(binary, document):
+    with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+        yaml.safe_dump(document, f, sort_keys=False)
+        path = f.name
+    try:
+        return subprocess.run([binary, "check", path], capture_output=True, text=True)
+    finally:
+        os.unlink(path)
+
+
+def mode_agree(binary, source_dir):
+    v = validator(source_dir)
+    failed = 0
+    checked_bases = set()
+    for what, base_path, edit, message in bad_models(source_dir):
+        base = load_yaml(base_path)
+        if base_path not in checked_bases:  # the unbroken base passes both
+            checked_bases.add(base_path)
+            result = railcrash_check(binary, base)
+            if result.returncode != 0 or errors_of(v, base):
+                print(f"FAIL: the base model {base_path} is rejected (railcrash check: {result.stderr.strip()})")
+                failed += 1
+        document = copy.deepcopy(base)
+        edit(document)
+        schema_errors = errors_of(v, document)
+        result = railcrash_check(binary, document)
+        loader_ok = result.returncode == 2 and message in result.stderr
+        if not schema_errors or not loader_ok:
+            failed += 1
+            print(f"FAIL: {what}: schema {'rejects' if schema_errors else 'ACCEPTS'} it; railcrash check exits "
+                  f"{result.returncode} with: {result.stderr.strip()[:400]} (expected a message with '{message}')")
+        else:
+            print(f"ok: {what}: schema: {describe(schema_errors[0])}; railcrash check: {result.stderr.strip()[:200]}")
+    return 1 if failed else 0
+
+
+def main():
+    if len(sys.argv) != 4 or sys.argv[1] not in ("current", "models", "agree"):
+        print(__doc__)
+        return 2
+    mode, binary, source_dir = sys.argv[1:]
+    return {"current": mode_current, "models": mode_models, "agree": mode_agree}[mode](binary, source_dir)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
