@@ -359,7 +359,7 @@ std::map<std::string, SectionKeys> section_keys() {
       {"dt", {number("euler: time step [s]", Range::Positive)}},
       {"output_interval", {number("time between output rows [s]", Range::Positive)}},
       {"force_dt", {flag("euler: run with dt even above the stability limit")}},
-      {"max_steps", {number("most steps either integrator may take (a whole number >= 1)", Range::Positive)}},
+      {"max_steps", {typed("integer", "most steps either integrator may take").set("minimum", Json::number(1))}},
       {"static_equilibrium", {flag("start from static equilibrium under gravity (computed before the run)")}},
       {"penalty_stiffness", {number("euler: stiffness of constraint penalty springs (" + unit_text(Unit::ForcePerLength) + ")", Range::Positive)}},
       {"penalty_damping", {number("euler: damping of constraint penalty springs (" + unit_text(Unit::ForceTimePerLength) + ")", Range::Positive)}},

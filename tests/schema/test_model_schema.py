@@ -128,6 +128,7 @@ def bad_models(source_dir):
     spring_mass = os.path.join(source_dir, "verification", "cases", "spring_mass.yaml")
     emu = os.path.join(source_dir, "models", "examples", "emu3_wall.yaml")
     anticlimber = os.path.join(source_dir, "models", "report", "final_two_car.yaml")
+    scenario = os.path.join(source_dir, "models", "scenarios", "scenario1_report_car.yaml")
 
     def rename(key, new):
         def edit(d):
@@ -170,6 +171,12 @@ def bad_models(source_dir):
         ("an unknown unit system", spring_mass, set_path("units", "furlongs"), "units must be"),
         ("an unknown top-level key", spring_mass, set_path("simulaton", {"t_end": 1.0}), "unknown key 'simulaton'"),
         ("a choice outside its values", anticlimber, anticlimber_word, "interlock_while_unloading"),
+        ("a third point on a two-point element", spring_mass,
+         lambda d: first_element(d, "linear_spring")["points"].append({"body": "mass"}), "needs exactly 2 points"),
+        ("a fractional max_steps", spring_mass, set_path("simulation", "max_steps", 10.5), "max_steps must be a whole number"),
+        ("a misspelt key of the scenario section", scenario, set_path("scenario", "override", "wheel_lift_limt", 1.0),
+         "unknown key 'wheel_lift_limt'"),
+        ("an unknown design category", scenario, set_path("scenario", "category", "C-V"), "category must be"),
         ("a misspelt key of a train's car", emu, set_path("trains", 0, "cars", 0, "reverse", True), "unknown key 'reverse'"),
         ("a train facing neither way", emu, set_path("trains", 0, "facing", "up"), "facing must be +x or -x"),
         ("a misspelt parameter in a car type", emu,
