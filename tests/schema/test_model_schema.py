@@ -4,7 +4,8 @@ Usage: python3 test_model_schema.py MODE RAILCRASH_BINARY SOURCE_DIR, MODE one o
   current   the committed schema equals what `railcrash schema` prints;
   models    every model file under models/ and verification/ (a YAML map with a top-level
             `railcrash` key; sweep plans, sensitivity designs and reading studies are other
-            formats) is valid against the schema;
+            formats) is valid against the schema, and so is what `railcrash expand` writes from
+            those with trains;
   agree     bad models (a misspelt parameter, a missing required one, a string for a number, an
             unknown element type, ...) are rejected by the schema AND by `railcrash check`, and
             their unbroken base by neither; a model with anchors and aliases is accepted by both,
@@ -109,10 +110,26 @@ def mode_models(binary, source_dir):
             print(f"FAIL: {os.path.relpath(path, source_dir)} is not valid against the schema:")
             for e in errors[:10]:
                 print("   ", describe(e))
+    # What `railcrash expand` writes from a model with trains is a flat model: valid too.
+    expanded = 0
+    for path, document in files:
+        if "trains" not in document:
+            continue
+        result = subprocess.run([binary, "expand", path], capture_output=True, text=True)
+        errors = errors_of(v, yaml.load(result.stdout, Loader=Yaml12Loader)) if result.returncode == 0 else []
+        if result.returncode != 0 or errors:
+            failed += 1
+            print(f"FAIL: railcrash expand {os.path.relpath(path, source_dir)}: exit {result.returncode} {result.stderr.strip()[:300]}")
+            for e in errors[:10]:
+                print("   ", describe(e))
+        expanded += 1
+    if expanded == 0:
+        print("FAIL: no model with trains to expand")
+        return 1
     if len(files) < 20:
         print(f"FAIL: only {len(files)} model files found under models/ and verification/")
         return 1
-    print(f"{len(files) - failed} of {len(files)} model files valid against the schema")
+    print(f"{len(files)} model files and {expanded} expanded train models checked against the schema, {failed} invalid")
     return 1 if failed else 0
 
 
