@@ -266,7 +266,11 @@ Json element_type_schema(const ElementType& type) {
 Json element_schema(const ElementRegistry& registry, const std::string& point, const std::string& description) {
   Json properties = Json::object();
   properties.set("name", word("the element's name (its output columns are <name>.<quantity>)"));
-  properties.set("type", one_of_words(registry.types(), "the element type (railcrash elements TYPE; docs/elements.md)"));
+  // enumDescriptions (VS Code's extension of JSON Schema): each type's law, shown as it is completed.
+  Json laws = Json::array();
+  for (const std::string& name : registry.types()) laws.push(Json::text(registry.find(name)->summary));
+  properties.set("type", one_of_words(registry.types(), "the element type (railcrash elements TYPE; docs/elements.md)")
+                             .set("enumDescriptions", laws));
   properties.set("points", list_of(definition_ref(point), "connection points, as many as the type takes"));
   Json cases = Json::array();
   for (const std::string& name : registry.types())
