@@ -246,9 +246,35 @@ def agree_on_text(binary, v, what, text, accepted, message=""):
     return True
 
 
+def scenario_keys_agree(v, source_dir):
+    """The scenario section's keys are described by hand in src/model_schema.cpp: they must be
+    the lists read_scenario_section (src/scenario/criteria.cpp) passes to only_keys."""
+    with open(os.path.join(source_dir, "src", "scenario", "criteria.cpp"), encoding="utf-8") as f:
+        text = f.read()
+    lists = re.findall(r'only_keys\(\w+,\s*\{([^}]*)\},\s*"([^"]*)"\)', text)
+    scenario = v.schema["definitions"]["scenario"]
+    where = {"the section": scenario, "mean_deceleration": scenario["properties"]["mean_deceleration"],
+             "survival_space": scenario["properties"]["survival_space"],
+             "survival_space: gauge": scenario["properties"]["survival_space"]["properties"]["gauges"]["items"],
+             "override": scenario["properties"]["override"]}
+    ok = len(lists) == len(where)
+    for keys, context in lists:
+        loader = set(re.findall(r'"([^"]+)"', keys))
+        schema = set(where[context]["properties"]) if context in where else set()
+        if loader != schema:
+            ok = False
+            print(f"FAIL: scenario section '{context}': criteria.cpp allows {sorted(loader)}, the schema {sorted(schema)}")
+    if len(lists) != len(where):
+        print(f"FAIL: criteria.cpp has {len(lists)} only_keys lists, the schema describes {len(where)} maps of the scenario section")
+    if ok:
+        print(f"ok: the scenario section's {len(lists)} key lists are the schema's")
+    return ok
+
+
 def mode_agree(binary, source_dir):
     v = validator(source_dir)
     failed = 0
+    failed += not scenario_keys_agree(v, source_dir)
     failed += not agree_on_text(binary, v, "anchors and aliases", ALIASES, True)
     failed += not agree_on_text(binary, v, "a merge key", MERGE, False, "unknown key '<<'")
     checked_bases = set()
