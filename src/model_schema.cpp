@@ -211,8 +211,8 @@ std::string presence_text(const Presence& presence) {
 /// meaning, unit and presence.
 Json parameter_schema(const ParameterSpec& spec) {
   const std::string range = range_text(spec.range);
-  const std::string description = spec.meaning + ". " + unit_text(spec.unit) + (range.empty() ? "" : ", " + range) + ". " +
-                                  presence_text(spec.presence);
+  const std::string unit = spec.unit == Unit::Choice ? "" : unit_text(spec.unit) + (range.empty() ? "" : ", " + range) + ". ";
+  const std::string description = spec.meaning + ". " + unit + presence_text(spec.presence);
   const std::vector<std::string> values = choice_values(spec);
   Json j;
   switch (spec.shape) {
