@@ -24,6 +24,7 @@
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/model_schema.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
@@ -758,6 +759,10 @@ int main(int argc, char** argv) {
   expand->add_option("--set", settings, "override a model key");
   expand->add_option("--out", expand_out, "model file to write (default: standard output)");
 
+  std::string schema_out;
+  CLI::App* schema = app.add_subcommand("schema", "write the JSON Schema of the model file (for editors: README \"Editor support\")");
+  schema->add_option("-o,--out", schema_out, "file to write (default: standard output)");
+
   std::string element_type_name;
   bool elements_markdown = false;
   CLI::App* elements = app.add_subcommand("elements", "element reference: the types, or one type's points and parameters");
@@ -773,6 +778,11 @@ int main(int argc, char** argv) {
     if (*check) return check_command(model_path, settings);
     if (*expand) return expand_command(model_path, settings, expand_out, expand->count("--out") > 0);
     if (*elements) return elements_command(element_type_name, elements_markdown);
+    if (*schema) {
+      if (schema->count("--out") > 0) railcrash::check_output_file(schema_out);
+      return write_generated_model(railcrash::model_schema_json(railcrash::ElementRegistry::instance()), schema_out,
+                                   "the model file's JSON Schema");
+    }
     if (*report) return report_command(report_dir, report_cfc, report_force_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {

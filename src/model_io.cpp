@@ -1234,4 +1234,10 @@ std::vector<std::string> model_file_keys() {
   return keys;
 }
 
+std::vector<std::pair<std::string, std::vector<std::string>>> model_file_sections() {
+  return {{"model", kTopKeys},          {"body", kBodyKeys},         {"point", kPointKeys},
+          {"load", kLoadKeys},          {"simulation", kSimulationKeys}, {"output", kOutputKeys},
+          {"responses", kResponseKeys}, {"crush_gauge", kCrushGaugeKeys}, {"variant", kVariantKeys}};
+}
+
 }  // namespace railcrash
