@@ -212,6 +212,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
         if (next) {
           active->finish();  // the counters of the steps so far
           next->take_run_from(*active);
+          next->continue_from_hand_over();
           successor = std::move(next);  // (the previous successor, if any, is done with)
           active = successor.get();
           dense = active->dense_output();

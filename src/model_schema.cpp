@@ -356,8 +356,10 @@ std::map<std::string, SectionKeys> section_keys() {
   };
   s["simulation"] = {
       {"t_end", {number("end time of the run [s]", Range::Positive), true}},
-      {"integrator", {one_of_words({"ida", "euler"}, "ida (SUNDIALS IDA, BDF with KLU; default) or euler (explicit Euler with "
-                                                     "penalty constraints, as IITRAIN)")}},
+      {"integrator", {one_of_words({"auto", "ida", "euler"},
+                                   "auto (default: IDA, handing the run to Euler where Euler is clearly the cheaper at "
+                                   "the same resolution), ida (SUNDIALS IDA, BDF with KLU) or euler (explicit Euler with "
+                                   "penalty constraints, as IITRAIN)")}},
       {"rtol", {number("ida: relative tolerance", Range::Positive)}},
       {"atol", {number("ida: absolute tolerance of lengths (" + kLength + "); default from the model's size", Range::Positive)}},
       {"dt", {number("euler: time step [s]", Range::Positive)}},

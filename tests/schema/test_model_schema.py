@@ -184,7 +184,7 @@ def bad_models(source_dir):
         ("a negative value where it must not be", spring_mass, spring("stiffness", -5.0), "must not be negative"),
         ("an unknown element type", spring_mass, spring("type", "linear_sprung"), "unknown element type 'linear_sprung'"),
         ("a misspelt body key", spring_mass, set_path("bodies", 0, "intertia", 0.1), "unknown key 'intertia'"),
-        ("an unknown integrator", spring_mass, set_path("simulation", "integrator", "rk4"), "integrator must be ida or euler"),
+        ("an unknown integrator", spring_mass, set_path("simulation", "integrator", "rk4"), "integrator must be auto, ida or euler"),
         ("an unknown unit system", spring_mass, set_path("units", "furlongs"), "units must be"),
         ("an unknown top-level key", spring_mass, set_path("simulaton", {"t_end": 1.0}), "unknown key 'simulaton'"),
         ("a choice outside its values", anticlimber, anticlimber_word, "interlock_while_unloading"),
