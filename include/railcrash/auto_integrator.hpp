@@ -19,10 +19,11 @@
 //   min_span_steps Euler steps and after at least min_events mode changes,
 //     (1) its cost exceeds Euler's by the margin (1.5), and
 //     (2) its mean step over the span is at least dt_E: Euler, first order, is not to take
-//         coarser steps than IDA's error control needs. On the SI multiple-unit models of
-//         bench/ IDA's steps are a tenth of Euler's stable step, and Euler there is 8-16 %
-//         off in the trailing cars' crush and 11 % in the energy absorbed (bench/README.md):
-//         cheaper, but not at the same accuracy, so IDA keeps those runs.
+//         coarser steps than IDA's error control needs. On the SI multiple-unit examples
+//         IDA's mean step is a third to a seventh of Euler's stable step, and Euler there is
+//         up to 16 % off in a trailing car's crush and 7-16 % in the energy the crush zones
+//         absorb (bench/README.md, "integrator: auto"): cheaper, but not at the same
+//         accuracy, so IDA keeps those runs.
 // * Euler goes on from IDA's state at the end of that step, in the element modes reached, and
 //   never hands the run back.
 // The run's output and summary.json ("integrator_used") say which method ran when and why.
