@@ -66,8 +66,9 @@ struct ScenarioRequest {
   std::optional<double> override_limit;         // [mm] largest vertical relative displacement
   std::optional<double> wheel_lift_limit;       // [mm]
   std::vector<std::string> passenger_bodies;    // train model bodies (a template's without the car1_ prefix)
-  std::vector<std::string> crush_zones;         // crush elements (named as passenger_bodies) whose crush is allowed:
-                                                // left out of the survival-space loss
+  std::vector<std::string> crush_zones;         // declared crush zones NAME or NAME:STROKE [mm] (named as passenger_bodies;
+                                                // a car type's element name reaches every instance): their crush up
+                                                // to the stroke (default: the end of the declared curve) is allowed
   std::vector<std::string> survival_gauge;      // optional: two bodies (front, rear), named as passenger_bodies
   double wagon_mass = 80.0;                     // [t] scenario 2
   std::vector<std::pair<double, double>> buffer_curve;  // [mm, kN] one buffer's force-stroke curve
@@ -80,6 +81,9 @@ struct ScenarioRequest {
   std::optional<double> obstacle_unloading_stiffness;   // [kN/mm] scenario 3
   std::optional<double> obstacle_height;                // [mm] scenario 3: its contact point above the rail
   std::optional<double> t_end;                          // [s] default: the template's
+  std::string unit;       // model with car types and trains: the train to use (default: its first)
+  std::string interface;  // model with car types and trains, scenario 1: the interface type joining the two
+                          // trains (default: that of the model's connection at the train's leading end)
 };
 
 /// YAML text of the scenario's model. Throws InputError naming the missing option, or what
