@@ -15,6 +15,7 @@
 #include "railcrash/run.hpp"
 #include "railcrash/scenario/criteria.hpp"
 #include "railcrash/scenario/en15227.hpp"
+#include "requests.hpp"
 
 using namespace railcrash;
 
@@ -23,14 +24,7 @@ namespace {
 const std::string kTrain = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml";
 
 ScenarioRequest report_car(int number) {
-  ScenarioRequest q;
-  q.number = number;
-  q.train_path = kTrain;
-  q.offset = 40.0;
-  q.deceleration_limit = 5.0;
-  q.survival_limit = 50.0;
-  q.override_limit = 100.0;
-  q.wheel_lift_limit = 20.0;
+  ScenarioRequest q = testing::example_request(number, kTrain);
   q.passenger_bodies = {"center_body"};
   q.survival_gauge = {"bolster_body", "rear_body"};
   q.buffer_curve = {{0.0, 0.0}, {105.0, 1000.0}, {150.0, 2000.0}};
