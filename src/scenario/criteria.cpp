@@ -236,12 +236,18 @@ double largest_lift(const std::vector<double>& penetration) {
   return largest;
 }
 
+double static_load(const std::vector<double>& reaction) {
+  for (const double q : reaction)
+    if (q != 0.0) return q;
+  return 0.0;
+}
+
 double largest_unloading(const std::vector<double>& reaction) {
-  if (reaction.empty()) return 0.0;
-  const double static_load = reaction.front();
-  if (static_load == 0.0) return std::numeric_limits<double>::infinity();
-  double lowest = 1.0;  // Q / Q0
-  for (const double q : reaction) lowest = std::min(lowest, q / static_load);
+  const double q0 = static_load(reaction);
+  if (q0 == 0.0) return reaction.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+  double lowest = 1.0;  // Q / Q0, from the first known reaction on
+  const auto first = std::find_if(reaction.begin(), reaction.end(), [](double q) { return q != 0.0; });
+  for (auto q = first; q != reaction.end(); ++q) lowest = std::min(lowest, *q / q0);
   return 1.0 - lowest;
 }
 
@@ -325,8 +331,8 @@ void ScenarioTracker::step(double, const double* y, const double* lambda, const 
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
     if (fresh.has(wheel_columns_[k])) step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
   for (std::size_t k = 0; k < support_columns_.size(); ++k)
-    if (fresh.has(support_columns_[k]) && reaction_[k].front() != 0.0)
-      step_extremes_.lowest_load[k] = std::min(step_extremes_.lowest_load[k], outputs[support_columns_[k]] / reaction_[k].front());
+    if (const double q0 = static_load(reaction_[k]); fresh.has(support_columns_[k]) && q0 != 0.0)
+      step_extremes_.lowest_load[k] = std::min(step_extremes_.lowest_load[k], outputs[support_columns_[k]] / q0);
 }
 
 void ScenarioTracker::sample(double t, const double* y, const double*, const double*, const double* outputs) {

@@ -130,8 +130,11 @@ double largest_shortening(const std::vector<double>& lengths);
 double largest_change(const std::vector<double>& values);
 /// Largest lift max(0, -penetration) of a wheel [length].
 double largest_lift(const std::vector<double>& penetration);
-/// Largest unloading (Q0 - Q) / Q0 of a rail reaction Q against its first value Q0 (the static
-/// wheel load; either sign); infinity when Q0 is 0 (no static load to compare with).
+/// The static load Q0 of a rail reaction history: its first non-zero value (explicit Euler's
+/// penalty joints report no reaction in the first sample); 0 if there is none.
+double static_load(const std::vector<double>& reaction);
+/// Largest unloading (Q0 - Q) / Q0 of a rail reaction Q against its static load Q0 (either
+/// sign); infinity when Q0 is 0 (no static load to compare with).
 double largest_unloading(const std::vector<double>& reaction);
 
 /// Collects the histories during a run and evaluates the criteria at the end.
