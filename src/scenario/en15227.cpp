@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cctype>
+#include <cstdio>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -212,6 +213,7 @@ struct Trains {
   std::vector<std::string> excluded;            // crush elements that are not the train's (the struck body's)
   std::vector<std::pair<std::string, std::optional<double>>> zones;  // declared crush zones, stroke [mm] if given
   std::vector<std::string> rail_supports;       // slider_joints holding the leading bogies (no wheel_rail)
+  std::string striking_label = "s*", standing_label = "t*";  // the trains' names in the header
   std::vector<std::string> wheels;              // the leading bogies' wheel_rail elements
   std::string interface_element;                // the anticlimber between two template-built trains
   std::vector<std::string> interface_bodies;    // otherwise the two bodies meeting at the interface
@@ -528,12 +530,9 @@ YAML::Node criteria_section(const ScenarioRequest& q, const Trains& trains, cons
 /// end of its declared loading curve (results/crush_zones.hpp: a crush_spring's last curve point,
 /// a draft gear's travel, an anticlimber's rupture deflection), the crush its curve declares.
 void resolve_zone_strokes(const YAML::Node& model_node, const std::string& path, const Units& u, Trains& trains) {
-  bool any_missing = false;
-  for (auto& zone : trains.zones) {
+  for (auto& zone : trains.zones)
     if (zone.second) zone.second = u.length(*zone.second);
-    else any_missing = true;
-  }
-  if (!any_missing) return;
+  if (trains.zones.empty()) return;
   YAML::Node copy = YAML::Clone(model_node);
   copy["name"] = "scenario";
   YAML::Emitter emitter;
@@ -541,13 +540,18 @@ void resolve_zone_strokes(const YAML::Node& model_node, const std::string& path,
   const Model model = load_model_text(std::string(emitter.c_str()) + "\n", path);
   const double to_file = u.millimetre ? 1e3 : 1.0;  // the loaded model is in SI for mm-t-s-N files
   for (auto& [name, stroke] : trains.zones) {
-    if (stroke) continue;
     const auto element = std::find_if(model.elements().begin(), model.elements().end(), [&](const auto& e) { return e->name() == name; });
-    const std::optional<DeclaredCurve> curve = element == model.elements().end() ? std::nullopt : declared_curve(**element);
+    if (element == model.elements().end() || (*element)->output_with_role(OutputRole::Crush).empty())
+      refuse("--crush-zones: '" + name + "' has no crush output (OutputRole::Crush): it is not part of a car's survival-space "
+             "measure, so declaring it a crush zone would change nothing; leave it out");
+    if (stroke) continue;
+    const std::optional<DeclaredCurve> curve = declared_curve(**element);
     if (!curve || curve->open_ended || curve->deformation.empty() || !(curve->deformation.back() > 0.0))
       refuse("--crush-zones: '" + name + "' declares no loading curve with an end (a crush_spring's curve, a draft gear's travel, an "
              "anticlimber's rupture deflection); give its stroke, NAME:STROKE [mm]");
-    stroke = curve->deformation.back() * to_file;
+    char text[32];  // 12 digits: the file's value back, without the unit conversion's round-off
+    std::snprintf(text, sizeof text, "%.12g", curve->deformation.back() * to_file);
+    stroke = std::stod(text);
   }
 }
 
@@ -759,6 +763,8 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
   trains.face_x = 0.0;
   doc.remove("name");
   trains.model = doc;
+  trains.striking_label = striking;
+  trains.standing_label = standing;
   trains.header << "# Trains: " << train_name << " of " << path << " (" << trains.cars_per_train << " cars, car types";
   for (const ExpandedCar& car : expansion.cars)
     if (starts_with(car.name, striking + ".")) trains.header << " " << car.type << (car.reversed ? " (reversed)" : "");
@@ -857,7 +863,8 @@ std::string make_scenario_model(const ScenarioRequest& q) {
   if (q.number == 1) {
     header << "# Vertical offset " << *q.offset << " mm = " << offset << " " << u.length_name()
            << " (--offset, required input): the standing train and its rails are raised by it.\n"
-           << "# Centre-of-mass frame: the striking train (s*) at +" << closing_speed / 2 << ", the standing one (t*) at -"
+           << "# Centre-of-mass frame: the striking train (" << trains.striking_label << ") at +" << closing_speed / 2 << ", the standing one ("
+           << trains.standing_label << ") at -"
            << closing_speed / 2 << " " << u.speed_name() << ".\n";
   } else if (q.number == 2) {
     add_struck_body({"wagon", "wagon_buffers", q.wagon_mass, &q.buffer_curve, *q.buffer_unloading_stiffness, *q.buffer_height, 2}, u, trains);

@@ -191,6 +191,12 @@ TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the 
   CHECK(strokes.at("standing.car2.front_crush") == Approx(0.2));
   CHECK(strokes.at("standing.car3.rear_crush") == Approx(0.2));
   CHECK(strokes.size() == 12);
+  // Without a stroke, a zone's is the end of its declared curve: the cab front's last point, 950 mm.
+  ScenarioRequest q = emu3(1, "emu3_unit_collision.yaml");
+  q.crush_zones = {"cab_car.front_crush"};
+  const Model declared = load_model_text(make_scenario_model(q), "s1.yaml");
+  for (const auto& zone : declared.scenario->survival_zones) CHECK(zone.stroke == Approx(0.95).epsilon(1e-12));
+  CHECK(declared.scenario->survival_zones.size() == 4);
 }
 
 TEST_CASE("scenario 1 from car types: the 40 mm offset acts through the anticlimber's interlock", "[scenario]") {
@@ -224,6 +230,8 @@ TEST_CASE("scenario from car types: what is missing is named", "[scenario]") {
   CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("no element named 'front_crash' in car type cab_car"));
   q.crush_zones = {"anticlimber"};
   CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("'impact.anticlimber' declares no loading curve with an end"));
+  q.crush_zones = {"draft_gear"};  // a draft gear has no crush output: not in the survival-space measure
+  CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("'striking.coupling1.draft_gear' has no crush output"));
   q.crush_zones = {"front_crush:x"};
   CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("the stroke after ':' must be a number"));
 }

@@ -38,6 +38,21 @@
 // scenario 1 puts the unit (s_*) against its mirror image (t_*), their front faces meeting at an
 // uncoupled coupler_end (front_faces, the face stiffness and height required inputs); --cars is
 // then the unit's own cars.
+// A model with car types and trains (train_expansion.hpp, e.g. models/examples/emu3_*.yaml) is
+// used as it composes its train (ScenarioRequest::unit, default its first): the train renamed
+// `striking`, facing +x with its leading interface at x = 0; in scenario 1 a copy `standing`
+// facing -x, raised with its rails by the offset, joined to it at the leading interfaces by a
+// connection `impact` of the interface type the model's own connection there uses (or
+// ScenarioRequest::interface). The document is expanded by the generator (the raise applies to
+// the expanded bodies and ground points); the model's own flat bodies and elements, other trains
+// and connections are left out. With an offset, the interface type must contain an anticlimber:
+// without a vertical interlock (or friction) the faces slide past each other and the offset
+// cannot produce override, so the request is refused. Car-type names reach every instance:
+// passenger bodies and crush zones (TYPE.NAME: only car type TYPE's instances). The leading
+// cars' wheels are their foremost wheel_rail elements or, without any, their foremost
+// slider_joints on ground (the rail supports of scenario/criteria.hpp's wheel unloading).
+// Crush zones (--crush-zones NAME[:STROKE mm]) become the section's `zones` with their strokes
+// in the model's units (without a stroke: the end of the element's declared curve).
 // Scenario 3: the train at --speed (required: the speed per category was not confirmed) into an
 // obstacle of 15 t (railwaynews.net, scenario 3) built like the wagon: one body on a frictionless
 // slider and a crush_spring with the obstacle's force-crush curve (required) at its contact height
