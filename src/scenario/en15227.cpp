@@ -224,7 +224,6 @@ struct Trains {
   std::ostringstream header;                    // the model file's comment lines
 };
 
-/// Refuses a --crush-zones name that is no element of the train model.
 /// A --crush-zones entry NAME or NAME:STROKE [mm].
 std::pair<std::string, std::optional<double>> crush_zone(const std::string& entry) {
   const auto colon = entry.find(':');
@@ -256,13 +255,14 @@ void add_zones(Trains& trains, const std::vector<std::string>& prefixes, const s
     }
 }
 
+/// Refuses a --crush-zones name that is no element of the train model.
 void check_crush_zones(const YAML::Node& root, const std::string& path, const std::vector<std::string>& entries, const std::string& prefix) {
   for (const std::string& name : crush_zone_names(entries)) {
     bool found = false;
     for (const YAML::Node& e : root["elements"]) found = found || (e["name"] && e["name"].as<std::string>() == prefix + name);
     if (!found)
       throw InputError(path + ": scenario train model: no element named '" + prefix + name + "' (from --crush-zones, which names the " +
-                       "crush elements of a car whose crush is allowed" + (prefix.empty() ? "" : ", without the car1_ prefix") + ")");
+                       "crush elements of a car whose crush up to their stroke is allowed" + (prefix.empty() ? "" : ", without the car1_ prefix") + ")");
   }
 }
 

@@ -57,8 +57,9 @@
 // obstacle of 15 t (railwaynews.net, scenario 3) built like the wagon: one body on a frictionless
 // slider and a crush_spring with the obstacle's force-crush curve (required) at its contact height
 // (required). No interface: override is judged by the leading bogie's wheel lift.
-// The struck body's spring (wagon_buffers, obstacle_crush) and --crush-zones are left out of the
-// survival-space loss (the cars' crush outputs, scenario/criteria.hpp).
+// The struck body's spring (wagon_buffers, obstacle_crush) is left out of the survival-space loss
+// (the cars' crush outputs, scenario/criteria.hpp), and the --crush-zones count only beyond their
+// strokes.
 // Scenario 4 is refused with the reason: its obstacle is pushed sideways, out of the plane.
 #pragma once
 
