@@ -377,7 +377,8 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
       r.pass = false;
       r.note = "not measured: the car has no crush element (no output with the crush role) besides the excluded ones";
     } else if (std::any_of(allowed_[k].begin(), allowed_[k].end(), [](double stroke) { return stroke > 0.0; })) {
-      r.note = r.value > 0.0 ? "crushed beyond its declared crush zones" : "its crush stayed within its declared crush zones";
+      r.note = r.value > 0.0 ? "crushed beyond its declared crush zones' strokes or in crush elements not declared zones"
+                             : "its crush stayed within its declared crush zones";
     }
     out.push_back(r);
   }
