@@ -743,17 +743,24 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
     fail_at(path, root["car_types"], "the leading car " + first_car + " has neither wheel_rail elements nor slider_joints holding a "
                                      "body on the rail (points on ground): the override criterion needs the leading bogie's wheels");
   if (standing_train) {
-    for (const auto& e : model.elements())
-      if (starts_with(e->name(), "impact.") && !e->output_with_role(OutputRole::VerticalInterlockForce).empty() && e->type() == "anticlimber")
-        trains.interface_element = e->name();
-    if (trains.interface_element.empty()) {
-      if (offset > 0.0)
-        fail_at(path, root["interface_types"][interface],
-                "interface type '" + interface + "' has no element with a vertical interlock (an anticlimber): between faces "
-                "without vertical friction or interlock the vertical offset cannot act (nothing holds the faces together "
-                "vertically, so override cannot develop); give --interface naming an interface type with an anticlimber");
-      trains.interface_bodies = {striking + "." + first_car + "." + front_body_local, standing + "." + first_car + "." + front_body_local};
+    // What holds the two fronts together vertically: an anticlimber's interlock, a coupler_end's
+    // face friction, a coupling's head friction or vertical spring.
+    bool vertical = false;
+    for (const YAML::Node& e : doc["elements"]) {
+      if (!e["name"] || !starts_with(e["name"].Scalar(), "impact.")) continue;
+      const std::string type = e["type"].Scalar();
+      const auto positive = [&](const char* key) { return e[key] && e[key].as<double>() > 0.0; };
+      if (type == "anticlimber") trains.interface_element = e["name"].Scalar();
+      vertical = vertical || type == "anticlimber" || (type == "coupler_end" && positive("friction")) ||
+                 (type == "coupling" && (positive("friction") || positive("vertical_stiffness")));
     }
+    if (!vertical && offset > 0.0)
+      fail_at(path, root["interface_types"][interface],
+              "interface type '" + interface + "' has no element that acts vertically between the fronts (an anticlimber's "
+              "interlock, a coupler_end's friction, a coupling's friction or vertical_stiffness): the vertical offset cannot act "
+              "(nothing holds the faces together vertically, so override cannot develop); give --interface naming one that has");
+    if (trains.interface_element.empty())
+      trains.interface_bodies = {striking + "." + first_car + "." + front_body_local, standing + "." + first_car + "." + front_body_local};
   }
   trains.front_body = striking + "." + first_car + "." + front_body_local;
   const Body& front = model.bodies()[static_cast<std::size_t>(*model.find_body(trains.front_body))];

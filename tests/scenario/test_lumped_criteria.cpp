@@ -221,7 +221,7 @@ TEST_CASE("scenario from car types: what is missing is named", "[scenario]") {
   ScenarioRequest q = emu3(1, "emu3_wall.yaml");
   CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("give --interface TYPE (its interface types: semi_permanent)"));
   q.interface = "semi_permanent";
-  CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("has no element with a vertical interlock"));
+  CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("has no element that acts vertically between the fronts"));
   q = emu3(1, "emu3_unit_collision.yaml");
   q.unit = "unitC";
   CHECK_THROWS_WITH(make_scenario_model(q), Catch::Contains("no train named 'unitC' (from --unit); its trains: unitA, unitB"));
