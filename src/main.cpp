@@ -745,6 +745,8 @@ int main(int argc, char** argv) {
            {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)", length_mm},
            {"--face-stiffness", "scenario 1 from a model declaring its cars: each front face's stiffness [kN/mm] (required)", stiffness},
            {"--face-height", "scenario 1 from a model declaring its cars: each front face's height [mm] (required)", length_mm},
+           {"--face-friction", "scenario 1 from a model declaring its cars: friction coefficient between the front faces (required with an offset)",
+            finite_number(0, 10, false, false)},
            {"--obstacle-unloading-stiffness", "scenario 3: the obstacle's unloading stiffness [kN/mm] (required)", stiffness},
            {"--obstacle-height", "scenario 3: height of the obstacle's contact point above the rail [mm] (required)", length_mm},
            {"--t-end", "end time of the run [s] (default: the train model's)", finite_number(0, 1000, true, false, "s")}})
@@ -794,6 +796,7 @@ int main(int argc, char** argv) {
       scenario_request.buffer_height = given("--buffer-height");
       scenario_request.face_stiffness = given("--face-stiffness");
       scenario_request.face_height = given("--face-height");
+      scenario_request.face_friction = given("--face-friction");
       scenario_request.obstacle_unloading_stiffness = given("--obstacle-unloading-stiffness");
       scenario_request.obstacle_height = given("--obstacle-height");
       scenario_request.t_end = given("--t-end");

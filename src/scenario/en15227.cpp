@@ -340,6 +340,10 @@ void unit_trains(const ScenarioRequest& q, const TrainUnit& unit, const Units& u
     required(q.face_stiffness, "--face-stiffness", "the stiffness of each front face where the two trains meet [kN/mm] (the model "
                                                    "meets a barrier, not a second train)");
     required(q.face_height, "--face-height", "the height of each front face: they push only while they overlap vertically [mm]");
+    if (offset > 0.0)
+      required(q.face_friction, "--face-friction", "the friction coefficient between the front faces: with a vertical offset, "
+                                                   "vertical friction is what lets the offset act (frictionless faces slide past "
+                                                   "each other and override cannot develop)");
   }
   trains.model = YAML::Clone(unit.root);
   YAML::Node bodies(YAML::NodeType::Sequence), elements(YAML::NodeType::Sequence);
@@ -382,12 +386,15 @@ void unit_trains(const ScenarioRequest& q, const TrainUnit& unit, const Units& u
     faces["free_length"] = flow_pair(behind, behind);
     faces["coupler_height"] = flow_pair(height, height);
     faces["coupled"] = false;
+    if (q.face_friction) faces["friction"] = *q.face_friction;
     faces["points"] = two_points("s_" + unit.front_body, flow_pair(0.0, unit.face_y - unit.front_body_y), "t_" + unit.front_body,
                                  flow_pair(0.0, unit.face_y - unit.front_body_y));
     elements.push_back(faces);
     trains.interface_bodies = {"s_" + unit.front_body, "t_" + unit.front_body};
     trains.header << "# The front faces meet at front_faces (coupler_end, uncoupled): " << *q.face_stiffness << " kN/mm per face (--face-stiffness), "
-                  << *q.face_height << " mm high (--face-height), required inputs.\n";
+                  << *q.face_height << " mm high (--face-height)";
+    if (q.face_friction) trains.header << ", friction " << *q.face_friction << " (--face-friction)";
+    trains.header << ", required inputs.\n";
   }
   trains.model["bodies"] = bodies;
   trains.model["elements"] = elements;

@@ -36,8 +36,9 @@
 // Any other car model whose bodies declare `car: NAME` (e.g. the barrier test's two cars) is a
 // train unit (scenario/train_unit.hpp: its striking end found from the elements' output roles):
 // scenario 1 puts the unit (s_*) against its mirror image (t_*), their front faces meeting at an
-// uncoupled coupler_end (front_faces, the face stiffness and height required inputs); --cars is
-// then the unit's own cars.
+// uncoupled coupler_end (front_faces, the face stiffness and height required inputs, and with an
+// offset the faces' friction coefficient: without vertical friction the faces slide past each
+// other and the offset cannot act); --cars is then the unit's own cars.
 // A model with car types and trains (train_expansion.hpp, e.g. models/examples/emu3_*.yaml) is
 // used as it composes its train (ScenarioRequest::unit, default its first): the train renamed
 // `striking`, facing +x with its leading interface at x = 0; in scenario 1 a copy `standing`
@@ -92,6 +93,8 @@ struct ScenarioRequest {
   std::optional<double> buffer_height;                  // [mm] above the rail
   std::optional<double> face_stiffness;                 // [kN/mm] scenario 1 from a unit model: each front face
   std::optional<double> face_height;                    // [mm] scenario 1 from a unit model: each front face
+  std::optional<double> face_friction;                  // [-] scenario 1 from a unit model: friction between the faces
+                                                        // (required with an offset: it is what lets the offset act)
   double obstacle_mass = 15.0;                          // [t] scenario 3
   std::vector<std::pair<double, double>> obstacle_curve;  // [mm, kN] scenario 3: the obstacle's force-crush curve
   std::optional<double> obstacle_unloading_stiffness;   // [kN/mm] scenario 3
