@@ -687,6 +687,14 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
   const std::vector<std::string> train_names = standing_train ? std::vector<std::string>{striking, standing} : std::vector<std::string>{striking};
   for (const ExpandedCar& car : expansion.cars) trains.cars.push_back(car.name);
   trains.cars_per_train = static_cast<int>(expansion.cars.size() / train_names.size());
+  // Mean deceleration per car: the named car-type bodies, or each car's heaviest body (its car body).
+  if (q.passenger_bodies.empty())
+    for (const ExpandedCar& car : expansion.cars) {
+      const Body* heaviest = nullptr;
+      for (const Body& b : model.bodies())
+        if (b.car == car.name && (!heaviest || b.mass > heaviest->mass)) heaviest = &b;
+      if (heaviest) trains.passenger_bodies.push_back(heaviest->name);
+    }
   for (const std::string& b : q.passenger_bodies) {
     bool found = false;
     for (const ExpandedCar& car : expansion.cars)
@@ -820,9 +828,6 @@ std::string make_scenario_model(const ScenarioRequest& q) {
   required(q.deceleration_limit, "--deceleration-limit", "the mean longitudinal deceleration limit of the passenger areas [g]");
   required(q.survival_limit, "--survival-space-limit", "the largest allowed crush of a car's survival space [mm]");
   if (q.number != 3) required(q.override_limit, "--override-limit", "the largest allowed vertical relative displacement at the interface [mm]");
-  if (q.passenger_bodies.empty())
-    refuse("missing --passenger-bodies: the car bodies of the passenger area, as the train model names them (without car1_ in a "
-           "two-car template), e.g. center_body");
   if (!q.survival_gauge.empty() && q.survival_gauge.size() != 2)
     refuse("--survival-gauge FRONT,REAR: give two bodies (without car1_ in a two-car template) at the ends of the survival space");
   if (q.number == 2) {
@@ -844,6 +849,9 @@ std::string make_scenario_model(const ScenarioRequest& q) {
   } catch (const YAML::Exception& e) {
     throw InputError(q.train_path + ": cannot read the train model: " + e.what());
   }
+  if (q.passenger_bodies.empty() && !is_car_type_model(root))
+    refuse("missing --passenger-bodies: the car bodies of the passenger area, as the train model names them (without car1_ in a "
+           "two-car template), e.g. center_body");
   Trains trains;
   Units u;
   const double offset_mm = q.number == 1 ? *q.offset : 0.0;  // [mm]

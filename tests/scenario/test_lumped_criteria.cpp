@@ -181,6 +181,11 @@ TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the 
   CHECK(c.interface_element == "impact.anticlimber");
   CHECK(c.survival_cars.size() == 6);
   CHECK(c.passenger_bodies.size() == 6);
+  // Without --passenger-bodies, each car's heaviest body: its car body.
+  ScenarioRequest per_car = emu3(1, "emu3_unit_collision.yaml");
+  per_car.passenger_bodies.clear();
+  const Model heaviest = load_model_text(make_scenario_model(per_car), "s1.yaml");
+  CHECK(heaviest.scenario->passenger_bodies == c.passenger_bodies);
   CHECK(c.rail_supports == std::vector<std::string>{"striking.car1.bogie_front_rail", "standing.car1.bogie_front_rail"});
   CHECK(c.closing_speed == Approx(10.0));  // 36 km/h in m/s
   CHECK(c.survival_limit == Approx(0.05));

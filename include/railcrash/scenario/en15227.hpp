@@ -49,7 +49,8 @@
 // and connections are left out. With an offset, the interface type must contain an anticlimber:
 // without a vertical interlock (or friction) the faces slide past each other and the offset
 // cannot produce override, so the request is refused. Car-type names reach every instance:
-// passenger bodies and crush zones (TYPE.NAME: only car type TYPE's instances). The leading
+// passenger bodies (default: each car's heaviest body, its car body) and crush zones (TYPE.NAME:
+// only car type TYPE's instances). The leading
 // cars' wheels are their foremost wheel_rail elements or, without any, their foremost
 // slider_joints on ground (the rail supports of scenario/criteria.hpp's wheel unloading).
 // Crush zones (--crush-zones NAME[:STROKE mm]) become the section's `zones` with their strokes
