@@ -24,6 +24,7 @@
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/model_schema.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
@@ -176,8 +177,7 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
     const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
-  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end,
-              model.simulation.integrator == IntegratorKind::Ida ? "ida" : "euler");
+  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end, integrator_name(model.simulation.integrator));
   return 0;
 }
 
@@ -244,6 +244,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
               o.ok ? "finished" : "FAILED", report.integrator.c_str(), o.t_reached, o.stats.wall_seconds, o.stats.steps,
               o.stats.residual_evaluations);
   if (!o.ok) std::printf("reason: %s\n", o.message.c_str());
+  if (!o.stats.hand_over_reason.empty()) std::printf("integrator auto: %s\n", o.stats.hand_over_reason.c_str());
   if (o.stats.phases_timed) {
     std::printf("wall time by phase [s]:");
     for (int p = 0; p < kPhaseCount; ++p) {
@@ -543,7 +544,8 @@ int main(int argc, char** argv) {
 
   CLI::App* run = app.add_subcommand("run", "run a model and write DIR/timeseries.csv, events.csv, summary.json");
   run->add_option("model", model_path, "model file (YAML)")->required();
-  run->add_option("--integrator", integrator, "ida or euler (default: the model's)")->check(CLI::IsMember({"ida", "euler"}));
+  run->add_option("--integrator", integrator, "auto, ida or euler (default: the model's; a model that names none: auto)")
+      ->check(CLI::IsMember({"auto", "ida", "euler"}));
   CLI::Option* t_end_option = run->add_option("--t-end", t_end, "end time");
   // --t-end, --atol, --dt, --output-interval and --max-steps go to the model's simulation keys,
   // whose check refuses a non-finite or out-of-range value naming the model file (model_io.cpp).
@@ -763,6 +765,10 @@ int main(int argc, char** argv) {
   expand->add_option("--set", settings, "override a model key");
   expand->add_option("--out", expand_out, "model file to write (default: standard output)");
 
+  std::string schema_out;
+  CLI::App* schema = app.add_subcommand("schema", "write the JSON Schema of the model file (for editors: README \"Editor support\")");
+  schema->add_option("-o,--out", schema_out, "file to write (default: standard output)");
+
   std::string element_type_name;
   bool elements_markdown = false;
   CLI::App* elements = app.add_subcommand("elements", "element reference: the types, or one type's points and parameters");
@@ -778,6 +784,11 @@ int main(int argc, char** argv) {
     if (*check) return check_command(model_path, settings);
     if (*expand) return expand_command(model_path, settings, expand_out, expand->count("--out") > 0);
     if (*elements) return elements_command(element_type_name, elements_markdown);
+    if (*schema) {
+      if (schema->count("--out") > 0) railcrash::check_output_file(schema_out);
+      return write_generated_model(railcrash::model_schema_json(railcrash::ElementRegistry::instance()), schema_out,
+                                   "the model file's JSON Schema");
+    }
     if (*report) return report_command(report_dir, report_cfc, report_force_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
@@ -819,7 +830,7 @@ int main(int argc, char** argv) {
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,
                                                    bisections, branch_window_ms);
     if (!integrator.empty())
-      overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
+      overrides.integrator = railcrash::integrator_from_name(integrator);
     if (*t_end_option) overrides.t_end = t_end;
     if (*rtol_option) overrides.rtol = rtol;
     if (*atol_option) overrides.atol = atol;

@@ -675,6 +675,10 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"provenance\": " << provenance_json(provenance_) << ",\n";
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
+  if (!s.hand_over_reason.empty())  // integrator auto: which method ran when, and why
+    j << "  \"integrator_used\": {\"method\": " << json_string(s.handed_over_at >= 0.0 ? "ida+euler" : "ida")
+      << ", \"euler_from_t\": " << (s.handed_over_at >= 0.0 ? json_number(s.handed_over_at) : "null")
+      << ", \"reason\": " << json_string(s.hand_over_reason) << "},\n";
   if (hdf5_)  // (the CSV files are the default: their summary is as it always was)
     j << "  \"output\": {\"format\": " << json_string(output_format_name(format_))
       << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"
