@@ -706,8 +706,11 @@ int main(int argc, char** argv) {
                                                       "built from a car model, with the criteria evaluated after the run");
   scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon, 3: deformable obstacle)")
       ->required()->check(finite_number(1, 4, false, false));
-  scenario->add_option("--train", scenario_request.train_path, "two-car template (car1_* striking, e.g. models/report/final_two_car.yaml) or a model whose bodies declare their cars (e.g. models/barrier/two_car_barrier.yaml)")
+  scenario->add_option("--train", scenario_request.train_path, "a model with car types and trains (e.g. models/examples/emu3_wall.yaml), a two-car template (car1_* striking, e.g. models/report/final_two_car.yaml) or a model whose bodies declare their cars (e.g. models/barrier/two_car_barrier.yaml)")
       ->required();
+  scenario->add_option("--unit", scenario_request.unit, "model with trains: the train to use (default: its first)");
+  scenario->add_option("--interface", scenario_request.interface,
+                       "model with trains, scenario 1: the interface type joining the two trains' fronts (default: the model's connection there)");
   scenario->add_option("--cars", scenario_request.cars, "cars per train")->capture_default_str()->check(finite_number(1, 1000, false, false));
   scenario->add_option("--category", scenario_request.category, "C-I, C-II, C-III or C-IV")->capture_default_str();
   scenario->add_option("--passenger-bodies", scenario_request.passenger_bodies,
@@ -715,7 +718,8 @@ int main(int argc, char** argv) {
   scenario->add_option("--survival-gauge", scenario_request.survival_gauge,
                        "FRONT,REAR: template bodies (without car1_) at the ends of the survival space")->delimiter(',');
   scenario->add_option("--crush-zones", scenario_request.crush_zones,
-                       "comma list of crush elements whose crush is allowed (left out of the survival-space loss)")->delimiter(',');
+                       "comma list of declared crush zones NAME or NAME:STROKE [mm]: their crush up to the stroke (default: the end of "
+                       "the declared curve) does not count as survival-space loss")->delimiter(',');
   scenario->add_option("--buffer-curve", buffer_curve, "scenario 2: one side buffer's force-stroke curve mm:kN,mm:kN,...");
   scenario->add_option("--wagon-mass", scenario_request.wagon_mass, "scenario 2: wagon mass [t]")->capture_default_str()
       ->check(finite_number(0, 10000, true, false, "t"));
@@ -743,6 +747,8 @@ int main(int argc, char** argv) {
            {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)", length_mm},
            {"--face-stiffness", "scenario 1 from a model declaring its cars: each front face's stiffness [kN/mm] (required)", stiffness},
            {"--face-height", "scenario 1 from a model declaring its cars: each front face's height [mm] (required)", length_mm},
+           {"--face-friction", "scenario 1 from a model declaring its cars: friction coefficient between the front faces (required with an offset)",
+            finite_number(0, 10, false, false)},
            {"--obstacle-unloading-stiffness", "scenario 3: the obstacle's unloading stiffness [kN/mm] (required)", stiffness},
            {"--obstacle-height", "scenario 3: height of the obstacle's contact point above the rail [mm] (required)", length_mm},
            {"--t-end", "end time of the run [s] (default: the train model's)", finite_number(0, 1000, true, false, "s")}})
@@ -801,6 +807,7 @@ int main(int argc, char** argv) {
       scenario_request.buffer_height = given("--buffer-height");
       scenario_request.face_stiffness = given("--face-stiffness");
       scenario_request.face_height = given("--face-height");
+      scenario_request.face_friction = given("--face-friction");
       scenario_request.obstacle_unloading_stiffness = given("--obstacle-unloading-stiffness");
       scenario_request.obstacle_height = given("--obstacle-height");
       scenario_request.t_end = given("--t-end");

@@ -1025,6 +1025,7 @@ Model build(const YAML::Node& root, Reader& r) {
       for (double* value : {&scaled->closing_speed, &scaled->deceleration_limit, &scaled->survival_limit, &scaled->override_limit,
                             &scaled->wheel_lift_limit})
         *value *= r.scale().length;
+      for (ScenarioCriteria::Zone& zone : scaled->survival_zones) zone.stroke *= r.scale().length;
       model.scenario = scaled;
     }
   }

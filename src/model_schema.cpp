@@ -522,7 +522,13 @@ Json scenario_schema() {
                            .set("limit", number("largest loss of survival space: " + kLength, Range::Positive))
                            .set("source", word(source))
                            .set("cars", names("cars (a body's car) whose crush outside their declared crush zones counts"))
-                           .set("excluded", names("elements left out of the survival space"))
+                           .set("excluded", names("elements left out of the survival space (the struck body's)"))
+                           .set("zones", list_of(section("a declared crush zone: its crush up to its stroke is not survival-space loss",
+                                                         Json::object()
+                                                             .set("element", word("the crush element"))
+                                                             .set("stroke", number("the crush it may take: " + kLength, Range::Positive)),
+                                                         {"element", "stroke"}),
+                                                 "declared crush zones"))
                            .set("gauges", list_of(section("a pair of bodies whose approach is lost survival space",
                                                           Json::object().set("name", word("the gauge's name")).set("front", word("front body")).set("rear", word("rear body")),
                                                           {"name", "front", "rear"}),
@@ -537,8 +543,10 @@ Json scenario_schema() {
                            .set("bodies", names("or the two bodies meeting at the interface [A, B]"))
                            .set("wheel_lift_limit", number("largest wheel lift: " + kLength, Range::Positive))
                            .set("wheel_lift_source", word(source))
-                           .set("wheels", names("the wheel_rail elements whose lift counts")),
-                       {"wheel_lift_limit", "wheel_lift_source", "wheels"})),
+                           .set("wheels", names("the wheel_rail elements whose lift counts (with wheel_lift_limit and wheel_lift_source)"))
+                           .set("rail_supports", names("or the slider_joints holding the leading bogies on the rail, whose "
+                                                       "unloading (Q0 - Q) / Q0 must stay below 1")),
+                       {})),
       {"standard", "number", "category", "closing_speed", "mean_deceleration", "survival_space", "override"});
 }
 

@@ -256,6 +256,7 @@ def scenario_keys_agree(v, source_dir):
     where = {"the section": scenario, "mean_deceleration": scenario["properties"]["mean_deceleration"],
              "survival_space": scenario["properties"]["survival_space"],
              "survival_space: gauge": scenario["properties"]["survival_space"]["properties"]["gauges"]["items"],
+             "survival_space: zone": scenario["properties"]["survival_space"]["properties"]["zones"]["items"],
              "override": scenario["properties"]["override"]}
     ok = len(lists) == len(where)
     for keys, context in lists:
