@@ -12,12 +12,14 @@ set -euo pipefail
 # sanitizer runtimes are in libclang-rt-14-dev).
 # libhdf5-dev: `run --format hdf5` (the serial library, pkg-config hdf5-serial); python3-h5py:
 # its CLI test reads the file as users would, with h5py and pandas.
+# python3-jsonschema + python3-yaml: the test that every model is valid against the model
+# file's JSON Schema (docs/railcrash-model.schema.json).
 # nlohmann-json3-dev: the report reads a run folder's JSON files with it (header-only).
 packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
           libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib
           libopenmpi-dev openmpi-bin clang libclang-rt-14-dev libhdf5-dev python3-h5py
-          nlohmann-json3-dev)
+          python3-jsonschema python3-yaml nlohmann-json3-dev)
 # --bench: also the benchmarks' own (not needed to build or test): libsimbody-dev for the
 # Simbody 3.7 comparison in bench/simbody.
 [ "${1:-}" = "--bench" ] && packages+=(libsimbody-dev)

@@ -94,9 +94,9 @@ Results run(const Model& model, const RunSettings& settings, const std::atomic<b
   railcrash::Model loaded = load_model_text(m.text, m.source, m.settings);
   RunOverrides overrides;
   if (settings.integrator) {
-    if (*settings.integrator == "ida") overrides.integrator = IntegratorKind::Ida;
-    else if (*settings.integrator == "euler") overrides.integrator = IntegratorKind::Euler;
-    else throw InputError("integrator must be \"ida\" or \"euler\", not \"" + *settings.integrator + "\"");
+    overrides.integrator = integrator_from_name(*settings.integrator);
+    if (!overrides.integrator)
+      throw InputError("integrator must be \"auto\", \"ida\" or \"euler\", not \"" + *settings.integrator + "\"");
   }
   overrides.t_end = settings.t_end;
   overrides.rtol = settings.rtol;

@@ -63,9 +63,8 @@ double EulerIntegrator::estimate_stability_limit(const DaeSystem& system, const 
   return denominator > 0.0 ? 2.0 / denominator : std::numeric_limits<double>::infinity();
 }
 
-PenaltyRows EulerIntegrator::make_penalty(double dt) const {
-  const int m = system_.constraint_rows();
-  const int nq = system_.body_unknowns();
+PenaltyRows EulerIntegrator::make_penalty(const DaeSystem& system, const Element::PenaltyOverrides& global, double dt) {
+  const int m = system.constraint_rows();
   PenaltyRows rows;
   rows.stiffness.assign(static_cast<std::size_t>(m), 0.0);
   rows.damping.assign(static_cast<std::size_t>(m), 0.0);
@@ -74,7 +73,7 @@ PenaltyRows EulerIntegrator::make_penalty(double dt) const {
   // an angle row gives sum 1/J_b. (Taken at the start only, (G M^-1 G^T)_rr would let the
   // penalty outrun the step once the bodies turn.)
   std::vector<double> inverse_effective_mass(static_cast<std::size_t>(m), 0.0);
-  const Model& model = system_.model();
+  const Model& model = system.model();
   for (std::size_t e = 0; e < model.elements().size(); ++e) {
     const Element& el = *model.elements()[e];
     for (int row = 0; row < el.constraint_count(); ++row) {
@@ -91,15 +90,13 @@ PenaltyRows EulerIntegrator::make_penalty(double dt) const {
       inverse_effective_mass[static_cast<std::size_t>(model.constraint_offset(e) + row)] = inverse;
     }
   }
-  (void)nq;
   const double rate = kPenaltyStepAngle / dt;
   for (int r = 0; r < m; ++r) {
     const auto row = static_cast<std::size_t>(r);
-    const Element& owner = system_.constraint_owner(r);
-    const bool rotational = system_.constraint_row_is_rotational(r);
+    const Element& owner = system.constraint_owner(r);
+    const bool rotational = system.constraint_row_is_rotational(r);
     const double effective_mass = 1.0 / inverse_effective_mass[row];
     const auto& own = owner.penalty();
-    const auto& global = settings_.penalty;
     const std::optional<double> k = rotational ? (own.rotational_stiffness ? own.rotational_stiffness : global.rotational_stiffness)
                                                : (own.stiffness ? own.stiffness : global.stiffness);
     const std::optional<double> c = rotational ? (own.rotational_damping ? own.rotational_damping : global.rotational_damping)
@@ -112,61 +109,100 @@ PenaltyRows EulerIntegrator::make_penalty(double dt) const {
 
 namespace {
 
-/// Refuses a step dt that needs more than max_steps steps to reach the model's t_end.
-void check_step_count(const Model& model, double dt, long max_steps) {
-  const double steps_needed = std::ceil(model.simulation.t_end / dt - 1e-9);  // [steps], a double: never overflows
-  if (!(steps_needed <= static_cast<double>(max_steps))) {
-    std::ostringstream msg;
-    msg << SourceLocation{model.file, 0}.prefix() << "explicit Euler with dt = " << dt << " needs " << steps_needed
-        << " steps to reach t_end = " << model.simulation.t_end << ", more than --max-steps " << max_steps
-        << "; use a larger dt (above " << model.simulation.t_end / static_cast<double>(max_steps)
-        << "), a shorter t_end, or raise --max-steps";
-    throw InputError(msg.str());
-  }
+/// Why a step dt that needs more than max_steps steps from t0 to the model's t_end cannot run ("" when it can).
+std::string step_count_problem(const Model& model, double dt, long max_steps, double t0) {
+  const double steps_needed = std::ceil((model.simulation.t_end - t0) / dt - 1e-9);  // [steps], a double: never overflows
+  if (steps_needed <= static_cast<double>(max_steps)) return "";
+  std::ostringstream msg;
+  msg << SourceLocation{model.file, 0}.prefix() << "explicit Euler with dt = " << dt << " needs " << steps_needed
+      << " steps to reach t_end = " << model.simulation.t_end << ", more than --max-steps " << max_steps
+      << "; use a larger dt (above " << model.simulation.t_end / static_cast<double>(max_steps)
+      << "), a shorter t_end, or raise --max-steps";
+  return msg.str();
+}
+
+/// Why a body without inertia stops Euler ("" when every body has one).
+std::string inertia_problem(const Model& model) {
+  for (const Body& b : model.bodies())
+    if (!(b.inertia > 0.0))
+      return b.where.prefix() + "body '" + b.name +
+             "' has zero inertia: explicit Euler needs every body's inertia to be positive "
+             "(use integrator: ida, or give the body an inertia)";
+  return "";
+}
+
+void throw_if(const std::string& problem) {
+  if (!problem.empty()) throw InputError(problem);
 }
 
 }  // namespace
 
+EulerIntegrator::Step EulerIntegrator::choose_step(const DaeSystem& system, const std::vector<double>& y,
+                                                   const EulerSettings& settings) {
+  if (settings.dt < 0.0 || !std::isfinite(settings.dt)) throw InputError("dt must be a positive step (or 0 for automatic)");
+  Step step;
+  if (settings.dt > 0.0) {
+    step.dt = settings.dt;
+    // Before penalties sized for a dt that cannot run.
+    throw_if(step_count_problem(system.model(), step.dt, settings.max_steps, 0.0));
+    step.penalty = make_penalty(system, settings.penalty, step.dt);
+    step.stability_limit = estimate_stability_limit(system, y, &step.penalty);
+    return step;
+  }
+  // Automatic: half the limit of the elements alone, then penalties for that step; shrink
+  // once more if the penalties lowered the limit.
+  const double physical_limit = estimate_stability_limit(system, y, nullptr);
+  step.dt = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * system.model().simulation.t_end;
+  for (int pass = 0; pass < 20; ++pass) {
+    step.penalty = make_penalty(system, settings.penalty, step.dt);
+    step.stability_limit = estimate_stability_limit(system, y, &step.penalty);
+    if (step.dt <= 0.8 * step.stability_limit) break;
+    step.dt = 0.5 * step.stability_limit;
+  }
+  return step;
+}
+
+std::string EulerIntegrator::refusal(const DaeSystem& system, const Step& step, const EulerSettings& settings, double t0) {
+  std::string problem = inertia_problem(system.model());
+  if (!problem.empty()) return problem;
+  if (step.dt > step.stability_limit && !settings.force_dt) {
+    std::ostringstream msg;
+    msg << "the Euler step dt = " << step.dt << " is above the stability limit " << step.stability_limit
+        << " of this model (largest stable step, penalty joints included); use dt <= " << step.stability_limit
+        << " (e.g. --dt " << 0.5 * step.stability_limit << "), or --force-dt to run anyway";
+    return msg.str();
+  }
+  return step_count_problem(system.model(), step.dt, settings.max_steps, t0);
+}
+
 EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings)
     : Integrator(system), settings_(settings) {
-  const Model& model = system.model();
-  for (const Body& b : model.bodies())
-    if (!(b.inertia > 0.0))
-      throw InputError(b.where.prefix() + "body '" + b.name +
-                       "' has zero inertia: explicit Euler needs every body's inertia to be positive "
-                       "(use integrator: ida, or give the body an inertia)");
+  throw_if(inertia_problem(system.model()));
   const StartReport start = prepare_start(system, y0_, start_events_);
   start_modes_ = system.modes().snapshot();
   assembly_correction_ = start.assembly.largest_position_change;
   settling_steps_ = start.equilibrium.steps;
   settling_displacement_ = start.equilibrium.largest_position_change;
+  Step step = choose_step(system, y0_, settings_);
+  throw_if(refusal(system, step, settings_, 0.0));
+  dt_ = step.dt;
+  stability_limit_ = step.stability_limit;
+  penalty_ = std::move(step.penalty);
+}
 
-  if (settings_.dt < 0.0 || !std::isfinite(settings_.dt)) throw InputError("dt must be a positive step (or 0 for automatic)");
-  if (settings_.dt > 0.0) {
-    dt_ = settings_.dt;
-    check_step_count(model, dt_, settings_.max_steps);  // before penalties sized for a dt that cannot run
-    penalty_ = make_penalty(dt_);
-    stability_limit_ = estimate_stability_limit(system, y0_, &penalty_);
-  } else {
-    // Automatic: half the limit of the elements alone, then penalties for that step; shrink
-    // once more if the penalties lowered the limit.
-    const double physical_limit = estimate_stability_limit(system, y0_, nullptr);
-    dt_ = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * model.simulation.t_end;
-    for (int pass = 0; pass < 20; ++pass) {
-      penalty_ = make_penalty(dt_);
-      stability_limit_ = estimate_stability_limit(system, y0_, &penalty_);
-      if (dt_ <= 0.8 * stability_limit_) break;
-      dt_ = 0.5 * stability_limit_;
-    }
-  }
-  if (dt_ > stability_limit_ && !settings_.force_dt) {
-    std::ostringstream msg;
-    msg << "the Euler step dt = " << dt_ << " is above the stability limit " << stability_limit_
-        << " of this model (largest stable step, penalty joints included); use dt <= " << stability_limit_
-        << " (e.g. --dt " << 0.5 * stability_limit_ << "), or --force-dt to run anyway";
-    throw InputError(msg.str());
-  }
-  check_step_count(model, dt_, settings_.max_steps);
+EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings, Step step, double t0,
+                                 const std::vector<double>& y, const std::vector<double>& quadratures)
+    : Integrator(system), settings_(settings), dt_(step.dt), stability_limit_(step.stability_limit),
+      penalty_(std::move(step.penalty)) {
+  throw_if(refusal(system, Step{dt_, stability_limit_, {}}, settings_, t0));
+  y_ = y;
+  quadratures_ = quadratures;
+  begin(t0, false);  // the run's observer is not ours yet: no events to report here
+}
+
+void EulerIntegrator::continue_from_hand_over() {
+  stats().stability_limit = stability_limit_;
+  stats().last_step = dt_;
 }
 
 void EulerIntegrator::start(double /*t_end*/) {
@@ -175,24 +211,29 @@ void EulerIntegrator::start(double /*t_end*/) {
   stats().settling_steps = settling_steps_;
   stats().settling_displacement = settling_displacement_;
   stats().last_step = dt_;
+  y_ = y0_;
+  quadratures_.assign(static_cast<std::size_t>(system_.quadrature_count()), 0.0);
+  // Modes as prepared (and settled) in the constructor; a second run starts from them too.
+  system_.modes().restore(start_modes_);
+  begin(0.0, true);
+}
+
+void EulerIntegrator::begin(double t0, bool run_start) {
   const int nq = system_.body_unknowns();
   const int m = system_.constraint_rows();
   const int nquad = system_.quadrature_count();
-  y_ = y0_;
   force_.assign(static_cast<std::size_t>(nq), 0.0);
   rates_.assign(static_cast<std::size_t>(nquad), 0.0);
-  quadratures_.assign(static_cast<std::size_t>(nquad), 0.0);
   lambda_.assign(static_cast<std::size_t>(m), 0.0);
   inverse_mass_.resize(static_cast<std::size_t>(nq));
   for (int k = 0; k < nq; ++k) inverse_mass_[static_cast<std::size_t>(k)] = 1.0 / system_.mass_diagonal(k);
-  t_ = 0.0;
+  t_ = t0;
+  t0_ = t0;
   step_ = 0;
   double* q = y_.data();
   double* v = y_.data() + nq;
-  // Modes as prepared (and settled) in the constructor; a second run starts from them too.
-  system_.modes().restore(start_modes_);
   // The multipliers' place in y (for output) holds the penalty forces.
-  system_.generalized_forces(0.0, q, v, force_.data(), &penalty_, lambda_.data());
+  system_.generalized_forces(t0, q, v, force_.data(), &penalty_, lambda_.data());
   std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);
   // Mode changes: the same root functions as IDA, checked at the end of every step (what
   // IITRAIN's "internal logic checks at each time step" did). A root that sits at zero right
@@ -201,8 +242,8 @@ void EulerIntegrator::start(double /*t_end*/) {
   g_before_.assign(static_cast<std::size_t>(root_count), 0.0);
   g_after_ = g_before_;
   direction_.assign(g_before_.size(), 0);
-  report_events(start_events_, y_.data());
-  if (root_count > 0) {
+  if (run_start) report_events(start_events_, y_.data());
+  if (root_count > 0 && run_start) {
     // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
     std::vector<double> yp(y_.size(), 0.0);
     for (int k = 0; k < nq; ++k) {
@@ -229,15 +270,15 @@ void EulerIntegrator::sweep() {
   outputs_current_ = true;
 }
 
-// The loop runs on time: step k ends at k dt (no drift), the last one at t_end exactly.
+// The loop runs on time: step k ends at t0 + k dt (no drift), the last one at t_end exactly.
 double EulerIntegrator::advance(double t_end) {
   const int nq = system_.body_unknowns();
   const int nquad = system_.quadrature_count();
   double* q = y_.data();
   double* v = y_.data() + nq;
   ++step_;
-  const bool last = static_cast<double>(step_) >= t_end / dt_ - 1e-9;
-  const double t_next = last ? t_end : static_cast<double>(step_) * dt_;
+  const bool last = static_cast<double>(step_) >= (t_end - t0_) / dt_ - 1e-9;
+  const double t_next = last ? t_end : t0_ + static_cast<double>(step_) * dt_;
   const double h = t_next - t_;
   // force_, rates_ and lambda_ at (t_, y_) come from the last sweep (start() or the last step).
   outputs_current_ = false;

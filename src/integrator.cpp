@@ -125,6 +125,28 @@ void Integrator::sample_up_to(double t_limit) {
   }
 }
 
+void Integrator::take_run_from(Integrator& previous) {
+  outcome_ = std::move(previous.outcome_);
+  observer_ = previous.observer_;
+  t_end_ = previous.t_end_;
+  output_interval_ = previous.output_interval_;
+  output_index_ = previous.output_index_;
+  t_sampled_ = previous.t_sampled_;
+  sample_y_ = std::move(previous.sample_y_);
+  sample_quadratures_ = std::move(previous.sample_quadratures_);
+  sample_outputs_ = std::move(previous.sample_outputs_);
+  sample_forces_ = std::move(previous.sample_forces_);
+  observe_sample_forces_ = previous.observe_sample_forces_;
+  last_sample_y_ = std::move(previous.last_sample_y_);
+  last_sample_quadratures_ = std::move(previous.last_sample_quadratures_);
+  observe_steps_ = previous.observe_steps_;
+  time_phases_ = previous.time_phases_;
+  phase_clock_ = previous.phase_clock_;
+  previous.phase_clock_ = PhaseClock{};
+  step_outputs_ = std::move(previous.step_outputs_);
+  previous.observer_ = nullptr;
+}
+
 RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& observer, const std::atomic<bool>* stop) {
   outcome_ = RunOutcome{};
   if (time_phases_) phase_clock_.start();
@@ -142,6 +164,9 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   last_sample_y_.clear();
   last_sample_quadratures_.clear();
   double t_reached = 0.0;
+  // The integrator taking the steps: this one, or the successor it handed the run to.
+  Integrator* active = this;
+  std::unique_ptr<Integrator> successor;
   try {
     {
       const PhaseClock::Scope timed(phase_clock(), Phase::Start);
@@ -151,62 +176,76 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
     outcome_.initial_energy = energy(sample_y_.data(), sample_quadratures_.data());
     outcome_.max_constraint_residual = 0.0;
     deliver_sample(0.0);
-    const bool dense = dense_output();
+    bool dense = dense_output();
     long steps_taken = 0;  // advance() calls in this run
     while (t_reached < t_end) {
       if (stop && stop->load()) {
-        outcome_.message = "interrupted at t = " + std::to_string(t_sampled_);
+        active->outcome_.message = "interrupted at t = " + std::to_string(active->t_sampled_);
         break;
       }
-      if (steps_taken++ >= max_steps()) {
+      if (steps_taken++ >= active->max_steps()) {
         std::ostringstream msg;
-        msg << "stopped at t = " << t_reached << " after --max-steps " << max_steps() << " steps"
-            << step_limit_advice(t_end);
-        outcome_.message = msg.str();
+        msg << "stopped at t = " << t_reached << " after --max-steps " << active->max_steps() << " steps"
+            << active->step_limit_advice(t_end);
+        active->outcome_.message = msg.str();
         break;
       }
-      t_reached = advance(t_end);
-      const std::string bad = non_finite_entry(current_state());
+      t_reached = active->advance(t_end);
+      const std::string bad = active->non_finite_entry(active->current_state());
       if (!bad.empty()) {
         std::ostringstream msg;
-        msg << divergence_phrase() << " at t = " << t_reached << ": " << bad << divergence_advice(last_sample_y_, t_sampled_);
+        msg << active->divergence_phrase() << " at t = " << t_reached << ": " << bad
+            << active->divergence_advice(active->last_sample_y_, active->t_sampled_);
         throw StepFailure(msg.str());
       }
-      deliver_step(t_reached, current_state());
+      active->deliver_step(t_reached, active->current_state());
       if (dense) {
-        sample_up_to(t_reached);
-      } else if (t_reached >= next_output_time() * (1.0 - 1e-12)) {
+        active->sample_up_to(t_reached);
+      } else if (t_reached >= active->next_output_time() * (1.0 - 1e-12)) {
         // The end of the step that passes an output time is the sample.
-        deliver_sample(t_reached);
-        while (static_cast<double>(output_index_) * output_interval_ <= t_reached * (1.0 + 1e-12)) ++output_index_;
+        active->deliver_sample(t_reached);
+        while (static_cast<double>(active->output_index_) * active->output_interval_ <= t_reached * (1.0 + 1e-12))
+          ++active->output_index_;
+      }
+      if (t_reached < t_end) {
+        std::unique_ptr<Integrator> next = active->hand_over(t_reached, active->current_state());
+        if (next) {
+          active->finish();  // the counters of the steps so far
+          next->take_run_from(*active);
+          next->continue_from_hand_over();
+          successor = std::move(next);  // (the previous successor, if any, is done with)
+          active = successor.get();
+          dense = active->dense_output();
+        }
       }
     }
   } catch (const InputError&) {
-    finish();
-    phase_clock_.stop();
+    active->finish();
+    active->phase_clock_.stop();
     throw;
   } catch (const std::exception& e) {
-    outcome_.message = e.what();
+    active->outcome_.message = e.what();
   }
-  outcome_.ok = outcome_.message.empty() && t_reached >= t_end;  // a run that did not reach t_end is never ok
-  if (outcome_.ok) {
-    outcome_.t_reached = t_reached;
-    final_state(outcome_.y, outcome_.quadratures);
+  RunOutcome& outcome = active->outcome_;
+  outcome.ok = outcome.message.empty() && t_reached >= t_end;  // a run that did not reach t_end is never ok
+  if (outcome.ok) {
+    outcome.t_reached = t_reached;
+    active->final_state(outcome.y, outcome.quadratures);
   } else {  // a failed or interrupted run ends at its last output sample, the last good state
-    outcome_.t_reached = t_sampled_;
-    outcome_.y = last_sample_y_;
-    outcome_.quadratures = last_sample_quadratures_;
+    outcome.t_reached = active->t_sampled_;
+    outcome.y = active->last_sample_y_;
+    outcome.quadratures = active->last_sample_quadratures_;
   }
-  if (!outcome_.y.empty()) outcome_.final_energy = energy(outcome_.y.data(), outcome_.quadratures.data());
-  else outcome_.final_energy = outcome_.initial_energy;  // stopped before the first sample, at t = 0
-  finish();
-  outcome_.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  if (phase_clock_.on()) {
-    outcome_.stats.phase_seconds = phase_clock_.stop();
-    outcome_.stats.phases_timed = true;
+  if (!outcome.y.empty()) outcome.final_energy = active->energy(outcome.y.data(), outcome.quadratures.data());
+  else outcome.final_energy = outcome.initial_energy;  // stopped before the first sample, at t = 0
+  active->finish();
+  outcome.stats.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (active->phase_clock_.on()) {
+    outcome.stats.phase_seconds = active->phase_clock_.stop();
+    outcome.stats.phases_timed = true;
   }
-  observer_ = nullptr;
-  return std::move(outcome_);
+  active->observer_ = nullptr;
+  return std::move(outcome);
 }
 
 double max_abs(const std::vector<double>& values) {

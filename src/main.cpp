@@ -24,6 +24,7 @@
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/model_schema.hpp"
 #include "railcrash/run.hpp"
 #include "railcrash/readings.hpp"
 #include "railcrash/sensitivity.hpp"
@@ -176,8 +177,7 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
     const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
-  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end,
-              model.simulation.integrator == IntegratorKind::Ida ? "ida" : "euler");
+  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end, integrator_name(model.simulation.integrator));
   return 0;
 }
 
@@ -245,6 +245,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
               o.ok ? "finished" : "FAILED", report.integrator.c_str(), o.t_reached, o.stats.wall_seconds, o.stats.steps,
               o.stats.residual_evaluations);
   if (!o.ok) std::printf("reason: %s\n", o.message.c_str());
+  if (!o.stats.hand_over_reason.empty()) std::printf("integrator auto: %s\n", o.stats.hand_over_reason.c_str());
   if (o.stats.phases_timed) {
     std::printf("wall time by phase [s]:");
     for (int p = 0; p < kPhaseCount; ++p) {
@@ -544,7 +545,8 @@ int main(int argc, char** argv) {
 
   CLI::App* run = app.add_subcommand("run", "run a model and write DIR/timeseries.csv, events.csv, summary.json");
   run->add_option("model", model_path, "model file (YAML)")->required();
-  run->add_option("--integrator", integrator, "ida or euler (default: the model's)")->check(CLI::IsMember({"ida", "euler"}));
+  run->add_option("--integrator", integrator, "auto, ida or euler (default: the model's; a model that names none: auto)")
+      ->check(CLI::IsMember({"auto", "ida", "euler"}));
   CLI::Option* t_end_option = run->add_option("--t-end", t_end, "end time");
   // --t-end, --atol, --dt, --output-interval and --max-steps go to the model's simulation keys,
   // whose check refuses a non-finite or out-of-range value naming the model file (model_io.cpp).
@@ -705,8 +707,11 @@ int main(int argc, char** argv) {
                                                       "built from a car model, with the criteria evaluated after the run");
   scenario->add_option("number", scenario_request.number, "scenario number (1: two identical trains, 2: 80 t wagon, 3: deformable obstacle)")
       ->required()->check(finite_number(1, 4, false, false));
-  scenario->add_option("--train", scenario_request.train_path, "two-car template (car1_* striking, e.g. models/report/final_two_car.yaml) or a model whose bodies declare their cars (e.g. models/barrier/two_car_barrier.yaml)")
+  scenario->add_option("--train", scenario_request.train_path, "a model with car types and trains (e.g. models/examples/emu3_wall.yaml), a two-car template (car1_* striking, e.g. models/report/final_two_car.yaml) or a model whose bodies declare their cars (e.g. models/barrier/two_car_barrier.yaml)")
       ->required();
+  scenario->add_option("--unit", scenario_request.unit, "model with trains: the train to use (default: its first)");
+  scenario->add_option("--interface", scenario_request.interface,
+                       "model with trains, scenario 1: the interface type joining the two trains' fronts (default: the model's connection there)");
   scenario->add_option("--cars", scenario_request.cars, "cars per train")->capture_default_str()->check(finite_number(1, 1000, false, false));
   scenario->add_option("--category", scenario_request.category, "C-I, C-II, C-III or C-IV")->capture_default_str();
   scenario->add_option("--passenger-bodies", scenario_request.passenger_bodies,
@@ -714,7 +719,8 @@ int main(int argc, char** argv) {
   scenario->add_option("--survival-gauge", scenario_request.survival_gauge,
                        "FRONT,REAR: template bodies (without car1_) at the ends of the survival space")->delimiter(',');
   scenario->add_option("--crush-zones", scenario_request.crush_zones,
-                       "comma list of crush elements whose crush is allowed (left out of the survival-space loss)")->delimiter(',');
+                       "comma list of declared crush zones NAME or NAME:STROKE [mm]: their crush up to the stroke (default: the end of "
+                       "the declared curve) does not count as survival-space loss")->delimiter(',');
   scenario->add_option("--buffer-curve", buffer_curve, "scenario 2: one side buffer's force-stroke curve mm:kN,mm:kN,...");
   scenario->add_option("--wagon-mass", scenario_request.wagon_mass, "scenario 2: wagon mass [t]")->capture_default_str()
       ->check(finite_number(0, 10000, true, false, "t"));
@@ -742,6 +748,8 @@ int main(int argc, char** argv) {
            {"--buffer-height", "scenario 2: buffer height above the rail [mm] (required)", length_mm},
            {"--face-stiffness", "scenario 1 from a model declaring its cars: each front face's stiffness [kN/mm] (required)", stiffness},
            {"--face-height", "scenario 1 from a model declaring its cars: each front face's height [mm] (required)", length_mm},
+           {"--face-friction", "scenario 1 from a model declaring its cars: friction coefficient between the front faces (required with an offset)",
+            finite_number(0, 10, false, false)},
            {"--obstacle-unloading-stiffness", "scenario 3: the obstacle's unloading stiffness [kN/mm] (required)", stiffness},
            {"--obstacle-height", "scenario 3: height of the obstacle's contact point above the rail [mm] (required)", length_mm},
            {"--t-end", "end time of the run [s] (default: the train model's)", finite_number(0, 1000, true, false, "s")}})
@@ -758,6 +766,10 @@ int main(int argc, char** argv) {
   expand->add_option("--set", settings, "override a model key");
   expand->add_option("--out", expand_out, "model file to write (default: standard output)");
 
+  std::string schema_out;
+  CLI::App* schema = app.add_subcommand("schema", "write the JSON Schema of the model file (for editors: README \"Editor support\")");
+  schema->add_option("-o,--out", schema_out, "file to write (default: standard output)");
+
   std::string element_type_name;
   bool elements_markdown = false;
   CLI::App* elements = app.add_subcommand("elements", "element reference: the types, or one type's points and parameters");
@@ -773,6 +785,11 @@ int main(int argc, char** argv) {
     if (*check) return check_command(model_path, settings);
     if (*expand) return expand_command(model_path, settings, expand_out, expand->count("--out") > 0);
     if (*elements) return elements_command(element_type_name, elements_markdown);
+    if (*schema) {
+      if (schema->count("--out") > 0) railcrash::check_output_file(schema_out);
+      return write_generated_model(railcrash::model_schema_json(railcrash::ElementRegistry::instance()), schema_out,
+                                   "the model file's JSON Schema");
+    }
     if (*report) return report_command(report_dir, report_cfc, report_force_cfc);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
@@ -791,6 +808,7 @@ int main(int argc, char** argv) {
       scenario_request.buffer_height = given("--buffer-height");
       scenario_request.face_stiffness = given("--face-stiffness");
       scenario_request.face_height = given("--face-height");
+      scenario_request.face_friction = given("--face-friction");
       scenario_request.obstacle_unloading_stiffness = given("--obstacle-unloading-stiffness");
       scenario_request.obstacle_height = given("--obstacle-height");
       scenario_request.t_end = given("--t-end");
@@ -813,7 +831,7 @@ int main(int argc, char** argv) {
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,
                                                    bisections, branch_window_ms);
     if (!integrator.empty())
-      overrides.integrator = integrator == "ida" ? railcrash::IntegratorKind::Ida : railcrash::IntegratorKind::Euler;
+      overrides.integrator = railcrash::integrator_from_name(integrator);
     if (*t_end_option) overrides.t_end = t_end;
     if (*rtol_option) overrides.rtol = rtol;
     if (*atol_option) overrides.atol = atol;

@@ -24,6 +24,21 @@ std::array<double, 2> TimeTable::at(double t) const {
   return out;
 }
 
+const char* integrator_name(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::Ida: return "ida";
+    case IntegratorKind::Euler: return "euler";
+    case IntegratorKind::Auto: return "auto";
+  }
+  return "?";
+}
+
+std::optional<IntegratorKind> integrator_from_name(const std::string& name) {
+  for (const IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Euler, IntegratorKind::Auto})
+    if (name == integrator_name(kind)) return kind;
+  return std::nullopt;
+}
+
 std::string output_rows_problem(const SimulationSettings& settings) {
   if (!(settings.output_interval > 0.0)) return "";  // the default, t_end / 500
   const double rows = settings.t_end / settings.output_interval;  // [rows]

@@ -887,9 +887,9 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   if (!(s.t_end > 0.0)) r.fail(t_end, "simulation: t_end must be positive (the end time of the run)");
   if (node["integrator"]) {
     const std::string name = r.text(node["integrator"], "simulation: integrator");
-    if (name == "ida") s.integrator = IntegratorKind::Ida;
-    else if (name == "euler") s.integrator = IntegratorKind::Euler;
-    else r.fail(node["integrator"], "simulation: integrator must be ida or euler, not '" + name + "'");
+    const std::optional<IntegratorKind> kind = integrator_from_name(name);
+    if (!kind) r.fail(node["integrator"], "simulation: integrator must be auto, ida or euler, not '" + name + "'");
+    s.integrator = *kind;
   }
   const auto positive = [&](const char* key) -> std::optional<double> {
     if (!node[key]) return std::nullopt;
@@ -1040,6 +1040,7 @@ Model build(const YAML::Node& root, Reader& r) {
       for (double* value : {&scaled->closing_speed, &scaled->deceleration_limit, &scaled->survival_limit, &scaled->override_limit,
                             &scaled->wheel_lift_limit})
         *value *= r.scale().length;
+      for (ScenarioCriteria::Zone& zone : scaled->survival_zones) zone.stroke *= r.scale().length;
       model.scenario = scaled;
     }
   }
@@ -1247,6 +1248,12 @@ std::vector<std::string> model_file_keys() {
     for (const std::string& key : *list)
       if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
   return keys;
+}
+
+std::vector<std::pair<std::string, std::vector<std::string>>> model_file_sections() {
+  return {{"model", kTopKeys},          {"body", kBodyKeys},         {"point", kPointKeys},
+          {"load", kLoadKeys},          {"simulation", kSimulationKeys}, {"output", kOutputKeys},
+          {"responses", kResponseKeys}, {"crush_gauge", kCrushGaugeKeys}, {"variant", kVariantKeys}};
 }
 
 }  // namespace railcrash

@@ -192,8 +192,8 @@ std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car,
 
 std::optional<double> car_elements_crush_at(const DaeSystem& system, const CarCrush& car, const double* y,
                                             const double* lambda, const double* outputs, const FreshOutputs& fresh,
-                                            std::vector<double>& scratch) {
-  if (fresh.has_all(car.columns)) return shared_crush(outputs, car.columns, car.shares);
+                                            std::vector<double>& scratch, const std::vector<double>* allowed) {
+  if (fresh.has_all(car.columns)) return shared_crush(outputs, car.columns, car.shares, allowed);
   if (std::none_of(car.columns.begin(), car.columns.end(), [&](int column) { return fresh.has(column); }))
     return std::nullopt;
   scratch.resize(system.output_names().size());
@@ -202,13 +202,16 @@ std::optional<double> car_elements_crush_at(const DaeSystem& system, const CarCr
     if (fresh.has(column)) scratch[static_cast<std::size_t>(column)] = outputs[column];
     else system.element_outputs(car.element_indices[k], y, lambda, scratch.data());  // at y, here
   }
-  return shared_crush(scratch.data(), car.columns, car.shares);
+  return shared_crush(scratch.data(), car.columns, car.shares, allowed);
 }
 
-double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares) {
+double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares,
+                    const std::vector<double>* allowed) {
   assert(columns.size() == shares.size());
+  assert(!allowed || allowed->size() == columns.size());
   double total = 0.0;  // [length]
-  for (std::size_t k = 0; k < columns.size(); ++k) total += shares[k] * std::max(0.0, outputs[columns[k]]);
+  for (std::size_t k = 0; k < columns.size(); ++k)
+    total += shares[k] * std::max(0.0, outputs[columns[k]] - (allowed ? (*allowed)[k] : 0.0));
   return total;
 }
 
@@ -672,6 +675,10 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"provenance\": " << provenance_json(provenance_) << ",\n";
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
+  if (!s.hand_over_reason.empty())  // integrator auto: which method ran when, and why
+    j << "  \"integrator_used\": {\"method\": " << json_string(s.handed_over_at >= 0.0 ? "ida+euler" : "ida")
+      << ", \"euler_from_t\": " << (s.handed_over_at >= 0.0 ? json_number(s.handed_over_at) : "null")
+      << ", \"reason\": " << json_string(s.hand_over_reason) << "},\n";
   if (hdf5_)  // (the CSV files are the default: their summary is as it always was)
     j << "  \"output\": {\"format\": " << json_string(output_format_name(format_))
       << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"

@@ -8,6 +8,7 @@
 #include <new>
 #include <sstream>
 
+#include "railcrash/auto_integrator.hpp"
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/ida_integrator.hpp"
 #include "railcrash/progress.hpp"
@@ -157,7 +158,7 @@ std::vector<OptionSetting> option_settings(const RunOverrides& o) {
     }
     return std::string(text);
   };
-  if (o.integrator) add("integrator", "--integrator", *o.integrator == IntegratorKind::Euler ? "euler" : "ida");
+  if (o.integrator) add("integrator", "--integrator", integrator_name(*o.integrator));
   if (o.t_end) add("t_end", "--t-end", number(*o.t_end));
   if (o.rtol) add("rtol", "--rtol", number(*o.rtol));
   if (o.atol) add("atol", "--atol", number(*o.atol));
@@ -209,13 +210,13 @@ void require_output_memory(const DaeSystem& system, bool keep_in_memory) {
 }  // namespace
 
 std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings) {
-  if (settings.integrator == IntegratorKind::Euler)
-    return std::make_unique<EulerIntegrator>(system,
-                                             EulerSettings{settings.dt, settings.force_dt, settings.penalty, settings.max_steps});
+  const EulerSettings euler{settings.dt, settings.force_dt, settings.penalty, settings.max_steps};
+  if (settings.integrator == IntegratorKind::Euler) return std::make_unique<EulerIntegrator>(system, euler);
   IdaSettings ida;
   ida.rtol = settings.rtol;
   ida.atol = settings.atol;
   ida.max_steps = settings.max_steps;
+  if (settings.integrator == IntegratorKind::Auto) return std::make_unique<AutoIntegrator>(system, ida, euler);
   return std::make_unique<IdaIntegrator>(system, ida);
 }
 
@@ -226,7 +227,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   std::unique_ptr<ResponseTracker> responses;
   std::vector<RunObserver*> observers;
   RunReport report;
-  report.integrator = model.simulation.integrator == IntegratorKind::Euler ? "euler" : "ida";
+  report.integrator = integrator_name(model.simulation.integrator);
   if (!out_dir.empty() || keep_in_memory) {
     require_output_memory(system, keep_in_memory);  // before the writer starts
     observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory, format)).get());

@@ -744,4 +744,10 @@ void expand_trains(YAML::Node& root, const std::string& file, TrainExpansion& ex
   Expander(root, file, expansion, setting_of, mark).run();
 }
 
+std::vector<std::pair<std::string, std::vector<std::string>>> train_expansion_sections() {
+  return {{"sections", kDefinitionSections}, {"car_type", kCarTypeKeys}, {"interface_type", kInterfaceTypeKeys},
+          {"interface", kInterfaceKeys},     {"train", kTrainKeys},       {"car", kCarKeys},
+          {"coupling", kCouplingKeys},       {"connection", kConnectionKeys}, {"end_point", kEndPointKeys}};
+}
+
 }  // namespace railcrash

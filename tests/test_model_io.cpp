@@ -619,7 +619,7 @@ TEST_CASE("unknown element types and body names are rejected with suggestions", 
   text = edit(kBase, "type: moment", "type: torque");
   expect_error("load type", text, line_of(text, "torque"), {"unknown type 'torque'", "force or moment"});
   text = edit(kBase, "integrator: euler", "integrator: rk4");
-  expect_error("integrator", text, line_of(text, "rk4"), {"integrator must be ida or euler", "rk4"});
+  expect_error("integrator", text, line_of(text, "rk4"), {"integrator must be auto, ida or euler", "rk4"});
 }
 
 TEST_CASE("vectors must have the right size", "[model_io]") {

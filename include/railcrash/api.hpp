@@ -81,7 +81,7 @@ class Model {
 
 /// Integrator settings for one run; unset fields keep the model's simulation section.
 struct RunSettings {
-  std::optional<std::string> integrator;      // "ida" or "euler"
+  std::optional<std::string> integrator;      // "auto", "ida" or "euler"
   std::optional<double> t_end;                // [s]
   std::optional<double> rtol;                 // ida: relative tolerance
   std::optional<double> atol;                 // ida: absolute tolerance on lengths [length]
@@ -118,7 +118,7 @@ struct PeakAcceleration {
 struct Summary {
   bool ok = false;
   std::string message;             // why the run stopped early ("" when ok)
-  std::string integrator;          // "ida" or "euler"
+  std::string integrator;          // "auto", "ida" or "euler" (summary_json's integrator_used: which ran)
   double t_reached = 0.0;          // [s]
   long steps = 0;
   double wall_seconds = 0.0;       // [s] integration only

@@ -30,7 +30,26 @@ struct EulerSettings {
 
 class EulerIntegrator : public Integrator {
  public:
+  /// The step Euler takes on a model from state y: settings.dt, or half the stability limit
+  /// of the elements with penalties sized for that step (lowered until the penalties keep it
+  /// stable), and the penalty rows for it.
+  struct Step {
+    double dt = 0.0;               // [time]
+    double stability_limit = 0.0;  // [time] largest stable step, penalties included
+    PenaltyRows penalty;
+  };
+  static Step choose_step(const DaeSystem& system, const std::vector<double>& y, const EulerSettings& settings);
+  /// Why Euler cannot run this model with these settings from state y ("" when it can): a
+  /// body without inertia, a step above the stability limit (without force_dt), more steps
+  /// than max_steps from t0 to t_end. The messages the constructor throws.
+  static std::string refusal(const DaeSystem& system, const Step& step, const EulerSettings& settings, double t0);
+
   EulerIntegrator(DaeSystem& system, EulerSettings settings);
+  /// Euler going on with a run another integrator took to t0 (Integrator::hand_over): from
+  /// state y (q, v; the multipliers' place is overwritten by the penalty forces) and the
+  /// quadratures there, in the element modes the system holds now, with the given step.
+  EulerIntegrator(DaeSystem& system, EulerSettings settings, Step step, double t0, const std::vector<double>& y,
+                  const std::vector<double>& quadratures);
   const char* name() const override { return "euler"; }
 
   /// Step actually used and the stability limit (valid after construction).
@@ -43,7 +62,12 @@ class EulerIntegrator : public Integrator {
                                          const PenaltyRows* penalty);
 
  private:
-  PenaltyRows make_penalty(double dt) const;
+  static PenaltyRows make_penalty(const DaeSystem& system, const Element::PenaltyOverrides& global, double dt);
+  /// The run's state at t0 from y_ and quadratures_ in the present modes: forces, penalty
+  /// forces, roots and outputs of the first step; at the run's start (run_start) also the
+  /// start's mode changes and the roots that start on their boundary.
+  void begin(double t0, bool run_start);
+  void continue_from_hand_over() override;
 
   // Integrator's steps (integrator.hpp).
   void start(double t_end) override;
@@ -83,7 +107,8 @@ class EulerIntegrator : public Integrator {
   std::vector<int> direction_;
   std::vector<EventRecord> events_;
   double t_ = 0.0;  // [time]
-  long step_ = 0;
+  double t0_ = 0.0;  // [time] where this integrator's steps began (0, or where it took over a run)
+  long step_ = 0;    // steps since t0_
 };
 
 }  // namespace railcrash

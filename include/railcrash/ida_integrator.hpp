@@ -45,7 +45,7 @@ class IdaIntegrator : public Integrator {
 
   struct Impl;
 
- private:
+ protected:
   // Integrator's steps (integrator.hpp).
   void start(double t_end) override;
   double advance(double t_end) override;
@@ -58,6 +58,8 @@ class IdaIntegrator : public Integrator {
   std::string divergence_phrase() const override { return "IDA's solution is not finite"; }
   long max_steps() const override { return settings_.max_steps; }
   void finish() override;
+
+ private:
   /// Before the first step: InputError naming the element or body whose residual, Jacobian or
   /// rates are not finite (or so large that IDA's norms overflow) at t = 0.
   void check_start(const double* y, const double* yp, const double* atol, double t_end) const;

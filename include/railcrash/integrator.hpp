@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -95,6 +96,8 @@ struct RunStatistics {
   long settling_steps = 0;           // static equilibrium: pseudo-time steps
   double settling_displacement = 0.0;  // [length] static equilibrium: largest move
   long factor_nonzeros = 0;          // ida: entries KLU stores: L, U and the off-diagonal blocks (last factorization)
+  double handed_over_at = -1.0;      // [time] integrator auto: when IDA handed the run to Euler (-1: it did not)
+  std::string hand_over_reason;      // integrator auto: why it did, or why IDA kept the run ("" before the run ends)
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
 };
@@ -234,6 +237,14 @@ class Integrator {
   /// computed them (Euler's one sweep per step, IDA's sweep of the step's roots), else null:
   /// deliver_step evaluates them.
   virtual const double* current_outputs() const { return nullptr; }
+  /// Asked after every accepted step (t: its end, y: current_state()) by a run loop that
+  /// may go on with another integrator (integrator: auto): the integrator that takes the rest of
+  /// the run from this state, or null to go on with this one. The run loop then calls this
+  /// one's finish(), and the successor goes on with the run's samples, statistics and events;
+  /// it must be ready to advance() from t (its start() is not called).
+  virtual std::unique_ptr<Integrator> hand_over(double /*t*/, const double* /*y*/) { return nullptr; }
+  /// Called on the successor once it holds the run (its statistics among it).
+  virtual void continue_from_hand_over() {}
 
   // ---- for the integrators: what the run loop owns ----
   /// Forwards committed mode changes (the state at that instant: y) to the observer and the
@@ -252,10 +263,15 @@ class Integrator {
   /// Whether the observer takes every step's element outputs (an integrator that can compute
   /// them with other work hands them over through current_outputs()).
   bool step_outputs_wanted() const { return observe_steps_; }
+  /// The state and quadratures at t for a successor (hand_over): as state_at gives them.
+  void state_for_successor(double t, std::vector<double>& y, std::vector<double>& quadratures) { state_at(t, y, quadratures); }
 
   DaeSystem& system_;
 
  private:
+  /// Moves the run in progress (outcome, observer, output times, last samples, phase clock)
+  /// from `previous` into this integrator, which goes on with it (hand_over).
+  void take_run_from(Integrator& previous);
   void deliver_sample(double t);
   /// Passes the state y at t, with its element outputs, to the observer's step().
   void deliver_step(double t, const double* y, int element = -1);

@@ -89,11 +89,18 @@ struct OutputPoint {
   SourceLocation where;
 };
 
-enum class IntegratorKind { Ida, Euler };
+/// ida: IDA + KLU on the DAE; euler: the report's explicit Euler with penalty joints; auto:
+/// IDA, handing the run to Euler where Euler is the cheaper (auto_integrator.hpp).
+enum class IntegratorKind { Ida, Euler, Auto };
+
+/// The integrator's name in model files, options and outputs ("ida", "euler", "auto").
+const char* integrator_name(IntegratorKind kind);
+/// The integrator of a name, or nullopt for a name that is none of them.
+std::optional<IntegratorKind> integrator_from_name(const std::string& name);
 
 struct SimulationSettings {
   double t_end = 1.0;               // [time]
-  IntegratorKind integrator = IntegratorKind::Ida;
+  IntegratorKind integrator = IntegratorKind::Auto;
   double rtol = 1e-6;               // ida: relative tolerance
   std::optional<double> atol;       // ida: absolute tolerance on lengths [length]; default derived from the model
   double dt = 0.0;                  // euler: step [time]; 0 = 0.5 x stability limit

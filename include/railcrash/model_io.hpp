@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "railcrash/model.hpp"
@@ -55,6 +56,11 @@ ExpandedModel expand_model_file(const std::string& path, const std::vector<std::
 /// simulation, outputs, responses and variant keys; the scenario section's are its own), each
 /// once: with the element registry's parameter names, the fuzzer's dictionary (tests/fuzz).
 std::vector<std::string> model_file_keys();
+
+/// The keys the loader allows in each section of the model file, by section: "model" (top level),
+/// "body", "point", "load", "simulation", "output", "responses", "crush_gauge", "variant". The
+/// loader's own lists: `railcrash schema` (model_schema.hpp) builds the JSON Schema from them.
+std::vector<std::pair<std::string, std::vector<std::string>>> model_file_sections();
 
 /// " (did you mean 'x'?)" when a word of `known` is close to `word` (edit distance < 3), else "".
 std::string suggestion(const std::string& word, const std::vector<std::string>& known);

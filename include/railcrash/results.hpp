@@ -157,8 +157,12 @@ struct CarCrush {
 std::vector<CarCrush> cars_of(const DaeSystem& system);
 
 /// Crush of a car at one time [length]: sum of share x max(0, outputs[column]) over its crush
-/// output columns (share 1, or 1/2 for an element between two cars).
-double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares);
+/// output columns (share 1, or 1/2 for an element between two cars). With `allowed` (one stroke
+/// [length] per column, infinity for none), each column counts only beyond its allowed stroke:
+/// share x max(0, outputs[column] - allowed) (the scenario's survival space beyond the declared
+/// crush zones).
+double shared_crush(const double* outputs, const std::vector<int>& columns, const std::vector<double>& shares,
+                    const std::vector<double>* allowed = nullptr);
 
 /// The car's length L [length] between its ends at state y, along the track (x).
 double car_length(const CarCrush& car, const double* y);
@@ -178,7 +182,7 @@ std::optional<double> car_crush_at(const DaeSystem& system, const CarCrush& car,
 /// y, with the same rule for the columns that are not fresh; the scenario's survival space.
 std::optional<double> car_elements_crush_at(const DaeSystem& system, const CarCrush& car, const double* y,
                                             const double* lambda, const double* outputs, const FreshOutputs& fresh,
-                                            std::vector<double>& scratch);
+                                            std::vector<double>& scratch, const std::vector<double>* allowed = nullptr);
 
 /// An element output column (index into DaeSystem::output_names()) that plays a role.
 struct RoleColumn {

@@ -82,6 +82,11 @@ class TrainExpansion {
 /// The keys of the model file the expansion reads (the fuzzer's dictionary adds them).
 const std::vector<std::string>& train_expansion_keys();
 
+/// The keys the expansion allows in each of its maps, by name: "sections" (its top-level
+/// sections), "car_type", "interface_type", "interface", "train", "car", "coupling",
+/// "connection", "end_point" (a point of an interface type's element). For `railcrash schema`.
+std::vector<std::pair<std::string, std::vector<std::string>>> train_expansion_sections();
+
 /// Whether a KEY=VALUE (or KEY*=FACTOR) setting edits a car type, interface type, train or
 /// connection (key starting car_types., interface_types., trains. or connections.): such
 /// settings apply before the expansion, so that a type's change reaches every instance.

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Writes the EN 15227 scenario models of the report's car (models/report/final_two_car.yaml)
-# and of the barrier test's two cars (models/barrier/two_car_barrier.yaml) into DIR (default:
+# Writes the EN 15227 scenario models of the report's car (models/report/final_two_car.yaml),
+# of the barrier test's two cars (models/barrier/two_car_barrier.yaml) and of the illustrative
+# 3-car EMU (models/examples/emu3_unit_collision.yaml, emu3_wall.yaml) into DIR (default:
 # this folder). Run from the repository root:
 #   models/scenarios/make.sh build/railcrash [DIR]
 # The limits and the buffer below are the values these examples were generated with, NOT values
@@ -12,7 +13,8 @@
 #   buffer centre 1060 mm above the rail.
 # The barrier cars' front faces in scenario 1 (the test met a wall, not a second train) take the
 # barrier model's own values: 875.6 kN/mm per face = its wall stiffness 5e6 lbf/in (its reading
-# 11), 304.8 mm high = its end beams' 12 in depth (its reading 4).
+# 11), 304.8 mm high = its end beams' 12 in depth (its reading 4); their friction coefficient
+# 0.3 (illustrative, a dry steel-on-steel value: no source) lets the 40 mm offset act.
 set -eu
 bin=$1
 dir=${2:-models/scenarios}
@@ -24,6 +26,13 @@ report_car=(--passenger-bodies center_body --survival-gauge bolster_body,rear_bo
 "$bin" scenario 2 --train "$train" "${limits[@]}" "${report_car[@]}" "${buffers[@]}" --out "$dir/scenario2_report_car.yaml"
 train=models/barrier/two_car_barrier.yaml
 barrier_cars=(--passenger-bodies lead_body,trail_body)
-"$bin" scenario 1 --train "$train" --offset 40 "${limits[@]}" "${barrier_cars[@]}" --face-stiffness 875.6 --face-height 304.8 \
+"$bin" scenario 1 --train "$train" --offset 40 "${limits[@]}" "${barrier_cars[@]}" --face-stiffness 875.6 --face-height 304.8 --face-friction 0.3 \
   --out "$dir/scenario1_barrier_cars.yaml"
 "$bin" scenario 2 --train "$train" "${limits[@]}" "${barrier_cars[@]}" "${buffers[@]}" --out "$dir/scenario2_barrier_cars.yaml"
+# The illustrative 3-car EMU built from car types (models/examples/emu3_*.yaml): its cab front's
+# curve reaches the 60 kN/mm survival-space segment at 900 mm, the intermediate car's and every
+# rear end's at 200 mm; those are the declared crush zones' strokes.
+emu3=(--passenger-bodies body --crush-zones cab_car.front_crush:900,intermediate_car.front_crush:200,rear_crush:200)
+"$bin" scenario 1 --train models/examples/emu3_unit_collision.yaml --offset 40 "${limits[@]}" "${emu3[@]}" \
+  --out "$dir/scenario1_emu3.yaml"
+"$bin" scenario 2 --train models/examples/emu3_wall.yaml "${limits[@]}" "${emu3[@]}" "${buffers[@]}" --out "$dir/scenario2_emu3.yaml"

@@ -24,7 +24,7 @@ for summary in sorted(out.glob("*/summary.json")):
     status = s["status"] + (" at t = %.4g s" % s["t_reached"] if s["status"] != "ok" else "")
     for c in s.get("scenario", {}).get("criteria", []):
         g = c["criterion"] == "mean_deceleration"
-        unit = " g" if g else " in"
+        unit = " g" if g else "" if c["criterion"] == "wheel_unloading" else " " + s["units"]["length"]
         value, limit = (c["value_g"], c["limit_g"]) if g else (c["value"], c["limit"])
         note = " (%s)" % c["note"] if c["note"] else ""
         print("| %s | %s | %s | %s | %s | %.4g%s | %.4g%s | %s%s |" % (model, integrator, status, c["criterion"], c["subject"],

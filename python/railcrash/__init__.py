@@ -109,7 +109,8 @@ def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, outpu
         set=None, timings=False):
     """Runs a model (a Model, or a model file's path) and returns its Results, in memory.
 
-    Unset arguments keep the model's simulation section. integrator: "ida" or "euler".
+    Unset arguments keep the model's simulation section. integrator: "auto", "ida" or "euler"
+    (auto: results.summary["integrator_used"] says which ran when, and why).
     timings: split the run's wall time by phase, as `railcrash run --timings`:
     results.summary["stats"]["seconds"] (residual, jacobian, linear_solve, ..., adding up to
     results.summary["stats"]["wall_seconds"]).
@@ -122,8 +123,8 @@ def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, outpu
         model = model.with_settings(set)
     settings = RunSettings()
     if integrator is not None:
-        if integrator not in ("ida", "euler"):
-            raise InputError(f"integrator must be 'ida' or 'euler', not {integrator!r}")
+        if integrator not in ("auto", "ida", "euler"):
+            raise InputError(f"integrator must be 'auto', 'ida' or 'euler', not {integrator!r}")
         settings.integrator = integrator
     for name, value in (("t_end", t_end), ("rtol", rtol), ("atol", atol), ("dt", dt),
                         ("output_interval", output_interval)):

@@ -107,6 +107,14 @@ class RunTest(unittest.TestCase):
         summary = result.summary
         self.assertEqual(summary["status"], "ok")
         self.assertEqual(summary["integrator"], "ida")
+        self.assertNotIn("integrator_used", summary)
+        # auto on a smooth motion without mode changes keeps IDA throughout, with IDA's result.
+        auto = railcrash.run(model, integrator="auto")
+        self.assertEqual(auto.summary["integrator"], "auto")
+        self.assertEqual(auto.summary["integrator_used"]["method"], "ida")
+        self.assertIsNone(auto.summary["integrator_used"]["euler_from_t"])
+        self.assertTrue(auto.summary["integrator_used"]["reason"].startswith("IDA kept the run"))
+        self.assertTrue(numpy.array_equal(auto.series("cart.x"), x))
         self.assertLess(abs(summary["energy"]["balance_error"]), 1e-5)
         # Signed extremes of the spring force (tension positive): +k A at x = 1.1, -k A at x = 0.9.
         self.assertAlmostEqual(summary["peaks"]["spring.force"]["max"], STIFFNESS * 0.1, places=3)

@@ -402,4 +402,19 @@ void register_anticlimber_elements(ElementRegistry& registry) {
                 [](ElementSpec& s) { return std::make_unique<Anticlimber>(s); }});
 }
 
+void Anticlimber::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                          ForceBlock& df_dv) const {
+  State stiffest = mode_as<State>(s);
+  const Kinematics<double> k = kinematics(s);
+  stiffest.contact = Contact::Engaged;
+  stiffest.interlock_released = false;
+  stiffest.horizontal = horizontal.fresh();
+  stiffest.vertical = vertical.fresh();
+  stiffest.torsional = torsional.fresh();
+  stiffest.vertical_reference = k.vertical;
+  stiffest.torsional_reference = k.rotation;
+  std::array<Pose<double>, 2> f{};
+  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
+}
+
 }  // namespace railcrash

@@ -171,6 +171,16 @@ double PiecewiseLineElement<Derived>::law_integral(const ElementState<double>& s
 }
 
 template <class Derived>
+void PiecewiseLineElement<Derived>::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
+                                                            ForceBlock& df_dv) const {
+  SegmentMode steepest;  // unbroken, on the segment of the largest |slope|
+  for (int k = 1; k < law_.segment_count(); ++k)
+    if (std::abs(law_.segment(k).slope) > std::abs(law_.segment(steepest.segment).slope)) steepest.segment = k;
+  std::array<Pose<double>, 2> f{};
+  this->add_force_jacobian(t, in_mode(s, steepest), f, df_dq, df_dv);
+}
+
+template <class Derived>
 void PiecewiseLineElement<Derived>::outputs(const ElementState<double>& s, const double*, double* out) const {
   const double x = measure_of(s);
   out[0] = law_value(mode_as<SegmentMode>(s), x);

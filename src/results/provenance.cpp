@@ -69,13 +69,13 @@ std::string provenance_json(const Provenance& p) {
   j += "], \"settings\": [";
   for (std::size_t k = 0; k < p.settings.size(); ++k) j += std::string(k ? ", " : "") + json_string(p.settings[k]);
   const SimulationSettings& s = p.simulation;
-  const bool euler = s.integrator == IntegratorKind::Euler;
-  j += "], \"simulation\": {\"integrator\": " + json_string(euler ? "euler" : "ida") + ", \"t_end\": " + json_number(s.t_end) +
+  const bool euler = s.integrator != IntegratorKind::Ida, ida = s.integrator != IntegratorKind::Euler;
+  j += "], \"simulation\": {\"integrator\": " + json_string(integrator_name(s.integrator)) + ", \"t_end\": " + json_number(s.t_end) +
        ", \"output_interval\": " + json_number(output_interval_of(s)) + ", \"max_steps\": " + std::to_string(s.max_steps);
   if (euler)
     j += ", \"dt\": " + (s.dt > 0.0 ? json_number(s.dt) : "\"0.5 x stability limit\"") +
          ", \"force_dt\": " + (s.force_dt ? "true" : "false");
-  else
+  if (ida)
     j += ", \"rtol\": " + json_number(s.rtol) + ", \"atol\": " + (s.atol ? json_number(*s.atol) : "\"from the model\"");
   j += std::string(", \"static_equilibrium\": ") + (s.static_equilibrium ? "true" : "false") + "}}";
   return j;

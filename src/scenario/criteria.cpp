@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "railcrash/dae_system.hpp"
@@ -122,7 +123,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
     c->passenger_bodies.push_back(r.body(b, "mean_deceleration: bodies"));
 
   const YAML::Node survival = r.required(section, "survival_space", "the section");
-  r.only_keys(survival, {"limit", "source", "cars", "excluded", "gauges"}, "survival_space");
+  r.only_keys(survival, {"limit", "source", "cars", "excluded", "zones", "gauges"}, "survival_space");
   c->survival_limit = r.positive(r.required(survival, "limit", "survival_space"), "survival_space: limit");
   c->survival_source = r.text(r.required(survival, "source", "survival_space"), "survival_space: source");
   if (!survival["cars"] && !survival["gauges"])
@@ -143,6 +144,17 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
         r.fail(e, "survival_space: excluded: no element named '" + name + "' in the model");
       c->survival_excluded.push_back(name);
     }
+  if (survival["zones"])
+    for (const YAML::Node& z : r.list(survival["zones"], "survival_space: zones")) {
+      r.only_keys(z, {"element", "stroke"}, "survival_space: zone");
+      const YAML::Node element = r.required(z, "element", "survival_space: zone");
+      const std::string name = r.text(element, "survival_space: zone element");
+      const auto& elements = model.elements();
+      if (std::none_of(elements.begin(), elements.end(), [&](const auto& e) { return e->name() == name; }))
+        r.fail(element, "survival_space: zones: no element named '" + name + "' in the model");
+      c->survival_zones.push_back({name, r.positive(r.required(z, "stroke", "survival_space: zone " + name),
+                                                    "survival_space: zone " + name + ": stroke")});
+    }
   if (survival["gauges"])
   for (const YAML::Node& g : r.list(survival["gauges"], "survival_space: gauges")) {
     r.only_keys(g, {"name", "front", "rear"}, "survival_space: gauge");
@@ -155,7 +167,8 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
   }
 
   const YAML::Node override_node = r.required(section, "override", "the section");
-  r.only_keys(override_node, {"limit", "source", "interface", "bodies", "wheel_lift_limit", "wheel_lift_source", "wheels"}, "override");
+  r.only_keys(override_node, {"limit", "source", "interface", "bodies", "wheel_lift_limit", "wheel_lift_source", "wheels", "rail_supports"},
+              "override");
   if (override_node["interface"] && override_node["bodies"])
     r.fail(override_node, "override: give either 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface), not both");
   if (!override_node["interface"] && !override_node["bodies"] && c->number != 3)
@@ -174,10 +187,20 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
   } else if (override_node["limit"] || override_node["source"]) {
     r.fail(override_node, "override: 'limit' and 'source' belong to an interface ('interface' or 'bodies'), which this scenario has not");
   }
-  c->wheel_lift_limit = r.positive(r.required(override_node, "wheel_lift_limit", "override"), "override: wheel_lift_limit");
-  c->wheel_lift_source = r.text(r.required(override_node, "wheel_lift_source", "override"), "override: wheel_lift_source");
-  for (const YAML::Node& w : r.list(r.required(override_node, "wheels", "override"), "override: wheels"))
-    c->wheels.push_back(r.element(w, "override: wheels", "wheel_rail"));
+  if (!override_node["wheels"] && !override_node["rail_supports"])
+    r.fail(override_node, "override: give 'wheels: [..]' (the leading bogies' wheel_rail elements) or 'rail_supports: [..]' "
+                          "(the slider_joints holding them on the rail)");
+  if (override_node["rail_supports"])
+    for (const YAML::Node& w : r.list(override_node["rail_supports"], "override: rail_supports"))
+      c->rail_supports.push_back(r.element(w, "override: rail_supports", "slider_joint"));
+  if (override_node["wheels"]) {
+    c->wheel_lift_limit = r.positive(r.required(override_node, "wheel_lift_limit", "override"), "override: wheel_lift_limit");
+    c->wheel_lift_source = r.text(r.required(override_node, "wheel_lift_source", "override"), "override: wheel_lift_source");
+    for (const YAML::Node& w : r.list(override_node["wheels"], "override: wheels"))
+      c->wheels.push_back(r.element(w, "override: wheels", "wheel_rail"));
+  } else if (override_node["wheel_lift_limit"] || override_node["wheel_lift_source"]) {
+    r.fail(override_node, "override: 'wheel_lift_limit' and 'wheel_lift_source' belong to 'wheels' (wheel_rail elements), which this scenario has not");
+  }
   return c;
 }
 
@@ -213,6 +236,21 @@ double largest_lift(const std::vector<double>& penetration) {
   return largest;
 }
 
+double static_load(const std::vector<double>& reaction) {
+  for (const double q : reaction)
+    if (q != 0.0) return q;
+  return 0.0;
+}
+
+double largest_unloading(const std::vector<double>& reaction) {
+  const double q0 = static_load(reaction);
+  if (q0 == 0.0) return reaction.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+  double lowest = 1.0;  // Q / Q0, from the first known reaction on
+  const auto first = std::find_if(reaction.begin(), reaction.end(), [](double q) { return q != 0.0; });
+  for (auto q = first; q != reaction.end(); ++q) lowest = std::min(lowest, *q / q0);
+  return 1.0 - lowest;
+}
+
 ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria& criteria)
     : system_(system), criteria_(criteria) {
   const Model& model = system.model();
@@ -230,6 +268,7 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
     kept.element_indices.clear();
     kept.columns.clear();
     kept.shares.clear();
+    std::vector<double> allowed;  // [length] 0, or a declared zone's stroke
     for (std::size_t k = 0; k < car->elements.size(); ++k) {
       const auto& excluded = criteria.survival_excluded;
       if (std::find(excluded.begin(), excluded.end(), car->elements[k]) != excluded.end()) continue;
@@ -237,8 +276,12 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
       kept.element_indices.push_back(car->element_indices[k]);
       kept.columns.push_back(car->columns[k]);
       kept.shares.push_back(car->shares[k]);
+      const auto& zones = criteria.survival_zones;
+      const auto zone = std::find_if(zones.begin(), zones.end(), [&](const auto& z) { return z.element == car->elements[k]; });
+      allowed.push_back(zone == zones.end() ? 0.0 : zone->stroke);
     }
     crush_of_cars_.push_back(kept);
+    allowed_.push_back(allowed);
   }
   if (!criteria.interface_element.empty()) {
     vertical_offset_column_ = column_of(system, criteria.interface_element + ".vertical_offset");
@@ -248,6 +291,9 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
     interface_upper_ = *model.find_body(criteria.interface_bodies[1]);
   }
   for (const std::string& w : criteria.wheels) wheel_columns_.push_back(column_of(system, w + ".penetration"));
+  for (const std::string& w : criteria.rail_supports) support_columns_.push_back(column_of(system, w + ".normal_reaction"));
+  reaction_.resize(support_columns_.size());
+  step_extremes_.lowest_load.assign(support_columns_.size(), 1.0);
   vx_.resize(passenger_index_.size());
   lengths_.resize(front_index_.size());
   car_crush_.resize(crush_of_cars_.size());
@@ -258,7 +304,7 @@ ScenarioTracker::ScenarioTracker(const DaeSystem& system, const ScenarioCriteria
 }
 
 double ScenarioTracker::car_crush_now(std::size_t k, const double* outputs) const {
-  return shared_crush(outputs, crush_of_cars_[k].columns, crush_of_cars_[k].shares);
+  return shared_crush(outputs, crush_of_cars_[k].columns, crush_of_cars_[k].shares, &allowed_[k]);
 }
 
 void ScenarioTracker::step(double, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) {
@@ -268,7 +314,7 @@ void ScenarioTracker::step(double, const double* y, const double* lambda, const 
         std::max(step_extremes_.shortening[k], lengths_[k].front() - distance(y, front_index_[k], rear_index_[k]));
   // A car's crush sums several elements' outputs, all of one instant (car_elements_crush_at).
   for (std::size_t k = 0; k < crush_of_cars_.size(); ++k) {
-    const std::optional<double> crush = car_elements_crush_at(system_, crush_of_cars_[k], y, lambda, outputs, fresh, crush_scratch_);
+    const std::optional<double> crush = car_elements_crush_at(system_, crush_of_cars_[k], y, lambda, outputs, fresh, crush_scratch_, &allowed_[k]);
     if (crush) step_extremes_.car_crush[k] = std::max(step_extremes_.car_crush[k], *crush);
   }
   bool offset_known = true;
@@ -284,6 +330,9 @@ void ScenarioTracker::step(double, const double* y, const double* lambda, const 
     step_extremes_.offset_change = std::max(step_extremes_.offset_change, std::abs(offset - vertical_offset_.front()));
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
     if (fresh.has(wheel_columns_[k])) step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
+  for (std::size_t k = 0; k < support_columns_.size(); ++k)
+    if (const double q0 = static_load(reaction_[k]); fresh.has(support_columns_[k]) && q0 != 0.0)
+      step_extremes_.lowest_load[k] = std::min(step_extremes_.lowest_load[k], outputs[support_columns_[k]] / q0);
 }
 
 void ScenarioTracker::sample(double t, const double* y, const double*, const double*, const double* outputs) {
@@ -300,6 +349,7 @@ void ScenarioTracker::sample(double t, const double* y, const double*, const dou
   }
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
     penetration_[k].push_back(outputs[wheel_columns_[k]]);
+  for (std::size_t k = 0; k < support_columns_.size(); ++k) reaction_[k].push_back(outputs[support_columns_[k]]);
 }
 
 std::vector<CriterionResult> ScenarioTracker::results() const {
@@ -326,6 +376,9 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     if (crush_of_cars_[k].columns.empty()) {  // nothing measured: not a pass
       r.pass = false;
       r.note = "not measured: the car has no crush element (no output with the crush role) besides the excluded ones";
+    } else if (std::any_of(allowed_[k].begin(), allowed_[k].end(), [](double stroke) { return stroke > 0.0; })) {
+      r.note = r.value > 0.0 ? "crushed beyond its declared crush zones' strokes or in crush elements not declared zones"
+                             : "its crush stayed within its declared crush zones";
     }
     out.push_back(r);
   }
@@ -346,6 +399,18 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     r.value = std::max(largest_lift(penetration_[k]), step_extremes_.lift[k]);
     r.limit = criteria_.wheel_lift_limit;
     r.pass = r.value <= r.limit;
+    out.push_back(r);
+  }
+  for (std::size_t k = 0; k < support_columns_.size(); ++k) {
+    CriterionResult r;
+    r.criterion = "wheel_unloading";
+    r.subject = criteria_.rail_supports[k];
+    r.value = std::max(largest_unloading(reaction_[k]), 1.0 - step_extremes_.lowest_load[k]);
+    r.limit = 1.0;
+    r.pass = r.value < r.limit;
+    r.note = !std::isfinite(r.value) ? "no static wheel load at the start (no gravity?): unloading not measured"
+             : r.pass                ? "the rail kept bearing the bogie"
+                                     : "the rail reaction reversed: the bogie's wheels would lift";
     out.push_back(r);
   }
   return out;
@@ -373,7 +438,10 @@ std::string ScenarioTracker::json() const {
     << ", \"category\": " << json_string(criteria_.category) << ", \"closing_speed\": " << json_number(criteria_.closing_speed)
     << ", \"pass\": " << (pass ? "true" : "false") << ", \"sources\": {\"mean_deceleration\": " << json_string(criteria_.deceleration_source)
     << ", \"survival_space\": " << json_string(criteria_.survival_source) << ", \"override\": " << json_string(criteria_.override_source)
-    << ", \"wheel_lift\": " << json_string(criteria_.wheel_lift_source) << "}, \"criteria\": [";
+    << ", \"wheel_lift\": " << json_string(criteria_.wheel_lift_source);
+  if (!criteria_.rail_supports.empty())
+    j << ", \"wheel_unloading\": \"limit 1: at (Q0 - Q) / Q0 = 1 the rail would pull the bogie down (a physical bound)\"";
+  j << "}, \"criteria\": [";
   for (std::size_t k = 0; k < all.size(); ++k) {
     const CriterionResult& r = all[k];
     j << (k ? ", " : "") << "{\"criterion\": " << json_string(r.criterion) << ", \"subject\": " << json_string(r.subject)

@@ -219,7 +219,7 @@ mkdir -p "$tmp/scenarios"
 cd "$src"
 expect_status "make.sh regenerates the scenario models" 0 models/scenarios/make.sh "$bin" "$tmp/scenarios"
 cd - > /dev/null
-for name in scenario1_report_car scenario2_report_car scenario1_barrier_cars scenario2_barrier_cars; do
+for name in scenario1_report_car scenario2_report_car scenario1_barrier_cars scenario2_barrier_cars scenario1_emu3 scenario2_emu3; do
   if cmp -s "$tmp/scenarios/$name.yaml" "$src/models/scenarios/$name.yaml"; then passes=$((passes + 1));
   else echo "FAIL: models/scenarios/$name.yaml differs from what make.sh writes now"; failures=$((failures + 1)); fi
   for integrator in ida euler; do

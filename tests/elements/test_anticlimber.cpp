@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "railcrash/elements/anticlimber.hpp"
+#include "railcrash/euler_integrator.hpp"
 #include "railcrash/run.hpp"
 #include "support.hpp"
 
@@ -1144,4 +1145,28 @@ TEST_CASE("anticlimber interlock_while_unloading must be hold or release", "[ele
   Parameters p;  // not given: hold
   CHECK_FALSE(anticlimber_of(testing::model_from_text(model_yaml(two_cars(), p, kCar1Face, kCar2Face, "t_end: 1")))
                   .release_while_unloading);
+}
+
+TEST_CASE("Euler's stability limit sees the stiffness of anticlimber faces that start apart", "[elements][anticlimber][integrators]") {
+  // Two 1000 kg car ends 0.05 m apart; the faces' horizontal elastic stiffness 1e9 N/m acts
+  // once they meet: omega^2 = k (1/m1 + 1/m2) = 2e6 s^-2, limit 2 / omega. The vertical and
+  // torsional laws are soft enough not to matter (1e3 N/m, 1e2 N m/rad on 100 kg m^2).
+  const Model model = testing::model_from_text(R"(railcrash: 1
+name: open anticlimber
+units: SI
+gravity: [0, 0]
+bodies:
+  - {name: a, mass: 1000, inertia: 100, position: [0, 0], velocity: [1, 0]}
+  - {name: b, mass: 1000, inertia: 100, position: [0.05, 0]}
+elements:
+  - {name: faces, type: anticlimber, points: [{body: a, at: [0, 0]}, {body: b, at: [0, 0]}],
+     horizontal_elastic_stiffness: 1.0e9, horizontal_plastic_stiffness: 1.0e6, horizontal_yield_deflection: 0.0025,
+     vertical_elastic_stiffness: 1.0e3, vertical_plastic_stiffness: 1.0e2, vertical_yield_deflection: 0.005,
+     torsional_elastic_stiffness: 1.0e2, torsional_plastic_stiffness: 1.0e1, torsional_yield_deflection: 0.01,
+     face_height: 0.3}
+simulation: {t_end: 0.1}
+)");
+  DaeSystem system(model);
+  const double limit = EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr);
+  CHECK(limit == Approx(2.0 / std::sqrt(2e6)).epsilon(1e-4));
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "railcrash/elements/nonlinear.hpp"
+#include "railcrash/euler_integrator.hpp"
 #include "railcrash/run.hpp"
 #include "support.hpp"
 
@@ -813,4 +814,20 @@ TEST_CASE("nonlinear elements reject incomplete or inconsistent parameters", "[e
   // Starting beyond the fracture load: 100 * 0.5 = 50 > 10.
   CHECK_THROWS_WITH(load("nonlinear_spring", "compression_stiffness_1: 100, extension_stiffness_1: 100, free_length: 0.5, fracture_load: 10"),
                     Catch::Contains("fracture_load"));
+}
+
+TEST_CASE("Euler's stability limit sees a piecewise law's steepest segment before the spring reaches it",
+          "[elements][nonlinear][integrators]") {
+  // A 1 kg mass on a special spring at its free length: 100 N/m up to 0.05 m of compression,
+  // 40000 N/m beyond. Starting on the soft segment (limit 2 / 10 = 0.2 s), the estimate must
+  // be the steep segment's 2 / sqrt(40000) = 0.01 s: an Euler step sized at the start would
+  // otherwise run unstable once the spring closes to its second segment.
+  const Model model = testing::model_from_text(
+      "railcrash: 1\nname: stiffening\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: m, mass: 1, inertia: 1, position: [1, 0], velocity: [-1, 0]}\n"
+      "elements:\n  - {name: e, type: special_spring, stiffness_1: 100, stiffness_2: 40000, breakpoint: 0.05, "
+      "free_length: 1.0, points: [{body: ground, at: [0, 0]}, {body: m, at: [0, 0]}]}\n"
+      "simulation: {t_end: 1}\n");
+  DaeSystem system(model);
+  CHECK(EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr) == Approx(0.01).epsilon(1e-9));
 }

@@ -126,8 +126,9 @@ TEST_CASE("Every file of a run carries its run id and provenance, with both file
                                          json_string((models / "multiple_unit.yaml").string()) + ", \"sha256\": \"" +
                                          sha256_hex(kMultipleUnit) + "\"}]"));
   CHECK_THAT(provenance, Catch::Contains("\"settings\": [\"simulation.t_end=0.03\", \"simulation.output_interval=0.002\"], "
-                                         "\"simulation\": {\"integrator\": \"ida\", \"t_end\": 0.03, \"output_interval\": 0.002, "
-                                         "\"max_steps\": 10000000, \"rtol\": 1e-06, \"atol\": \"from the model\""));
+                                         "\"simulation\": {\"integrator\": \"auto\", \"t_end\": 0.03, \"output_interval\": 0.002, "
+                                         "\"max_steps\": 10000000, \"dt\": \"0.5 x stability limit\", \"force_dt\": false, "
+                                         "\"rtol\": 1e-06, \"atol\": \"from the model\""));  // auto: both methods' settings
   for (const char* name : {"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv"})
     CHECK(first_line(dir / name) == "# railcrash provenance " + provenance);
   CHECK_THAT(slurp(dir / "model.json"), Catch::StartsWith("{\n  \"format\": 1,\n  \"run_id\": \"" + run.run_id + "\",\n"));

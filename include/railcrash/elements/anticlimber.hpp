@@ -293,6 +293,11 @@ class Anticlimber : public ForceElement<Anticlimber> {
   static constexpr int kRootCount = 11;
 
   bool applies_moment() const override { return true; }
+  /// Engaged, elastic and interlocked in all three directions, whatever the mode: faces that
+  /// start apart have no stiffness at t = 0, and Euler's stability limit must see the
+  /// stiffness they will meet with (without it, a 1e9 N/m face between 1 t car ends ran
+  /// above its limit).
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   void initialize(const ElementState<double>& initial) override;
   int root_count() const override { return kRootCount; }
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;

@@ -208,6 +208,10 @@ class PiecewiseLineElement : public ForceElement<Derived> {
   double measure_of(const ElementState<double>& s) const { return static_cast<const Derived*>(this)->measure(s); }
   /// Outputs: the law value f (force) and x.
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
+  /// On the law's steepest segment, unbroken, whatever the segment now: a spring that starts
+  /// on a soft or open segment (a special spring's gap) meets its steeper ones later, and
+  /// Euler's stability limit must see them.
+  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
 
  protected:
   /// fracture_sides: 0 (no fracture_load), 1 (f reaching +fracture_load) or 2 (|f|).

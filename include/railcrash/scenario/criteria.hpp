@@ -19,10 +19,16 @@
 //   mean deceleration  per body: its longitudinal velocity vx(t), low-pass filtered at the
 //                      channel class `cfc` (results/cfc_filter.hpp), then the collision pulse
 //                      of results/crash_pulse.hpp: |velocity change| / duration of the collision.
-//   survival space     per car (`cars:`): the largest crush of the car over the run, the sum of
-//                      its crush outputs (OutputRole::Crush) as car_elements_crush_at sums them
-//                      (an element between two cars by half), without the `excluded:` elements
-//                      (crush zones, the struck wagon's buffers or obstacle);
+//   survival space     per car (`cars:`): the largest loss of the car's survival space over the
+//                      run: the sum of its crush outputs (OutputRole::Crush) as
+//                      car_elements_crush_at sums them (an element between two cars by half),
+//                      each declared crush zone (`zones: [{element: E, stroke: S}]`) counting
+//                      only its crush beyond its stroke S, and without the `excluded:` elements
+//                      (the struck wagon's buffers or obstacle: not the train's). A lumped car's
+//                      bodies are rigid, so its length shortens only in its crush elements: a car
+//                      whose crush stays within its zones' strokes keeps its survival space
+//                      (value 0, a pass); one whose zone bottoms out loses what it crushes beyond.
+//                      A car with no crush element at all is "not measured" (a fail);
 //   survival gauge     per gauge (`gauges:`, optional, beside): the largest shortening of the
 //                      distance between the two bodies' centres of gravity, L(0) - L(t).
 //   override           the interface anticlimber's vertical_offset: largest |v(t) - v(0)| (the
@@ -32,7 +38,13 @@
 //                      y_B - y_A (scenario 2: the train's front end and the wagon); scenario 3
 //                      has neither (and no override limit): only the wheel lift;
 //                      wheel lift: the largest lift max(0, -penetration) of the listed wheel_rail
-//                      elements (the leading bogies' wheels).
+//                      elements (the leading bogies' wheels);
+//                      wheel unloading (`rail_supports:`, slider_joints holding a bogie on the
+//                      rail, for cars without wheel_rail elements): the largest unloading
+//                      (Q0 - Q) / Q0 of the rail's normal reaction Q against its value Q0 at the
+//                      start (the static wheel load); at 1 the rail would have to pull the bogie
+//                      down, i.e. its wheels would lift: limit 1, a physical bound, not a value
+//                      of the standard.
 #pragma once
 
 #include <functional>
@@ -66,7 +78,12 @@ struct ScenarioCriteria {
     std::string name, front_body, rear_body;
   };
   std::vector<std::string> survival_cars;  // cars (bodies' car:) whose crush outputs are the survival-space loss
-  std::vector<std::string> survival_excluded;  // crush elements that are not survival space (crush zones, the struck body's)
+  std::vector<std::string> survival_excluded;  // crush elements that are not the train's (the struck body's)
+  struct Zone {
+    std::string element;
+    double stroke = 0.0;  // [length] crush allowed before the survival space behind it is reached
+  };
+  std::vector<Zone> survival_zones;  // declared crush zones
   std::vector<Gauge> survival_gauges;
   double survival_limit = 0.0;  // [length] largest allowed shortening
   std::string survival_source;
@@ -76,6 +93,7 @@ struct ScenarioCriteria {
   double override_limit = 0.0;     // [length] largest vertical relative displacement
   std::string override_source;
   std::vector<std::string> wheels; // wheel_rail elements of the leading bogies
+  std::vector<std::string> rail_supports;  // slider_joints holding the leading bogies on the rail
   double wheel_lift_limit = 0.0;   // [length]
   std::string wheel_lift_source;
 
@@ -112,6 +130,12 @@ double largest_shortening(const std::vector<double>& lengths);
 double largest_change(const std::vector<double>& values);
 /// Largest lift max(0, -penetration) of a wheel [length].
 double largest_lift(const std::vector<double>& penetration);
+/// The static load Q0 of a rail reaction history: its first non-zero value (explicit Euler's
+/// penalty joints report no reaction in the first sample); 0 if there is none.
+double static_load(const std::vector<double>& reaction);
+/// Largest unloading (Q0 - Q) / Q0 of a rail reaction Q against its static load Q0 (either
+/// sign); infinity when Q0 is 0 (no static load to compare with).
+double largest_unloading(const std::vector<double>& reaction);
 
 /// Collects the histories during a run and evaluates the criteria at the end.
 class ScenarioTracker : public RunObserver {
@@ -139,15 +163,17 @@ class ScenarioTracker : public RunObserver {
   std::vector<double> crush_scratch_;                   // their elements' outputs evaluated at an event (car_crush_at)
   int vertical_offset_column_ = -1, override_column_ = -1;
   int interface_lower_ = -1, interface_upper_ = -1;  // bodies of interface_bodies
-  std::vector<int> wheel_columns_;
+  std::vector<int> wheel_columns_, support_columns_;
+  std::vector<std::vector<double>> allowed_;  // per survival car: each column's allowed stroke (shared_crush)
   std::vector<double> times_;
-  std::vector<std::vector<double>> vx_, lengths_, penetration_, car_crush_;
+  std::vector<std::vector<double>> vx_, lengths_, penetration_, car_crush_, reaction_;
   std::vector<double> vertical_offset_;
   bool overridden_ = false;
   struct StepExtremes {                  // from step(), beside the rows' histories
     std::vector<double> shortening;      // [length] per survival gauge
     std::vector<double> car_crush;       // [length] per survival car
     std::vector<double> lift;            // [length] per wheel
+    std::vector<double> lowest_load;     // [-] per rail support: smallest Q / Q0
     double offset_change = 0.0;          // [length] interface
   } step_extremes_;
 };

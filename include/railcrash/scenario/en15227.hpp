@@ -36,14 +36,32 @@
 // Any other car model whose bodies declare `car: NAME` (e.g. the barrier test's two cars) is a
 // train unit (scenario/train_unit.hpp: its striking end found from the elements' output roles):
 // scenario 1 puts the unit (s_*) against its mirror image (t_*), their front faces meeting at an
-// uncoupled coupler_end (front_faces, the face stiffness and height required inputs); --cars is
-// then the unit's own cars.
+// uncoupled coupler_end (front_faces, the face stiffness and height required inputs, and with an
+// offset the faces' friction coefficient: without vertical friction the faces slide past each
+// other and the offset cannot act); --cars is then the unit's own cars.
+// A model with car types and trains (train_expansion.hpp, e.g. models/examples/emu3_*.yaml) is
+// used as it composes its train (ScenarioRequest::unit, default its first): the train renamed
+// `striking`, facing +x with its leading interface at x = 0; in scenario 1 a copy `standing`
+// facing -x, raised with its rails by the offset, joined to it at the leading interfaces by a
+// connection `impact` of the interface type the model's own connection there uses (or
+// ScenarioRequest::interface). The document is expanded by the generator (the raise applies to
+// the expanded bodies and ground points); the model's own flat bodies and elements, other trains
+// and connections are left out. With an offset, the interface type must contain an anticlimber:
+// without a vertical interlock (or friction) the faces slide past each other and the offset
+// cannot produce override, so the request is refused. Car-type names reach every instance:
+// passenger bodies (default: each car's heaviest body, its car body) and crush zones (TYPE.NAME:
+// only car type TYPE's instances). The leading
+// cars' wheels are their foremost wheel_rail elements or, without any, their foremost
+// slider_joints on ground (the rail supports of scenario/criteria.hpp's wheel unloading).
+// Crush zones (--crush-zones NAME[:STROKE mm]) become the section's `zones` with their strokes
+// in the model's units (without a stroke: the end of the element's declared curve).
 // Scenario 3: the train at --speed (required: the speed per category was not confirmed) into an
 // obstacle of 15 t (railwaynews.net, scenario 3) built like the wagon: one body on a frictionless
 // slider and a crush_spring with the obstacle's force-crush curve (required) at its contact height
 // (required). No interface: override is judged by the leading bogie's wheel lift.
-// The struck body's spring (wagon_buffers, obstacle_crush) and --crush-zones are left out of the
-// survival-space loss (the cars' crush outputs, scenario/criteria.hpp).
+// The struck body's spring (wagon_buffers, obstacle_crush) is left out of the survival-space loss
+// (the cars' crush outputs, scenario/criteria.hpp), and the --crush-zones count only beyond their
+// strokes.
 // Scenario 4 is refused with the reason: its obstacle is pushed sideways, out of the plane.
 #pragma once
 
@@ -66,8 +84,9 @@ struct ScenarioRequest {
   std::optional<double> override_limit;         // [mm] largest vertical relative displacement
   std::optional<double> wheel_lift_limit;       // [mm]
   std::vector<std::string> passenger_bodies;    // train model bodies (a template's without the car1_ prefix)
-  std::vector<std::string> crush_zones;         // crush elements (named as passenger_bodies) whose crush is allowed:
-                                                // left out of the survival-space loss
+  std::vector<std::string> crush_zones;         // declared crush zones NAME or NAME:STROKE [mm] (named as passenger_bodies;
+                                                // a car type's element name reaches every instance): their crush up
+                                                // to the stroke (default: the end of the declared curve) is allowed
   std::vector<std::string> survival_gauge;      // optional: two bodies (front, rear), named as passenger_bodies
   double wagon_mass = 80.0;                     // [t] scenario 2
   std::vector<std::pair<double, double>> buffer_curve;  // [mm, kN] one buffer's force-stroke curve
@@ -75,11 +94,16 @@ struct ScenarioRequest {
   std::optional<double> buffer_height;                  // [mm] above the rail
   std::optional<double> face_stiffness;                 // [kN/mm] scenario 1 from a unit model: each front face
   std::optional<double> face_height;                    // [mm] scenario 1 from a unit model: each front face
+  std::optional<double> face_friction;                  // [-] scenario 1 from a unit model: friction between the faces
+                                                        // (required with an offset: it is what lets the offset act)
   double obstacle_mass = 15.0;                          // [t] scenario 3
   std::vector<std::pair<double, double>> obstacle_curve;  // [mm, kN] scenario 3: the obstacle's force-crush curve
   std::optional<double> obstacle_unloading_stiffness;   // [kN/mm] scenario 3
   std::optional<double> obstacle_height;                // [mm] scenario 3: its contact point above the rail
   std::optional<double> t_end;                          // [s] default: the template's
+  std::string unit;       // model with car types and trains: the train to use (default: its first)
+  std::string interface;  // model with car types and trains, scenario 1: the interface type joining the two
+                          // trains (default: that of the model's connection at the train's leading end)
 };
 
 /// YAML text of the scenario's model. Throws InputError naming the missing option, or what

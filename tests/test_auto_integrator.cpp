@@ -1,0 +1,132 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+
+#include "railcrash/auto_integrator.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
+#include "support.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+std::string source_path(const std::string& relative) { return std::string(RAILCRASH_SOURCE_DIR) + "/" + relative; }
+
+// A 2 kg mass on a 200 N/m spring from the ground along x, released 0.1 m from rest:
+// x(t) - 1 = 0.1 cos(10 t).
+std::string oscillator(double t_end, const std::string& extra = "") {
+  std::ostringstream s;
+  s << "railcrash: 1\nname: osc\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: mass, mass: 2.0, inertia: 0.1, position: [1.1, 0]}\nelements:\n"
+    << "  - {name: spring, type: linear_spring, stiffness: 200, free_length: 1.0, "
+    << "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+    << "simulation: {t_end: " << t_end << extra << "}\n";
+  return s.str();
+}
+
+struct SampleTimes : RunObserver {
+  std::vector<double> times;
+  void sample(double t, const double*, const double*, const double*, const double*) override { times.push_back(t); }
+};
+
+IdaSettings ida_settings(const Model& model) {
+  IdaSettings ida;
+  ida.rtol = model.simulation.rtol;
+  ida.atol = model.simulation.atol;
+  return ida;
+}
+
+EulerSettings euler_settings(const Model& model) {
+  const SimulationSettings& s = model.simulation;
+  return {s.dt, s.force_dt, s.penalty, s.max_steps};
+}
+
+}  // namespace
+
+TEST_CASE("IDA hands a run to Euler that goes on from its state with the run's samples and counters", "[integrators][auto]") {
+  const double dt = 1e-4, t_end = 2.0, interval = 0.01;  // [s]
+  const Model model = testing::model_from_text(oscillator(t_end, ", dt: 1e-4"));
+  DaeSystem system(model);
+  AutoSettings rule;  // a hand-over at the first chance: after IDA's sixth step
+  rule.startup_steps = 5;
+  rule.min_events = 0;
+  rule.min_span_steps = 0.0;
+  rule.margin = 0.0;
+  rule.require_resolution = false;
+  AutoIntegrator integrator(system, ida_settings(model), euler_settings(model), rule);
+  SampleTimes observer;
+  const RunOutcome outcome = integrator.run(t_end, interval, observer);
+  REQUIRE(outcome.ok);
+  const double t_switch = outcome.stats.handed_over_at;
+  INFO(outcome.stats.hand_over_reason);
+  REQUIRE(t_switch > 0.0);
+  CHECK(t_switch < 0.1);
+  CHECK_THAT(outcome.stats.hand_over_reason, Catch::Contains("handed the run to Euler at t = "));
+  // Euler's steps run from the hand-over on its own grid t_switch + k dt, the last one ending at t_end.
+  const auto euler_steps = static_cast<long>(std::ceil((t_end - t_switch) / dt - 1e-9));
+  CHECK(outcome.stats.steps == rule.startup_steps + 1 + euler_steps);
+  CHECK(outcome.stats.last_step == dt);
+  // A sample per output time: IDA's on the times, Euler's at the end of the step that passes one.
+  REQUIRE(observer.times.size() == 201);
+  for (std::size_t k = 0; k < observer.times.size(); ++k) {
+    const double t_out = std::min(t_end, static_cast<double>(k) * interval);
+    CHECK(observer.times[k] >= t_out * (1.0 - 1e-12));
+    CHECK(observer.times[k] <= t_out + dt * (1.0 + 1e-9));
+  }
+  // The motion goes on: the analytic solution within Euler's error (omega dt = 1e-3).
+  CHECK(outcome.y[0] - 1.0 == Approx(0.1 * std::cos(10.0 * t_end)).margin(3e-4));
+  // Energy books carried across: the spring's initial 1 J, held by semi-implicit Euler to O(omega dt).
+  CHECK(outcome.initial_energy.elastic == Approx(1.0).epsilon(1e-12));
+  CHECK(outcome.final_energy.kinetic + outcome.final_energy.elastic == Approx(1.0).epsilon(3e-3));
+}
+
+TEST_CASE("auto keeps IDA on the report's two-car crash and gives IDA's result bit for bit", "[integrators][auto]") {
+  const std::string file = source_path("models/report/final_two_car.yaml");
+  const Model ida_model = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=ida"});
+  const Model auto_model = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=auto"});
+  DaeSystem ida_system(ida_model), auto_system(auto_model);
+  SampleTimes a, b;
+  const RunOutcome by_ida = make_integrator(ida_system, ida_model.simulation)->run(0.02, 0.001, a);
+  const RunOutcome by_auto = make_integrator(auto_system, auto_model.simulation)->run(0.02, 0.001, b);
+  REQUIRE(by_ida.ok);
+  REQUIRE(by_auto.ok);
+  INFO(by_auto.stats.hand_over_reason);
+  CHECK(by_auto.stats.handed_over_at < 0.0);
+  CHECK_THAT(by_auto.stats.hand_over_reason, Catch::StartsWith("IDA kept the run") && Catch::Contains("cheaper"));
+  CHECK(by_auto.y == by_ida.y);
+  CHECK(by_auto.stats.steps == by_ida.stats.steps);
+  CHECK(by_auto.events.size() == by_ida.events.size());
+}
+
+TEST_CASE("auto keeps IDA on an SI multiple-unit crash whose IDA steps are shorter than Euler's", "[integrators][auto]") {
+  // bench/README.md "integrator: auto": Euler at its own step is cheaper here but 3-11 % off in
+  // the energy the crush zones absorb; IDA's mean step is a sixth of Euler's.
+  const Model model = load_model(source_path("models/examples/emu_two_car_crush_zones.yaml"),
+                                 {"simulation.integrator=auto", "simulation.output_interval=0.01"});
+  const RunOutcome outcome = testing::simulate(model, 0.01);
+  INFO(outcome.stats.hand_over_reason);
+  CHECK(outcome.stats.handed_over_at < 0.0);
+  CHECK_THAT(outcome.stats.hand_over_reason, Catch::Contains("shorter than Euler's"));
+}
+
+TEST_CASE("auto keeps IDA where Euler cannot run the model and says why", "[integrators][auto]") {
+  // dt 1 s is above the oscillator's stability limit 2 / omega = 0.2 s.
+  const Model model = testing::model_from_text(oscillator(1.0, ", integrator: auto, dt: 1.0"));
+  const RunOutcome outcome = testing::simulate(model, 0.1);
+  INFO(outcome.stats.hand_over_reason);
+  CHECK(outcome.stats.handed_over_at < 0.0);
+  CHECK_THAT(outcome.stats.hand_over_reason,
+             Catch::Contains("Euler cannot run this model") && Catch::Contains("above the stability limit"));
+}
+
+TEST_CASE("a model that names no integrator runs with auto and a model may name it", "[integrators][auto][model_io]") {
+  CHECK(testing::model_from_text(oscillator(1.0)).simulation.integrator == IntegratorKind::Auto);
+  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: auto")).simulation.integrator == IntegratorKind::Auto);
+  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: euler")).simulation.integrator == IntegratorKind::Euler);
+  CHECK_THROWS_WITH(testing::model_from_text(oscillator(1.0, ", integrator: rk4")),
+                    Catch::Contains("integrator must be auto, ida or euler, not 'rk4'"));
+  for (const IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Euler, IntegratorKind::Auto})
+    CHECK(integrator_from_name(integrator_name(kind)) == kind);
+}
