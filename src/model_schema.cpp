@@ -114,6 +114,10 @@ Json typed(const char* type, const std::string& description) {
 }
 
 Json word(const std::string& description) { return typed("string", description); }
+/// A name the loader bounds (kMaxNameLength, model_io.hpp).
+Json name_word(const std::string& description) {
+  return word(description).set("maxLength", Json::number(static_cast<double>(kMaxNameLength)));
+}
 Json flag(const std::string& description) { return typed("boolean", description); }
 
 /// The bounds of `range` on a number's schema.
@@ -265,7 +269,7 @@ Json element_type_schema(const ElementType& type) {
 /// type names one of the registry's, and the type's own keys apply (if type = X then element_X).
 Json element_schema(const ElementRegistry& registry, const std::string& point, const std::string& description) {
   Json properties = Json::object();
-  properties.set("name", word("the element's name (its output columns are <name>.<quantity>)"));
+  properties.set("name", name_word("the element's name (its output columns are <name>.<quantity>)"));
   // enumDescriptions (VS Code's extension of JSON Schema): each type's law, shown as it is completed.
   Json laws = Json::array();
   for (const std::string& name : registry.types()) laws.push(Json::text(registry.find(name)->summary));
@@ -304,7 +308,7 @@ std::map<std::string, SectionKeys> section_keys() {
   std::map<std::string, SectionKeys> s;
   s["model"] = {
       {"railcrash", {Json::object().set("description", Json::text("model format version: 1")).set("const", Json::number(1)), true}},
-      {"name", {word("the model's name"), true}},
+      {"name", {name_word("the model's name"), true}},
       {"description", {word("what the model is (free text)")}},
       {"units", {one_of_words({"SI", "in-lbf-s", "mm-t-s-N"},
                               "unit system of every number in the file: SI (kg, m, s, N), in-lbf-s (the 1980 report's: weights in "
@@ -320,7 +324,7 @@ std::map<std::string, SectionKeys> section_keys() {
       {"scenario", {definition_ref("scenario", "EN 15227 scenario criteria (written by railcrash scenario)")}},
   };
   s["body"] = {
-      {"name", {word("the body's name (ground is reserved)"), true}},
+      {"name", {name_word("the body's name (ground is reserved)"), true}},
       {"mass", {number("mass [SI: kg, mm-t-s-N: t, in-lbf-s: lbf*s^2/in]; give mass or (in-lbf-s) weight", Range::Positive)}},
       {"weight", {number("weight [lbf], in-lbf-s models only, instead of mass", Range::Positive)}},
       {"inertia", {number("centroidal moment of inertia [SI: kg*m^2, mm-t-s-N: t*mm^2, in-lbf-s: lbf*s^2*in]; 0: a point mass",
@@ -375,7 +379,7 @@ std::map<std::string, SectionKeys> section_keys() {
        {number("euler: rotational penalty damping (" + unit_text(Unit::MomentTimePerAngle) + ")", Range::Positive)}},
   };
   s["output"] = {
-      {"name", {word("the point's name (its columns); default <body>_point<k>")}},
+      {"name", {name_word("the point's name (its columns); default <body>_point<k>")}},
       {"body", {word("the body the point is on"), true}},
       {"at", {pair("offset from the body's centre of mass, in the body's frame [x, y]: " + kLength + "; default [0, 0]")}},
       {"quantities", {Json::object()
@@ -396,7 +400,7 @@ std::map<std::string, SectionKeys> section_keys() {
                                               "the part of the run in which R2's vertical force counts")}},
   };
   s["crush_gauge"] = {
-      {"name", {word("the gauge's name"), true}},
+      {"name", {name_word("the gauge's name"), true}},
       {"points", {Json::object()
                       .set("type", Json::text("array"))
                       .set("description", Json::text("two points [{body, at}, {body, at}]: front and rear"))
@@ -408,7 +412,7 @@ std::map<std::string, SectionKeys> section_keys() {
   s["variant"] = {
       {"railcrash", {Json::object().set("description", Json::text("model format version: 1")).set("const", Json::number(1)), true}},
       {"variant_of", {word("the base model file, relative to this file's folder"), true}},
-      {"name", {word("the variant's name (replaces the base model's)")}},
+      {"name", {name_word("the variant's name (replaces the base model's)")}},
       {"description", {word("what the variant changes")}},
       {"set", {Json::object()
                    .set("type", Json::text("object"))
@@ -446,7 +450,7 @@ std::map<std::string, SectionKeys> section_keys() {
   };
   s["interface"] = s["point"];  // a car end: {body, at} on the car type's bodies
   s["train"] = {
-      {"name", {word("the train's name (generated names start with it: <train>.<car>.<name>)"), true}},
+      {"name", {name_word("the train's name (generated names start with it: <train>.<car>.<name>)"), true}},
       {"description", {word("what the train is")}},
       {"front", {number("global x of the first car's leading end: " + kLength + "; default 0")}},
       {"facing", {one_of_words({"+x", "-x"}, "where the train's front points; default +x")}},
@@ -462,7 +466,7 @@ std::map<std::string, SectionKeys> section_keys() {
   };
   s["car"] = {
       {"type", {word("a car type's name"), true}},
-      {"name", {word("the car's name in the train; default car<k>")}},
+      {"name", {name_word("the car's name in the train; default car<k>")}},
       {"reversed", {flag("turned round: its rear end leads; default false")}},
   };
   s["coupling"] = {
@@ -470,7 +474,7 @@ std::map<std::string, SectionKeys> section_keys() {
       {"gap", {number("gap between the two ends: " + kLength + "; default 0")}},
   };
   s["connection"] = {
-      {"name", {word("the connection's name (its elements are <connection>.<name>)"), true}},
+      {"name", {name_word("the connection's name (its elements are <connection>.<name>)"), true}},
       {"type", {word("an interface type's name"), true}},
       {"ends", {Json::object()
                     .set("type", Json::text("array"))
@@ -530,7 +534,7 @@ Json scenario_schema() {
                                                          {"element", "stroke"}),
                                                  "declared crush zones"))
                            .set("gauges", list_of(section("a pair of bodies whose approach is lost survival space",
-                                                          Json::object().set("name", word("the gauge's name")).set("front", word("front body")).set("rear", word("rear body")),
+                                                          Json::object().set("name", name_word("the gauge's name")).set("front", word("front body")).set("rear", word("rear body")),
                                                           {"name", "front", "rear"}),
                                                   "body pairs")),
                        {"limit", "source"}))

@@ -183,6 +183,7 @@ def bad_models(source_dir):
         ("a list where a number belongs", spring_mass, spring("free_length", [1.0, 2.0]), "must be a number"),
         ("a negative value where it must not be", spring_mass, spring("stiffness", -5.0), "must not be negative"),
         ("an unknown element type", spring_mass, spring("type", "linear_sprung"), "unknown element type 'linear_sprung'"),
+        ("a name above the loader's 256 characters", spring_mass, spring("name", "s" * 300), "more than the limit of 256"),
         ("a misspelt body key", spring_mass, set_path("bodies", 0, "intertia", 0.1), "unknown key 'intertia'"),
         ("an unknown integrator", spring_mass, set_path("simulation", "integrator", "rk4"), "integrator must be auto, ida or euler"),
         ("an unknown unit system", spring_mass, set_path("units", "furlongs"), "units must be"),
