@@ -68,7 +68,11 @@ void ResponseTracker::track_collision_post(double t, const double* y, const doub
   if (anticlimber_element_ < 0 || !fresh.has(horizontal_deformation_column_)) return;
   const TrackedState state{t, outputs[horizontal_deformation_column_], relative_velocity(y)};
   if (responses_.overridden) {
-    if (settings_.override_velocity_at == ResponseSettings::OverrideVelocityAt::CollisionPost) after_override_.push_back(state);
+    // States after one already at the post cannot decide when it was first reached.
+    if (settings_.override_velocity_at == ResponseSettings::OverrideVelocityAt::CollisionPost && t <= at_post_by_) {
+      after_override_.push_back(state);
+      if (state.crush >= settings_.collision_post_distance) at_post_by_ = t;
+    }
   } else if (!have_last_ || t >= last_.t) {  // (samples inside a step arrive after its end)
     last_ = state;
     have_last_ = true;
@@ -102,7 +106,10 @@ void ResponseTracker::event(const EventRecord& record, const double* y) {
   responses_.override_relative_velocity = responses_.relative_velocity_at_override;
   // The report's relative velocity is taken when the end sill reaches the collision post
   // (result(), from the states tracked from here on and the last one before).
-  if (have_last_) after_override_.push_back(last_);
+  if (have_last_) {
+    after_override_.push_back(last_);
+    if (last_.crush >= settings_.collision_post_distance) at_post_by_ = last_.t;
+  }
 }
 
 void ResponseTracker::find_collision_post(Responses& r) const {

@@ -31,6 +31,7 @@
 // separates (a reading: models/report/README.md).
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -93,6 +94,7 @@ class ResponseTracker : public RunObserver {
   bool have_last_ = false;
   TrackedState last_{0.0, 0.0, 0.0};
   std::vector<TrackedState> after_override_;
+  double at_post_by_ = std::numeric_limits<double>::infinity();  // [time] a state at or past the post
   /// Sets R2's relative velocity and the collision post's time from after_override_.
   void find_collision_post(Responses& r) const;
 };
