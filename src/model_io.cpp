@@ -571,7 +571,8 @@ const std::vector<std::string> kLoadKeys = {"type", "body", "at", "value"};
 const std::vector<std::string> kPointKeys = {"body", "at"};
 const std::vector<std::string> kOutputKeys = {"name", "body", "at", "quantities"};
 const std::vector<std::string> kResponseKeys = {"crush_gauges", "crush", "reference_crush", "anticlimber", "vertical_yield_force",
-                                                "reference_velocity", "vertical_force_window"};
+                                                "reference_velocity", "vertical_force_window", "override_velocity_at",
+                                                "collision_post_distance"};
 const std::vector<std::string> kCrushGaugeKeys = {"name", "points"};
 const std::vector<std::string> kVariantKeys = {"railcrash", "variant_of", "name", "description", "set"};
 const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt", "max_steps",
@@ -876,6 +877,22 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     if (!node["reference_velocity"])
       r.fail(node, "responses: an anticlimber needs 'reference_velocity' (the velocity that fails the collision post, for R2 after override)");
     s.reference_velocity = *positive("reference_velocity") * r.scale().length;
+    using At = ResponseSettings::OverrideVelocityAt;
+    if (node["override_velocity_at"]) {
+      const std::string at = r.text(node["override_velocity_at"], "responses: override_velocity_at");
+      if (at == "collision_post") s.override_velocity_at = At::CollisionPost;
+      else if (at == "override") s.override_velocity_at = At::Override;
+      else
+        r.fail(node["override_velocity_at"],
+               "responses: override_velocity_at must be collision_post (when the overriding end sill reaches the other "
+               "car's collision post, the report's) or override (at the override event)");
+    }
+    if (const auto distance = positive("collision_post_distance")) s.collision_post_distance = *distance * r.scale().length;
+    else s.collision_post_distance = s.reference_crush;  // the report's words for both
+    if (s.override_velocity_at == At::CollisionPost && !(s.collision_post_distance > 0.0))
+      r.fail(node, "responses: R2 after an override takes the relative velocity when the overriding end sill reaches the "
+                   "collision post: give 'collision_post_distance' (the anticlimber faces' approach from first touch at "
+                   "which it does; default 'reference_crush') or 'override_velocity_at: override'");
   }
 }
 

@@ -398,6 +398,12 @@ std::map<std::string, SectionKeys> section_keys() {
       {"reference_velocity", {number("the velocity that fails the collision post (R2 after override): " + kVelocity, Range::Positive)}},
       {"vertical_force_window", {one_of_words({"whole_run", "until_largest_crush", "until_separation"},
                                               "the part of the run in which R2's vertical force counts")}},
+      {"override_velocity_at", {one_of_words({"collision_post", "override"},
+                                             "when R2's relative velocity is taken after an override: when the "
+                                             "overriding end sill reaches the collision post (default) or at the override")}},
+      {"collision_post_distance", {number("the anticlimber faces' approach from first touch at which the overriding end "
+                                          "sill reaches the other car's collision post (default reference_crush): " + kLength,
+                                          Range::Positive)}},
   };
   s["crush_gauge"] = {
       {"name", {name_word("the gauge's name"), true}},

@@ -42,16 +42,41 @@ double ResponseTracker::gauge_length(const CrushGauge& gauge, const double* y) c
   return std::sqrt(dot(d, d));
 }
 
-void ResponseTracker::sample(double, const double* y, const double*, const double*, const double* outputs) {
+void ResponseTracker::sample(double t, const double* y, const double*, const double*, const double* outputs) {
   if (!started_) {  // lengths at the start of the run (after any settling)
     for (const CrushGauge& g : settings_.crush_gauges) initial_length_.push_back(gauge_length(g, y));
     started_ = true;
   }
   track_extrema(y, outputs, FreshOutputs{});
+  track_collision_post(t, y, outputs, FreshOutputs{});
 }
 
-void ResponseTracker::step(double, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) {
-  if (started_) track_extrema(y, outputs, fresh);  // (events at the start come before the first sample)
+void ResponseTracker::step(double t, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) {
+  if (!started_) return;  // (events at the start come before the first sample)
+  track_extrema(y, outputs, fresh);
+  track_collision_post(t, y, outputs, fresh);
+}
+
+double ResponseTracker::relative_velocity(const double* y) const {
+  const Element& e = *system_.model().elements()[static_cast<std::size_t>(anticlimber_element_)];
+  const int nq = system_.body_unknowns();
+  const auto vx = [&](int slot) { return e.slot_body(slot) == kGround ? 0.0 : y[nq + 3 * e.slot_body(slot)]; };
+  return std::abs(vx(1) - vx(0));
+}
+
+void ResponseTracker::track_collision_post(double t, const double* y, const double* outputs, const FreshOutputs& fresh) {
+  if (anticlimber_element_ < 0 || !fresh.has(horizontal_deformation_column_)) return;
+  const TrackedState state{t, outputs[horizontal_deformation_column_], relative_velocity(y)};
+  if (responses_.overridden) {
+    // States after one already at the post cannot decide when it was first reached.
+    if (settings_.override_velocity_at == ResponseSettings::OverrideVelocityAt::CollisionPost && t <= at_post_by_) {
+      after_override_.push_back(state);
+      if (state.crush >= settings_.collision_post_distance) at_post_by_ = t;
+    }
+  } else if (!have_last_ || t >= last_.t) {  // (samples inside a step arrive after its end)
+    last_ = state;
+    have_last_ = true;
+  }
 }
 
 void ResponseTracker::track_extrema(const double* y, const double* outputs, const FreshOutputs& fresh) {
@@ -75,12 +100,39 @@ void ResponseTracker::event(const EventRecord& record, const double* y) {
     vertical_window_closed_ = true;
   if (responses_.overridden) return;
   if (record.what.find("override") == std::string::npos) return;
-  const Element& e = *system_.model().elements()[static_cast<std::size_t>(anticlimber_element_)];
-  const int nq = system_.body_unknowns();
-  const auto vx = [&](int slot) { return e.slot_body(slot) == kGround ? 0.0 : y[nq + 3 * e.slot_body(slot)]; };
   responses_.overridden = true;
   responses_.override_time = record.t;
-  responses_.override_relative_velocity = std::abs(vx(1) - vx(0));
+  responses_.relative_velocity_at_override = relative_velocity(y);
+  responses_.override_relative_velocity = responses_.relative_velocity_at_override;
+  // The report's relative velocity is taken when the end sill reaches the collision post
+  // (result(), from the states tracked from here on and the last one before).
+  if (have_last_) {
+    after_override_.push_back(last_);
+    if (last_.crush >= settings_.collision_post_distance) at_post_by_ = last_.t;
+  }
+}
+
+void ResponseTracker::find_collision_post(Responses& r) const {
+  std::vector<TrackedState> states = after_override_;
+  std::stable_sort(states.begin(), states.end(), [](const TrackedState& a, const TrackedState& b) { return a.t < b.t; });
+  const double post = settings_.collision_post_distance;
+  r.override_relative_velocity = 0.0;  // never reached: the end sill never hits the post
+  if (states.empty() || states.front().crush >= post) {  // already past it when the faces passed each other
+    r.collision_post_reached = !states.empty();
+    r.collision_post_time = r.override_time;
+    r.override_relative_velocity = r.collision_post_reached ? r.relative_velocity_at_override : 0.0;
+    return;
+  }
+  for (std::size_t i = 1; i < states.size(); ++i) {
+    if (states[i].crush < post) continue;
+    const TrackedState& a = states[i - 1];
+    const TrackedState& b = states[i];
+    const double s = (post - a.crush) / (b.crush - a.crush);  // b.crush > a.crush here
+    r.collision_post_reached = true;
+    r.collision_post_time = std::max(r.override_time, a.t + s * (b.t - a.t));
+    r.override_relative_velocity = a.velocity + s * (b.velocity - a.velocity);
+    return;
+  }
 }
 
 Responses ResponseTracker::result() const {
@@ -89,6 +141,8 @@ Responses ResponseTracker::result() const {
   for (double c : r.max_crush) crush = settings_.total_crush ? crush + c : std::max(crush, c);
   if (settings_.crush_from_anticlimber) crush = r.max_anticlimber_crush;
   r.r1 = settings_.reference_crush > 0.0 ? crush / settings_.reference_crush : 0.0;
+  if (r.overridden && settings_.override_velocity_at == ResponseSettings::OverrideVelocityAt::CollisionPost)
+    find_collision_post(r);
   if (r.overridden)
     r.r2 = 1.0 + (settings_.reference_velocity > 0.0 ? r.override_relative_velocity / settings_.reference_velocity : 0.0);
   else
@@ -104,6 +158,12 @@ std::string ResponseTracker::json() const {
     << ", \"override\": " << (r.overridden ? "true" : "false")
     << ", \"override_time\": " << (r.overridden ? json_number(r.override_time) : "null")
     << ", \"override_relative_velocity\": " << json_number(r.override_relative_velocity)
+    << ", \"override_velocity_at\": "
+    << json_string(settings_.override_velocity_at == ResponseSettings::OverrideVelocityAt::CollisionPost ? "collision_post" : "override")
+    << ", \"relative_velocity_at_override\": " << json_number(r.relative_velocity_at_override)
+    << ", \"collision_post_distance\": " << json_number(settings_.collision_post_distance)
+    << ", \"collision_post_reached\": " << (r.collision_post_reached ? "true" : "false")
+    << ", \"collision_post_time\": " << (r.collision_post_reached ? json_number(r.collision_post_time) : "null")
     << ", \"max_vertical_anticlimber_force\": " << json_number(r.max_vertical_force)
     << ", \"max_anticlimber_crush\": " << json_number(r.max_anticlimber_crush)
     << ", \"vertical_yield_force\": " << json_number(r.vertical_yield_force) << ", \"vertical_force_window\": "

@@ -61,7 +61,7 @@ TEST_CASE("R2 from the anticlimber: vertical force over yield, or 1 + relative s
       "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
       "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n    torsional_yield_deflection: 0.01\n"
       "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
-      "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n"
+      "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n  override_velocity_at: override\n"
       "simulation: {t_end: 0.5, rtol: 1e-8, output_interval: 0.0005}\n";
   const Model model = testing::model_from_text(text);
   const RunReport report = run_model(model, "");
@@ -71,7 +71,9 @@ TEST_CASE("R2 from the anticlimber: vertical force over yield, or 1 + relative s
   INFO("max vertical force " << r.max_vertical_force << ", override " << r.overridden << " at " << r.override_time);
   REQUIRE(r.overridden);
   CHECK(r.max_vertical_force > r.vertical_yield_force);  // it yielded before overriding
-  // After override: R2 = 1 + |relative horizontal velocity| / reference velocity.
+  // After override (override_velocity_at: override, the variant from before issue 40):
+  // R2 = 1 + |relative horizontal velocity at the override| / reference velocity.
+  CHECK(r.override_relative_velocity == r.relative_velocity_at_override);
   CHECK(r.r2 == Approx(1.0 + r.override_relative_velocity / 4.0));
   CHECK(r.override_relative_velocity > 0.0);
   CHECK(r.override_relative_velocity < 2.0);  // the crush slowed it down
@@ -181,7 +183,7 @@ TEST_CASE("R2's window: the whole run, until the largest crush or until separati
                                   "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n"
                                   "    torsional_yield_deflection: 0.01\n"
                                   "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
-                                  "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n" +
+                                  "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n  collision_post_distance: 1.0\n" +
                                   (window.empty() ? std::string() : "  vertical_force_window: " + window + "\n") +
                                   "simulation: {t_end: 0.08, rtol: 1e-9, output_interval: 1.0e-5}\n";
     const RunReport report = run_model(testing::model_from_text(text), "");
@@ -209,4 +211,114 @@ TEST_CASE("R2's window: the whole run, until the largest crush or until separati
   at_the_event(run("whole_run"), at_separation);
   CHECK_THROWS_WITH(load_model_text(testing::anticlimber_r1_model_text(0.1), "r1.yaml", {"responses.vertical_force_window=later"}),
                     Catch::Contains("vertical_force_window must be whole_run, until_largest_crush or until_separation"));
+}
+
+namespace {
+
+// A 1000 kg car end at x = 0.1 m moving at -2 m/s towards an anticlimber face on ground at
+// x = 0, braked by a constant 1000 N (deceleration 1 m/s^2), no gravity. Its face is 0.2 m
+// above the ground face, more than the 0.1 m face height: the faces miss each other at contact
+// (x = 0) and override. From there the faces' approach is d_h = -x.
+RunReport override_run(const std::string& responses_extra) {
+  const std::string text =
+      "railcrash: 1\nname: post\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: car, mass: 1000, inertia: 100, position: [0.1, 0], velocity: [-2, 0]}\nelements:\n"
+      "  - name: ac\n    type: anticlimber\n"
+      "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n    horizontal_yield_deflection: 0.01\n"
+      "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
+      "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n    torsional_yield_deflection: 0.01\n"
+      "    face_height: 0.1\n    initial_misalignment: 0.2\n"
+      "    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
+      "loads:\n  - {type: force, body: car, at: [0, 0], value: [1000, 0]}\n"
+      "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n" + responses_extra +
+      "simulation: {t_end: 2.5, rtol: 1e-9, output_interval: 0.001}\n";
+  const RunReport report = run_model(testing::model_from_text(text), "");
+  REQUIRE(report.outcome.ok);
+  REQUIRE(report.responses.overridden);
+  return report;
+}
+
+}  // namespace
+
+TEST_CASE("R2 after override takes the relative velocity when the end sill reaches the collision post, closed form",
+          "[responses]") {
+  // Uniform deceleration a = 1 m/s^2 from 2 m/s at x = 0.1: v^2 = 4 - 2 a (0.1 - x).
+  // Override at x = 0: v = sqrt(3.8) = 1.94936 m/s, t = 2 - sqrt(3.8) = 0.050641 s.
+  // The collision post 0.5 m behind the face (approach d_h = 0.5, x = -0.5):
+  // v = sqrt(2.8) = 1.67332 m/s, t = 2 - sqrt(2.8) = 0.326680 s; R2 = 1 + 1.67332 / 4.
+  const RunReport at_post = override_run("  collision_post_distance: 0.5\n");
+  const Responses& r = at_post.responses;
+  CHECK(r.override_time == Approx(2.0 - std::sqrt(3.8)).epsilon(1e-6));
+  CHECK(r.relative_velocity_at_override == Approx(std::sqrt(3.8)).epsilon(1e-6));
+  REQUIRE(r.collision_post_reached);
+  CHECK(r.collision_post_time == Approx(2.0 - std::sqrt(2.8)).epsilon(1e-5));
+  CHECK(r.override_relative_velocity == Approx(std::sqrt(2.8)).epsilon(1e-6));
+  CHECK(r.r2 == Approx(1.0 + std::sqrt(2.8) / 4.0).epsilon(1e-6));
+  // The default distance is reference_crush (the report's "distance from the anticlimber to
+  // the collision post" defines both).
+  const RunReport by_default = override_run("  crush: anticlimber\n  reference_crush: 0.5\n");
+  CHECK(by_default.responses.override_relative_velocity == Approx(std::sqrt(2.8)).epsilon(1e-6));
+  // The variant from before issue 40: the velocity at the override.
+  const RunReport at_override = override_run("  collision_post_distance: 0.5\n  override_velocity_at: override\n");
+  CHECK(at_override.responses.r2 == Approx(1.0 + std::sqrt(3.8) / 4.0).epsilon(1e-6));
+  // A post farther than the car ever gets (it stops at x = -1.9, d_h = 1.9): never hit, R2 = 1.
+  const RunReport never = override_run("  collision_post_distance: 3.0\n");
+  CHECK_FALSE(never.responses.collision_post_reached);
+  CHECK(never.responses.r2 == 1.0);
+  // Without a distance (no reference_crush either) the report's R2 cannot be taken.
+  CHECK_THROWS_WITH(testing::model_from_text(
+                        "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: car, mass: 1, inertia: 1, position: [0.1, 0]}\n"
+                        "elements:\n  - name: ac\n    type: anticlimber\n"
+                        "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n"
+                        "    horizontal_yield_deflection: 0.01\n    vertical_elastic_stiffness: 1.0e6\n"
+                        "    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
+                        "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n"
+                        "    torsional_yield_deflection: 0.01\n    face_height: 0.1\n"
+                        "    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
+                        "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n"
+                        "simulation: {t_end: 0.1}\n"),
+                    Catch::Contains("collision_post_distance"));
+}
+
+namespace {
+
+// A 1000 kg car end (pitch inertia 100 kg m^2) whose anticlimber face is 0.5 m ahead of its
+// centre of mass, driven at 2 m/s into a face on ground, no gravity. With the face centre at
+// the height of the centre of mass the horizontal force has no arm and nothing loads the
+// interlock vertically.
+double largest_vertical_force(const std::string& car_point_y, const std::string& misalignment) {
+  const std::string text =
+      "railcrash: 1\nname: p9\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: car, mass: 1000, inertia: 100, position: [0.51, 0], velocity: [-2, 0]}\nelements:\n"
+      "  - name: ac\n    type: anticlimber\n"
+      "    horizontal_elastic_stiffness: 1.0e7\n    horizontal_plastic_stiffness: 1.0e5\n    horizontal_yield_deflection: 0.01\n"
+      "    vertical_elastic_stiffness: 1.0e6\n    vertical_plastic_stiffness: 1.0e4\n    vertical_yield_deflection: 0.01\n"
+      "    torsional_elastic_stiffness: 1.0e6\n    torsional_plastic_stiffness: 1.0e4\n    torsional_yield_deflection: 0.01\n"
+      "    face_height: 0.1\n" + misalignment +
+      "    points: [{body: ground, at: [0, 0]}, {body: car, at: [-0.5, " + car_point_y + "]}]\n"
+      "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n  collision_post_distance: 1.0\n"
+      "simulation: {t_end: 0.06, rtol: 1e-9, output_interval: 0.0005}\n";
+  const RunReport report = run_model(testing::model_from_text(text), "");
+  REQUIRE(report.outcome.ok);
+  REQUIRE_FALSE(report.responses.overridden);
+  return report.responses.max_vertical_force;
+}
+
+}  // namespace
+
+TEST_CASE("P9: the initial misalignment is where face 2 is, so the horizontal force pitches the car ends", "[responses]") {
+  const double aligned = largest_vertical_force("0", "");
+  CHECK(aligned == Approx(0.0).margin(1e-6));
+  // Face 2 0.03 m above point 2: the same model as point 2 at the face centre.
+  const double misaligned = largest_vertical_force("0", "    initial_misalignment: 0.03\n");
+  const double at_face_centre = largest_vertical_force("0.03", "");
+  CHECK(misaligned == Approx(at_face_centre).epsilon(1e-9));
+  // The horizontal force (about 1.1e5 N) acts 0.03 m above the car's centre of mass: the car
+  // pitches and its face, 0.5 m ahead, moves down on the interlock.
+  CHECK(misaligned > 1000.0);
+  // The variant from before issue 40 (misalignment_geometry: offset): the interlock takes the
+  // offset at contact as its reference, so a constant misalignment changes nothing.
+  const double offset_only =
+      largest_vertical_force("0", "    initial_misalignment: 0.03\n    misalignment_geometry: offset\n");
+  CHECK(offset_only == Approx(aligned).margin(1e-6));
 }

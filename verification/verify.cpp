@@ -372,17 +372,20 @@ namespace {
 // distance from perfect agreement that the case below allows. R1's run 0 is calibrated.
 constexpr double kReachedR1Error = 0.005;                 // rel (ours 1.2535)
 // R2 and R3 from the largest vertical anticlimber force over every step and event (it was
-// over the 1 ms rows, 0.661 and 1.914, before commit 5ec9569).
-constexpr double kReachedR2Error = 0.10;                  // rel (ours 0.6699: +9.82 %)
-constexpr double kReachedR3Error = 0.033;                 // rel (ours 1.9234: +3.13 %)
-// R2's changes below about 0.02 are within its numerical noise at the model's rtol 1e-5: since
-// IDA's first step after a restart is taken from the step before the event, run 9's R2 change is
-// +0.0018 against the report's -0.009 (it was -0.00003, a sign kept by noise), and the sign
-// share fell from 10 to 9 of 13, rho from 0.367 to 0.337 (verification/report_comparison.md).
-constexpr double kReachedSignShortfall[2] = {0.34, 0.31};  // 1 - share kept (R1 4 of 6, R2 9 of 13)
-constexpr double kReachedRhoShortfall[2] = {0.84, 0.70};   // 1 - rho (R1 0.19, R2 0.337), less 0.03
-constexpr double kReachedTopFiveMissing[2] = {1.0, 2.0};   // R1 4 of 5, R2 3 of 5
-constexpr double kReachedGoals = 3.0;                      // R2 10 %, R3 5 %, R1 top five
+// over the 1 ms rows, 0.661 and 1.914, before commit 5ec9569). Since issue 40 the anticlimber's
+// misalignment is geometric (misalignment_geometry: face; the struck car's face 1 in above its
+// point): run 0's R2 0.6699 -> 0.6537, R3 1.9234 -> 1.9072, R2 signs 9 -> 10 of 13, R2 rho
+// 0.337 -> 0.433, R1 rho 0.19 -> 0.21, R2 top five 3 -> 4, goals 3 -> 4 (verification/
+// report_comparison.md, "P9 and R2 after override").
+constexpr double kReachedR2Error = 0.075;                 // rel (ours 0.6537: +7.16 %)
+constexpr double kReachedR3Error = 0.025;                 // rel (ours 1.9072: +2.26 %)
+// R2's changes below about 0.02 are within its numerical noise at the model's rtol 1e-5
+// (run 9's R2 change is +0.0024 against the report's -0.009: noise; verification/
+// report_comparison.md).
+constexpr double kReachedSignShortfall[2] = {0.34, 0.24};  // 1 - share kept (R1 4 of 6, R2 10 of 13)
+constexpr double kReachedRhoShortfall[2] = {0.82, 0.60};   // 1 - rho (R1 0.207, R2 0.433), less 0.03
+constexpr double kReachedTopFiveMissing[2] = {1.0, 1.0};   // R1 4 of 5, R2 4 of 5
+constexpr double kReachedGoals = 4.0;                      // R2 10 %, R3 5 %, R1 top five, R2 top five                      // R2 10 %, R3 5 %, R1 top five
 
 }  // namespace
 

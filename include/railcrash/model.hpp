@@ -68,6 +68,17 @@ struct ResponseSettings {
   std::string anticlimber;                    // element whose vertical force and override make R2
   std::optional<double> vertical_yield_force; // [force] default: the anticlimber's own
   double reference_velocity = 0.0;            // [length/time] velocity that fails the collision post
+  /// When R2's relative horizontal velocity is taken after an override. The report (Section
+  /// 4.1): "at the time the end sill of the overriding car hits the collision post of the
+  /// other car".
+  ///   CollisionPost  the first time after the override that the anticlimber's horizontal
+  ///                  deformation (the faces' approach since they first touched, which goes on
+  ///                  after the faces have passed each other) reaches collision_post_distance;
+  ///   Override       at the override event itself (before issue 40; a labelled variant).
+  enum class OverrideVelocityAt { CollisionPost, Override };
+  OverrideVelocityAt override_velocity_at = OverrideVelocityAt::CollisionPost;
+  double collision_post_distance = 0.0;       // [length] default: reference_crush (the report's
+                                              // "distance from the anticlimber to the collision post")
   /// Over which part of the run R2's largest vertical force is taken (a reading; the report
   /// says only "maximum vertical force at anticlimbers"):
   ///   WholeRun          every output sample of the run;

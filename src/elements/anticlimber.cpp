@@ -122,6 +122,12 @@ Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type,
            "'horizontal_rupture_deflection' must not exceed 'length' (the structure cannot crush further than its length)");
   face_height = p.value("face_height");
   initial_misalignment = p.value("initial_misalignment");
+  const std::optional<std::string> geometry = p.word("misalignment_geometry");
+  if (*geometry != "face" && *geometry != "offset")
+    p.fail("misalignment_geometry",
+           "'misalignment_geometry' must be face (face 2's centre is initial_misalignment above point 2: the forces act "
+           "there) or offset (the misalignment is only added to the vertical offset), not '" + *geometry + "'");
+  misalignment_at_face = *geometry == "face";
   if (facing && *facing != 1.0 && *facing != -1.0)
     p.fail("facing", "'facing' must be 1 (body 1's face looks along its +x axis) or -1 (along -x)");
 }
@@ -138,8 +144,8 @@ Anticlimber::Deformations Anticlimber::deformations(const State& st, const Eleme
   const Pose<double>& v2 = s.v[slot2()];
   const Rotation<double>& rotation1 = s.rotation[slot1()];
   const Rotation<double>& rotation2 = s.rotation[slot2()];
-  const Vec2<double> d = point_position(q2, rotation2, p2.sx, p2.sy) - point_position(q1, rotation1, p1.sx, p1.sy);
-  const Vec2<double> d_rate = point_velocity(v2, rotation2, p2.sx, p2.sy) - point_velocity(v1, rotation1, p1.sx, p1.sy);
+  const Vec2<double> d = point_position(q2, rotation2, p2.sx, face2_sy()) - point_position(q1, rotation1, p1.sx, p1.sy);
+  const Vec2<double> d_rate = point_velocity(v2, rotation2, p2.sx, face2_sy()) - point_velocity(v1, rotation1, p1.sx, p1.sy);
   // e1' = omega1 n1, n1' = -omega1 e1.
   const double along_rate = dot(d_rate, k.e1) + v1.theta * dot(d, k.n1);
   const double across_rate = dot(d_rate, k.n1) - v1.theta * dot(d, k.e1);
@@ -381,6 +387,11 @@ void register_anticlimber_elements(ElementRegistry& registry) {
                         "length of the anticlimber / end structure: bounds the horizontal rupture deflection"});
   parameters.push_back({"initial_misalignment", Unit::Length, default_value(0.0), Range::Any,
                         "vertical offset of the faces added to that of the points (face 2 above face 1 > 0)"});
+  parameters.push_back({"misalignment_geometry", Unit::Choice, default_word("face"), Range::Any,
+                        "face: face 2's centre is initial_misalignment above point 2 in body 2's frame (the forces act "
+                        "there; the same as giving point 2 at the face centre); offset: the misalignment is only added "
+                        "to the vertical offset (before issue 40; a constant offset then cancels in the interlock)",
+                        Shape::Word});
   parameters.push_back({"facing", Unit::Choice, optional("the side of P2 at the start"), Range::Any,
                         "1: body 1's face looks along its +x axis, -1: along -x"});
   parameters.push_back({"interlock_while_unloading", Unit::Choice, default_word("hold"), Range::Any,

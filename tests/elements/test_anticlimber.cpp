@@ -39,6 +39,7 @@ struct Parameters {
   LawValues torsional{1e4, 1e2, 0.01, std::nullopt};
   double face_height = 0.2;
   double misalignment = 0.0;
+  std::string misalignment_geometry;  // empty: not given (face)
   std::optional<double> facing;
   std::optional<double> length;
   std::string interlock;  // interlock_while_unloading; empty: not given (hold)
@@ -62,6 +63,7 @@ std::string parameters_yaml(const Parameters& p) {
   std::string s = law_yaml("horizontal", p.horizontal) + law_yaml("vertical", p.vertical) + law_yaml("torsional", p.torsional);
   s += "    face_height: " + number(p.face_height) + "\n";
   if (p.misalignment != 0.0) s += "    initial_misalignment: " + number(p.misalignment) + "\n";
+  if (!p.misalignment_geometry.empty()) s += "    misalignment_geometry: " + p.misalignment_geometry + "\n";
   if (p.facing) s += "    facing: " + number(*p.facing) + "\n";
   if (p.length) s += "    length: " + number(*p.length) + "\n";
   if (!p.interlock.empty()) s += "    interlock_while_unloading: " + p.interlock + "\n";
@@ -497,8 +499,10 @@ TEST_CASE("anticlimber applies no force while open, after override and once crus
 }
 
 TEST_CASE("anticlimber forces follow the three laws at a known configuration", "[elements][anticlimber]") {
-  // Ground face at (0, 0) looking along +x; the car's face 0.5 m behind its centre (and 0.02 m
-  // above). The car is then put at (0.47, 0.13), turned by 0.02 rad, pressed into the face.
+  // Ground face at (0, 0) looking along +x; the car's point 0.5 m behind its centre (and 0.02 m
+  // above), its face 0.01 m above that (initial_misalignment, misalignment_geometry: face): the
+  // face centre is (-0.5, 0.03) in the car's frame, where the forces act. The car is then put at
+  // (0.47, 0.13), turned by 0.02 rad, pressed into the face.
   const std::vector<BodySpec> bodies{{"b", 10.0, 1.0, 0.6, 0.0, 0.0, 0.0, 0.0, 0.0}};
   Parameters p;
   p.misalignment = 0.01;
@@ -518,10 +522,10 @@ TEST_CASE("anticlimber forces follow the three laws at a known configuration", "
   testing::set_mode<Anticlimber::State>(system, st);
 
   const double x = 0.47, y = 0.13, theta = 0.02;
-  const Vec arm = rotated(theta, -0.5, 0.02);
+  const Vec arm = rotated(theta, -0.5, 0.02 + 0.01);  // to the face centre (point + misalignment)
   const Vec r2{x + arm.x, y + arm.y};
   const double d_h = -r2.x;               // gap = r2 . (1, 0)
-  const double v = r2.y + 0.01;           // + initial misalignment
+  const double v = r2.y;                  // the face centre's height
   REQUIRE(d_h > 0.01);                    // beyond the horizontal yield deflection
   const double h = 1e4 + 1e4 * (d_h - 0.01);                      // F_y + k_p (d - d_y)
   const double vf = 2e5 * ((v - 0.03) - 0.004);                    // k_e (d_v - p)
@@ -791,6 +795,7 @@ TEST_CASE("anticlimber shear failure, bending failure then override under prescr
   p.vertical.rupture = 0.1;
   p.torsional.rupture = 0.05;
   p.misalignment = 0.02;
+  p.misalignment_geometry = "offset";  // the closed form below adds the misalignment to v only
   p.face_height = 0.2;
   const Drive drive{1.0, 0.5, 0.2};
   // Contact at t = 0.1 (gap 0.1 at 1 m/s) with v = 0.02 + 0.5 * 0.1 = 0.07 < 0.2: engaged.

@@ -15,10 +15,21 @@
 //   gap         g = facing (d . e1); the faces touch at g = 0. The model must start with
 //               g >= 0 (there is no crush history to start from).
 //   horizontal deformation   d_h = -g  (crush, positive when the faces are pressed together)
-//   vertical offset          v = d . n1 + initial_misalignment  (face 2 above face 1 > 0).
-//               Give the points at the face centres and leave initial_misalignment at 0, or
-//               give both points at the same nominal height and the offset of the faces as
-//               initial_misalignment (the report's way: Table 9, P9).
+//   vertical offset          v = d . n1  (face 2 above face 1 > 0).
+//   initial_misalignment m (report Table 9, P9: "a slight misalignment of the anticlimbers")
+//               with misalignment_geometry: face (default, issue 40): face 2's centre is m
+//               above point P2 along body 2's +y axis, i.e. P2 + (0, m) in body 2's frame is
+//               the point used everywhere above (r2, the offset v, and where the forces act).
+//               Giving both points at the same nominal height with m is then exactly the same
+//               model as giving P2 at the face centre with m = 0. The misalignment acts through
+//               the line of action of the horizontal force (a couple H m on the car ends, which
+//               pitches them and so loads the interlock) and the room left before override.
+//               misalignment_geometry: offset (the behaviour before issue 40, a labelled
+//               variant): m is only added to v (v = d . n1 + m); the forces act at P2. As the
+//               interlock takes v at engagement as its reference (below), a constant m then
+//               cancels from every force: m changes nothing until override is near (the
+//               report's Table 11 run 9, P9 +20 %, moved R1 by -0.08 % and R2 by -1.48 %
+//               with no override, so IITRAIN's misalignment did act on the forces).
 //   relative rotation        phi = theta2 - theta1.
 // Once the faces engage (below) the ribbed faces interlock at the offset and rotation of that
 // moment: vertical deformation d_v = v - v_e and torsional deformation d_t = phi - phi_e.
@@ -214,6 +225,7 @@ class Anticlimber : public ForceElement<Anticlimber> {
   double face_height;            // [length] height of each face (override when |v| >= it)
   std::optional<double> length;  // [length] of the crushable structure (bounds the crush)
   double initial_misalignment;   // [length] vertical offset of face 2 above face 1 added to the geometry
+  bool misalignment_at_face = true;  // misalignment_geometry: face (true) or offset (false)
   std::optional<double> facing;  // +1 / -1: body 1's face looks along +e1 / -e1 (default: from the start)
   bool release_while_unloading = false;  // interlock_while_unloading: release (true) or hold (false)
 
@@ -253,11 +265,11 @@ class Anticlimber : public ForceElement<Anticlimber> {
     Kinematics<T> k;
     k.e1 = rotate(rotation1, 1.0, 0.0);
     k.n1 = rotate(rotation1, 0.0, 1.0);
-    const Vec2<T> r2 = point_position(q2, s.rotation[slot2()], p2.sx, p2.sy);
+    const Vec2<T> r2 = point_position(q2, s.rotation[slot2()], p2.sx, face2_sy());
     const Vec2<T> d = r2 - point_position(q1, rotation1, p1.sx, p1.sy);
     k.arm1 = r2 - Vec2<T>{q1.x, q1.y};
     k.horizontal = -(*facing) * dot(d, k.e1);
-    k.vertical = dot(d, k.n1) + initial_misalignment;
+    k.vertical = dot(d, k.n1) + (misalignment_at_face ? 0.0 : initial_misalignment);
     k.rotation = q2.theta - q1.theta;
     return k;
   }
@@ -276,7 +288,7 @@ class Anticlimber : public ForceElement<Anticlimber> {
     const T push = h * (*facing);
     const Vec2<T> force{push * k.e1.x - v * k.n1.x, push * k.e1.y - v * k.n1.y};
     const PointRef& p2 = point(1);
-    add_point_force(s.rotation[slot2()], p2.sx, p2.sy, force, f[slot2()]);
+    add_point_force(s.rotation[slot2()], p2.sx, face2_sy(), force, f[slot2()]);
     Pose<T>& f1 = f[slot1()];
     f1.x -= force.x;
     f1.y -= force.y;
@@ -321,6 +333,9 @@ class Anticlimber : public ForceElement<Anticlimber> {
  private:
   std::size_t slot1() const { return static_cast<std::size_t>(point_slot(0)); }
   std::size_t slot2() const { return static_cast<std::size_t>(point_slot(1)); }
+  /// Body 2's y coordinate of face 2's centre: P2's, raised by the misalignment when it is
+  /// geometric (misalignment_geometry: face).
+  double face2_sy() const { return point(1).sy + (misalignment_at_face ? initial_misalignment : 0.0); }
   /// Deformations and their rates at s in mode st (vertical / torsional relative to the
   /// engagement references).
   struct Deformations {
