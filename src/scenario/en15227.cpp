@@ -547,7 +547,9 @@ void resolve_zone_strokes(const YAML::Node& model_node, const std::string& path,
   const Model model = load_model_text(std::string(emitter.c_str()) + "\n", path);
   const double to_file = u.millimetre ? 1e3 : 1.0;  // the loaded model is in SI for mm-t-s-N files
   for (auto& [name, stroke] : trains.zones) {
-    const auto element = std::find_if(model.elements().begin(), model.elements().end(), [&](const auto& e) { return e->name() == name; });
+    // (the name through an init-capture: clang refuses to capture a structured binding)
+    const auto element = std::find_if(model.elements().begin(), model.elements().end(),
+                                      [&zone_name = name](const auto& e) { return e->name() == zone_name; });
     if (element == model.elements().end() || (*element)->output_with_role(OutputRole::Crush).empty())
       refuse("--crush-zones: '" + name + "' has no crush output (OutputRole::Crush): it is not part of a car's survival-space "
              "measure, so declaring it a crush zone would change nothing; leave it out");
