@@ -248,7 +248,9 @@ PYBIND11_MODULE(_railcrash, m) {
         return out;
       }, "committed mode changes: (t, element, event, value) tuples")
       .def_property_readonly("summary_json", [](const rc::Results& r) { return r.summary_json; })
-      .def_property_readonly("message", [](const rc::Results& r) { return r.summary.message; });
+      .def_property_readonly("message", [](const rc::Results& r) { return r.summary.message; })
+      .def_property_readonly("accuracy_warnings", [](const rc::Results& r) { return r.summary.accuracy_warnings; },
+                             "the run's accuracy warnings (summary.json's): energy drift or joints opening past the stated limits");
 
   py::class_<rc::ModelBuilder>(m, "ModelBuilder",
                                "Builds a model in code; build() checks it as a model file is checked.")

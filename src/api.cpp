@@ -12,6 +12,7 @@
 #include "railcrash/dae_system.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/results.hpp"
+#include "railcrash/results/accuracy_check.hpp"
 #include "railcrash/run.hpp"
 
 #ifndef RAILCRASH_VERSION
@@ -123,6 +124,7 @@ Results run(const Model& model, const RunSettings& settings, const std::atomic<b
   s.wall_seconds = o.stats.wall_seconds;
   s.energy_balance_error = EnergyBalance::between(o.initial_energy, o.final_energy).error();
   s.max_constraint_residual = o.max_constraint_residual;
+  s.accuracy_warnings = accuracy_warnings(accuracy_facts(o, report.integrator, loaded.units));
   for (const railcrash::CarCrush& car : report.car_crush) s.cars.push_back(CarCrush{car.car, car.max_crush, car.t});
   const double g = standard_gravity(loaded);
   for (std::size_t i = 0; i < report.acceleration_peaks.size(); ++i) {

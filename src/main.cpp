@@ -23,6 +23,7 @@
 #include "railcrash/element_reference.hpp"
 #include "railcrash/euler_integrator.hpp"
 #include "railcrash/initial_conditions.hpp"
+#include "railcrash/results/accuracy_check.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/model_schema.hpp"
 #include "railcrash/run.hpp"
@@ -263,6 +264,8 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
               energy.kinetic, energy.elastic, energy.gravity, energy.dissipated, energy.external_work,
               energy.integration_drift(), energy.initial_total);
   std::printf("largest constraint residual %.3g\n", o.max_constraint_residual);
+  for (const std::string& warning : accuracy_warnings(accuracy_facts(o, report.integrator, model.units)))
+    std::printf("WARNING accuracy: %s\n", warning.c_str());
   if (report.has_responses) {
     const Responses& r = report.responses;
     std::printf("responses  R1 %.3f (crush)  R2 %.3f (override)  R3 %.3f  override: %s\n", r.r1, r.r2, r.r3,

@@ -1,4 +1,5 @@
 #include "railcrash/results.hpp"
+#include "railcrash/results/accuracy_check.hpp"
 
 #include <algorithm>
 #include <fcntl.h>
@@ -709,15 +710,16 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   }
   j << "},\n";
   j << "  \"constraint_residual_max\": " << json_number(outcome.max_constraint_residual) << ",\n";
-  const double scale = std::max({std::abs(energy.initial_total), std::abs(energy.kinetic) + std::abs(energy.elastic) +
-                                                                     std::abs(energy.gravity) + std::abs(energy.dissipated) +
-                                                                     std::abs(energy.external_work)});
   j << "  \"energy\": {\"kinetic\": " << json_number(energy.kinetic) << ", \"elastic\": " << json_number(energy.elastic)
     << ", \"gravity\": " << json_number(energy.gravity) << ", \"dissipated\": " << json_number(energy.dissipated)
     << ", \"external_work\": " << json_number(energy.external_work) << ", \"initial_total\": "
     << json_number(energy.initial_total) << ", \"integration_drift\": " << json_number(energy.integration_drift())
     << ", \"balance_error\": " << json_number(energy.error())
-    << ", \"relative_balance_error\": " << json_number(scale > 0.0 ? energy.error() / scale : 0.0) << "},\n";
+    << ", \"relative_balance_error\": " << json_number(relative_balance_error(energy)) << "},\n";
+  j << "  \"accuracy_warnings\": [";  // (results/accuracy_check.hpp: the limits and why)
+  const std::vector<std::string> warnings = accuracy_warnings(accuracy_facts(outcome, integrator, model.units));
+  for (std::size_t k = 0; k < warnings.size(); ++k) j << (k ? ", " : "") << json_string(warnings[k]);
+  j << "],\n";
   const double ke_integral = outcome.quadratures.empty() ? 0.0 : outcome.quadratures[DaeSystem::kKineticIntegral];
   j << "  \"kinetic_energy_integral\": " << json_number(ke_integral) << ",\n";
   j << "  \"peaks\": {";

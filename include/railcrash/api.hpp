@@ -124,6 +124,8 @@ struct Summary {
   double wall_seconds = 0.0;       // [s] integration only
   double energy_balance_error = 0.0;       // [energy] kinetic + elastic + gravity + dissipated - initial - external work
   double max_constraint_residual = 0.0;    // [length] largest |Phi| over the samples
+  std::vector<std::string> accuracy_warnings;  // summary.json's: energy drift or joint opening past the limits
+                                               // of results/accuracy_check.hpp, each with what to change
   std::vector<CarCrush> cars;
   std::vector<PeakAcceleration> peak_accelerations;  // every body, in model order
   bool has_responses = false;      // the model has a responses section: R1-R3 below

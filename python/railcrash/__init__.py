@@ -31,6 +31,7 @@ import json as _json
 import math as _math
 import numbers as _numbers
 import os as _os
+import warnings as _warnings
 
 import numpy as _numpy
 
@@ -40,7 +41,7 @@ from . import _railcrash
 for _name in ("InputError", "SolverError", "Model", "ModelBuilder", "Results", "RunSettings"):
     getattr(_railcrash, _name).__module__ = "railcrash"
 
-__all__ = ["load", "from_yaml", "run", "sensitivity", "sweep", "Model", "ModelBuilder", "Results", "InputError", "SolverError", "__version__"]
+__all__ = ["load", "from_yaml", "run", "AccuracyWarning", "sensitivity", "sweep", "Model", "ModelBuilder", "Results", "InputError", "SolverError", "__version__"]
 
 
 def _setting_value(key, value):
@@ -105,6 +106,11 @@ def _with(self, set):
 Model.with_settings = _with
 
 
+class AccuracyWarning(UserWarning):
+    """A run's own energy balance or constraint residual says its numbers carry an integration
+    error past the stated limits (README "Accuracy warnings"); the message says what to change."""
+
+
 def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, output_interval=None, force_dt=False,
         set=None, timings=False):
     """Runs a model (a Model, or a model file's path) and returns its Results, in memory.
@@ -135,7 +141,10 @@ def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, outpu
         setattr(settings, name, float(value))
     settings.force_dt = bool(force_dt)
     settings.timings = bool(timings)
-    return _railcrash._run(model, settings)
+    results = _railcrash._run(model, settings)
+    for text in results.accuracy_warnings:  # (as `railcrash run` prints them: README "Accuracy warnings")
+        _warnings.warn(text, AccuracyWarning, stacklevel=2)
+    return results
 
 
 def _summary(self):

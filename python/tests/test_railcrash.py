@@ -257,6 +257,23 @@ class RunTest(unittest.TestCase):
         b = railcrash.run(valued, rtol=1e-5).series("anticlimber.horizontal_force")
         numpy.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-6)
 
+    def test_euler_default_step_on_an_si_unit_warns_and_ida_does_not(self):
+        """A user's SI unit under Euler's default step loses its energy balance (README "Accuracy
+        warnings"): run() warns with AccuracyWarning, as `railcrash run` prints it; IDA does not."""
+        unit = SOURCE / "models" / "examples" / "emu3_unit_collision.yaml"
+        with self.assertWarns(railcrash.AccuracyWarning) as caught:
+            euler = railcrash.run(unit, integrator="euler")
+        self.assertTrue(euler.ok, euler.message)
+        self.assertIn("of the energy turned over", str(caught.warning))
+        self.assertEqual(euler.accuracy_warnings, euler.summary["accuracy_warnings"])
+        self.assertEqual(len(euler.accuracy_warnings), 2)
+        self.assertGreater(abs(euler.summary["energy"]["relative_balance_error"]), 0.01)
+        import warnings
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", railcrash.AccuracyWarning)
+            ida = railcrash.run(unit, integrator="ida")
+        self.assertEqual(ida.accuracy_warnings, [])
+
     def test_timings_split_the_wall_time_by_phase(self):
         timed = railcrash.run(railcrash.from_yaml(ANTICLIMBER), timings=True)
         self.assertTrue(timed.ok, timed.message)

@@ -1,0 +1,51 @@
+#pragma once
+// Accuracy warnings: a finished run whose own energy balance or constraint residual says that
+// its numbers carry an integration error larger than an engineer would hand in.
+//
+// Two measures every run already reports (summary.json's energy and constraint_residual_max):
+//   - the energy the integration created or lost, as a share of the energy turned over:
+//       share = |integration_drift| / max(|initial total|, |kinetic| + |elastic| + |gravity|
+//                                                          + |dissipated| + |external work|)
+//     (summary.json's relative_balance_error);
+//   - the largest constraint residual |Phi| at the output samples, a length: with Euler it is
+//     how far its penalty springs let the joints open.
+// A run is warned about when the share exceeds kEnergyShareLimit or the residual exceeds
+// kConstraintResidualLimit. The limits are stated, not tuned to pass: on the report's models
+// (in-lbf-s) Euler at the printed step turns 0.015-0.087 % and opens joints by at most
+// 0.29 mm; on the SI example models its default step creates 2.9-9.9 % and opens joints by
+// 6 mm to 0.46 m (bench/accuracy_warnings.py prints these figures; README "Accuracy warnings").
+#include <string>
+#include <vector>
+
+#include "railcrash/model.hpp"
+
+namespace railcrash {
+
+struct EnergyBalance;
+struct RunOutcome;
+
+constexpr double kEnergyShareLimit = 0.01;          // [-] of the energy turned over
+constexpr double kConstraintResidualLimit = 1.0e-3;  // [m] (converted to the model's length unit)
+
+/// summary.json's relative_balance_error: the energy the integration gained (error()) over the
+/// energy turned over; 0 for a model that turns none over.
+double relative_balance_error(const EnergyBalance& energy);
+
+/// What the run said about its own accuracy, as what an engineer would act on.
+struct AccuracyFacts {
+  double relative_balance_error = 0.0;    // [-] as summary.json
+  double max_constraint_residual = 0.0;   // [length of the model's unit system]
+  UnitSystem units = UnitSystem::SI;
+  bool euler_ran = false;                 // Euler integrated all of the run or its rest (auto's hand-over)
+  double euler_step = 0.0;                // [s] its step, when euler_ran
+};
+
+/// The facts of a finished run; `integrator` is the method the run was set to ("ida", "euler"
+/// or "auto": auto counts as Euler from its hand-over on).
+AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integrator, UnitSystem units);
+
+/// One sentence per limit exceeded, each naming the figure, the limit and what to change; empty
+/// when the run is within both limits.
+std::vector<std::string> accuracy_warnings(const AccuracyFacts& facts);
+
+}  // namespace railcrash

@@ -1,0 +1,68 @@
+#include "railcrash/results/accuracy_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "railcrash/dae_system.hpp"
+#include "railcrash/integrator.hpp"
+
+namespace railcrash {
+
+double relative_balance_error(const EnergyBalance& energy) {
+  const double turned_over = std::max(std::abs(energy.initial_total),
+                                      std::abs(energy.kinetic) + std::abs(energy.elastic) + std::abs(energy.gravity) +
+                                          std::abs(energy.dissipated) + std::abs(energy.external_work));
+  return turned_over > 0.0 ? energy.error() / turned_over : 0.0;
+}
+
+AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integrator, UnitSystem units) {
+  AccuracyFacts facts;
+  facts.relative_balance_error = relative_balance_error(EnergyBalance::between(outcome.initial_energy, outcome.final_energy));
+  facts.max_constraint_residual = outcome.max_constraint_residual;
+  facts.units = units;
+  facts.euler_ran = integrator == "euler" || outcome.stats.handed_over_at >= 0.0;
+  facts.euler_step = outcome.stats.last_step;
+  return facts;
+}
+
+namespace {
+
+std::string format(const char* pattern, double a, double b) {
+  char text[256];
+  std::snprintf(text, sizeof text, pattern, a, b);
+  return text;
+}
+
+/// What to change, for the method that integrated the run.
+std::string remedy(const AccuracyFacts& facts) {
+  if (facts.euler_ran)
+    return format("Euler's step was %.3g s: halve it (--dt %.3g) and compare, or run with --integrator ida; "
+                  "`railcrash converge` shows how the results move with the step",
+                  facts.euler_step, facts.euler_step / 2);
+  return "tighten IDA's tolerance (--rtol, --atol) and compare; `railcrash converge` shows how the results move with it";
+}
+
+}  // namespace
+
+std::vector<std::string> accuracy_warnings(const AccuracyFacts& facts) {
+  std::vector<std::string> warnings;
+  const double share = std::abs(facts.relative_balance_error);
+  if (share > kEnergyShareLimit) {
+    char text[160];
+    std::snprintf(text, sizeof text, "the integration %s %.3g %% of the energy turned over (more than %.3g %%): ",
+                  facts.relative_balance_error > 0 ? "created" : "lost", 100 * share, 100 * kEnergyShareLimit);
+    warnings.push_back(text + remedy(facts));
+  }
+  const bool si = facts.units == UnitSystem::SI;
+  const double limit = si ? kConstraintResidualLimit : kConstraintResidualLimit / 0.0254;  // [m] or [in]
+  if (facts.max_constraint_residual > limit) {
+    char text[200];
+    std::snprintf(text, sizeof text, "joints open by up to %.3g %s at the output samples (more than %.3g %s): ",
+                  facts.max_constraint_residual, si ? "m" : "in", limit, si ? "m" : "in");
+    warnings.push_back(text + remedy(facts));
+  }
+  return warnings;
+}
+
+}  // namespace railcrash

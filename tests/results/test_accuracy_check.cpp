@@ -1,0 +1,119 @@
+// Accuracy warnings (results/accuracy_check.hpp): the limits on their own, then on a model of
+// one's own in SI (models/examples/emu3_unit_collision.yaml) against the report's car.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "railcrash/dae_system.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/results/accuracy_check.hpp"
+#include "railcrash/run.hpp"
+
+using namespace railcrash;
+
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("relative balance error is the energy gained over the energy turned over", "[unit][accuracy]") {
+  EnergyBalance e;
+  e.initial_total = 1000.0;
+  e.kinetic = 300.0;
+  e.elastic = 100.0;
+  e.gravity = -50.0;
+  e.dissipated = 700.0;  // 1050 at the end against 1000 at the start: 50 gained
+  e.external_work = 0.0;
+  // turned over: max(1000, 300 + 100 + 50 + 700 + 0) = 1150
+  CHECK(relative_balance_error(e) == Approx(50.0 / 1150.0).epsilon(1e-14));
+  EnergyBalance nothing;
+  CHECK(relative_balance_error(nothing) == 0.0);
+}
+
+TEST_CASE("accuracy warnings fire past the stated limits and name what to change", "[unit][accuracy]") {
+  AccuracyFacts facts;
+  facts.units = UnitSystem::SI;
+  facts.euler_ran = true;
+  facts.euler_step = 4.0e-4;  // [s]
+  facts.relative_balance_error = 0.0099;
+  facts.max_constraint_residual = 0.00099;  // [m]
+  CHECK(accuracy_warnings(facts).empty());
+
+  facts.relative_balance_error = -0.0101;  // lost
+  std::vector<std::string> w = accuracy_warnings(facts);
+  REQUIRE(w.size() == 1);
+  CHECK(contains(w[0], "lost 1.01 %"));
+  CHECK(contains(w[0], "--dt 0.0002"));
+  CHECK(contains(w[0], "--integrator ida"));
+
+  facts.relative_balance_error = 0.05;  // created
+  facts.max_constraint_residual = 0.0011;
+  w = accuracy_warnings(facts);
+  REQUIRE(w.size() == 2);
+  CHECK(contains(w[0], "created 5 %"));
+  CHECK(contains(w[1], "0.0011 m"));
+
+  // in-lbf-s: the limit is 1 mm = 0.03937 in
+  facts.units = UnitSystem::InLbfS;
+  facts.relative_balance_error = 0.0;
+  facts.max_constraint_residual = 0.039;
+  CHECK(accuracy_warnings(facts).empty());
+  facts.max_constraint_residual = 0.040;
+  w = accuracy_warnings(facts);
+  REQUIRE(w.size() == 1);
+  CHECK(contains(w[0], "0.04 in"));
+
+  // IDA: the remedy is its tolerance, not a step
+  facts.euler_ran = false;
+  w = accuracy_warnings(facts);
+  REQUIRE(w.size() == 1);
+  CHECK(contains(w[0], "--rtol"));
+  CHECK_FALSE(contains(w[0], "--dt"));
+}
+
+TEST_CASE("a user's SI unit run by Euler's default step is warned about and the same run by IDA is not",
+          "[unit][accuracy]") {
+  const std::string path = std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/emu3_unit_collision.yaml";
+  for (const std::string integrator : {"euler", "ida"}) {
+    CAPTURE(integrator);
+    const Model model = load_model(path, {"simulation.integrator=" + integrator});
+    const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+    REQUIRE(report.outcome.ok);
+    const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
+    // The share from summary.json's own energy figures, computed here.
+    const nlohmann::json& e = summary["energy"];
+    const double parts = std::abs(e["kinetic"].get<double>()) + std::abs(e["elastic"].get<double>()) +
+                         std::abs(e["gravity"].get<double>()) + std::abs(e["dissipated"].get<double>()) +
+                         std::abs(e["external_work"].get<double>());
+    const double share = std::abs(e["integration_drift"].get<double>()) / std::max(std::abs(e["initial_total"].get<double>()), parts);
+    const double residual = summary["constraint_residual_max"].get<double>();  // [m]
+    const std::vector<std::string> warnings = summary["accuracy_warnings"].get<std::vector<std::string>>();
+    if (integrator == "euler") {
+      CHECK(share > 0.02);       // measured 3.9 % at Euler's default step
+      CHECK(residual > 0.1);     // measured 0.44 m
+      REQUIRE(warnings.size() == 2);
+      CHECK(contains(warnings[0], "created"));
+      CHECK(contains(warnings[1], "joints open"));
+    } else {
+      CHECK(share < 1e-4);
+      CHECK(residual < 1e-6);
+      CHECK(warnings.empty());
+    }
+  }
+}
+
+TEST_CASE("the report's car run by Euler at its printed step is within the limits", "[unit][accuracy]") {
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/preliminary_car.yaml",
+                                 {"simulation.integrator=euler"});
+  const RunReport report = run_model(model, "", nullptr, false, true);
+  REQUIRE(report.outcome.ok);
+  const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
+  CHECK(std::abs(summary["energy"]["relative_balance_error"].get<double>()) < 0.001);  // measured 0.025 %
+  CHECK(summary["constraint_residual_max"].get<double>() < 0.03937);                    // measured 0.0105 in
+  CHECK(summary["accuracy_warnings"].empty());
+}
