@@ -169,10 +169,6 @@ std::vector<OptionSetting> option_settings(const RunOverrides& o) {
   return settings;
 }
 
-double output_interval_of(const SimulationSettings& settings) {
-  return settings.output_interval > 0.0 ? settings.output_interval : settings.t_end / 500.0;
-}
-
 namespace {
 std::atomic<double> g_output_memory_limit{4.0 * 1024 * 1024 * 1024};  // [bytes]
 }  // namespace

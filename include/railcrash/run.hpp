@@ -36,8 +36,11 @@ void apply_overrides(Model& model, const RunOverrides& overrides);
 /// The integrator the model's settings ask for.
 std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings);
 
-/// Output interval actually used (the setting, or t_end / 500).
-double output_interval_of(const SimulationSettings& settings);
+/// Output interval actually used (the setting, or t_end / 500). (Inline: the loader's
+/// provenance uses it, and the fuzz target links the loader without the run's sources.)
+inline double output_interval_of(const SimulationSettings& settings) {
+  return settings.output_interval > 0.0 ? settings.output_interval : settings.t_end / 500.0;
+}
 
 struct RunReport {
   RunOutcome outcome;
