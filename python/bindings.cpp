@@ -117,8 +117,7 @@ std::pair<std::vector<std::string>, std::vector<std::vector<std::string>>> sweep
     return railcrash::run_sweep(model_path, plan, out_dir, options);
   });
   std::vector<std::vector<std::string>> rows;
-  for (const auto& line : result.lines)
-    if (line) rows.push_back(railcrash::csv_fields(*line));
+  for (const auto& [number, line] : result.lines) rows.push_back(railcrash::csv_fields(line));
   return {railcrash::csv_fields(railcrash::sweep_csv_header(plan)), rows};
 }
 
