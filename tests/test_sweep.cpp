@@ -134,6 +134,115 @@ TEST_CASE("sweep designs: the generator and transforms are fixed by their defini
   CHECK(uniform.value_at(0.25) == -3.0);
 }
 
+namespace {
+
+/// A plan made in memory (no model check: the generator only reads the levels): factors named
+/// f0, f1, ... with levels "F.J" (factor F, level J), or distributions for the sampled designs.
+SweepPlan plan_in_memory(SweepDesignKind design, const std::vector<std::size_t>& level_counts) {
+  SweepPlan plan;
+  plan.path = "plan.yaml";
+  plan.design = design;
+  plan.settings = {"simulation.t_end=0.1"};
+  for (std::size_t f = 0; f < level_counts.size(); ++f) {
+    SweepFactor factor;
+    factor.key = "f" + std::to_string(f);
+    for (std::size_t j = 0; j < level_counts[f]; ++j) factor.levels.push_back(std::to_string(f) + "." + std::to_string(j));
+    plan.factors.push_back(factor);
+  }
+  return plan;
+}
+
+}  // namespace
+
+TEST_CASE("sweep runs one at a time: run k of a 21.6-million-run factorial from its digits, without a list of runs", "[sweep]") {
+  Files files;
+  const std::string model_text = read(files.model);
+  const std::vector<std::size_t> counts{10, 7, 13, 4, 11, 9, 3, 20};  // 21,621,600 runs
+  const SweepPlan plan = plan_in_memory(SweepDesignKind::full_factorial, counts);
+  const SweepRunGenerator generator(plan, files.model, model_text);
+  REQUIRE(generator.count() == 21621600u);
+  // Run k's level of factor f is digit f of k in the mixed radix of the level counts, the last
+  // factor fastest: (k / (product of the counts after f)) mod count_f.
+  for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{20}, std::size_t{1234567}, std::size_t{9999999},
+                              std::size_t{21621599}}) {
+    INFO("run " << k);
+    const SweepRunSpec spec = generator.spec(k);
+    REQUIRE(spec.levels.size() == counts.size());
+    REQUIRE(spec.settings.size() == 1 + counts.size());
+    CHECK(spec.settings[0] == "simulation.t_end=0.1");
+    std::size_t stride = 1;
+    for (std::size_t f = counts.size(); f-- > 0;) {
+      const std::size_t digit = k / stride % counts[f];
+      CHECK(spec.levels[f] == std::to_string(f) + "." + std::to_string(digit));
+      CHECK(spec.settings[1 + f] == "f" + std::to_string(f) + "=" + spec.levels[f]);
+      stride *= counts[f];
+    }
+  }
+  // 1234567 = ((((((0 7 + 3) 13 + 12) 4 + 3) 11 + 9) 9 + 2) 3 + 0) 20 + 7, worked by hand.
+  CHECK(generator.levels(1234567) == std::vector<std::string>{"0.0", "1.3", "2.12", "3.3", "4.9", "5.2", "6.0", "7.7"});
+  CHECK(generator.spec(5).hash == generator.spec(5).hash);
+  CHECK(generator.spec(5).hash != generator.spec(6).hash);
+}
+
+TEST_CASE("sweep runs one at a time: every design's run k equals its design generator's row k, taken in any order", "[sweep]") {
+  Files files;
+  const std::string model_text = read(files.model);
+  const std::vector<std::size_t> order{7, 3, 4, 0, 11, 5, 6, 1, 2, 10, 8, 9};  // runs out of turn: a generator keeps no cursor state wrong
+  SECTION("full factorial") {
+    const SweepPlan plan = plan_in_memory(SweepDesignKind::full_factorial, {3, 2, 2});
+    const SweepRunGenerator generator(plan, files.model, model_text);
+    const auto rows = full_factorial({3, 2, 2});
+    REQUIRE(generator.count() == rows.size());
+    for (const std::size_t k : order)
+      for (std::size_t f = 0; f < 3; ++f) CHECK(generator.levels(k)[f] == plan.factors[f].levels[rows[k][f]]);
+  }
+  SECTION("one at a time") {
+    const SweepPlan plan = plan_in_memory(SweepDesignKind::one_at_a_time, {3, 5, 3});
+    const SweepRunGenerator generator(plan, files.model, model_text);
+    const auto rows = one_at_a_time({3, 5, 3});
+    REQUIRE(generator.count() == 12);
+    for (const std::size_t k : order)
+      for (std::size_t f = 0; f < 3; ++f)
+        CHECK(generator.levels(k)[f] == (rows[k][f] < 0 ? "" : plan.factors[f].levels[static_cast<std::size_t>(rows[k][f])]));
+    CHECK(generator.spec(0).settings == std::vector<std::string>{"simulation.t_end=0.1"});  // the model's values
+  }
+  for (const SweepDesignKind design : {SweepDesignKind::latin_hypercube, SweepDesignKind::monte_carlo}) {
+    SweepPlan plan = plan_in_memory(design, {0, 0});
+    plan.samples = 12;
+    plan.seed = 9;
+    plan.factors[0].distribution = SweepDistribution{SweepDistribution::Kind::uniform, -3.0, 5.0};
+    plan.factors[1].distribution = SweepDistribution{SweepDistribution::Kind::normal, 2.0, 0.5};
+    const SweepRunGenerator generator(plan, files.model, model_text);
+    const auto rows = design == SweepDesignKind::latin_hypercube ? latin_hypercube(12, 2, 9) : monte_carlo(12, 2, 9);
+    REQUIRE(generator.count() == 12);
+    for (const std::size_t k : order) {
+      INFO("run " << k);
+      CHECK(std::stod(generator.levels(k)[0]) == -3.0 + 8.0 * rows[k][0]);
+      CHECK(std::stod(generator.levels(k)[1]) == 2.0 + 0.5 * normal_quantile(rows[k][1]));
+    }
+  }
+}
+
+TEST_CASE("sweep runs one at a time: Monte Carlo run k of ten million from draws 2k and 2k + 1 of the seed's sequence", "[sweep]") {
+  Files files;
+  SweepPlan plan = plan_in_memory(SweepDesignKind::monte_carlo, {0, 0});
+  plan.samples = 10000000;
+  plan.seed = 77;
+  plan.factors[0].distribution = SweepDistribution{SweepDistribution::Kind::uniform, 10.0, 20.0};
+  plan.factors[1].distribution = SweepDistribution{SweepDistribution::Kind::uniform, 0.0, 1.0};
+  const SweepRunGenerator generator(plan, files.model, read(files.model));
+  REQUIRE(generator.count() == 10000000u);
+  for (const std::size_t k : {std::size_t{9999999}, std::size_t{5000000}, std::size_t{5000001}, std::size_t{0}}) {
+    INFO("run " << k);
+    std::mt19937_64 draws(77);
+    draws.discard(2 * k);
+    const double u0 = (static_cast<double>(draws() >> 12) + 0.5) / 4503599627370496.0;  // 2^52
+    const double u1 = (static_cast<double>(draws() >> 12) + 0.5) / 4503599627370496.0;
+    CHECK(std::stod(generator.levels(k)[0]) == 10.0 + 10.0 * u0);
+    CHECK(std::stod(generator.levels(k)[1]) == u1);
+  }
+}
+
 TEST_CASE("sweep plans: an unknown key, a level of the wrong type and an empty design name the plan's line", "[sweep]") {
   Files files;
   const std::string head = "sweep: 1\ndesign: full_factorial\nfactors:\n";
