@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
 #include "railcrash/sweep.hpp"
 #include "railcrash/table_text.hpp"
 #include "support.hpp"
@@ -492,4 +494,59 @@ TEST_CASE("sweep: --resume reruns the rows of an edited base model and --keep-ru
     CHECK(number_in(rows[0], "R1") == Approx(crush_for(0.012) / 0.02).epsilon(1e-5));
     CHECK(number_in(rows[1], "R1") == Approx(crush_for(0.010) / 0.02).epsilon(1e-5));
   }
+}
+
+TEST_CASE("sweep: runs.csv says which method each run used, and an older runs.csv without the columns resumes", "[sweep][auto]") {
+  Files files;
+  // A 1 kg ball dropped 5 cm onto a floor (contact 1e5 N/m): ten bounces in 2 s, a lift-off and a
+  // touch-down each. With Euler's step 1 ms, integrator auto hands the run to Euler after the
+  // fifth mode change (IDA's mean step about 2 ms, each restart dearer than Euler's steps); with
+  // 1e-5 s Euler's steps cost far more and IDA keeps the run.
+  const std::string ball = files.dir + "/ball.yaml";
+  std::ofstream(ball) << "railcrash: 1\nname: ball\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+                         "  - {name: ball, mass: 1.0, inertia: 0.01, position: [0, 0.05]}\nelements:\n"
+                         "  - {name: floor, type: contact, stiffness: 1.0e5, damping: 20, friction: 0, line_point: [0, 0], "
+                         "line_normal: [0, 1], points: [{body: ball, at: [0, 0]}]}\n"
+                         "simulation: {t_end: 2.0, output_interval: 0.01, dt: 1.0e-3}\n";
+  files.write_plan("sweep: 1\ndesign: runs\nfactors:\n  - key: simulation.integrator\n  - key: simulation.dt\nruns:\n"
+                   "  - {simulation.integrator: ida}\n  - {simulation.integrator: euler}\n  - {simulation.integrator: auto}\n"
+                   "  - {simulation.integrator: auto, simulation.dt: 1.0e-5}\nresponses: [t_reached]\n");
+  const SweepPlan plan = load_sweep_plan(files.plan, ball);
+  SweepOptions options;
+  const SweepResult result = run_sweep(ball, plan, files.dir + "/methods", options);
+  REQUIRE(result.done() == 4);
+  // The hand-over time from the same run made outside the sweep (summary.json's integrator_used).
+  const RunReport auto_run = run_model(load_model(ball, {"simulation.integrator=auto"}), "");
+  REQUIRE(auto_run.outcome.stats.handed_over_at > 0.0);
+  const auto rows = csv_rows(files.dir + "/methods/runs.csv");
+  REQUIRE(rows.size() == 4);
+  CHECK(rows[0].at("integrator_used") == "ida");
+  CHECK(rows[0].at("euler_from_t").empty());
+  CHECK(rows[1].at("integrator_used") == "euler");
+  CHECK(rows[1].at("euler_from_t").empty());
+  CHECK(rows[2].at("integrator_used") == "ida+euler");
+  CHECK(std::stod(rows[2].at("euler_from_t")) == auto_run.outcome.stats.handed_over_at);
+  CHECK(std::stod(rows[2].at("euler_from_t")) > 0.05);  // after the first bounces (the fall alone takes 0.1 s)
+  CHECK(rows[3].at("integrator_used") == "ida");
+  CHECK(rows[3].at("euler_from_t").empty());
+
+  // runs.csv as railcrash wrote it before the two columns: its rows are kept, the columns empty.
+  const std::string header = sweep_csv_header(plan);
+  const std::string old_header = header.substr(0, header.size() - std::string(",integrator_used,euler_from_t").size());
+  std::istringstream written(read(files.dir + "/methods/runs.csv"));
+  std::string line, old_text = old_header + "\n";
+  std::getline(written, line);
+  for (int k = 0; k < 2 && std::getline(written, line); ++k) old_text += line.substr(0, line.rfind(',', line.rfind(',') - 1)) + "\n";
+  std::filesystem::create_directories(files.dir + "/old");
+  std::ofstream(files.dir + "/old/runs.csv") << old_text;
+  options.resume = true;
+  const SweepResult resumed = run_sweep(ball, plan, files.dir + "/old", options);
+  CHECK(resumed.resumed == 2);
+  CHECK(resumed.done() == 4);
+  const auto resumed_rows = csv_rows(files.dir + "/old/runs.csv");
+  REQUIRE(resumed_rows.size() == 4);
+  CHECK(resumed_rows[0].at("integrator_used").empty());  // resumed: not recorded then
+  CHECK(resumed_rows[1].at("integrator_used").empty());
+  CHECK(resumed_rows[2].at("integrator_used") == "ida+euler");
+  CHECK(resumed_rows[0].at("t_reached") == rows[0].at("t_reached"));
 }
