@@ -159,12 +159,18 @@ if [ $status -eq 0 ] && [ "$(head -1 "$tmp/dry")" = "$tmp/huge.yaml: 10000000 ru
    grep -q '^1234567,[0-9a-f]\{16\},0.92,0.93,0.94,0.95,0.96,0.97,0.98$' "$tmp/dry" && [ -z "$(levels_right "$tmp/dry")" ]; then pass
 else fail "--dry-run of 10^7 runs: status $status, $(cat "$tmp/dry" "$tmp/stderr"; levels_right "$tmp/dry")"; fi
 # The sweep itself, stopped by SIGTERM once runs.csv holds a few rows, then resumed and stopped again.
+huge_launcher=()
 huge_rows() { local n; n=$( { wc -l < "$tmp/huge/runs.csv"; } 2> /dev/null || echo 1); echo $((n - 1)); }
 run_huge_until() {  # ROWS [--resume]: starts the sweep, stops it once runs.csv holds ROWS rows (60 s at most)
   local rows=$1 waited=0
   shift
-  (ulimit -v 1500000; exec "$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --max-runs 0 --jobs 2 --out "$tmp/huge" "$@") \
-    > "$tmp/huge.out" 2> "$tmp/huge.err" &
+  if [ ${#huge_launcher[@]} -gt 0 ]; then  # (OpenMPI maps more address space than ulimit -v leaves: no limit)
+    "${huge_launcher[@]}" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --max-runs 0 --out "$tmp/huge" "$@" \
+      > "$tmp/huge.out" 2> "$tmp/huge.err" &
+  else
+    (ulimit -v 1500000; exec "$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --max-runs 0 --jobs 2 --out "$tmp/huge" "$@") \
+      > "$tmp/huge.out" 2> "$tmp/huge.err" &
+  fi
   local pid=$!
   while kill -0 $pid 2> /dev/null && [ "$(huge_rows)" -lt "$rows" ] && [ $waited -lt 600 ]; do sleep 0.1; waited=$((waited + 1)); done
   kill -TERM $pid 2> /dev/null
@@ -194,6 +200,17 @@ if [ -n "$mpirun" ]; then
   status=$?
   if [ $status -eq 2 ] && [ "$(grep -c "bad_key.yaml:4:" "$tmp/stderr")" -eq 1 ]; then pass
   else fail "mpirun with a bad plan: status $status, $(cat "$tmp/stderr")"; fi
+  # The 10^7-run plan over 2 ranks: rank 0 hands out run numbers from a cursor, each rank makes its run from the number.
+  rm -rf "$tmp/huge"
+  huge_launcher=("$mpirun" --oversubscribe -np 2)
+  run_huge_until 4
+  first_rows=$(huge_rows)
+  if [ $huge_status -ne 0 ] && [ "$first_rows" -ge 4 ] && [ -z "$(levels_right "$tmp/huge/runs.csv")" ]; then pass
+  else fail "mpirun: 10^7 runs stopped after $first_rows rows: status $huge_status, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err")"; fi
+  run_huge_until $((first_rows + 4)) --resume
+  if [ $huge_status -ne 0 ] && [ "$(huge_rows)" -ge $((first_rows + 4)) ] && [ -z "$(levels_right "$tmp/huge/runs.csv")" ] &&
+     [ "$(cut -d, -f1 "$tmp/huge/runs.csv" | sort -u | wc -l)" -eq $(($(huge_rows) + 1)) ]; then pass
+  else fail "mpirun: 10^7 runs resumed: status $huge_status, $(huge_rows) rows, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err")"; fi
   # railcrash links no MPI and runs railcrash-mpi beside it under a launcher: without it, exit 2 saying so.
   mkdir "$tmp/alone" && cp "$bin" "$tmp/alone/railcrash"
   PMIX_RANK=0 "$tmp/alone/railcrash" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --out "$tmp/alone/out" > /dev/null 2> "$tmp/stderr"
