@@ -709,11 +709,12 @@ int main(int argc, char** argv) {
   sweep->add_option("--out", out_dir, "output folder")->capture_default_str();
   bool sweep_dry_run = false;
   std::vector<std::size_t> sweep_show_runs;
-  sweep->add_flag("--dry-run", sweep_dry_run,
+  CLI::Option* dry_run_option = sweep->add_flag("--dry-run", sweep_dry_run,
                   "run nothing: print the plan's run count and the levels of the runs --show-runs lists (default: the "
                   "first 10 and the last), as runs.csv's first columns");
   sweep->add_option("--show-runs", sweep_show_runs, "with --dry-run: the run numbers to print (e.g. 0,1,9999999)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->needs(dry_run_option);
 
   std::string consist_out;
   int consist_cars = 2;
