@@ -49,6 +49,8 @@ py::dict sensitivity_run_dict(const railcrash::SensitivityRun& run) {
   row["wall_seconds"] = run.wall_seconds;
   row["outcomes"] = run.ok ? run.outcomes.text() : std::string();  // the discrete outcome (issue 40)
   row["branch"] = run.ok ? run.outcomes.order() : std::string();    // order only: equal texts, one branch
+  row["integrator_used"] = run.integrator.method;     // "ida", "euler", "ida+euler" ("" : the run did not start)
+  row["euler_from_t"] = run.integrator.euler_from_t;  // ida+euler: when IDA handed the run to Euler (else NaN)
   return row;
 }
 
@@ -117,8 +119,7 @@ std::pair<std::vector<std::string>, std::vector<std::vector<std::string>>> sweep
     return railcrash::run_sweep(model_path, plan, out_dir, options);
   });
   std::vector<std::vector<std::string>> rows;
-  for (const auto& line : result.lines)
-    if (line) rows.push_back(railcrash::csv_fields(*line));
+  for (const auto& [number, line] : result.lines) rows.push_back(railcrash::csv_fields(line));
   return {railcrash::csv_fields(railcrash::sweep_csv_header(plan)), rows};
 }
 

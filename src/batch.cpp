@@ -1,6 +1,8 @@
 #include "railcrash/batch.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <cerrno>
 #include <condition_variable>
 #include <cstdio>
@@ -14,6 +16,7 @@
 #include <thread>
 
 #include "railcrash/error.hpp"
+#include "railcrash/run.hpp"
 
 namespace railcrash {
 
@@ -178,30 +181,35 @@ struct BatchAccess {
   }
 };
 
-std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void(std::size_t, const RunControl&)>& task,
-                                     const BatchOptions& options,
-                                     const std::function<void(std::size_t, BatchRunState)>& on_finished) {
-  std::vector<BatchRunState> states(count, BatchRunState::not_started);
-  if (count == 0) return states;
-  const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(std::max(1, options.jobs)), count);
+void run_batch_stream(std::size_t most_runs, const std::function<std::optional<std::size_t>()>& next_run,
+                      const std::function<void(std::size_t, const RunControl&)>& task, const BatchOptions& options,
+                      const std::function<void(std::size_t, BatchRunState)>& on_finished) {
+  if (most_runs == 0) return;
+  const std::size_t threads = std::min<std::size_t>(static_cast<std::size_t>(std::max(1, options.jobs)), most_runs);
   // One control per thread, reused by that thread's runs; the supervisor reads them all.
   std::vector<std::unique_ptr<RunControl>> slots;
   for (std::size_t t = 0; t < threads; ++t) slots.push_back(std::make_unique<RunControl>());
-  std::atomic<std::size_t> next{0};
-  std::mutex report;
+  std::mutex taking, report;
+  bool exhausted = false;  // next_run said there are no more (guarded by taking)
   const BatchSupervisor supervisor(slots, options);
+  const auto take = [&]() -> std::optional<std::size_t> {
+    const std::lock_guard<std::mutex> lock(taking);
+    if (exhausted || (options.stop && options.stop->load())) return std::nullopt;
+    const std::optional<std::size_t> k = next_run();
+    if (!k) exhausted = true;
+    return k;
+  };
   const auto worker = [&](RunControl& control) {
-    for (std::size_t k = next++; k < count; k = next++) {
-      if (options.stop && options.stop->load()) break;
+    for (std::optional<std::size_t> k = take(); k; k = take()) {
       BatchAccess::start(control);
-      task(k, control);
+      task(*k, control);
       BatchAccess::finish(control);
       // A run stopped by the caller's flag has a partial result; one that ended by itself
       // before the supervisor noticed the flag is complete.
-      states[k] = control.interrupted() ? BatchRunState::interrupted : BatchRunState::finished;
+      const BatchRunState state = control.interrupted() ? BatchRunState::interrupted : BatchRunState::finished;
       if (on_finished) {
         const std::lock_guard<std::mutex> lock(report);
-        on_finished(k, states[k]);
+        on_finished(*k, state);
       }
     }
   };
@@ -213,13 +221,48 @@ std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void
       pool.emplace_back(worker, std::ref(*slots[t]));
     } catch (const std::system_error& e) {
       std::fprintf(stderr, "railcrash: --jobs %zu: only %zu thread%s could be started (%s); running the %zu runs with %zu\n",
-                   threads, t, t == 1 ? "" : "s", e.code().message().c_str(), count, t);
+                   threads, t, t == 1 ? "" : "s", e.code().message().c_str(), most_runs, t);
       break;
     }
   }
   worker(*slots[0]);
   for (std::thread& t : pool) t.join();
+}
+
+std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void(std::size_t, const RunControl&)>& task,
+                                     const BatchOptions& options,
+                                     const std::function<void(std::size_t, BatchRunState)>& on_finished) {
+  std::vector<BatchRunState> states(count, BatchRunState::not_started);
+  std::size_t next = 0;
+  run_batch_stream(
+      count, [&]() -> std::optional<std::size_t> { return next < count ? std::optional<std::size_t>(next++) : std::nullopt; },
+      task, options, [&](std::size_t k, BatchRunState state) {
+        states[k] = state;
+        if (on_finished) on_finished(k, state);
+      });
   return states;
+}
+
+std::string IntegratorUsed::euler_from_t_text() const {
+  if (std::isnan(euler_from_t)) return "";
+  char text[40];
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(text, sizeof text, "%.*g", digits, euler_from_t);
+    if (std::strtod(text, nullptr) == euler_from_t) break;
+  }
+  return text;
+}
+
+IntegratorUsed integrator_used(const RunReport& report) {
+  IntegratorUsed used;
+  if (report.integrator.empty()) return used;
+  if (report.outcome.stats.handed_over_at >= 0.0) {
+    used.method = "ida+euler";
+    used.euler_from_t = report.outcome.stats.handed_over_at;
+  } else {
+    used.method = report.integrator == "euler" ? "euler" : "ida";
+  }
+  return used;
 }
 
 }  // namespace railcrash

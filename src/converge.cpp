@@ -821,7 +821,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
   std::ostringstream csv;
   csv << "method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events";
   for (const ConvergeQuantity& q : r.quantities) csv << "," << csv_field(q.name) << "," << csv_field(q.name + "_error");
-  csv << ",message,outcomes,branch\n";
+  csv << ",message,outcomes,branch,integrator_used,euler_from_t\n";
   const auto number = [](double v) { return std::isfinite(v) ? format_number(v) : std::string(); };
   const OutcomeSignature reference_outcomes = outcome_signature(r.reference.events);
   const auto row = [&](const ConvergeRun& run) {
@@ -833,8 +833,12 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
     // The run's discrete outcome (issue 40), and whether it is the reference's ("same") or not.
     const OutcomeSignature outcomes = outcome_signature(run.events);
     csv << "," << csv_field(run.message) << "," << csv_field(run.ok ? outcomes.text() : "") << ","
-        << (!run.ok || !r.reference.ok ? "" : &run == &r.reference ? "reference" : same_branch(outcomes, reference_outcomes) ? "same" : "changed")
-        << "\n";
+        << (!run.ok || !r.reference.ok ? "" : &run == &r.reference ? "reference" : same_branch(outcomes, reference_outcomes) ? "same" : "changed");
+    // The method that ran (the study names ida or euler for each run; an IDA run is never handed over).
+    IntegratorUsed used;
+    used.method = run.method == "euler" ? "euler" : run.stats.handed_over_at >= 0.0 ? "ida+euler" : "ida";
+    if (run.stats.handed_over_at >= 0.0) used.euler_from_t = run.stats.handed_over_at;
+    csv << "," << used.method << "," << used.euler_from_t_text() << "\n";
   };
   row(r.reference);
   for (const ConvergeRun& run : r.euler) row(run);

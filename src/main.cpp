@@ -446,6 +446,22 @@ int converge_command(const std::string& path, const railcrash::ConvergeOptions& 
   return result.reference.ok && !g_stop.load() ? 0 : 1;
 }
 
+/// `sweep --dry-run`: the plan's run count and the levels of the runs listed, generated one at a
+/// time (a plan of any size under --max-runs 0), nothing run or written.
+int sweep_dry_run_command(const std::string& path, const std::string& plan_path, std::size_t max_runs,
+                          std::vector<std::size_t> show_runs) {
+  using namespace railcrash;
+  const SweepPlan plan = load_sweep_plan(plan_path, path);
+  require_sweep_run_count(plan, max_runs);
+  const SweepRunGenerator generator(plan, path, read_model_text(path));
+  if (show_runs.empty()) {
+    for (std::size_t k = 0; k < std::min<std::size_t>(10, generator.count()); ++k) show_runs.push_back(k);
+    if (generator.count() > 10) show_runs.push_back(generator.count() - 1);
+  }
+  std::fputs(sweep_dry_run_text(plan, generator, show_runs).c_str(), stdout);
+  return 0;
+}
+
 int sweep_command(const std::string& path, const std::string& plan_path, int jobs, double run_limit, bool resume,
                   bool keep_runs, std::size_t max_runs, const std::string& out_dir) {
   using namespace railcrash;
@@ -474,11 +490,11 @@ int sweep_command(const std::string& path, const std::string& plan_path, int job
   const SweepResult result = run_sweep(path, plan, out_dir, options);
   const std::size_t failed = failed_sweep_runs(plan, result);
   std::printf("%zu of %zu runs done (%zu resumed), %zu failed, with %d jobs in %.1f s; results in %s/ (runs.csv, summary.md)\n",
-              result.done(), result.specs.size(), result.resumed, failed, options.jobs,
+              result.done(), result.total, result.resumed, failed, options.jobs,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), out_dir.c_str());
-  if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
+  if (result.done() < result.total) std::printf("interrupted: run again with --resume to finish\n");
   if (failed > 0) std::printf("%zu run%s failed (status and message in runs.csv)\n", failed, failed == 1 ? "" : "s");
-  return result.done() == result.specs.size() && failed == 0 && !g_stop.load() ? 0 : 1;
+  return result.done() == result.total && failed == 0 && !g_stop.load() ? 0 : 1;
 }
 
 /// Writes a generated model to out_path (standard output when empty); `what` names it on stderr.
@@ -694,6 +710,14 @@ int main(int argc, char** argv) {
   sweep->add_option("--max-runs", max_runs, "refuse a plan of more runs than this before any is generated (0: no limit)")
       ->capture_default_str()->check(run_limit_count);
   sweep->add_option("--out", out_dir, "output folder")->capture_default_str();
+  bool sweep_dry_run = false;
+  std::vector<std::size_t> sweep_show_runs;
+  CLI::Option* dry_run_option = sweep->add_flag("--dry-run", sweep_dry_run,
+                  "run nothing: print the plan's run count and the levels of the runs --show-runs lists (default: the "
+                  "first 10 and the last), as runs.csv's first columns");
+  sweep->add_option("--show-runs", sweep_show_runs, "with --dry-run: the run numbers to print (e.g. 0,1,9999999)")
+      ->delimiter(',')
+      ->needs(dry_run_option);
 
   std::string consist_out;
   int consist_cars = 2;
@@ -829,6 +853,7 @@ int main(int argc, char** argv) {
 #ifdef RAILCRASH_MPI_PROGRAM
     if (*sweep && railcrash::launched_by_mpi()) exec_mpi_program(argv);
 #endif
+    if (*sweep && sweep_dry_run) return sweep_dry_run_command(model_path, plan_path, max_runs, sweep_show_runs);
     if (*sweep) return sweep_command(model_path, plan_path, jobs, run_limit, resume, keep_runs, max_runs, out_dir);
     if (*readings) return readings_command(model_path, design_path, readings_path, jobs, first_order_only, run_limit, max_runs, out_dir);
     if (*sensitivity) return sensitivity_command(model_path, design_path, jobs, central, only, first_order_only, run_limit, max_runs, out_dir,

@@ -603,6 +603,40 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
   return results;
 }
 
+namespace {
+
+/// A combination's runs' methods for readings.csv: the methods its runs used ("ida", "euler",
+/// "ida+euler" in that order, joined by spaces), the earliest hand-over to Euler and how many
+/// runs were handed over.
+struct CombinationIntegrators {
+  std::string methods;
+  IntegratorUsed earliest;
+  std::size_t handed_over_runs = 0;
+};
+
+CombinationIntegrators combination_integrators(const SensitivityResult& study) {
+  CombinationIntegrators used;
+  bool seen[3] = {false, false, false};
+  const auto add = [&](const SensitivityRun& run) {
+    const std::string& method = run.integrator.method;
+    seen[0] = seen[0] || method == "ida";
+    seen[1] = seen[1] || method == "euler";
+    if (method != "ida+euler") return;
+    seen[2] = true;
+    ++used.handed_over_runs;
+    if (std::isnan(used.earliest.euler_from_t) || run.integrator.euler_from_t < used.earliest.euler_from_t) used.earliest = run.integrator;
+  };
+  add(study.base);
+  for (const SensitivityRun& run : study.runs) add(run);
+  for (const SensitivityRun& run : study.second_order_runs) add(run);
+  const char* names[3] = {"ida", "euler", "ida+euler"};
+  for (int k = 0; k < 3; ++k)
+    if (seen[k]) used.methods += (used.methods.empty() ? "" : " ") + std::string(names[k]);
+  return used;
+}
+
+}  // namespace
+
 std::string write_readings(const std::vector<ReadingsCombinationResult>& results, const ReadingsPlan& plan,
                            const SensitivityDesign& design, const std::string& directory) {
   std::filesystem::create_directories(directory);
@@ -626,7 +660,7 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
     csv << ",R" << k << ",R" << k << "_error,R" << k << "_sign_runs,R" << k << "_sign_agree,R" << k << "_spearman,R" << k
         << "_rms,R" << k << "_sign_runs_all,R" << k << "_sign_agree_all,R" << k << "_spearman_all,R" << k << "_rms_all,R" << k
         << "_top5_shared,R" << k << "_top5";
-  csv << ",goals_met,score,failed_runs,wall_seconds\n";
+  csv << ",goals_met,score,failed_runs,wall_seconds,integrator_used,euler_from_t,handed_over_runs\n";
   for (std::size_t rank = 0; rank < order.size(); ++rank) {
     const ReadingsCombinationResult& r = results[order[rank]];
     csv << rank + 1 << "," << order[rank];
@@ -639,8 +673,10 @@ std::string write_readings(const std::vector<ReadingsCombinationResult>& results
           << "," << csv_field(a.spearman) << "," << csv_field(a.rms) << "," << a.significant_runs_all << "," << a.sign_agreements_all
           << "," << csv_field(a.spearman_all) << "," << csv_field(a.rms_all) << "," << a.top_five_shared << "," << csv_text(top);
     }
+    const CombinationIntegrators used = combination_integrators(r.study);
     csv << "," << r.agreement.goals_met << "," << csv_field(r.agreement.score) << "," << r.failed_runs << ","
-        << format(r.wall_seconds, "%.1f") << "\n";
+        << format(r.wall_seconds, "%.1f") << "," << used.methods << "," << used.earliest.euler_from_t_text() << ","
+        << used.handed_over_runs << "\n";
   }
   write_whole_file((std::filesystem::path(directory) / "readings.csv").string(), csv.str());
 

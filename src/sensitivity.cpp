@@ -308,6 +308,7 @@ SensitivityRun run_one(const std::string& model_path, const CheckedYamlText& mod
                                   : report.outcome.message;
     run.responses = report.responses;
     run.outcomes = report.outcomes;
+    run.integrator = integrator_used(report);
   } catch (const std::exception& e) {
     run.ok = false;
     run.message = e.what();
@@ -792,7 +793,7 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
   // Runs: sensitivity.csv, and Table 11 / Tables 12-13 in the Markdown.
   {
     std::ostringstream csv;
-    csv << "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message,branch,outcomes\n";
+    csv << "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message,branch,outcomes,integrator_used,euler_from_t\n";
     std::vector<const SensitivityRun*> all{&result.base};
     for (const SensitivityRun& r : result.runs) all.push_back(&r);
     for (const SensitivityRun& r : result.second_order_runs) all.push_back(&r);
@@ -807,7 +808,8 @@ std::string write_sensitivity(const SensitivityResult& result, const Sensitivity
       csv << k << ',' << order << ',' << names << ',' << values << ',' << (r.ok ? "ok" : (r.interrupted ? "interrupted" : "failed")) << ','
           << csv_number(r.responses.r1) << ',' << csv_number(r.responses.r2) << ',' << csv_number(r.responses.r3) << ','
           << (r.responses.overridden ? 1 : 0) << ',' << number(r.wall_seconds, "%.2f") << ',' << csv_text(r.message) << ','
-          << branch_label(r, result.base, k == 0) << ',' << csv_text(r.ok ? r.outcomes.text() : "") << '\n';
+          << branch_label(r, result.base, k == 0) << ',' << csv_text(r.ok ? r.outcomes.text() : "") << ','
+          << r.integrator.method << ',' << r.integrator.euler_from_t_text() << '\n';
     }
     write_whole_file(directory + "/sensitivity.csv", csv.str());
   }

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <mutex>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -357,59 +359,112 @@ void require_sweep_run_count(const SweepPlan& plan, std::size_t max_runs) {
   require_run_count(sweep_run_count(plan), max_runs, plan.path + ": the sweep's plan");
 }
 
-std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text) {
+SweepRunGenerator::SweepRunGenerator(const SweepPlan& plan, const std::string& model_path, const std::string& model_text)
+    : plan_(plan) {
+  const std::optional<std::size_t> count = sweep_run_count(plan);
+  if (!count)
+    throw InputError(plan.path + ": the sweep's plan has more runs than " +
+                     std::to_string(std::numeric_limits<std::size_t>::max()) + "; make it smaller");
+  count_ = *count;
   const std::size_t n = plan.factors.size();
-  std::vector<std::vector<std::string>> levels;
-  std::vector<std::size_t> counts;
-  for (const SweepFactor& f : plan.factors) counts.push_back(f.levels.size());
-  switch (plan.design) {
-    case SweepDesignKind::full_factorial:
-      for (const auto& row : full_factorial(counts)) {
-        levels.emplace_back(n);
-        for (std::size_t f = 0; f < n; ++f) levels.back()[f] = plan.factors[f].levels[row[f]];
-      }
-      break;
-    case SweepDesignKind::one_at_a_time:
-      for (const auto& row : one_at_a_time(counts)) {
-        levels.emplace_back(n);
-        for (std::size_t f = 0; f < n; ++f)
-          if (row[f] >= 0) levels.back()[f] = plan.factors[f].levels[static_cast<std::size_t>(row[f])];
-      }
-      break;
-    case SweepDesignKind::latin_hypercube:
-    case SweepDesignKind::monte_carlo: {
-      const auto probabilities = plan.design == SweepDesignKind::latin_hypercube ? latin_hypercube(plan.samples, n, plan.seed)
-                                                                                 : monte_carlo(plan.samples, n, plan.seed);
-      for (const auto& row : probabilities) {
-        levels.emplace_back(n);
-        for (std::size_t f = 0; f < n; ++f) levels.back()[f] = exact(plan.factors[f].distribution->value_at(row[f]));
-      }
-      break;
-    }
-    case SweepDesignKind::runs:
-      levels = plan.runs;
-      break;
+  if (plan.design == SweepDesignKind::latin_hypercube) {
+    const auto rows = latin_hypercube(plan.samples, n, plan.seed);  // (rows freed below: the flat copy is kept)
+    hypercube_.reserve(plan.samples * n);
+    for (const auto& row : rows) hypercube_.insert(hypercube_.end(), row.begin(), row.end());
   }
   // What every run reads besides its settings: the program (with the libraries' versions) and
   // every model file (a variant and its base), each text after its length.
-  std::uint64_t inputs = fnv1a(version_text());
+  inputs_hash_ = fnv1a(version_text());
   for (const std::string& text : model_input_texts(model_text, model_path))
-    inputs = fnv1a(text, fnv1a(std::string(1, '\0') + std::to_string(text.size()) + std::string(1, '\0'), inputs));
-  std::vector<SweepRunSpec> specs;
-  for (auto& row : levels) {
-    SweepRunSpec spec;
-    spec.settings = plan.settings;
-    for (std::size_t f = 0; f < n; ++f)
-      if (!row[f].empty()) spec.settings.push_back(factor_setting(plan.factors[f], row[f]));
-    std::uint64_t hash = inputs;
-    for (const std::string& s : spec.settings) hash = fnv1a(s, fnv1a(std::string(1, '\0'), hash));
-    char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
-    spec.hash = text;
-    spec.levels = std::move(row);
-    specs.push_back(std::move(spec));
+    inputs_hash_ = fnv1a(text, fnv1a(std::string(1, '\0') + std::to_string(text.size()) + std::string(1, '\0'), inputs_hash_));
+}
+
+std::vector<std::string> SweepRunGenerator::levels(std::size_t k) const {
+  RAILCRASH_DEMAND(k < count_);
+  const std::size_t n = plan_.factors.size();
+  std::vector<std::string> levels(n);
+  switch (plan_.design) {
+    case SweepDesignKind::full_factorial: {
+      std::size_t rest = k;  // mixed-radix digits, the last factor changing fastest (as full_factorial)
+      for (std::size_t f = n; f-- > 0;) {
+        const std::size_t count = plan_.factors[f].levels.size();
+        levels[f] = plan_.factors[f].levels[rest % count];
+        rest /= count;
+      }
+      break;
+    }
+    case SweepDesignKind::one_at_a_time: {
+      if (k == 0) break;  // every factor at the model's value
+      std::size_t rest = k - 1;
+      for (std::size_t f = 0; f < n; ++f) {
+        const std::size_t count = plan_.factors[f].levels.size();
+        if (rest < count) {
+          levels[f] = plan_.factors[f].levels[rest];
+          break;
+        }
+        rest -= count;
+      }
+      break;
+    }
+    case SweepDesignKind::latin_hypercube:
+      for (std::size_t f = 0; f < n; ++f) levels[f] = exact(plan_.factors[f].distribution->value_at(hypercube_[k * n + f]));
+      break;
+    case SweepDesignKind::monte_carlo: {
+      // monte_carlo's draws: run k's are draws k n ... k n + n - 1 of the seed's sequence.
+      std::vector<double> probabilities(n);
+      {
+        const std::lock_guard<std::mutex> lock(generator_mutex_);
+        if (k != generator_next_run_ || k == 0) {
+          generator_.seed(plan_.seed);
+          generator_.discard(static_cast<unsigned long long>(k) * n);
+        }
+        for (double& u : probabilities) u = unit_uniform(generator_);
+        generator_next_run_ = k + 1;
+      }
+      for (std::size_t f = 0; f < n; ++f) levels[f] = exact(plan_.factors[f].distribution->value_at(probabilities[f]));
+      break;
+    }
+    case SweepDesignKind::runs:
+      levels = plan_.runs[k];
+      break;
   }
+  return levels;
+}
+
+SweepRunSpec SweepRunGenerator::spec(std::size_t k) const {
+  SweepRunSpec spec;
+  spec.levels = levels(k);
+  spec.settings = plan_.settings;
+  for (std::size_t f = 0; f < plan_.factors.size(); ++f)
+    if (!spec.levels[f].empty()) spec.settings.push_back(factor_setting(plan_.factors[f], spec.levels[f]));
+  std::uint64_t hash = inputs_hash_;
+  for (const std::string& s : spec.settings) hash = fnv1a(s, fnv1a(std::string(1, '\0'), hash));
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(hash));
+  spec.hash = text;
+  return spec;
+}
+
+std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text) {
+  const SweepRunGenerator generator(plan, model_path, model_text);
+  std::vector<SweepRunSpec> specs;
+  specs.reserve(generator.count());
+  for (std::size_t k = 0; k < generator.count(); ++k) specs.push_back(generator.spec(k));
   return specs;
+}
+
+std::string sweep_dry_run_text(const SweepPlan& plan, const SweepRunGenerator& generator, const std::vector<std::size_t>& runs) {
+  std::string text = plan.path + ": " + std::to_string(generator.count()) + " runs\nrun,hash";
+  for (const SweepFactor& f : plan.factors) text += "," + csv_field(f.column());
+  text += '\n';
+  for (const std::size_t k : runs) {
+    if (k >= generator.count()) continue;
+    const SweepRunSpec spec = generator.spec(k);
+    text += std::to_string(k) + "," + spec.hash;
+    for (const std::string& level : spec.levels) text += "," + csv_field(level);
+    text += '\n';
+  }
+  return text;
 }
 
 namespace {
@@ -465,6 +520,7 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     row.message = report.outcome.message;
     row.outcomes = report.outcomes.text();
     row.branch = report.outcomes.order();
+    row.integrator = integrator_used(report);
     if (!report.outcome.ok && control.timed_out()) row.message = "stopped at the run time limit (t = " + exact(report.outcome.t_reached) + ")";
     if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
     // railcrash's own summary, just written: YAML::Load without the structure check that
@@ -492,9 +548,16 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
 }
 
 /// Fields of a runs.csv row: run, hash, the factors, status, the responses, wall_seconds,
-/// message, outcomes, branch (sweep_csv_header's columns).
+/// message, outcomes, branch, integrator_used, euler_from_t (sweep_csv_header's columns).
 namespace {
-std::size_t runs_csv_fields(const SweepPlan& plan) { return 2 + plan.factors.size() + 1 + plan.responses.size() + 4; }
+constexpr std::size_t kColumnsAfterResponses = 6;  // wall_seconds, message, outcomes, branch, integrator_used, euler_from_t
+/// The columns a runs.csv written before integrator_used and euler_from_t has no field for.
+constexpr const char* kIntegratorColumns = ",integrator_used,euler_from_t";
+std::size_t runs_csv_fields(const SweepPlan& plan) {
+  return 2 + plan.factors.size() + 1 + plan.responses.size() + kColumnsAfterResponses;
+}
+std::size_t wall_seconds_field(const SweepPlan& plan) { return 3 + plan.factors.size() + plan.responses.size(); }
+std::size_t branch_field(const SweepPlan& plan) { return wall_seconds_field(plan) + 3; }
 }  // namespace
 
 std::string sweep_csv_header(const SweepPlan& plan) {
@@ -502,7 +565,7 @@ std::string sweep_csv_header(const SweepPlan& plan) {
   for (const SweepFactor& f : plan.factors) header += "," + csv_field(f.column());
   header += ",status";
   for (const std::string& r : plan.responses) header += "," + csv_field(r);
-  return header + ",wall_seconds,message,outcomes,branch";
+  return header + ",wall_seconds,message,outcomes,branch" + kIntegratorColumns;
 }
 
 std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const SweepRunSpec& spec, const SweepRow& row) {
@@ -513,11 +576,8 @@ std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const Swee
   (void)plan;
   char wall[32];
   std::snprintf(wall, sizeof wall, "%.3f", row.wall_seconds);
-  return line + "," + wall + "," + csv_text(row.message) + "," + csv_text(row.outcomes) + "," + csv_text(row.branch);
-}
-
-std::size_t SweepResult::done() const {
-  return static_cast<std::size_t>(std::count_if(lines.begin(), lines.end(), [](const auto& l) { return l.has_value(); }));
+  return line + "," + wall + "," + csv_text(row.message) + "," + csv_text(row.outcomes) + "," + csv_text(row.branch) + "," +
+         row.integrator.method + "," + row.integrator.euler_from_t_text();
 }
 
 namespace {
@@ -659,8 +719,8 @@ bool is_number(const std::string& text) {
 /// Checks a complete row of an earlier runs.csv field by field: a run number, a 16-digit hash,
 /// ok or failed, numbers (or nothing) for the responses, a number for wall_seconds. InputError
 /// with the line and column of the first field that is not.
-void check_resumed_row(const std::string& path, const SweepPlan& plan, const CsvRecord& row) {
-  const std::size_t expected = runs_csv_fields(plan);
+void check_resumed_row(const std::string& path, const SweepPlan& plan, const CsvRecord& row, bool without_integrator) {
+  const std::size_t expected = runs_csv_fields(plan) - (without_integrator ? 2 : 0);
   if (row.fields.size() != expected)
     csv_error(path, row.line, 1, std::to_string(row.fields.size()) + " fields where the header has " + std::to_string(expected));
   const auto at = [&](std::size_t k, const std::string& what) { csv_error(path, row.line, row.field_columns[k], what); };
@@ -676,17 +736,15 @@ void check_resumed_row(const std::string& path, const SweepPlan& plan, const Csv
     if (!value.empty() && !is_number(value))
       at(status + 1 + r, plan.responses[r] + " '" + value.substr(0, 40) + "' is not a number (nor empty)");
   }
-  const std::size_t wall = expected - 4;
+  const std::size_t wall = wall_seconds_field(plan);
   if (!is_number(row.fields[wall])) at(wall, "wall_seconds '" + row.fields[wall].substr(0, 40) + "' is not a number");
 }
 
 }  // namespace
 
-SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
-                        const std::string& directory, bool resume) {
+SweepResult start_sweep(const SweepPlan& plan, const SweepRunGenerator& generator, const std::string& directory, bool resume) {
   SweepResult result;
-  result.specs = sweep_runs(plan, model_path, model_text);
-  result.lines.resize(result.specs.size());
+  result.total = generator.count();
   std::filesystem::create_directories(directory);
   const std::string csv_path = directory + "/runs.csv";
   const std::string header = sweep_csv_header(plan);
@@ -700,44 +758,62 @@ SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, co
     content << in.rdbuf();
     if (in.bad()) throw InputError(csv_path + ": cannot read it to resume");
     std::vector<CsvRecord> records = csv_records(csv_path, content.str());
+    // A runs.csv written before the columns integrator_used and euler_from_t: its rows are read
+    // as they are and kept with those two fields empty (not recorded).
+    const std::string header_without_integrator = header.substr(0, header.size() - std::strlen(kIntegratorColumns));
+    const bool without_integrator = !records.empty() && records.front().text == header_without_integrator;
     // The last record is cut short when the file does not end with its line break, or (an
     // editor may have added one) when it has fewer fields than a row.
-    const std::size_t row_fields = runs_csv_fields(plan);
+    const std::size_t row_fields = runs_csv_fields(plan) - (without_integrator ? 2 : 0);
     if (!records.empty() &&
         (!records.back().complete || (records.size() > 1 && records.back().fields.size() < row_fields))) {
       result.torn_row_line = records.back().line;
       records.pop_back();
     }
-    if (!records.empty() && records.front().text != header)
+    if (!records.empty() && records.front().text != header && !without_integrator)
       throw InputError(csv_path + ": its columns are not this plan's (" + records.front().text.substr(0, 80) +
                        "...); resume with the same plan, or write to another --out");
     struct OldRow {
       std::string number, rest;  // rest: the fields after the hash
+      bool matched = false;
     };
     std::map<std::string, OldRow> by_hash;
     std::vector<std::string> old_hashes;
     for (std::size_t r = 1; r < records.size(); ++r) {
       const CsvRecord& row = records[r];
-      check_resumed_row(csv_path, plan, row);
+      check_resumed_row(csv_path, plan, row, without_integrator);
       const std::size_t first = row.text.find(',');
-      by_hash[row.fields[1]] = {row.fields[0], row.text.substr(row.text.find(',', first + 1) + 1)};
+      by_hash[row.fields[1]] = {row.fields[0], row.text.substr(row.text.find(',', first + 1) + 1) + (without_integrator ? ",," : "")};
       old_hashes.push_back(row.fields[1]);
     }
-    for (std::size_t k = 0; k < result.specs.size(); ++k)
-      if (const auto it = by_hash.find(result.specs[k].hash); it != by_hash.end()) {
-        result.lines[k] = std::to_string(k) + "," + result.specs[k].hash + "," + it->second.rest;
-        ++result.resumed;
-        if (const std::optional<std::size_t> old = run_folder_number(it->second.number)) kept_folders[*old] = k;
-      }
-    std::set<std::string> hashes;
-    for (const SweepRunSpec& spec : result.specs) hashes.insert(spec.hash);
-    result.stale_rows = static_cast<std::size_t>(
-        std::count_if(old_hashes.begin(), old_hashes.end(), [&](const std::string& hash) { return !hashes.count(hash); }));
+    const auto keep = [&](std::size_t k, const std::string& hash, OldRow& old) {
+      result.lines[k] = std::to_string(k) + "," + hash + "," + old.rest;
+      old.matched = true;
+      if (const std::optional<std::size_t> number = run_folder_number(old.number)) kept_folders[*number] = k;
+    };
+    // Each row at its own run number first (the plan unchanged: no other run is generated) ...
+    std::size_t unmatched = 0;
+    for (auto& [hash, old] : by_hash) {
+      const std::optional<std::size_t> k = run_folder_number(old.number);
+      if (k && *k < result.total && !result.lines.count(*k) && generator.spec(*k).hash == hash) keep(*k, hash, old);
+      else ++unmatched;
+    }
+    // ... and only when some row is not there, every run's hash, one run at a time.
+    for (std::size_t k = 0; unmatched > 0 && k < result.total; ++k) {
+      if (result.lines.count(k)) continue;
+      const std::string hash = generator.spec(k).hash;
+      const auto it = by_hash.find(hash);
+      if (it == by_hash.end()) continue;
+      if (!it->second.matched) --unmatched;
+      keep(k, hash, it->second);
+    }
+    result.resumed = result.lines.size();
+    result.stale_rows = static_cast<std::size_t>(std::count_if(
+        old_hashes.begin(), old_hashes.end(), [&](const std::string& hash) { return !by_hash.at(hash).matched; }));
   }
   result.stale_folders = match_run_folders(directory, kept_folders);
   std::string text = header + '\n';
-  for (const auto& line : result.lines)
-    if (line) text += *line + '\n';
+  for (const auto& [k, line] : result.lines) text += line + '\n';
   write_whole_file(csv_path, text);  // (FileWriteError names the file)
   return result;
 }
@@ -774,12 +850,17 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
   const FolderLock folder_lock(directory);          // one sweep per folder (before anything there changes)
   if (const std::string note = folder_lock.removal_note(directory); !note.empty() && options.note) options.note(note + "\n");
   const CheckedYamlText model_text = check_model_text(read_model_text(model_path), model_path);
-  SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
+  const SweepRunGenerator generator(plan, model_path, model_text.text());
+  SweepResult result = start_sweep(plan, generator, directory, options.resume);
   if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
-  std::vector<std::size_t> pending;
-  for (std::size_t k = 0; k < result.specs.size(); ++k)
-    if (!result.lines[k]) pending.push_back(k);
-  std::vector<SweepRow> rows(pending.size());
+  // The runs not done, in order, one at a time as threads take them: the run numbers resumed
+  // are skipped, nothing is held for the others.
+  std::vector<std::size_t> resumed_numbers;
+  for (const auto& [k, line] : result.lines) resumed_numbers.push_back(k);
+  auto next_resumed = resumed_numbers.begin();
+  std::size_t next_run = 0;
+  std::mutex rows_mutex;
+  std::map<std::size_t, std::pair<SweepRunSpec, SweepRow>> finished;  // from a run's end to on_finished (at most --jobs)
   BatchOptions batch;
   batch.jobs = options.jobs;
   batch.run_time_limit = options.run_time_limit;
@@ -789,20 +870,35 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
   // after it (runs.csv ends at the failed row, which --resume drops), and the error is thrown.
   std::optional<FileWriteError> write_failure;
   std::atomic<bool> write_failed{false};
-  run_batch(
-      pending.size(),
-      [&](std::size_t i, const RunControl& control) {
+  run_batch_stream(
+      result.total - result.done(),
+      [&]() -> std::optional<std::size_t> {
+        if (write_failed.load()) return std::nullopt;
+        while (next_resumed != resumed_numbers.end() && *next_resumed == next_run) ++next_resumed, ++next_run;
+        if (next_run >= result.total) return std::nullopt;
+        return next_run++;
+      },
+      [&](std::size_t k, const RunControl& control) {
         if (write_failed.load()) return;
         char folder[32];
-        std::snprintf(folder, sizeof folder, "/runs/%04zu", pending[i]);
-        rows[i] = run_sweep_spec(plan, model_path, model_text, result.specs[pending[i]], control,
-                                 options.keep_runs ? directory + folder : "");
+        std::snprintf(folder, sizeof folder, "/runs/%04zu", k);
+        SweepRunSpec spec = generator.spec(k);
+        SweepRow row = run_sweep_spec(plan, model_path, model_text, spec, control, options.keep_runs ? directory + folder : "");
+        const std::lock_guard<std::mutex> lock(rows_mutex);
+        finished[k] = {std::move(spec), std::move(row)};
       },
       batch,
-      [&](std::size_t i, BatchRunState state) {
+      [&](std::size_t k, BatchRunState state) {
+        std::pair<SweepRunSpec, SweepRow> run;
+        {
+          const std::lock_guard<std::mutex> lock(rows_mutex);
+          const auto it = finished.find(k);
+          if (it == finished.end()) return;  // (a write failed before the run)
+          run = std::move(it->second);
+          finished.erase(it);
+        }
         if (state != BatchRunState::finished || write_failed.load()) return;  // an interrupted run is run again on --resume
-        const std::size_t k = pending[i];
-        const std::string line = sweep_csv_line(plan, k, result.specs[k], rows[i]);
+        const std::string line = sweep_csv_line(plan, k, run.first, run.second);
         try {
           append_sweep_line(directory, line);
         } catch (const FileWriteError& e) {
@@ -811,7 +907,7 @@ SweepResult run_sweep(const std::string& model_path, const SweepPlan& plan, cons
           return;
         }
         result.lines[k] = line;
-        if (options.progress) options.progress(k, rows[i], ++done, result.specs.size());
+        if (options.progress) options.progress(k, run.second, ++done, result.total);
       });
   if (write_failure) throw *write_failure;
   write_sweep(plan, result, directory);
@@ -855,12 +951,11 @@ const char* design_name(SweepDesignKind kind) {
 
 /// The runs whose discrete outcome differs from run 0's (issue 40): runs.csv's column branch.
 std::string sweep_branches_markdown(const SweepPlan& plan, const SweepResult& result) {
-  const std::size_t branch_field = runs_csv_fields(plan) - 1;
+  const std::size_t branch_column = branch_field(plan);
   std::vector<std::pair<std::size_t, std::string>> branches;  // run number, branch of ok runs
-  for (std::size_t k = 0; k < result.lines.size(); ++k) {
-    if (!result.lines[k]) continue;
-    const std::vector<std::string> fields = csv_fields(*result.lines[k]);
-    if (fields.size() > branch_field && fields[2 + plan.factors.size()] == "ok") branches.emplace_back(k, fields[branch_field]);
+  for (const auto& [k, line] : result.lines) {
+    const std::vector<std::string> fields = csv_fields(line);
+    if (fields.size() > branch_column && fields[2 + plan.factors.size()] == "ok") branches.emplace_back(k, fields[branch_column]);
   }
   if (branches.empty() || branches.front().first != 0) return "";
   std::ostringstream md;
@@ -879,25 +974,23 @@ std::string sweep_branches_markdown(const SweepPlan& plan, const SweepResult& re
 
 std::size_t failed_sweep_runs(const SweepPlan& plan, const SweepResult& result) {
   std::size_t failed = 0;
-  for (const auto& line : result.lines)
-    if (line && csv_fields(*line)[2 + plan.factors.size()] != "ok") ++failed;
+  for (const auto& [k, line] : result.lines)
+    if (csv_fields(line)[2 + plan.factors.size()] != "ok") ++failed;
   return failed;
 }
 
 std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const std::string& directory) {
   std::filesystem::create_directories(directory);
   std::string csv = sweep_csv_header(plan) + '\n';
-  for (const auto& line : result.lines)
-    if (line) csv += *line + '\n';
+  for (const auto& [k, line] : result.lines) csv += line + '\n';
   write_whole_file(directory + "/runs.csv", csv);  // (FileWriteError names the file: the command fails)
   const std::size_t factor_count = plan.factors.size();
   // Per finished run: the levels and the responses of ok runs.
   std::vector<std::vector<std::string>> levels;
   std::vector<std::vector<double>> values;
   const std::size_t failed = failed_sweep_runs(plan, result);
-  for (const auto& line : result.lines) {
-    if (!line) continue;
-    const std::vector<std::string> fields = csv_fields(*line);
+  for (const auto& [k, line] : result.lines) {
+    const std::vector<std::string> fields = csv_fields(line);
     if (fields[2 + factor_count] != "ok") continue;
     levels.emplace_back(fields.begin() + 2, fields.begin() + 2 + static_cast<std::ptrdiff_t>(factor_count));
     values.emplace_back();
@@ -907,9 +1000,9 @@ std::string write_sweep(const SweepPlan& plan, const SweepResult& result, const 
     }
   }
   std::ostringstream md;
-  md << "# Sweep " << plan.path << "\n\n" << design_name(plan.design) << " design, " << result.specs.size() << " runs: "
+  md << "# Sweep " << plan.path << "\n\n" << design_name(plan.design) << " design, " << result.total << " runs: "
      << result.done() << " done (" << result.resumed << " from an earlier runs.csv), " << failed << " failed, "
-     << result.specs.size() - result.done() << " not run. Rows: runs.csv.\n";
+     << result.total - result.done() << " not run. Rows: runs.csv.\n";
   md << sweep_branches_markdown(plan, result);
   const bool trend = sampled(plan.design);
   md << "\n## Main effects\n\n"

@@ -77,18 +77,23 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
                const std::string& directory, const SweepOptions& options, int ranks) {
   const FolderLock folder_lock(directory);  // one sweep per folder
   if (const std::string note = folder_lock.removal_note(directory); !note.empty() && options.note) options.note(note + "\n");
-  SweepResult result = start_sweep(plan, model_path, model_text.text(), directory, options.resume);
+  const SweepRunGenerator generator(plan, model_path, model_text.text());
+  SweepResult result = start_sweep(plan, generator, directory, options.resume);
   if (const std::string note = sweep_start_note(result, directory); !note.empty() && options.note) options.note(note);
   std::optional<FileWriteError> write_failure;  // a row that could not be appended: no more runs are handed out
-  std::vector<long> pending;
-  for (std::size_t k = 0; k < result.specs.size(); ++k)
-    if (!result.lines[k]) pending.push_back(static_cast<long>(k));
+  // The runs not done, in order, handed out one at a time: the run numbers resumed are skipped,
+  // nothing is held for the others.
+  std::vector<std::size_t> resumed_numbers;
+  for (const auto& [k, line] : result.lines) resumed_numbers.push_back(k);
+  auto next_resumed = resumed_numbers.begin();
   std::mutex mutex;  // guards next, done and result.lines, shared with rank 0's own worker thread
   std::size_t next = 0, done = result.done();
   const auto take = [&]() -> long {
     const std::lock_guard<std::mutex> lock(mutex);
-    if ((options.stop && options.stop->load()) || write_failure || next >= pending.size()) return -1;
-    return pending[next++];
+    if ((options.stop && options.stop->load()) || write_failure) return -1;
+    while (next_resumed != resumed_numbers.end() && *next_resumed == next) ++next_resumed, ++next;
+    if (next >= result.total) return -1;
+    return static_cast<long>(next++);
   };
   const auto record = [&](long number, const std::string& line) {
     if (line.empty()) return;  // interrupted: run again on --resume
@@ -106,15 +111,15 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
       const std::vector<std::string> fields = csv_fields(line);
       SweepRow row;
       row.status = fields[2 + plan.factors.size()];
-      const std::size_t wall_field = 3 + plan.factors.size() + plan.responses.size();  // then message, outcomes, branch
+      const std::size_t wall_field = 3 + plan.factors.size() + plan.responses.size();  // then message, outcomes, branch, ...
       row.wall_seconds = std::atof(fields[wall_field].c_str());
       row.message = fields[wall_field + 1];
-      options.progress(static_cast<std::size_t>(number), row, done, result.specs.size());
+      options.progress(static_cast<std::size_t>(number), row, done, result.total);
     }
   };
   std::thread own([&] {
     for (long k = take(); k >= 0; k = take())
-      record(k, run_here(plan, model_path, model_text, directory, options, result.specs[static_cast<std::size_t>(k)],
+      record(k, run_here(plan, model_path, model_text, directory, options, generator.spec(static_cast<std::size_t>(k)),
                          static_cast<std::size_t>(k)));
   });
   int working = ranks - 1;  // other ranks not yet told to stop
@@ -133,15 +138,15 @@ int coordinate(const SweepPlan& plan, const std::string& model_path, const Check
   write_sweep(plan, result, directory);
   const std::size_t failed = failed_sweep_runs(plan, result);
   std::printf("%zu of %zu runs done (%zu resumed), %zu failed, on %d MPI ranks; results in %s/ (runs.csv, summary.md)\n",
-              result.done(), result.specs.size(), result.resumed, failed, ranks, directory.c_str());
-  if (result.done() < result.specs.size()) std::printf("interrupted: run again with --resume to finish\n");
-  return result.done() == result.specs.size() && failed == 0 ? 0 : 1;
+              result.done(), result.total, result.resumed, failed, ranks, directory.c_str());
+  if (result.done() < result.total) std::printf("interrupted: run again with --resume to finish\n");
+  return result.done() == result.total && failed == 0 ? 0 : 1;
 }
 
 /// Ranks above 0: ask for a run, run it, send its line, until told to stop.
 void work(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text, const std::string& directory,
           const SweepOptions& options) {
-  const std::vector<SweepRunSpec> specs = sweep_runs(plan, model_path, model_text.text());
+  const SweepRunGenerator generator(plan, model_path, model_text.text());  // run k made when it is handed out
   std::string message = "-1\n";
   for (;;) {
     send_text(message);
@@ -149,7 +154,7 @@ void work(const SweepPlan& plan, const std::string& model_path, const CheckedYam
     MPI_Recv(&number, 1, MPI_LONG, 0, kWorkTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (number < 0) return;
     const std::size_t k = static_cast<std::size_t>(number);
-    message = std::to_string(number) + "\n" + run_here(plan, model_path, model_text, directory, options, specs[k], k);
+    message = std::to_string(number) + "\n" + run_here(plan, model_path, model_text, directory, options, generator.spec(k), k);
   }
 }
 
@@ -187,7 +192,7 @@ int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, 
   try {
     if (ranks == 1) {
       const SweepResult result = run_sweep(model_path, plan, directory, options);
-      status = result.done() == result.specs.size() && failed_sweep_runs(plan, result) == 0 ? 0 : 1;
+      status = result.done() == result.total && failed_sweep_runs(plan, result) == 0 ? 0 : 1;
     } else {
       const CheckedYamlText checked = check_model_text(model_text, model_path);  // once per rank, for all its runs
       if (rank == 0) status = coordinate(plan, model_path, checked, directory, options, ranks);

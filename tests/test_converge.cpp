@@ -271,9 +271,14 @@ TEST_CASE("convergence study: log-log slope and the files written", "[converge]"
   std::string header, line;
   std::getline(csv, header);
   CHECK(header == "method,step,rtol,status,wall_s,steps,residual_evaluations,jacobian_evaluations,events,"
-                  "displacement_rms,displacement_rms_error,message,outcomes,branch");
+                  "displacement_rms,displacement_rms_error,message,outcomes,branch,integrator_used,euler_from_t");
   int rows = 0;
-  while (std::getline(csv, line)) ++rows;
+  while (std::getline(csv, line)) {
+    ++rows;
+    // The method each run used (the study names ida for the reference and IDA runs, euler for Euler's).
+    const std::string method = line.substr(0, line.find(','));
+    CHECK_THAT(line, Catch::EndsWith(std::string(",") + (method == "euler" ? "euler" : "ida") + ","));
+  }
   CHECK(rows == 4);  // reference, two Euler, one IDA
   CHECK(std::filesystem::file_size(dir + "/converge.svg") > 0);
   std::filesystem::remove_all(dir);

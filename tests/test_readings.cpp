@@ -208,6 +208,20 @@ TEST_CASE("a reading study ranks first the reading that reproduces the published
   const std::string md = write_readings(results, plan, design, out);
   CHECK_THAT(md, Contains("| 1 | 1 | printed |"));  // ranked first: combination 1
   CHECK(std::filesystem::exists(out + "/readings.csv"));
+  {
+    // The methods of each combination's runs: the model names none (auto), and IDA keeps these
+    // one-impact runs: "ida", no hand-over, none of the runs handed over.
+    std::ifstream csv(out + "/readings.csv");
+    std::string header, line;
+    std::getline(csv, header);
+    CHECK_THAT(header, Catch::EndsWith(",failed_runs,wall_seconds,integrator_used,euler_from_t,handed_over_runs"));
+    int rows = 0;
+    while (std::getline(csv, line)) {
+      ++rows;
+      CHECK_THAT(line, Catch::EndsWith(",ida,,0"));
+    }
+    CHECK(rows == 2);
+  }
   CHECK(std::filesystem::exists(out + "/combination_001/sensitivity.csv"));
   CHECK(std::filesystem::exists(out + "/combination_001/comparison.md"));
   // The side by side of the matching combination: no error, every sign kept, ours = published.

@@ -85,10 +85,43 @@ TEST_CASE("first-order study: each run against the closed-form crush, derivative
   std::ifstream csv(files.dir + "/out/sensitivity.csv");
   std::string header;
   std::getline(csv, header);
-  CHECK(header == "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message,branch,outcomes");
+  CHECK(header == "run,order,parameters,values,status,R1,R2,R3,override,wall_seconds,message,branch,outcomes,integrator_used,euler_from_t");
   // A0 of the first-order form: the base response less the sum of the coefficients (report eq. 1-3).
   CHECK(result.constant[0] ==
         Approx(result.base.responses.r1 - result.derivatives[0][0] - result.derivatives[1][0]).epsilon(1e-12));
+}
+
+TEST_CASE("sensitivity.csv and the runs say which method each run used", "[sensitivity][auto]") {
+  Files files;
+  const SensitivityDesign design = load_design(files.design);
+  SensitivityOptions options;
+  options.jobs = 2;
+  options.only = {"P7"};
+  // The R1 model names no integrator: auto, whose IDA keeps this one-impact run (a hand-over
+  // needs 5 mode changes). A model that names ida or euler runs with it.
+  for (const std::string integrator : {"", "ida", "euler"}) {
+    INFO("integrator " << (integrator.empty() ? "auto" : integrator));
+    options.settings.clear();
+    if (!integrator.empty()) options.settings = {"simulation.integrator=" + integrator, "simulation.dt=1e-5"};
+    const SensitivityResult result = run_sensitivity(files.model, design, options);
+    REQUIRE(result.base.ok);
+    REQUIRE(result.runs.size() == 1);
+    const std::string expected = integrator == "euler" ? "euler" : "ida";
+    CHECK(result.base.integrator.method == expected);
+    CHECK(result.runs[0].integrator.method == expected);
+    CHECK(std::isnan(result.runs[0].integrator.euler_from_t));
+    const std::string folder = files.dir + "/methods_" + expected + integrator;
+    write_sensitivity(result, design, folder);
+    std::ifstream csv(folder + "/sensitivity.csv");
+    std::string line;
+    std::getline(csv, line);
+    int rows = 0;
+    while (std::getline(csv, line)) {
+      ++rows;
+      CHECK_THAT(line, Catch::EndsWith("," + expected + ","));  // integrator_used, then euler_from_t empty
+    }
+    CHECK(rows == 2);
+  }
 }
 
 TEST_CASE("central differences and a subset of parameters", "[sensitivity]") {
@@ -575,7 +608,7 @@ TEST_CASE("branch change: a gear that fractures at run 0 and not at +20 % is fla
   std::getline(csv, line);
   CHECK_THAT(line, Catch::Contains(",base,\"gear:fracture@"));
   std::getline(csv, line);
-  CHECK_THAT(line, Catch::EndsWith(",changed,\"none\""));
+  CHECK_THAT(line, Catch::EndsWith(",changed,\"none\",ida,"));  // then integrator_used (auto, kept by IDA) and euler_from_t
   std::getline(csv, line);
   CHECK_THAT(line, Catch::Contains(",same,\"gear:fracture@"));
   CHECK(std::filesystem::exists(files.dir + "/out/sensitivity_branches.csv"));

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "railcrash/error.hpp"
+#include "railcrash/model_io.hpp"
+#include "railcrash/run.hpp"
 #include "railcrash/sweep.hpp"
 #include "railcrash/table_text.hpp"
 #include "support.hpp"
@@ -65,7 +67,7 @@ std::string without_timing(const std::string& csv) {
   std::istringstream in(csv);
   while (std::getline(in, line)) {
     std::vector<std::string> fields = csv_fields(line);
-    fields.erase(fields.end() - 4);  // wall_seconds (then message, outcomes, branch)
+    fields.erase(fields.end() - 6);  // wall_seconds (then message, outcomes, branch, integrator_used, euler_from_t)
     for (const std::string& f : fields) out += f + "|";
     out += "\n";
   }
@@ -134,6 +136,115 @@ TEST_CASE("sweep designs: the generator and transforms are fixed by their defini
   CHECK(uniform.value_at(0.25) == -3.0);
 }
 
+namespace {
+
+/// A plan made in memory (no model check: the generator only reads the levels): factors named
+/// f0, f1, ... with levels "F.J" (factor F, level J), or distributions for the sampled designs.
+SweepPlan plan_in_memory(SweepDesignKind design, const std::vector<std::size_t>& level_counts) {
+  SweepPlan plan;
+  plan.path = "plan.yaml";
+  plan.design = design;
+  plan.settings = {"simulation.t_end=0.1"};
+  for (std::size_t f = 0; f < level_counts.size(); ++f) {
+    SweepFactor factor;
+    factor.key = "f" + std::to_string(f);
+    for (std::size_t j = 0; j < level_counts[f]; ++j) factor.levels.push_back(std::to_string(f) + "." + std::to_string(j));
+    plan.factors.push_back(factor);
+  }
+  return plan;
+}
+
+}  // namespace
+
+TEST_CASE("sweep runs one at a time: run k of a 21.6-million-run factorial from its digits, without a list of runs", "[sweep]") {
+  Files files;
+  const std::string model_text = read(files.model);
+  const std::vector<std::size_t> counts{10, 7, 13, 4, 11, 9, 3, 20};  // 21,621,600 runs
+  const SweepPlan plan = plan_in_memory(SweepDesignKind::full_factorial, counts);
+  const SweepRunGenerator generator(plan, files.model, model_text);
+  REQUIRE(generator.count() == 21621600u);
+  // Run k's level of factor f is digit f of k in the mixed radix of the level counts, the last
+  // factor fastest: (k / (product of the counts after f)) mod count_f.
+  for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{20}, std::size_t{1234567}, std::size_t{9999999},
+                              std::size_t{21621599}}) {
+    INFO("run " << k);
+    const SweepRunSpec spec = generator.spec(k);
+    REQUIRE(spec.levels.size() == counts.size());
+    REQUIRE(spec.settings.size() == 1 + counts.size());
+    CHECK(spec.settings[0] == "simulation.t_end=0.1");
+    std::size_t stride = 1;
+    for (std::size_t f = counts.size(); f-- > 0;) {
+      const std::size_t digit = k / stride % counts[f];
+      CHECK(spec.levels[f] == std::to_string(f) + "." + std::to_string(digit));
+      CHECK(spec.settings[1 + f] == "f" + std::to_string(f) + "=" + spec.levels[f]);
+      stride *= counts[f];
+    }
+  }
+  // 1234567 = ((((((0 7 + 3) 13 + 12) 4 + 3) 11 + 9) 9 + 2) 3 + 0) 20 + 7, worked by hand.
+  CHECK(generator.levels(1234567) == std::vector<std::string>{"0.0", "1.3", "2.12", "3.3", "4.9", "5.2", "6.0", "7.7"});
+  CHECK(generator.spec(5).hash == generator.spec(5).hash);
+  CHECK(generator.spec(5).hash != generator.spec(6).hash);
+}
+
+TEST_CASE("sweep runs one at a time: every design's run k equals its design generator's row k, taken in any order", "[sweep]") {
+  Files files;
+  const std::string model_text = read(files.model);
+  const std::vector<std::size_t> order{7, 3, 4, 0, 11, 5, 6, 1, 2, 10, 8, 9};  // runs out of turn: a generator keeps no cursor state wrong
+  SECTION("full factorial") {
+    const SweepPlan plan = plan_in_memory(SweepDesignKind::full_factorial, {3, 2, 2});
+    const SweepRunGenerator generator(plan, files.model, model_text);
+    const auto rows = full_factorial({3, 2, 2});
+    REQUIRE(generator.count() == rows.size());
+    for (const std::size_t k : order)
+      for (std::size_t f = 0; f < 3; ++f) CHECK(generator.levels(k)[f] == plan.factors[f].levels[rows[k][f]]);
+  }
+  SECTION("one at a time") {
+    const SweepPlan plan = plan_in_memory(SweepDesignKind::one_at_a_time, {3, 5, 3});
+    const SweepRunGenerator generator(plan, files.model, model_text);
+    const auto rows = one_at_a_time({3, 5, 3});
+    REQUIRE(generator.count() == 12);
+    for (const std::size_t k : order)
+      for (std::size_t f = 0; f < 3; ++f)
+        CHECK(generator.levels(k)[f] == (rows[k][f] < 0 ? "" : plan.factors[f].levels[static_cast<std::size_t>(rows[k][f])]));
+    CHECK(generator.spec(0).settings == std::vector<std::string>{"simulation.t_end=0.1"});  // the model's values
+  }
+  for (const SweepDesignKind design : {SweepDesignKind::latin_hypercube, SweepDesignKind::monte_carlo}) {
+    SweepPlan plan = plan_in_memory(design, {0, 0});
+    plan.samples = 12;
+    plan.seed = 9;
+    plan.factors[0].distribution = SweepDistribution{SweepDistribution::Kind::uniform, -3.0, 5.0};
+    plan.factors[1].distribution = SweepDistribution{SweepDistribution::Kind::normal, 2.0, 0.5};
+    const SweepRunGenerator generator(plan, files.model, model_text);
+    const auto rows = design == SweepDesignKind::latin_hypercube ? latin_hypercube(12, 2, 9) : monte_carlo(12, 2, 9);
+    REQUIRE(generator.count() == 12);
+    for (const std::size_t k : order) {
+      INFO("run " << k);
+      CHECK(std::stod(generator.levels(k)[0]) == -3.0 + 8.0 * rows[k][0]);
+      CHECK(std::stod(generator.levels(k)[1]) == 2.0 + 0.5 * normal_quantile(rows[k][1]));
+    }
+  }
+}
+
+TEST_CASE("sweep runs one at a time: Monte Carlo run k of ten million from draws 2k and 2k + 1 of the seed's sequence", "[sweep]") {
+  Files files;
+  SweepPlan plan = plan_in_memory(SweepDesignKind::monte_carlo, {0, 0});
+  plan.samples = 10000000;
+  plan.seed = 77;
+  plan.factors[0].distribution = SweepDistribution{SweepDistribution::Kind::uniform, 10.0, 20.0};
+  plan.factors[1].distribution = SweepDistribution{SweepDistribution::Kind::uniform, 0.0, 1.0};
+  const SweepRunGenerator generator(plan, files.model, read(files.model));
+  REQUIRE(generator.count() == 10000000u);
+  for (const std::size_t k : {std::size_t{9999999}, std::size_t{5000000}, std::size_t{5000001}, std::size_t{0}}) {
+    INFO("run " << k);
+    std::mt19937_64 draws(77);
+    draws.discard(2 * k);
+    const double u0 = (static_cast<double>(draws() >> 12) + 0.5) / 4503599627370496.0;  // 2^52
+    const double u1 = (static_cast<double>(draws() >> 12) + 0.5) / 4503599627370496.0;
+    CHECK(std::stod(generator.levels(k)[0]) == 10.0 + 10.0 * u0);
+    CHECK(std::stod(generator.levels(k)[1]) == u1);
+  }
+}
+
 TEST_CASE("sweep plans: an unknown key, a level of the wrong type and an empty design name the plan's line", "[sweep]") {
   Files files;
   const std::string head = "sweep: 1\ndesign: full_factorial\nfactors:\n";
@@ -173,7 +284,7 @@ TEST_CASE("sweep: R1 of each run against the closed-form crush, and 1 and 2 jobs
   // only the elastic range is not left for d_y = 0.008 (k d_y^2 / 2 = 320 J < 1125 J): plastic too.
   const std::vector<std::string> lines = [&] {
     std::vector<std::string> v;
-    for (const auto& l : one.lines) v.push_back(*l);
+    for (const auto& [number, l] : one.lines) v.push_back(l);
     return v;
   }();
   const auto field = [&](std::size_t run, std::size_t column) { return std::stod(csv_fields(lines[run])[column]); };
@@ -383,4 +494,59 @@ TEST_CASE("sweep: --resume reruns the rows of an edited base model and --keep-ru
     CHECK(number_in(rows[0], "R1") == Approx(crush_for(0.012) / 0.02).epsilon(1e-5));
     CHECK(number_in(rows[1], "R1") == Approx(crush_for(0.010) / 0.02).epsilon(1e-5));
   }
+}
+
+TEST_CASE("sweep: runs.csv says which method each run used, and an older runs.csv without the columns resumes", "[sweep][auto]") {
+  Files files;
+  // A 1 kg ball dropped 5 cm onto a floor (contact 1e5 N/m): ten bounces in 2 s, a lift-off and a
+  // touch-down each. With Euler's step 1 ms, integrator auto hands the run to Euler after the
+  // fifth mode change (IDA's mean step about 2 ms, each restart dearer than Euler's steps); with
+  // 1e-5 s Euler's steps cost far more and IDA keeps the run.
+  const std::string ball = files.dir + "/ball.yaml";
+  std::ofstream(ball) << "railcrash: 1\nname: ball\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+                         "  - {name: ball, mass: 1.0, inertia: 0.01, position: [0, 0.05]}\nelements:\n"
+                         "  - {name: floor, type: contact, stiffness: 1.0e5, damping: 20, friction: 0, line_point: [0, 0], "
+                         "line_normal: [0, 1], points: [{body: ball, at: [0, 0]}]}\n"
+                         "simulation: {t_end: 2.0, output_interval: 0.01, dt: 1.0e-3}\n";
+  files.write_plan("sweep: 1\ndesign: runs\nfactors:\n  - key: simulation.integrator\n  - key: simulation.dt\nruns:\n"
+                   "  - {simulation.integrator: ida}\n  - {simulation.integrator: euler}\n  - {simulation.integrator: auto}\n"
+                   "  - {simulation.integrator: auto, simulation.dt: 1.0e-5}\nresponses: [t_reached]\n");
+  const SweepPlan plan = load_sweep_plan(files.plan, ball);
+  SweepOptions options;
+  const SweepResult result = run_sweep(ball, plan, files.dir + "/methods", options);
+  REQUIRE(result.done() == 4);
+  // The hand-over time from the same run made outside the sweep (summary.json's integrator_used).
+  const RunReport auto_run = run_model(load_model(ball, {"simulation.integrator=auto"}), "");
+  REQUIRE(auto_run.outcome.stats.handed_over_at > 0.0);
+  const auto rows = csv_rows(files.dir + "/methods/runs.csv");
+  REQUIRE(rows.size() == 4);
+  CHECK(rows[0].at("integrator_used") == "ida");
+  CHECK(rows[0].at("euler_from_t").empty());
+  CHECK(rows[1].at("integrator_used") == "euler");
+  CHECK(rows[1].at("euler_from_t").empty());
+  CHECK(rows[2].at("integrator_used") == "ida+euler");
+  CHECK(std::stod(rows[2].at("euler_from_t")) == auto_run.outcome.stats.handed_over_at);
+  CHECK(std::stod(rows[2].at("euler_from_t")) > 0.05);  // after the first bounces (the fall alone takes 0.1 s)
+  CHECK(rows[3].at("integrator_used") == "ida");
+  CHECK(rows[3].at("euler_from_t").empty());
+
+  // runs.csv as railcrash wrote it before the two columns: its rows are kept, the columns empty.
+  const std::string header = sweep_csv_header(plan);
+  const std::string old_header = header.substr(0, header.size() - std::string(",integrator_used,euler_from_t").size());
+  std::istringstream written(read(files.dir + "/methods/runs.csv"));
+  std::string line, old_text = old_header + "\n";
+  std::getline(written, line);
+  for (int k = 0; k < 2 && std::getline(written, line); ++k) old_text += line.substr(0, line.rfind(',', line.rfind(',') - 1)) + "\n";
+  std::filesystem::create_directories(files.dir + "/old");
+  std::ofstream(files.dir + "/old/runs.csv") << old_text;
+  options.resume = true;
+  const SweepResult resumed = run_sweep(ball, plan, files.dir + "/old", options);
+  CHECK(resumed.resumed == 2);
+  CHECK(resumed.done() == 4);
+  const auto resumed_rows = csv_rows(files.dir + "/old/runs.csv");
+  REQUIRE(resumed_rows.size() == 4);
+  CHECK(resumed_rows[0].at("integrator_used").empty());  // resumed: not recorded then
+  CHECK(resumed_rows[1].at("integrator_used").empty());
+  CHECK(resumed_rows[2].at("integrator_used") == "ida+euler");
+  CHECK(resumed_rows[0].at("t_reached") == rows[0].at("t_reached"));
 }

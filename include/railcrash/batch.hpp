@@ -10,11 +10,27 @@
 #include <chrono>
 #include <cstddef>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <mutex>
 #include <string>
 #include <vector>
 
 namespace railcrash {
+
+struct RunReport;
+
+/// The method a study's run used, for the studies' columns integrator_used and euler_from_t:
+/// "ida" or "euler" (the one the model names; integrator auto whose IDA kept the run: "ida"), or
+/// "ida+euler" (integrator auto: IDA handed the run to Euler at euler_from_t [the model's time
+/// unit], as summary.json's integrator_used says). "" and NaN for a run that did not start.
+struct IntegratorUsed {
+  std::string method;
+  double euler_from_t = std::numeric_limits<double>::quiet_NaN();
+  /// euler_from_t as a CSV field: the shortest text that reads back as the same number, "" for NaN.
+  std::string euler_from_t_text() const;
+};
+IntegratorUsed integrator_used(const RunReport& report);
 
 struct BatchOptions {
   int jobs = 1;                              // threads (at most one per run)
@@ -56,6 +72,13 @@ enum class BatchRunState {
 std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void(std::size_t, const RunControl&)>& task,
                                      const BatchOptions& options,
                                      const std::function<void(std::size_t, BatchRunState)>& on_finished = {});
+
+/// run_batch for a study of any size: the run numbers come from next_run (called one call at a
+/// time, in the order runs start; nullopt: no more runs), so the batch holds nothing per run.
+/// Threads: options.jobs, but no more than most_runs (the most runs next_run will give).
+void run_batch_stream(std::size_t most_runs, const std::function<std::optional<std::size_t>()>& next_run,
+                      const std::function<void(std::size_t, const RunControl&)>& task, const BatchOptions& options,
+                      const std::function<void(std::size_t, BatchRunState)>& on_finished = {});
 
 /// How many runs ended by themselves (fewer than states.size() when the batch was interrupted).
 std::size_t finished_runs(const std::vector<BatchRunState>& states);

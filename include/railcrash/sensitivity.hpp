@@ -68,6 +68,7 @@
 
 #include "railcrash/run_count.hpp"
 #include "railcrash/error.hpp"
+#include "railcrash/batch.hpp"
 #include "railcrash/outcomes.hpp"
 #include "railcrash/responses.hpp"
 #include "railcrash/yaml_file.hpp"
@@ -141,6 +142,7 @@ struct SensitivityRun {
   double wall_seconds = 0.0;
   bool interrupted = false;    // stopped, or never started, because the study was interrupted
   OutcomeSignature outcomes;   // the run's discrete outcome (outcomes.hpp)
+  IntegratorUsed integrator;   // the method the run used (batch.hpp): sensitivity.csv's integrator_used, euler_from_t
 };
 
 /// A first-order run whose discrete outcome differs from run 0's (issue 40): the step is bisected

@@ -38,6 +38,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <mutex>
 #include <optional>
 #include <random>
 #include <string>
@@ -107,11 +109,41 @@ struct SweepRunSpec {
   std::string hash;                    // 16 hex digits of FNV-1a over everything the run reads (below)
 };
 
-/// The plan's runs, in order. `model_text` is the text of the model file at `model_path`. A run's
-/// hash covers everything it reads: railcrash's and its libraries' versions (version_text), the
-/// text of every model file (the model and, for a variant, its base: model_input_texts) and the
-/// run's settings in order (the plan's `set`, then each factor's).
+/// The plan's runs, generated one at a time: run k is made from k alone (the full factorial's
+/// k by its mixed-radix digits, the first factor slowest; one at a time's by the level counts;
+/// Monte Carlo's from draws k x factors on of the seed's sequence), so a plan of any size is
+/// counted and run without a list of its runs. A Latin hypercube's strata are matched by
+/// shuffles of the whole design: it holds its samples x factors probabilities (8 bytes each).
+/// `model_text` is the text of the model file at `model_path`. A run's hash covers everything it
+/// reads: railcrash's and its libraries' versions (version_text), the text of every model file
+/// (the model and, for a variant, its base: model_input_texts) and the run's settings in order
+/// (the plan's `set`, then each factor's). Safe to call from several threads. `plan` must
+/// outlive the generator.
+class SweepRunGenerator {
+ public:
+  /// InputError when the plan has more runs than std::size_t holds.
+  SweepRunGenerator(const SweepPlan& plan, const std::string& model_path, const std::string& model_text);
+  std::size_t count() const { return count_; }
+  /// Run k's level of each factor, YAML text ("" = the model's value); k < count().
+  std::vector<std::string> levels(std::size_t k) const;
+  SweepRunSpec spec(std::size_t k) const;
+
+ private:
+  const SweepPlan& plan_;
+  std::size_t count_ = 0;
+  std::uint64_t inputs_hash_ = 0;          // FNV-1a over the version text and every model file
+  std::vector<double> hypercube_;          // latin_hypercube: probabilities, samples x factors, row by row
+  mutable std::mutex generator_mutex_;     // monte_carlo: the draws, kept where the last run left them
+  mutable std::mt19937_64 generator_;
+  mutable std::size_t generator_next_run_ = 0;
+};
+
+/// Every run of the plan in order (SweepRunGenerator's; for small plans and tests).
 std::vector<SweepRunSpec> sweep_runs(const SweepPlan& plan, const std::string& model_path, const std::string& model_text);
+
+/// `railcrash sweep --dry-run`: the plan's run count, then runs.csv's first columns (run, hash,
+/// the factors' levels) of each run listed in `runs` (numbers past the count are left out).
+std::string sweep_dry_run_text(const SweepPlan& plan, const SweepRunGenerator& generator, const std::vector<std::size_t>& runs);
 
 /// The number of runs the plan has, counted without generating them (nullopt: more than
 /// std::size_t holds): the product of the level counts (full factorial), 1 + their sum (one at
@@ -127,6 +159,7 @@ struct SweepRow {
   std::string message;
   std::string outcomes;                // the run's discrete outcome, with times (OutcomeSignature::text)
   std::string branch;                  // the same, order only (OutcomeSignature::order): runs with equal ones are on one branch
+  IntegratorUsed integrator;           // the method the run used (batch.hpp): runs.csv's integrator_used, euler_from_t
 };
 
 /// Runs one specification (used by the thread pool and by MPI ranks); `model_text` is the model
@@ -134,7 +167,8 @@ struct SweepRow {
 SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, const CheckedYamlText& model_text,
                         const SweepRunSpec& spec, const RunControl& control, const std::string& run_folder = "");
 
-/// runs.csv: header and one line per row (run number, hash, factors, status, responses, wall, message).
+/// runs.csv: header and one line per row (run number, hash, factors, status, responses,
+/// wall_seconds, message, outcomes, branch, integrator_used, euler_from_t).
 std::string sweep_csv_header(const SweepPlan& plan);
 std::string sweep_csv_line(const SweepPlan& plan, std::size_t number, const SweepRunSpec& spec, const SweepRow& row);
 
@@ -150,13 +184,13 @@ struct SweepOptions {
 };
 
 struct SweepResult {
-  std::vector<SweepRunSpec> specs;
-  std::vector<std::optional<std::string>> lines;  // runs.csv line per run; empty: not run (interrupted)
+  std::size_t total = 0;                          // runs in the plan
+  std::map<std::size_t, std::string> lines;       // runs.csv line of each run done, by run number (runs not done: none)
   std::size_t resumed = 0;                        // rows taken from an earlier runs.csv
   std::size_t stale_rows = 0;     // rows of the earlier runs.csv (resuming) whose hash is no run of the plan: dropped
   std::size_t stale_folders = 0;  // folders DIR/runs/NNNN of no row kept: removed
   std::size_t torn_row_line = 0;  // resuming: the line of the earlier runs.csv's last row, cut short (dropped); 0: none
-  std::size_t done() const;
+  std::size_t done() const { return lines.size(); }
 };
 
 /// Starts DIR/runs.csv (or, resuming, reads the rows it has whose hash matches a run): the
@@ -166,8 +200,10 @@ struct SweepResult {
 /// InputError if a resumed file has other columns, or (with its line and column) anything that is
 /// no complete row of them but for a last row cut short, which is dropped (torn_row_line).
 /// The new runs.csv is written whole (write_whole_file); FileWriteError if it cannot be.
-SweepResult start_sweep(const SweepPlan& plan, const std::string& model_path, const std::string& model_text,
-                        const std::string& directory, bool resume);
+/// A row of an earlier runs.csv is matched to the run of its own number when that run's hash is
+/// the row's; only when some row is not, every run's hash is computed (one at a time) to find
+/// the rows' runs. Memory: the rows of the earlier file, never a list of the plan's runs.
+SweepResult start_sweep(const SweepPlan& plan, const SweepRunGenerator& generator, const std::string& directory, bool resume);
 /// Lines that say how many rows start_sweep dropped and folders it removed ("" when none).
 std::string sweep_start_note(const SweepResult& result, const std::string& directory);
 /// Appends one finished line to DIR/runs.csv (by write(2), every byte checked: a killed sweep

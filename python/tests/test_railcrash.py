@@ -442,6 +442,30 @@ class SweepTest(unittest.TestCase):
         self.assertEqual(table["status"], ["ok", "ok"])
         self.assertAlmostEqual(table["R1"][1], crush_for(0.012) / 0.02, delta=1e-5)
 
+    def test_the_method_each_run_used(self):
+        """integrator_used and euler_from_t: a ball bouncing on a floor (ten bounces in 2 s) run
+        with ida, euler and auto, which hands it to Euler (Euler's step 1 ms) after five mode
+        changes, at the time the same run made alone reports in summary.json."""
+        ball = ("railcrash: 1\nname: ball\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
+                "  - {name: ball, mass: 1.0, inertia: 0.01, position: [0, 0.05]}\nelements:\n"
+                "  - {name: floor, type: contact, stiffness: 1.0e5, damping: 20, friction: 0, line_point: [0, 0], "
+                "line_normal: [0, 1], points: [{body: ball, at: [0, 0]}]}\n"
+                "simulation: {t_end: 2.0, output_interval: 0.01, dt: 1.0e-3}\n")
+        with tempfile.TemporaryDirectory() as folder:
+            model = pathlib.Path(folder) / "ball.yaml"
+            model.write_text(ball)
+            plan = {"sweep": 1, "design": "full_factorial",
+                    "factors": [{"key": "simulation.integrator", "levels": ["ida", "euler", "auto"]}],
+                    "responses": ["t_reached"]}
+            table = railcrash.sweep(model, plan, jobs=2)
+            alone = railcrash.run(model)
+        self.assertEqual(list(table["integrator_used"]), ["ida", "euler", "ida+euler"])
+        euler_from_t = numpy.asarray(table["euler_from_t"], dtype=float)
+        self.assertTrue(numpy.isnan(euler_from_t[0]) and numpy.isnan(euler_from_t[1]))
+        self.assertEqual(alone.summary["integrator_used"]["method"], "ida+euler")
+        # (summary.json writes 12 significant digits, runs.csv the exact double)
+        self.assertAlmostEqual(euler_from_t[2], alone.summary["integrator_used"]["euler_from_t"], delta=1e-11)
+
     def test_a_plan_error_names_the_line(self):
         with tempfile.TemporaryDirectory() as folder:
             model = pathlib.Path(folder) / "model.yaml"
@@ -473,6 +497,9 @@ class SensitivityTest(unittest.TestCase):
         # The anticlimber only yields: no discrete outcome, one branch, nothing to bisect.
         self.assertEqual([r["branch"] for r in runs], ["none", "none"])
         self.assertEqual(table["branch_changes"], [])
+        # The model names no integrator: auto, and IDA keeps these one-impact runs.
+        self.assertEqual([r["integrator_used"] for r in runs], ["ida", "ida"])
+        self.assertTrue(all(math.isnan(r["euler_from_t"]) for r in runs))
 
     def test_only_and_central(self):
         """--only and --central: the rows name the parameters that ran."""

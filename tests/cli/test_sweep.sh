@@ -13,9 +13,9 @@ passes=0
 
 pass() { passes=$((passes + 1)); }
 fail() { echo "FAIL: $1"; failures=$((failures + 1)); }
-# runs.csv without the wall_seconds column (the fourth from the end, before message, outcomes and branch; these are
-# quoted, no commas inside here).
-untimed() { awk -F, 'BEGIN { OFS = "," } { $(NF - 3) = ""; print }' "$1"; }
+# runs.csv without the wall_seconds column (the sixth from the end, before message, outcomes, branch, integrator_used
+# and euler_from_t; these hold no commas here).
+untimed() { awk -F, 'BEGIN { OFS = "," } { $(NF - 5) = ""; print }' "$1"; }
 same_rows() {  # description file expected-file
   if [ -f "$2" ] && diff <(untimed "$2") <(untimed "$3") > "$tmp/diff"; then pass; else fail "$1"; sed 's/^/  | /' "$tmp/diff" | head; fi
 }
@@ -127,6 +127,67 @@ sed -e 's/^samples: 12/samples: 6/' "$tmp/plan.yaml" > "$tmp/six.yaml"
 if grep -q "^12 folders of $tmp/keep/runs/ belonged to no row of runs.csv" "$tmp/keep.out" && [ "$(ls "$tmp/keep/runs" | wc -l)" -eq 6 ]; then pass
 else fail "an edited plan's --keep-runs folders: $(cat "$tmp/keep.out"; ls "$tmp/keep/runs")"; fi
 
+# A plan of 10^7 runs (issue 36): counted without a list of its runs, run k's levels made from k
+# alone, and run, stopped and resumed within 1.5 GB of address space (ulimit -v; a list of its
+# runs, as railcrash made before, takes several GB and ends in bad_alloc before the first run).
+{
+  printf 'sweep: 1\ndesign: full_factorial\nfactors:\n'
+  for key in horizontal_elastic_stiffness horizontal_plastic_stiffness horizontal_yield_deflection vertical_elastic_stiffness \
+             vertical_plastic_stiffness vertical_yield_deflection torsional_elastic_stiffness; do
+    printf '  - {key: elements.ac.%s, scale: true, levels: [0.91, 0.92, 0.93, 0.94, 0.95, 0.96, 0.97, 0.98, 0.99, 1.0]}\n' "$key"
+  done
+  printf 'responses: [R1]\n'
+} > "$tmp/huge.yaml"
+"$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --out "$tmp/huge" > /dev/null 2> "$tmp/stderr"
+status=$?
+if [ $status -eq 2 ] && grep -q "huge.yaml: the sweep's plan: 10000000 runs, more than the limit of 1000000 (--max-runs)" "$tmp/stderr"; then pass
+else fail "10^7 runs over the default --max-runs: status $status, $(cat "$tmp/stderr")"; fi
+# Run k's level of factor f (0-based): 0.91 + 0.01 d, d digit f of k in base 10 (the first factor the
+# most significant of 7 digits), against the rows the dry run prints.
+levels_right() {  # file with rows run,hash,7 levels: prints the rows whose levels are not the formula's
+  awk -F, 'NR > 0 && $1 ~ /^[0-9]+$/ {
+    for (f = 0; f < 7; ++f) {
+      d = int($1 / 10 ^ (6 - f)) % 10
+      if ((($(3 + f)) - (0.91 + 0.01 * d)) ^ 2 > 1e-24) { print "run " $1 " factor " f ": " $(3 + f) ", expected " 0.91 + 0.01 * d }
+    }
+  }' "$1"
+}
+(ulimit -v 1500000; "$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --max-runs 0 --dry-run --show-runs 0,1,10,1234567,9999999) \
+  > "$tmp/dry" 2> "$tmp/stderr"
+status=$?
+if [ $status -eq 0 ] && [ "$(head -1 "$tmp/dry")" = "$tmp/huge.yaml: 10000000 runs" ] && [ "$(grep -c '^[0-9]' "$tmp/dry")" -eq 5 ] &&
+   grep -q '^1234567,[0-9a-f]\{16\},0.92,0.93,0.94,0.95,0.96,0.97,0.98$' "$tmp/dry" && [ -z "$(levels_right "$tmp/dry")" ]; then pass
+else fail "--dry-run of 10^7 runs: status $status, $(cat "$tmp/dry" "$tmp/stderr"; levels_right "$tmp/dry")"; fi
+# The sweep itself, stopped by SIGTERM once runs.csv holds a few rows, then resumed and stopped again.
+huge_launcher=()
+huge_rows() { local n; n=$( { wc -l < "$tmp/huge/runs.csv"; } 2> /dev/null || echo 1); echo $((n - 1)); }
+run_huge_until() {  # ROWS [--resume]: starts the sweep, stops it once runs.csv holds ROWS rows (60 s at most)
+  local rows=$1 waited=0
+  shift
+  if [ ${#huge_launcher[@]} -gt 0 ]; then  # (OpenMPI maps more address space than ulimit -v leaves: no limit)
+    "${huge_launcher[@]}" "$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --max-runs 0 --out "$tmp/huge" "$@" \
+      > "$tmp/huge.out" 2> "$tmp/huge.err" &
+  else
+    (ulimit -v 1500000; exec "$bin" sweep "$tmp/model.yaml" --plan "$tmp/huge.yaml" --max-runs 0 --jobs 2 --out "$tmp/huge" "$@") \
+      > "$tmp/huge.out" 2> "$tmp/huge.err" &
+  fi
+  local pid=$!
+  while kill -0 $pid 2> /dev/null && [ "$(huge_rows)" -lt "$rows" ] && [ $waited -lt 600 ]; do sleep 0.1; waited=$((waited + 1)); done
+  kill -TERM $pid 2> /dev/null
+  wait $pid
+  huge_status=$?
+}
+run_huge_until 4
+first_rows=$(huge_rows)
+if [ $huge_status -eq 1 ] && [ "$first_rows" -ge 4 ] && grep -q "^$first_rows of 10000000 runs done (0 resumed)" "$tmp/huge.out" &&
+   [ -z "$(levels_right "$tmp/huge/runs.csv")" ] && [ "$(awk -F, 'NR == 2 { print $1 "," $10 }' "$tmp/huge/runs.csv")" = "0,ok" ]; then pass
+else fail "10^7 runs stopped after $first_rows rows: status $huge_status, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err"; levels_right "$tmp/huge/runs.csv")"; fi
+run_huge_until $((first_rows + 4)) --resume
+if [ $huge_status -eq 1 ] && [ "$(huge_rows)" -ge $((first_rows + 4)) ] &&
+   grep -q "^$(huge_rows) of 10000000 runs done ($first_rows resumed)" "$tmp/huge.out" && [ -z "$(levels_right "$tmp/huge/runs.csv")" ] &&
+   [ "$(cut -d, -f1 "$tmp/huge/runs.csv" | sort -u | wc -l)" -eq $(($(huge_rows) + 1)) ]; then pass
+else fail "10^7 runs resumed: status $huge_status, $(huge_rows) rows, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err")"; fi
+
 if [ -n "$mpirun" ]; then
   # CI runs as root on 2 cores: allow root, oversubscribe, and yield when idle.
   # OpenMPI keeps some allocations to the end of the process: no leak report in a sanitizer build.
@@ -139,6 +200,17 @@ if [ -n "$mpirun" ]; then
   status=$?
   if [ $status -eq 2 ] && [ "$(grep -c "bad_key.yaml:4:" "$tmp/stderr")" -eq 1 ]; then pass
   else fail "mpirun with a bad plan: status $status, $(cat "$tmp/stderr")"; fi
+  # The 10^7-run plan over 2 ranks: rank 0 hands out run numbers from a cursor, each rank makes its run from the number.
+  rm -rf "$tmp/huge"
+  huge_launcher=("$mpirun" --oversubscribe -np 2)
+  run_huge_until 4
+  first_rows=$(huge_rows)
+  if [ $huge_status -ne 0 ] && [ "$first_rows" -ge 4 ] && [ -z "$(levels_right "$tmp/huge/runs.csv")" ]; then pass
+  else fail "mpirun: 10^7 runs stopped after $first_rows rows: status $huge_status, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err")"; fi
+  run_huge_until $((first_rows + 4)) --resume
+  if [ $huge_status -ne 0 ] && [ "$(huge_rows)" -ge $((first_rows + 4)) ] && [ -z "$(levels_right "$tmp/huge/runs.csv")" ] &&
+     [ "$(cut -d, -f1 "$tmp/huge/runs.csv" | sort -u | wc -l)" -eq $(($(huge_rows) + 1)) ]; then pass
+  else fail "mpirun: 10^7 runs resumed: status $huge_status, $(huge_rows) rows, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err")"; fi
   # railcrash links no MPI and runs railcrash-mpi beside it under a launcher: without it, exit 2 saying so.
   mkdir "$tmp/alone" && cp "$bin" "$tmp/alone/railcrash"
   PMIX_RANK=0 "$tmp/alone/railcrash" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --out "$tmp/alone/out" > /dev/null 2> "$tmp/stderr"
