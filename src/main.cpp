@@ -225,8 +225,6 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   if (format == OutputFormat::Hdf5) require_hdf5();
-  if (format == OutputFormat::Hdf5 && with_report)
-    throw InputError("--report reads the CSV files: leave out --report with --format hdf5, or use --format csv");
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   // The folder is this run's: locked against a second writer, then an earlier run's files go
   // (the writer would remove them too), said here.

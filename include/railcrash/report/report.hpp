@@ -10,6 +10,12 @@
 // style and the plotting library the build fetched from npm (assets.hpp), so it opens
 // without network access.
 //
+// A run with --format hdf5 (results/hdf5_file.hpp) has timeseries.h5 in place of
+// timeseries.csv, accelerations.csv, energy.csv and events.csv: the report reads its tables
+// (Hdf5Reader, the library loaded at run time as for writing) and shows the same page; its run
+// id is the file's run_id attribute. A timeseries.h5 that cannot be opened (cut short, not
+// HDF5) or lacks the timeseries table throws InputError naming the file and HDF5's reason.
+//
 // Plotted bodies: the car bodies (names containing "body"), else every body. Element forces:
 // every element output named force, *_force; the crash elements (anticlimber, crush_spring,
 // draft_gear, coupler_end, couplings) are shown first and get force-deformation loops. Long
