@@ -19,6 +19,7 @@
 #include "railcrash/report/assets.hpp"
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/report/folder_file.hpp"
+#include "railcrash/report/pdf.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/hdf5_file.hpp"
@@ -467,11 +468,21 @@ ReportResult write_study_report(const fs::path& dir) {
   return result;
 }
 
+ReportResult write_page_of_folder(const std::string& run_dir, const ReportOptions& options);
+
 }  // namespace
 
 bool have_plotting_library() { return assets::kHaveLibrary; }
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options) {
+  ReportResult result = write_page_of_folder(run_dir, options);
+  if (options.pdf) result.pdf_path = print_pdf(result.path);
+  return result;
+}
+
+namespace {
+
+ReportResult write_page_of_folder(const std::string& run_dir, const ReportOptions& options) {
   const fs::path dir(run_dir);
   std::error_code error;
   if (!fs::is_directory(dir, error))
@@ -755,5 +766,7 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
                            model_value.is_null() ? "null" : model_json, data);
   return result;
 }
+
+}  // namespace
 
 }  // namespace railcrash::report

@@ -67,7 +67,7 @@ void compare_data(const nlohmann::json& a, const nlohmann::json& b, const std::s
   if (a.is_object()) {
     for (const auto& [key, value] : a.items())
       if (!b.contains(key)) differences.push_back(where + "." + key + " only in the first");
-      else compare_data(value, b.at(key), where + "." + key, relative_tolerance, numbers, differences);
+      else compare_data(value, b.at(key), where + "." + key, series_tolerance, numbers, differences);
     for (const auto& [key, value] : b.items())
       if (!a.contains(key)) differences.push_back(where + "." + key + " only in the second");
   } else if (a.is_array()) {

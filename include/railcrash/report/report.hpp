@@ -48,6 +48,7 @@ struct ReportOptions {
   double force_cfc = 60.0;             // channel frequency class of the element force plot (0: unfiltered)
   std::size_t max_plot_points = 4000;  // per series
   std::size_t max_frames = 1000;       // animation frames (fewer for very large models)
+  bool pdf = false;                    // also print the page to report.pdf (report/pdf.hpp: headless Chromium)
 };
 
 struct ReportResult {
@@ -55,6 +56,7 @@ struct ReportResult {
   std::vector<std::string> problems;  // shown at the top of the page
   std::size_t rows = 0;               // complete rows of timeseries.csv
   std::string study;                  // "converge", "sensitivity" or "readings" for a study folder (rows: its files)
+  std::string pdf_path;               // RUN_DIR/report.pdf when options.pdf
 };
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options = {});
