@@ -438,7 +438,7 @@ std::string write_page(const fs::path& dir, const std::string& title, const std:
 /// Files of a `converge`, `readings`, `sensitivity` or `sweep` folder, in the order shown.
 const char* const kStudyFiles[] = {"converge.md", "converge.csv", "readings.md", "readings.csv", "sensitivity.md", "comparison.md",
                                    "sensitivity.csv", "sensitivity_first_order.csv", "sensitivity_second_order.csv",
-                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv", "summary.md", "runs.csv"};
+                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv", "sensitivity_branches.csv", "summary.md", "runs.csv"};
 
 /// A report of a study folder: its Markdown summary, its tables and its chart.
 ReportResult write_study_report(const fs::path& dir) {
