@@ -23,3 +23,16 @@ echo "docs/report_crush_zones.png: $(stat -c %s docs/report_crush_zones.png) byt
 build/railcrash report "$out/final_two_car" --pdf > /dev/null
 pdftoppm -png -r 60 -f 1 -l 1 -singlefile "$out/final_two_car/report.pdf" "$PWD/docs/report_pdf_page1"
 echo "docs/report_pdf_page1.png: $(stat -c %s docs/report_pdf_page1.png) bytes"
+
+# The study pages (issue 39 item 6): a sweep of the SI draft-gear example across two branch
+# changes, the report's first-order sensitivity study, a convergence study.
+build/railcrash sweep models/examples/draft_gear_branches_si.yaml --plan tests/report/branch_sweep_plan.yaml --out "$out/sweep" > /dev/null
+build/railcrash sensitivity models/report/final_two_car.yaml --first-order --jobs 2 --out "$out/sensitivity" > /dev/null
+build/railcrash converge verification/cases/damped_spring_mass.yaml --t-end 0.5 --euler-dt 0.01 --euler-steps 3 --rtols 1e-3,1e-4,1e-5 \
+  --quantities displacement_rms --out "$out/converge" > /dev/null
+for study in sweep sensitivity converge; do
+  build/railcrash report "$out/$study" > /dev/null
+  chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
+    --window-size=1200,1250 --screenshot="$PWD/docs/report_$study.png" "file://$out/$study/report.html" > /dev/null 2>&1
+  echo "docs/report_$study.png: $(stat -c %s docs/report_$study.png) bytes"
+done
