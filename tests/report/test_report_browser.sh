@@ -69,6 +69,14 @@ console.log("report ok: " + check.plots.length + " plots, " + check.frames.count
 JS
 [ -s "$out/report_screenshot.png" ] || fail "no screenshot"
 
+# An EN 15227 scenario's criteria (issue 38's note): wheel unloading is a fraction of the static
+# wheel load, (Q0 - Q) / Q0, never labelled with a length unit.
+"$bin" run "$src/models/scenarios/scenario1_emu3.yaml" --out "$tmp/scenario" --report --quiet > /dev/null 2>&1 || fail "run scenario1_emu3"
+timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=3000 --dump-dom "file://$tmp/scenario/report.html" > "$tmp/scenario.html" \
+  2> /dev/null || fail "chromium --dump-dom (scenario)"
+grep -Eq 'wheel unloading: [^<]*</th><td[^>]*>pass: [0-9.e+-]+ of the static wheel load \(limit 1 of the static wheel load' "$tmp/scenario.html" ||
+  { grep -o 'wheel unloading[^<]*</th><td[^>]*>[^<]*' "$tmp/scenario.html" | head -2; fail "wheel unloading is not labelled as a fraction of the static wheel load"; }
+
 # The study folders (issue 39 item 6, issue 40 item 5): a convergence study, a sweep across two
 # branch changes of an SI model, and a sensitivity study of the report's model: each page's
 # charts drawn with the plotting library, without a script error; a screenshot of each.

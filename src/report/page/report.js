@@ -469,9 +469,10 @@
             sc.pass ? "status-ok" : "status-failed");
         (sc.criteria || []).forEach(function (c) {
           var g = c.criterion === "mean_deceleration";
-          var unit = g ? " g" : " " + lengthUnit;
+          // wheel unloading is (Q0 - Q) / Q0, a fraction of the static wheel load (scenario/criteria.hpp), not a length
+          var unit = g ? " g" : c.criterion === "wheel_unloading" ? " of the static wheel load" : " " + lengthUnit;
           var value = g ? c.value_g : c.value, limit = g ? c.limit_g : c.limit;
-          row(c.criterion.replace("_", " ") + ": " + c.subject,
+          row(c.criterion.replace(/_/g, " ") + ": " + c.subject,
               (c.pass ? "pass" : "FAIL") + ": " + fmt(value, 4) + unit + " (limit " + fmt(limit, 4) + unit + ", margin " + fmt(limit - value, 4) + unit + ")" +
               (c.note ? "; " + c.note : ""), c.pass ? "status-ok" : "status-failed");
         });
