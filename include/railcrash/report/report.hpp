@@ -21,9 +21,17 @@
 // draft_gear, coupler_end, couplings) are shown first and get force-deformation loops. Long
 // series are decimated with decimate_minmax (peaks kept), animation frames uniformly.
 //
-// A folder of `railcrash converge`, `sensitivity` or `readings` (converge.csv, sensitivity.csv or
-// readings.csv, no timeseries.csv) gets a page of its Markdown summaries and CSV files as
-// tables, and the convergence chart (converge.svg).
+// A folder of `railcrash converge`, `sensitivity`, `readings` or `sweep` (converge.csv,
+// sensitivity.csv, readings.csv or runs.csv, no timeseries.csv) gets a page of its Markdown
+// summaries (headings as headings) and CSV files as tables, the convergence chart
+// (converge.svg), and charts the page draws from the CSV files with the plotting library
+// (page/report.js): a sweep's responses against each factor with the main effects, points
+// coloured by runs.csv's branch (issue 40) and branch changes marked; a sensitivity study's
+// tornado charts (sensitivity_first_order.csv, sensitivity_branches.csv); a convergence study's
+// error against cost (converge.csv). Columns are found by name: extra columns are shown in
+// the tables and left out of the charts.
+//
+// options.pdf: the page is also printed to report.pdf (report/pdf.hpp).
 //
 // The header shows the run's provenance (results/provenance.hpp) from summary.json.
 //
