@@ -506,8 +506,8 @@ ReportResult write_page_of_folder(const std::string& run_dir, const ReportOption
     series_run_id = hdf5->attribute("run_id");
   }
   if (!series.found)
-    throw InputError("'" + run_dir + "' has no timeseries.csv (nor timeseries.h5): it is not a run folder (write one with `railcrash run MODEL --out " +
-                     run_dir + "`)");
+    throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (nor is there a timeseries.h5 of `run --format hdf5`; "
+                     "write one with `railcrash run MODEL --out " + run_dir + "`)");
   if (series.rows == 0 || series.columns.empty() || series.columns[0] != "t")
     throw InputError("'" + (dir / series_file).string() + "' has no complete row of results" +
                      (problems.empty() ? std::string() : " (" + problems.front() + ")") + ": nothing to report");
