@@ -6,7 +6,8 @@ set -euo pipefail
 # pybind11 + numpy + python3-dev: the Python module; pandas and matplotlib: its dataframe()
 # and the Python example (all from Debian, for /usr/bin/python3; no pip).
 # nodejs + npm: the build fetches the run report's plotting library (uPlot, pinned in
-# src/report/js/package-lock.json) from the npm registry; chromium: the report's browser test.
+# src/report/js/package-lock.json) from the npm registry; chromium: the report's browser test
+# and `report --pdf`; poppler-utils: the PDF test turns its pages into images (pdftoppm).
 # libopenmpi-dev + openmpi-bin: `railcrash sweep` across ranks (mpirun/srun) and its test.
 # clang + libclang-rt-14-dev: the libFuzzer target (README "Fuzzing"; libFuzzer and the
 # sanitizer runtimes are in libclang-rt-14-dev).
@@ -16,7 +17,7 @@ set -euo pipefail
 # file's JSON Schema (docs/railcrash-model.schema.json).
 # nlohmann-json3-dev: the report reads a run folder's JSON files with it (header-only).
 packages=(build-essential cmake ninja-build pkg-config file dpkg-dev
-          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium
+          libeigen3-dev libsuitesparse-dev libsundials-dev libyaml-cpp-dev libcli11-dev catch2 chromium poppler-utils
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pandas python3-matplotlib
           libopenmpi-dev openmpi-bin clang libclang-rt-14-dev libhdf5-dev python3-h5py
           python3-jsonschema python3-yaml nlohmann-json3-dev)

@@ -3,7 +3,7 @@
 # its report, docs/report.png, shown in the README; and the SI example with crush zones
 # (models/examples/emu_two_car_crush_zones.yaml): docs/report_crush_zones.png, its report from
 # the force-deformation loops over their declared curves to the energy per crush zone.
-# Needs build/railcrash and chromium.
+# Needs build/railcrash, chromium and (for the PDF page) poppler-utils.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=$(mktemp -d)
@@ -17,3 +17,22 @@ build/railcrash run models/examples/emu_two_car_crush_zones.yaml --out "$out/emu
 chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
   --window-size=1400,1550 --screenshot="$PWD/docs/report_crush_zones.png" "file://$out/emu/report.html#crush-zones" > /dev/null 2>&1
 echo "docs/report_crush_zones.png: $(stat -c %s docs/report_crush_zones.png) bytes"
+
+# `railcrash report --pdf` (headless Chromium): the flagship's PDF, its first page as PNG
+# (pdftoppm, Debian's poppler-utils), docs/report_pdf_page1.png.
+build/railcrash report "$out/final_two_car" --pdf > /dev/null
+pdftoppm -png -r 60 -f 1 -l 1 -singlefile "$out/final_two_car/report.pdf" "$PWD/docs/report_pdf_page1"
+echo "docs/report_pdf_page1.png: $(stat -c %s docs/report_pdf_page1.png) bytes"
+
+# The study pages (issue 39 item 6): a sweep of the SI draft-gear example across two branch
+# changes, the report's first-order sensitivity study, a convergence study.
+build/railcrash sweep models/examples/draft_gear_branches_si.yaml --plan tests/report/branch_sweep_plan.yaml --out "$out/sweep" > /dev/null
+build/railcrash sensitivity models/report/final_two_car.yaml --first-order --jobs 2 --out "$out/sensitivity" > /dev/null
+build/railcrash converge verification/cases/damped_spring_mass.yaml --t-end 0.5 --euler-dt 0.01 --euler-steps 3 --rtols 1e-3,1e-4,1e-5 \
+  --quantities displacement_rms --out "$out/converge" > /dev/null
+for study in sweep sensitivity converge; do
+  build/railcrash report "$out/$study" > /dev/null
+  chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
+    --window-size=1200,1250 --screenshot="$PWD/docs/report_$study.png" "file://$out/$study/report.html" > /dev/null 2>&1
+  echo "docs/report_$study.png: $(stat -c %s docs/report_$study.png) bytes"
+done

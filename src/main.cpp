@@ -206,18 +206,19 @@ int elements_command(const std::string& type_name, bool markdown) {
   return 0;
 }
 
-int report_command(const std::string& run_dir, double cfc, double force_cfc = 60.0) {
+int report_command(const std::string& run_dir, double cfc, double force_cfc = 60.0, bool pdf = false) {
   railcrash::report::ReportOptions options;
   options.cfc = cfc;
   options.force_cfc = force_cfc;
+  options.pdf = pdf;
   const railcrash::report::ReportResult result = railcrash::report::write_report(run_dir, options);
   for (const std::string& problem : result.problems) std::fprintf(stderr, "report: %s\n", problem.c_str());
-  if (!result.study.empty()) {
+  if (!result.study.empty())
     std::printf("report of the %s study (%zu files) written to %s\n", result.study.c_str(), result.rows, result.path.c_str());
-    return 0;
-  }
-  std::printf("report of %zu output rows written to %s%s\n", result.rows, result.path.c_str(),
-              railcrash::report::have_plotting_library() ? "" : " (without plots: this build has no plotting library)");
+  else
+    std::printf("report of %zu output rows written to %s%s\n", result.rows, result.path.c_str(),
+                railcrash::report::have_plotting_library() ? "" : " (without plots: this build has no plotting library)");
+  if (!result.pdf_path.empty()) std::printf("PDF of the report written to %s\n", result.pdf_path.c_str());
   return 0;
 }
 
@@ -226,8 +227,6 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   if (format == OutputFormat::Hdf5) require_hdf5();
-  if (format == OutputFormat::Hdf5 && with_report)
-    throw InputError("--report reads the CSV files: leave out --report with --format hdf5, or use --format csv");
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   // The folder is this run's: locked against a second writer, then an earlier run's files go
   // (the writer would remove them too), said here.
@@ -609,6 +608,8 @@ int main(int argc, char** argv) {
   report->add_option("--force-cfc", report_force_cfc,
                      "channel frequency class of the element force plot (SAE J211-1 lists CFC 60 for barrier face forces); 0: unfiltered")
       ->capture_default_str()->check(finite_number(0, 1000, false, false, "Hz"));
+  bool report_pdf = false;
+  report->add_flag("--pdf", report_pdf, "also print the page to RUN_DIR/report.pdf with headless Chromium (Debian's chromium on PATH)");
 
   std::string design_path = "report", only;
   int jobs = 0;
@@ -817,7 +818,7 @@ int main(int argc, char** argv) {
       return write_generated_model(railcrash::model_schema_json(railcrash::ElementRegistry::instance()), schema_out,
                                    "the model file's JSON Schema");
     }
-    if (*report) return report_command(report_dir, report_cfc, report_force_cfc);
+    if (*report) return report_command(report_dir, report_cfc, report_force_cfc, report_pdf);
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
       if (scenario->count("--out") > 0) railcrash::check_output_file(scenario_out);

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -18,8 +19,10 @@
 #include "railcrash/report/assets.hpp"
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/report/folder_file.hpp"
+#include "railcrash/report/pdf.hpp"
 #include "railcrash/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/table_text.hpp"
 #include "railcrash/whole_file.hpp"
@@ -189,15 +192,17 @@ NumericTable read_numeric_csv(const fs::path& path, std::vector<std::string>& pr
 
 /// Throws InputError when the run folder's files are not all of one run: the run id of
 /// summary.json (if there is one) and of every data file the report reads (timeseries.csv's
-/// provenance line, model.json's "run_id", accelerations.csv's, energy.csv's, events.csv's) must
-/// be the same; files without an id (an older railcrash) agree only with each other.
-void require_one_run(const fs::path& dir, const std::string& summary, bool summary_found, const std::string& timeseries_comment) {
+/// provenance line or timeseries.h5's run_id attribute, model.json's "run_id", accelerations.csv's,
+/// energy.csv's, events.csv's) must be the same; files without an id (an older railcrash) agree
+/// only with each other.
+void require_one_run(const fs::path& dir, const std::string& summary, bool summary_found, const std::string& timeseries_file,
+                     const std::string& timeseries_run_id) {
   struct FileRun {
     std::string name, id;  // id "": the file carries none
   };
   std::vector<FileRun> files;
   if (summary_found) files.push_back({"summary.json", run_id_in(summary).value_or("")});
-  files.push_back({"timeseries.csv", run_id_in(timeseries_comment).value_or("")});
+  files.push_back({timeseries_file, timeseries_run_id});
   for (const char* name : {"model.json", "accelerations.csv", "energy.csv", "events.csv"}) {
     // The id is near the top: model.json's third line, a CSV file's first.
     const FolderFile file = read_folder_file_head((dir / name).string(), 4096);
@@ -215,6 +220,42 @@ void require_one_run(const fs::path& dir, const std::string& summary, bool summa
                        "' is " + of_run(reference.id) + ": the folder holds the files of two runs, and the report would show "
                        "one run's results under the other's; run the model again into this folder (a run removes the files of "
                        "an earlier one) or into an empty folder");
+}
+
+/// A table of timeseries.h5 (results/hdf5_file.hpp) as the report holds a CSV file's.
+NumericTable numeric_table(Hdf5Table&& read) {
+  NumericTable table;
+  table.found = read.found;
+  table.columns = std::move(read.columns);
+  for (std::size_t k = 0; k < table.columns.size(); ++k) table.index.emplace(table.columns[k], static_cast<int>(k));
+  table.data = std::move(read.values);
+  table.rows = read.rows;
+  return table;
+}
+
+/// One row of events.csv or of timeseries.h5's events.
+struct EventRow {
+  double t = 0.0;  // [time]
+  std::string element, event;
+  double value = 0.0;
+};
+
+constexpr std::size_t kMaxEvents = 20000;  // shown in the page's event log
+
+/// The rows of events.csv (t, element, event, value), at most kMaxEvents.
+std::vector<EventRow> read_events_csv(const fs::path& path, bool* found) {
+  std::vector<EventRow> rows;
+  const std::string text = read_file(path, found);
+  Lines in(text);
+  std::string line, comment;
+  std::size_t line_number = 0;
+  header_line(in, line, comment, line_number);
+  while (rows.size() < kMaxEvents && in.next(line)) {
+    const std::vector<std::string> f = csv_fields(line);
+    if (f.size() != 4) continue;
+    rows.push_back({std::strtod(f[0].c_str(), nullptr), f[1], f[2], std::strtod(f[3].c_str(), nullptr)});
+  }
+  return rows;
 }
 
 int column_of(const NumericTable& table, const std::string& name) {
@@ -397,7 +438,7 @@ std::string write_page(const fs::path& dir, const std::string& title, const std:
 /// Files of a `converge`, `readings`, `sensitivity` or `sweep` folder, in the order shown.
 const char* const kStudyFiles[] = {"converge.md", "converge.csv", "readings.md", "readings.csv", "sensitivity.md", "comparison.md",
                                    "sensitivity.csv", "sensitivity_first_order.csv", "sensitivity_second_order.csv",
-                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv", "summary.md", "runs.csv"};
+                                   "sensitivity_derivatives.csv", "sensitivity_ranking.csv", "sensitivity_branches.csv", "summary.md", "runs.csv"};
 
 /// A report of a study folder: its Markdown summary, its tables and its chart.
 ReportResult write_study_report(const fs::path& dir) {
@@ -427,37 +468,61 @@ ReportResult write_study_report(const fs::path& dir) {
   return result;
 }
 
+ReportResult write_page_of_folder(const std::string& run_dir, const ReportOptions& options);
+
 }  // namespace
 
 bool have_plotting_library() { return assets::kHaveLibrary; }
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options) {
+  ReportResult result = write_page_of_folder(run_dir, options);
+  if (options.pdf) result.pdf_path = print_pdf(result.path);
+  return result;
+}
+
+namespace {
+
+ReportResult write_page_of_folder(const std::string& run_dir, const ReportOptions& options) {
   const fs::path dir(run_dir);
   std::error_code error;
   if (!fs::is_directory(dir, error))
     throw InputError("run folder '" + run_dir + "' does not exist; give the --out folder of a `railcrash run`");
   ReportResult result;
   std::vector<std::string>& problems = result.problems;
-  const NumericTable series = read_numeric_csv(dir / "timeseries.csv", problems);
+  NumericTable series = read_numeric_csv(dir / "timeseries.csv", problems);
   if (!series.found && (fs::exists(dir / "converge.csv") || fs::exists(dir / "sensitivity.csv") || fs::exists(dir / "readings.csv") ||
                         fs::exists(dir / "runs.csv")))
     return write_study_report(dir);
-  if (!series.found && fs::exists(dir / "timeseries.h5"))
-    throw InputError("'" + run_dir + "' was written with --format hdf5 (timeseries.h5) and the report reads the CSV files: "
-                     "run again with --format csv (the default) for a report");
+  // A run with --format hdf5: the per-row tables are the datasets of timeseries.h5 (results/hdf5_file.hpp).
+  std::unique_ptr<Hdf5Reader> hdf5;
+  std::string series_file = "timeseries.csv", series_run_id = run_id_in(series.comment).value_or("");
+  if (!series.found && read_folder_file_head((dir / "timeseries.h5").string(), 8).found) {  // (refuses a link or a FIFO)
+    hdf5 = std::make_unique<Hdf5Reader>((dir / "timeseries.h5").string());
+    series_file = "timeseries.h5";
+    series = numeric_table(hdf5->table("timeseries", max_table_bytes()));
+    if (!series.found)
+      throw InputError("'" + hdf5->path() + "' has no table timeseries: it is not the file of a `railcrash run --format hdf5`; run the "
+                       "model again");
+    series_run_id = hdf5->attribute("run_id");
+  }
   if (!series.found)
-    throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (write one with `railcrash run MODEL --out " +
-                     run_dir + "`)");
+    throw InputError("'" + run_dir + "' has no timeseries.csv: it is not a run folder (nor is there a timeseries.h5 of `run --format hdf5`; "
+                     "write one with `railcrash run MODEL --out " + run_dir + "`)");
   if (series.rows == 0 || series.columns.empty() || series.columns[0] != "t")
-    throw InputError("'" + run_dir + "/timeseries.csv' has no complete row of results" +
+    throw InputError("'" + (dir / series_file).string() + "' has no complete row of results" +
                      (problems.empty() ? std::string() : " (" + problems.front() + ")") + ": nothing to report");
+  // A per-row table other than the timeseries: accelerations, energy.
+  const auto read_table = [&](const std::string& name) {
+    return hdf5 ? numeric_table(hdf5->table(name, max_table_bytes())) : read_numeric_csv(dir / (name + ".csv"), problems);
+  };
+  const std::string missing_table_reason = hdf5 ? " (timeseries.h5 has no such table)" : " (older run folder)";
   result.rows = series.rows;
 
   bool found = false, summary_found = false;
   const std::string summary = read_json_file(dir / "summary.json", &summary_found);
   if (!summary_found) problems.insert(problems.begin(), "no summary.json: the run did not finish (it was killed, crashed or is still running); "
                                                 "the report shows the rows written so far");
-  require_one_run(dir, summary, summary_found, series.comment);
+  require_one_run(dir, summary, summary_found, series_file, series_run_id);
   const nlohmann::json summary_value = parse_json("summary.json", summary, problems);
   if (string_at(summary_value, "status") == "failed") {  // a failed run says so first
     const auto reached = summary_value.find("t_reached");
@@ -517,8 +582,8 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   }
 
   // Accelerations, filtered.
-  const NumericTable accelerations = read_numeric_csv(dir / "accelerations.csv", problems);
-  if (!accelerations.found) problems.push_back("no accelerations.csv (older run folder): no acceleration plots");
+  const NumericTable accelerations = read_table("accelerations");
+  if (!accelerations.found) problems.push_back("no accelerations table" + missing_table_reason + ": no acceleration plots");
   if (accelerations.found && accelerations.rows >= 3) {
     const std::vector<double>& ta = accelerations.data[0];
     const double interval = cfc::typical_interval(ta);
@@ -616,14 +681,14 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   }
 
   // Energy partition.
-  const NumericTable energy = read_numeric_csv(dir / "energy.csv", problems);
+  const NumericTable energy = read_table("energy");
   std::string energy_json = "null";
   if (energy.found && energy.rows > 0) {
     std::vector<PlotSeries> list;
     for (std::size_t c = 1; c < energy.columns.size(); ++c) list.push_back({energy.columns[c], energy.data[c], true});
     energy_json = plot_json("energy", "Energy partition", "energy", energy.data[0], list, options.max_plot_points);
   } else if (!energy.found) {
-    problems.push_back("no energy.csv (older run folder): no energy plot");
+    problems.push_back("no energy table" + missing_table_reason + ": no energy plot");
   }
 
   // Animation frames: uniform stride, bounded total size.
@@ -666,19 +731,17 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
   std::string events = "[";
   {
     bool events_found = false;
-    const std::string text = read_file(dir / "events.csv", &events_found);
-    if (!events_found) problems.push_back("no events.csv");
-    Lines in(text);
-    std::string line, comment;
-    std::size_t line_number = 0;
-    header_line(in, line, comment, line_number);
-    std::size_t count = 0;
-    while (count < 20000 && in.next(line)) {
-      const std::vector<std::string> f = csv_fields(line);
-      if (f.size() != 4) continue;
-      events += std::string(count++ ? ",\n" : "") + "[" + number(std::strtod(f[0].c_str(), nullptr)) + "," + js(f[1]) + "," +
-                js(f[2]) + "," + number(std::strtod(f[3].c_str(), nullptr)) + "]";
+    std::vector<EventRow> rows;
+    if (hdf5) {
+      for (Hdf5Event& e : hdf5->events("events", kMaxEvents, &events_found))
+        rows.push_back({e.t, std::move(e.element), std::move(e.event), e.value});
+    } else {
+      rows = read_events_csv(dir / "events.csv", &events_found);
     }
+    if (!events_found) problems.push_back(hdf5 ? "no events table in timeseries.h5" : "no events.csv");
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      events += std::string(k ? ",\n" : "") + "[" + number(rows[k].t) + "," + js(rows[k].element) + "," + js(rows[k].event) + "," +
+                number(rows[k].value) + "]";
   }
   events += "]";
 
@@ -703,5 +766,7 @@ ReportResult write_report(const std::string& run_dir, const ReportOptions& optio
                            model_value.is_null() ? "null" : model_json, data);
   return result;
 }
+
+}  // namespace
 
 }  // namespace railcrash::report

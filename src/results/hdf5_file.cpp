@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <type_traits>
 
@@ -42,6 +43,20 @@ bool Hdf5File::flush() { return false; }
 bool Hdf5File::compound(int) const { return false; }
 void Hdf5File::write_block(Table&) {}
 bool Hdf5File::fail(const std::string&) { return false; }
+
+Hdf5Reader::Hdf5Reader(const std::string& path) : path_(path) {
+  throw InputError("'" + path + "' is an HDF5 file (a run with --format hdf5) and this railcrash was built without HDF5; "
+                   "install Debian's libhdf5-dev (scripts/install-deps.sh does), configure and build again, or run the "
+                   "model again with --format csv (the default)");
+}
+Hdf5Reader::~Hdf5Reader() = default;
+std::string Hdf5Reader::attribute(const std::string&) const { return ""; }
+Hdf5Table Hdf5Reader::table(const std::string&, std::uint64_t) const { return {}; }
+std::vector<Hdf5Event> Hdf5Reader::events(const std::string&, std::size_t, bool* found) const {
+  *found = false;
+  return {};
+}
+void Hdf5Reader::fail(const std::string& what) const { throw InputError("'" + path_ + "': " + what); }
 
 #else
 
@@ -303,6 +318,182 @@ bool Hdf5File::flush() {
   for (const auto& table : tables_) write_block(*table);
   if (error_.empty() && H5Fflush(file_, H5F_SCOPE_LOCAL) < 0) fail("cannot write " + path_);
   return error_.empty();
+}
+
+// ---- Reading back (the report) ----
+
+namespace {
+
+/// HDF5's innermost message of the error stack, cleared ("" when there is none).
+std::string innermost_message() {
+  std::string message;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, keep_innermost, &message);
+  H5Eclear2(H5E_DEFAULT);
+  return message;
+}
+
+/// Frees a string HDF5 allocated (a member name, a variable-length string read).
+struct HdfText {
+  char* text = nullptr;
+  ~HdfText() {
+    if (text) H5free_memory(text);
+  }
+  std::string get() const { return text ? std::string(text) : std::string(); }
+};
+
+}  // namespace
+
+void Hdf5Reader::fail(const std::string& what) const {
+  const std::string message = innermost_message();
+  throw InputError("'" + path_ + "' " + what + (message.empty() ? std::string() : " (HDF5: " + message + ")") +
+                   ": the file is damaged or was not written by `railcrash run --format hdf5` (a run killed before its "
+                   "first flush, or a copy cut short); run the model again");
+}
+
+Hdf5Reader::Hdf5Reader(const std::string& path) : path_(path) {
+  H5dont_atexit();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are thrown with their message, not printed
+  file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file_ < 0) fail("cannot be opened as an HDF5 file");
+}
+
+Hdf5Reader::~Hdf5Reader() {
+  if (file_ >= 0) H5Fclose(file_);
+  H5Eclear2(H5E_DEFAULT);
+}
+
+std::string Hdf5Reader::attribute(const std::string& name) const {
+  const htri_t exists = H5Aexists(file_, name.c_str());
+  if (exists < 0) fail("cannot be read (the attribute " + name + ")");
+  if (exists == 0) return "";
+  const Handle attribute(H5Aopen(file_, name.c_str(), H5P_DEFAULT));
+  const Handle type(utf8_string_type());
+  HdfText text;
+  if (!attribute.valid() || !type.valid() || H5Aread(attribute.get(), type.get(), &text.text) < 0)
+    fail("has an attribute " + name + " that is not a text");
+  return text.get();
+}
+
+Hdf5Table Hdf5Reader::table(const std::string& name, std::uint64_t max_bytes) const {
+  Hdf5Table table;
+  const htri_t exists = H5Lexists(file_, name.c_str(), H5P_DEFAULT);
+  if (exists < 0) fail("cannot be read (looking for the table " + name + ")");
+  if (exists == 0) return table;
+  table.found = true;
+  const Handle dataset(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
+  if (!dataset.valid()) fail("cannot open its table " + name);
+  const Handle file_type(H5Dget_type(dataset.get()));
+  const Handle file_space(H5Dget_space(dataset.get()));
+  if (!file_type.valid() || !file_space.valid()) fail("cannot read the type of its table " + name);
+  const int rank = H5Sget_simple_extent_ndims(file_space.get());
+  hsize_t extent[2] = {0, 0};
+  if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(file_space.get(), extent, nullptr) < 0)
+    fail("has a table " + name + " that is neither a table of rows nor a matrix");
+  const H5T_class_t type_class = H5Tget_class(file_type.get());
+  // The memory type of one row: a compound of float64 fields of the file's names, or float64 (a matrix).
+  hid_t row_type_id = -1;
+  if (rank == 1 && type_class == H5T_COMPOUND) {
+    const int members = H5Tget_nmembers(file_type.get());
+    if (members <= 0) fail("has a table " + name + " without columns");
+    row_type_id = H5Tcreate(H5T_COMPOUND, sizeof(double) * static_cast<std::size_t>(members));
+    for (int k = 0; k < members && row_type_id >= 0; ++k) {
+      HdfText member;
+      member.text = H5Tget_member_name(file_type.get(), static_cast<unsigned>(k));
+      const H5T_class_t member_class = H5Tget_member_class(file_type.get(), static_cast<unsigned>(k));
+      if (!member.text || (member_class != H5T_FLOAT && member_class != H5T_INTEGER)) {
+        H5Tclose(row_type_id);
+        fail("has a column " + member.get() + " in its table " + name + " that is not a number");
+      }
+      table.columns.push_back(member.get());
+      if (H5Tinsert(row_type_id, member.text, sizeof(double) * static_cast<std::size_t>(k), H5T_NATIVE_DOUBLE) < 0) {
+        H5Tclose(row_type_id);
+        row_type_id = -1;
+      }
+    }
+  } else if (rank == 2 && type_class == H5T_FLOAT) {
+    // A matrix: its column names in the dataset <name>_columns.
+    const std::string names_name = name + "_columns";
+    const Handle names(H5Lexists(file_, names_name.c_str(), H5P_DEFAULT) > 0 ? H5Dopen2(file_, names_name.c_str(), H5P_DEFAULT) : -1);
+    const Handle names_space(names.valid() ? H5Dget_space(names.get()) : -1);
+    hsize_t count = 0;
+    if (!names_space.valid() || H5Sget_simple_extent_ndims(names_space.get()) != 1 ||
+        H5Sget_simple_extent_dims(names_space.get(), &count, nullptr) < 0 || count != extent[1])
+      fail("has a matrix " + name + " without the column names " + names_name + " of its " + std::to_string(extent[1]) + " columns");
+    const Handle text_type(utf8_string_type());
+    std::vector<char*> pointers(count, nullptr);
+    if (!text_type.valid() || H5Dread(names.get(), text_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0)
+      fail("has column names " + names_name + " that are not texts");
+    for (char* text : pointers) table.columns.emplace_back(text ? text : "");
+    H5Dvlen_reclaim(text_type.get(), names_space.get(), H5P_DEFAULT, pointers.data());
+    row_type_id = H5Tcopy(H5T_NATIVE_DOUBLE);
+  } else {
+    fail("has a table " + name + " that is not numeric");
+  }
+  const Handle row_type(row_type_id);
+  if (!row_type.valid()) fail("cannot read its table " + name);
+  const std::size_t columns = table.columns.size();
+  table.rows = static_cast<std::size_t>(extent[0]);
+  const std::uint64_t bytes = std::uint64_t{sizeof(double)} * columns * table.rows;
+  if (bytes > max_bytes)
+    throw InputError("'" + path_ + "': its table " + name + " holds " + std::to_string(table.rows) + " rows of " + std::to_string(columns) +
+                     " columns, " + std::to_string(bytes / 1000000) + " MB of values, more than the report's limit of " +
+                     std::to_string(max_bytes / 1000000) + " MB (an eighth of this machine's memory); run again with a "
+                     "longer --output-interval (fewer rows), or read the file with other tools (h5py)");
+  table.values.assign(columns, std::vector<double>(table.rows));
+  // Blocks of rows (about 4 MB), each a hyperslab of the file's rows, copied into the columns.
+  const hsize_t block_rows = std::max<hsize_t>(1, (hsize_t{4} << 20) / (sizeof(double) * columns));
+  std::vector<double> block;
+  for (hsize_t first = 0; first < extent[0]; first += block_rows) {
+    const hsize_t rows = std::min(block_rows, extent[0] - first);
+    const hsize_t start[2] = {first, 0}, count[2] = {rows, extent[1]};
+    block.resize(static_cast<std::size_t>(rows) * columns);
+    const Handle memory_space(H5Screate_simple(rank, count, nullptr));
+    if (!memory_space.valid() || H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0 ||
+        H5Dread(dataset.get(), row_type.get(), memory_space.get(), file_space.get(), H5P_DEFAULT, block.data()) < 0)
+      fail("cannot read rows " + std::to_string(first) + " to " + std::to_string(first + rows - 1) + " of its table " + name);
+    for (std::size_t r = 0; r < rows; ++r)
+      for (std::size_t c = 0; c < columns; ++c) table.values[c][static_cast<std::size_t>(first) + r] = block[r * columns + c];
+  }
+  return table;
+}
+
+std::vector<Hdf5Event> Hdf5Reader::events(const std::string& name, std::size_t max_rows, bool* found) const {
+  std::vector<Hdf5Event> out;
+  *found = false;
+  const htri_t exists = H5Lexists(file_, name.c_str(), H5P_DEFAULT);
+  if (exists < 0) fail("cannot be read (looking for the table " + name + ")");
+  if (exists == 0) return out;
+  *found = true;
+  const Handle dataset(H5Dopen2(file_, name.c_str(), H5P_DEFAULT));
+  const Handle file_space(dataset.valid() ? H5Dget_space(dataset.get()) : -1);
+  hsize_t rows = 0;
+  if (!file_space.valid() || H5Sget_simple_extent_ndims(file_space.get()) != 1 || H5Sget_simple_extent_dims(file_space.get(), &rows, nullptr) < 0)
+    fail("has no table of rows " + name);
+  rows = std::min<hsize_t>(rows, max_rows);
+  if (rows == 0) return out;
+  struct Row {
+    double t;
+    char* element;
+    char* event;
+    double value;
+  };
+  const Handle text(utf8_string_type());
+  const Handle row_type(H5Tcreate(H5T_COMPOUND, sizeof(Row)));
+  bool ok = text.valid() && row_type.valid();
+  ok = ok && H5Tinsert(row_type.get(), "t", offsetof(Row, t), H5T_NATIVE_DOUBLE) >= 0;
+  ok = ok && H5Tinsert(row_type.get(), "element", offsetof(Row, element), text.get()) >= 0;
+  ok = ok && H5Tinsert(row_type.get(), "event", offsetof(Row, event), text.get()) >= 0;
+  ok = ok && H5Tinsert(row_type.get(), "value", offsetof(Row, value), H5T_NATIVE_DOUBLE) >= 0;
+  const hsize_t start = 0;
+  const Handle memory_space(H5Screate_simple(1, &rows, nullptr));
+  std::vector<Row> data(static_cast<std::size_t>(rows), Row{0.0, nullptr, nullptr, 0.0});
+  ok = ok && memory_space.valid() && H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &start, nullptr, &rows, nullptr) >= 0 &&
+       H5Dread(dataset.get(), row_type.get(), memory_space.get(), file_space.get(), H5P_DEFAULT, data.data()) >= 0;
+  if (!ok) fail("cannot read its table " + name + " (t, element, event, value)");
+  for (const Row& row : data)
+    out.push_back({row.t, row.element ? row.element : "", row.event ? row.event : "", row.value});
+  H5Dvlen_reclaim(row_type.get(), memory_space.get(), H5P_DEFAULT, data.data());
+  return out;
 }
 
 #endif

@@ -1,4 +1,5 @@
-// Debian's serial HDF5, loaded when a run first asks for it (`--format hdf5`), not at start-up.
+// Debian's serial HDF5, loaded when a run first asks for it (`--format hdf5`) or the report reads
+// a run folder's timeseries.h5, not at start-up.
 //
 // libhdf5_serial.so.103 brings in libcurl and libcrypto (its read-only S3 driver) and, through
 // them, 20-odd more libraries (GnuTLS, Kerberos, LDAP, SSH, ...): linked in the ordinary way, the
@@ -34,7 +35,7 @@ void* hdf5_library() {
     if (!library) failure = dlerror();
   });
   if (!library)
-    throw railcrash::InputError("--format hdf5: cannot load HDF5 (" + failure +
+    throw railcrash::InputError("HDF5 (--format hdf5, or the report of such a run's timeseries.h5): cannot load it (" + failure +
                                 "); install Debian's libhdf5-103-1 (scripts/install-deps.sh does), or leave out "
                                 "--format hdf5 for the CSV files");
   return library;
@@ -145,6 +146,34 @@ herr_t H5Dwrite_chunk(hid_t dataset, hid_t transfer, uint32_t filters, const hsi
   return forward<&H5Dwrite_chunk>("H5Dwrite_chunk", dataset, transfer, filters, offset, bytes, data);
 }
 herr_t H5Dclose(hid_t dataset) { return forward<&H5Dclose>("H5Dclose", dataset); }
+
+// Reading back (Hdf5Reader: the report of a --format hdf5 run folder).
+hid_t H5Fopen(const char* name, unsigned flags, hid_t access) { return forward<&H5Fopen>("H5Fopen", name, flags, access); }
+htri_t H5Lexists(hid_t location, const char* name, hid_t link_access) {
+  return forward<&H5Lexists>("H5Lexists", location, name, link_access);
+}
+htri_t H5Aexists(hid_t object, const char* name) { return forward<&H5Aexists>("H5Aexists", object, name); }
+hid_t H5Aopen(hid_t object, const char* name, hid_t access) { return forward<&H5Aopen>("H5Aopen", object, name, access); }
+herr_t H5Aread(hid_t attribute, hid_t memory_type, void* data) { return forward<&H5Aread>("H5Aread", attribute, memory_type, data); }
+hid_t H5Dopen2(hid_t location, const char* name, hid_t access) { return forward<&H5Dopen2>("H5Dopen2", location, name, access); }
+hid_t H5Dget_type(hid_t dataset) { return forward<&H5Dget_type>("H5Dget_type", dataset); }
+herr_t H5Dread(hid_t dataset, hid_t memory_type, hid_t memory_space, hid_t file_space, hid_t transfer, void* data) {
+  return forward<&H5Dread>("H5Dread", dataset, memory_type, memory_space, file_space, transfer, data);
+}
+herr_t H5Dvlen_reclaim(hid_t type, hid_t space, hid_t transfer, void* data) {
+  return forward<&H5Dvlen_reclaim>("H5Dvlen_reclaim", type, space, transfer, data);
+}
+int H5Sget_simple_extent_ndims(hid_t space) { return forward<&H5Sget_simple_extent_ndims>("H5Sget_simple_extent_ndims", space); }
+int H5Sget_simple_extent_dims(hid_t space, hsize_t dimensions[], hsize_t maximum[]) {
+  return forward<&H5Sget_simple_extent_dims>("H5Sget_simple_extent_dims", space, dimensions, maximum);
+}
+H5T_class_t H5Tget_class(hid_t type) { return forward<&H5Tget_class>("H5Tget_class", type); }
+int H5Tget_nmembers(hid_t type) { return forward<&H5Tget_nmembers>("H5Tget_nmembers", type); }
+char* H5Tget_member_name(hid_t type, unsigned member) { return forward<&H5Tget_member_name>("H5Tget_member_name", type, member); }
+H5T_class_t H5Tget_member_class(hid_t type, unsigned member) {
+  return forward<&H5Tget_member_class>("H5Tget_member_class", type, member);
+}
+herr_t H5free_memory(void* memory) { return forward<&H5free_memory>("H5free_memory", memory); }
 
 }  // extern "C"
 #pragma GCC visibility pop

@@ -19,7 +19,6 @@ model=$src/models/report/final_two_car.yaml
 
 expect_status "an unknown format" 2 "$bin" run "$model" --format parquet --out "$tmp/bad"
 expect_text "the unknown format's message names the choices" "$tmp/stderr" "csv"
-expect_status "--report with hdf5" 2 "$bin" run "$model" --format hdf5 --report --out "$tmp/bad"
 
 "$bin" run "$model" --t-end 0.001 --format hdf5 --out "$tmp/probe" --quiet > "$tmp/stdout" 2> "$tmp/stderr"
 if grep -q "built without HDF5" "$tmp/stderr"; then
@@ -39,11 +38,14 @@ expect_status "run with csv" 0 "$bin" run "$model" --t-end 0.02 --output-interva
 expect_status "run with hdf5" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 --out "$tmp/h5" --quiet
 expect_text "run names the file" "$tmp/stdout" "timeseries.h5"
 expect_text "summary.json names the format" "$tmp/h5/summary.json" '"format": "hdf5"'
-expect_status "report of an hdf5 run folder" 2 "$bin" report "$tmp/h5"
-expect_text "the report says it reads the CSV files" "$tmp/stderr" "was written with --format hdf5"
+expect_status "report of an hdf5 run folder" 0 "$bin" report "$tmp/h5"
+expect_text "the report reads timeseries.h5's 21 rows" "$tmp/stdout" "^report of 21 output rows written to $tmp/h5/report.html"
+expect_status "run --format hdf5 --report" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 --report \
+  --out "$tmp/h5_report" --quiet
+expect_text "it writes the report" "$tmp/stdout" "^report of 21 output rows written to $tmp/h5_report/report.html"
 
 # The issue's case: an HDF5 run into the folder of a CSV run. The run removes the CSV run's
-# files and says so; the report then refuses the folder as an HDF5 one, not with the old rows.
+# files and says so; the report then shows the HDF5 run's rows, not the old ones.
 cp -r "$tmp/csv" "$tmp/csv_then_h5"
 expect_status "an hdf5 run into a csv run's folder" 0 "$bin" run "$model" --t-end 0.02 --output-interval 0.001 --format hdf5 \
   --out "$tmp/csv_then_h5" --quiet
@@ -51,8 +53,8 @@ expect_text "it says which files of the csv run it removed" "$tmp/stdout" \
   "^removed the files of an earlier run from $tmp/csv_then_h5/: timeseries.csv, events.csv, accelerations.csv, energy.csv, summary.json, model.json, energy_zones.csv$"
 left=$(ls "$tmp/csv_then_h5" | grep -c '\.csv$')
 [ "$left" -eq 0 ] && passes=$((passes + 1)) || { echo "FAIL: $left CSV files of the earlier run left"; failures=$((failures + 1)); }
-expect_status "report of that folder" 2 "$bin" report "$tmp/csv_then_h5"
-expect_text "it is an hdf5 run folder now" "$tmp/stderr" "was written with --format hdf5"
+expect_status "report of that folder" 0 "$bin" report "$tmp/csv_then_h5"
+expect_text "it reports the hdf5 run" "$tmp/stdout" "^report of 21 output rows written to $tmp/csv_then_h5/report.html"
 
 # A write failing mid-run (files limited to 200 kB, SIGXFSZ ignored: the write fails with EFBIG):
 # exit 1 with the file and the reason, not a crash.
@@ -66,6 +68,8 @@ expect_text "it names the file and the reason" "$tmp/stdout" "cannot write $tmp/
 expect_status "consist with csv" 0 "$bin" run "$tmp/consist.yaml" --t-end 0.002 --output-interval 0.001 --out "$tmp/consist_csv" --quiet
 expect_status "consist with hdf5" 0 "$bin" run "$tmp/consist.yaml" --t-end 0.002 --output-interval 0.001 --format hdf5 \
     --out "$tmp/consist_h5" --quiet
+expect_status "report of the consist's hdf5 folder (a matrix table)" 0 "$bin" report "$tmp/consist_h5"
+expect_text "it reads the matrix's 3 rows" "$tmp/stdout" "^report of 3 output rows written to $tmp/consist_h5/report.html"
 
 if ! "$python" -c "import h5py, pandas" 2> /dev/null; then
   echo "h5py or pandas missing for $python (Debian: python3-h5py python3-pandas): the file is not read back here"

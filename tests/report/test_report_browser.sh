@@ -69,14 +69,91 @@ console.log("report ok: " + check.plots.length + " plots, " + check.frames.count
 JS
 [ -s "$out/report_screenshot.png" ] || fail "no screenshot"
 
-# A convergence study's folder: its tables and chart.
+# An EN 15227 scenario's criteria (issue 38's note): wheel unloading is a fraction of the static
+# wheel load, (Q0 - Q) / Q0, never labelled with a length unit.
+"$bin" run "$src/models/scenarios/scenario1_emu3.yaml" --out "$tmp/scenario" --report --quiet > /dev/null 2>&1 || fail "run scenario1_emu3"
+timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=3000 --dump-dom "file://$tmp/scenario/report.html" > "$tmp/scenario.html" \
+  2> /dev/null || fail "chromium --dump-dom (scenario)"
+grep -Eq 'wheel unloading: [^<]*</th><td[^>]*>pass: [0-9.e+-]+ of the static wheel load \(limit 1 of the static wheel load' "$tmp/scenario.html" ||
+  { grep -o 'wheel unloading[^<]*</th><td[^>]*>[^<]*' "$tmp/scenario.html" | head -2; fail "wheel unloading is not labelled as a fraction of the static wheel load"; }
+
+# The study folders (issue 39 item 6, issue 40 item 5): a convergence study, a sweep across two
+# branch changes of an SI model, and a sensitivity study of the report's model: each page's
+# charts drawn with the plotting library, without a script error; a screenshot of each.
 "$bin" converge "$src/verification/cases/damped_spring_mass.yaml" --t-end 0.5 --euler-dt 0.01 --euler-steps 3 --rtols 1e-3,1e-4 \
   --quantities displacement_rms --out "$tmp/converge" > /dev/null 2>&1 || fail "converge"
-"$bin" report "$tmp/converge" > /dev/null || fail "report of a converge folder"
-timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=3000 --dump-dom "file://$tmp/converge/report.html" > "$tmp/study.html" 2> "$tmp/chromium.log" ||
-  fail "chromium --dump-dom (study)"
-if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the study report (above)"; fi
-grep -q 'data-status="ran"' "$tmp/study.html" || fail "the study report's script did not run"
-grep -Eq '&quot;tables&quot;:[1-9][0-9]*,&quot;chart&quot;:true' "$tmp/study.html" || grep -Eq '"tables":[1-9][0-9]*,"chart":true' "$tmp/study.html" ||
-  { grep -o '<div id="self-check"[^<]*' "$tmp/study.html"; fail "the study report has no tables or no chart"; }
-echo "PASS: report opens in Chromium without errors; screenshot in $out/report_screenshot.png"
+"$bin" sweep "$src/models/examples/draft_gear_branches_si.yaml" --plan "$src/tests/report/branch_sweep_plan.yaml" --out "$tmp/sweep" \
+  > /dev/null 2>&1 || fail "sweep"
+"$bin" sensitivity "$src/models/report/final_two_car.yaml" --only P7,P17 --first-order --out "$tmp/sensitivity" > /dev/null 2>&1 ||
+  fail "sensitivity"
+for study in converge sweep sensitivity; do
+  "$bin" report "$tmp/$study" > /dev/null || fail "report of a $study folder"
+  timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=3000 --dump-dom "file://$tmp/$study/report.html" > "$tmp/$study.html" \
+    2> "$tmp/chromium.log" || fail "chromium --dump-dom ($study)"
+  if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the $study report (above)"; fi
+  timeout 120 "$chromium" "${flags[@]}" --window-size=1200,1400 --screenshot="$out/report_$study.png" "file://$tmp/$study/report.html" \
+    > /dev/null 2>&1 || fail "chromium --screenshot ($study)"
+  [ -s "$out/report_$study.png" ] || fail "no screenshot of the $study report"
+done
+"$node" - "$tmp" <<'JS' || fail "study pages (above)"
+const fs = require("fs");
+const tmp = process.argv[2];
+const problems = [];
+function selfCheck(study) {
+  const dom = fs.readFileSync(tmp + "/" + study + ".html", "utf8");
+  const m = dom.match(/<div id="self-check"[^>]*data-status="([a-z]+)"[^>]*>([^<]*)<\/div>/);
+  if (!m) { problems.push(study + ": the page's script did not run to the end"); return null; }
+  const check = JSON.parse(m[2].replace(/&quot;/g, '"').replace(/&lt;/g, "<").replace(/&gt;/g, ">").replace(/&amp;/g, "&"));
+  if (m[1] !== "ran" || check.errors.length) problems.push(study + ": script errors " + JSON.stringify(check.errors));
+  for (const c of check.charts || []) if (!(c.drawn && c.points > 0)) problems.push(study + ": chart " + c.id + " not drawn: " + JSON.stringify(c));
+  return check;
+}
+function csv(text) { return text.trim().split("\n").map((line) => line.match(/("([^"]|"")*"|[^,]*)(,|$)/g).map((f) => f.replace(/,$/, "").replace(/^"|"$/g, ""))); }
+// Converge: the SVG and the error against cost of displacement_rms, Euler's 3 runs and IDA's 2.
+const converge = selfCheck("converge");
+if (converge) {
+  if (!converge.chart || !(converge.tables > 0)) problems.push("converge: no tables or no converge.svg");
+  const c = converge.charts.find((q) => q.id === "converge:displacement_rms_error");
+  if (!c || c.series !== 2 || c.points !== 5) problems.push("converge: error against cost should have 2 methods and 5 runs: " + JSON.stringify(c));
+}
+// Sweep: each response against each factor (2 x 2), three branches, the two changes along the
+// fracture load at the midpoints of the levels between which runs.csv's branch changes, none along the mass.
+const sweep = selfCheck("sweep");
+if (sweep) {
+  const rows = csv(fs.readFileSync(tmp + "/sweep/runs.csv", "utf8"));
+  const h = rows[0], load = h.indexOf("elements.car2_draft_gear.fracture_load"), branch = h.indexOf("branch");
+  const branchAt = {};
+  for (const r of rows.slice(1)) (branchAt[r[load]] = branchAt[r[load]] || new Set()).add(r[branch]);
+  const expected = [];
+  const keys = Object.keys(branchAt).sort((a, b) => Number(a) - Number(b));
+  for (let k = 1; k < keys.length; ++k)
+    if ([...branchAt[keys[k]]].join() !== [...branchAt[keys[k - 1]]].join()) expected.push((Number(keys[k]) + Number(keys[k - 1])) / 2);
+  if (JSON.stringify(expected) !== JSON.stringify([1.1e6, 1.25e6])) problems.push("sweep: runs.csv's branches are not the plan's: " + JSON.stringify([...Object.entries(branchAt)].map(([k, v]) => [k, [...v]])));
+  if (!sweep.found || sweep.found.branches !== 3) problems.push("sweep: 3 branches expected: " + JSON.stringify(sweep.found));
+  if (sweep.charts.length !== 4) problems.push("sweep: 4 charts expected (R1, R2 against 2 factors): " + sweep.charts.map((c) => c.id));
+  for (const response of ["R1", "R2"]) {
+    const along = sweep.charts.find((c) => c.id === "sweep:" + response + ":elements.car2_draft_gear.fracture_load");
+    const mass = sweep.charts.find((c) => c.id === "sweep:" + response + ":bodies.car1.mass");
+    if (!along || JSON.stringify(along.marks) !== JSON.stringify(expected)) problems.push("sweep: branch changes along the load " + JSON.stringify(along && along.marks));
+    if (!along || along.series !== 4 || along.points !== 8 + 4) problems.push("sweep: a point per run on 3 branch series plus 4 means: " + JSON.stringify(along));
+    if (!mass || mass.marks.length !== 0) problems.push("sweep: a branch change along the mass: " + JSON.stringify(mass));
+  }
+  if (!(sweep.headings >= 3)) problems.push("sweep: summary.md's headings not rendered as headings: " + sweep.headings);
+}
+// Sensitivity: a tornado chart per response, its bars in the order of |first-order coefficient|.
+const sensitivity = selfCheck("sensitivity");
+if (sensitivity) {
+  const rows = csv(fs.readFileSync(tmp + "/sensitivity/sensitivity_first_order.csv", "utf8"));
+  const flagged = new Set(csv(fs.readFileSync(tmp + "/sensitivity/sensitivity_branches.csv", "utf8")).slice(1).map((r) => r[1]));
+  for (const [c, response] of [[2, "R1"], [3, "R2"], [4, "R3"]]) {
+    const terms = rows.slice(1).filter((r) => r[0] !== "1").sort((a, b) => Math.abs(Number(b[c])) - Math.abs(Number(a[c])));
+    const order = terms.map((r) => r[0] + (flagged.has(r[0]) ? " *" : ""));
+    const chart = sensitivity.charts.find((q) => q.id === "tornado:" + response);
+    if (!chart || JSON.stringify(chart.order) !== JSON.stringify(order)) problems.push("sensitivity: tornado " + response + " order " + JSON.stringify(chart && chart.order) + ", expected " + JSON.stringify(order));
+  }
+  if (!(sensitivity.headings >= 3)) problems.push("sensitivity: sensitivity.md's headings not rendered: " + sensitivity.headings);
+}
+if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
+console.log("study pages ok: converge, sweep (" + sweep.charts.length + " charts), sensitivity (" + sensitivity.charts.length + " tornado charts)");
+JS
+echo "PASS: report and study pages open in Chromium without errors; screenshots in $out/report_*.png"

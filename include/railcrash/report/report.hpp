@@ -10,14 +10,28 @@
 // style and the plotting library the build fetched from npm (assets.hpp), so it opens
 // without network access.
 //
+// A run with --format hdf5 (results/hdf5_file.hpp) has timeseries.h5 in place of
+// timeseries.csv, accelerations.csv, energy.csv and events.csv: the report reads its tables
+// (Hdf5Reader, the library loaded at run time as for writing) and shows the same page; its run
+// id is the file's run_id attribute. A timeseries.h5 that cannot be opened (cut short, not
+// HDF5) or lacks the timeseries table throws InputError naming the file and HDF5's reason.
+//
 // Plotted bodies: the car bodies (names containing "body"), else every body. Element forces:
 // every element output named force, *_force; the crash elements (anticlimber, crush_spring,
 // draft_gear, coupler_end, couplings) are shown first and get force-deformation loops. Long
 // series are decimated with decimate_minmax (peaks kept), animation frames uniformly.
 //
-// A folder of `railcrash converge`, `sensitivity` or `readings` (converge.csv, sensitivity.csv or
-// readings.csv, no timeseries.csv) gets a page of its Markdown summaries and CSV files as
-// tables, and the convergence chart (converge.svg).
+// A folder of `railcrash converge`, `sensitivity`, `readings` or `sweep` (converge.csv,
+// sensitivity.csv, readings.csv or runs.csv, no timeseries.csv) gets a page of its Markdown
+// summaries (headings as headings) and CSV files as tables, the convergence chart
+// (converge.svg), and charts the page draws from the CSV files with the plotting library
+// (page/report.js): a sweep's responses against each factor with the main effects, points
+// coloured by runs.csv's branch (issue 40) and branch changes marked; a sensitivity study's
+// tornado charts (sensitivity_first_order.csv, sensitivity_branches.csv); a convergence study's
+// error against cost (converge.csv). Columns are found by name: extra columns are shown in
+// the tables and left out of the charts.
+//
+// options.pdf: the page is also printed to report.pdf (report/pdf.hpp).
 //
 // The header shows the run's provenance (results/provenance.hpp) from summary.json.
 //
@@ -42,6 +56,7 @@ struct ReportOptions {
   double force_cfc = 60.0;             // channel frequency class of the element force plot (0: unfiltered)
   std::size_t max_plot_points = 4000;  // per series
   std::size_t max_frames = 1000;       // animation frames (fewer for very large models)
+  bool pdf = false;                    // also print the page to report.pdf (report/pdf.hpp: headless Chromium)
 };
 
 struct ReportResult {
@@ -49,6 +64,7 @@ struct ReportResult {
   std::vector<std::string> problems;  // shown at the top of the page
   std::size_t rows = 0;               // complete rows of timeseries.csv
   std::string study;                  // "converge", "sensitivity" or "readings" for a study folder (rows: its files)
+  std::string pdf_path;               // RUN_DIR/report.pdf when options.pdf
 };
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options = {});

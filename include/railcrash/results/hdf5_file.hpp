@@ -83,4 +83,47 @@ class Hdf5File {
   bool fail(const std::string& what);
 };
 
+/// A numeric table of timeseries.h5 read back (compound or matrix layout alike).
+struct Hdf5Table {
+  bool found = false;                       // false: the file has no dataset of that name
+  std::vector<std::string> columns;         // names, in the CSV file's order
+  std::vector<std::vector<double>> values;  // per column, one value per row
+  std::size_t rows = 0;
+};
+
+/// One row of the events table read back.
+struct Hdf5Event {
+  double t = 0.0;  // [time]
+  std::string element, event;
+  double value = 0.0;
+};
+
+/// Reads back what Hdf5File wrote (`railcrash report` of a --format hdf5 run folder), with the
+/// library loaded as for writing. Every failure is an InputError naming the file (and the
+/// table) with HDF5's innermost message and what to do: a truncated or damaged file cannot be
+/// opened, a table of the wrong kind is refused.
+class Hdf5Reader {
+ public:
+  /// Opens path read-only. Throws InputError when it cannot (not an HDF5 file, truncated, no HDF5 in this build).
+  explicit Hdf5Reader(const std::string& path);
+  ~Hdf5Reader();
+  Hdf5Reader(const Hdf5Reader&) = delete;
+  Hdf5Reader& operator=(const Hdf5Reader&) = delete;
+
+  /// A text attribute of the file (root group); "" when there is none.
+  std::string attribute(const std::string& name) const;
+  /// A numeric table whole; found false when the file has none of that name. A table of more
+  /// than max_bytes of values is an InputError (the report's memory limit, report/folder_file.hpp).
+  Hdf5Table table(const std::string& name, std::uint64_t max_bytes) const;
+  /// The events table (t, element, event, value), at most max_rows of its first rows; found false when there is none.
+  std::vector<Hdf5Event> events(const std::string& name, std::size_t max_rows, bool* found) const;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  [[maybe_unused]] std::int64_t file_ = -1;  // hid_t
+  /// Throws InputError "'path' [table]: what (HDF5: reason); advice".
+  [[noreturn]] void fail(const std::string& what) const;
+};
+
 }  // namespace railcrash

@@ -30,7 +30,6 @@
   var model = parseBlock("model-json", problems);
   problems = (data.problems || []).concat(problems);
   var check = {errors: window.railcrashErrors, plots: [], frames: null};
-  if (data.study) { studyReport(); return; }
 
   // ---------------------------------------------------------------- a study folder (converge, readings, sensitivity, sweep)
   function csvRows(text) {  // RFC 4180 fields
@@ -58,6 +57,287 @@
     });
     return t;
   }
+  // The charts of a study page (uPlot): a sweep's responses against each factor with the main
+  // effect (the mean at each level) and the points coloured by discrete outcome (runs.csv's
+  // branch, issue 40) with every branch change marked; a sensitivity study's tornado chart of
+  // first-order effects per response; a convergence study's error against cost.
+  var studyPalette = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+  var studyCharts = [];
+  function isNumber(text) { return text !== undefined && text !== null && String(text).trim() !== "" && isFinite(Number(text)); }
+  function studyChart(container, id, options, columns, note, extra) {
+    var box = el("div", {"class": "plot study-chart"});
+    container.appendChild(box);
+    var u = new uPlot(options, columns, box);
+    if (note) box.appendChild(el("div", {"class": "note"}, note));
+    var points = 0;
+    columns.slice(1).forEach(function (c) { c.forEach(function (v) { if (v !== null && v !== undefined) ++points; }); });
+    var entry = {id: id, series: columns.length - 1, points: points, drawn: !!u.ctx};
+    for (var k in extra || {}) entry[k] = extra[k];
+    studyCharts.push(entry);
+    return entry;
+  }
+  function verticalMarks(marks, colour, text) {  // uPlot draw hook: dashed vertical lines at x values, labelled
+    return function (u) {
+      var c = u.ctx;
+      marks.slice().sort(function (a, b) { return a - b; }).forEach(function (x, k) {
+        var px = u.valToPos(x, "x", true);
+        if (!isFinite(px)) return;
+        c.save();
+        c.strokeStyle = colour;
+        c.lineWidth = 2 * (window.devicePixelRatio || 1);
+        c.setLineDash([6, 4]);
+        c.beginPath();
+        c.moveTo(px, u.bbox.top);
+        c.lineTo(px, u.bbox.top + u.bbox.height);
+        c.stroke();
+        c.fillStyle = colour;
+        c.font = Math.round(11 * (window.devicePixelRatio || 1)) + "px sans-serif";
+        c.fillText(text, px + 4, u.bbox.top + (14 + 14 * (k % 3)) * (window.devicePixelRatio || 1));  // staggered: close marks stay legible
+        c.restore();
+      });
+    };
+  }
+
+  // An axis whose tick labels stay short: values of 1e5 and more (or below 1e-3) in units of a power of ten named in its label.
+  function scaledAxis(label, values, extra) {
+    var largest = 0;
+    values.forEach(function (v) { if (isFinite(v) && Math.abs(v) > largest) largest = Math.abs(v); });
+    var exponent = largest >= 1e5 || (largest > 0 && largest < 1e-3) ? Math.floor(Math.log10(largest)) : 0;
+    var axis = {label: label + (exponent ? " [x 1e" + exponent + "]" : ""), values: tickLabels(Math.pow(10, -exponent))};
+    for (var k in extra || {}) axis[k] = extra[k];
+    return axis;
+  }
+  function logLabels(u, splits) {  // a log axis: 0.01 ... 1000 as numbers, else 1e-5
+    return splits.map(function (v) {
+      if (v === null || v === undefined || !(v > 0)) return "";
+      return v >= 0.01 && v < 1e4 ? String(Number(v.toPrecision(3))) : v.toExponential(0).replace("e+", "e");
+    });
+  }
+
+  function sweepCharts(box, rows) {
+    var header = rows[0] || [], body = rows.slice(1).filter(function (r) { return r.length === header.length; });
+    var iHash = header.indexOf("hash"), iStatus = header.indexOf("status"), iWall = header.indexOf("wall_seconds");
+    var iBranch = header.indexOf("branch"), iRun = header.indexOf("run");
+    if (iHash < 0 || iStatus < 0) return {};
+    var notResponses = {integrator_used: true, euler_from_t: true, wall_seconds: true, message: true, outcomes: true, branch: true};
+    var factors = [], responses = [];
+    for (var f = iHash + 1; f < iStatus; ++f) factors.push(f);
+    for (var r = iStatus + 1; r < (iWall > iStatus ? iWall : header.length); ++r)
+      if (!notResponses[header[r]]) responses.push(r);
+    var ok = body.filter(function (row) { return row[iStatus] === "ok"; });
+    responses = responses.filter(function (r) { return ok.some(function (row) { return isNumber(row[r]); }); });
+    // Branches: run 0's first, then in order of appearance.
+    var branches = [], branchOf = function (row) { return iBranch >= 0 ? row[iBranch] : ""; };
+    var base = ok.filter(function (row) { return row[iRun] === "0"; })[0];
+    if (base) branches.push(branchOf(base));
+    ok.forEach(function (row) { if (branches.indexOf(branchOf(row)) < 0) branches.push(branchOf(row)); });
+    var colourOf = function (b) { return studyPalette[branches.indexOf(b) % studyPalette.length]; };
+    box.appendChild(el("h2", {}, "Responses against each factor"));
+    var intro = "Each chart: one response against one factor; a point per ok run, coloured by its discrete outcome (runs.csv, column branch); " +
+                "the black line is the main effect (the response's mean over the runs at each level of the factor).";
+    if (branches.length > 1) intro += " A red dashed line marks a branch change: two runs that differ only in this factor end on different branches " +
+                                      "between these levels, and a response may jump there (a finite difference across it is not a sensitivity).";
+    box.appendChild(el("p", {}, intro));
+    if (iBranch >= 0) {
+      var legend = el("div", {"class": "branch-legend"});
+      branches.forEach(function (b, k) {
+        var count = ok.filter(function (row) { return branchOf(row) === b; }).length;
+        var line = el("div");
+        var swatch = el("span", {"class": "swatch-dot"});
+        swatch.style.background = colourOf(b);
+        line.appendChild(swatch);
+        line.appendChild(el("span", {}, "branch " + (k + 1) + (k === 0 && base ? " (run 0's)" : "") + ", " + count + " run" + (count === 1 ? "" : "s") + ": "));
+        line.appendChild(el("code", {}, b || "(none)"));
+        legend.appendChild(line);
+      });
+      box.appendChild(legend);
+    }
+    var chartsBox = el("div");
+    box.appendChild(chartsBox);
+    var changes = 0, charts = 0;
+    factors.forEach(function (fi) {
+      var numeric = ok.every(function (row) { return isNumber(row[fi]); });
+      var levels = [];
+      ok.forEach(function (row) { if (levels.indexOf(row[fi]) < 0) levels.push(row[fi]); });
+      if (numeric) levels.sort(function (a, b) { return Number(a) - Number(b); });
+      var xOf = function (row) { return numeric ? Number(row[fi]) : levels.indexOf(row[fi]); };
+      // Branch changes along this factor: runs equal in every other factor, adjacent in this one, on different branches.
+      var groups = {};
+      ok.forEach(function (row) {
+        var key = factors.filter(function (g) { return g !== fi; }).map(function (g) { return row[g]; }).join("\u0001");
+        (groups[key] = groups[key] || []).push(row);
+      });
+      var marks = [];
+      Object.keys(groups).forEach(function (key) {
+        var g = groups[key].slice().sort(function (a, b) { return xOf(a) - xOf(b); });
+        for (var k = 1; k < g.length; ++k)
+          if (branchOf(g[k]) !== branchOf(g[k - 1]) && xOf(g[k]) !== xOf(g[k - 1])) {
+            var mid = (xOf(g[k]) + xOf(g[k - 1])) / 2;
+            if (marks.indexOf(mid) < 0) marks.push(mid);
+          }
+      });
+      changes += marks.length;
+      responses.forEach(function (ri) {
+        if (charts >= 40) return;
+        var runs = ok.filter(function (row) { return isNumber(row[ri]); }).sort(function (a, b) { return xOf(a) - xOf(b); });
+        if (!runs.length) return;
+        ++charts;
+        var xs = runs.map(xOf);
+        var columns = [xs];
+        var mean = xs.map(function () { return null; });
+        levels.forEach(function (level) {
+          var at = runs.filter(function (row) { return row[fi] === level; });
+          if (!at.length) return;
+          var sum = 0;
+          at.forEach(function (row) { sum += Number(row[ri]); });
+          mean[runs.indexOf(at[0])] = sum / at.length;
+        });
+        columns.push(mean);
+        var series = [{label: header[fi]}, {label: "main effect (mean)", stroke: "#222", width: 1.5, spanGaps: true, points: {show: false}}];
+        branches.forEach(function (b, k) {
+          columns.push(runs.map(function (row) { return branchOf(row) === b ? Number(row[ri]) : null; }));
+          series.push({label: "branch " + (k + 1), stroke: colourOf(b), fill: colourOf(b), paths: function () { return null; },
+                       points: {show: true, size: 9, space: 0, fill: colourOf(b), stroke: colourOf(b)}});
+        });
+        var xAxis = scaledAxis(header[fi], xs);
+        var xScale = {time: false};
+        if (!numeric) {
+          xAxis.values = function (u, splits) { return splits.map(function (v) { return levels[v] !== undefined && v === Math.round(v) ? levels[v] : ""; }); };
+          xAxis.splits = function () { return levels.map(function (l, k) { return k; }); };
+          xScale.range = [-0.5, levels.length - 0.5];
+        } else {
+          // Padded beyond the first and last level: uPlot finds the points in view by searching x, and with
+          // several runs at the last level (equal x) it would stop at the first of them.
+          var low = xs[0], high = xs[xs.length - 1], pad = high > low ? 0.06 * (high - low) : Math.abs(low || 1) * 0.1;
+          xScale.range = [low - pad, high + pad];
+        }
+        studyChart(chartsBox, "sweep:" + header[ri] + ":" + header[fi], {
+          title: header[ri] + " against " + header[fi], width: 480, height: 300,
+          scales: {x: xScale}, axes: [xAxis, scaledAxis(header[ri], runs.map(function (row) { return Number(row[ri]); }), {size: 70})],
+          series: series, legend: {live: false}, cursor: {drag: {x: false, y: false}},
+          hooks: {draw: [verticalMarks(marks, "#c00", "branch change")]}
+        }, columns, marks.length ? marks.length + " branch change" + (marks.length === 1 ? "" : "s") + " along " + header[fi] : "",
+           {marks: marks.slice().sort(function (a, b) { return a - b; })});
+      });
+    });
+    return {branches: branches.length, changes: changes};
+  }
+
+  function tornadoCharts(box, files) {
+    var first = files["sensitivity_first_order.csv"];
+    if (!first) return {};
+    var rows = csvRows(first.text), header = rows[0] || [];
+    var terms = rows.slice(1).filter(function (r) { return r.length === header.length && r[0] !== "1"; });
+    var branchRows = files["sensitivity_branches.csv"] ? csvRows(files["sensitivity_branches.csv"].text) : [];
+    var bHeader = branchRows[0] || [], branchByParameter = {};
+    branchRows.slice(1).forEach(function (r) { if (r.length === bHeader.length) branchByParameter[r[bHeader.indexOf("parameter")]] = r; });
+    box.appendChild(el("h2", {}, "Tornado charts: first-order effects"));
+    box.appendChild(el("p", {}, "Each response's first-order coefficients (sensitivity_first_order.csv: the change of the response for a unit change " +
+      "of the parameter's scale factor), largest magnitude on top." + (Object.keys(branchByParameter).length ?
+      " A parameter marked * crosses a branch change (sensitivity_branches.csv): its grey bar is the effect within run 0's branch." : "")));
+    var chartsBox = el("div");
+    box.appendChild(chartsBox);
+    var responses = 0;
+    header.forEach(function (response, c) {  // (a function per response: the axis callbacks keep their own names)
+      if (c < 2) return;
+      var list = terms.filter(function (r) { return isNumber(r[c]); }).map(function (r) {
+        var b = branchByParameter[r[0]], within = b ? b[bHeader.indexOf("within_" + header[c])] : undefined;
+        return {name: r[0] + (b ? " *" : ""), value: Number(r[c]), within: isNumber(within) ? Number(within) : null};
+      });
+      list.sort(function (a, b) { return Math.abs(b.value) - Math.abs(a.value); });
+      list = list.slice(0, 25);
+      if (!list.length) return;
+      ++responses;
+      var names = list.map(function (e) { return e.name; });
+      var index = list.map(function (e, k) { return k; });
+      var positive = list.map(function (e) { return e.value >= 0 ? e.value : null; });
+      var negative = list.map(function (e) { return e.value < 0 ? e.value : null; });
+      var within = list.map(function (e) { return e.within; });
+      var series = [{label: "parameter"},
+        {label: "increases " + header[c], fill: "#d62728", stroke: "#d62728", paths: uPlot.paths.bars({size: [0.7, 60]}), points: {show: false}},
+        {label: "decreases " + header[c], fill: "#1f77b4", stroke: "#1f77b4", paths: uPlot.paths.bars({size: [0.7, 60]}), points: {show: false}}];
+      var columns = [index, positive, negative];
+      if (within.some(function (v) { return v !== null; })) {
+        series.push({label: "within run 0's branch", fill: "rgba(90,90,90,0.75)", stroke: "#333", paths: uPlot.paths.bars({size: [0.3, 30]}), points: {show: false}});
+        columns.push(within);
+      }
+      studyChart(chartsBox, "tornado:" + header[c], {
+        title: header[c] + ": first-order effects", width: 520, height: 60 + 24 * list.length,
+        scales: {x: {time: false, ori: 1, dir: -1, range: [-0.5, list.length - 0.5]}, y: {ori: 0, dir: 1}},
+        axes: [{side: 3, size: 110, gap: 4, splits: function () { return index; },
+                values: function (u, splits) { return splits.map(function (v) { return names[v] || ""; }); }, grid: {show: false}},
+               {side: 2, label: "first-order coefficient", values: tickLabels(1)}],
+        series: series, legend: {live: false}, cursor: {show: false}
+      }, columns, "", {order: names});
+    });
+    return {responses: responses, flagged: Object.keys(branchByParameter).length};
+  }
+
+  function convergeCharts(box, rows) {
+    var header = rows[0] || [], body = rows.slice(1).filter(function (r) { return r.length === header.length && r[header.indexOf("status")] === "ok"; });
+    var iMethod = header.indexOf("method"), iCost = header.indexOf("residual_evaluations"), iWall = header.indexOf("wall_s");
+    if (iMethod < 0 || iCost < 0) return {};
+    var quantities = header.filter(function (h) { return /_error$/.test(h); }).filter(function (h) {
+      var i = header.indexOf(h);
+      return body.some(function (r) { return r[iMethod] !== "reference" && isNumber(r[i]) && Number(r[i]) > 0; });
+    });
+    box.appendChild(el("h2", {}, "Error against cost"));
+    box.appendChild(el("p", {}, "Each quantity's relative error against the reference run, over the residual evaluations each run took (log-log): " +
+      "one line per method (Euler at its steps, IDA at its tolerances); further down and to the left is better."));
+    var chartsBox = el("div");
+    box.appendChild(chartsBox);
+    var methods = [];
+    body.forEach(function (r) { if (r[iMethod] !== "reference" && methods.indexOf(r[iMethod]) < 0) methods.push(r[iMethod]); });
+    quantities.forEach(function (q) {
+      var iq = header.indexOf(q);
+      var runs = body.filter(function (r) { return r[iMethod] !== "reference" && isNumber(r[iq]) && Number(r[iq]) > 0 && Number(r[iCost]) > 0; });
+      runs.sort(function (a, b) { return Number(a[iCost]) - Number(b[iCost]); });
+      if (!runs.length) return;
+      var columns = [runs.map(function (r) { return Number(r[iCost]); })];
+      var series = [{label: "residual evaluations"}];
+      methods.forEach(function (m, k) {
+        columns.push(runs.map(function (r) { return r[iMethod] === m ? Number(r[iq]) : null; }));
+        series.push({label: m, stroke: studyPalette[k % studyPalette.length], width: 2, spanGaps: true,
+                     points: {show: true, size: 7, space: 0, fill: studyPalette[k % studyPalette.length]}});
+      });
+      studyChart(chartsBox, "converge:" + q, {
+        title: q.replace(/_error$/, "") + ": relative error against cost", width: 520, height: 320,
+        scales: {x: {time: false, distr: 3}, y: {distr: 3}},
+        axes: [{label: "residual evaluations", values: logLabels}, {label: "relative error", size: 70, values: logLabels}],
+        series: series, legend: {live: false}
+      }, columns);
+    });
+    return {quantities: quantities.length};
+  }
+
+  // Markdown: headings as headings, tables as tables, the rest as paragraphs with `code` spans (text, never markup).
+  function markdown(box, text) {
+    var lines = text.split("\n"), pending = [], tables = 0;
+    function flush() { if (pending.length) { box.appendChild(table(pending)); ++tables; pending = []; } }
+    function paragraph(tag, line) {
+      var node = el(tag);
+      line.split("`").forEach(function (part, k) {
+        if (k % 2) node.appendChild(el("code", {}, part));
+        else node.appendChild(document.createTextNode(part.replace(/\*\*/g, "")));
+      });
+      return node;
+    }
+    lines.forEach(function (line) {
+      var trimmed = line.trim();
+      if (trimmed.charAt(0) === "|") {
+        if (/^\|[\s|:-]+\|$/.test(trimmed)) return;  // the separator row
+        pending.push(trimmed.replace(/^\||\|$/g, "").split("|").map(function (c) { return c.trim(); }));
+        return;
+      }
+      flush();
+      var heading = /^(#{1,6})\s+(.*)$/.exec(trimmed);
+      if (heading) box.appendChild(paragraph("h" + Math.min(6, heading[1].length + 2), heading[2]));  // under the page's h1 and the file's h2
+      else if (trimmed) box.appendChild(paragraph("p", trimmed));
+    });
+    flush();
+    return tables;
+  }
+
   function studyReport() {
     ["animation-section", "plots-section", "loops-section", "zones-section", "energy-section"].forEach(function (id) {
       document.getElementById(id).hidden = true;
@@ -68,9 +348,24 @@
                                   " study: " + data.run_dir));
     var box = el("section");
     document.body.insertBefore(box, document.getElementById("footer"));
+    var files = {};
+    data.files.forEach(function (file) { files[file.name] = file; });
+    var found = {};
+    if (typeof window.uPlot !== "function") {
+      box.appendChild(el("p", {"class": "no-library"}, "This railcrash was built without its plotting library (npm was not available when it " +
+        "was built): the study's charts are left out."));
+    } else {
+      try {
+        if (data.study === "sweep" && files["runs.csv"]) found = sweepCharts(box, csvRows(files["runs.csv"].text));
+        if (data.study === "sensitivity") found = tornadoCharts(box, files);
+        if (data.study === "converge" && files["converge.csv"]) found = convergeCharts(box, csvRows(files["converge.csv"].text));
+      } catch (e) {
+        window.railcrashErrors.push("study charts: " + e.message);
+      }
+    }
     var tables = 0;
     if (data.chart) {
-      box.appendChild(el("h2", {}, "Error against cost"));
+      box.appendChild(el("h2", {}, "Convergence chart (converge.svg)"));
       box.appendChild(el("img", {src: data.chart, alt: "converge.svg"}));
     }
     data.files.forEach(function (file) {
@@ -80,26 +375,16 @@
         ++tables;
         return;
       }
-      // Markdown: its tables as tables, the rest as paragraphs (text, never markup).
-      var lines = file.text.split("\n"), pending = [];
-      function flush() { if (pending.length) { box.appendChild(table(pending)); ++tables; pending = []; } }
-      lines.forEach(function (line) {
-        var trimmed = line.trim();
-        if (trimmed.charAt(0) === "|") {
-          if (/^\|[\s|:-]+\|$/.test(trimmed)) return;  // the separator row
-          pending.push(trimmed.replace(/^\||\|$/g, "").split("|").map(function (c) { return c.trim(); }));
-          return;
-        }
-        flush();
-        if (trimmed) box.appendChild(el("p", {}, trimmed.replace(/^#+\s*/, "")));
-      });
-      flush();
+      tables += markdown(box, file.text);
     });
     document.getElementById("footer").textContent = "railcrash report of a " + data.study + " folder";
     var selfCheck = document.getElementById("self-check");
-    selfCheck.textContent = JSON.stringify({errors: window.railcrashErrors, study: data.study, tables: tables, chart: !!data.chart});
+    selfCheck.textContent = JSON.stringify({errors: window.railcrashErrors, study: data.study, tables: tables, chart: !!data.chart,
+                                            charts: studyCharts, found: found, headings: box.querySelectorAll("h3, h4, h5").length});
     selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
   }
+
+  if (data.study) { studyReport(); return; }
 
   // ---------------------------------------------------------------- header and problems
   var units = (summary && summary.units) || {};
@@ -184,9 +469,10 @@
             sc.pass ? "status-ok" : "status-failed");
         (sc.criteria || []).forEach(function (c) {
           var g = c.criterion === "mean_deceleration";
-          var unit = g ? " g" : " " + lengthUnit;
+          // wheel unloading is (Q0 - Q) / Q0, a fraction of the static wheel load (scenario/criteria.hpp), not a length
+          var unit = g ? " g" : c.criterion === "wheel_unloading" ? " of the static wheel load" : " " + lengthUnit;
           var value = g ? c.value_g : c.value, limit = g ? c.limit_g : c.limit;
-          row(c.criterion.replace("_", " ") + ": " + c.subject,
+          row(c.criterion.replace(/_/g, " ") + ": " + c.subject,
               (c.pass ? "pass" : "FAIL") + ": " + fmt(value, 4) + unit + " (limit " + fmt(limit, 4) + unit + ", margin " + fmt(limit - value, 4) + unit + ")" +
               (c.note ? "; " + c.note : ""), c.pass ? "status-ok" : "status-failed");
         });
