@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 #include "railcrash/element_registry.hpp"
 #include "railcrash/error.hpp"
@@ -199,15 +200,25 @@ class Editor {
       for (const YAML::Node& item : node) out.push_back(copy(item, line, inside_setting || setting_of_(node)));
     } else if (node.IsMap()) {
       const bool set = inside_setting || setting_of_(node);
-      for (const auto& entry : node) {
-        const YAML::Node key = copy(entry.first, line, set);
-        out.force_insert(key, copy(entry.second, line_of(entry.first) ? line_of(entry.first) : line, set));
-      }
+      for (const auto& entry : node)
+        out.force_insert(shared_key(entry.first, line, set), copy(entry.second, line_of(entry.first) ? line_of(entry.first) : line, set));
     }
     expansion_.add(out, line, note);
     if (!inside_setting)
       if (const std::string* setting = setting_of_(node)) mark_(out, *setting);
     return out;
+  }
+
+  /// A map's key for a copy: the key itself, shared by every copy of its map, since nothing edits
+  /// a key in place (a third of a car's nodes are keys: copying them was a third of the
+  /// expansion's time). Its origin is registered once, with the instance that copied it first:
+  /// a key's error (unknown, given twice) is the same in every instance, and the loader reads the
+  /// instances in the order they were placed, so it meets it in that one. An emitter would write
+  /// shared nodes as anchors and aliases: the expanded text is written from unshared_copy().
+  YAML::Node shared_key(const YAML::Node& key, int fallback_line, bool inside_setting) {
+    if (!key.IsScalar()) return copy(key, fallback_line, inside_setting);
+    if (registered_keys_.insert(&key.Scalar()).second) expansion_.add(key, line_of(key) ? line_of(key) : fallback_line, note);
+    return key;
   }
 
   /// A node the expansion made (the pool's), at `line`.
@@ -233,6 +244,7 @@ class Editor {
  private:
   YAML::Node pool_{YAML::NodeType::Sequence};
   std::size_t pooled_ = 0;
+  std::unordered_set<const void*> registered_keys_;  // the shared keys (by their data) whose origin is registered
   TrainExpansion& expansion_;
   const SettingOf& setting_of_;
   const MarkSetting& mark_;
@@ -739,6 +751,25 @@ bool apply_instance_setting(YAML::Node& root, const std::string& setting, const 
       }
   }
   return false;
+}
+
+YAML::Node unshared_copy(const YAML::Node& node) {
+  YAML::Node pool(YAML::NodeType::Sequence);  // every copy in one memory (as Editor::make)
+  std::size_t used = 0;
+  const std::function<YAML::Node(const YAML::Node&)> copy = [&](const YAML::Node& from) {
+    YAML::Node out = pool[used++];
+    out.SetStyle(from.Style());
+    if (from.IsScalar()) {
+      out = from.Scalar();
+    } else if (from.IsSequence()) {
+      for (const YAML::Node& item : from) out.push_back(copy(item));
+    } else if (from.IsMap()) {
+      for (const auto& entry : from) out.force_insert(copy(entry.first), copy(entry.second));
+    }
+    if (!from.Tag().empty()) out.SetTag(from.Tag());
+    return out;
+  };
+  return copy(node);
 }
 
 void expand_trains(YAML::Node& root, const std::string& file, TrainExpansion& expansion, const SettingOf& setting_of,
