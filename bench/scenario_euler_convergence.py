@@ -43,6 +43,29 @@ def first_reactions(folder, supports):
     return out
 
 
+def histories(folder, supports, interface):
+    """Per rail support: the lowest reaction after the first non-zero one (and its time) and the
+    largest; for the interface anticlimber: its vertical offset's largest and smallest value and
+    their times. From timeseries.csv (the output rows)."""
+    with open(folder / "timeseries.csv") as f:
+        rows = list(csv.reader(row for row in f if not row.startswith("#")))
+    header, rows = rows[0], rows[1:]
+    t = [float(r[0]) for r in rows]
+    out = {}
+    for s in supports:
+        c = header.index(s + ".normal_reaction")
+        q = [float(r[c]) for r in rows]
+        first = next(k for k, v in enumerate(q) if v != 0.0)
+        sign = 1.0 if q[first] > 0 else -1.0
+        later = [(sign * q[k], t[k]) for k in range(first + 1, len(q))]
+        out[s] = (min(later), max(later))
+    if interface and interface + ".vertical_offset" in header:
+        c = header.index(interface + ".vertical_offset")
+        v = [(float(r[c]), t[k]) for k, r in enumerate(rows)]
+        out[interface] = (max(v), min(v))
+    return out
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("binary")
@@ -91,6 +114,18 @@ def main():
         firsts = [first_reactions(folder, supports) for _, folder, _, _ in results]
         for s in supports:
             print("| %s | %s |" % (s, " | ".join("%.3g: %.6g" % f[s] if s in f else "-" for f in firsts)))
+        interface = next((c["subject"] for c in results[0][2]["scenario"]["criteria"] if c["criterion"] == "override"), "")
+        print("\nAfter it, from the output rows: each support's lowest and largest reaction [%s] (t [s]), and the interface's "
+              "vertical offset, largest and smallest [%s] (t [s]):\n" % (results[0][2]["units"]["force"], length))
+        print("| quantity | " + " | ".join(label for label, *_ in results) + " |")
+        print("|---|" + "---|" * len(results))
+        h = [histories(folder, supports, interface) for _, folder, _, _ in results]
+        for s in supports:
+            print("| %s lowest | %s |" % (s, " | ".join("%.7g (%.3g)" % x[s][0] for x in h)))
+            print("| %s largest | %s |" % (s, " | ".join("%.7g (%.3g)" % x[s][1] for x in h)))
+        if interface and interface in h[0]:
+            print("| %s vertical offset largest | %s |" % (interface, " | ".join("%.5g (%.3g)" % x[interface][0] for x in h)))
+            print("| %s vertical offset smallest | %s |" % (interface, " | ".join("%.5g (%.3g)" % x[interface][1] for x in h)))
 
 
 if __name__ == "__main__":
