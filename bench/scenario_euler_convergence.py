@@ -102,6 +102,8 @@ def main():
             cells.append("-" if c is None else "%.4g" % (c["value_g"] if criterion == "mean_deceleration" else c["value"]))
         print("| %s | %s | %s |" % (criterion, subject, " | ".join(cells)))
     print("| steps | | " + " | ".join(str(s["stats"]["steps"]) for _, _, s, _ in results) + " |")
+    print("| Euler's stability limit [s] | | " + " | ".join("%.3g" % s["stats"]["stability_limit"] if s["stats"].get("stability_limit") else "-"
+                                                      for _, _, s, _ in results) + " |")
     print("| last step [s] | | " + " | ".join("%.3g" % s["stats"]["last_step"] for _, _, s, _ in results) + " |")
     print("| integrator used | | " + " | ".join(s["integrator_used"]["method"] if s.get("integrator_used") else s["integrator"]
                                              for _, _, s, _ in results) + " |")
