@@ -656,10 +656,15 @@ ParsedSetting parse_setting(const std::string& setting, const std::string& where
   return out;
 }
 
-/// Sets (or scales) `key` of `holder` to the setting's value.
+/// Sets (or scales) `key` of `holder` to the setting's value. The key is marked as the setting's
+/// too, unless it was there already and `mark_existing_key` is false: an expanded instance's keys
+/// are its car type's own nodes, shared with every other instance (Editor::shared_key), and a
+/// setting on one instance must not claim them for the others' messages.
 void set_value(YAML::Node holder, const std::string& key, const ParsedSetting& s, const std::string& label,
-               const std::string& shown_key, const MarkSetting& mark) {
+               const std::string& shown_key, const MarkSetting& mark, bool mark_existing_key = true) {
   const std::string where = label + ": ";
+  const YAML::Node& view = holder;  // (const: looking never adds the key)
+  const bool mark_key = mark_existing_key || !view[key].IsDefined();
   if (s.scale) {
     double factor = 0.0, value = 0.0;
     try {
@@ -677,8 +682,9 @@ void set_value(YAML::Node holder, const std::string& key, const ParsedSetting& s
       throw ZeroScaledError(where + "'" + shown_key + "' is 0 in the model, so a factor changes nothing; "
                             "set a value with KEY=VALUE instead (or leave this parameter out)");
     holder[key] = number_text(value * factor);
-    for (const auto& entry : holder)
-      if (entry.first.IsScalar() && entry.first.Scalar() == key) mark(entry.first, label);
+    if (mark_key)
+      for (const auto& entry : holder)
+        if (entry.first.IsScalar() && entry.first.Scalar() == key) mark(entry.first, label);
     return;
   }
   YAML::Node value;
@@ -689,8 +695,9 @@ void set_value(YAML::Node holder, const std::string& key, const ParsedSetting& s
   }
   mark(value, label);
   holder[key] = value;
-  for (const auto& entry : holder)
-    if (entry.first.IsScalar() && entry.first.Scalar() == key) mark(entry.first, label);
+  if (mark_key)
+    for (const auto& entry : holder)
+      if (entry.first.IsScalar() && entry.first.Scalar() == key) mark(entry.first, label);
 }
 
 }  // namespace
@@ -746,7 +753,7 @@ bool apply_instance_setting(YAML::Node& root, const std::string& setting, const 
     if (!list || !list.IsSequence()) continue;
     for (const YAML::Node& item : list)
       if (item.IsMap() && item["name"] && item["name"].IsScalar() && item["name"].Scalar() == name) {
-        set_value(item, key.substr(dot + 1), parse_setting(setting, label + ": "), label, key, mark);
+        set_value(item, key.substr(dot + 1), parse_setting(setting, label + ": "), label, key, mark, false);
         return true;
       }
   }
