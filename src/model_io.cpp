@@ -1253,7 +1253,7 @@ ExpandedModel expand_model_file(const std::string& path, const std::vector<std::
   ExpandedModel out;
   out.cars = expansion.cars;
   YAML::Emitter emitter;
-  emitter << root;
+  emitter << unshared_copy(root);  // (the expansion shares keys: no anchors in the text)
   out.text = "# " + path + " with its car types and trains expanded (railcrash expand)\n" + std::string(emitter.c_str()) + "\n";
   return out;
 }

@@ -228,6 +228,35 @@ TEST_CASE("an error in a car type's element names the type's line and the instan
                         Contains("(interface type 'bar', line 18; coupling unitA.coupling1 (line 25))"));
 }
 
+TEST_CASE("a key's error in a car type names the type's line and the first instance, and the expanded text has no anchors", "[trains]") {
+  // The copies of a car type share its map keys (train_expansion.cpp, Editor::shared_key): an
+  // unknown key still names the type's line and the instance the loader meets first.
+  CHECK_THROWS_WITH(testing::model_from_text(replaced(kTrainModel, "unloading_stiffness: 1.0e5", "unloading_stifness: 1.0e5")),
+                    Contains("test.yaml:11: element 'unitA.car1.crush' (crush_spring): unknown key 'unloading_stifness'") &&
+                        Contains("(car type 'coach', line 6; instance unitA.car1, line 27)"));
+  CHECK_THROWS_WITH(testing::model_from_text(replaced(kTrainModel, "{name: nose, mass: 10,", "{name: nose, mas: 10,")),
+                    Contains("test.yaml:9: body 'unitA.car1.nose'") && Contains("unknown key 'mas'") &&
+                        Contains("(car type 'coach', line 6; instance unitA.car1, line 27)"));
+  CHECK_THROWS_WITH(testing::model_from_text(replaced(kTrainModel, "stiffness: 1.0e6", "stifness: 1.0e6")),
+                    Contains("test.yaml:20: element 'unitA.coupling1.spring' (linear_spring): unknown key 'stifness'") &&
+                        Contains("(interface type 'bar', line 18; coupling unitA.coupling1 (line 25))"));
+  // A setting on one instance does not claim the type's shared key for the other instances'
+  // messages: car1's unknown key still names the file's line, not car3's setting.
+  CHECK_THROWS_WITH(load_model_text(replaced(kTrainModel, "unloading_stiffness: 1.0e5", "unloading_stifness: 1.0e5"), "test.yaml",
+                                    {"unitA.car3.crush.unloading_stifness=2.0e5"}),
+                    Contains("test.yaml:11: element 'unitA.car1.crush' (crush_spring): unknown key 'unloading_stifness'") &&
+                        Contains("(car type 'coach', line 6; instance unitA.car1, line 27)"));
+  // An emitter writes a node reached twice as an anchor (&1) and aliases (*1): the expanded
+  // text is written from an unshared copy, each key spelled out in each instance.
+  const std::string text = expand_model_file(write_temp("railcrash_shared_keys.yaml", kTrainModel), {}).text;
+  CHECK(text.find('&') == std::string::npos);
+  CHECK(text.find('*') == std::string::npos);
+  std::size_t instances = 0;
+  for (auto at = text.find("unloading_stiffness: 1.0e5"); at != std::string::npos; at = text.find("unloading_stiffness: 1.0e5", at + 1))
+    ++instances;
+  CHECK(instances == 3);
+}
+
 TEST_CASE("settings address a car type (every instance) or one instance, the type's first", "[trains]") {
   const auto masses = [](const Model& m) {
     std::vector<double> out;

@@ -109,6 +109,11 @@ void apply_train_definition_setting(YAML::Node& root, const std::string& setting
 /// nothing) when no body or element of the document has the name before the last '.'.
 bool apply_instance_setting(YAML::Node& root, const std::string& setting, const std::string& label, const MarkSetting& mark);
 
+/// A copy of `node` in which no node is reached twice: the expansion shares map keys between
+/// the instances of a car type, which an emitter would write as anchors (&1) and aliases (*1);
+/// the expanded model is emitted from this copy.
+YAML::Node unshared_copy(const YAML::Node& node);
+
 /// Expands `root` in place (nothing happens to a document without car_types / trains);
 /// `file` names the model in messages; `setting_of`/`mark` carry settings' labels over to copies.
 /// Throws InputError "file:line: ..." for a bad definition.

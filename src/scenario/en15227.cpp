@@ -666,6 +666,7 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
   TrainExpansion expansion;
   expand_trains(doc, path, expansion, [](const YAML::Node&) -> const std::string* { return nullptr; },
                 [](const YAML::Node&, const std::string&) {});
+  doc.reset(unshared_copy(doc));  // (the expansion shares keys between instances: the text is written from doc)
   // The standing train and its rails (its points on ground) raised by the offset.
   const auto of_standing = [&](const YAML::Node& node) { return node["name"] && starts_with(node["name"].Scalar(), standing + "."); };
   for (YAML::Node b : doc["bodies"])
