@@ -66,6 +66,12 @@ class IdaIntegrator : public Integrator {
   /// Why IDA failed, in the model's terms: a non-finite residual's element or body, a
   /// singular configuration of the joints, the unknowns with the largest weighted errors.
   std::string explain_failure(int flag);
+  /// Whether element e's mode change at t_event (its load in the old modes `before`: at the
+  /// event and at t_n) leaves IDA's step to t_n within the local tolerances without a restart
+  /// (the lag test; see advance()). quadratures: at t_n.
+  bool lag_within_tolerance(int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
+                            const double* y_at_event, double t_n, const double* y_n, const double* quadratures,
+                            double weight_at_event = 0.5, double weight_at_n = 0.5) const;
   /// "; the largest force on it, F, comes from FILE:LINE: element 'NAME' (TYPE)" for body unknown k at t = 0.
   std::string largest_force_on(int k, const double* y) const;
 
