@@ -8,13 +8,18 @@ namespace railcrash {
 
 // ---- ModeTracker ----
 
-ModeTracker::ModeTracker(DaeSystem& system, std::vector<double> unknown_floor)
-    : system_(system), unknown_floor_(std::move(unknown_floor)) {
+ModeTracker::ModeTracker(DaeSystem& system, std::vector<double> unknown_floor) : system_(system) {
   const auto roots = static_cast<std::size_t>(system_.root_count());
   previous_.assign(roots, 0.0);
   now_.assign(roots, 0.0);
   on_boundary_.assign(roots, 0);
   y_probe_.assign(static_cast<std::size_t>(system_.size()), 0.0);
+  set_unknown_floor(std::move(unknown_floor));
+}
+
+void ModeTracker::set_unknown_floor(std::vector<double> unknown_floor) {
+  unknown_floor_ = std::move(unknown_floor);
+  unknown_floor_.resize(static_cast<std::size_t>(system_.size()), 0.0);
 }
 
 void ModeTracker::arm(double t, const double* y) {

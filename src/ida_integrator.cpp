@@ -42,11 +42,12 @@ std::string flag_name(int flag) {
 /// flagged too): a mode it enters sits on its own boundary, where round-off alone would decide
 /// whether it flips back. `rates_cache` keeps the consistent-rates solver's ordering between
 /// restarts of one run.
-void restart_state(DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
+void restart_state(ModeTracker& modes, double t, std::vector<double>& y, std::vector<double>& yp,
                    std::vector<EventRecord>& events, std::vector<char>& changed_elements, ConsistentRatesCache& rates_cache) {
+  const DaeSystem& system = modes.system();
   changed_elements.resize(system.model().elements().size(), 0);
   consistent_rates(system, t, y, yp, &rates_cache);
-  for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events, &changed_elements); ++pass)
+  for (int pass = 0; pass < 10 && modes.commit_boundary(t, y.data(), yp.data(), events, &changed_elements); ++pass)
     consistent_rates(system, t, y, yp, &rates_cache);
 }
 
@@ -119,11 +120,7 @@ struct IdaIntegrator::Impl {
   // The run in progress (IdaIntegrator::start sets them up, advance takes one step).
   double rtol = 0.0;
   double t_reached = 0.0;                   // IDA's last step (or restart) time
-  // The event layer (events.hpp): root functions and boundary bookkeeping across steps, the
-  // crossings of a step and their location on IDA's polynomial over it.
-  std::unique_ptr<ModeTracker> modes;
-  EventLocator locator;
-  IdaStepInterpolant interpolant{*this};
+  IdaStepInterpolant interpolant{*this};  // IDA's polynomial over its last step, for the event layer
   std::vector<EventRecord> events;
   ConsistentRatesCache rates_cache;  // the consistent-rates solver's ordering, kept between restarts
   bool at_start = true;  // no step taken since start()
@@ -147,7 +144,7 @@ struct IdaIntegrator::Impl {
   double non_finite_t = 0.0;
   std::vector<double> non_finite_y, non_finite_yp;
 
-  explicit Impl(const DaeSystem& s) : system(s), locator(s) {}
+  explicit Impl(const DaeSystem& s) : system(s) {}
   ~Impl() {
     if (ida) IDAFree(&ida);
     if (linear_solver) SUNLinSolFree(linear_solver);
@@ -411,7 +408,7 @@ void IdaIntegrator::start(double t_end) {
     std::vector<double> yp0;
     std::vector<EventRecord> start_events = settling_events;
     std::vector<char> changed_at_start;  // none yet
-    restart_state(system_, 0.0, y0, yp0, start_events, changed_at_start, impl.rates_cache);
+    restart_state(mode_tracker(), 0.0, y0, yp0, start_events, changed_at_start, impl.rates_cache);
     std::copy(y0.begin(), y0.end(), y);
     std::copy(yp0.begin(), yp0.end(), yp);
     const std::vector<double> ids = system_.differential_ids();
@@ -463,7 +460,7 @@ void IdaIntegrator::start(double t_end) {
     outputs_.assign(system_.output_names().size(), 0.0);
     outputs_current_ = false;
     // root_noise's floor: an unknown's rounding counts as at least its absolute tolerance's.
-    impl.modes = std::make_unique<ModeTracker>(system_, std::vector<double>(atol, atol + n));
+    mode_tracker().set_unknown_floor(std::vector<double>(atol, atol + n));
     impl.sweep.y.assign(static_cast<std::size_t>(n), 0.0);
     impl.sweep.g.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
     impl.sweep.outputs.assign(system_.output_names().size(), 0.0);
@@ -476,7 +473,7 @@ void IdaIntegrator::start(double t_end) {
     // crossing. Taken as it was, a root at exactly 0 (a crush zone touching at rest, not pushed
     // yet) was never "above zero before" and its contact went unseen until another element's
     // restart.
-    impl.modes->arm(0.0, y);
+    mode_tracker().arm(0.0, y);
   }
 }
 
@@ -504,8 +501,8 @@ double IdaIntegrator::advance(double t_end) {
   // are found again.
   const int root_count = system_.root_count();
   std::vector<EventRecord>& events = impl.events;
-  ModeTracker& modes = *impl.modes;
-  EventLocator& locator = impl.locator;
+  ModeTracker& modes = mode_tracker();
+  EventLocator& locator = event_locator();
   std::vector<Crossing>& crossings = locator.queue();
 
   double t_n = impl.t_reached;
@@ -637,7 +634,7 @@ double IdaIntegrator::advance(double t_end) {
         // their boundary there), quadratures interpolated to it.
         std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
         std::vector<char> changed_now = modes.changed_at(c.t);  // the elements that changed at c.t
-        restart_state(system_, c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
+        restart_state(mode_tracker(), c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
         report_events(events, y_restart.data());
         impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
         std::copy(y_restart.begin(), y_restart.end(), y);

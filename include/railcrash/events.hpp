@@ -56,8 +56,9 @@ struct Crossing {
 class ModeTracker {
  public:
   /// unknown_floor: per unknown of y, the magnitude below which its rounding counts as that
-  /// floor (IDA's absolute tolerances) for root_noise.
-  ModeTracker(DaeSystem& system, std::vector<double> unknown_floor);
+  /// floor (IDA's absolute tolerances) for root_noise; empty: none (zero).
+  ModeTracker(DaeSystem& system, std::vector<double> unknown_floor = {});
+  void set_unknown_floor(std::vector<double> unknown_floor);
 
   const DaeSystem& system() const { return system_; }
   int root_count() const { return system_.root_count(); }
@@ -94,6 +95,12 @@ class ModeTracker {
   /// mode changed.
   bool commit_all(double t, const double* y, const std::vector<int>& direction, std::vector<EventRecord>& events) {
     return system_.commit_roots(t, y, direction.data(), events);
+  }
+  /// At a (re)start at (t, y, y'): commits the roots that sit on their mode's boundary and are
+  /// about to leave it (DaeSystem::commit_boundary_roots); changed_elements as there.
+  bool commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
+                       std::vector<char>* changed_elements = nullptr) {
+    return system_.commit_boundary_roots(t, y, yp, events, changed_elements);
   }
   /// How often element e changed mode in this step.
   int changes_of(int e) const;
