@@ -282,6 +282,36 @@ struct IdaIntegrator::Impl {
     return std::max(own, std::min(kRestartStepFraction * step_before, kReachableMultiple * own));
   }
 
+  /// How a restart chooses IDA's first step from the step before it (none: IDA's own).
+  enum class FirstStep {
+    // After an event: a fraction of the step that crossed it (restart_first_step). IDA's own
+    // first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an impact, and it then
+    // climbs back at order 1, doubling per step, with a Jacobian at nearly every step (cj
+    // changes each time): 170 restarts in the 0.25 s two-car crash cost a tenth of its steps
+    // and half its Jacobians. It starts instead from a fraction of the step that crossed the
+    // event, a scale the solution has just shown; an impact faster than that is met by IDA's
+    // error test, which cuts the step. The fraction is measured (bench/README.md, "The first
+    // step after a restart"). The error test cuts at most 10 times, by 0.25 from the second
+    // cut on, so the start stays within kReachableMultiple of IDA's own: the step before a
+    // dropped ball touches a floor is its free flight's, 0.17 s, ten million times its first
+    // step in contact at rtol 1e-10 (tests/elements/test_contact.cpp).
+    AfterEvent,
+    // The same restart again after its first step failed: a tenth of the step before.
+    Retry,
+  };
+  /// The one way IDA restarts: from the state `from` holds (t, y, y', quadratures), in the
+  /// present modes; IDA's counters go to stats first (reinitialize).
+  void restart(const RestartRetry& from, FirstStep rule, double t_end, RunStatistics& stats) {
+    std::copy(from.y.begin(), from.y.end(), N_VGetArrayPointer(y));
+    std::copy(from.yp.begin(), from.yp.end(), N_VGetArrayPointer(yp));
+    std::copy(from.quad.begin(), from.quad.end(), N_VGetArrayPointer(quad));
+    reinitialize(from.t, t_end, stats);
+    double first_step = 0.0;  // IDA's own
+    if (from.step_before > 0.0)
+      first_step = rule == FirstStep::Retry ? 0.1 * from.step_before : restart_first_step(from.step_before, from.t, t_end);
+    check(IDASetInitStep(ida, first_step), "IDASetInitStep");
+  }
+
   static void error_handler(int, const char* module, const char* function, char* message, void* user) {
     auto* self = static_cast<Impl*>(user);
     self->last_sundials_message = std::string(module) + "/" + function + ": " + message;
@@ -477,38 +507,36 @@ void IdaIntegrator::start(double t_end) {
   }
 }
 
+// ---- events: located element by element on IDA's interpolating polynomial ----
+// IDA's own root finding evaluates every root function of the model several times per located
+// root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here IDA takes one
+// step at a time (IDA_ONE_STEP); after each step the root functions are evaluated once (~ N),
+// and only a root that fell through zero during the step is located (events.hpp:
+// EventLocator): on the polynomial IDA itself interpolates with over the step, written as its
+// Taylor series at t_n (derivatives from IDAGetDky), evaluated only for the unknowns its
+// element reads (Illinois method, to IDA's own root tolerance 100 eps max(|t|, h)). Events are
+// committed in time order. IDA's solution is already at t_n, computed with the old laws over
+// [t_event, t_n]: when the new law agrees with the old one there within the local tolerance
+// (a kink: a stiffness changes, the force does not jump), IDA goes on as over any non-smooth
+// right-hand side; a jump (rupture, joint failure, preload) restarts from consistent values
+// at t_event, and the later crossings of that step are found again.
 double IdaIntegrator::advance(double t_end) {
   Impl& impl = *impl_;
   outputs_current_ = false;  // (until this step's sweep)
-  const int n = system_.size();
-  const int nquad = system_.quadrature_count();
-  const Model& model = system_.model();
-  double* y = N_VGetArrayPointer(impl.y);
-  double* yp = N_VGetArrayPointer(impl.yp);
-  // ---- events: located element by element on IDA's interpolating polynomial ----
-  // IDA's own root finding evaluates every root function of the model several times per
-  // located root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here
-  // IDA takes one step at a time (IDA_ONE_STEP); after each step the root functions are
-  // evaluated once (~ N), and only a root that fell through zero during the step is located
-  // (events.hpp: EventLocator): on the polynomial IDA itself interpolates with over the step,
-  // written as its Taylor series at t_n (derivatives from IDAGetDky), evaluated only for the
-  // unknowns its element reads (Illinois method, to IDA's own root tolerance 100 eps
-  // max(|t|, h)). Events are committed in time order. IDA's solution is already at t_n,
-  // computed with the old laws over [t_event, t_n]: when the new law agrees with the old one
-  // there within the local tolerance (a kink: a stiffness changes, the force does not jump),
-  // IDA goes on as over any non-smooth right-hand side; a jump (rupture, joint failure,
-  // preload) restarts from consistent values at t_event, and the later crossings of that step
-  // are found again.
-  const int root_count = system_.root_count();
-  std::vector<EventRecord>& events = impl.events;
-  ModeTracker& modes = mode_tracker();
-  EventLocator& locator = event_locator();
-  std::vector<Crossing>& crossings = locator.queue();
+  const double t_n = take_step(t_end);
+  const double t_step_start = impl.t_reached;  // (take_step's retry moves it back to the restart)
+  const PhaseClock::Scope events_timed(phase_clock(), Phase::Events);
+  const bool restarted = system_.root_count() > 0 && handle_events(t_step_start, t_n, t_end);
+  if (!restarted) impl.t_reached = t_n;  // (the run loop samples up to it)
+  return impl.t_reached;
+}
 
+double IdaIntegrator::take_step(double t_end) {
+  Impl& impl = *impl_;
   double t_n = impl.t_reached;
   impl.last_sundials_message.clear();
   impl.non_finite_y.clear();
-  impl.sweep.roots_wanted = root_count > 0;
+  impl.sweep.roots_wanted = system_.root_count() > 0;
   impl.sweep.outputs_wanted = step_outputs_wanted();
   impl.sweep.valid = false;
   int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
@@ -523,11 +551,7 @@ double IdaIntegrator::advance(double t_end) {
     impl.retry.available = false;
     {
       const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
-      std::copy(impl.retry.y.begin(), impl.retry.y.end(), N_VGetArrayPointer(impl.y));
-      std::copy(impl.retry.yp.begin(), impl.retry.yp.end(), N_VGetArrayPointer(impl.yp));
-      std::copy(impl.retry.quad.begin(), impl.retry.quad.end(), N_VGetArrayPointer(impl.quad));
-      impl.reinitialize(impl.retry.t, t_end, stats());
-      impl.check(IDASetInitStep(impl.ida, 0.1 * impl.retry.step_before), "IDASetInitStep");
+      impl.restart(impl.retry, Impl::FirstStep::Retry, t_end, stats());
     }
     t_n = impl.t_reached = impl.retry.t;
     impl.last_sundials_message.clear();
@@ -544,134 +568,142 @@ double IdaIntegrator::advance(double t_end) {
     throw StepFailure(msg.str());
   }
   impl.at_start = false;
-  const double t_step_start = impl.t_reached;
-  bool restarted = false;
+  return t_n;
+}
 
-  const PhaseClock::Scope events_timed(phase_clock(), Phase::Events);
-  if (root_count > 0) {
-    // The step's element outputs come from the same sweep as its roots; they stand for the
-    // step's end only if no mode changes in it (below).
-    std::vector<double>& g_now = modes.now();
-    double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
-    const Impl::QuadratureSweep& sweep = impl.sweep;
-    if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.outputs_wanted) &&
-        std::memcmp(sweep.y.data(), y, sizeof(double) * static_cast<std::size_t>(n)) == 0) {
-      std::copy(sweep.g.begin(), sweep.g.end(), g_now.begin());
-      if (step_outputs != nullptr) std::copy(sweep.outputs.begin(), sweep.outputs.end(), step_outputs);
-    } else {
-      system_.roots(t_n, y, g_now.data(), step_outputs);
-    }
-    modes.scan(t_n, y, crossings);
-    outputs_current_ = step_outputs != nullptr && crossings.empty();
-    if (!crossings.empty()) {
-      IdaStepInterpolant& step_interpolant = impl.interpolant;
-      step_interpolant.load(t_step_start, t_n);
-      double step = 0.0;
-      impl.check(IDAGetLastStep(impl.ida, &step), "IDAGetLastStep");
-      const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), std::abs(step));
-      locator.locate_queue(step_interpolant, modes.previous(), g_now, tolerance);
-      impl.check(IDAGetQuad(impl.ida, &t_n, impl.quad), "IDAGetQuad");
-      const double* quad_n = N_VGetArrayPointer(impl.quad);
-      modes.begin_step();
-      for (std::size_t i = 0; i < crossings.size(); ++i) {
-        Crossing c = crossings[i];
-        if (modes.changes_of(c.element) != c.generation) continue;  // found in a mode the element has left
-        if (c.generation >= 20) {  // an element switching back and forth within one step: restart
-          restarted = true;
-        }
-        // The state at the event from IDA's interpolation (the same numbers a restart uses),
-        // nudged to where the root is at or below zero (EventLocator::event_state).
-        const double* y_at_event = locator.event_state(step_interpolant, c, tolerance);
-        const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
-                                                           system_.element_load(c.element, t_n, y)};
-        sample_up_to(c.t);  // (uses y_out, not the event state)
-        observe_before_event(c.t, y_at_event, c.element);
-        events.clear();
-        if (restarted)
-          modes.record_change(c.element, c.t);
-        else if (!modes.commit(c.element, c.local, c.t, y_at_event, events))
-          continue;
-        ++stats().root_returns;
-        // A kink (the element says its force is continuous, and it is at the event state)
-        // needs no restart when the lag is within tolerance: IDA goes on with its order and
-        // history. A jump always restarts (bench/README.md, "Kinks are not jumps").
-        const bool kink = !restarted && events.size() == 1 && events.front().kink &&
-                          lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n, 1.0, 0.0);
-        if (kink && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
-          report_events(events, y_at_event, c.element);
-          // The element's new mode may end within this step too: its roots that are at or
-          // below zero at t_n are located in [t_event, t_n] (or committed at once when
-          // already outside at t_event) and queued in time order.
-          const int offset = system_.root_offset(c.element);
-          const int count = model.elements()[static_cast<std::size_t>(c.element)]->root_count();
-          const int generation = modes.changes_of(c.element);
-          system_.element_roots(c.element, t_n, y, g_now.data() + offset);
-          for (int j = 0; j < count; ++j) {
-            const double g_end = g_now[static_cast<std::size_t>(offset + j)];
-            if (g_end > 0.0) continue;
-            double g_start = locator.root_at(step_interpolant, c.element, j, c.t);
-            if (g_start <= 0.0 && g_start >= -modes.root_noise(c.element, j, c.t, y_at_event)) {
-              // On the new mode's boundary by construction (see root_noise): not a second
-              // change at this instant. Still at the boundary at t_n (within round-off): the
-              // root starts the next step armed at +0, so a real later crossing is found;
-              // clearly out by t_n: the crossing is located after the event.
-              const double noise_end = modes.root_noise(c.element, j, t_n, y);
-              if (g_end >= -noise_end) {
-                modes.set_on_boundary(offset + j);
-                continue;
-              }
-              g_start = std::numeric_limits<double>::min();
-            }
-            const double t_next =
-                g_start > 0.0 ? locator.locate(step_interpolant, c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
-            locator.insert_after(i, Crossing{t_next, c.element, j, generation});
-          }
-          continue;
-        }
-        restarted = true;
-        const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
-        // Restart at the event: consistent rates for the new law (and roots that sit on
-        // their boundary there), quadratures interpolated to it.
-        std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
-        std::vector<char> changed_now = modes.changed_at(c.t);  // the elements that changed at c.t
-        restart_state(mode_tracker(), c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
-        report_events(events, y_restart.data());
-        impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
-        std::copy(y_restart.begin(), y_restart.end(), y);
-        std::copy(yp_restart.begin(), yp_restart.end(), yp);
-        std::copy(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad, N_VGetArrayPointer(impl.quad));
-        impl.retry.available = true;
-        impl.retry.t = c.t;
-        impl.check(IDAGetLastStep(impl.ida, &impl.retry.step_before), "IDAGetLastStep");
-        impl.retry.available = impl.retry.step_before > 0.0;
-        impl.retry.y = y_restart;
-        impl.retry.yp = yp_restart;
-        impl.retry.quad.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + nquad);
-        impl.reinitialize(c.t, t_end, stats());
-        // IDA's own first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an
-        // impact, and it then climbs back at order 1, doubling per step, with a Jacobian at
-        // nearly every step (cj changes each time): 170 restarts in the 0.25 s two-car crash
-        // cost a tenth of its steps and half its Jacobians. It starts instead from a fraction
-        // of the step that crossed the event, a scale the solution has just shown; an impact
-        // faster than that is met by IDA's error test, which cuts the step. The fraction is
-        // measured (bench/README.md, "The first step after a restart"). The error test cuts
-        // at most 10 times, by 0.25 from the second cut on, so the start stays within
-        // kReachableMultiple of IDA's own: the step before a dropped ball touches a floor is its
-        // free flight's, 0.17 s, ten million times its first step in contact at rtol 1e-10
-        // (tests/elements/test_contact.cpp).
-        impl.check(IDASetInitStep(impl.ida, impl.retry.available ? impl.restart_first_step(impl.retry.step_before, c.t, t_end) : 0.0),
-                   "IDASetInitStep");
-        modes.arm(c.t, y);
-        impl.t_reached = c.t;
-        restarted = true;
-        break;
-      }
-      if (!restarted) modes.refresh_changed(t_n, y);  // the changed elements' roots at t_n, in their new modes
-    }
-    if (!restarted) modes.end_step();
+bool IdaIntegrator::handle_events(double t_step_start, double t_n, double t_end) {
+  Impl& impl = *impl_;
+  const int n = system_.size();
+  const double* y = N_VGetArrayPointer(impl.y);
+  ModeTracker& modes = mode_tracker();
+  EventLocator& locator = event_locator();
+  std::vector<Crossing>& crossings = locator.queue();
+  std::vector<double>& g_now = modes.now();
+  // The step's element outputs come from the same sweep as its roots; they stand for the
+  // step's end only if no mode changes in it (below).
+  double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
+  const Impl::QuadratureSweep& sweep = impl.sweep;
+  if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.outputs_wanted) &&
+      std::memcmp(sweep.y.data(), y, sizeof(double) * static_cast<std::size_t>(n)) == 0) {
+    std::copy(sweep.g.begin(), sweep.g.end(), g_now.begin());
+    if (step_outputs != nullptr) std::copy(sweep.outputs.begin(), sweep.outputs.end(), step_outputs);
+  } else {
+    system_.roots(t_n, y, g_now.data(), step_outputs);
   }
-  if (!restarted) impl.t_reached = t_n;  // (the run loop samples up to it)
-  return impl.t_reached;
+  modes.scan(t_n, y, crossings);
+  outputs_current_ = step_outputs != nullptr && crossings.empty();
+  if (crossings.empty()) {
+    modes.end_step();
+    return false;
+  }
+  IdaStepInterpolant& step = impl.interpolant;
+  step.load(t_step_start, t_n);
+  double last_step = 0.0;
+  impl.check(IDAGetLastStep(impl.ida, &last_step), "IDAGetLastStep");
+  const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), std::abs(last_step));
+  locator.locate_queue(step, modes.previous(), g_now, tolerance);
+  double t_quad = t_n;
+  impl.check(IDAGetQuad(impl.ida, &t_quad, impl.quad), "IDAGetQuad");
+  const double* quad_n = N_VGetArrayPointer(impl.quad);
+  std::vector<EventRecord>& events = impl.events;
+  modes.begin_step();
+  bool restart_now = false;
+  for (std::size_t i = 0; i < crossings.size(); ++i) {
+    Crossing c = crossings[i];
+    if (modes.changes_of(c.element) != c.generation) continue;  // found in a mode the element has left
+    if (c.generation >= 20) restart_now = true;  // an element switching back and forth within one step: restart
+    // The state at the event from IDA's interpolation (the same numbers a restart uses),
+    // nudged to where the root is at or below zero (EventLocator::event_state).
+    const double* y_at_event = locator.event_state(step, c, tolerance);
+    const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
+                                                       system_.element_load(c.element, t_n, y)};
+    sample_up_to(c.t);  // (uses y_out, not the event state)
+    observe_before_event(c.t, y_at_event, c.element);
+    events.clear();
+    if (restart_now)
+      modes.record_change(c.element, c.t);
+    else if (!modes.commit(c.element, c.local, c.t, y_at_event, events))
+      continue;
+    ++stats().root_returns;
+    // A kink (the element says its force is continuous, and it is at the event state) needs
+    // no restart when the lag is within tolerance: IDA goes on with its order and history. A
+    // jump always restarts (bench/README.md, "Kinks are not jumps").
+    const bool kink = !restart_now && events.size() == 1 && events.front().kink &&
+                      lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n, 1.0, 0.0);
+    if (kink && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
+      report_events(events, y_at_event, c.element);
+      queue_new_mode_crossings(c, i, y_at_event, tolerance);
+      continue;
+    }
+    restart_at_event(c, y_at_event, t_end);
+    return true;
+  }
+  modes.refresh_changed(t_n, y);  // the changed elements' roots at t_n, in their new modes
+  modes.end_step();
+  return false;
+}
+
+void IdaIntegrator::queue_new_mode_crossings(const Crossing& c, std::size_t index, const double* y_at_event,
+                                             double tolerance) {
+  // The element's new mode may end within this step too: its roots that are at or below zero
+  // at t_n are located in [t_event, t_n] (or committed at once when already outside at
+  // t_event) and queued in time order.
+  Impl& impl = *impl_;
+  IdaStepInterpolant& step = impl.interpolant;
+  ModeTracker& modes = mode_tracker();
+  EventLocator& locator = event_locator();
+  const double t_n = step.t1();
+  const double* y = N_VGetArrayPointer(impl.y);
+  std::vector<double>& g_now = modes.now();
+  const int offset = system_.root_offset(c.element);
+  const int count = system_.model().elements()[static_cast<std::size_t>(c.element)]->root_count();
+  const int generation = modes.changes_of(c.element);
+  system_.element_roots(c.element, t_n, y, g_now.data() + offset);
+  for (int j = 0; j < count; ++j) {
+    const double g_end = g_now[static_cast<std::size_t>(offset + j)];
+    if (g_end > 0.0) continue;
+    double g_start = locator.root_at(step, c.element, j, c.t);
+    if (g_start <= 0.0 && g_start >= -modes.root_noise(c.element, j, c.t, y_at_event)) {
+      // On the new mode's boundary by construction (see ModeTracker::root_noise): not a second
+      // change at this instant. Still at the boundary at t_n (within round-off): the root
+      // starts the next step armed at +0, so a real later crossing is found; clearly out by
+      // t_n: the crossing is located after the event.
+      const double noise_end = modes.root_noise(c.element, j, t_n, y);
+      if (g_end >= -noise_end) {
+        modes.set_on_boundary(offset + j);
+        continue;
+      }
+      g_start = std::numeric_limits<double>::min();
+    }
+    const double t_next = g_start > 0.0 ? locator.locate(step, c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
+    locator.insert_after(index, Crossing{t_next, c.element, j, generation});
+  }
+}
+
+void IdaIntegrator::restart_at_event(const Crossing& c, const double* y_at_event, double t_end) {
+  Impl& impl = *impl_;
+  const int n = system_.size();
+  const int nquad = system_.quadrature_count();
+  std::vector<EventRecord>& events = impl.events;
+  const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
+  // Restart at the event: consistent rates for the new law (and roots that sit on their
+  // boundary there), quadratures interpolated to it.
+  std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
+  std::vector<char> changed_now = mode_tracker().changed_at(c.t);  // the elements that changed at c.t
+  restart_state(mode_tracker(), c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
+  report_events(events, y_restart.data());
+  impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
+  // Kept until IDA's first step after it succeeds, for one retry (take_step).
+  Impl::RestartRetry& retry = impl.retry;
+  retry.t = c.t;
+  impl.check(IDAGetLastStep(impl.ida, &retry.step_before), "IDAGetLastStep");
+  retry.available = retry.step_before > 0.0;
+  retry.y = std::move(y_restart);
+  retry.yp = std::move(yp_restart);
+  retry.quad.assign(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad);
+  impl.restart(retry, Impl::FirstStep::AfterEvent, t_end, stats());
+  mode_tracker().arm(c.t, N_VGetArrayPointer(impl.y));
+  impl.t_reached = c.t;
 }
 
 bool IdaIntegrator::lag_within_tolerance(int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,

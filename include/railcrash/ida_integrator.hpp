@@ -66,6 +66,19 @@ class IdaIntegrator : public Integrator {
   /// Why IDA failed, in the model's terms: a non-finite residual's element or body, a
   /// singular configuration of the joints, the unknowns with the largest weighted errors.
   std::string explain_failure(int flag);
+  /// IDA's next step (IDA_ONE_STEP, with one retry of a failed first step after a restart);
+  /// the time it reached. Throws StepFailure.
+  double take_step(double t_end);
+  /// After a step from t_step_start to t_n: its roots, and the crossings in it located and
+  /// committed in time order (events.hpp); kinks within tolerance go on, a jump restarts at
+  /// its event (then true: the step's end is discarded).
+  bool handle_events(double t_step_start, double t_n, double t_end);
+  /// After a kink at crossing c (queue position `index`) that IDA goes on across: the new
+  /// mode's roots that end within the step, located and queued.
+  void queue_new_mode_crossings(const Crossing& c, std::size_t index, const double* y_at_event, double tolerance);
+  /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
+  /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
+  void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);
   /// Whether element e's mode change at t_event (its load in the old modes `before`: at the
   /// event and at t_n) leaves IDA's step to t_n within the local tolerances without a restart
   /// (the lag test; see advance()). quadratures: at t_n.
