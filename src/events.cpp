@@ -6,6 +6,15 @@
 
 namespace railcrash {
 
+namespace {
+
+/// How many root functions element e has (its roots are DaeSystem::root_offset(e) onwards).
+int root_count_of(const DaeSystem& system, int e) {
+  return system.model().elements()[static_cast<std::size_t>(e)]->root_count();
+}
+
+}  // namespace
+
 // ---- ModeTracker ----
 
 ModeTracker::ModeTracker(DaeSystem& system, std::vector<double> unknown_floor) : system_(system) {
@@ -40,7 +49,7 @@ double ModeTracker::root_noise(int e, int local, double t, const double* y) {
   // Only the element's own unknowns are read (y_probe_ has the model's size, the rest unused):
   // clearing the whole vector per call cost O(N) per crossing in a train.
   for (const int i : unknowns) y_probe_[static_cast<std::size_t>(i)] = y[i];
-  const int count = system_.model().elements()[static_cast<std::size_t>(e)]->root_count();
+  const int count = root_count_of(system_, e);
   g_element_.resize(static_cast<std::size_t>(count));
   g_probe_.resize(static_cast<std::size_t>(count));
   system_.element_roots(e, t, y_probe_.data(), g_element_.data());
@@ -90,7 +99,7 @@ bool ModeTracker::commit(int e, int local, double t, const double* y, std::vecto
 
 void ModeTracker::record_change(int e, double t) {
   const int offset = system_.root_offset(e);
-  const int count = system_.model().elements()[static_cast<std::size_t>(e)]->root_count();
+  const int count = root_count_of(system_, e);
   for (int j = 0; j < count; ++j) on_boundary_[static_cast<std::size_t>(offset + j)] = 0;  // a new mode
   const auto seen = std::find(changed_.begin(), changed_.end(), e);
   if (seen == changed_.end()) {
@@ -120,7 +129,7 @@ void ModeTracker::refresh_changed(double t_n, const double* y) {
   for (const int e : changed_) system_.element_roots(e, t_n, y, now_.data() + system_.root_offset(e));
   for (const int e : changed_) {
     const int offset = system_.root_offset(e);
-    const int count = system_.model().elements()[static_cast<std::size_t>(e)]->root_count();
+    const int count = root_count_of(system_, e);
     for (int k = offset; k < offset + count; ++k)
       if (on_boundary_[static_cast<std::size_t>(k)] && now_[static_cast<std::size_t>(k)] <= 0.0)
         now_[static_cast<std::size_t>(k)] = std::numeric_limits<double>::min();
@@ -135,7 +144,7 @@ EventLocator::EventLocator(const DaeSystem& system) : system_(system) {
 
 double EventLocator::root_at(StepInterpolant& step, int e, int local, double t) {
   step.unknowns_at(system_.element_unknowns(e), t, y_local_.data());
-  g_element_.resize(static_cast<std::size_t>(system_.model().elements()[static_cast<std::size_t>(e)]->root_count()));
+  g_element_.resize(static_cast<std::size_t>(root_count_of(system_, e)));
   system_.element_roots(e, t, y_local_.data(), g_element_.data());
   return g_element_[static_cast<std::size_t>(local)];
 }
@@ -174,7 +183,7 @@ const double* EventLocator::event_state(StepInterpolant& step, Crossing& c, doub
   const double t_n = step.t1();
   double t_event = c.t;
   const double* y_at_event = step.state_at(t_event);
-  g_element_.resize(static_cast<std::size_t>(system_.model().elements()[static_cast<std::size_t>(c.element)]->root_count()));
+  g_element_.resize(static_cast<std::size_t>(root_count_of(system_, c.element)));
   system_.element_roots(c.element, t_event, y_at_event, g_element_.data());
   double g_event = g_element_[static_cast<std::size_t>(c.local)];
   const double mismatch = g_event > 0.0 ? g_event - root_at(step, c.element, c.local, c.t) : 0.0;

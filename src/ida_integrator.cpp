@@ -720,12 +720,11 @@ bool IdaIntegrator::lag_within_tolerance(int e, const std::array<DaeSystem::Elem
   // 0.5). A kink's continuity check takes the change at the event alone, held over the lag
   // (1 and 0): the part of the lag a kink must not have.
   const Impl& impl = *impl_;
-  const Model& model = system_.model();
   const int nq = system_.body_unknowns();
   const double rtol = impl.rtol;
   const double* atol = N_VGetArrayPointer(impl.atol);
   const double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
-  const Element& el = *model.elements()[static_cast<std::size_t>(e)];
+  const Element& el = *system_.model().elements()[static_cast<std::size_t>(e)];
   if (el.constraint_count() > 0 && system_.element_failed(static_cast<std::size_t>(e))) return false;
   const double lag = t_n - t_event;
   const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
