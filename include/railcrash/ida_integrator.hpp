@@ -14,7 +14,9 @@
 // * Events: IDA takes one step at a time; after each step every root function is evaluated
 //   once and a root that fell through zero is located element by element on IDA's own
 //   interpolating polynomial (its Taylor form at t_n from IDAGetDky, evaluated only for the
-//   unknowns the element reads), so locating an event costs the same in any model size.
+//   unknowns the element reads), so locating an event costs the same in any model size. The
+//   bookkeeping and the location are the event layer's (events.hpp: ModeTracker,
+//   EventLocator, owned by the run loop's Integrator); IDA gives it a StepInterpolant.
 //   Events are committed in time order; IDA goes on without a restart when the new law agrees
 //   with the old one over the rest of the step within the local tolerances (kinks), and
 //   restarts from consistent values at the event otherwise (jumps, joint failures).
