@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "klu_solver.hpp"
+#include "railcrash/event_loop.hpp"
 #include "railcrash/events.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/serial_vector_ops.hpp"
@@ -507,6 +508,40 @@ void IdaIntegrator::start(double t_end) {
   }
 }
 
+/// IDA's decisions about the mode changes located inside its step (event_loop.hpp).
+class IdaEventHandler final : public EventHandler {
+ public:
+  /// The step ends at t_n in state y_n with quadratures quad_n; the run at t_end.
+  IdaEventHandler(IdaIntegrator& ida, double t_n, const double* y_n, const double* quad_n, double t_end)
+      : ida_(ida), t_n_(t_n), y_n_(y_n), quad_n_(quad_n), t_end_(t_end) {}
+
+  void before_change(const Crossing& c, const double* y_at_event) override {
+    before_ = {ida_.system_.element_load(c.element, c.t, y_at_event), ida_.system_.element_load(c.element, t_n_, y_n_)};
+    ida_.sample_up_to(c.t);  // (uses y_out, not the event state)
+    ida_.observe_before_event(c.t, y_at_event, c.element);
+  }
+  void committed(const Crossing& /*c*/) override { ++ida_.stats().root_returns; }
+  bool goes_on_across(const Crossing& c, const double* y_at_event, const std::vector<EventRecord>& events) override {
+    // A kink (the element says its force is continuous, and it is at the event state) needs
+    // no restart when the lag is within tolerance: IDA goes on with its order and history. A
+    // jump always restarts (bench/README.md, "Kinks are not jumps").
+    const bool kink = events.size() == 1 && events.front().kink &&
+                      ida_.lag_within_tolerance(c.element, before_, c.t, y_at_event, t_n_, y_n_, quad_n_, 1.0, 0.0);
+    if (!(kink && ida_.lag_within_tolerance(c.element, before_, c.t, y_at_event, t_n_, y_n_, quad_n_))) return false;
+    ida_.report_events(events, y_at_event, c.element);
+    return true;
+  }
+  void restart_at(const Crossing& c, const double* y_at_event) override { ida_.restart_at_event(c, y_at_event, t_end_); }
+
+ private:
+  IdaIntegrator& ida_;
+  double t_n_;
+  const double* y_n_;
+  const double* quad_n_;
+  double t_end_;
+  std::array<DaeSystem::ElementLoad, 2> before_{};  // the element's loads in its old modes: at the event, at t_n
+};
+
 // ---- events: located element by element on IDA's interpolating polynomial ----
 // IDA's own root finding evaluates every root function of the model several times per located
 // root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here IDA takes one
@@ -605,79 +640,8 @@ bool IdaIntegrator::handle_events(double t_step_start, double t_n, double t_end)
   double t_quad = t_n;
   impl.check(IDAGetQuad(impl.ida, &t_quad, impl.quad), "IDAGetQuad");
   const double* quad_n = N_VGetArrayPointer(impl.quad);
-  std::vector<EventRecord>& events = impl.events;
-  modes.begin_step();
-  bool restart_now = false;
-  for (std::size_t i = 0; i < crossings.size(); ++i) {
-    Crossing c = crossings[i];
-    if (modes.changes_of(c.element) != c.generation) continue;  // found in a mode the element has left
-    if (c.generation >= 20) restart_now = true;  // an element switching back and forth within one step: restart
-    // The state at the event from IDA's interpolation (the same numbers a restart uses),
-    // nudged to where the root is at or below zero (EventLocator::event_state).
-    const double* y_at_event = locator.event_state(step, c, tolerance);
-    const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
-                                                       system_.element_load(c.element, t_n, y)};
-    sample_up_to(c.t);  // (uses y_out, not the event state)
-    observe_before_event(c.t, y_at_event, c.element);
-    events.clear();
-    if (restart_now)
-      modes.record_change(c.element, c.t);
-    else if (!modes.commit(c.element, c.local, c.t, y_at_event, events))
-      continue;
-    ++stats().root_returns;
-    // A kink (the element says its force is continuous, and it is at the event state) needs
-    // no restart when the lag is within tolerance: IDA goes on with its order and history. A
-    // jump always restarts (bench/README.md, "Kinks are not jumps").
-    const bool kink = !restart_now && events.size() == 1 && events.front().kink &&
-                      lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n, 1.0, 0.0);
-    if (kink && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
-      report_events(events, y_at_event, c.element);
-      queue_new_mode_crossings(c, i, y_at_event, tolerance);
-      continue;
-    }
-    restart_at_event(c, y_at_event, t_end);
-    return true;
-  }
-  modes.refresh_changed(t_n, y);  // the changed elements' roots at t_n, in their new modes
-  modes.end_step();
-  return false;
-}
-
-void IdaIntegrator::queue_new_mode_crossings(const Crossing& c, std::size_t index, const double* y_at_event,
-                                             double tolerance) {
-  // The element's new mode may end within this step too: its roots that are at or below zero
-  // at t_n are located in [t_event, t_n] (or committed at once when already outside at
-  // t_event) and queued in time order.
-  Impl& impl = *impl_;
-  IdaStepInterpolant& step = impl.interpolant;
-  ModeTracker& modes = mode_tracker();
-  EventLocator& locator = event_locator();
-  const double t_n = step.t1();
-  const double* y = N_VGetArrayPointer(impl.y);
-  std::vector<double>& g_now = modes.now();
-  const int offset = system_.root_offset(c.element);
-  const int count = system_.model().elements()[static_cast<std::size_t>(c.element)]->root_count();
-  const int generation = modes.changes_of(c.element);
-  system_.element_roots(c.element, t_n, y, g_now.data() + offset);
-  for (int j = 0; j < count; ++j) {
-    const double g_end = g_now[static_cast<std::size_t>(offset + j)];
-    if (g_end > 0.0) continue;
-    double g_start = locator.root_at(step, c.element, j, c.t);
-    if (g_start <= 0.0 && g_start >= -modes.root_noise(c.element, j, c.t, y_at_event)) {
-      // On the new mode's boundary by construction (see ModeTracker::root_noise): not a second
-      // change at this instant. Still at the boundary at t_n (within round-off): the root
-      // starts the next step armed at +0, so a real later crossing is found; clearly out by
-      // t_n: the crossing is located after the event.
-      const double noise_end = modes.root_noise(c.element, j, t_n, y);
-      if (g_end >= -noise_end) {
-        modes.set_on_boundary(offset + j);
-        continue;
-      }
-      g_start = std::numeric_limits<double>::min();
-    }
-    const double t_next = g_start > 0.0 ? locator.locate(step, c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
-    locator.insert_after(index, Crossing{t_next, c.element, j, generation});
-  }
+  IdaEventHandler handler(*this, t_n, y, quad_n, t_end);
+  return commit_crossings(step, y, modes, locator, handler, tolerance, impl.events);
 }
 
 void IdaIntegrator::restart_at_event(const Crossing& c, const double* y_at_event, double t_end) {

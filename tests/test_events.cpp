@@ -1,12 +1,15 @@
-// The event layer on its own (events.hpp): the locator against an analytic step interpolant,
-// the mode tracker's boundary bookkeeping and commits.
+// The event layer on its own (events.hpp, event_loop.hpp): the locator against an analytic
+// step interpolant, the mode tracker's boundary bookkeeping and commits, the loop over a
+// step's crossings with a handler that goes on across them or restarts.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "railcrash/event_loop.hpp"
 #include "railcrash/events.hpp"
 #include "support.hpp"
 
@@ -175,4 +178,72 @@ TEST_CASE("the mode tracker carries a root at zero as on its boundary, commits a
   system.modes().restore(before);
   system.roots(0.1, y.data(), g.data());
   CHECK(g[0] == Approx(-0.01));  // open again: the distance from the circle
+}
+
+namespace {
+
+/// Records what the event loop asks; goes on across every change or none.
+class RecordingHandler final : public EventHandler {
+ public:
+  explicit RecordingHandler(bool go_on) : go_on_(go_on) {}
+  void before_change(const Crossing& c, const double* y_at_event) override {
+    before_times.push_back(c.t);
+    x_at_event.push_back(y_at_event[0]);
+  }
+  void committed(const Crossing& /*c*/) override { ++commits; }
+  bool goes_on_across(const Crossing& /*c*/, const double* /*y_at_event*/, const std::vector<EventRecord>& events) override {
+    reported += static_cast<int>(events.size());  // (records it was asked about)
+    return go_on_;
+  }
+  void restart_at(const Crossing& c, const double* /*y_at_event*/) override { restart_times.push_back(c.t); }
+  std::vector<double> before_times, x_at_event, restart_times;
+  int commits = 0, reported = 0;
+
+ private:
+  bool go_on_;
+};
+
+}  // namespace
+
+TEST_CASE("the event loop commits a located crossing and goes on across it or restarts there", "[events]") {
+  const double tolerance = 1e-12;
+  for (const bool go_on : {true, false}) {
+    const Model model = ball_and_circle(2.0, -1.0);
+    DaeSystem system(model);
+    ParabolaStep step(system.size());
+    ModeTracker modes(system);
+    EventLocator locator(system);
+    std::vector<double> y_start(static_cast<std::size_t>(system.size()));
+    std::copy(step.state_at(0.0), step.state_at(0.0) + system.size(), y_start.begin());
+    modes.arm(0.0, y_start.data());
+    std::vector<double> y_end(static_cast<std::size_t>(system.size()));
+    std::copy(step.state_at(1.2), step.state_at(1.2) + system.size(), y_end.begin());
+    system.roots(1.2, y_end.data(), modes.now().data());
+    modes.scan(1.2, y_end.data(), locator.queue());
+    REQUIRE(locator.queue().size() == 1);
+    locator.locate_queue(step, modes.previous(), modes.now(), tolerance);
+    RecordingHandler handler(go_on);
+    std::vector<EventRecord> events;
+    const bool restarted = commit_crossings(step, y_end.data(), modes, locator, handler, tolerance, events);
+    CHECK(restarted == !go_on);
+    // One change: the contact closes where x(t) = 2 - t^2 reaches the circle, t = 1.
+    REQUIRE(handler.before_times.size() == 1);
+    CHECK(std::abs(handler.before_times[0] - 1.0) <= 2.0 * tolerance);
+    CHECK(handler.x_at_event[0] <= 1.0);
+    CHECK(handler.x_at_event[0] == Approx(1.0).margin(1e-11));
+    CHECK(handler.commits == 1);
+    CHECK(handler.reported == 1);  // asked once, with the change's one record
+    REQUIRE(events.size() == 1);
+    CHECK(events[0].element == "bump");
+    CHECK(modes.changes_of(0) == 1);
+    if (go_on) {
+      // The step stands: its end's roots, refreshed in the new (contact) mode, start the next
+      // step: the penetration at x = 0.56, 0.44.
+      CHECK(handler.restart_times.empty());
+      CHECK(modes.previous()[0] == Approx(0.44));
+    } else {
+      REQUIRE(handler.restart_times.size() == 1);
+      CHECK(handler.restart_times[0] == handler.before_times[0]);
+    }
+  }
 }

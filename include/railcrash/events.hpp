@@ -17,12 +17,12 @@
 //
 // Roots are positive inside their mode (element.hpp): a fall through zero leaves the mode.
 //
-// What an integrator still does itself: take its step, give its StepInterpolant, and decide
-// per located event whether it can go on across it (IDA's lag test for kinks) or restarts
-// (IdaIntegrator::restart_at_event); Euler commits at its step's end. Not yet here: the loop
-// over a step's crossings (IdaIntegrator::handle_events) with a restart hook, so that a new
-// dense integrator gets it without writing it; the element modes themselves (ElementStates)
-// still live in the DaeSystem, whose commit methods the tracker calls.
+// What an integrator still does itself: take its step and give its StepInterpolant; a dense
+// one answers an EventHandler (event_loop.hpp: commit_crossings, the loop over a step's
+// crossings): whether it goes on across a change (IDA's lag test) and its restart. Euler
+// commits at its step's end. Not yet here: the element modes themselves (ElementStates) still
+// live in the DaeSystem, whose commit methods the tracker calls; the integrators still read
+// the model's elements for their tolerances (IDA's body sizes) and penalties (Euler).
 #pragma once
 
 #include <vector>

@@ -62,6 +62,7 @@ class IdaIntegrator : public Integrator {
   void finish() override;
 
  private:
+  friend class IdaEventHandler;  // (ida_integrator.cpp) IDA's side of the event loop
   /// Before the first step: InputError naming the element or body whose residual, Jacobian or
   /// rates are not finite (or so large that IDA's norms overflow) at t = 0.
   void check_start(const double* y, const double* yp, const double* atol, double t_end) const;
@@ -72,12 +73,10 @@ class IdaIntegrator : public Integrator {
   /// the time it reached. Throws StepFailure.
   double take_step(double t_end);
   /// After a step from t_step_start to t_n: its roots, and the crossings in it located and
-  /// committed in time order (events.hpp); kinks within tolerance go on, a jump restarts at
-  /// its event (then true: the step's end is discarded).
+  /// committed in time order (events.hpp, event_loop.hpp: IDA's decisions are an
+  /// IdaEventHandler's); kinks within tolerance go on, a jump restarts at its event (then
+  /// true: the step's end is discarded).
   bool handle_events(double t_step_start, double t_n, double t_end);
-  /// After a kink at crossing c (queue position `index`) that IDA goes on across: the new
-  /// mode's roots that end within the step, located and queued.
-  void queue_new_mode_crossings(const Crossing& c, std::size_t index, const double* y_at_event, double tolerance);
   /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
   /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
   void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);
