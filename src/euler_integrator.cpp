@@ -236,33 +236,49 @@ void EulerIntegrator::begin(double t0, bool run_start) {
   system_.generalized_forces(t0, q, v, force_.data(), &penalty_, lambda_.data());
   std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);
   // Mode changes: the same root functions as IDA, checked at the end of every step (what
-  // IITRAIN's "internal logic checks at each time step" did). A root that sits at zero right
-  // after its commit is ignored until it leaves zero.
+  // IITRAIN's "internal logic checks at each time step" did) by the event layer on a step
+  // known at its end alone (EulerStep). A root that sits at zero right after its commit is
+  // ignored until it leaves zero.
+  ModeTracker& modes = mode_tracker();
   const int root_count = system_.root_count();
-  g_before_.assign(static_cast<std::size_t>(root_count), 0.0);
-  g_after_ = g_before_;
-  direction_.assign(g_before_.size(), 0);
+  modes.previous().assign(static_cast<std::size_t>(root_count), 0.0);
+  modes.now() = modes.previous();
+  direction_.assign(modes.previous().size(), 0);
   if (run_start) report_events(start_events_, y_.data());
   if (root_count > 0 && run_start) {
     // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
+    EulerStep step(*this, t0, t0);
     std::vector<double> yp(y_.size(), 0.0);
-    for (int k = 0; k < nq; ++k) {
-      yp[static_cast<std::size_t>(k)] = v[k];
-      yp[static_cast<std::size_t>(nq + k)] = force_[static_cast<std::size_t>(k)] * inverse_mass_[static_cast<std::size_t>(k)];
-    }
+    step.rates_at(t0, yp.data());
     events_.clear();
-    if (system_.commit_boundary_roots(0.0, y_.data(), yp.data(), events_)) report_events(events_, y_.data());
+    if (modes.commit_boundary(0.0, y_.data(), yp.data(), events_)) report_events(events_, y_.data());
   }
   outputs_.assign(system_.output_names().size(), 0.0);
   sweep();
-  std::swap(g_before_, g_after_);
+  modes.end_step();
+}
+
+const double* EulerIntegrator::EulerStep::state_at(double /*t*/) { return euler_.y_.data(); }
+
+void EulerIntegrator::EulerStep::unknowns_at(const std::vector<int>& unknowns, double /*t*/, double* y) {
+  for (const int i : unknowns) y[i] = euler_.y_[static_cast<std::size_t>(i)];
+}
+
+void EulerIntegrator::EulerStep::rates_at(double /*t*/, double* yp) {
+  // q' = v and v' = M^-1 f at the step's end (the last sweep's forces); the multipliers' rates 0.
+  const int nq = euler_.system_.body_unknowns();
+  std::fill(yp, yp + euler_.y_.size(), 0.0);
+  for (int k = 0; k < nq; ++k) {
+    yp[k] = euler_.y_[static_cast<std::size_t>(nq + k)];
+    yp[nq + k] = euler_.force_[static_cast<std::size_t>(k)] * euler_.inverse_mass_[static_cast<std::size_t>(k)];
+  }
 }
 
 void EulerIntegrator::sweep() {
   const int nq = system_.body_unknowns();
   DaeSystem::SweepExtras extras;
   extras.powers = rates_.data();
-  extras.roots = g_after_.data();
+  extras.roots = mode_tracker().now().data();
   extras.outputs = outputs_.data();
   extras.y_lambda = y_.data() + 2 * nq;  // the roots and outputs see y's multipliers, as roots(t, y) does
   const PhaseClock::Scope timed(phase_clock(), Phase::Residual);
@@ -279,7 +295,8 @@ double EulerIntegrator::advance(double t_end) {
   ++step_;
   const bool last = static_cast<double>(step_) >= (t_end - t0_) / dt_ - 1e-9;
   const double t_next = last ? t_end : t0_ + static_cast<double>(step_) * dt_;
-  const double h = t_next - t_;
+  const double t_start = t_;
+  const double h = t_next - t_start;
   // force_, rates_ and lambda_ at (t_, y_) come from the last sweep (start() or the last step).
   outputs_current_ = false;
   for (int k = 0; k < nquad; ++k) quadratures_[static_cast<std::size_t>(k)] += h * rates_[static_cast<std::size_t>(k)];
@@ -291,26 +308,23 @@ double EulerIntegrator::advance(double t_end) {
   ++stats().steps;
   stats().residual_evaluations += 1;
   std::copy(lambda_.begin(), lambda_.end(), y_.begin() + 2 * nq);
-  sweep();  // the next step's forces, this state's roots (into g_after_) and outputs
-  if (!g_before_.empty()) {
-    bool fired = false;
-    for (std::size_t k = 0; k < g_after_.size(); ++k) {
-      const double before = g_before_[k], after = g_after_[k];
-      // Roots are positive inside their mode (element.hpp): a fall from >= 0 to < 0 leaves it.
-      direction_[k] = (before >= 0.0 && after < 0.0) ? -1 : (before < 0.0 && after >= 0.0) ? 1 : 0;
-      fired = fired || direction_[k] != 0;
-    }
-    if (fired) {
+  sweep();  // the next step's forces, this state's roots (into the mode tracker's now()) and outputs
+  ModeTracker& modes = mode_tracker();
+  if (modes.root_count() > 0) {
+    // The step is known at its end alone: crossings are committed there, all at once.
+    if (EventLocator::step_end_crossings(modes.previous(), modes.now(), direction_)) {
       const PhaseClock::Scope timed(phase_clock(), Phase::Events);
-      observe_before_event(t_, y_.data());
+      EulerStep step(*this, t_start, t_);
+      const double* y_end = step.state_at(step.t1());
+      observe_before_event(t_, y_end);
       events_.clear();
-      if (system_.commit_roots(t_, y_.data(), direction_.data(), events_)) {
+      if (modes.commit_all(t_, y_end, direction_, events_)) {
         ++stats().reinitializations;
         sweep();  // forces, roots and outputs in the new modes
       }
       report_events(events_, y_.data());
     }
-    std::swap(g_before_, g_after_);
+    modes.end_step();
   }
   return t_;
 }

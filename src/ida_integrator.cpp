@@ -15,6 +15,8 @@
 #include <sstream>
 
 #include "klu_solver.hpp"
+#include "railcrash/event_loop.hpp"
+#include "railcrash/events.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/serial_vector_ops.hpp"
 
@@ -41,11 +43,12 @@ std::string flag_name(int flag) {
 /// flagged too): a mode it enters sits on its own boundary, where round-off alone would decide
 /// whether it flips back. `rates_cache` keeps the consistent-rates solver's ordering between
 /// restarts of one run.
-void restart_state(DaeSystem& system, double t, std::vector<double>& y, std::vector<double>& yp,
+void restart_state(ModeTracker& modes, double t, std::vector<double>& y, std::vector<double>& yp,
                    std::vector<EventRecord>& events, std::vector<char>& changed_elements, ConsistentRatesCache& rates_cache) {
+  const DaeSystem& system = modes.system();
   changed_elements.resize(system.model().elements().size(), 0);
   consistent_rates(system, t, y, yp, &rates_cache);
-  for (int pass = 0; pass < 10 && system.commit_boundary_roots(t, y.data(), yp.data(), events, &changed_elements); ++pass)
+  for (int pass = 0; pass < 10 && modes.commit_boundary(t, y.data(), yp.data(), events, &changed_elements); ++pass)
     consistent_rates(system, t, y, yp, &rates_cache);
 }
 
@@ -75,6 +78,30 @@ std::vector<double> body_sizes(const Model& model) {
 
 }  // namespace
 
+/// IDA's interpolating polynomial over its last step [t0, t1] (events.hpp): the whole state
+/// and the rates from IDAGetDky, an element's unknowns from the same polynomial written as its
+/// Taylor series at t1 (derivatives from IDAGetDky once per step with crossings), evaluated
+/// for those unknowns alone.
+class IdaStepInterpolant final : public StepInterpolant {
+ public:
+  explicit IdaStepInterpolant(IdaIntegrator::Impl& impl) : impl_(impl) {}
+  /// The step [t0, t1] IDA has just taken: its Taylor form at t1.
+  void load(double t0, double t1);
+  double t0() const override { return t0_; }
+  double t1() const override { return t1_; }
+  bool dense() const override { return true; }
+  const double* state_at(double t) override;
+  void unknowns_at(const std::vector<int>& unknowns, double t, double* y) override;
+  void rates_at(double t, double* yp) override;
+
+ private:
+  IdaIntegrator::Impl& impl_;
+  double t0_ = 0.0, t1_ = 0.0;
+  std::vector<double> taylor_;  // (order + 1) x n: y^(j)(t1) / j!
+  int order_ = -1;
+  int n_ = 0;
+};
+
 /// Everything SUNDIALS owns for one run; destroyed in reverse order of creation.
 struct IdaIntegrator::Impl {
   const DaeSystem& system;
@@ -83,7 +110,8 @@ struct IdaIntegrator::Impl {
   N_Vector local_errors = nullptr;  // IDA's estimated local errors (failure diagnosis)
   SUNMatrix jacobian = nullptr;
   SUNLinearSolver linear_solver = nullptr;
-  N_Vector derivative = nullptr;   // IDAGetDky's output
+  N_Vector derivative = nullptr;   // IDAGetDky's output (the interpolant's state_at)
+  N_Vector rates_out = nullptr;    // the interpolant's rates_at
   N_Vector y_out = nullptr, quad_out = nullptr;  // dense output
   void* ida = nullptr;
   std::exception_ptr callback_error;
@@ -93,24 +121,9 @@ struct IdaIntegrator::Impl {
   // The run in progress (IdaIntegrator::start sets them up, advance takes one step).
   double rtol = 0.0;
   double t_reached = 0.0;                   // IDA's last step (or restart) time
-  std::vector<double> g_previous, g_now;    // root functions at the last step and now
-  std::vector<double> taylor;               // (order + 1) x n: y^(j)(t_n) / j!
-  std::vector<double> y_local;              // one element's unknowns, interpolated
-  std::vector<double> g_element;            // one element's roots
-  std::vector<double> y_probe, g_probe;     // root_noise's perturbed unknowns and roots
-  // Roots that sit on their mode's boundary within round-off (see root_noise in advance()):
-  // they are carried as +0 in g_previous and count as crossed only when clearly below zero.
-  std::vector<char> on_boundary;
-  int taylor_order = -1;
-  double taylor_time = 0.0;
+  IdaStepInterpolant interpolant{*this};  // IDA's polynomial over its last step, for the event layer
   std::vector<EventRecord> events;
   ConsistentRatesCache rates_cache;  // the consistent-rates solver's ordering, kept between restarts
-  struct Crossing {
-    double t;
-    int element, local;
-    int generation;  // the element's mode changes in this step when it was found
-  };
-  std::vector<Crossing> crossings;
   bool at_start = true;  // no step taken since start()
   // The last restart, kept until IDA's first step after it succeeds (see advance()).
   struct RestartRetry {
@@ -137,7 +150,7 @@ struct IdaIntegrator::Impl {
     if (ida) IDAFree(&ida);
     if (linear_solver) SUNLinSolFree(linear_solver);
     if (jacobian) SUNMatDestroy(jacobian);
-    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &local_errors, &derivative, &y_out, &quad_out})
+    for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &local_errors, &derivative, &rates_out, &y_out, &quad_out})
       if (*v) N_VDestroy(*v);
     if (context) SUNContext_Free(&context);
   }
@@ -270,6 +283,36 @@ struct IdaIntegrator::Impl {
     return std::max(own, std::min(kRestartStepFraction * step_before, kReachableMultiple * own));
   }
 
+  /// How a restart chooses IDA's first step from the step before it (none: IDA's own).
+  enum class FirstStep {
+    // After an event: a fraction of the step that crossed it (restart_first_step). IDA's own
+    // first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an impact, and it then
+    // climbs back at order 1, doubling per step, with a Jacobian at nearly every step (cj
+    // changes each time): 170 restarts in the 0.25 s two-car crash cost a tenth of its steps
+    // and half its Jacobians. It starts instead from a fraction of the step that crossed the
+    // event, a scale the solution has just shown; an impact faster than that is met by IDA's
+    // error test, which cuts the step. The fraction is measured (bench/README.md, "The first
+    // step after a restart"). The error test cuts at most 10 times, by 0.25 from the second
+    // cut on, so the start stays within kReachableMultiple of IDA's own: the step before a
+    // dropped ball touches a floor is its free flight's, 0.17 s, ten million times its first
+    // step in contact at rtol 1e-10 (tests/elements/test_contact.cpp).
+    AfterEvent,
+    // The same restart again after its first step failed: a tenth of the step before.
+    Retry,
+  };
+  /// The one way IDA restarts: from the state `from` holds (t, y, y', quadratures), in the
+  /// present modes; IDA's counters go to stats first (reinitialize).
+  void restart(const RestartRetry& from, FirstStep rule, double t_end, RunStatistics& stats) {
+    std::copy(from.y.begin(), from.y.end(), N_VGetArrayPointer(y));
+    std::copy(from.yp.begin(), from.yp.end(), N_VGetArrayPointer(yp));
+    std::copy(from.quad.begin(), from.quad.end(), N_VGetArrayPointer(quad));
+    reinitialize(from.t, t_end, stats);
+    double first_step = 0.0;  // IDA's own
+    if (from.step_before > 0.0)
+      first_step = rule == FirstStep::Retry ? 0.1 * from.step_before : restart_first_step(from.step_before, from.t, t_end);
+    check(IDASetInitStep(ida, first_step), "IDASetInitStep");
+  }
+
   static void error_handler(int, const char* module, const char* function, char* message, void* user) {
     auto* self = static_cast<Impl*>(user);
     self->last_sundials_message = std::string(module) + "/" + function + ": " + message;
@@ -283,6 +326,43 @@ struct IdaIntegrator::Impl {
     }
   }
 };
+
+void IdaStepInterpolant::load(double t0, double t1) {
+  t0_ = t0;
+  t1_ = t1;
+  n_ = static_cast<int>(N_VGetLength(impl_.y));
+  int order = 1;
+  impl_.check(IDAGetLastOrder(impl_.ida, &order), "IDAGetLastOrder");
+  taylor_.assign(static_cast<std::size_t>(order + 1) * static_cast<std::size_t>(n_), 0.0);
+  double factorial = 1.0;
+  for (int j = 0; j <= order; ++j) {
+    if (j > 0) factorial *= j;
+    impl_.check(IDAGetDky(impl_.ida, t1, j, impl_.derivative), "IDAGetDky");
+    const double* d = N_VGetArrayPointer(impl_.derivative);
+    for (int i = 0; i < n_; ++i) taylor_[static_cast<std::size_t>(j * n_ + i)] = d[i] / factorial;
+  }
+  order_ = order;
+}
+
+const double* IdaStepInterpolant::state_at(double t) {
+  impl_.check(IDAGetDky(impl_.ida, t, 0, impl_.derivative), "IDAGetDky");
+  return N_VGetArrayPointer(impl_.derivative);
+}
+
+void IdaStepInterpolant::unknowns_at(const std::vector<int>& unknowns, double t, double* y) {
+  const double dt = t - t1_;
+  for (const int i : unknowns) {
+    double value = taylor_[static_cast<std::size_t>(order_ * n_ + i)];
+    for (int j = order_ - 1; j >= 0; --j) value = value * dt + taylor_[static_cast<std::size_t>(j * n_ + i)];
+    y[i] = value;
+  }
+}
+
+void IdaStepInterpolant::rates_at(double t, double* yp) {
+  impl_.check(IDAGetDky(impl_.ida, t, 1, impl_.rates_out), "IDAGetDky");
+  const double* d = N_VGetArrayPointer(impl_.rates_out);
+  std::copy(d, d + N_VGetLength(impl_.rates_out), yp);
+}
 
 IdaIntegrator::IdaIntegrator(DaeSystem& system, IdaSettings settings) : Integrator(system), settings_(settings) {
   if (!(settings_.rtol > 0.0) || !std::isfinite(settings_.rtol))
@@ -359,7 +439,7 @@ void IdaIntegrator::start(double t_end) {
     std::vector<double> yp0;
     std::vector<EventRecord> start_events = settling_events;
     std::vector<char> changed_at_start;  // none yet
-    restart_state(system_, 0.0, y0, yp0, start_events, changed_at_start, impl.rates_cache);
+    restart_state(mode_tracker(), 0.0, y0, yp0, start_events, changed_at_start, impl.rates_cache);
     std::copy(y0.begin(), y0.end(), y);
     std::copy(yp0.begin(), yp0.end(), yp);
     const std::vector<double> ids = system_.differential_ids();
@@ -407,12 +487,11 @@ void IdaIntegrator::start(double t_end) {
     impl.derivative = impl.created(N_VClone(impl.y), "N_VClone");
     impl.y_out = impl.created(N_VClone(impl.y), "N_VClone");
     impl.quad_out = impl.created(N_VClone(impl.quad), "N_VClone");
-    impl.g_previous.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
+    impl.rates_out = impl.created(N_VClone(impl.y), "N_VClone");
     outputs_.assign(system_.output_names().size(), 0.0);
     outputs_current_ = false;
-    impl.g_now = impl.g_previous;
-    impl.y_local.assign(static_cast<std::size_t>(n), 0.0);
-    impl.y_probe.assign(static_cast<std::size_t>(n), 0.0);
+    // root_noise's floor: an unknown's rounding counts as at least its absolute tolerance's.
+    mode_tracker().set_unknown_floor(std::vector<double>(atol, atol + n));
     impl.sweep.y.assign(static_cast<std::size_t>(n), 0.0);
     impl.sweep.g.assign(static_cast<std::size_t>(system_.root_count()), 0.0);
     impl.sweep.outputs.assign(system_.output_names().size(), 0.0);
@@ -420,203 +499,79 @@ void IdaIntegrator::start(double t_end) {
     impl.t_reached = 0.0;
     impl.at_start = true;
     report_events(start_events, y);
-    impl.on_boundary.assign(static_cast<std::size_t>(system_.root_count()), 0);
-    if (system_.root_count() > 0) system_.roots(0.0, y, impl.g_previous.data());
-    // As after a restart (advance's mark_boundary_roots): a root at or below zero that
-    // restart_state did not commit starts on its boundary, carried as +0, so that its first
-    // fall below zero is a crossing. Taken as it was, a root at exactly 0 (a crush zone touching
-    // at rest, not pushed yet) was never "above zero before" and its contact went unseen until
-    // another element's restart.
-    for (std::size_t k = 0; k < impl.g_previous.size(); ++k)
-      if (impl.g_previous[k] <= 0.0) {
-        impl.g_previous[k] = std::numeric_limits<double>::min();
-        impl.on_boundary[k] = 1;
-      }
+    // As after a restart (ModeTracker::arm): a root at or below zero that restart_state did not
+    // commit starts on its boundary, carried as +0, so that its first fall below zero is a
+    // crossing. Taken as it was, a root at exactly 0 (a crush zone touching at rest, not pushed
+    // yet) was never "above zero before" and its contact went unseen until another element's
+    // restart.
+    mode_tracker().arm(0.0, y);
   }
 }
 
+/// IDA's decisions about the mode changes located inside its step (event_loop.hpp).
+class IdaEventHandler final : public EventHandler {
+ public:
+  /// The step ends at t_n in state y_n with quadratures quad_n; the run at t_end.
+  IdaEventHandler(IdaIntegrator& ida, double t_n, const double* y_n, const double* quad_n, double t_end)
+      : ida_(ida), t_n_(t_n), y_n_(y_n), quad_n_(quad_n), t_end_(t_end) {}
+
+  void before_change(const Crossing& c, const double* y_at_event) override {
+    before_ = {ida_.system_.element_load(c.element, c.t, y_at_event), ida_.system_.element_load(c.element, t_n_, y_n_)};
+    ida_.sample_up_to(c.t);  // (uses y_out, not the event state)
+    ida_.observe_before_event(c.t, y_at_event, c.element);
+  }
+  void committed(const Crossing& /*c*/) override { ++ida_.stats().root_returns; }
+  bool goes_on_across(const Crossing& c, const double* y_at_event, const std::vector<EventRecord>& events) override {
+    // A kink (the element says its force is continuous, and it is at the event state) needs
+    // no restart when the lag is within tolerance: IDA goes on with its order and history. A
+    // jump always restarts (bench/README.md, "Kinks are not jumps").
+    const bool kink = events.size() == 1 && events.front().kink &&
+                      ida_.lag_within_tolerance(c.element, before_, c.t, y_at_event, t_n_, y_n_, quad_n_, 1.0, 0.0);
+    if (!(kink && ida_.lag_within_tolerance(c.element, before_, c.t, y_at_event, t_n_, y_n_, quad_n_))) return false;
+    ida_.report_events(events, y_at_event, c.element);
+    return true;
+  }
+  void restart_at(const Crossing& c, const double* y_at_event) override { ida_.restart_at_event(c, y_at_event, t_end_); }
+
+ private:
+  IdaIntegrator& ida_;
+  double t_n_;
+  const double* y_n_;
+  const double* quad_n_;
+  double t_end_;
+  std::array<DaeSystem::ElementLoad, 2> before_{};  // the element's loads in its old modes: at the event, at t_n
+};
+
+// ---- events: located element by element on IDA's interpolating polynomial ----
+// IDA's own root finding evaluates every root function of the model several times per located
+// root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here IDA takes one
+// step at a time (IDA_ONE_STEP); after each step the root functions are evaluated once (~ N),
+// and only a root that fell through zero during the step is located (events.hpp:
+// EventLocator): on the polynomial IDA itself interpolates with over the step, written as its
+// Taylor series at t_n (derivatives from IDAGetDky), evaluated only for the unknowns its
+// element reads (Illinois method, to IDA's own root tolerance 100 eps max(|t|, h)). Events are
+// committed in time order. IDA's solution is already at t_n, computed with the old laws over
+// [t_event, t_n]: when the new law agrees with the old one there within the local tolerance
+// (a kink: a stiffness changes, the force does not jump), IDA goes on as over any non-smooth
+// right-hand side; a jump (rupture, joint failure, preload) restarts from consistent values
+// at t_event, and the later crossings of that step are found again.
 double IdaIntegrator::advance(double t_end) {
   Impl& impl = *impl_;
   outputs_current_ = false;  // (until this step's sweep)
-  const int n = system_.size();
-  const int nq = system_.body_unknowns();
-  const int nquad = system_.quadrature_count();
-  const Model& model = system_.model();
-  const double rtol = impl.rtol;
-  const double* atol = N_VGetArrayPointer(impl.atol);
-  const double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
-  double* y = N_VGetArrayPointer(impl.y);
-  double* yp = N_VGetArrayPointer(impl.yp);
-  std::vector<Impl::Crossing>& crossings = impl.crossings;
-  using Crossing = Impl::Crossing;
-  // ---- events: located element by element on IDA's interpolating polynomial ----
-  // IDA's own root finding evaluates every root function of the model several times per
-  // located root, so in a long train (events ~ N, each costing ~ N) it grows as N^2. Here
-  // IDA takes one step at a time (IDA_ONE_STEP); after each step the root functions are
-  // evaluated once (~ N), and only a root that fell through zero during the step is located:
-  // on the polynomial IDA itself interpolates with over the step, written as its Taylor
-  // series at t_n (derivatives from IDAGetDky), evaluated only for the unknowns its element
-  // reads (Illinois method, to IDA's own root tolerance 100 eps max(|t|, h)). Events are
-  // committed in time order. IDA's solution is already at t_n, computed with the old laws
-  // over [t_event, t_n]: when the new law agrees with the old one there within the local
-  // tolerance (a kink: a stiffness changes, the force does not jump), IDA goes on as over
-  // any non-smooth right-hand side; a jump (rupture, joint failure, preload) restarts from
-  // consistent values at t_event, and the later crossings of that step are found again.
-  const int root_count = system_.root_count();
-  std::vector<EventRecord>& events = impl.events;
-  std::vector<double>& g_previous = impl.g_previous;
-  std::vector<double>& g_now = impl.g_now;
-  std::vector<double>& taylor = impl.taylor;
-  std::vector<double>& y_local = impl.y_local;
-  std::vector<double>& g_element = impl.g_element;
-  N_Vector derivative = impl.derivative;
-  int& taylor_order = impl.taylor_order;
-  double& taylor_time = impl.taylor_time;
-  const auto load_taylor = [&](double t_n) {
-    int order = 1;
-    impl.check(IDAGetLastOrder(impl.ida, &order), "IDAGetLastOrder");
-    taylor.assign(static_cast<std::size_t>(order + 1) * static_cast<std::size_t>(n), 0.0);
-    double factorial = 1.0;
-    for (int j = 0; j <= order; ++j) {
-      if (j > 0) factorial *= j;
-      impl.check(IDAGetDky(impl.ida, t_n, j, derivative), "IDAGetDky");
-      const double* d = N_VGetArrayPointer(derivative);
-      for (int i = 0; i < n; ++i) taylor[static_cast<std::size_t>(j * n + i)] = d[i] / factorial;
-    }
-    taylor_order = order;
-    taylor_time = t_n;
-  };
-  // Fills the unknowns element e reads at time t from the Taylor series.
-  const auto interpolate_element = [&](int e, double t, std::vector<double>& target) {
-    const double dt = t - taylor_time;
-    for (const int i : system_.element_unknowns(e)) {
-      double value = taylor[static_cast<std::size_t>(taylor_order * n + i)];
-      for (int j = taylor_order - 1; j >= 0; --j) value = value * dt + taylor[static_cast<std::size_t>(j * n + i)];
-      target[static_cast<std::size_t>(i)] = value;
-    }
-  };
-  const auto element_root_at = [&](int e, int local, double t) {
-    interpolate_element(e, t, y_local);
-    g_element.resize(static_cast<std::size_t>(model.elements()[static_cast<std::size_t>(e)]->root_count()));
-    system_.element_roots(e, t, y_local.data(), g_element.data());
-    return g_element[static_cast<std::size_t>(local)];
-  };
-  // Illinois on [a, b] with g(a) > 0 >= g(b): the earliest time where g reaches zero.
-  const auto locate = [&](int e, int local, double a, double ga, double b, double gb, double tolerance) {
-    int side = 0;
-    for (int iteration = 0; iteration < 100 && b - a > tolerance; ++iteration) {
-      double t = b - gb * (b - a) / (gb - ga);
-      const double margin = 0.1 * tolerance;
-      t = std::min(std::max(t, a + margin), b - margin);
-      const double g = element_root_at(e, local, t);
-      if (g > 0.0) {
-        a = t, ga = g;
-        if (side == -1) gb *= 0.5;
-        side = -1;
-      } else {
-        b = t, gb = g;
-        if (side == 1) ga *= 0.5;
-        side = 1;
-      }
-    }
-    return b;
-  };
+  const double t_n = take_step(t_end);
+  const double t_step_start = impl.t_reached;  // (take_step's retry moves it back to the restart)
+  const PhaseClock::Scope events_timed(phase_clock(), Phase::Events);
+  const bool restarted = system_.root_count() > 0 && handle_events(t_step_start, t_n, t_end);
+  if (!restarted) impl.t_reached = t_n;  // (the run loop samples up to it)
+  return impl.t_reached;
+}
 
-  std::vector<double>& y_probe = impl.y_probe;
-  std::vector<double>& g_probe = impl.g_probe;
-  std::vector<char>& on_boundary = impl.on_boundary;
-  // After a restart: a root at or below zero that restart_state did not commit (zero, and not
-  // falling within its look-ahead) starts on its boundary rather than unseen.
-  const auto mark_boundary_roots = [&](std::vector<double>& g) {
-    for (std::size_t k = 0; k < g.size(); ++k) {
-      on_boundary[k] = 0;
-      if (g[k] <= 0.0) {
-        g[k] = std::numeric_limits<double>::min();
-        on_boundary[k] = 1;
-      }
-    }
-  };
-  // The round-off level of root `local` of element e at state y_state: how much the root moves
-  // when each unknown it reads moves by its own rounding (|y_i| eps), summed over them, times a
-  // safety factor. Any root found below zero by no more than this is taken as resting on its
-  // mode's boundary, not leaving the mode, and carried as +0 (on_boundary) until clearly
-  // below: after a step (an element resting on a kink), and for a mode just entered, whose
-  // roots the commit may have put on the boundary by construction (a crush spring unloading at
-  // its largest crush, where "back on the curve" is zero): committing it would flip the element
-  // back at the same instant, as often as round-off decides.
-  const auto root_noise = [&](int e, int local, double t, const double* y_state) {
-    constexpr double kSafety = 64.0;
-    const double eps = std::numeric_limits<double>::epsilon();
-    const std::vector<int>& unknowns = system_.element_unknowns(e);
-    // Only the element's own unknowns are read (y_probe has the model's size, the rest unused):
-    // clearing the whole vector per call cost O(N) per crossing in a train.
-    for (const int i : unknowns) y_probe[static_cast<std::size_t>(i)] = y_state[i];
-    const int count = model.elements()[static_cast<std::size_t>(e)]->root_count();
-    g_element.resize(static_cast<std::size_t>(count));
-    g_probe.resize(static_cast<std::size_t>(count));
-    system_.element_roots(e, t, y_probe.data(), g_element.data());
-    const double g0 = g_element[static_cast<std::size_t>(local)];
-    double noise = kSafety * eps * std::abs(g0);
-    for (const int i : unknowns) {
-      double& yi = y_probe[static_cast<std::size_t>(i)];
-      const double saved = yi;
-      const double magnitude = std::max(std::abs(saved), atol[i]);
-      const double delta = 1e-7 * magnitude;
-      yi = saved + delta;
-      system_.element_roots(e, t, y_probe.data(), g_probe.data());
-      yi = saved;
-      noise += kSafety * eps * magnitude * std::abs(g_probe[static_cast<std::size_t>(local)] - g0) / delta;
-    }
-    return noise;
-  };
-
-  // The lag test of a mode change without restart, from the element that changed alone
-  // (so an event costs the same in a 2-car and in a 200-car model): over [t_event, t_n] IDA
-  // used its old law; the velocity error that made is about |change of its forces| / M
-  // (t_n - t_event) on its bodies (trapezoid between t_event and t_n: a kink, continuous at
-  // t_event, counts half), the error of its work quadrature |change of its power|
-  // (t_n - t_event); both must stay within the local tolerances. A constraint element that
-  // failed always restarts: its equations changed.
-  // weight_at_event and weight_at_n weigh the two ends' force changes (the trapezoid: 0.5 and
-  // 0.5). A kink's continuity check takes the change at the event alone, held over the lag
-  // (1 and 0): the part of the lag a kink must not have.
-  const auto lag_within_tolerance = [&](int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
-                                        const double* y_at_event, double t_n, const double* y_n,
-                                        const double* quadratures, double weight_at_event = 0.5, double weight_at_n = 0.5) {
-    const Element& el = *model.elements()[static_cast<std::size_t>(e)];
-    if (el.constraint_count() > 0 && system_.element_failed(static_cast<std::size_t>(e))) return false;
-    const double lag = t_n - t_event;
-    const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
-    const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);
-    const int work = DaeSystem::kFirstElementWork + e;
-    const double power_change = weight_at_event * std::abs(after_event.power - before[0].power) +
-                                weight_at_n * std::abs(after_n.power - before[1].power);
-    if (power_change * lag > rtol * std::abs(quadratures[work]) + quad_atol[work]) return false;
-    for (std::size_t slot = 0; slot < 2; ++slot) {
-      const int b = after_event.body[slot];
-      if (b == kGround) continue;
-      const double changes[3] = {
-          weight_at_event * std::abs(after_event.force[slot].x - before[0].force[slot].x) +
-              weight_at_n * std::abs(after_n.force[slot].x - before[1].force[slot].x),
-          weight_at_event * std::abs(after_event.force[slot].y - before[0].force[slot].y) +
-              weight_at_n * std::abs(after_n.force[slot].y - before[1].force[slot].y),
-          weight_at_event * std::abs(after_event.force[slot].theta - before[0].force[slot].theta) +
-              weight_at_n * std::abs(after_n.force[slot].theta - before[1].force[slot].theta)};
-      for (int c = 0; c < 3; ++c) {
-        if (changes[c] == 0.0) continue;
-        const int k = 3 * b + c;
-        const double mass = system_.mass_diagonal(k);
-        // A zero-inertia rotation (mass 0) has no estimate: restart.
-        if (!(mass > 0.0) || changes[c] / mass * lag > rtol * std::abs(y_n[nq + k]) + atol[nq + k]) return false;
-      }
-    }
-    return true;
-  };
-
+double IdaIntegrator::take_step(double t_end) {
+  Impl& impl = *impl_;
   double t_n = impl.t_reached;
   impl.last_sundials_message.clear();
   impl.non_finite_y.clear();
-  impl.sweep.roots_wanted = root_count > 0;
+  impl.sweep.roots_wanted = system_.root_count() > 0;
   impl.sweep.outputs_wanted = step_outputs_wanted();
   impl.sweep.valid = false;
   int flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
@@ -631,11 +586,7 @@ double IdaIntegrator::advance(double t_end) {
     impl.retry.available = false;
     {
       const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
-      std::copy(impl.retry.y.begin(), impl.retry.y.end(), N_VGetArrayPointer(impl.y));
-      std::copy(impl.retry.yp.begin(), impl.retry.yp.end(), N_VGetArrayPointer(impl.yp));
-      std::copy(impl.retry.quad.begin(), impl.retry.quad.end(), N_VGetArrayPointer(impl.quad));
-      impl.reinitialize(impl.retry.t, t_end, stats());
-      impl.check(IDASetInitStep(impl.ida, 0.1 * impl.retry.step_before), "IDASetInitStep");
+      impl.restart(impl.retry, Impl::FirstStep::Retry, t_end, stats());
     }
     t_n = impl.t_reached = impl.retry.t;
     impl.last_sundials_message.clear();
@@ -652,200 +603,119 @@ double IdaIntegrator::advance(double t_end) {
     throw StepFailure(msg.str());
   }
   impl.at_start = false;
-  const double t_step_start = impl.t_reached;
-  bool restarted = false;
+  return t_n;
+}
 
-  const PhaseClock::Scope events_timed(phase_clock(), Phase::Events);
-  if (root_count > 0) {
-    // The step's element outputs come from the same sweep as its roots; they stand for the
-    // step's end only if no mode changes in it (below).
-    double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
-    const Impl::QuadratureSweep& sweep = impl.sweep;
-    if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.outputs_wanted) &&
-        std::memcmp(sweep.y.data(), y, sizeof(double) * static_cast<std::size_t>(n)) == 0) {
-      std::copy(sweep.g.begin(), sweep.g.end(), g_now.begin());
-      if (step_outputs != nullptr) std::copy(sweep.outputs.begin(), sweep.outputs.end(), step_outputs);
-    } else {
-      system_.roots(t_n, y, g_now.data(), step_outputs);
-    }
-    crossings.clear();
-    for (int k = 0; k < root_count; ++k) {
-      const auto kk = static_cast<std::size_t>(k);
-      if (g_now[kk] > 0.0) {
-        on_boundary[kk] = 0;  // inside its mode: an ordinary root again
-        continue;
-      }
-      if (!(g_previous[kk] > 0.0)) continue;
-      const int owner = system_.root_owner(k);
-      const int local = k - system_.root_offset(owner);
-      if (g_now[kk] >= -root_noise(owner, local, t_n, y)) {
-        // Below zero by no more than round-off: an element resting on a boundary (a leveler at
-        // a kink), not leaving its mode; carried as +0 until clearly below.
-        on_boundary[kk] = 1;
-        g_now[kk] = std::numeric_limits<double>::min();
-        continue;
-      }
-      crossings.push_back({t_n, owner, local, 0});
-    }
-    outputs_current_ = step_outputs != nullptr && crossings.empty();
-    if (!crossings.empty()) {
-      load_taylor(t_n);
-      double step = 0.0;
-      impl.check(IDAGetLastStep(impl.ida, &step), "IDAGetLastStep");
-      const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), std::abs(step));
-      for (Crossing& c : crossings) {
-        const int k = system_.root_offset(c.element) + c.local;
-        c.t = locate(c.element, c.local, t_step_start, g_previous[static_cast<std::size_t>(k)], t_n,
-                     g_now[static_cast<std::size_t>(k)], tolerance);
-      }
-      std::stable_sort(crossings.begin(), crossings.end(), [](const Crossing& x, const Crossing& z) { return x.t < z.t; });
-      impl.check(IDAGetQuad(impl.ida, &t_n, impl.quad), "IDAGetQuad");
-      const double* quad_n = N_VGetArrayPointer(impl.quad);
-      std::vector<int> done;  // elements that changed mode in this step
-      std::vector<int> changes;  // how often each of them changed (crossings found before are stale)
-      std::vector<double> change_times;  // when each of them last changed
-      const auto changes_of = [&](int e) {
-        const auto it = std::find(done.begin(), done.end(), e);
-        return it == done.end() ? 0 : changes[static_cast<std::size_t>(it - done.begin())];
-      };
-      for (std::size_t i = 0; i < crossings.size(); ++i) {
-        Crossing c = crossings[i];
-        if (changes_of(c.element) != c.generation) continue;  // found in a mode the element has left
-        if (c.generation >= 20) {  // an element switching back and forth within one step: restart
-          restarted = true;
-        }
-        // The state at the event from IDA's interpolation (the same numbers a restart
-        // uses). The root was located on the Taylor form of the same polynomial; where
-        // round-off leaves it a hair above zero in this state, the event moves forward by
-        // growing multiples of the tolerance until it is at or below zero (at t_n it is).
-        double t_event = c.t;
-        impl.check(IDAGetDky(impl.ida, t_event, 0, derivative), "IDAGetDky");
-        const double* y_at_event = N_VGetArrayPointer(derivative);
-        g_element.resize(static_cast<std::size_t>(model.elements()[static_cast<std::size_t>(c.element)]->root_count()));
-        system_.element_roots(c.element, t_event, y_at_event, g_element.data());
-        // Each try is judged first on the element's own unknowns (the Taylor form, corrected by
-        // its round-off difference from IDAGetDky's state at the located time); the whole state
-        // is interpolated only where that estimate is no longer above zero, and always at t_n.
-        // (Interpolating the whole state at every try was 25 % of a 200 + 200-car run: bench/README.md.)
-        double g_event = g_element[static_cast<std::size_t>(c.local)];
-        const double mismatch = g_event > 0.0 ? g_event - element_root_at(c.element, c.local, c.t) : 0.0;
-        for (double nudge = tolerance; g_event > 0.0 && t_event < t_n; nudge *= 4.0) {
-          t_event = std::min(t_n, c.t + nudge);
-          if (t_event < t_n && element_root_at(c.element, c.local, t_event) + mismatch > 0.0) continue;
-          impl.check(IDAGetDky(impl.ida, t_event, 0, derivative), "IDAGetDky");
-          system_.element_roots(c.element, t_event, y_at_event, g_element.data());
-          g_event = g_element[static_cast<std::size_t>(c.local)];
-        }
-        c.t = t_event;
-        const std::array<DaeSystem::ElementLoad, 2> before{system_.element_load(c.element, c.t, y_at_event),
-                                                           system_.element_load(c.element, t_n, y)};
-        sample_up_to(c.t);  // (uses y_out, not the event state)
-        observe_before_event(c.t, y_at_event, c.element);
-        events.clear();
-        if (!restarted && !system_.commit_element_root(c.element, c.local, -1, c.t, y_at_event, events)) continue;
-        for (int j = 0; j < model.elements()[static_cast<std::size_t>(c.element)]->root_count(); ++j)
-          on_boundary[static_cast<std::size_t>(system_.root_offset(c.element) + j)] = 0;  // a new mode
-        const auto seen = std::find(done.begin(), done.end(), c.element);
-        if (seen == done.end()) {
-          done.push_back(c.element);
-          changes.push_back(1);
-          change_times.push_back(c.t);
-        } else {
-          ++changes[static_cast<std::size_t>(seen - done.begin())];
-          change_times[static_cast<std::size_t>(seen - done.begin())] = c.t;
-        }
-        ++stats().root_returns;
-        // A kink (the element says its force is continuous, and it is at the event state)
-        // needs no restart when the lag is within tolerance: IDA goes on with its order and
-        // history. A jump always restarts (bench/README.md, "Kinks are not jumps").
-        const bool kink = !restarted && events.size() == 1 && events.front().kink &&
-                          lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n, 1.0, 0.0);
-        if (kink && lag_within_tolerance(c.element, before, c.t, y_at_event, t_n, y, quad_n)) {
-          report_events(events, y_at_event, c.element);
-          // The element's new mode may end within this step too: its roots that are at or
-          // below zero at t_n are located in [t_event, t_n] (or committed at once when
-          // already outside at t_event) and queued in time order.
-          const int offset = system_.root_offset(c.element);
-          const int count = model.elements()[static_cast<std::size_t>(c.element)]->root_count();
-          const int generation = changes_of(c.element);
-          system_.element_roots(c.element, t_n, y, g_now.data() + offset);
-          for (int j = 0; j < count; ++j) {
-            const double g_end = g_now[static_cast<std::size_t>(offset + j)];
-            if (g_end > 0.0) continue;
-            double g_start = element_root_at(c.element, j, c.t);
-            if (g_start <= 0.0 && g_start >= -root_noise(c.element, j, c.t, y_at_event)) {
-              // On the new mode's boundary by construction (see root_noise): not a second
-              // change at this instant. Still at the boundary at t_n (within round-off): the
-              // root starts the next step armed at +0, so a real later crossing is found;
-              // clearly out by t_n: the crossing is located after the event.
-              const double noise_end = root_noise(c.element, j, t_n, y);
-              if (g_end >= -noise_end) {
-                on_boundary[static_cast<std::size_t>(offset + j)] = 1;
-                continue;
-              }
-              g_start = std::numeric_limits<double>::min();
-            }
-            const double t_next = g_start > 0.0 ? locate(c.element, j, c.t, g_start, t_n, g_end, tolerance) : c.t;
-            const Crossing next{t_next, c.element, j, generation};
-            crossings.insert(std::upper_bound(crossings.begin() + static_cast<std::ptrdiff_t>(i) + 1, crossings.end(), next,
-                                              [](const Crossing& x, const Crossing& z) { return x.t < z.t; }),
-                             next);
-          }
-          continue;
-        }
-        restarted = true;
-        const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
-        // Restart at the event: consistent rates for the new law (and roots that sit on
-        // their boundary there), quadratures interpolated to it.
-        std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
-        std::vector<char> changed_now(model.elements().size(), 0);  // the elements that changed at c.t
-        for (std::size_t k = 0; k < done.size(); ++k)
-          if (change_times[k] == c.t) changed_now[static_cast<std::size_t>(done[k])] = 1;
-        restart_state(system_, c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
-        report_events(events, y_restart.data());
-        impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
-        std::copy(y_restart.begin(), y_restart.end(), y);
-        std::copy(yp_restart.begin(), yp_restart.end(), yp);
-        std::copy(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad, N_VGetArrayPointer(impl.quad));
-        impl.retry.available = true;
-        impl.retry.t = c.t;
-        impl.check(IDAGetLastStep(impl.ida, &impl.retry.step_before), "IDAGetLastStep");
-        impl.retry.available = impl.retry.step_before > 0.0;
-        impl.retry.y = y_restart;
-        impl.retry.yp = yp_restart;
-        impl.retry.quad.assign(N_VGetArrayPointer(impl.quad), N_VGetArrayPointer(impl.quad) + nquad);
-        impl.reinitialize(c.t, t_end, stats());
-        // IDA's own first step after IDAReInit is 0.5 / ||y'|| (weighted), tiny after an
-        // impact, and it then climbs back at order 1, doubling per step, with a Jacobian at
-        // nearly every step (cj changes each time): 170 restarts in the 0.25 s two-car crash
-        // cost a tenth of its steps and half its Jacobians. It starts instead from a fraction
-        // of the step that crossed the event, a scale the solution has just shown; an impact
-        // faster than that is met by IDA's error test, which cuts the step. The fraction is
-        // measured (bench/README.md, "The first step after a restart"). The error test cuts
-        // at most 10 times, by 0.25 from the second cut on, so the start stays within
-        // kReachableMultiple of IDA's own: the step before a dropped ball touches a floor is its
-        // free flight's, 0.17 s, ten million times its first step in contact at rtol 1e-10
-        // (tests/elements/test_contact.cpp).
-        impl.check(IDASetInitStep(impl.ida, impl.retry.available ? impl.restart_first_step(impl.retry.step_before, c.t, t_end) : 0.0),
-                   "IDASetInitStep");
-        system_.roots(c.t, y, g_previous.data());
-        mark_boundary_roots(g_previous);
-        impl.t_reached = c.t;
-        restarted = true;
-        break;
-      }
-      if (!restarted) {  // the changed elements' roots at t_n, in their new modes
-        for (const int e : done) system_.element_roots(e, t_n, y, g_now.data() + system_.root_offset(e));
-        for (const int e : done)
-          for (int k = system_.root_offset(e); k < system_.root_offset(e) + model.elements()[static_cast<std::size_t>(e)]->root_count(); ++k)
-            if (on_boundary[static_cast<std::size_t>(k)] && g_now[static_cast<std::size_t>(k)] <= 0.0)
-              g_now[static_cast<std::size_t>(k)] = std::numeric_limits<double>::min();
-      }
-    }
-    if (!restarted) std::swap(g_previous, g_now);
+bool IdaIntegrator::handle_events(double t_step_start, double t_n, double t_end) {
+  Impl& impl = *impl_;
+  const int n = system_.size();
+  const double* y = N_VGetArrayPointer(impl.y);
+  ModeTracker& modes = mode_tracker();
+  EventLocator& locator = event_locator();
+  std::vector<Crossing>& crossings = locator.queue();
+  std::vector<double>& g_now = modes.now();
+  // The step's element outputs come from the same sweep as its roots; they stand for the
+  // step's end only if no mode changes in it (below).
+  double* step_outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
+  const Impl::QuadratureSweep& sweep = impl.sweep;
+  if (sweep.valid && sweep.t == t_n && (step_outputs == nullptr || sweep.outputs_wanted) &&
+      std::memcmp(sweep.y.data(), y, sizeof(double) * static_cast<std::size_t>(n)) == 0) {
+    std::copy(sweep.g.begin(), sweep.g.end(), g_now.begin());
+    if (step_outputs != nullptr) std::copy(sweep.outputs.begin(), sweep.outputs.end(), step_outputs);
+  } else {
+    system_.roots(t_n, y, g_now.data(), step_outputs);
   }
-  if (!restarted) impl.t_reached = t_n;  // (the run loop samples up to it)
-  return impl.t_reached;
+  modes.scan(t_n, y, crossings);
+  outputs_current_ = step_outputs != nullptr && crossings.empty();
+  if (crossings.empty()) {
+    modes.end_step();
+    return false;
+  }
+  IdaStepInterpolant& step = impl.interpolant;
+  step.load(t_step_start, t_n);
+  double last_step = 0.0;
+  impl.check(IDAGetLastStep(impl.ida, &last_step), "IDAGetLastStep");
+  const double tolerance = 100.0 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t_n), std::abs(last_step));
+  locator.locate_queue(step, modes.previous(), g_now, tolerance);
+  double t_quad = t_n;
+  impl.check(IDAGetQuad(impl.ida, &t_quad, impl.quad), "IDAGetQuad");
+  const double* quad_n = N_VGetArrayPointer(impl.quad);
+  IdaEventHandler handler(*this, t_n, y, quad_n, t_end);
+  return commit_crossings(step, y, modes, locator, handler, tolerance, impl.events);
+}
+
+void IdaIntegrator::restart_at_event(const Crossing& c, const double* y_at_event, double t_end) {
+  Impl& impl = *impl_;
+  const int n = system_.size();
+  const int nquad = system_.quadrature_count();
+  std::vector<EventRecord>& events = impl.events;
+  const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
+  // Restart at the event: consistent rates for the new law (and roots that sit on their
+  // boundary there), quadratures interpolated to it.
+  std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
+  std::vector<char> changed_now = mode_tracker().changed_at(c.t);  // the elements that changed at c.t
+  restart_state(mode_tracker(), c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
+  report_events(events, y_restart.data());
+  impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
+  // Kept until IDA's first step after it succeeds, for one retry (take_step).
+  Impl::RestartRetry& retry = impl.retry;
+  retry.t = c.t;
+  impl.check(IDAGetLastStep(impl.ida, &retry.step_before), "IDAGetLastStep");
+  retry.available = retry.step_before > 0.0;
+  retry.y = std::move(y_restart);
+  retry.yp = std::move(yp_restart);
+  retry.quad.assign(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad);
+  impl.restart(retry, Impl::FirstStep::AfterEvent, t_end, stats());
+  mode_tracker().arm(c.t, N_VGetArrayPointer(impl.y));
+  impl.t_reached = c.t;
+}
+
+bool IdaIntegrator::lag_within_tolerance(int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
+                                         const double* y_at_event, double t_n, const double* y_n,
+                                         const double* quadratures, double weight_at_event, double weight_at_n) const {
+  // The lag test of a mode change without restart, from the element that changed alone
+  // (so an event costs the same in a 2-car and in a 200-car model): over [t_event, t_n] IDA
+  // used its old law; the velocity error that made is about |change of its forces| / M
+  // (t_n - t_event) on its bodies (trapezoid between t_event and t_n: a kink, continuous at
+  // t_event, counts half), the error of its work quadrature |change of its power|
+  // (t_n - t_event); both must stay within the local tolerances. A constraint element that
+  // failed always restarts: its equations changed.
+  // weight_at_event and weight_at_n weigh the two ends' force changes (the trapezoid: 0.5 and
+  // 0.5). A kink's continuity check takes the change at the event alone, held over the lag
+  // (1 and 0): the part of the lag a kink must not have.
+  const Impl& impl = *impl_;
+  const int nq = system_.body_unknowns();
+  const double rtol = impl.rtol;
+  const double* atol = N_VGetArrayPointer(impl.atol);
+  const double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
+  const Element& el = *system_.model().elements()[static_cast<std::size_t>(e)];
+  if (el.constraint_count() > 0 && system_.element_failed(static_cast<std::size_t>(e))) return false;
+  const double lag = t_n - t_event;
+  const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
+  const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);
+  const int work = DaeSystem::kFirstElementWork + e;
+  const double power_change = weight_at_event * std::abs(after_event.power - before[0].power) +
+                              weight_at_n * std::abs(after_n.power - before[1].power);
+  if (power_change * lag > rtol * std::abs(quadratures[work]) + quad_atol[work]) return false;
+  for (std::size_t slot = 0; slot < 2; ++slot) {
+    const int b = after_event.body[slot];
+    if (b == kGround) continue;
+    const double changes[3] = {
+        weight_at_event * std::abs(after_event.force[slot].x - before[0].force[slot].x) +
+            weight_at_n * std::abs(after_n.force[slot].x - before[1].force[slot].x),
+        weight_at_event * std::abs(after_event.force[slot].y - before[0].force[slot].y) +
+            weight_at_n * std::abs(after_n.force[slot].y - before[1].force[slot].y),
+        weight_at_event * std::abs(after_event.force[slot].theta - before[0].force[slot].theta) +
+            weight_at_n * std::abs(after_n.force[slot].theta - before[1].force[slot].theta)};
+    for (int c = 0; c < 3; ++c) {
+      if (changes[c] == 0.0) continue;
+      const int k = 3 * b + c;
+      const double mass = system_.mass_diagonal(k);
+      // A zero-inertia rotation (mass 0) has no estimate: restart.
+      if (!(mass > 0.0) || changes[c] / mass * lag > rtol * std::abs(y_n[nq + k]) + atol[nq + k]) return false;
+    }
+  }
+  return true;
 }
 
 void IdaIntegrator::check_start(const double* y, const double* yp, const double* atol, double t_end) const {

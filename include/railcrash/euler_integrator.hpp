@@ -62,6 +62,24 @@ class EulerIntegrator : public Integrator {
                                          const PenaltyRows* penalty);
 
  private:
+  /// Euler's step for the event layer: known at its end alone (not dense), the state there.
+  class EulerStep final : public StepInterpolant {
+   public:
+    EulerStep(EulerIntegrator& euler, double t0, double t1) : euler_(euler), t0_(t0), t1_(t1) {}
+    double t0() const override { return t0_; }
+    double t1() const override { return t1_; }
+    bool dense() const override { return false; }
+    /// The state at the step's end, whatever t.
+    const double* state_at(double t) override;
+    void unknowns_at(const std::vector<int>& unknowns, double t, double* y) override;
+    /// q' = v, v' = M^-1 f from the last sweep's forces, at the step's end.
+    void rates_at(double t, double* yp) override;
+
+   private:
+    EulerIntegrator& euler_;
+    double t0_, t1_;
+  };
+
   static PenaltyRows make_penalty(const DaeSystem& system, const Element::PenaltyOverrides& global, double dt);
   /// The run's state at t0 from y_ and quadratures_ in the present modes: forces, penalty
   /// forces, roots and outputs of the first step; at the run's start (run_start) also the
@@ -101,10 +119,9 @@ class EulerIntegrator : public Integrator {
   // penalty forces of the last step), quadratures, time and step count.
   std::vector<double> y_, quadratures_;
   std::vector<double> force_, rates_, lambda_, inverse_mass_;
-  std::vector<double> g_before_, g_after_;  // root functions before and after a step
   std::vector<double> outputs_;             // element outputs at y_ (sweep())
   bool outputs_current_ = false;            // outputs_ belong to y_ and the present modes
-  std::vector<int> direction_;
+  std::vector<int> direction_;              // roots that fired in the last step (EventLocator::step_end_crossings)
   std::vector<EventRecord> events_;
   double t_ = 0.0;  // [time]
   double t0_ = 0.0;  // [time] where this integrator's steps began (0, or where it took over a run)

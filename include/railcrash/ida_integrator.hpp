@@ -14,7 +14,9 @@
 // * Events: IDA takes one step at a time; after each step every root function is evaluated
 //   once and a root that fell through zero is located element by element on IDA's own
 //   interpolating polynomial (its Taylor form at t_n from IDAGetDky, evaluated only for the
-//   unknowns the element reads), so locating an event costs the same in any model size.
+//   unknowns the element reads), so locating an event costs the same in any model size. The
+//   bookkeeping and the location are the event layer's (events.hpp: ModeTracker,
+//   EventLocator, owned by the run loop's Integrator); IDA gives it a StepInterpolant.
 //   Events are committed in time order; IDA goes on without a restart when the new law agrees
 //   with the old one over the rest of the step within the local tolerances (kinks), and
 //   restarts from consistent values at the event otherwise (jumps, joint failures).
@@ -60,12 +62,30 @@ class IdaIntegrator : public Integrator {
   void finish() override;
 
  private:
+  friend class IdaEventHandler;  // (ida_integrator.cpp) IDA's side of the event loop
   /// Before the first step: InputError naming the element or body whose residual, Jacobian or
   /// rates are not finite (or so large that IDA's norms overflow) at t = 0.
   void check_start(const double* y, const double* yp, const double* atol, double t_end) const;
   /// Why IDA failed, in the model's terms: a non-finite residual's element or body, a
   /// singular configuration of the joints, the unknowns with the largest weighted errors.
   std::string explain_failure(int flag);
+  /// IDA's next step (IDA_ONE_STEP, with one retry of a failed first step after a restart);
+  /// the time it reached. Throws StepFailure.
+  double take_step(double t_end);
+  /// After a step from t_step_start to t_n: its roots, and the crossings in it located and
+  /// committed in time order (events.hpp, event_loop.hpp: IDA's decisions are an
+  /// IdaEventHandler's); kinks within tolerance go on, a jump restarts at its event (then
+  /// true: the step's end is discarded).
+  bool handle_events(double t_step_start, double t_n, double t_end);
+  /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
+  /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
+  void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);
+  /// Whether element e's mode change at t_event (its load in the old modes `before`: at the
+  /// event and at t_n) leaves IDA's step to t_n within the local tolerances without a restart
+  /// (the lag test; see advance()). quadratures: at t_n.
+  bool lag_within_tolerance(int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
+                            const double* y_at_event, double t_n, const double* y_n, const double* quadratures,
+                            double weight_at_event = 0.5, double weight_at_n = 0.5) const;
   /// "; the largest force on it, F, comes from FILE:LINE: element 'NAME' (TYPE)" for body unknown k at t = 0.
   std::string largest_force_on(int k, const double* y) const;
 

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "railcrash/dae_system.hpp"
+#include "railcrash/events.hpp"
 
 namespace railcrash {
 
@@ -203,7 +204,7 @@ class Integrator {
     using std::runtime_error::runtime_error;
   };
 
-  explicit Integrator(DaeSystem& system) : system_(system) {}
+  explicit Integrator(DaeSystem& system) : system_(system), modes_(system), locator_(system) {}
 
   // ---- per-integrator steps ----
   /// Prepares the state at t = 0 (reporting start events through report_events).
@@ -258,6 +259,10 @@ class Integrator {
   /// Dense output: samples every output time up to t_limit not sampled yet.
   void sample_up_to(double t_limit);
   RunStatistics& stats() { return outcome_.stats; }
+  /// The event layer (events.hpp), owned here for the integrator's steps: the element modes'
+  /// bookkeeping (every commit of a mode change goes through it) and the crossings' locator.
+  ModeTracker& mode_tracker() { return modes_; }
+  EventLocator& event_locator() { return locator_; }
   /// The run's phase clock when it is timed, else null (for PhaseClock::Scope).
   PhaseClock* phase_clock() { return phase_clock_.on() ? &phase_clock_ : nullptr; }
   /// Whether the observer takes every step's element outputs (an integrator that can compute
@@ -278,6 +283,9 @@ class Integrator {
   double next_output_time() const;
   /// Names the first non-finite entry of y ("" when all are finite).
   std::string non_finite_entry(const double* y) const;
+
+  ModeTracker modes_;
+  EventLocator locator_;
 
   // State of the run in progress.
   RunOutcome outcome_;
