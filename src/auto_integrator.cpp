@@ -57,6 +57,28 @@ std::unique_ptr<Integrator> AutoIntegrator::hand_over(double t, const double* /*
   return euler;
 }
 
+std::unique_ptr<Integrator> AutoIntegrator::rescue(const std::string& failure, double* t) {
+  if (!euler_step_) return nullptr;
+  std::vector<double> state, quadratures;
+  double t_good = 0.0;
+  try {
+    t_good = current_time();
+    state_for_successor(t_good, state, quadratures);
+  } catch (const std::exception&) {
+    return nullptr;  // no good state to go on from: the run fails with IDA's message
+  }
+  const double dt = euler_step_->dt;
+  auto euler = std::make_unique<EulerIntegrator>(system_, euler_settings_, std::move(*euler_step_), t_good, state, quadratures);
+  euler_step_.reset();
+  stats().handed_over_at = t_good;
+  char head[200];
+  std::snprintf(head, sizeof head, "IDA failed; Euler (step %.4g) took the rest of the run from IDA's last good state at t = %.6g: ",
+                dt, t_good);
+  stats().hand_over_reason = head + failure;
+  *t = t_good;
+  return euler;
+}
+
 void AutoIntegrator::finish() {
   IdaIntegrator::finish();
   if (stats().handed_over_at >= 0.0) return;  // the reason of the hand-over stands

@@ -760,6 +760,12 @@ std::string IdaIntegrator::largest_force_on(int k, const double* y) const {
   return text.str();
 }
 
+double IdaIntegrator::current_time() const {
+  double t = 0.0;
+  if (IDAGetCurrentTime(impl_->ida, &t) != IDA_SUCCESS) throw StepFailure("IDAGetCurrentTime failed");
+  return t;
+}
+
 std::string IdaIntegrator::explain_failure(int flag) {
   Impl& impl = *impl_;
   std::ostringstream why;

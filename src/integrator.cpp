@@ -190,7 +190,21 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
         active->outcome_.message = msg.str();
         break;
       }
-      t_reached = active->advance(t_end);
+      try {
+        t_reached = active->advance(t_end);
+      } catch (const StepFailure& failure) {
+        double t_good = t_reached;
+        std::unique_ptr<Integrator> next = active->rescue(failure.what(), &t_good);
+        if (!next) throw;
+        active->finish();  // the counters of the steps so far
+        next->take_run_from(*active);
+        next->continue_from_hand_over();
+        successor = std::move(next);
+        active = successor.get();
+        dense = active->dense_output();
+        t_reached = t_good;
+        continue;
+      }
       const std::string bad = active->non_finite_entry(active->current_state());
       if (!bad.empty()) {
         std::ostringstream msg;

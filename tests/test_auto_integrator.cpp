@@ -130,3 +130,37 @@ TEST_CASE("a model that names no integrator runs with auto and a model may name 
   for (const IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Euler, IntegratorKind::Auto})
     CHECK(integrator_from_name(integrator_name(kind)) == kind);
 }
+
+TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and says so", "[integrators][auto]") {
+  // IDA stops with IDA_CONV_FAIL at t = 4.68 ms on this model (the file says what is known).
+  // No force from outside acts (no gravity, no ground element): the x-momentum of the bodies,
+  // 81,700 kg x 12 m/s for the moving unit, stays what it was through IDA's part, the hand-over
+  // and Euler's part (Euler's internal forces are equal and opposite at every step).
+  const std::string file = source_path("tests/robustness/models/ida_fails_stiff_anticlimber.yaml");
+  const Model ida_model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.05"});
+  DaeSystem ida_system(ida_model);
+  SampleTimes ida_samples;
+  const RunOutcome by_ida = make_integrator(ida_system, ida_model.simulation)->run(0.05, 0.001, ida_samples);
+  REQUIRE_FALSE(by_ida.ok);
+  CHECK_THAT(by_ida.message, Catch::Contains("IDA_CONV_FAIL"));
+  // "IDA failed at t = T with ...": auto's IDA takes the same steps up to T.
+  const std::size_t at = by_ida.message.find("IDA failed at t = ");
+  REQUIRE(at != std::string::npos);
+  const double t_failed = std::stod(by_ida.message.substr(at + 18));
+
+  const Model auto_model = load_model(file, {"simulation.integrator=auto", "simulation.t_end=0.05"});
+  DaeSystem auto_system(auto_model);
+  SampleTimes auto_samples;
+  const RunOutcome outcome = make_integrator(auto_system, auto_model.simulation)->run(0.05, 0.001, auto_samples);
+  INFO(outcome.message);
+  INFO(outcome.stats.hand_over_reason);
+  REQUIRE(outcome.ok);
+  CHECK(outcome.t_reached == Approx(0.05));
+  CHECK_THAT(outcome.stats.hand_over_reason, Catch::StartsWith("IDA failed; Euler") && Catch::Contains("IDA_CONV_FAIL"));
+  CHECK(outcome.stats.handed_over_at == Approx(t_failed).epsilon(1e-5));
+  CHECK(outcome.stats.handed_over_at > by_ida.t_reached);  // after IDA's last sample
+  double momentum = 0.0;  // [kg m/s]
+  for (std::size_t b = 0; b < auto_model.bodies().size(); ++b)
+    momentum += auto_model.bodies()[b].mass * outcome.y[3 * auto_model.body_count() + 3 * b];
+  CHECK(momentum == Approx((41000.0 + 900.0 + 900.0 + 38000.0 + 900.0) * 12.0).epsilon(1e-9));
+}

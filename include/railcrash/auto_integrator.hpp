@@ -56,6 +56,10 @@ class AutoIntegrator : public IdaIntegrator {
  protected:
   void start(double t_end) override;
   std::unique_ptr<Integrator> hand_over(double t, const double* y) override;
+  /// IDA failed: Euler takes the rest of the run from IDA's last good state, and the run says
+  /// so (RunStatistics::hand_over_reason, summary.json's integrator_used). Null when Euler
+  /// cannot run the model or already has the run.
+  std::unique_ptr<Integrator> rescue(const std::string& failure, double* t) override;
   void finish() override;
 
  private:

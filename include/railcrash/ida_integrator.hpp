@@ -60,6 +60,8 @@ class IdaIntegrator : public Integrator {
   std::string divergence_phrase() const override { return "IDA's solution is not finite"; }
   long max_steps() const override { return settings_.max_steps; }
   void finish() override;
+  /// IDA's current time: after a failed step, the time of its last good state (state_at there).
+  double current_time() const;
 
  private:
   friend class IdaEventHandler;  // (ida_integrator.cpp) IDA's side of the event loop

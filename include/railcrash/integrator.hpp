@@ -246,6 +246,11 @@ class Integrator {
   virtual std::unique_ptr<Integrator> hand_over(double /*t*/, const double* /*y*/) { return nullptr; }
   /// Called on the successor once it holds the run (its statistics among it).
   virtual void continue_from_hand_over() {}
+  /// Asked when advance() failed with a StepFailure (failure: its message) by the run loop: the
+  /// integrator that takes the rest of the run from this one's last good state (integrator:
+  /// auto hands IDA's failed run to Euler), or null to end the run failed. *t: the time of
+  /// that state, where the successor starts. As hand_over otherwise.
+  virtual std::unique_ptr<Integrator> rescue(const std::string& /*failure*/, double* /*t*/) { return nullptr; }
 
   // ---- for the integrators: what the run loop owns ----
   /// Forwards committed mode changes (the state at that instant: y) to the observer and the
