@@ -384,6 +384,173 @@
     selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
   }
 
+  // ---------------------------------------------------------------- runs side by side (issue 39 item 5)
+  // `railcrash report RUN_A RUN_B [...]`: each run's identity, the summary tables with the
+  // differences to the first run (computed by report.cpp write_comparison), the outcome
+  // signatures, and the time histories with a line per run.
+  function compareReport() {
+    ["animation-section", "plots-section", "loops-section", "zones-section", "energy-section"].forEach(function (id) {
+      document.getElementById(id).hidden = true;
+    });
+    var runs = data.runs, n = runs.length;
+    var colours = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+    var check = {errors: [], compare: true, runs: n, tables: [], charts: [], outcomes: ""};
+    var problemBox = document.getElementById("problems");
+    problems.forEach(function (p) {
+      problemBox.appendChild(el("div", {"class": /FAILED|no summary/.test(p) ? "problem failed" : "problem"}, p));
+    });
+    var head = document.getElementById("header");
+    head.textContent = "";
+    head.appendChild(el("h1", {}, "railcrash: " + n + " runs side by side"));
+    head.appendChild(el("p", {}, "Differences are each run's value minus the first run's (" + runs[0].label +
+                                 "), and that difference in % of the first run's magnitude."));
+    var box = el("section", {id: "compare"});
+    document.body.insertBefore(box, document.getElementById("footer"));
+    function number(v) {
+      if (v === null || v === undefined) return "\u2013";
+      if (v === 0) return "0";
+      var a = Math.abs(v);
+      return a >= 1e5 || a < 1e-3 ? v.toExponential(3) : String(Number(v.toPrecision(4)));
+    }
+    function signed(v) { return v === null || v === undefined ? "\u2013" : (v > 0 ? "+" : "") + number(v); }
+    // Identity of each run.
+    box.appendChild(el("h2", {}, "Runs"));
+    var identity = el("table", {"class": "compare", id: "compare-runs"});
+    var tr = el("tr");
+    tr.appendChild(el("th", {}, ""));
+    runs.forEach(function (r, k) {
+      var th = el("th", {}, r.label);
+      th.style.borderBottom = "3px solid " + colours[k % colours.length];
+      tr.appendChild(th);
+    });
+    identity.appendChild(tr);
+    function identityRow(name, cell) {
+      var row = el("tr");
+      row.appendChild(el("th", {}, name));
+      runs.forEach(function (r, k) {
+        var c = cell(r, k);
+        row.appendChild(el("td", c.cls ? {"class": c.cls} : {}, c.text));
+      });
+      identity.appendChild(row);
+    }
+    identityRow("folder", function (r) { return {text: r.folder}; });
+    identityRow("model", function (r) { return {text: r.model}; });
+    identityRow("integrator", function (r) { return {text: r.integrator}; });
+    identityRow("status", function (r) {
+      return {text: r.status + (r.message ? ": " + r.message : ""), cls: r.status === "ok" ? "status-ok" : "status-failed"};
+    });
+    identityRow("t reached [s]", function (r) { return {text: number(r.t_reached)}; });
+    identityRow("output rows (" + runs.map(function (r) { return r.file; }).filter(function (f, k, a) { return a.indexOf(f) === k; }).join(", ") + ")",
+                function (r) { return {text: String(r.rows)}; });
+    identityRow("settings (--set)", function (r) { return {text: r.settings.length ? r.settings.join(" ") : "none"}; });
+    identityRow("run id", function (r) { return {text: r.run_id}; });
+    var differing = 0;
+    identityRow("outcome branch", function (r, k) {
+      var same = data.outcomes[k].branch === data.outcomes[0].branch;
+      if (!same) ++differing;
+      return {text: (data.outcomes[k].branch || "(no discrete outcome)") + (k ? (same ? " (same as " + runs[0].label + ")" : " (DIFFERS)") : ""),
+              cls: k && !same ? "differs" : ""};
+    });
+    identityRow("outcome signature", function (r, k) { return {text: data.outcomes[k].signature || "\u2013"}; });
+    box.appendChild(identity);
+    check.outcomes = differing ? "differ" : "same";
+
+    // The summary tables.
+    data.tables.forEach(function (t) {
+      var container = box;
+      if (t.id === "peaks") {
+        var details = el("details", {"class": "compare-peaks"});
+        details.appendChild(el("summary", {}, t.title + ": " + t.rows.length + " rows"));
+        box.appendChild(details);
+        container = details;
+      } else {
+        box.appendChild(el("h2", {}, t.title));
+      }
+      var table = el("table", {"class": "compare", id: "compare-" + t.id});
+      var header = el("tr");
+      header.appendChild(el("th", {}, "quantity"));
+      runs.forEach(function (r, k) {
+        header.appendChild(el("th", {}, r.label + (t.unit ? " [" + t.unit + "]" : "")));
+        if (k) {
+          header.appendChild(el("th", {}, "\u0394 " + r.label + (t.unit ? " [" + t.unit + "]" : "")));
+          header.appendChild(el("th", {}, "\u0394 " + r.label + " [%]"));
+        }
+      });
+      table.appendChild(header);
+      var cells = 0;
+      t.rows.forEach(function (row) {
+        var line = el("tr");
+        line.appendChild(el("th", {}, row.name));
+        row.values.forEach(function (v, k) {
+          line.appendChild(el("td", {"data-run": String(k)}, number(v)));
+          if (k) {
+            var big = row.percent[k] !== null && Math.abs(row.percent[k]) >= 5;
+            line.appendChild(el("td", {"class": "difference", "data-run": String(k)}, signed(row.difference[k])));
+            line.appendChild(el("td", {"class": big ? "difference big" : "difference", "data-run": String(k)},
+                                row.percent[k] === null ? "\u2013" : (row.percent[k] > 0 ? "+" : "") + row.percent[k].toFixed(2)));
+          }
+          ++cells;
+        });
+        table.appendChild(line);
+      });
+      container.appendChild(table);
+      check.tables.push({id: t.id, rows: t.rows.length, cells: cells});
+    });
+    if (data.unshared.length) {
+      var list = el("details", {"class": "compare-unshared"});
+      list.appendChild(el("summary", {}, "Columns not shared: " + data.unshared.length + " timeseries columns are not in every run (not overlaid)"));
+      list.appendChild(el("p", {}, data.unshared.join("; ")));
+      box.appendChild(list);
+    }
+
+    // The time histories, a line per run.
+    box.appendChild(el("h2", {}, "Time histories (a line per run)"));
+    if (typeof window.uPlot !== "function") {
+      box.appendChild(el("p", {"class": "no-library"}, "This railcrash was built without its plotting library: the charts are left out."));
+    } else {
+      var groups = {displacement: "Car bodies: displacement", velocity: "Car bodies: velocity", force: "Crash elements: force",
+                    deformation: "Crash elements: deformation", energy: "Energy partition"};
+      var grids = {};
+      data.charts.forEach(function (c) {
+        var kind = c.id.split(":")[0];
+        if (!grids[kind]) {
+          box.appendChild(el("h3", {}, groups[kind] || kind));
+          grids[kind] = el("div", {"class": "compare-grid"});
+          box.appendChild(grids[kind]);
+        }
+        var largest = 0;
+        c.series.forEach(function (s) { s.values.forEach(function (v) { if (v !== null && Math.abs(v) > largest) largest = Math.abs(v); }); });
+        var unit = c.unit, factor = 1;
+        if ((unit === "N" || unit === "J") && largest >= 1e6) { unit = "M" + unit; factor = 1e-6; }
+        else if ((unit === "N" || unit === "J") && largest >= 1e3) { unit = "k" + unit; factor = 1e-3; }
+        else if ((unit === "m" || unit === "m/s") && largest > 0 && largest < 1) { unit = "m" + unit; factor = 1e3; }
+        var series = [{label: "t [s]"}], columns = [c.t];
+        c.series.forEach(function (s, k) {
+          series.push({label: s.name, stroke: colours[k % colours.length], width: 1.25, spanGaps: true, show: s.present});
+          columns.push(s.values);
+        });
+        var plotBox = el("div", {"class": "plot"});
+        grids[kind].appendChild(plotBox);
+        try {
+          var u = new uPlot({title: c.title, width: 440, height: 250, scales: {x: {time: false}}, series: series,
+                             axes: [{label: "t [s]", values: tickLabels(1)}, {label: unit, size: 60, values: tickLabels(factor)}],
+                             legend: {live: true}, cursor: {sync: {key: "railcrash-compare"}}}, columns, plotBox);
+          var points = 0;
+          columns.slice(1).forEach(function (col) { col.forEach(function (v) { if (v !== null) ++points; }); });
+          check.charts.push({id: c.id, series: c.series.length, points: points, drawn: !!u.ctx});
+        } catch (e) {
+          window.railcrashErrors.push("chart " + c.id + ": " + e.message);
+        }
+      });
+    }
+    document.getElementById("footer").textContent = "railcrash report of " + n + " runs side by side (" + (data.library || "no plotting library") + ")";
+    check.errors = window.railcrashErrors;
+    var selfCheck = document.getElementById("self-check");
+    selfCheck.textContent = JSON.stringify(check);
+    selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  }
+
+  if (data.compare) { compareReport(); return; }
   if (data.study) { studyReport(); return; }
 
   // ---------------------------------------------------------------- header and problems
