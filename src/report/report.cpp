@@ -980,12 +980,33 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
     problems.push_back(std::to_string(unshared.size()) + " timeseries columns are not in every run and are not overlaid (listed under "
                        "\"Columns not shared\")");
 
+  // Units: the model's (summary.json "units": SI, or in-lbf-s for the report's models); runs of
+  // two unit systems are not compared value by value.
+  const auto unit_of = [](const ComparedRun& run, const char* quantity, const char* fallback) {
+    const std::string unit = string_at(at_path(run.summary, {"units"}) ? *at_path(run.summary, {"units"}) : nlohmann::json(), quantity);
+    return unit.empty() ? std::string(fallback) : unit;
+  };
+  for (std::size_t k = 1; k < n; ++k)
+    if (unit_of(runs[k], "system", "SI") != unit_of(runs[0], "system", "SI"))
+      throw InputError("'" + (runs[k].dir / "summary.json").string() + "' is in units " + unit_of(runs[k], "system", "SI") + " but '" +
+                       (runs[0].dir / "summary.json").string() + "' in " + unit_of(runs[0], "system", "SI") +
+                       ": their values cannot be compared as they stand; run both models in one unit system");
+  const std::string length_unit = unit_of(runs[0], "length", "m"), energy_unit = unit_of(runs[0], "energy", "J"),
+                    force_unit = unit_of(runs[0], "force", "N"), speed_unit = length_unit + "/" + unit_of(runs[0], "time", "s");
+
+  // Runs ending at different times: the end-of-run quantities are of different instants.
+  for (std::size_t k = 1; k < n; ++k) {
+    const double a = number_or_nan(at_path(runs[0].summary, {"t_reached"})), b = number_or_nan(at_path(runs[k].summary, {"t_reached"}));
+    if (std::isfinite(a) && std::isfinite(b) && std::fabs(a - b) > 1e-9 * std::max(std::fabs(a), std::fabs(b)))
+      problems.push_back(runs[k].label + " ends at t = " + number(b) + " s and " + runs[0].label + " at t = " + number(a) +
+                         " s: the energies at the end and the peaks are of different spans of time");
+  }
   // Summary tables, the differences to the first run.
   std::vector<ComparisonTable> tables;
-  ComparisonTable crush("car_crush", "Car crush: each car's largest shortening between its ends (summary.json car_crush)", "m", n);
-  ComparisonTable zones("zone_energy", "Energy absorbed per crush zone (summary.json crush_zones, as energy_zones.csv)", "J", n);
-  ComparisonTable cars("car_energy", "Energy absorbed per car (crush zones' shares)", "J", n);
-  ComparisonTable energy("energy", "Energy at the end of the run (summary.json energy)", "J", n);
+  ComparisonTable crush("car_crush", "Car crush: each car's largest shortening between its ends (summary.json car_crush)", length_unit, n);
+  ComparisonTable zones("zone_energy", "Energy absorbed per crush zone (summary.json crush_zones, as energy_zones.csv)", energy_unit, n);
+  ComparisonTable cars("car_energy", "Energy absorbed per car (crush zones' shares)", energy_unit, n);
+  ComparisonTable energy("energy", "Energy at the end of the run (summary.json energy)", energy_unit, n);
   ComparisonTable accelerations("accelerations", "Peak longitudinal acceleration of the car bodies, CFC 60 (summary.json peak_accelerations x_cfc)", "g", n);
   ComparisonTable criteria("criteria", "Responses and criteria (summary.json responses R1-R3, scenario)", "", n);
   ComparisonTable peaks("peaks", "Peak values of every output (summary.json peaks: max and min)", "", n);
@@ -1076,8 +1097,8 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
       x.push_back(&d);
       v.push_back(column(runs[k], car_bodies[b] + ".vx"));
     }
-    charts.push_back(overlay_json("displacement:" + car_bodies[b], car_bodies[b] + ": x(t) - x(0)", "m", times, x, labels, per_run));
-    charts.push_back(overlay_json("velocity:" + car_bodies[b], car_bodies[b] + ": longitudinal velocity", "m/s", times, v, labels, per_run));
+    charts.push_back(overlay_json("displacement:" + car_bodies[b], car_bodies[b] + ": x(t) - x(0)", length_unit, times, x, labels, per_run));
+    charts.push_back(overlay_json("velocity:" + car_bodies[b], car_bodies[b] + ": longitudinal velocity", speed_unit, times, v, labels, per_run));
   }
   // Crash elements (model.json roles crash_force, crash_deformation) of the first run shared by all.
   const auto roles = element_roles(runs[0].model);
@@ -1104,8 +1125,8 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
       d.push_back(shared.count(deformation_column) ? column(runs[k], deformation_column) : nullptr);
     }
     const std::string filter_name = options.force_cfc > 0 ? "CFC " + number(options.force_cfc) : "unfiltered";
-    charts.push_back(overlay_json("force:" + element, element + ": " + force_role->second + " (" + filter_name + ")", "N", ft, f, labels, per_run));
-    if (d[0]) charts.push_back(overlay_json("deformation:" + element, element + ": " + deformation_role->second, "m", times, d, labels, per_run));
+    charts.push_back(overlay_json("force:" + element, element + ": " + force_role->second + " (" + filter_name + ")", force_unit, ft, f, labels, per_run));
+    if (d[0]) charts.push_back(overlay_json("deformation:" + element, element + ": " + deformation_role->second, length_unit, times, d, labels, per_run));
     ++crash_charts;
   }
   // Energy partition: a chart per column every run's energy table has.
@@ -1121,7 +1142,7 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
         et.push_back(&run.energy.data[0]);
         ev.push_back(&run.energy.data[static_cast<std::size_t>(j)]);
       }
-      if (all) charts.push_back(overlay_json("energy:" + name, "Energy: " + name, "J", et, ev, labels, per_run));
+      if (all) charts.push_back(overlay_json("energy:" + name, "Energy: " + name, energy_unit, et, ev, labels, per_run));
     }
   std::string charts_json = "[";
   for (std::size_t k = 0; k < charts.size(); ++k) charts_json += (k ? ",\n" : "") + charts[k];
