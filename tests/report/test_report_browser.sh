@@ -50,6 +50,11 @@ if (!check.axes || check.axes.length < 7) problems.push("no tick labels in the s
 for (const a of check.axes || []) if (!a.distinct) problems.push("plot " + a.id + " repeats a tick label: " + JSON.stringify(a.labels));
 const forceAxis = (check.axes || []).find((a) => a.id === "forces");
 if (!forceAxis || forceAxis.y_label !== "kN") problems.push("the force plot's axis is not in kN: " + JSON.stringify(forceAxis));
+// Follow a car (issue 39 item 4): the first car stays at the canvas centre at the first and the
+// last frame, drawn larger than in the whole-model view.
+const follow = check.follow;
+if (!follow || follow.car !== "car1" || follow.cars !== 2 || follow.offsets_px.some((d) => Math.abs(d) > 1) || !(follow.zoom > 1.2))
+  problems.push("following car1 does not keep it centred and larger: " + JSON.stringify(follow));
 const jump = check.event_jump;
 if (!jump || Math.abs(jump.frame_t - jump.event_t) > jump.spacing || jump.current !== "current")
   problems.push("a click on an event does not move the animation to it: " + JSON.stringify(jump));

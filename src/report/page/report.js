@@ -755,6 +755,55 @@
     var scale = 0.92 * Math.min(canvas.width / w, canvas.height / h);
     view = {scale: scale, x0: 0.5 * (xmin + xmax), y0: 0.5 * (ymin + ymax)};
   }
+  // Follow a car (issue 39 item 4): a long train fitted whole is a strip a few pixels high; the
+  // "follow" list zooms to one car (its bodies' outline over 70 % of the canvas width) and
+  // keeps it centred at every frame, the rail's sleepers passing underneath. The wheel still zooms.
+  var followCar = "";
+  function carBox(f, car) {  // bounding box of a car's bodies at frame f
+    var box = {xmin: Infinity, xmax: -Infinity, ymin: Infinity, ymax: -Infinity};
+    model.bodies.forEach(function (b, i) {
+      if (b.car !== car) return;
+      hulls[i].forEach(function (p) {
+        var g = place(f, i, p);
+        if (!g) return;
+        box.xmin = Math.min(box.xmin, g[0]); box.xmax = Math.max(box.xmax, g[0]);
+        box.ymin = Math.min(box.ymin, g[1]); box.ymax = Math.max(box.ymax, g[1]);
+      });
+    });
+    return isFinite(box.xmin) ? box : null;
+  }
+  function followView(f, keepScale) {
+    var box = carBox(f, followCar);
+    if (!box) return;
+    var w = Math.max(box.xmax - box.xmin, 1e-9), h = Math.max(box.ymax - Math.min(box.ymin, 0), 1e-9);
+    var scale = keepScale && view ? view.scale : Math.min(0.7 * canvas.width / w, 0.8 * canvas.height / h);
+    view = {scale: scale, x0: 0.5 * (box.xmin + box.xmax), y0: 0.5 * (box.ymax + Math.min(box.ymin, 0))};
+  }
+  // The rail: the line y = 0 (top of rail) with sleepers every 0.6 m (24 in), drawn when they are
+  // at least 4 pixels apart, so that a followed car is seen to move along the track.
+  var sleeperSpacing = model && model.units && model.units.length === "in" ? 24 : 0.6;
+  function drawRail() {
+    var y = canvas.height / 2 + view.y0 * view.scale;  // screen y of world y = 0
+    ctx.strokeStyle = "#555";
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    ctx.moveTo(0, y); ctx.lineTo(canvas.width, y);
+    ctx.stroke();
+    ctx.lineWidth = 1;
+    var step = sleeperSpacing * view.scale;
+    if (!(step >= 4)) return;
+    var first = Math.ceil((view.x0 - canvas.width / 2 / view.scale) / sleeperSpacing);
+    var last = Math.floor((view.x0 + canvas.width / 2 / view.scale) / sleeperSpacing);
+    ctx.strokeStyle = "#a08060";
+    ctx.lineWidth = Math.max(1, Math.min(6, 0.25 * step));
+    ctx.beginPath();
+    for (var k = first; k <= last && k - first < 5000; ++k) {
+      var x = canvas.width / 2 + (k * sleeperSpacing - view.x0) * view.scale;
+      ctx.moveTo(x, y + 1); ctx.lineTo(x, y + Math.max(3, Math.min(10, 0.3 * step)));
+    }
+    ctx.stroke();
+    ctx.lineWidth = 1;
+  }
   function toScreen(p) {
     return [canvas.width / 2 + (p[0] - view.x0) * view.scale, canvas.height / 2 - (p[1] - view.y0) * view.scale];
   }
@@ -779,24 +828,19 @@
 
   function draw(f) {
     if (!haveAnimation) return;
+    if (followCar) followView(f, !!view);
     if (!view) fitView();
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.clearRect(0, 0, canvas.width, canvas.height);
-    // Ground line y = 0.
-    ctx.strokeStyle = "#999";
-    ctx.setLineDash([6, 4]);
-    ctx.beginPath();
-    var g0 = toScreen([view.x0 - 1e12, 0]), g1 = toScreen([view.x0 + 1e12, 0]);
-    ctx.moveTo(0, g0[1]); ctx.lineTo(canvas.width, g1[1]);
-    ctx.stroke();
-    ctx.setLineDash([]);
+    drawRail();
     model.bodies.forEach(function (b, i) {
       var pts = hulls[i].map(function (p) { return place(f, i, p); });
       if (pts.some(function (p) { return !p; })) return;
       ctx.beginPath();
       pts.forEach(function (p, k) { var s = toScreen(p); if (k) ctx.lineTo(s[0], s[1]); else ctx.moveTo(s[0], s[1]); });
       ctx.closePath();
-      ctx.fillStyle = b.name.indexOf("car2") === 0 ? "rgba(120,160,220,0.35)" : "rgba(150,200,150,0.35)";
+      ctx.fillStyle = followCar && b.car === followCar ? "rgba(240,170,60,0.45)"
+                      : b.name.indexOf("car2") === 0 ? "rgba(120,160,220,0.35)" : "rgba(150,200,150,0.35)";
       ctx.fill();
       ctx.strokeStyle = "#555";
       ctx.lineWidth = 1;
@@ -907,6 +951,19 @@
   slider.addEventListener("input", function () { setFrame(Number(slider.value)); });
   document.getElementById("colour-by").addEventListener("change", function () { draw(frameIndex); legend(); });
   document.getElementById("reset-view").addEventListener("click", function () { view = null; draw(frameIndex); });
+  var followSelect = document.getElementById("follow");
+  var carNames = [];
+  if (haveAnimation) model.bodies.forEach(function (b) { if (b.car && carNames.indexOf(b.car) < 0) carNames.push(b.car); });
+  carNames.forEach(function (car) { followSelect.appendChild(el("option", {value: car}, car)); });
+  if (!carNames.length) document.getElementById("follow-label").hidden = true;
+  followSelect.addEventListener("change", function () { followCar = followSelect.value; view = null; draw(frameIndex); });
+  var followAsked = /^#follow=(.+)$/.exec(location.hash);  // report.html#follow=CAR: opens following CAR
+  function followFromAddress() {
+    if (!followAsked || carNames.indexOf(decodeURIComponent(followAsked[1])) < 0) return;
+    followSelect.value = followCar = decodeURIComponent(followAsked[1]);
+    view = null;
+    draw(frameIndex);
+  }
   canvas.addEventListener("wheel", function (e) {
     if (!view) return;
     e.preventDefault();
@@ -1275,7 +1332,21 @@
       check.event_jump = {event_t: events[k][0], frame_t: frames.t[frameIndex],
                           spacing: frames.t.length > 1 ? frames.t[1] - frames.t[0] : 0, current: eventRows[k].className};
     }
+    if (carNames.length) {  // following the first car: it stays centred and is drawn larger than the whole model
+      var wholeScale = (fitView(), view.scale);
+      followCar = carNames[0];
+      view = null;
+      var centres = [0, frames.t.length - 1].map(function (f) {
+        setFrame(f);
+        var b = carBox(f, followCar);
+        return toScreen([0.5 * (b.xmin + b.xmax), 0])[0] - canvas.width / 2;
+      });
+      check.follow = {car: followCar, cars: carNames.length, offsets_px: centres, zoom: view.scale / wholeScale};
+      followCar = "";
+      view = null;
+    }
     setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
+    followFromAddress();
   }
   // report.html#crush-zones: the loops and the energy per crush zone alone (docs' screenshot, printing).
   if (location.hash === "#crush-zones")
