@@ -928,6 +928,11 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
   if (run_dirs.size() < 2)
     throw InputError("a side-by-side report needs two run folders or more (`railcrash report RUN_A RUN_B`); for one run, "
                      "`railcrash report RUN_DIR` writes RUN_DIR/report.html");
+  const fs::path out = out_path.empty() ? fs::path(default_comparison_path(run_dirs)) : fs::path(out_path);
+  const fs::path out_dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  std::error_code out_error;
+  if (!fs::is_directory(out_dir, out_error))
+    throw InputError("the folder of the page '" + out.string() + "' does not exist: create it, or give --out a path in a folder that exists");
   ReportResult result;
   std::vector<std::string>& problems = result.problems;
   std::vector<ComparedRun> runs;
@@ -967,9 +972,9 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
   }
   if (shared.size() <= 1) {
     const auto first_columns = [](const ComparedRun& run) {
-      std::string out;
-      for (std::size_t c = 1; c < run.series.columns.size() && c < 4; ++c) out += (c > 1 ? ", " : "") + run.series.columns[c];
-      return out + (run.series.columns.size() > 4 ? ", ..." : "");
+      std::string names;
+      for (std::size_t c = 1; c < run.series.columns.size() && c < 4; ++c) names += (c > 1 ? ", " : "") + run.series.columns[c];
+      return names + (run.series.columns.size() > 4 ? ", ..." : "");
     };
     throw InputError("'" + (runs[0].dir / runs[0].series_file).string() + "' (" + first_columns(runs[0]) + ") and the other runs' " +
                      "timeseries share no column but t: they are runs of different models, whose time histories cannot be "
@@ -1159,10 +1164,7 @@ ReportResult write_comparison(const std::vector<std::string>& run_dirs, const st
                            ",\n\"unshared\": " + unshared_json + ",\n\"charts\": " + charts_json + "}";
   std::string title = "railcrash runs side by side:";
   for (const ComparedRun& run : runs) title += " " + run.label;
-  fs::path out = out_path;
-  if (out.empty()) out = default_comparison_path(run_dirs);
-  result.path = write_page(out.parent_path().empty() ? fs::path(".") : out.parent_path(), title, "null", "null", data,
-                           out.filename().string());
+  result.path = write_page(out_dir, title, "null", "null", data, out.filename().string());
   result.rows = n;
   if (options.pdf) result.pdf_path = print_pdf(result.path);
   return result;

@@ -21,7 +21,10 @@ model="$src/models/examples/emu3_unit_collision.yaml"
 [ -s "$tmp/compare_base_faster.html" ] || { cat "$tmp/report.log"; fail "no $tmp/compare_base_faster.html"; }
 grep -q "2 runs side by side written to $tmp/compare_base_faster.html" "$tmp/report.log" || { cat "$tmp/report.log"; fail "report's message"; }
 # --out, and the page needs nothing from outside.
-"$bin" report "$tmp/base" "$tmp/faster" --out "$tmp/pages/side.html" > /dev/null 2>&1 && fail "--out into a missing folder was accepted"
+"$bin" report "$tmp/base" "$tmp/faster" --out "$tmp/pages/side.html" > "$tmp/missing.log" 2>&1
+status=$?
+[ $status -eq 2 ] && grep -q "the folder of the page '$tmp/pages/side.html' does not exist" "$tmp/missing.log" ||
+  { cat "$tmp/missing.log"; fail "--out into a missing folder: exit $status, expected 2 and the folder named"; }
 mkdir -p "$tmp/pages"
 "$bin" report "$tmp/base" "$tmp/faster" --out "$tmp/pages/side.html" > /dev/null 2>&1 || fail "report --out"
 if grep -Eq '<(script|link|img|iframe)[^>]* (src|href)=' "$tmp/pages/side.html"; then fail "the page refers to an outside resource"; fi
