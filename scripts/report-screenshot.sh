@@ -36,3 +36,12 @@ for study in sweep sensitivity converge; do
     --window-size=1200,1250 --screenshot="$PWD/docs/report_$study.png" "file://$out/$study/report.html" > /dev/null 2>&1
   echo "docs/report_$study.png: $(stat -c %s docs/report_$study.png) bytes"
 done
+
+# Runs side by side (issue 39 item 5): the SI EMU collision at 36 km/h and with the striking unit
+# at 43.2 km/h (--set trains.unitA.speed=12000 mm/s), t_end 0.12 s: docs/report_compare.png.
+build/railcrash run models/examples/emu3_unit_collision.yaml --t-end 0.12 --out "$out/36kmh" --quiet > /dev/null
+build/railcrash run models/examples/emu3_unit_collision.yaml --t-end 0.12 --set trains.unitA.speed=12000 --out "$out/43kmh" --quiet > /dev/null
+build/railcrash report "$out/36kmh" "$out/43kmh" --out "$out/compare.html" > /dev/null
+chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
+  --window-size=1300,2900 --screenshot="$PWD/docs/report_compare.png" "file://$out/compare.html" > /dev/null 2>&1
+echo "docs/report_compare.png: $(stat -c %s docs/report_compare.png) bytes"

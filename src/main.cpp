@@ -206,6 +206,19 @@ int elements_command(const std::string& type_name, bool markdown) {
   return 0;
 }
 
+/// `railcrash report RUN_A RUN_B [...]`: the runs side by side (report.hpp write_comparison).
+int compare_command(const std::vector<std::string>& run_dirs, const std::string& out, double force_cfc, bool pdf) {
+  railcrash::report::ReportOptions options;
+  options.force_cfc = force_cfc;
+  options.pdf = pdf;
+  const railcrash::report::ReportResult result = railcrash::report::write_comparison(run_dirs, out, options);
+  for (const std::string& problem : result.problems) std::fprintf(stderr, "report: %s\n", problem.c_str());
+  std::printf("%zu runs side by side written to %s%s\n", result.rows, result.path.c_str(),
+              railcrash::report::have_plotting_library() ? "" : " (without charts: this build has no plotting library)");
+  if (!result.pdf_path.empty()) std::printf("PDF of the page written to %s\n", result.pdf_path.c_str());
+  return 0;
+}
+
 int report_command(const std::string& run_dir, double cfc, double force_cfc = 60.0, bool pdf = false) {
   railcrash::report::ReportOptions options;
   options.cfc = cfc;
@@ -598,10 +611,14 @@ int main(int argc, char** argv) {
                 "split the run's wall time by phase (residual, Jacobian, linear solver, events, restarts, output, ...): "
                 "printed, and summary.json's stats.seconds");
 
-  std::string report_dir;
+  std::vector<std::string> report_dirs;
+  std::string report_out;
   double report_cfc = 60.0;
-  CLI::App* report = app.add_subcommand("report", "write RUN_DIR/report.html: header, animation, event log, plots (one self-contained file)");
-  report->add_option("run_dir", report_dir, "run folder (the --out of `railcrash run`)")->required();
+  CLI::App* report = app.add_subcommand("report", "write RUN_DIR/report.html: header, animation, event log, plots (one self-contained file); "
+                                                  "with two run folders or more, one page of the runs side by side");
+  report->add_option("run_dir", report_dirs, "run folder (the --out of `railcrash run`); two or more: the runs side by side, "
+                                             "differences to the first")->required();
+  report->add_option("--out", report_out, "side by side only: the page's path (default: compare_<A>_<B>.html beside the first run folder)");
   report->add_option("--cfc", report_cfc, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000)")
       ->capture_default_str()->check(finite_number(60, 1000, false, false, "Hz"));
   double report_force_cfc = 60.0;
@@ -818,7 +835,13 @@ int main(int argc, char** argv) {
       return write_generated_model(railcrash::model_schema_json(railcrash::ElementRegistry::instance()), schema_out,
                                    "the model file's JSON Schema");
     }
-    if (*report) return report_command(report_dir, report_cfc, report_force_cfc, report_pdf);
+    if (*report) {
+      if (report_dirs.size() > 1) return compare_command(report_dirs, report_out, report_force_cfc, report_pdf);
+      if (!report_out.empty())
+        throw railcrash::InputError("report --out names the page of runs side by side (two run folders or more); the report of one run "
+                                    "is written to " + report_dirs[0] + "/report.html");
+      return report_command(report_dirs[0], report_cfc, report_force_cfc, report_pdf);
+    }
     if (*consist) return consist_command(model_path, consist_cars, consist_out, consist->count("--out") > 0);
     if (*scenario) {
       if (scenario->count("--out") > 0) railcrash::check_output_file(scenario_out);

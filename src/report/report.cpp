@@ -3,6 +3,7 @@
 #include "railcrash/report/report.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -414,7 +415,7 @@ std::string html_text(const std::string& text) {
 /// style and library. Placeholders are filled in page order, each once, so that nothing
 /// inserted is searched again. Returns the path.
 std::string write_page(const fs::path& dir, const std::string& title, const std::string& summary, const std::string& model,
-                       const std::string& data) {
+                       const std::string& data, const std::string& file_name = "report.html") {
   std::string page = joined(assets::kTemplate);
   std::string library = joined(assets::kLibraryScript);
   replace_all(library, "</script", "<\\/script");
@@ -430,7 +431,7 @@ std::string write_page(const fs::path& dir, const std::string& title, const std:
   fill(page, cursor, "{{LIBRARY_SCRIPT}}", library);
   fill(page, cursor, "{{SCRIPT}}", script);
   // Whole or not at all, never through a link or into a FIFO named report.html (whole_file.hpp).
-  const std::string path = (dir / "report.html").string();
+  const std::string path = (dir / file_name).string();
   write_whole_file(path, page);
   return path;
 }
@@ -768,5 +769,422 @@ ReportResult write_page_of_folder(const std::string& run_dir, const ReportOption
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------- runs side by side (issue 39 item 5)
+
+namespace {
+
+/// A number of a JSON value, NaN when it is not one.
+double number_or_nan(const nlohmann::json* value) {
+  return value && value->is_number() ? value->get<double>() : std::nan("");
+}
+
+/// The JSON value at a path of keys, null when a key is missing.
+const nlohmann::json* at_path(const nlohmann::json& root, std::initializer_list<const char*> keys) {
+  const nlohmann::json* at = &root;
+  for (const char* key : keys) {
+    if (!at->is_object()) return nullptr;
+    const auto it = at->find(key);
+    if (it == at->end()) return nullptr;
+    at = &*it;
+  }
+  return at;
+}
+
+/// One run folder as the side-by-side page reads it.
+struct ComparedRun {
+  fs::path dir;
+  std::string label;          // the folder's name (with its position when two share one)
+  std::string series_file;    // timeseries.csv or timeseries.h5
+  NumericTable series, energy;
+  nlohmann::json summary, model;
+};
+
+/// Reads a run folder's timeseries (CSV or HDF5), energy table, summary.json and model.json,
+/// with the single-run page's checks (one run per folder, a complete row).
+ComparedRun read_compared_run(const std::string& run_dir, std::vector<std::string>& problems) {
+  ComparedRun run;
+  run.dir = fs::path(run_dir);
+  std::error_code error;
+  if (!fs::is_directory(run.dir, error))
+    throw InputError("run folder '" + run_dir + "' does not exist; give the --out folders of `railcrash run`s to compare");
+  std::vector<std::string> own;
+  run.series = read_numeric_csv(run.dir / "timeseries.csv", own);
+  run.series_file = "timeseries.csv";
+  std::string series_run_id = run_id_in(run.series.comment).value_or("");
+  std::unique_ptr<Hdf5Reader> hdf5;
+  if (!run.series.found && read_folder_file_head((run.dir / "timeseries.h5").string(), 8).found) {
+    hdf5 = std::make_unique<Hdf5Reader>((run.dir / "timeseries.h5").string());
+    run.series_file = "timeseries.h5";
+    run.series = numeric_table(hdf5->table("timeseries", max_table_bytes()));
+    series_run_id = hdf5->attribute("run_id");
+  }
+  if (!run.series.found)
+    throw InputError("'" + run_dir + "' has no timeseries.csv nor timeseries.h5: it is not a run folder (a study folder or a "
+                     "typing error?); give the --out folders of `railcrash run`s");
+  if (run.series.rows == 0 || run.series.columns.empty() || run.series.columns[0] != "t")
+    throw InputError("'" + (run.dir / run.series_file).string() + "' has no complete row of results: nothing to compare");
+  bool summary_found = false, model_found = false;
+  const std::string summary = read_json_file(run.dir / "summary.json", &summary_found);
+  require_one_run(run.dir, summary, summary_found, run.series_file, series_run_id);
+  if (!summary_found) own.push_back("no summary.json: the run did not finish; its summary quantities are left blank");
+  run.summary = parse_json("summary.json", summary, own);
+  if (string_at(run.summary, "status") == "failed")
+    own.insert(own.begin(), "the run FAILED at t = " + number(number_or_nan(at_path(run.summary, {"t_reached"}))) + " s: " +
+                                string_at(run.summary, "message"));
+  run.model = parse_json("model.json", read_json_file(run.dir / "model.json", &model_found), own);
+  run.energy = hdf5 ? numeric_table(hdf5->table("energy", max_table_bytes())) : read_numeric_csv(run.dir / "energy.csv", own);
+  for (const std::string& p : own) problems.push_back(run_dir + ": " + p);
+  return run;
+}
+
+/// A table of summary quantities, a row per quantity, a value per run; the differences to the
+/// first run (absolute and in % of its magnitude) are computed here, so that the page shows
+/// what the test checks.
+class ComparisonTable {
+ public:
+  ComparisonTable(std::string id, std::string title, std::string unit, std::size_t runs)
+      : id_(std::move(id)), title_(std::move(title)), unit_(std::move(unit)), runs_(runs) {}
+  void set(const std::string& row, std::size_t run, double value) {
+    auto it = index_.find(row);
+    if (it == index_.end()) {
+      it = index_.emplace(row, rows_.size()).first;
+      rows_.push_back({row, std::vector<double>(runs_, std::nan(""))});
+    }
+    rows_[it->second].second[run] = value;
+  }
+  bool empty() const { return rows_.empty(); }
+  std::string json() const {
+    std::string out = "{\"id\": " + js(id_) + ", \"title\": " + js(title_) + ", \"unit\": " + js(unit_) + ", \"rows\": [";
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      const std::vector<double>& v = rows_[r].second;
+      std::vector<double> difference(v.size(), std::nan("")), percent(v.size(), std::nan(""));
+      for (std::size_t k = 1; k < v.size(); ++k) {
+        difference[k] = v[k] - v[0];  // NaN when either is missing
+        if (std::isfinite(difference[k]) && v[0] != 0.0) percent[k] = 100.0 * difference[k] / std::fabs(v[0]);
+      }
+      out += std::string(r ? ",\n" : "") + "{\"name\": " + js(rows_[r].first) + ", \"values\": " + precise(v) +
+             ", \"difference\": " + precise(difference) + ", \"percent\": " + precise(percent) + "}";
+    }
+    return out + "]}";
+  }
+
+ private:
+  static std::string precise(const std::vector<double>& values) {
+    std::string out = "[";
+    for (std::size_t k = 0; k < values.size(); ++k) out += std::string(k ? "," : "") + (std::isfinite(values[k]) ? json_number(values[k]) : "null");
+    return out + "]";
+  }
+  std::string id_, title_, unit_;
+  std::size_t runs_;
+  std::map<std::string, std::size_t> index_;
+  std::vector<std::pair<std::string, std::vector<double>>> rows_;
+};
+
+/// The numeric leaves of a JSON object as "a.b.c" -> value (booleans as 0/1).
+void numeric_leaves(const nlohmann::json& value, const std::string& prefix, std::vector<std::pair<std::string, double>>& out) {
+  if (value.is_object()) {
+    for (const auto& [key, item] : value.items()) numeric_leaves(item, prefix.empty() ? key : prefix + "." + key, out);
+  } else if (value.is_number()) {
+    out.emplace_back(prefix, value.get<double>());
+  } else if (value.is_boolean()) {
+    out.emplace_back(prefix + " (1: true)", value.get<bool>() ? 1.0 : 0.0);
+  }
+}
+
+/// One chart per quantity and entity, a line per run: the union of the runs' (decimated) output
+/// times, each run's values at its own times and null between (the page spans the gaps).
+std::string overlay_json(const std::string& id, const std::string& title, const std::string& unit,
+                         const std::vector<const std::vector<double>*>& times, const std::vector<const std::vector<double>*>& values,
+                         const std::vector<std::string>& labels, std::size_t max_points) {
+  std::map<double, std::vector<double>> merged;
+  const std::size_t runs = times.size();
+  for (std::size_t k = 0; k < runs; ++k) {
+    if (!times[k] || !values[k]) continue;
+    const Decimated d = decimate_minmax(*times[k], {*values[k]}, max_points);
+    for (std::size_t i = 0; i < d.x.size(); ++i) {
+      auto it = merged.find(d.x[i]);
+      if (it == merged.end()) it = merged.emplace(d.x[i], std::vector<double>(runs, std::nan(""))).first;
+      it->second[k] = d.series[0][i];
+    }
+  }
+  std::vector<double> t;
+  std::vector<std::vector<double>> columns(runs);
+  for (const auto& [time, row] : merged) {
+    t.push_back(time);
+    for (std::size_t k = 0; k < runs; ++k) columns[k].push_back(row[k]);
+  }
+  std::string out = "{\"id\": " + js(id) + ", \"title\": " + js(title) + ", \"unit\": " + js(unit) + ", \"t\": " + numbers(t) + ", \"series\": [";
+  for (std::size_t k = 0; k < runs; ++k) {
+    out += std::string(k ? ", " : "") + "{\"name\": " + js(labels[k]) + ", \"present\": " + (times[k] && values[k] ? "true" : "false") +
+           ", \"values\": " + numbers(columns[k]) + "}";
+  }
+  return out + "]}";
+}
+
+}  // namespace
+
+ReportResult write_comparison(const std::vector<std::string>& run_dirs, const std::string& out_path, const ReportOptions& options) {
+  if (run_dirs.size() < 2)
+    throw InputError("a side-by-side report needs two run folders or more (`railcrash report RUN_A RUN_B`); for one run, "
+                     "`railcrash report RUN_DIR` writes RUN_DIR/report.html");
+  const fs::path out = out_path.empty() ? fs::path(default_comparison_path(run_dirs)) : fs::path(out_path);
+  const fs::path out_dir = out.parent_path().empty() ? fs::path(".") : out.parent_path();
+  std::error_code out_error;
+  if (!fs::is_directory(out_dir, out_error))
+    throw InputError("the folder of the page '" + out.string() + "' does not exist: create it, or give --out a path in a folder that exists");
+  ReportResult result;
+  std::vector<std::string>& problems = result.problems;
+  std::vector<ComparedRun> runs;
+  for (const std::string& dir : run_dirs) runs.push_back(read_compared_run(dir, problems));
+  const std::size_t n = runs.size();
+  // Labels: the folders' names, with the position when two have the same name.
+  for (std::size_t k = 0; k < n; ++k) {
+    runs[k].label = fs::absolute(runs[k].dir).lexically_normal().filename().string();
+    if (runs[k].label.empty()) runs[k].label = fs::absolute(runs[k].dir).lexically_normal().parent_path().filename().string();
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t j = 0; j < n; ++j)
+      if (j != k && runs[j].label == runs[k].label) {
+        for (std::size_t m = 0; m < n; ++m) runs[m].label = std::to_string(m + 1) + ": " + runs[m].label;
+        j = k = n;
+      }
+
+  // Columns: overlay those every run has; list the others. No shared column but t: refuse.
+  std::set<std::string> shared(runs[0].series.columns.begin(), runs[0].series.columns.end());
+  for (std::size_t k = 1; k < n; ++k) {
+    std::set<std::string> both;
+    for (const std::string& c : runs[k].series.columns)
+      if (shared.count(c)) both.insert(c);
+    shared = std::move(both);
+  }
+  std::vector<std::string> unshared;  // "column (only in a, b)"
+  {
+    std::map<std::string, std::vector<std::string>> holders;
+    for (const ComparedRun& run : runs)
+      for (const std::string& c : run.series.columns)
+        if (!shared.count(c)) holders[c].push_back(run.label);
+    for (const auto& [column, labels] : holders) {
+      std::string who;
+      for (const std::string& l : labels) who += (who.empty() ? "" : ", ") + l;
+      unshared.push_back(column + " (only in " + who + ")");
+    }
+  }
+  if (shared.size() <= 1) {
+    const auto first_columns = [](const ComparedRun& run) {
+      std::string names;
+      for (std::size_t c = 1; c < run.series.columns.size() && c < 4; ++c) names += (c > 1 ? ", " : "") + run.series.columns[c];
+      return names + (run.series.columns.size() > 4 ? ", ..." : "");
+    };
+    throw InputError("'" + (runs[0].dir / runs[0].series_file).string() + "' (" + first_columns(runs[0]) + ") and the other runs' " +
+                     "timeseries share no column but t: they are runs of different models, whose time histories cannot be "
+                     "overlaid; compare runs of one model (e.g. `railcrash run MODEL --set ... --out B`), or give the runs "
+                     "that share bodies and elements");
+  }
+  if (!unshared.empty())
+    problems.push_back(std::to_string(unshared.size()) + " timeseries columns are not in every run and are not overlaid (listed under "
+                       "\"Columns not shared\")");
+
+  // Units: the model's (summary.json "units": SI, or in-lbf-s for the report's models); runs of
+  // two unit systems are not compared value by value.
+  const auto unit_of = [](const ComparedRun& run, const char* quantity, const char* fallback) {
+    const std::string unit = string_at(at_path(run.summary, {"units"}) ? *at_path(run.summary, {"units"}) : nlohmann::json(), quantity);
+    return unit.empty() ? std::string(fallback) : unit;
+  };
+  for (std::size_t k = 1; k < n; ++k)
+    if (unit_of(runs[k], "system", "SI") != unit_of(runs[0], "system", "SI"))
+      throw InputError("'" + (runs[k].dir / "summary.json").string() + "' is in units " + unit_of(runs[k], "system", "SI") + " but '" +
+                       (runs[0].dir / "summary.json").string() + "' in " + unit_of(runs[0], "system", "SI") +
+                       ": their values cannot be compared as they stand; run both models in one unit system");
+  const std::string length_unit = unit_of(runs[0], "length", "m"), energy_unit = unit_of(runs[0], "energy", "J"),
+                    force_unit = unit_of(runs[0], "force", "N"), speed_unit = length_unit + "/" + unit_of(runs[0], "time", "s");
+
+  // Runs ending at different times: the end-of-run quantities are of different instants.
+  for (std::size_t k = 1; k < n; ++k) {
+    const double a = number_or_nan(at_path(runs[0].summary, {"t_reached"})), b = number_or_nan(at_path(runs[k].summary, {"t_reached"}));
+    if (std::isfinite(a) && std::isfinite(b) && std::fabs(a - b) > 1e-9 * std::max(std::fabs(a), std::fabs(b)))
+      problems.push_back(runs[k].label + " ends at t = " + number(b) + " s and " + runs[0].label + " at t = " + number(a) +
+                         " s: the energies at the end and the peaks are of different spans of time");
+  }
+  // Summary tables, the differences to the first run.
+  std::vector<ComparisonTable> tables;
+  ComparisonTable crush("car_crush", "Car crush: each car's largest shortening between its ends (summary.json car_crush)", length_unit, n);
+  ComparisonTable zones("zone_energy", "Energy absorbed per crush zone (summary.json crush_zones, as energy_zones.csv)", energy_unit, n);
+  ComparisonTable cars("car_energy", "Energy absorbed per car (crush zones' shares)", energy_unit, n);
+  ComparisonTable energy("energy", "Energy at the end of the run (summary.json energy)", energy_unit, n);
+  ComparisonTable accelerations("accelerations", "Peak longitudinal acceleration of the car bodies, CFC 60 (summary.json peak_accelerations x_cfc)", "g", n);
+  ComparisonTable criteria("criteria", "Responses and criteria (summary.json responses R1-R3, scenario)", "", n);
+  ComparisonTable peaks("peaks", "Peak values of every output (summary.json peaks: max and min)", "", n);
+  std::string outcomes = "[";
+  for (std::size_t k = 0; k < n; ++k) {
+    const nlohmann::json& s = runs[k].summary;
+    if (const nlohmann::json* cc = at_path(s, {"car_crush"}); cc && cc->is_object())
+      for (const auto& [car, value] : cc->items()) crush.set(car, k, number_or_nan(at_path(value, {"max_crush"})));
+    if (const nlohmann::json* list = at_path(s, {"crush_zones", "zones"}); list && list->is_array())
+      for (const nlohmann::json& zone : *list) zones.set(string_at(zone, "element"), k, number_or_nan(at_path(zone, {"absorbed"})));
+    if (const nlohmann::json* total = at_path(s, {"crush_zones", "total_absorbed"})) zones.set("total", k, number_or_nan(total));
+    if (const nlohmann::json* by_car = at_path(s, {"crush_zones", "cars"}); by_car && by_car->is_object())
+      for (const auto& [car, value] : by_car->items()) cars.set(car, k, number_or_nan(at_path(value, {"absorbed"})));
+    for (const char* key : {"kinetic", "elastic", "dissipated", "external_work", "initial_total", "integration_drift"})
+      if (const nlohmann::json* e = at_path(s, {"energy", key})) energy.set(key, k, number_or_nan(e));
+    if (const nlohmann::json* bodies = at_path(s, {"peak_accelerations", "bodies"}); bodies && bodies->is_object())
+      for (const auto& [body, value] : bodies->items())
+        if (body.find("body") != std::string::npos) accelerations.set(body, k, number_or_nan(at_path(value, {"x_cfc", "g"})));
+    for (const char* section : {"responses", "scenario"})
+      if (const nlohmann::json* r = at_path(s, {section})) {
+        std::vector<std::pair<std::string, double>> leaves;
+        numeric_leaves(*r, section, leaves);
+        for (const auto& [name, value] : leaves) criteria.set(name, k, value);
+      }
+    if (const nlohmann::json* p = at_path(s, {"peaks"}); p && p->is_object())
+      for (const auto& [name, value] : p->items()) {
+        peaks.set(name + " max", k, number_or_nan(at_path(value, {"max"})));
+        peaks.set(name + " min", k, number_or_nan(at_path(value, {"min"})));
+      }
+    const nlohmann::json* o = at_path(s, {"outcomes"});
+    outcomes += std::string(k ? ", " : "") + "{\"signature\": " + js(o ? string_at(*o, "signature") : "") +
+                ", \"branch\": " + js(o ? string_at(*o, "branch") : "") + "}";
+  }
+  outcomes += "]";
+  std::string tables_json = "[";
+  for (const ComparisonTable* table : {&crush, &zones, &cars, &energy, &accelerations, &criteria, &peaks})
+    if (!table->empty()) tables_json += std::string(tables_json.size() > 1 ? ",\n" : "") + table->json();
+  tables_json += "]";
+
+  // Identity of each run.
+  std::string runs_json = "[";
+  for (std::size_t k = 0; k < n; ++k) {
+    const nlohmann::json& s = runs[k].summary;
+    const nlohmann::json* reached = at_path(s, {"t_reached"});
+    const nlohmann::json* settings = at_path(s, {"provenance", "settings"});
+    std::string model_name = string_at(s, "model");
+    if (model_name.empty()) model_name = string_at(runs[k].model, "name");
+    runs_json += std::string(k ? ",\n" : "") + "{\"label\": " + js(runs[k].label) + ", \"folder\": " +
+                 js(fs::absolute(runs[k].dir).lexically_normal().string()) + ", \"model\": " + js(model_name) +
+                 ", \"integrator\": " + js(string_at(s, "integrator")) + ", \"status\": " +
+                 js(s.is_null() ? "no summary.json" : string_at(s, "status")) + ", \"message\": " + js(string_at(s, "message")) +
+                 ", \"t_reached\": " + (reached && reached->is_number() ? json_number(reached->get<double>()) : "null") +
+                 ", \"run_id\": " + js(string_at(s, "run_id")) + ", \"file\": " + js(runs[k].series_file) +
+                 ", \"rows\": " + std::to_string(runs[k].series.rows) +
+                 ", \"settings\": " + (settings && settings->is_array() ? settings->dump() : "[]") + "}";
+  }
+  runs_json += "]";
+
+  // Time histories: one chart per quantity and entity, a line per run.
+  std::vector<std::string> labels;
+  for (const ComparedRun& run : runs) labels.push_back(run.label);
+  std::vector<std::string> charts;
+  const auto column = [](const ComparedRun& run, const std::string& name) -> const std::vector<double>* {
+    const int c = column_of(run.series, name);
+    return c < 0 ? nullptr : &run.series.data[static_cast<std::size_t>(c)];
+  };
+  std::vector<const std::vector<double>*> times;
+  for (const ComparedRun& run : runs) times.push_back(&run.series.data[0]);
+  const std::size_t per_run = std::max<std::size_t>(200, options.max_plot_points / n);
+  // Car bodies (names containing "body", else every body) shared by all runs.
+  std::vector<std::string> bodies;
+  for (const std::string& c : runs[0].series.columns)
+    if (c.size() > 2 && c.compare(c.size() - 2, 2, ".x") == 0 && shared.count(c) && shared.count(c.substr(0, c.size() - 2) + ".vx"))
+      bodies.push_back(c.substr(0, c.size() - 2));
+  std::vector<std::string> car_bodies;
+  for (const std::string& b : bodies)
+    if (b.find("body") != std::string::npos) car_bodies.push_back(b);
+  if (car_bodies.empty()) car_bodies = bodies;
+  if (car_bodies.size() > 30) car_bodies.resize(30);
+  std::vector<std::vector<double>> displacement_store(n * car_bodies.size());
+  for (std::size_t b = 0; b < car_bodies.size(); ++b) {
+    std::vector<const std::vector<double>*> x, v;
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::vector<double>& position = *column(runs[k], car_bodies[b] + ".x");
+      std::vector<double>& d = displacement_store[b * n + k];
+      d.resize(position.size());
+      for (std::size_t i = 0; i < position.size(); ++i) d[i] = position[i] - position[0];
+      x.push_back(&d);
+      v.push_back(column(runs[k], car_bodies[b] + ".vx"));
+    }
+    charts.push_back(overlay_json("displacement:" + car_bodies[b], car_bodies[b] + ": x(t) - x(0)", length_unit, times, x, labels, per_run));
+    charts.push_back(overlay_json("velocity:" + car_bodies[b], car_bodies[b] + ": longitudinal velocity", speed_unit, times, v, labels, per_run));
+  }
+  // Crash elements (model.json roles crash_force, crash_deformation) of the first run shared by all.
+  const auto roles = element_roles(runs[0].model);
+  std::size_t crash_charts = 0;
+  std::vector<std::vector<double>> force_store;
+  force_store.reserve(2 * n * roles.size() + 1);
+  for (const auto& [element, role_map] : roles) {
+    const auto force_role = role_map.find("crash_force");
+    if (force_role == role_map.end() || crash_charts >= 40) continue;
+    const std::string force_column = element + "." + force_role->second;
+    if (!shared.count(force_column)) continue;
+    std::vector<const std::vector<double>*> f, d, ft;
+    const auto deformation_role = role_map.find("crash_deformation");
+    const std::string deformation_column = deformation_role == role_map.end() ? "" : element + "." + deformation_role->second;
+    for (std::size_t k = 0; k < n; ++k) {
+      // The forces at the channel class asked (as the single-run page: CFC 60 by default).
+      std::vector<std::string> filter_problems;
+      const FilteredForces filtered = filter_forces(runs[k].series.data[0], {{element, *column(runs[k], force_column), true}},
+                                                    options.force_cfc, filter_problems);
+      force_store.push_back(filtered.t);
+      ft.push_back(&force_store.back());
+      force_store.push_back(filtered.series[0].values);
+      f.push_back(&force_store.back());
+      d.push_back(shared.count(deformation_column) ? column(runs[k], deformation_column) : nullptr);
+    }
+    const std::string filter_name = options.force_cfc > 0 ? "CFC " + number(options.force_cfc) : "unfiltered";
+    charts.push_back(overlay_json("force:" + element, element + ": " + force_role->second + " (" + filter_name + ")", force_unit, ft, f, labels, per_run));
+    if (d[0]) charts.push_back(overlay_json("deformation:" + element, element + ": " + deformation_role->second, length_unit, times, d, labels, per_run));
+    ++crash_charts;
+  }
+  // Energy partition: a chart per column every run's energy table has.
+  if (runs[0].energy.found)
+    for (std::size_t c = 1; c < runs[0].energy.columns.size(); ++c) {
+      const std::string& name = runs[0].energy.columns[c];
+      std::vector<const std::vector<double>*> et, ev;
+      bool all = true;
+      for (const ComparedRun& run : runs) {
+        const int j = column_of(run.energy, name);
+        all = all && j >= 0 && run.energy.rows > 0;
+        if (!all) break;
+        et.push_back(&run.energy.data[0]);
+        ev.push_back(&run.energy.data[static_cast<std::size_t>(j)]);
+      }
+      if (all) charts.push_back(overlay_json("energy:" + name, "Energy: " + name, energy_unit, et, ev, labels, per_run));
+    }
+  std::string charts_json = "[";
+  for (std::size_t k = 0; k < charts.size(); ++k) charts_json += (k ? ",\n" : "") + charts[k];
+  charts_json += "]";
+  std::string unshared_json = "[";
+  for (std::size_t k = 0; k < unshared.size(); ++k) unshared_json += (k ? ", " : "") + js(unshared[k]);
+  unshared_json += "]";
+  std::string problems_json = "[";
+  for (std::size_t k = 0; k < problems.size(); ++k) problems_json += (k ? ", " : "") + js(problems[k]);
+  problems_json += "]";
+
+  const std::string data = "{\"compare\": true, \"problems\": " + problems_json + ", \"library\": " + js(assets::kLibraryName) +
+                           ",\n\"runs\": " + runs_json + ",\n\"tables\": " + tables_json + ",\n\"outcomes\": " + outcomes +
+                           ",\n\"unshared\": " + unshared_json + ",\n\"charts\": " + charts_json + "}";
+  std::string title = "railcrash runs side by side:";
+  for (const ComparedRun& run : runs) title += " " + run.label;
+  result.path = write_page(out_dir, title, "null", "null", data, out.filename().string());
+  result.rows = n;
+  if (options.pdf) result.pdf_path = print_pdf(result.path);
+  return result;
+}
+
+std::string default_comparison_path(const std::vector<std::string>& run_dirs) {
+  // Beside the first run folder: compare_<A>_<B>[...].html, the names cut to keep it short.
+  const fs::path first = fs::absolute(fs::path(run_dirs.empty() ? "." : run_dirs[0])).lexically_normal();
+  const fs::path first_dir = first.filename().empty() ? first.parent_path() : first;
+  std::string name = "compare";
+  for (const std::string& dir : run_dirs) {
+    fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
+    if (p.filename().empty()) p = p.parent_path();
+    std::string part = p.filename().string();
+    for (char& c : part)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
+    name += "_" + part.substr(0, 40);
+    if (name.size() > 150) break;
+  }
+  return (first_dir.parent_path() / (name + ".html")).string();
+}
 
 }  // namespace railcrash::report

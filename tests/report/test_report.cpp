@@ -459,3 +459,14 @@ TEST_CASE("railcrash report of a --format hdf5 run folder shows the series of th
   fs::remove_all(hdf5);
 }
 #endif
+
+TEST_CASE("railcrash report side by side: the default page path and fewer than two runs", "[report]") {
+  using railcrash::report::default_comparison_path;
+  const fs::path base = fs::absolute("out").lexically_normal();
+  CHECK(default_comparison_path({"out/a", "out/b"}) == (base / "compare_a_b.html").string());
+  CHECK(default_comparison_path({"out/a/", "out/speed 12"}) == (base / "compare_a_speed_12.html").string());
+  CHECK(default_comparison_path({"out/a", "elsewhere/b", "c"}) == (base / "compare_a_b_c.html").string());
+  const std::string long_name(60, 'x');
+  CHECK(default_comparison_path({"out/" + long_name, "out/b"}) == (base / ("compare_" + long_name.substr(0, 40) + "_b.html")).string());
+  CHECK_THROWS_AS(railcrash::report::write_comparison({"out/a"}, ""), railcrash::InputError);
+}

@@ -50,6 +50,11 @@ if (!check.axes || check.axes.length < 7) problems.push("no tick labels in the s
 for (const a of check.axes || []) if (!a.distinct) problems.push("plot " + a.id + " repeats a tick label: " + JSON.stringify(a.labels));
 const forceAxis = (check.axes || []).find((a) => a.id === "forces");
 if (!forceAxis || forceAxis.y_label !== "kN") problems.push("the force plot's axis is not in kN: " + JSON.stringify(forceAxis));
+// Follow a car (issue 39 item 4): the first car stays at the canvas centre at the first and the
+// last frame, drawn larger than in the whole-model view.
+const follow = check.follow;
+if (!follow || follow.car !== "car1" || follow.cars !== 2 || follow.offsets_px.some((d) => Math.abs(d) > 1) || !(follow.zoom > 1.2))
+  problems.push("following car1 does not keep it centred and larger: " + JSON.stringify(follow));
 const jump = check.event_jump;
 if (!jump || Math.abs(jump.frame_t - jump.event_t) > jump.spacing || jump.current !== "current")
   problems.push("a click on an event does not move the animation to it: " + JSON.stringify(jump));
@@ -155,5 +160,46 @@ if (sensitivity) {
 }
 if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
 console.log("study pages ok: converge, sweep (" + sweep.charts.length + " charts), sensitivity (" + sensitivity.charts.length + " tornado charts)");
+JS
+
+# Runs side by side (issue 39 item 5): two runs of the SI EMU collision, the second faster and,
+# when this build writes HDF5, as timeseries.h5; the page opens without a script error, every
+# chart is drawn with a line per run, and the car crush table's % difference shown for the
+# striking cab is the one computed here from the two summary.json files.
+emu="$src/models/examples/emu3_unit_collision.yaml"
+"$bin" run "$emu" --t-end 0.1 --out "$tmp/base" --quiet > /dev/null 2>&1 || fail "run base"
+format=csv
+"$bin" run "$emu" --t-end 0.001 --format hdf5 --out "$tmp/probe" --quiet > /dev/null 2>&1 && format=hdf5
+"$bin" run "$emu" --t-end 0.1 --set trains.unitA.speed=12000 --format $format --out "$tmp/faster" --quiet > /dev/null 2>&1 ||
+  fail "run faster ($format)"
+"$bin" report "$tmp/base" "$tmp/faster" --out "$tmp/compare.html" > /dev/null || fail "report base faster"
+timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=5000 --dump-dom "file://$tmp/compare.html" > "$tmp/compare_dom.html" \
+  2> "$tmp/chromium.log" || fail "chromium --dump-dom (compare)"
+if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the side-by-side page (above)"; fi
+timeout 120 "$chromium" "${flags[@]}" --window-size=1400,1800 --screenshot="$out/report_compare.png" "file://$tmp/compare.html" \
+  > /dev/null 2>&1 || fail "chromium --screenshot (compare)"
+[ -s "$out/report_compare.png" ] || fail "no screenshot of the side-by-side page"
+"$node" - "$tmp" <<'JS' || fail "side-by-side page (above)"
+const fs = require("fs");
+const tmp = process.argv[2];
+const dom = fs.readFileSync(tmp + "/compare_dom.html", "utf8");
+const problems = [];
+const m = dom.match(/<div id="self-check"[^>]*data-status="([a-z]+)"[^>]*>([^<]*)<\/div>/);
+if (!m) { console.log("compare: the page's script did not run to the end"); process.exit(1); }
+const check = JSON.parse(m[2].replace(/&quot;/g, '"').replace(/&lt;/g, "<").replace(/&gt;/g, ">").replace(/&amp;/g, "&"));
+if (m[1] !== "ran" || check.errors.length) problems.push("compare: script errors " + JSON.stringify(check.errors));
+const data = JSON.parse(fs.readFileSync(tmp + "/compare.html", "utf8").match(/<script type="application\/json" id="report-data">([\s\S]*?)<\/script>/)[1]);
+if (check.charts.length !== data.charts.length || check.charts.length < 20) problems.push("compare: " + check.charts.length + " of " + data.charts.length + " charts drawn");
+for (const c of check.charts) if (!(c.drawn && c.series === 2 && c.points > 0)) problems.push("compare: chart " + c.id + " not drawn with 2 lines: " + JSON.stringify(c));
+for (const id of ["car_crush", "zone_energy", "car_energy", "energy", "accelerations", "peaks"])
+  if (!check.tables.find((t) => t.id === id && t.rows > 0)) problems.push("compare: no table " + id);
+const a = JSON.parse(fs.readFileSync(tmp + "/base/summary.json", "utf8")), b = JSON.parse(fs.readFileSync(tmp + "/faster/summary.json", "utf8"));
+const ca = a.car_crush["unitA.car1"].max_crush, cb = b.car_crush["unitA.car1"].max_crush;
+const percent = (100 * (cb - ca) / Math.abs(ca)).toFixed(2);
+const row = dom.match(/<table class="compare" id="compare-car_crush">[\s\S]*?<tr><th>unitA\.car1<\/th>((?:<td[^>]*>[^<]*<\/td>)+)<\/tr>/);
+const cells = row ? [...row[1].matchAll(/<td[^>]*>([^<]*)<\/td>/g)].map((c) => c[1]) : [];
+if (cells.length !== 4 || cells[3] !== (Number(percent) > 0 ? "+" : "") + percent) problems.push("compare: unitA.car1's crush cells " + JSON.stringify(cells) + ", expected the % difference " + percent);
+if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
+console.log("side-by-side page ok: " + check.charts.length + " charts, " + check.tables.length + " tables, unitA.car1 crush " + cells[3] + " %");
 JS
 echo "PASS: report and study pages open in Chromium without errors; screenshots in $out/report_*.png"

@@ -69,6 +69,25 @@ struct ReportResult {
 
 ReportResult write_report(const std::string& run_dir, const ReportOptions& options = {});
 
+/// `railcrash report RUN_A RUN_B [...] --out FILE.html` (issue 39 item 5): one page of two or
+/// more run folders (CSV or HDF5) side by side. A table of each run's identity (folder, model,
+/// integrator, status, t reached, --set settings), tables of summary.json's quantities with the
+/// difference of each run to the first (absolute and in % of the first run's magnitude): car
+/// crush per car, energy per crush zone and per car, the energy at the end, the car bodies' CFC 60
+/// peak accelerations, responses R1-R3 and scenario criteria, every output's peak; the discrete
+/// outcome signature of each run; and time-history charts with a line per run (car bodies'
+/// displacement and velocity, crash elements' force at --force-cfc and deformation, each energy
+/// column). Only the timeseries columns every run has are overlaid, the others are listed; runs
+/// that share no column but t (different models) throw InputError. out_path "": the path of
+/// default_comparison_path. result.rows: the number of runs.
+ReportResult write_comparison(const std::vector<std::string>& run_dirs, const std::string& out_path,
+                              const ReportOptions& options = {});
+
+/// The side-by-side page's default path: beside the first run folder (in its parent folder),
+/// compare_<A>_<B>[...].html of the folders' names (other characters than letters, digits, '-'
+/// and '.' as '_', each name cut at 40 characters). Runs out/a and out/b: out/compare_a_b.html.
+std::string default_comparison_path(const std::vector<std::string>& run_dirs);
+
 /// Whether this build inlines a plotting library (npm was available at build time).
 bool have_plotting_library();
 

@@ -384,6 +384,173 @@
     selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
   }
 
+  // ---------------------------------------------------------------- runs side by side (issue 39 item 5)
+  // `railcrash report RUN_A RUN_B [...]`: each run's identity, the summary tables with the
+  // differences to the first run (computed by report.cpp write_comparison), the outcome
+  // signatures, and the time histories with a line per run.
+  function compareReport() {
+    ["animation-section", "plots-section", "loops-section", "zones-section", "energy-section"].forEach(function (id) {
+      document.getElementById(id).hidden = true;
+    });
+    var runs = data.runs, n = runs.length;
+    var colours = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+    var check = {errors: [], compare: true, runs: n, tables: [], charts: [], outcomes: ""};
+    var problemBox = document.getElementById("problems");
+    problems.forEach(function (p) {
+      problemBox.appendChild(el("div", {"class": /FAILED|no summary/.test(p) ? "problem failed" : "problem"}, p));
+    });
+    var head = document.getElementById("header");
+    head.textContent = "";
+    head.appendChild(el("h1", {}, "railcrash: " + n + " runs side by side"));
+    head.appendChild(el("p", {}, "Differences are each run's value minus the first run's (" + runs[0].label +
+                                 "), and that difference in % of the first run's magnitude."));
+    var box = el("section", {id: "compare"});
+    document.body.insertBefore(box, document.getElementById("footer"));
+    function number(v) {
+      if (v === null || v === undefined) return "\u2013";
+      if (v === 0) return "0";
+      var a = Math.abs(v);
+      return a >= 1e5 || a < 1e-3 ? v.toExponential(3) : String(Number(v.toPrecision(4)));
+    }
+    function signed(v) { return v === null || v === undefined ? "\u2013" : (v > 0 ? "+" : "") + number(v); }
+    // Identity of each run.
+    box.appendChild(el("h2", {}, "Runs"));
+    var identity = el("table", {"class": "compare", id: "compare-runs"});
+    var tr = el("tr");
+    tr.appendChild(el("th", {}, ""));
+    runs.forEach(function (r, k) {
+      var th = el("th", {}, r.label);
+      th.style.borderBottom = "3px solid " + colours[k % colours.length];
+      tr.appendChild(th);
+    });
+    identity.appendChild(tr);
+    function identityRow(name, cell) {
+      var row = el("tr");
+      row.appendChild(el("th", {}, name));
+      runs.forEach(function (r, k) {
+        var c = cell(r, k);
+        row.appendChild(el("td", c.cls ? {"class": c.cls} : {}, c.text));
+      });
+      identity.appendChild(row);
+    }
+    identityRow("folder", function (r) { return {text: r.folder}; });
+    identityRow("model", function (r) { return {text: r.model}; });
+    identityRow("integrator", function (r) { return {text: r.integrator}; });
+    identityRow("status", function (r) {
+      return {text: r.status + (r.message ? ": " + r.message : ""), cls: r.status === "ok" ? "status-ok" : "status-failed"};
+    });
+    identityRow("t reached [s]", function (r) { return {text: number(r.t_reached)}; });
+    identityRow("output rows (" + runs.map(function (r) { return r.file; }).filter(function (f, k, a) { return a.indexOf(f) === k; }).join(", ") + ")",
+                function (r) { return {text: String(r.rows)}; });
+    identityRow("settings (--set)", function (r) { return {text: r.settings.length ? r.settings.join(" ") : "none"}; });
+    identityRow("run id", function (r) { return {text: r.run_id}; });
+    var differing = 0;
+    identityRow("outcome branch", function (r, k) {
+      var same = data.outcomes[k].branch === data.outcomes[0].branch;
+      if (!same) ++differing;
+      return {text: (data.outcomes[k].branch || "(no discrete outcome)") + (k ? (same ? " (same as " + runs[0].label + ")" : " (DIFFERS)") : ""),
+              cls: k && !same ? "differs" : ""};
+    });
+    identityRow("outcome signature", function (r, k) { return {text: data.outcomes[k].signature || "\u2013"}; });
+    box.appendChild(identity);
+    check.outcomes = differing ? "differ" : "same";
+
+    // The summary tables.
+    data.tables.forEach(function (t) {
+      var container = box;
+      if (t.id === "peaks") {
+        var details = el("details", {"class": "compare-peaks"});
+        details.appendChild(el("summary", {}, t.title + ": " + t.rows.length + " rows"));
+        box.appendChild(details);
+        container = details;
+      } else {
+        box.appendChild(el("h2", {}, t.title));
+      }
+      var table = el("table", {"class": "compare", id: "compare-" + t.id});
+      var header = el("tr");
+      header.appendChild(el("th", {}, "quantity"));
+      runs.forEach(function (r, k) {
+        header.appendChild(el("th", {}, r.label + (t.unit ? " [" + t.unit + "]" : "")));
+        if (k) {
+          header.appendChild(el("th", {}, "\u0394 " + r.label + (t.unit ? " [" + t.unit + "]" : "")));
+          header.appendChild(el("th", {}, "\u0394 " + r.label + " [%]"));
+        }
+      });
+      table.appendChild(header);
+      var cells = 0;
+      t.rows.forEach(function (row) {
+        var line = el("tr");
+        line.appendChild(el("th", {}, row.name));
+        row.values.forEach(function (v, k) {
+          line.appendChild(el("td", {"data-run": String(k)}, number(v)));
+          if (k) {
+            var big = row.percent[k] !== null && Math.abs(row.percent[k]) >= 5;
+            line.appendChild(el("td", {"class": "difference", "data-run": String(k)}, signed(row.difference[k])));
+            line.appendChild(el("td", {"class": big ? "difference big" : "difference", "data-run": String(k)},
+                                row.percent[k] === null ? "\u2013" : (row.percent[k] > 0 ? "+" : "") + row.percent[k].toFixed(2)));
+          }
+          ++cells;
+        });
+        table.appendChild(line);
+      });
+      container.appendChild(table);
+      check.tables.push({id: t.id, rows: t.rows.length, cells: cells});
+    });
+    if (data.unshared.length) {
+      var list = el("details", {"class": "compare-unshared"});
+      list.appendChild(el("summary", {}, "Columns not shared: " + data.unshared.length + " timeseries columns are not in every run (not overlaid)"));
+      list.appendChild(el("p", {}, data.unshared.join("; ")));
+      box.appendChild(list);
+    }
+
+    // The time histories, a line per run.
+    box.appendChild(el("h2", {}, "Time histories (a line per run)"));
+    if (typeof window.uPlot !== "function") {
+      box.appendChild(el("p", {"class": "no-library"}, "This railcrash was built without its plotting library: the charts are left out."));
+    } else {
+      var groups = {displacement: "Car bodies: displacement", velocity: "Car bodies: velocity", force: "Crash elements: force",
+                    deformation: "Crash elements: deformation", energy: "Energy partition"};
+      var grids = {};
+      data.charts.forEach(function (c) {
+        var kind = c.id.split(":")[0];
+        if (!grids[kind]) {
+          box.appendChild(el("h3", {}, groups[kind] || kind));
+          grids[kind] = el("div", {"class": "compare-grid"});
+          box.appendChild(grids[kind]);
+        }
+        var largest = 0;
+        c.series.forEach(function (s) { s.values.forEach(function (v) { if (v !== null && Math.abs(v) > largest) largest = Math.abs(v); }); });
+        var unit = c.unit, factor = 1;
+        if ((unit === "N" || unit === "J") && largest >= 1e6) { unit = "M" + unit; factor = 1e-6; }
+        else if ((unit === "N" || unit === "J") && largest >= 1e3) { unit = "k" + unit; factor = 1e-3; }
+        else if ((unit === "m" || unit === "m/s") && largest > 0 && largest < 1) { unit = "m" + unit; factor = 1e3; }
+        var series = [{label: "t [s]"}], columns = [c.t];
+        c.series.forEach(function (s, k) {
+          series.push({label: s.name, stroke: colours[k % colours.length], width: 1.25, spanGaps: true, show: s.present});
+          columns.push(s.values);
+        });
+        var plotBox = el("div", {"class": "plot"});
+        grids[kind].appendChild(plotBox);
+        try {
+          var u = new uPlot({title: c.title, width: 440, height: 250, scales: {x: {time: false}}, series: series,
+                             axes: [{label: "t [s]", values: tickLabels(1)}, {label: unit, size: 60, values: tickLabels(factor)}],
+                             legend: {live: true}, cursor: {sync: {key: "railcrash-compare"}}}, columns, plotBox);
+          var points = 0;
+          columns.slice(1).forEach(function (col) { col.forEach(function (v) { if (v !== null) ++points; }); });
+          check.charts.push({id: c.id, series: c.series.length, points: points, drawn: !!u.ctx});
+        } catch (e) {
+          window.railcrashErrors.push("chart " + c.id + ": " + e.message);
+        }
+      });
+    }
+    document.getElementById("footer").textContent = "railcrash report of " + n + " runs side by side (" + (data.library || "no plotting library") + ")";
+    check.errors = window.railcrashErrors;
+    var selfCheck = document.getElementById("self-check");
+    selfCheck.textContent = JSON.stringify(check);
+    selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+  }
+
+  if (data.compare) { compareReport(); return; }
   if (data.study) { studyReport(); return; }
 
   // ---------------------------------------------------------------- header and problems
@@ -588,6 +755,55 @@
     var scale = 0.92 * Math.min(canvas.width / w, canvas.height / h);
     view = {scale: scale, x0: 0.5 * (xmin + xmax), y0: 0.5 * (ymin + ymax)};
   }
+  // Follow a car (issue 39 item 4): a long train fitted whole is a strip a few pixels high; the
+  // "follow" list zooms to one car (its bodies' outline over 70 % of the canvas width) and
+  // keeps it centred at every frame, the rail's sleepers passing underneath. The wheel still zooms.
+  var followCar = "";
+  function carBox(f, car) {  // bounding box of a car's bodies at frame f
+    var box = {xmin: Infinity, xmax: -Infinity, ymin: Infinity, ymax: -Infinity};
+    model.bodies.forEach(function (b, i) {
+      if (b.car !== car) return;
+      hulls[i].forEach(function (p) {
+        var g = place(f, i, p);
+        if (!g) return;
+        box.xmin = Math.min(box.xmin, g[0]); box.xmax = Math.max(box.xmax, g[0]);
+        box.ymin = Math.min(box.ymin, g[1]); box.ymax = Math.max(box.ymax, g[1]);
+      });
+    });
+    return isFinite(box.xmin) ? box : null;
+  }
+  function followView(f, keepScale) {
+    var box = carBox(f, followCar);
+    if (!box) return;
+    var w = Math.max(box.xmax - box.xmin, 1e-9), h = Math.max(box.ymax - Math.min(box.ymin, 0), 1e-9);
+    var scale = keepScale && view ? view.scale : Math.min(0.7 * canvas.width / w, 0.8 * canvas.height / h);
+    view = {scale: scale, x0: 0.5 * (box.xmin + box.xmax), y0: 0.5 * (box.ymax + Math.min(box.ymin, 0))};
+  }
+  // The rail: the line y = 0 (top of rail) with sleepers every 0.6 m (24 in), drawn when they are
+  // at least 4 pixels apart, so that a followed car is seen to move along the track.
+  var sleeperSpacing = model && model.units && model.units.length === "in" ? 24 : 0.6;
+  function drawRail() {
+    var y = canvas.height / 2 + view.y0 * view.scale;  // screen y of world y = 0
+    ctx.strokeStyle = "#555";
+    ctx.lineWidth = 2;
+    ctx.beginPath();
+    ctx.moveTo(0, y); ctx.lineTo(canvas.width, y);
+    ctx.stroke();
+    ctx.lineWidth = 1;
+    var step = sleeperSpacing * view.scale;
+    if (!(step >= 4)) return;
+    var first = Math.ceil((view.x0 - canvas.width / 2 / view.scale) / sleeperSpacing);
+    var last = Math.floor((view.x0 + canvas.width / 2 / view.scale) / sleeperSpacing);
+    ctx.strokeStyle = "#a08060";
+    ctx.lineWidth = Math.max(1, Math.min(6, 0.25 * step));
+    ctx.beginPath();
+    for (var k = first; k <= last && k - first < 5000; ++k) {
+      var x = canvas.width / 2 + (k * sleeperSpacing - view.x0) * view.scale;
+      ctx.moveTo(x, y + 1); ctx.lineTo(x, y + Math.max(3, Math.min(10, 0.3 * step)));
+    }
+    ctx.stroke();
+    ctx.lineWidth = 1;
+  }
   function toScreen(p) {
     return [canvas.width / 2 + (p[0] - view.x0) * view.scale, canvas.height / 2 - (p[1] - view.y0) * view.scale];
   }
@@ -612,24 +828,19 @@
 
   function draw(f) {
     if (!haveAnimation) return;
+    if (followCar) followView(f, !!view);
     if (!view) fitView();
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.clearRect(0, 0, canvas.width, canvas.height);
-    // Ground line y = 0.
-    ctx.strokeStyle = "#999";
-    ctx.setLineDash([6, 4]);
-    ctx.beginPath();
-    var g0 = toScreen([view.x0 - 1e12, 0]), g1 = toScreen([view.x0 + 1e12, 0]);
-    ctx.moveTo(0, g0[1]); ctx.lineTo(canvas.width, g1[1]);
-    ctx.stroke();
-    ctx.setLineDash([]);
+    drawRail();
     model.bodies.forEach(function (b, i) {
       var pts = hulls[i].map(function (p) { return place(f, i, p); });
       if (pts.some(function (p) { return !p; })) return;
       ctx.beginPath();
       pts.forEach(function (p, k) { var s = toScreen(p); if (k) ctx.lineTo(s[0], s[1]); else ctx.moveTo(s[0], s[1]); });
       ctx.closePath();
-      ctx.fillStyle = b.name.indexOf("car2") === 0 ? "rgba(120,160,220,0.35)" : "rgba(150,200,150,0.35)";
+      ctx.fillStyle = followCar && b.car === followCar ? "rgba(240,170,60,0.45)"
+                      : b.name.indexOf("car2") === 0 ? "rgba(120,160,220,0.35)" : "rgba(150,200,150,0.35)";
       ctx.fill();
       ctx.strokeStyle = "#555";
       ctx.lineWidth = 1;
@@ -740,6 +951,19 @@
   slider.addEventListener("input", function () { setFrame(Number(slider.value)); });
   document.getElementById("colour-by").addEventListener("change", function () { draw(frameIndex); legend(); });
   document.getElementById("reset-view").addEventListener("click", function () { view = null; draw(frameIndex); });
+  var followSelect = document.getElementById("follow");
+  var carNames = [];
+  if (haveAnimation) model.bodies.forEach(function (b) { if (b.car && carNames.indexOf(b.car) < 0) carNames.push(b.car); });
+  carNames.forEach(function (car) { followSelect.appendChild(el("option", {value: car}, car)); });
+  if (!carNames.length) document.getElementById("follow-label").hidden = true;
+  followSelect.addEventListener("change", function () { followCar = followSelect.value; view = null; draw(frameIndex); });
+  var followAsked = /^#follow=(.+)$/.exec(location.hash);  // report.html#follow=CAR: opens following CAR
+  function followFromAddress() {
+    if (!followAsked || carNames.indexOf(decodeURIComponent(followAsked[1])) < 0) return;
+    followSelect.value = followCar = decodeURIComponent(followAsked[1]);
+    view = null;
+    draw(frameIndex);
+  }
   canvas.addEventListener("wheel", function (e) {
     if (!view) return;
     e.preventDefault();
@@ -1108,7 +1332,21 @@
       check.event_jump = {event_t: events[k][0], frame_t: frames.t[frameIndex],
                           spacing: frames.t.length > 1 ? frames.t[1] - frames.t[0] : 0, current: eventRows[k].className};
     }
+    if (carNames.length) {  // following the first car: it stays centred and is drawn larger than the whole model
+      var wholeScale = (fitView(), view.scale);
+      followCar = carNames[0];
+      view = null;
+      var centres = [0, frames.t.length - 1].map(function (f) {
+        setFrame(f);
+        var b = carBox(f, followCar);
+        return toScreen([0.5 * (b.xmin + b.xmax), 0])[0] - canvas.width / 2;
+      });
+      check.follow = {car: followCar, cars: carNames.length, offsets_px: centres, zoom: view.scale / wholeScale};
+      followCar = "";
+      view = null;
+    }
     setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
+    followFromAddress();
   }
   // report.html#crush-zones: the loops and the energy per crush zone alone (docs' screenshot, printing).
   if (location.hash === "#crush-zones")
