@@ -45,3 +45,10 @@ build/railcrash report "$out/36kmh" "$out/43kmh" --out "$out/compare.html" > /de
 chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
   --window-size=1300,2900 --screenshot="$PWD/docs/report_compare.png" "file://$out/compare.html" > /dev/null 2>&1
 echo "docs/report_compare.png: $(stat -c %s docs/report_compare.png) bytes"
+
+# Walls (issue 39 item 4): the SI unit into a rigid wall, its cab followed (#follow=unitA.car1),
+# at the middle frame (t = 0.2 s): docs/report_wall.png, the animation part of the page.
+build/railcrash run models/examples/emu3_wall.yaml --out "$out/wall" --report --quiet > /dev/null
+chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$out/profile" \
+  --window-size=1300,1100 --screenshot="$PWD/docs/report_wall.png" "file://$out/wall/report.html#follow=unitA.car1" > /dev/null 2>&1
+echo "docs/report_wall.png: $(stat -c %s docs/report_wall.png) bytes"

@@ -233,6 +233,17 @@ class Element {
   virtual std::vector<std::string> output_names() const { return {}; }
   /// Which of those outputs play which role (OutputRole); most elements have none.
   virtual std::vector<RoleOfOutput> output_roles() const { return {}; }
+  /// A surface fixed to the ground that the element's point meets (a wall, a barrier face), for
+  /// drawing the scene (model.json, the report's animation); not used by the physics.
+  struct GroundSurface {
+    enum class Kind { Line, Circle } kind = Kind::Line;
+    double x = 0.0, y = 0.0;    // [length] line: a point on it; circle: its centre
+    double nx = 0.0, ny = 1.0;  // line: unit normal toward the free side
+    double radius = 0.0;        // [length] circle
+    bool inside = false;        // circle: the free side is inside it
+  };
+  /// The element's ground surface, if it has one (the contact element's line or circle).
+  virtual std::optional<GroundSurface> ground_surface() const { return std::nullopt; }
   /// The output playing `role`, or "" when the element has none.
   std::string output_with_role(OutputRole role) const;
   /// Values of those quantities; lambda are the element's constraint multipliers (if any).

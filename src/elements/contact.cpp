@@ -53,6 +53,19 @@ SurfaceContact::SurfaceContact(ElementSpec& spec, bool wheel_rail)
   }
 }
 
+std::optional<Element::GroundSurface> SurfaceContact::ground_surface() const {
+  if (type() == std::string("wheel_rail")) return std::nullopt;
+  GroundSurface g;
+  g.kind = surface == Surface::Line ? GroundSurface::Kind::Line : GroundSurface::Kind::Circle;
+  g.x = px;
+  g.y = py;
+  g.nx = nx;
+  g.ny = ny;
+  g.radius = radius;
+  g.inside = inside;
+  return g;
+}
+
 void SurfaceContact::enter_mode(State& st, double penetration, double rate) const {
   if (penetration < 0.0 || (penetration == 0.0 && rate <= 0.0)) {
     st.mode = Mode::Open;

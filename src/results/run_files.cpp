@@ -80,7 +80,16 @@ void write_model_geometry(const DaeSystem& system, const std::string& path, cons
     const auto roles = el.output_roles();
     for (std::size_t k = 0; k < roles.size(); ++k)
       j << (k ? ", " : "") << json_string(output_role_name(roles[k].role)) << ": " << json_string(roles[k].output);
-    j << "}}";
+    j << "}";
+    if (const std::optional<Element::GroundSurface> g = el.ground_surface()) {  // a wall or barrier, drawn by the report
+      if (g->kind == Element::GroundSurface::Kind::Line)
+        j << ", \"surface\": {\"kind\": \"line\", \"point\": [" << json_number(g->x) << ", " << json_number(g->y)
+          << "], \"normal\": [" << json_number(g->nx) << ", " << json_number(g->ny) << "]}";
+      else
+        j << ", \"surface\": {\"kind\": \"circle\", \"center\": [" << json_number(g->x) << ", " << json_number(g->y)
+          << "], \"radius\": " << json_number(g->radius) << ", \"inside\": " << (g->inside ? "true" : "false") << "}";
+    }
+    j << "}";
   }
   j << "\n  ]\n}\n";
   std::ofstream out(path);

@@ -185,3 +185,27 @@ TEST_CASE("contact Jacobian matches central differences in every mode", "[elemen
   REQUIRE(contact.state().mode == SurfaceContact::Mode::Released);
   check_mode(0.002);
 }
+
+TEST_CASE("contact: its wall or barrier surface is given for drawing the scene, a wheel's rail is not", "[elements][contact]") {
+  // A line given with a normal of length 2 is normalised; a circle keeps centre, radius and side.
+  const Model model = testing::model_from_text(body_on(
+      "  - {name: wall, type: contact, line_point: [0.05, 0.2], line_normal: [-2, 0], stiffness: 1.0e6, points: [{body: ball, at: [0, 0]}]}\n"
+      "  - {name: drum, type: contact, circle_center: [0, 1.5], circle_radius: 1.5, inside: true, stiffness: 1.0e6, points: [{body: ball, at: [0, 0]}]}\n"
+      "  - {name: wheel, type: wheel_rail, wheel_radius: 0.4, stiffness: 1.0e6, points: [{body: ball, at: [0, 0]}]}\n",
+      0.0, 1.0, 0.0, 0.0, "t_end: 0.1"));
+  const auto wall = model.elements()[0]->ground_surface();
+  REQUIRE(wall);
+  CHECK(wall->kind == Element::GroundSurface::Kind::Line);
+  CHECK(wall->x == 0.05);
+  CHECK(wall->y == 0.2);
+  CHECK(wall->nx == -1.0);
+  CHECK(wall->ny == 0.0);
+  const auto drum = model.elements()[1]->ground_surface();
+  REQUIRE(drum);
+  CHECK(drum->kind == Element::GroundSurface::Kind::Circle);
+  CHECK(drum->x == 0.0);
+  CHECK(drum->y == 1.5);
+  CHECK(drum->radius == 1.5);
+  CHECK(drum->inside);
+  CHECK_FALSE(model.elements()[2]->ground_surface());
+}

@@ -202,4 +202,34 @@ if (cells.length !== 4 || cells[3] !== (Number(percent) > 0 ? "+" : "") + percen
 if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
 console.log("side-by-side page ok: " + check.charts.length + " charts, " + check.tables.length + " tables, unitA.car1 crush " + cells[3] + " %");
 JS
+# Walls (issue 39 item 4): the SI unit into a rigid wall; model.json carries the contact's line
+# (x = 0.05 m, normal -x) and the animation draws it on the canvas, to the right of the cab's
+# front (the wall's solid side), at every frame.
+"$bin" run "$src/models/examples/emu3_wall.yaml" --t-end 0.05 --out "$tmp/wall" --report --quiet > /dev/null 2>&1 || fail "run emu3_wall"
+timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=5000 --dump-dom "file://$tmp/wall/report.html" > "$tmp/wall.html" \
+  2> "$tmp/chromium.log" || fail "chromium --dump-dom (wall)"
+if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the wall run's report (above)"; fi
+timeout 120 "$chromium" "${flags[@]}" --window-size=1400,1300 --screenshot="$out/report_wall.png" "file://$tmp/wall/report.html" \
+  > /dev/null 2>&1 || fail "chromium --screenshot (wall)"
+"$node" - "$tmp" <<'JS' || fail "wall drawn (above)"
+const fs = require("fs");
+const tmp = process.argv[2];
+const model = JSON.parse(fs.readFileSync(tmp + "/wall/model.json", "utf8"));
+const problems = [];
+const wall = model.elements.find((e) => e.name === "wall");
+if (!wall || !wall.surface || wall.surface.kind !== "line" || JSON.stringify(wall.surface.point) !== "[0.05,0]" ||
+    JSON.stringify(wall.surface.normal) !== "[-1,0]")
+  problems.push("model.json: the wall's surface " + JSON.stringify(wall && wall.surface));
+if (model.elements.some((e) => e.surface && e.name !== "wall")) problems.push("model.json: a surface on another element");
+const dom = fs.readFileSync(tmp + "/wall.html", "utf8");
+const m = dom.match(/<div id="self-check"[^>]*data-status="([a-z]+)"[^>]*>([^<]*)<\/div>/);
+if (!m) { console.log("wall: the page's script did not run to the end"); process.exit(1); }
+const check = JSON.parse(m[2].replace(/&quot;/g, '"').replace(/&lt;/g, "<").replace(/&gt;/g, ">").replace(/&amp;/g, "&"));
+if (m[1] !== "ran" || check.errors.length) problems.push("wall: script errors " + JSON.stringify(check.errors));
+const drawn = check.surfaces || [];
+if (drawn.length !== 1 || drawn[0].element !== "wall" || drawn[0].kind !== "line" || !drawn[0].on_canvas)
+  problems.push("wall: not drawn on the canvas: " + JSON.stringify(drawn));
+if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
+console.log("wall ok: drawn at " + JSON.stringify(drawn[0].point_px) + " px");
+JS
 echo "PASS: report and study pages open in Chromium without errors; screenshots in $out/report_*.png"

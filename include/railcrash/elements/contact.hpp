@@ -116,6 +116,8 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
               Event& event) const override;
   void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
+  /// The wall or barrier surface (none for wheel_rail: the animation draws the rail itself).
+  std::optional<GroundSurface> ground_surface() const override;
   std::vector<std::string> output_names() const override { return {"normal_force", "friction_force", "penetration"}; }
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;
 

@@ -807,6 +807,53 @@
   function toScreen(p) {
     return [canvas.width / 2 + (p[0] - view.x0) * view.scale, canvas.height / 2 - (p[1] - view.y0) * view.scale];
   }
+  // Walls and barriers (issue 39 item 4): a contact element's ground surface from model.json,
+  // a line (a wall) drawn across the canvas with hatching on its solid side, or a circle (a
+  // barrier face) with its solid side shaded. drawnSurfaces: what the last frame drew, for the self-check.
+  var drawnSurfaces = [];
+  function drawSurfaces() {
+    drawnSurfaces = [];
+    var reach = (canvas.width + canvas.height) / view.scale;  // [length] longer than the canvas's diagonal
+    elements.forEach(function (e) {
+      var g = e.surface;
+      if (!g) return;
+      ctx.save();
+      ctx.strokeStyle = "#333";
+      ctx.fillStyle = "rgba(90,90,90,0.25)";
+      ctx.lineWidth = 3;
+      if (g.kind === "line") {
+        var n = g.normal, d = [-n[1], n[0]];  // along the line
+        var a = toScreen([g.point[0] - reach * d[0], g.point[1] - reach * d[1]]);
+        var b = toScreen([g.point[0] + reach * d[0], g.point[1] + reach * d[1]]);
+        ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(b[0], b[1]); ctx.stroke();
+        // The solid side (against the normal), shaded 12 px deep, hatched every 10 px.
+        var depth = 12, sn = [-n[0] * depth, n[1] * depth];  // screen offset into the solid (screen y down)
+        ctx.beginPath();
+        ctx.moveTo(a[0], a[1]); ctx.lineTo(b[0], b[1]); ctx.lineTo(b[0] + sn[0], b[1] + sn[1]); ctx.lineTo(a[0] + sn[0], a[1] + sn[1]);
+        ctx.closePath(); ctx.fill();
+        ctx.lineWidth = 1;
+        var length = Math.hypot(b[0] - a[0], b[1] - a[1]), ux = (b[0] - a[0]) / length, uy = (b[1] - a[1]) / length;
+        ctx.beginPath();
+        for (var s = 0; s < length && s < 20000; s += 10) {
+          var x = a[0] + ux * s, y = a[1] + uy * s;
+          ctx.moveTo(x, y); ctx.lineTo(x + sn[0] + ux * 6, y + sn[1] + uy * 6);
+        }
+        ctx.stroke();
+        var p = toScreen(g.point);
+        drawnSurfaces.push({element: e.name, kind: "line", point_px: p,
+                            on_canvas: p[0] >= 0 && p[0] <= canvas.width && p[1] >= 0 && p[1] <= canvas.height});
+      } else if (g.kind === "circle") {
+        var c = toScreen(g.center), r = g.radius * view.scale;
+        ctx.beginPath(); ctx.arc(c[0], c[1], r, 0, 2 * Math.PI);
+        if (!g.inside) ctx.fill();  // outside contact: the solid is the circle
+        ctx.stroke();
+        var gap = Math.hypot(c[0] - canvas.width / 2, c[1] - canvas.height / 2);
+        drawnSurfaces.push({element: e.name, kind: "circle", center_px: c, radius_px: r,
+                            on_canvas: gap - r < Math.hypot(canvas.width, canvas.height) / 2 && gap + r > 0});
+      }
+      ctx.restore();
+    });
+  }
 
   function modeOf(elementName, t) {  // category from the element's last event up to t
     var list = eventsByElement[elementName];
@@ -833,6 +880,7 @@
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.clearRect(0, 0, canvas.width, canvas.height);
     drawRail();
+    drawSurfaces();
     model.bodies.forEach(function (b, i) {
       var pts = hulls[i].map(function (p) { return place(f, i, p); });
       if (pts.some(function (p) { return !p; })) return;
@@ -1326,6 +1374,7 @@
     setFrame(frames.t.length - 1);
     var last = canvasDigest();
     check.frames = {count: frames.t.length, first: first, last: last, differ: first !== last};
+    check.surfaces = drawnSurfaces;  // at the last frame, the whole model in view
     if (eventRows.length) {  // a click on the last event moves the animation to its time
       var k = eventRows.length - 1;
       eventRows[k].click();
