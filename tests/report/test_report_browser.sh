@@ -19,6 +19,17 @@ if grep -Eq '<(script|link|img|iframe)[^>]* (src|href)=' "$tmp/run/report.html";
 flags=(--headless=new --no-sandbox --disable-gpu --no-first-run --disable-extensions --hide-scrollbars
        --user-data-dir="$tmp/profile" --enable-logging=stderr --v=0)
 url="file://$tmp/run/report.html"
+# open_page WHAT URL DOM BUDGET SCREENSHOT SIZE: the page's DOM after BUDGET ms of virtual time,
+# failing on a script error or a failed load in Chromium's log, then its screenshot.
+open_page() {
+  local what=$1 page=$2 dom=$3 budget=$4 shot=$5 size=$6
+  timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget="$budget" --dump-dom "$page" > "$dom" 2> "$tmp/chromium.log" ||
+    fail "chromium --dump-dom ($what)"
+  if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the $what (above)"; fi
+  timeout 120 "$chromium" "${flags[@]}" --window-size="$size" --screenshot="$shot" "$page" > /dev/null 2>&1 ||
+    fail "chromium --screenshot ($what)"
+  [ -s "$shot" ] || fail "no screenshot of the $what"
+}
 timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=5000 --dump-dom "$url" > "$tmp/dom.html" 2> "$tmp/chromium.log" ||
   { tail -20 "$tmp/chromium.log"; fail "chromium --dump-dom"; }
 # Console errors and failed loads show in Chromium's log.
@@ -93,12 +104,7 @@ grep -Eq 'wheel unloading: [^<]*</th><td[^>]*>pass: [0-9.e+-]+ of the static whe
   fail "sensitivity"
 for study in converge sweep sensitivity; do
   "$bin" report "$tmp/$study" > /dev/null || fail "report of a $study folder"
-  timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=3000 --dump-dom "file://$tmp/$study/report.html" > "$tmp/$study.html" \
-    2> "$tmp/chromium.log" || fail "chromium --dump-dom ($study)"
-  if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the $study report (above)"; fi
-  timeout 120 "$chromium" "${flags[@]}" --window-size=1200,1400 --screenshot="$out/report_$study.png" "file://$tmp/$study/report.html" \
-    > /dev/null 2>&1 || fail "chromium --screenshot ($study)"
-  [ -s "$out/report_$study.png" ] || fail "no screenshot of the $study report"
+  open_page "$study report" "file://$tmp/$study/report.html" "$tmp/$study.html" 3000 "$out/report_$study.png" 1200,1400
 done
 "$node" - "$tmp" <<'JS' || fail "study pages (above)"
 const fs = require("fs");
@@ -173,12 +179,7 @@ format=csv
 "$bin" run "$emu" --t-end 0.1 --set trains.unitA.speed=12000 --format $format --out "$tmp/faster" --quiet > /dev/null 2>&1 ||
   fail "run faster ($format)"
 "$bin" report "$tmp/base" "$tmp/faster" --out "$tmp/compare.html" > /dev/null || fail "report base faster"
-timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=5000 --dump-dom "file://$tmp/compare.html" > "$tmp/compare_dom.html" \
-  2> "$tmp/chromium.log" || fail "chromium --dump-dom (compare)"
-if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the side-by-side page (above)"; fi
-timeout 120 "$chromium" "${flags[@]}" --window-size=1400,1800 --screenshot="$out/report_compare.png" "file://$tmp/compare.html" \
-  > /dev/null 2>&1 || fail "chromium --screenshot (compare)"
-[ -s "$out/report_compare.png" ] || fail "no screenshot of the side-by-side page"
+open_page "side-by-side page" "file://$tmp/compare.html" "$tmp/compare_dom.html" 5000 "$out/report_compare.png" 1400,1800
 "$node" - "$tmp" <<'JS' || fail "side-by-side page (above)"
 const fs = require("fs");
 const tmp = process.argv[2];
@@ -206,11 +207,7 @@ JS
 # (x = 0.05 m, normal -x) and the animation draws it on the canvas, to the right of the cab's
 # front (the wall's solid side), at every frame.
 "$bin" run "$src/models/examples/emu3_wall.yaml" --t-end 0.05 --out "$tmp/wall" --report --quiet > /dev/null 2>&1 || fail "run emu3_wall"
-timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=5000 --dump-dom "file://$tmp/wall/report.html" > "$tmp/wall.html" \
-  2> "$tmp/chromium.log" || fail "chromium --dump-dom (wall)"
-if grep -E "Uncaught|net::ERR_|Failed to load resource" "$tmp/chromium.log"; then fail "JavaScript error in the wall run's report (above)"; fi
-timeout 120 "$chromium" "${flags[@]}" --window-size=1400,1300 --screenshot="$out/report_wall.png" "file://$tmp/wall/report.html" \
-  > /dev/null 2>&1 || fail "chromium --screenshot (wall)"
+open_page "wall run's report" "file://$tmp/wall/report.html" "$tmp/wall.html" 5000 "$out/report_wall.png" 1400,1300
 "$node" - "$tmp" <<'JS' || fail "wall drawn (above)"
 const fs = require("fs");
 const tmp = process.argv[2];
