@@ -167,6 +167,16 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   // The integrator taking the steps: this one, or the successor it handed the run to.
   Integrator* active = this;
   std::unique_ptr<Integrator> successor;
+  bool dense = false;
+  // The successor (hand_over, rescue) goes on with the run: this one's counters close first.
+  const auto pass_run_to = [&](std::unique_ptr<Integrator> next) {
+    active->finish();
+    next->take_run_from(*active);
+    next->continue_from_hand_over();
+    successor = std::move(next);  // (the previous successor, if any, is done with)
+    active = successor.get();
+    dense = active->dense_output();
+  };
   try {
     {
       const PhaseClock::Scope timed(phase_clock(), Phase::Start);
@@ -176,7 +186,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
     outcome_.initial_energy = energy(sample_y_.data(), sample_quadratures_.data());
     outcome_.max_constraint_residual = 0.0;
     deliver_sample(0.0);
-    bool dense = dense_output();
+    dense = dense_output();
     long steps_taken = 0;  // advance() calls in this run
     while (t_reached < t_end) {
       if (stop && stop->load()) {
@@ -196,12 +206,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
         double t_good = t_reached;
         std::unique_ptr<Integrator> next = active->rescue(failure.what(), &t_good);
         if (!next) throw;
-        active->finish();  // the counters of the steps so far
-        next->take_run_from(*active);
-        next->continue_from_hand_over();
-        successor = std::move(next);
-        active = successor.get();
-        dense = active->dense_output();
+        pass_run_to(std::move(next));
         t_reached = t_good;
         continue;
       }
@@ -222,15 +227,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
           ++active->output_index_;
       }
       if (t_reached < t_end) {
-        std::unique_ptr<Integrator> next = active->hand_over(t_reached, active->current_state());
-        if (next) {
-          active->finish();  // the counters of the steps so far
-          next->take_run_from(*active);
-          next->continue_from_hand_over();
-          successor = std::move(next);  // (the previous successor, if any, is done with)
-          active = successor.get();
-          dense = active->dense_output();
-        }
+        if (std::unique_ptr<Integrator> next = active->hand_over(t_reached, active->current_state())) pass_run_to(std::move(next));
       }
     }
   } catch (const InputError&) {
