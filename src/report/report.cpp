@@ -532,6 +532,11 @@ ReportResult write_page_of_folder(const std::string& run_dir, const ReportOption
                                           (have_reached ? " at t = " + json_number(reached->get<double>()) + " s" : std::string()) +
                                           ": " + string_at(summary_value, "message") + "; the report shows the results up to then");
   }
+  // The run's own accuracy warnings (results/accuracy_check.hpp), at the top as `run` printed them.
+  if (const auto warnings = summary_value.is_object() ? summary_value.find("accuracy_warnings") : summary_value.end();
+      warnings != summary_value.end() && warnings->is_array())
+    for (const nlohmann::json& w : *warnings)
+      if (w.is_string()) problems.push_back("Accuracy: " + w.get<std::string>());
   const std::string model_json = read_json_file(dir / "model.json", &found);
   if (!found) problems.push_back("no model.json (written by `railcrash run` since the report came in): no animation; run the model again");
   const nlohmann::json model_value = parse_json("model.json", model_json, problems);

@@ -206,6 +206,19 @@ TEST_CASE("railcrash report: a good run, a truncated one, one without summary, a
     CHECK(failed.problems[0] == "The run FAILED at t = 0.3 s: IDA: error test failed \"repeatedly\"; the report shows the results up to then");
   }
 
+  // The run's accuracy warnings (summary.json) are listed at the top, after a failure.
+  {
+    std::string summary = slurp(dir / "summary.json");
+    const std::string none = "\"accuracy_warnings\": []";
+    REQUIRE(summary.find(none) != std::string::npos);
+    summary.replace(summary.find(none), none.size(), "\"accuracy_warnings\": [\"joints open by up to 0.44 m\"]");
+    std::ofstream(dir / "summary.json", std::ios::trunc) << summary;
+    const railcrash::report::ReportResult warned = write_report(dir.string());
+    REQUIRE(warned.problems.size() == 2);
+    CHECK_THAT(warned.problems[0], Catch::StartsWith("The run FAILED"));
+    CHECK(warned.problems[1] == "Accuracy: joints open by up to 0.44 m");
+  }
+
   // Cut timeseries.csv in the middle of a row and remove the summary: a run killed half-way.
   const std::string series = slurp(dir / "timeseries.csv");
   {
