@@ -34,7 +34,8 @@ def models():
     names += sorted(glob.glob(os.path.join(ROOT, "models/scenarios/*.yaml")))
     names += [os.path.join(ROOT, p) for p in ("models/report/final_two_car.yaml", "models/report/preliminary_car.yaml",
                                               "models/barrier/two_car_barrier.yaml",
-                                              "tests/robustness/models/ida_fails_stiff_anticlimber.yaml")]
+                                              "tests/robustness/models/stiff_anticlimber_unit.yaml",
+                                              "tests/robustness/models/crush_through_unit.yaml")]
     return [n for n in names if os.path.exists(n)]
 
 

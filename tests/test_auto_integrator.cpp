@@ -131,24 +131,43 @@ TEST_CASE("a model that names no integrator runs with auto and a model may name 
     CHECK(integrator_from_name(integrator_name(kind)) == kind);
 }
 
+TEST_CASE("IDA runs a unit whose only forces at t = 0 are round-off: they set no tolerance scale", "[integrators][ida]") {
+  // No force acts at t = 0 but round-off (2e-8 N: draft gears whose points sit 1e-16 m inside
+  // their free length). Taken as the force scale, it gave the multipliers a tolerance of 2e-12 N
+  // and IDA stopped with IDA_CONV_FAIL at 4.5 ms (d2514da); the kinetic scale now takes over.
+  // x-momentum, 81,700 kg x 12 m/s, has no outside force to change it.
+  const std::string file = source_path("tests/robustness/models/stiff_anticlimber_unit.yaml");
+  const Model model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.1"});
+  DaeSystem system(model);
+  SampleTimes samples;
+  const RunOutcome outcome = make_integrator(system, model.simulation)->run(0.1, 0.001, samples);
+  INFO(outcome.message);
+  REQUIRE(outcome.ok);
+  double momentum = 0.0;  // [kg m/s]
+  for (std::size_t b = 0; b < model.bodies().size(); ++b)
+    momentum += model.bodies()[b].mass * outcome.y[3 * model.body_count() + 3 * b];
+  CHECK(momentum == Approx((41000.0 + 900.0 + 900.0 + 38000.0 + 900.0) * 12.0).epsilon(1e-9));
+}
+
 TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and says so", "[integrators][auto]") {
-  // IDA stops with IDA_CONV_FAIL at t = 4.68 ms on this model (the file says what is known).
+  // An absolute length tolerance of 1e-16 m, below the round-off of the model's 42 m
+  // coordinates: IDA stops with IDA_ERR_FAIL at the first contact (1.67 ms).
   // No force from outside acts (no gravity, no ground element): the x-momentum of the bodies,
   // 81,700 kg x 12 m/s for the moving unit, stays what it was through IDA's part, the hand-over
   // and Euler's part (Euler's internal forces are equal and opposite at every step).
-  const std::string file = source_path("tests/robustness/models/ida_fails_stiff_anticlimber.yaml");
-  const Model ida_model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.05"});
+  const std::string file = source_path("tests/robustness/models/stiff_anticlimber_unit.yaml");
+  const Model ida_model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.05", "simulation.atol=1e-16"});
   DaeSystem ida_system(ida_model);
   SampleTimes ida_samples;
   const RunOutcome by_ida = make_integrator(ida_system, ida_model.simulation)->run(0.05, 0.001, ida_samples);
   REQUIRE_FALSE(by_ida.ok);
-  CHECK_THAT(by_ida.message, Catch::Contains("IDA_CONV_FAIL"));
+  CHECK_THAT(by_ida.message, Catch::Contains("IDA_ERR_FAIL"));
   // "IDA failed at t = T with ...": auto's IDA takes the same steps up to T.
   const std::size_t at = by_ida.message.find("IDA failed at t = ");
   REQUIRE(at != std::string::npos);
   const double t_failed = std::stod(by_ida.message.substr(at + 18));
 
-  const Model auto_model = load_model(file, {"simulation.integrator=auto", "simulation.t_end=0.05"});
+  const Model auto_model = load_model(file, {"simulation.integrator=auto", "simulation.t_end=0.05", "simulation.atol=1e-16"});
   DaeSystem auto_system(auto_model);
   SampleTimes auto_samples;
   const RunOutcome outcome = make_integrator(auto_system, auto_model.simulation)->run(0.05, 0.001, auto_samples);
@@ -156,7 +175,7 @@ TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and
   INFO(outcome.stats.hand_over_reason);
   REQUIRE(outcome.ok);
   CHECK(outcome.t_reached == Approx(0.05));
-  CHECK_THAT(outcome.stats.hand_over_reason, Catch::StartsWith("IDA failed; Euler") && Catch::Contains("IDA_CONV_FAIL"));
+  CHECK_THAT(outcome.stats.hand_over_reason, Catch::StartsWith("IDA failed; Euler") && Catch::Contains("IDA_ERR_FAIL"));
   CHECK(outcome.stats.handed_over_at == Approx(t_failed).epsilon(1e-5));
   CHECK(outcome.stats.handed_over_at > by_ida.t_reached);  // after IDA's last sample
   double momentum = 0.0;  // [kg m/s]

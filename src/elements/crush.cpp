@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "railcrash/error.hpp"
 #include <string>
 
 namespace railcrash {
@@ -89,6 +91,11 @@ void CrushSpring::initialize(const ElementState<double>& initial) {
     throw InputError(where().prefix() + "crush_spring '" + name() +
                      "': its two points coincide in the initial configuration, so it has no direction; move them apart");
   if (!free_length) free_length = length;
+  {  // the initial direction P1 -> P2 in body 1's frame (the points-meet root)
+    const Vec2<double> d = line_geometry(*this, initial).d;
+    const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(point_slot(0))];
+    reference_axis_ = {(r.cos * d.x + r.sin * d.y) / length, (-r.sin * d.x + r.cos * d.y) / length};
+  }
   initial_state_ = State{};
   enter_mode_at(initial_state_, crush_of(initial), crush_rate_of(initial));
   if (initial_state_.mode == Mode::Loading && crush_of(initial) > 0.0)
@@ -112,10 +119,19 @@ void CrushSpring::stiffest_force_jacobian(double, const ElementState<double>& s,
   ad::extract_forces(fd, f, df_dq, df_dv);
 }
 
+double CrushSpring::points_meet_gap(const ElementState<double>& s) const {
+  // Signed: the distance along the initial direction, turned with body 1, goes negative when
+  // the points pass each other within a step (Euler's), where the unsigned length may not dip.
+  const auto k1 = static_cast<std::size_t>(point_slot(0));
+  const Vec2<double> axis = rotate(s.rotation[k1], reference_axis_.x, reference_axis_.y);
+  return dot(line_geometry(*this, s).d, axis) - kPointsMeetFraction * *free_length;
+}
+
 void CrushSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
   const double crush = crush_of(s);
   const State& st = mode_as<State>(s);
   g[0] = g[1] = g[2] = 1.0;
+  g[kPointsMeetRoot] = points_meet_gap(s);
   switch (st.mode) {
     case Mode::Loading: {
       const auto k = static_cast<std::size_t>(st.segment);
@@ -134,10 +150,28 @@ void CrushSpring::roots(double, const ElementState<double>& s, const double*, do
   }
 }
 
-bool CrushSpring::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
+bool CrushSpring::commit(int index, int direction, double t, const ElementState<double>& s, const double*, void* mode,
                          Event& event) const {
   const double crush = crush_of(s);
   State& st = *static_cast<State*>(mode);
+  // Checked whatever root fired: Euler commits one root per element and step, and the step
+  // that carries P2 past P1 may also reverse the crush rate (root 0, first in line).
+  if (points_meet_gap(s) < 0.0 || (index == kPointsMeetRoot && direction < 0)) {
+    // No mode goes on from here: the run stops with what it has (Integrator::run keeps the
+    // samples up to now and takes this as the run's message; not a step failure, so auto does
+    // not hand the run to Euler either).
+    const double ahead = points_meet_gap(s) + kPointsMeetFraction * *free_length;  // P2 ahead of P1 [length]
+    char where_now[96];
+    if (ahead > 0.0) std::snprintf(where_now, sizeof where_now, "its points are %g apart", ahead);
+    else std::snprintf(where_now, sizeof where_now, "its points have passed each other (by %g)", -ahead);
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "' is crushed through its whole length at t = %.6g s: %s, of a free_length of %g, where its "
+                  "force has no direction left. The structure needs a stroke it does not have: give a free_length "
+                  "above the crush its curve must reach, a stiffer end of the curve, or less energy to absorb",
+                  t, where_now, *free_length);
+    throw SolverError(where().prefix() + "crush_spring '" + name() + text);
+  }
   switch (st.mode) {
     case Mode::Loading:
       if (direction > 0) return false;

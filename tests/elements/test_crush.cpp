@@ -318,3 +318,37 @@ simulation: {t_end: 0.05, integrator: ida, rtol: 1e-9, output_interval: 0.001}
     CHECK(std::abs(zone_contact->value) < 1e-6);  // crush at contact [m]; f654aee (IDA): 6.3 mm
   }
 }
+
+TEST_CASE("crush spring crushed through its free length stops the run naming it under every integrator",
+          "[elements][crush][faults]") {
+  // 100 kg at 50 m/s: 125 kJ against the structure's 1e5 N over its 1 m (curve tabulated to
+  // the free length). Elastic rise to d_y = 0.01 m at k = 1e7 N/m: a quarter-wave arc, reached
+  // at t_y = asin(d_y w / v) / w (w = sqrt(k / m)) with v_y^2 = v^2 - k d_y^2 / m; then a
+  // constant 1e5 N: d - d_y = v_y t - a t^2 / 2 (a = F0 / m) up to the points-meet margin,
+  // crush 0.999 m. Before this check IDA stopped with singular equations there and Euler went
+  // on through the other side with the force reversed.
+  const double speed = 50.0, gap = 0.5, m = 100.0, k = 1e7, d_y = 0.01, f0 = 1e5;
+  const double w = std::sqrt(k / m);
+  const double t_y = std::asin(d_y * w / speed) / w;
+  const double v_y = std::sqrt(speed * speed - k * d_y * d_y / m);
+  const double a = f0 / m, plastic = 0.999 - d_y;
+  const double t_meet = gap / speed + t_y + (v_y - std::sqrt(v_y * v_y - 2.0 * a * plastic)) / a;  // [s] 0.0375
+  for (const char* integrator : {"ida", "euler", "auto"}) {
+    INFO(integrator);
+    const Model model = testing::model_from_text(impact(speed, gap, integrator));
+    DaeSystem system(model);
+    struct Quiet : RunObserver {
+      void sample(double, const double*, const double*, const double*, const double*) override {}
+    } observer;
+    const RunOutcome outcome = make_integrator(system, model.simulation)->run(0.2, 0.001, observer);
+    INFO(outcome.message);
+    CHECK_FALSE(outcome.ok);
+    CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: crush_spring 'crush' is crushed through its whole length at t = "));
+    CHECK_THAT(outcome.message, Catch::Contains("of a free_length of 1,"));
+    const double t_message = std::stod(outcome.message.substr(outcome.message.find("at t = ") + 7));
+    CHECK(t_message == Approx(t_meet).epsilon(std::string(integrator) == "euler" ? 1e-3 : 1e-5));
+    CHECK(outcome.t_reached <= t_message);  // the run keeps its samples up to there
+    CHECK(outcome.t_reached > t_message - 0.0011);
+    CHECK(outcome.stats.handed_over_at < 0.0);  // auto: not an IDA failure, no hand-over to Euler
+  }
+}

@@ -16,6 +16,9 @@
 //   open                  P = 0, or tension_stiffness * (d - d_p) (< 0) when that is given
 //                         leaves when d > d_p (contact again: elastic, or loading if the
 //                         structure has never been crushed)
+// In every mode, L reaching 1e-3 free_length (the points meet) stops the run with a message:
+// the force has no direction there (a curve may be tabulated beyond free_length; that part is
+// never reached).
 // Roots are written positive inside their mode (element.hpp's convention).
 // The loader refuses an unloading_stiffness below the curve's steepest segment slope: from a
 // crush on such a segment the unloading line would rise above the loading curve (more force
@@ -73,7 +76,17 @@ class CrushSpring : public ForceElement<CrushSpring> {
   double segment_slope(int segment) const;
 
   void initialize(const ElementState<double>& initial) override;
-  int root_count() const override { return 3; }
+  /// Root 3, in every mode: P2 comes within kPointsMeetFraction of the free length of P1,
+  /// measured along the initial direction P1 -> P2 turned with body 1 (so a step that carries P2
+  /// past P1 is caught too) (crush reaches 99.9 % of free_length). The run stops there with a message
+  /// naming the element (SolverError from commit): beyond it u = (r2 - r1) / L is lost, and
+  /// Euler went on through the other side with the force reversed (a silent wrong answer).
+  static constexpr int kPointsMeetRoot = 3;
+  static constexpr double kPointsMeetFraction = 1e-3;
+  Vec2<double> reference_axis_{1.0, 0.0};  // [-] initial unit direction P1 -> P2 in body 1's frame (initialize)
+  int root_count() const override { return 4; }
+  /// Root 3's value: P2's distance from P1 along the turned initial direction, less the margin [length].
+  double points_meet_gap(const ElementState<double>& s) const;
   void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
   bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
               Event& event) const override;
