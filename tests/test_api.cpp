@@ -159,14 +159,15 @@ TEST_CASE("api: a model built in code oscillates with period 2 pi sqrt(m / k)", 
 TEST_CASE("api: a built body may declare its car, and the summary then has that car's crush", "[api]") {
   // A 2 kg cart at 1 m/s into a crush spring on the ground with a 1 N plateau after 1 mm:
   // the crush grows until the plateau has taken the kinetic energy, 1 J = 1 N x (d - 0.0005 m).
+  // (The cart starts 2 m out: with 1 m, as before, it went through the spring's ground point.)
   rc::ModelBuilder b("crusher", "SI");
   b.gravity(0.0, 0.0);
-  rc::BodySpec cart{"cart", 2.0, 0.1, 1.0, 0.0};
+  rc::BodySpec cart{"cart", 2.0, 0.1, 2.0, 0.0};
   cart.vx = -1.0;
   cart.car = "train";
   b.body(cart);
   b.element("crush", "crush_spring", {{"ground", 0.0, 0.0}, {"cart", 0.0, 0.0}},
-            {{"free_length", 1.0}, {"curve", std::vector<std::vector<double>>{{0.0, 0.0}, {0.001, 1.0}, {2.0, 1.0}}},
+            {{"free_length", 2.0}, {"curve", std::vector<std::vector<double>>{{0.0, 0.0}, {0.001, 1.0}, {2.0, 1.0}}},
              {"unloading_stiffness", 1.0e4}});
   rc::RunSettings s;
   s.t_end = 2.5;

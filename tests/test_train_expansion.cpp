@@ -169,11 +169,11 @@ elements:
   - {name: unitA.mid.rail, type: slider_joint, points: [{body: ground, at: [-2.8, 1.0]}, {body: unitA.mid.body}]}
   - {name: unitA.coupling1.spring, type: linear_spring, stiffness: 1.0e6, points: [{body: unitA.mid.nose, at: [0.4, 0]}, {body: unitA.car1.body, at: [-4.4, 0]}]}
 loads:
-  - {type: force, body: unitA.car1.nose, value: [[0, [0, 0]], [0.01, [-2.0e4, 0]]]}
+  - {type: force, body: unitA.car1.nose, value: [[0, [0, 0]], [0.01, [-2.0e3, 0]]]}
 simulation:
   t_end: 0.05
 )";
-  two_cars += "loads:\n  - {type: force, body: unitA.car1.nose, value: [[0, [0, 0]], [0.01, [-2.0e4, 0]]]}\n";
+  two_cars += "loads:\n  - {type: force, body: unitA.car1.nose, value: [[0, [0, 0]], [0.01, [-2.0e3, 0]]]}\n";
   const Model expanded = testing::model_from_text(two_cars);
   const Model by_hand = testing::model_from_text(flat);
   REQUIRE(expanded.body_count() == by_hand.body_count());
@@ -301,9 +301,9 @@ TEST_CASE("mm-t-s-N models equal the same model in SI", "[trains][units]") {
   mm = replaced(mm, "front: 10.0", "front: 10000");
   mm = replaced(mm, "speed: 2.0", "speed: 2000");
   mm = replaced(mm, "gap: 0.2", "gap: 200");
-  const std::string load_si = "loads:\n  - {type: force, body: unitA.car1.nose, at: [0.1, 0], value: [[0, [0, 0]], [0.01, [-2.0e4, -100]]]}\n"
+  const std::string load_si = "loads:\n  - {type: force, body: unitA.car1.nose, at: [0.1, 0], value: [[0, [0, 0]], [0.01, [-2.0e3, -100]]]}\n"
                               "  - {type: moment, body: unitA.mid.body, value: 50}\n";
-  const std::string load_mm = "loads:\n  - {type: force, body: unitA.car1.nose, at: [100, 0], value: [[0, [0, 0]], [0.01, [-2.0e4, -100]]]}\n"
+  const std::string load_mm = "loads:\n  - {type: force, body: unitA.car1.nose, at: [100, 0], value: [[0, [0, 0]], [0.01, [-2.0e3, -100]]]}\n"
                               "  - {type: moment, body: unitA.mid.body, value: 5.0e4}\n";
   const Model a = testing::model_from_text(si + load_si), b = testing::model_from_text(mm + load_mm);
   CHECK(b.units == UnitSystem::SI);
