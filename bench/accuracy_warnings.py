@@ -23,10 +23,10 @@ with tempfile.TemporaryDirectory() as tmp:
         for method in ("euler", "ida"):
             out = pathlib.Path(tmp) / "run"
             subprocess.run([str(BUILD / "railcrash"), "run", str(ROOT / "models" / f"{name}.yaml"), "--integrator", method,
-                            "--out", str(out), "--quiet"], check=True, stdout=subprocess.DEVNULL)
+                            "--out", str(out), "--quiet"], stdout=subprocess.DEVNULL)  # a failed run: said below
             s = json.loads((out / "summary.json").read_text())
             unit = s["units"]["length"]
             residual = s["constraint_residual_max"]
             opening = f"{residual * 1000:.3g} mm" if unit == "m" else f"{residual * 25.4:.3g} mm"
             print(f"{name:34} {method:6} {100 * s['energy']['relative_balance_error']:>14.3g} {opening:>16} "
-                  f"{len(s['accuracy_warnings'])}")
+                  f"{len(s['accuracy_warnings'])}" + ("" if s["status"] == "ok" else f"  FAILED: {s['message'][:110]}"))
