@@ -149,6 +149,16 @@ if (sweep) {
     if (!along || along.series !== 4 || along.points !== 8 + 4) problems.push("sweep: a point per run on 3 branch series plus 4 means: " + JSON.stringify(along));
     if (!mass || mass.marks.length !== 0) problems.push("sweep: a branch change along the mass: " + JSON.stringify(mass));
   }
+  // R2 is 0 in every run (the model has no anticlimber): its axis runs 0..1, not uPlot's 0..100.
+  const r2Values = rows.slice(1).map((r) => Number(r[h.indexOf("R2")]));
+  const r2 = sweep.charts.find((c) => c.id === "sweep:R2:bodies.car1.mass");
+  if (r2Values.some((v) => v !== 0) || !r2 || JSON.stringify(r2.y) !== "[0,1]") problems.push("sweep: R2 (all 0) axis " + JSON.stringify(r2 && r2.y) + ", expected [0,1]");
+  // R1 varies: its axis covers every run's R1 with 5 % to spare.
+  const r1Values = rows.slice(1).map((r) => Number(r[h.indexOf("R1")]));
+  const r1 = sweep.charts.find((c) => c.id === "sweep:R1:bodies.car1.mass");
+  const r1Low = Math.min(...r1Values), r1High = Math.max(...r1Values), r1Pad = 0.05 * (r1High - r1Low);
+  if (!r1 || !r1.y || Math.abs(r1.y[0] - (r1Low - r1Pad)) > 1e-9 * r1High || Math.abs(r1.y[1] - (r1High + r1Pad)) > 1e-9 * r1High)
+    problems.push("sweep: R1 axis " + JSON.stringify(r1 && r1.y) + ", expected " + JSON.stringify([r1Low - r1Pad, r1High + r1Pad]));
   if (!(sweep.headings >= 3)) problems.push("sweep: summary.md's headings not rendered as headings: " + sweep.headings);
 }
 // Sensitivity: a tornado chart per response, its bars in the order of |first-order coefficient|.

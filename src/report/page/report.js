@@ -72,6 +72,8 @@
     var points = 0;
     columns.slice(1).forEach(function (c) { c.forEach(function (v) { if (v !== null && v !== undefined) ++points; }); });
     var entry = {id: id, series: columns.length - 1, points: points, drawn: !!u.ctx};
+    // The y axis' range as drawn (uPlot sets the scales at its first draw, after this).
+    Object.defineProperty(entry, "y", {enumerable: true, get: function () { return u.scales.y ? [u.scales.y.min, u.scales.y.max] : null; }});
     for (var k in extra || {}) entry[k] = extra[k];
     studyCharts.push(entry);
     return entry;
@@ -112,6 +114,15 @@
       if (v === null || v === undefined || !(v > 0)) return "";
       return v >= 0.01 && v < 1e4 ? String(Number(v.toPrecision(3))) : v.toExponential(0).replace("e+", "e");
     });
+  }
+
+  // A response's axis: 5 % beyond its runs' range; one value in every run (R2 = 0 in a model
+  // without an anticlimber) gets 0..1, or 10 % either side of it, not uPlot's default 0..100.
+  function responseRange(u, min, max) {
+    if (min === null || max === null || !isFinite(min) || !isFinite(max)) return [0, 1];
+    if (max === min) return min === 0 ? [0, 1] : [min - 0.1 * Math.abs(min), max + 0.1 * Math.abs(max)];
+    var pad = 0.05 * (max - min);
+    return [min - pad, max + pad];
   }
 
   function sweepCharts(box, rows) {
@@ -213,7 +224,8 @@
         }
         studyChart(chartsBox, "sweep:" + header[ri] + ":" + header[fi], {
           title: header[ri] + " against " + header[fi], width: 480, height: 300,
-          scales: {x: xScale}, axes: [xAxis, scaledAxis(header[ri], runs.map(function (row) { return Number(row[ri]); }), {size: 70})],
+          scales: {x: xScale, y: {range: responseRange}},
+          axes: [xAxis, scaledAxis(header[ri], runs.map(function (row) { return Number(row[ri]); }), {size: 70})],
           series: series, legend: {live: false}, cursor: {drag: {x: false, y: false}},
           hooks: {draw: [verticalMarks(marks, "#c00", "branch change")]}
         }, columns, marks.length ? marks.length + " branch change" + (marks.length === 1 ? "" : "s") + " along " + header[fi] : "",
@@ -379,9 +391,15 @@
     });
     document.getElementById("footer").textContent = "railcrash report of a " + data.study + " folder";
     var selfCheck = document.getElementById("self-check");
-    selfCheck.textContent = JSON.stringify({errors: window.railcrashErrors, study: data.study, tables: tables, chart: !!data.chart,
-                                            charts: studyCharts, found: found, headings: box.querySelectorAll("h3, h4, h5").length});
-    selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+    var writeCheck = function () {
+      selfCheck.textContent = JSON.stringify({errors: window.railcrashErrors, study: data.study, tables: tables, chart: !!data.chart,
+                                              charts: studyCharts, found: found, headings: box.querySelectorAll("h3, h4, h5").length});
+      selfCheck.setAttribute("data-status", window.railcrashErrors.length ? "errors" : "ran");
+    };
+    writeCheck();
+    // Again once uPlot has drawn (it sets its scales at the first draw, in an animation frame):
+    // the charts' y ranges as drawn.
+    requestAnimationFrame(function () { setTimeout(writeCheck, 0); });
   }
 
   // ---------------------------------------------------------------- runs side by side (issue 39 item 5)
