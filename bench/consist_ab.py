@@ -13,7 +13,7 @@ median of the per-pair ratios of the latter (new / base: a pair runs seconds apa
 VM's slow and fast phases fall on both), and each phase's ratio of medians.
 
 A single round of `bench/run.sh consist` scatters by +-0.1 in its fitted exponent on this VM
-(bench/README.md); the ratio of two builds measured side by side does not. Its slope against
+(bench/HISTORY.md); the ratio of two builds measured side by side does not. Its slope against
 log N is the change of the exponent: printed last.
 """
 import argparse

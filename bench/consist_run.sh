@@ -1,5 +1,5 @@
 #!/bin/bash
-# The consist through `railcrash run` against `railcrash_bench consist` (issue 14; bench/README.md,
+# The consist through `railcrash run` against `railcrash_bench consist` (issue 14; bench/HISTORY.md,
 # "The run path on a long consist"), and optionally against another railcrash build:
 #   bench/consist_run.sh [--cars "20 100 200"] [--rounds 2] [--base OLD/railcrash]
 # Per round and size: the bench's process CPU (user + system) and its solver's CPU, `railcrash

@@ -66,7 +66,9 @@ def main():
     binary = pathlib.Path(args.build) / "railcrash"
     model = ROOT / "models" / "report" / "final_two_car.yaml"
     mpirun = shutil.which("mpirun")
-    with_mpi = mpirun is not None and b"libmpi" in subprocess.run(["ldd", str(binary)], capture_output=True).stdout
+    # `railcrash sweep` under mpirun execs railcrash-mpi, built beside it when CMake found MPI
+    # (railcrash itself links no MPI since the start-up work: bench/HISTORY.md, "Start-up").
+    with_mpi = mpirun is not None and (binary.parent / "railcrash-mpi").exists()
     with tempfile.TemporaryDirectory(prefix="railcrash_sweep_bench_") as scratch:
         plan = pathlib.Path(scratch) / "plan.yaml"
         plan.write_text(PLAN.format(runs=args.runs))

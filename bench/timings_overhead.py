@@ -1,7 +1,6 @@
 #!/usr/bin/python3
 """What `railcrash run --timings` costs: each case with and without it, alternating, CPU of
-the process (user + system), medians over the repeats (bench/README.md, "Where a run's time
-goes"). Usage: bench/timings_overhead.py [--executable build/railcrash] [--repeats 7]"""
+the process (user + system), medians over the repeats (README.md, `--timings`). Usage: bench/timings_overhead.py [--executable build/railcrash] [--repeats 7]"""
 import argparse
 import pathlib
 import statistics

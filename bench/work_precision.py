@@ -6,7 +6,7 @@
 
 Issue 14's goal for the two-car crash is CPU "at equal accuracy in every engineering
 quantity". Comparing two builds at one rtol each does not settle that: the same build's
-errors scatter by up to 10x between neighbouring rtols (bench/README.md), and two builds
+errors scatter by up to 10x between neighbouring rtols (bench/HISTORY.md), and two builds
 at the same rtol need not be equally accurate. Here both executables (this tree's
 build/railcrash, or --executable, and COMMIT's, built by compare_commit.py) run the same
 model (compare_commit.py's choice) at every rtol of a grid, interleaved, REPEATS times each;
@@ -43,7 +43,7 @@ from compare_commit import MODEL, ROOT, accepts, build_commit
 
 NAMES = ["max crush", "peak coupler force", "R2", "CFC-60 car body", "pin shear time", "anticlimber contact time"]
 # Event timing (issue 14's fifth quantity): the first occurrence of these (element, event) pairs
-# in events.csv, as in the IDA-against-Euler table of bench/README.md (the struck car's
+# in events.csv, as in the IDA-against-Euler table of bench/HISTORY.md (the struck car's
 # draft-gear pin shear near 4.76 ms, the anticlimbers' first contact near 6.19 ms); relative
 # errors over those times.
 EVENTS = {"pin shear time": ("car2_draft_gear", "pin shear"), "anticlimber contact time": ("anticlimber", "contact")}

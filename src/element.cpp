@@ -49,7 +49,7 @@ class ElementPool {
       const std::size_t block = std::max(kBlockBytes, bytes);
       // Not std::make_unique, which value-initializes the block: that wrote all 1 MiB with x87
       // stores (max_align_t holds a long double) and faulted in its 256 pages at the first
-      // element, 7 % of a slider-crank run (bench/README.md, "Start-up"). Default-initialized,
+      // element, 7 % of a slider-crank run (bench/HISTORY.md, "Start-up"). Default-initialized,
       // a page is touched when an element is first carved from it.
       blocks_.push_back(std::unique_ptr<std::max_align_t[]>(new std::max_align_t[block / sizeof(std::max_align_t)]));
       next_ = reinterpret_cast<char*>(blocks_.back().get());

@@ -101,7 +101,7 @@ TEST_CASE("auto keeps IDA on the report's two-car crash and gives IDA's result b
 }
 
 TEST_CASE("auto keeps IDA on an SI multiple-unit crash whose IDA steps are shorter than Euler's", "[integrators][auto]") {
-  // bench/README.md "integrator: auto": Euler at its own step is cheaper here but 3-11 % off in
+  // bench/HISTORY.md "integrator: auto": Euler at its own step is cheaper here but 3-11 % off in
   // the energy the crush zones absorb; IDA's mean step is a sixth of Euler's.
   const Model model = load_model(source_path("models/examples/emu_two_car_crush_zones.yaml"),
                                  {"simulation.integrator=auto", "simulation.output_interval=0.01"});

@@ -88,7 +88,7 @@ TEST_CASE("the roles say which outputs are crush, contact, coupler and interlock
 
 TEST_CASE("a long train's elements lie side by side in memory, not one per page of the loader's heap", "[element][memory]") {
   // Loaded from a model file, each element object used to sit on its own 4 KiB page among the
-  // parser's allocations (a median 2.9 KiB between consecutive elements; bench/README.md).
+  // parser's allocations (a median 2.9 KiB between consecutive elements; bench/HISTORY.md).
   // From the element pool (element.cpp) they fill the pages they occupy.
   const Model model = load_model_text(make_consist_model(source_path("models/report/final_two_car.yaml"), 20), "consist.yaml");
   REQUIRE(model.elements().size() == 1200);

@@ -5,7 +5,7 @@
 // stack (`mov -0x8(%rbp),%rax` for each element; `gdb -batch -ex 'disassemble Vaxpy_Serial'
 // build/railcrash`), about 16 instructions per element of an axpy. IDA calls these operations
 // about a hundred times per step, and in the report's two-car crash they were a fifth of the
-// run (bench/README.md, "SUNDIALS's vector operations compiled here").
+// run (bench/HISTORY.md, "SUNDIALS's vector operations compiled here").
 //
 // use_compiled_serial_ops(v) points v's operation table at functions in this file for the
 // operations IDA calls every step. Each computes exactly what SUNDIALS 6.4.1's nvector_serial.c
