@@ -15,7 +15,7 @@
 namespace railcrash {
 
 /// The process was started by an MPI launcher (OpenMPI's mpirun, or a PMI/PMIx one as srun).
-/// Inline: the railcrash executable, which links no MPI, asks it too (src/main.cpp).
+/// Inline: the railcrash executable, which links no MPI, asks it too (src/cli/sweep_command.cpp).
 inline bool launched_by_mpi() {
   for (const char* variable : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"})
     if (std::getenv(variable)) return true;

@@ -81,6 +81,30 @@ expect_text "converge CSV header" "$tmp/conv/converge.csv" '^method,step,rtol,st
 expect_status "converge with an unknown quantity exits 2" 2 "$bin" converge "$spring" --quantities max_crunch
 expect_text "it names the quantity" "$tmp/stderr" "unknown quantity 'max_crunch'"
 
+# The studies' shared options are declared once (src/cli/common.cpp): every study's --help gives
+# each the same help text, and converge takes --run-limit as the others do (and --run-timeout,
+# its former name).
+same_help() {  # description option command...: the option's help text (the line after its name) alike in each
+  local description=$1 option=$2 first="" text command
+  shift 2
+  for command in "$@"; do
+    text=$("$bin" "$command" --help | grep -A1 -- "^  $option[ ,]" | sed -n 2p | sed 's/^ *//')
+    if [ -z "$text" ]; then echo "FAIL: $description: $command --help has no $option"; failures=$((failures + 1)); return; fi
+    [ -z "$first" ] && first=$text
+    if [ "$text" != "$first" ]; then
+      echo "FAIL: $description: $command --help says '$text', $1 --help '$first'"; failures=$((failures + 1)); return
+    fi
+  done
+  passes=$((passes + 1))
+}
+same_help "--run-limit: one help text" --run-limit sensitivity readings sweep converge
+same_help "--max-runs: one help text" --max-runs sensitivity readings sweep
+same_help "--jobs: one help text" --jobs sensitivity readings sweep
+expect_status "converge takes --run-limit" 0 "$bin" converge "$spring" --t-end 0.5 --euler-steps 0 --rtols 1e-3 --quantities displacement_rms --run-limit 600 --out "$tmp/conv_limit"
+expect_status "converge still takes --run-timeout" 0 "$bin" converge "$spring" --t-end 0.5 --euler-steps 0 --rtols 1e-3 --quantities displacement_rms --run-timeout 600 --out "$tmp/conv_timeout"
+expect_status "converge --run-limit -1 exits 2" 2 "$bin" converge "$spring" --run-limit -1
+expect_text "it gives the range" "$tmp/stderr" "'-1' is not in range: give a finite number of at least 0 \[s\]"
+
 # readings: bad readings files exit 2 naming the file and line, before any run starts (the
 # report model's study would take minutes, so an exit within seconds shows nothing ran).
 report_model=$src/models/report/final_two_car.yaml
