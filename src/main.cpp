@@ -178,7 +178,7 @@ int check_command(const std::string& path, const std::vector<std::string>& setti
     const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
-  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end, integrator_name(model.simulation.integrator));
+  std::printf("simulation t_end %g, integrator %s\n", model.run_spec.simulation.t_end, integrator_name(model.run_spec.simulation.integrator));
   return 0;
 }
 
@@ -577,7 +577,7 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "run a model and write DIR/timeseries.csv, events.csv, summary.json");
   run->add_option("model", model_path, "model file (YAML)")->required();
   run->add_option("--integrator", integrator, "auto, ida or euler (default: the model's; a model that names none: auto)")
-      ->check(CLI::IsMember({"auto", "ida", "euler"}));
+      ->check(CLI::IsMember(railcrash::integrator_names()));
   CLI::Option* t_end_option = run->add_option("--t-end", t_end, "end time");
   // --t-end, --atol, --dt, --output-interval and --max-steps go to the model's simulation keys,
   // whose check refuses a non-finite or out-of-range value naming the model file (model_io.cpp).
