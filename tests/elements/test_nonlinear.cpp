@@ -451,7 +451,7 @@ TEST_CASE("a breakpoint that is no kink is merged: the report's symmetric dashpo
                 "damping_compression_1: 1180, damping_compression_2: 173, compression_switch_velocity: 4.5, "
                 "damping_extension_1: 1180, damping_extension_2: 173, extension_switch_velocity: 4.5");
   dashpot.velocity = 10.0;
-  dashpot.run_spec.simulation = ida(1.0);
+  dashpot.simulation = ida(1.0);
   const Model model = testing::model_from_text(axial_yaml(dashpot));
   const auto& law = dynamic_cast<const NonlinearDashpot&>(*model.elements().front()).law();
   REQUIRE(law.segment_count() == 3);
@@ -470,7 +470,7 @@ TEST_CASE("a breakpoint that is no kink is merged: the report's symmetric dashpo
   gap.velocity = -2.0;
   gap.mass = 10.0;
   const double half_period = kPi / std::sqrt(17500.0), t_end = 2.1;
-  gap.run_spec.simulation = ida(t_end);
+  gap.simulation = ida(t_end);
   const Model gap_model = testing::model_from_text(axial_yaml(gap));
   const auto& gap_law = dynamic_cast<const SpecialSpring&>(*gap_model.elements().front()).law();
   REQUIRE(gap_law.segment_count() == 2);

@@ -118,7 +118,7 @@ TEST_CASE("scenario criteria: survival-space cars, excluded elements and the int
   const std::string gauges = "gauges: [{name: ab, front: a, rear: b}]";
   CHECK_THAT(error(with(text, gauges, "cars: [car_b]")), Catch::Contains("cases.yaml:35") && Catch::Contains("no body declares 'car: car_b'"));
   CHECK_THAT(error(with(text, gauges, "cars: [car_a], excluded: [face]")), Catch::Contains("excluded: no element named 'face'"));
-  CHECK_THAT(error(with(text, gauges, "limit: 1")), Catch::Contains("give 'cars: [..]'"));
+  CHECK_THAT(error(with(text, ", " + gauges, "")), Catch::Contains("give 'cars: [..]'"));
   // Only scenario 3 (an obstacle) goes without an interface, and then has no override limit.
   const std::string no_interface = with(text, "limit: 0.1, source: test, interface: faces, ", "");
   CHECK_THAT(error(no_interface), Catch::Contains("only scenario 3 (an obstacle) has no interface"));
@@ -169,6 +169,7 @@ TEST_CASE("scenario criteria: a misspelt or repeated key is named with the close
 TEST_CASE("scenario criteria: an anticlimber is known by one check, of its type name or of the element", "[scenario]") {
   std::string flat = kTwoCarts;
   flat = flat.substr(0, flat.find("scenario:"));
+  flat = with(flat, "    face_height: 0.2\n", "    face_height: 0.2\n    facing: 1\n");  // the faces touch at the start
   flat = with(flat, "simulation:", "  - {name: s, type: linear_spring, stiffness: 1.0, free_length: 3.0, points: [{body: a}, {body: b}]}\nsimulation:");
   const Model model = load_model_text(flat, "cases.yaml");
   REQUIRE(model.elements().size() == 2);
