@@ -719,7 +719,6 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
   return load;
 }
 
-
 void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
   r.require_list(node, "outputs");
   std::vector<std::string> taken;  // names whose columns exist already
