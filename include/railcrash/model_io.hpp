@@ -32,7 +32,10 @@ using SectionFail = std::function<void(const YAML::Node& where, const std::strin
 using ScenarioSectionReader = std::shared_ptr<const ScenarioCriteria> (*)(const YAML::Node& section, const Model& model,
                                                                           double length_scale, const SectionFail& fail);
 /// Registers the reader of the `scenario:` section (a model with one is refused without it).
-/// Returns true, to initialise a static with.
+/// Returns true, to initialise a static with. scenario/criteria.cpp registers it from a static
+/// initialiser, which runs whenever that file is linked: every program that runs models links it
+/// (run.cpp uses its ScenarioTracker); a program linking librailcrash.a that only loads models
+/// names read_scenario_section itself (tests/fuzz/fuzz_model.cpp).
 bool set_scenario_section_reader(ScenarioSectionReader reader);
 
 /// Reads and checks a model file; the model comes back finalized.
