@@ -437,7 +437,7 @@ int numbers_benchmark(const std::string& model_path, const std::string& results,
   Model model = load_model(model_path);
   DaeSystem system(model);
   RowNumbers rows(system);
-  const RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, model.simulation.output_interval, rows);
+  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, model.run_spec.simulation.output_interval, rows);
   if (!outcome.ok) throw std::runtime_error("the run failed: " + outcome.message);
   const std::vector<double>& numbers = rows.numbers;
   std::vector<char> text(numbers.size() * 33);

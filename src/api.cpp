@@ -47,7 +47,7 @@ struct Access {
     impl->units = unit_system_name(loaded.units);
     for (const Body& b : loaded.bodies()) impl->bodies.push_back(b.name);
     for (const auto& e : loaded.elements()) impl->elements.emplace_back(e->name(), e->type());
-    impl->t_end = loaded.simulation.t_end;
+    impl->t_end = loaded.run_spec.simulation.t_end;
     impl->columns = timeseries_columns(DaeSystem(loaded));
     return Model(std::move(impl));
   }
@@ -97,7 +97,7 @@ Results run(const Model& model, const RunSettings& settings, const std::atomic<b
   if (settings.integrator) {
     overrides.integrator = integrator_from_name(*settings.integrator);
     if (!overrides.integrator)
-      throw InputError("integrator must be \"auto\", \"ida\" or \"euler\", not \"" + *settings.integrator + "\"");
+      throw InputError("integrator must be " + integrator_names_text("\"") + ", not \"" + *settings.integrator + "\"");
   }
   overrides.t_end = settings.t_end;
   overrides.rtol = settings.rtol;

@@ -257,10 +257,10 @@ IntegratorUsed integrator_used(const RunReport& report) {
   IntegratorUsed used;
   if (report.integrator.empty()) return used;
   if (report.outcome.stats.handed_over_at >= 0.0) {
-    used.method = "ida+euler";
+    used.method = kIdaThenEulerMethod;
     used.euler_from_t = report.outcome.stats.handed_over_at;
   } else {
-    used.method = report.integrator == "euler" ? "euler" : "ida";
+    used.method = integrator_name(report.integrator == integrator_name(IntegratorKind::Euler) ? IntegratorKind::Euler : IntegratorKind::Ida);
   }
   return used;
 }

@@ -25,6 +25,10 @@ namespace railcrash {
 
 namespace {
 
+/// The methods of a convergence study's runs (besides "reference"): the integrators' names.
+constexpr const char* kEulerMethod = integrator_name(IntegratorKind::Euler);
+constexpr const char* kIdaMethod = integrator_name(IntegratorKind::Ida);
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr long kProbeSteps = 2000;  // Euler steps timed by the plan to estimate the study's cost
 
@@ -54,7 +58,7 @@ ConvergeQuantity resolve_quantity(const std::string& requested, const DaeSystem&
                                   const std::string& force_unit) {
   using Kind = ConvergeQuantity::Kind;
   const Model& model = system.model();
-  const ResponseSettings& responses = model.responses;
+  const ResponseSettings& responses = model.run_spec.responses;
   ConvergeQuantity q;
   q.name = requested;
   const std::string key = lower(requested);
@@ -239,13 +243,13 @@ Model load_for_run(const ConvergePlan& plan, const std::string& method, double s
   RunOverrides overrides;
   overrides.t_end = plan.t_end;
   overrides.output_interval = plan.output_interval;
-  if (method == "euler") {
+  if (method == kEulerMethod) {
     overrides.integrator = IntegratorKind::Euler;
     overrides.dt = step;
   } else {
     overrides.integrator = IntegratorKind::Ida;
     // A model that sets atol gets it scaled with rtol, so a tighter run is tighter everywhere.
-    if (model.simulation.atol) overrides.atol = *model.simulation.atol * rtol / model.simulation.rtol;
+    if (model.run_spec.simulation.atol) overrides.atol = *model.run_spec.simulation.atol * rtol / model.run_spec.simulation.rtol;
     overrides.rtol = rtol;
   }
   apply_overrides(model, overrides);
@@ -262,16 +266,16 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
     const Model model = load_for_run(plan, method, step, rtol);
     DaeSystem system(model);
     std::unique_ptr<ResponseTracker> responses;
-    if (model.responses.defined()) responses = std::make_unique<ResponseTracker>(system, model.responses);
+    if (model.run_spec.responses.defined()) responses = std::make_unique<ResponseTracker>(system, model.run_spec.responses);
     std::unique_ptr<ResultWriter> accelerations;
     if (std::any_of(plan.quantities.begin(), plan.quantities.end(),
                     [](const ConvergeQuantity& q) { return q.kind == ConvergeQuantity::Kind::PeakAcceleration; }))
       accelerations = std::make_unique<ResultWriter>("", system);
     Recorder recorder(system, run, responses.get(), accelerations.get());
     const auto start = Clock::now();
-    std::unique_ptr<Integrator> integrator = make_integrator(system, model.simulation);
+    std::unique_ptr<Integrator> integrator = make_integrator(system, model.run_spec.simulation);
     const RunOutcome outcome =
-        integrator->run(model.simulation.t_end, output_interval_of(model.simulation), recorder, control.stop_flag());
+        integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), recorder, control.stop_flag());
     const bool timed_out = control.timed_out();
     run.wall_seconds = seconds_since(start);
     run.ok = outcome.ok;
@@ -426,7 +430,7 @@ TimeAtLevel time_at_level(const std::vector<ConvergeRun>& runs, std::size_t quan
   std::vector<Point> points;  // usable runs, loosest setting first
   for (const ConvergeRun& r : runs)
     if (r.ok && r.wall_seconds > 0.0 && std::isfinite(r.errors[quantity]))
-      points.push_back({r.method == "euler" ? r.step : r.rtol, r.wall_seconds, r.errors[quantity]});
+      points.push_back({r.method == kEulerMethod ? r.step : r.rtol, r.wall_seconds, r.errors[quantity]});
   if (points.empty()) return {kNaN, "no runs"};
   std::sort(points.begin(), points.end(), [](const Point& a, const Point& b) { return a.setting > b.setting; });
   std::size_t first_reliable = points.size();  // the loosest run from which on every tighter one meets the level
@@ -553,9 +557,9 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
     throw InputError("--euler-safety must be between 0 and 1 (e.g. 0.8)");
   if (options.euler_first_step < 0.0 || !std::isfinite(options.euler_first_step))
     throw InputError("--euler-dt must be a positive step");
-  if (!(options.reference_rtol > 0.0)) throw InputError("--reference-rtol must be positive (e.g. 1e-9)");
+  if (const std::string problem = rtol_problem(options.reference_rtol, "--reference-rtol"); !problem.empty()) throw InputError(problem);
   for (double r : options.rtols)
-    if (!(r > 0.0) || !std::isfinite(r)) throw InputError("--rtols: every tolerance must be positive, not " + format_number(r));
+    if (const std::string problem = rtol_problem(r, "--rtols: every tolerance"); !problem.empty()) throw InputError(problem);
   for (double r : options.rtols)
     if (r <= options.reference_rtol)
       throw InputError("--rtols: " + format_number(r) + " is not looser than the reference tolerance " +
@@ -573,8 +577,8 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   overrides.t_end = options.t_end;
   overrides.output_interval = options.output_interval;
   const Model model = load_model(model_path, options.settings, option_settings(overrides));
-  plan.t_end = model.simulation.t_end;
-  plan.output_interval = output_interval_of(model.simulation);
+  plan.t_end = model.run_spec.simulation.t_end;
+  plan.output_interval = output_interval_of(model.run_spec.simulation);
   plan.model_name = model.name;
   const bool si = model.units == UnitSystem::SI;
   plan.length_unit = si ? "m" : "in";
@@ -609,7 +613,7 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   double dt0 = options.euler_first_step;
   std::unique_ptr<EulerIntegrator> euler;
   if (dt0 > 0.0) {
-    euler = std::make_unique<EulerIntegrator>(system, EulerSettings{dt0, false, model.simulation.penalty});
+    euler = std::make_unique<EulerIntegrator>(system, EulerSettings{dt0, false, model.run_spec.simulation.penalty});
   } else {
     // The elements' own limit at the start (what `railcrash check` prints), then the penalties.
     std::vector<double> y0 = system.initial_state();
@@ -620,7 +624,7 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
       throw InputError("the model's elements give Euler no stability limit (no stiffness); give a first step with --euler-dt");
     dt0 = commensurate(options.euler_safety * plan.element_stability_limit);
     for (int pass = 0; pass < 10; ++pass) {
-      euler = std::make_unique<EulerIntegrator>(system, EulerSettings{dt0, true, model.simulation.penalty});
+      euler = std::make_unique<EulerIntegrator>(system, EulerSettings{dt0, true, model.run_spec.simulation.penalty});
       if (dt0 <= euler->stability_limit()) break;
       dt0 = commensurate(options.euler_safety * euler->stability_limit());
     }
@@ -633,11 +637,11 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   // steps is refused now, not when its run comes (after the others have run).
   const double smallest_step = plan.euler_steps.back();
   const double steps_needed = std::ceil(plan.t_end / smallest_step - 1e-9);  // [steps]
-  if (!(steps_needed <= static_cast<double>(model.simulation.max_steps)))
+  if (!(steps_needed <= static_cast<double>(model.run_spec.simulation.max_steps)))
     throw InputError(model_path + ": --euler-steps " + std::to_string(options.euler_runs) + " from dt " + format_number(dt0) +
                      " s goes down to " + fmt("%.4g", smallest_step) + " s, which needs " + fmt("%.4g", steps_needed) +
                      " steps to reach t_end = " + format_number(plan.t_end) + ", more than max_steps " +
-                     std::to_string(model.simulation.max_steps) + "; use fewer --euler-steps, a larger --euler-dt or a shorter --t-end");
+                     std::to_string(model.run_spec.simulation.max_steps) + "; use fewer --euler-steps, a larger --euler-dt or a shorter --t-end");
   // Time a short run at dt_0 for the cost per step (the same for every step size).
   NullObserver none;
   const double probe_end = std::min(plan.t_end, static_cast<double>(kProbeSteps) * dt0);
@@ -667,8 +671,8 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
     double step = 0.0, rtol = 0.0;
   };
   std::vector<Job> jobs{{"reference", 0.0, plan.options.reference_rtol}};
-  for (double dt : plan.euler_steps) jobs.push_back({"euler", dt, 0.0});
-  for (double rtol : plan.options.rtols) jobs.push_back({"ida", 0.0, rtol});
+  for (double dt : plan.euler_steps) jobs.push_back({kEulerMethod, dt, 0.0});
+  for (double rtol : plan.options.rtols) jobs.push_back({kIdaMethod, 0.0, rtol});
   std::vector<ConvergeRun> runs(jobs.size());
   BatchOptions batch;
   batch.jobs = plan.options.jobs;
@@ -715,10 +719,10 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
   if (!result.reference_note.empty())
     result.reference_note += result.reference.ok ? "used rtol " + fmt("%.0e", result.reference.rtol) + " instead."
                                                  : "no looser reference tried (it must stay 10x tighter than every run).";
-  for (std::size_t k = 1; k < runs.size(); ++k) (runs[k].method == "euler" ? result.euler : result.ida).push_back(runs[k]);
+  for (std::size_t k = 1; k < runs.size(); ++k) (runs[k].method == kEulerMethod ? result.euler : result.ida).push_back(runs[k]);
   // The model's response settings and body count, for the analysis.
   const Model model = load_model(plan.model_path, plan.options.settings);
-  analyse(result, plan, model.responses, model.body_count());
+  analyse(result, plan, model.run_spec.responses, model.body_count());
   result.total_seconds = seconds_since(start);
   return result;
 }
@@ -769,7 +773,7 @@ std::string convergence_markdown(const ConvergeResult& r) {
     if (q.applicable) md << "---|";
   md << "\n";
   const auto row = [&](const ConvergeRun& run) {
-    md << "| " << run.method << " | " << (run.method == "euler" ? fmt("%.4g", run.step) : fmt("%.0e", run.rtol)) << " | "
+    md << "| " << run.method << " | " << (run.method == kEulerMethod ? fmt("%.4g", run.step) : fmt("%.0e", run.rtol)) << " | "
        << (run.ok ? "ok" : "failed") << " | " << fmt("%.3g", run.wall_seconds) << " | " << run.stats.steps << " | "
        << run.stats.residual_evaluations << " | " << run.stats.jacobian_evaluations << " | " << run.stats.events << " |";
     for (std::size_t q = 0; q < nq; ++q)
@@ -781,7 +785,7 @@ std::string convergence_markdown(const ConvergeResult& r) {
   for (const ConvergeRun& run : r.ida) row(run);
   for (const auto* runs : {&r.euler, &r.ida})
     for (const ConvergeRun& run : *runs)
-      if (!run.ok) md << "\n" << run.method << " " << (run.method == "euler" ? "dt " + fmt("%.4g", run.step) : "rtol " + fmt("%.0e", run.rtol))
+      if (!run.ok) md << "\n" << run.method << " " << (run.method == kEulerMethod ? "dt " + fmt("%.4g", run.step) : "rtol " + fmt("%.0e", run.rtol))
                       << " failed: " << run.message << "\n";
 
   md << "\nObserved orders (least-squares slope of log error, number of runs in the fit):\n\n"
@@ -825,7 +829,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
   const auto number = [](double v) { return std::isfinite(v) ? format_number(v) : std::string(); };
   const OutcomeSignature reference_outcomes = outcome_signature(r.reference.events);
   const auto row = [&](const ConvergeRun& run) {
-    csv << run.method << "," << (run.method == "euler" ? number(run.step) : "") << "," << (run.method == "euler" ? "" : number(run.rtol))
+    csv << run.method << "," << (run.method == kEulerMethod ? number(run.step) : "") << "," << (run.method == kEulerMethod ? "" : number(run.rtol))
         << "," << (run.ok ? "ok" : "failed") << "," << number(run.wall_seconds) << "," << run.stats.steps << ","
         << run.stats.residual_evaluations << "," << run.stats.jacobian_evaluations << "," << run.stats.events;
     for (std::size_t q = 0; q < r.quantities.size(); ++q)
@@ -836,7 +840,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
         << (!run.ok || !r.reference.ok ? "" : &run == &r.reference ? "reference" : same_branch(outcomes, reference_outcomes) ? "same" : "changed");
     // The method that ran (the study names ida or euler for each run; an IDA run is never handed over).
     IntegratorUsed used;
-    used.method = run.method == "euler" ? "euler" : run.stats.handed_over_at >= 0.0 ? "ida+euler" : "ida";
+    used.method = run.method == kEulerMethod ? kEulerMethod : run.stats.handed_over_at >= 0.0 ? kIdaThenEulerMethod : kIdaMethod;
     if (run.stats.handed_over_at >= 0.0) used.euler_from_t = run.stats.handed_over_at;
     csv << "," << used.method << "," << used.euler_from_t_text() << "\n";
   };

@@ -904,7 +904,7 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
   // Second-order Taylor step (q + h v + h^2 a / 2, v + h a): a body at rest on a boundary
   // leaves it through its acceleration alone. h is small against the run's time scale but
   // large enough for h^2 a / 2 to survive round-off in q.
-  const double h = 1e-6 * std::min(1.0, model_.simulation.t_end);
+  const double h = 1e-6 * std::min(1.0, model_.run_spec.simulation.t_end);
   const int nq = body_unknowns();
   std::vector<double> y_ahead(y, y + size());
   for (int k = 0; k < nq; ++k) {

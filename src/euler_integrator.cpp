@@ -111,12 +111,12 @@ namespace {
 
 /// Why a step dt that needs more than max_steps steps from t0 to the model's t_end cannot run ("" when it can).
 std::string step_count_problem(const Model& model, double dt, long max_steps, double t0) {
-  const double steps_needed = std::ceil((model.simulation.t_end - t0) / dt - 1e-9);  // [steps], a double: never overflows
+  const double steps_needed = std::ceil((model.run_spec.simulation.t_end - t0) / dt - 1e-9);  // [steps], a double: never overflows
   if (steps_needed <= static_cast<double>(max_steps)) return "";
   std::ostringstream msg;
   msg << SourceLocation{model.file, 0}.prefix() << "explicit Euler with dt = " << dt << " needs " << steps_needed
-      << " steps to reach t_end = " << model.simulation.t_end << ", more than --max-steps " << max_steps
-      << "; use a larger dt (above " << model.simulation.t_end / static_cast<double>(max_steps)
+      << " steps to reach t_end = " << model.run_spec.simulation.t_end << ", more than --max-steps " << max_steps
+      << "; use a larger dt (above " << model.run_spec.simulation.t_end / static_cast<double>(max_steps)
       << "), a shorter t_end, or raise --max-steps";
   return msg.str();
 }
@@ -152,7 +152,7 @@ EulerIntegrator::Step EulerIntegrator::choose_step(const DaeSystem& system, cons
   // Automatic: half the limit of the elements alone, then penalties for that step; shrink
   // once more if the penalties lowered the limit.
   const double physical_limit = estimate_stability_limit(system, y, nullptr);
-  step.dt = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * system.model().simulation.t_end;
+  step.dt = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * system.model().run_spec.simulation.t_end;
   for (int pass = 0; pass < 20; ++pass) {
     step.penalty = make_penalty(system, settings.penalty, step.dt);
     step.stability_limit = estimate_stability_limit(system, y, &step.penalty);

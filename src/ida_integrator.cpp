@@ -365,8 +365,7 @@ void IdaStepInterpolant::rates_at(double t, double* yp) {
 }
 
 IdaIntegrator::IdaIntegrator(DaeSystem& system, IdaSettings settings) : Integrator(system), settings_(settings) {
-  if (!(settings_.rtol > 0.0) || !std::isfinite(settings_.rtol))
-    throw InputError("rtol must be a positive number (typical: 1e-6)");
+  if (const std::string problem = rtol_problem(settings_.rtol, "rtol"); !problem.empty()) throw InputError(problem);
 }
 
 IdaIntegrator::~IdaIntegrator() = default;

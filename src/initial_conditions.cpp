@@ -653,7 +653,7 @@ StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector
   system.reset_modes();
   y = system.initial_state();
   report.assembly = assemble_initial_state(system, y);
-  if (system.model().simulation.static_equilibrium) {
+  if (system.model().run_spec.simulation.static_equilibrium) {
     report.equilibrium = settle_static_equilibrium(system, y, events);
     const AssemblyReport projection = assemble_initial_state(system, y);
     report.assembly.largest_velocity_change = std::max(report.assembly.largest_velocity_change, projection.largest_velocity_change);

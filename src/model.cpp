@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace railcrash {
@@ -24,19 +25,31 @@ std::array<double, 2> TimeTable::at(double t) const {
   return out;
 }
 
-const char* integrator_name(IntegratorKind kind) {
-  switch (kind) {
-    case IntegratorKind::Ida: return "ida";
-    case IntegratorKind::Euler: return "euler";
-    case IntegratorKind::Auto: return "auto";
-  }
-  return "?";
+std::optional<IntegratorKind> integrator_from_name(const std::string& name) {
+  for (const IntegratorName& entry : kIntegratorNames)
+    if (name == entry.name) return entry.kind;
+  return std::nullopt;
 }
 
-std::optional<IntegratorKind> integrator_from_name(const std::string& name) {
-  for (const IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Euler, IntegratorKind::Auto})
-    if (name == integrator_name(kind)) return kind;
-  return std::nullopt;
+std::vector<std::string> integrator_names() {
+  std::vector<std::string> names;
+  for (const IntegratorName& entry : kIntegratorNames) names.emplace_back(entry.name);
+  return names;
+}
+
+std::string integrator_names_text(const std::string& quote) {
+  const std::vector<std::string> names = integrator_names();
+  std::string text;
+  for (std::size_t k = 0; k < names.size(); ++k)
+    text += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + quote + names[k] + quote;
+  return text;
+}
+
+std::string rtol_problem(double rtol, const std::string& what) {
+  if (rtol > 0.0 && std::isfinite(rtol)) return "";
+  char value[32];
+  std::snprintf(value, sizeof value, "%g", rtol);
+  return what + " must be a positive number (the relative tolerance; typical: 1e-6), not " + value;
 }
 
 std::string output_rows_problem(const SimulationSettings& settings) {

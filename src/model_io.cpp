@@ -1,5 +1,4 @@
 #include "railcrash/model_io.hpp"
-#include "railcrash/scenario/criteria.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -11,6 +10,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <unordered_set>
 
 #include "railcrash/element_registry.hpp"
@@ -21,36 +21,8 @@
 namespace railcrash {
 
 namespace {
-
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> previous(b.size() + 1), current(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    current[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j)
-      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-    std::swap(previous, current);
-  }
-  return previous[b.size()];
-}
-
-std::string join(const std::vector<std::string>& words) {
-  std::string out;
-  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
-  return out;
-}
-
+std::string join(const std::vector<std::string>& words) { return join_words(words); }
 }  // namespace
-
-std::string suggestion(const std::string& word, const std::vector<std::string>& known) {
-  std::string best;
-  std::size_t best_distance = 3;
-  for (const auto& k : known) {
-    const std::size_t d = edit_distance(word, k);
-    if (d < best_distance) { best_distance = d; best = k; }
-  }
-  return best.empty() ? "" : " (did you mean '" + best + "'?)";
-}
 
 std::string name_length_problem(const std::string& what, const std::string& name) {
   std::size_t characters = 0;  // UTF-8 code points: every byte but the continuation bytes
@@ -186,16 +158,7 @@ class Reader {
 
   /// Rejects keys outside `allowed` (naming the closest allowed one) and repeated keys.
   void check_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
-    std::set<std::string> seen;
-    for (const auto& entry : map) {
-      if (!entry.first.IsScalar()) fail(entry.first, context + ": keys must be plain words; allowed keys: " + join(allowed));
-      const std::string key = entry.first.Scalar();
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        fail(entry.first, context + ": unknown key '" + key + "'" + suggestion(key, allowed) +
-                              "; allowed keys: " + join(allowed));
-      if (!seen.insert(key).second)
-        fail(entry.first, context + ": key '" + key + "' is given twice; keep only one");
-    }
+    if (const auto problem = yaml_keys_problem(map, allowed, context)) fail(problem->where, problem->message);
   }
 
   double number(const YAML::Node& node, const std::string& what) const {
@@ -625,6 +588,46 @@ Body read_body(const Reader& r, const YAML::Node& node, UnitSystem units, double
   return b;
 }
 
+/// The index of the body `name` (read from `body_node`) names: kGround for ground, unless
+/// `refuse_ground` says why the ground will not do here. An unknown name is refused with the
+/// closest name and the names there are.
+int body_index(const Reader& r, const YAML::Node& body_node, const std::string& name, const Model& model, const std::string& context,
+               const char* refuse_ground = nullptr) {
+  const auto index = model.find_body(name);
+  if (!index) {
+    std::vector<std::string> names;
+    if (!refuse_ground) names.push_back("ground");
+    for (const Body& b : model.bodies()) names.push_back(b.name);
+    r.fail(body_node, context + ": unknown body '" + name + "'" + suggestion(name, names) + "; bodies are: " + join(names));
+  }
+  if (*index == kGround && refuse_ground) r.fail(body_node, context + ": " + refuse_ground);
+  return *index;
+}
+
+/// A point's `at`: its offset [length] from the body's centre of mass, body frame.
+std::pair<double, double> read_offset(const Reader& r, const YAML::Node& at, const std::string& context) {
+  const auto xy = r.numbers(at, 2, context + ": at");
+  return {xy[0] * r.scale().length, xy[1] * r.scale().length};
+}
+
+/// The body point of a map's `body` (a body's name, or ground unless `refuse_ground` says why
+/// not) and `at` (default [0, 0]): an element's point, a crush gauge's, an output's.
+PointRef read_body_point(const Reader& r, const YAML::Node& map, const Model& model, const std::string& context,
+                         const char* refuse_ground = nullptr) {
+  const YAML::Node body_node = r.required(map, "body", context);
+  PointRef ref;
+  ref.body = body_index(r, body_node, r.text(body_node, context + ": body"), model, context, refuse_ground);
+  if (map["at"]) std::tie(ref.sx, ref.sy) = read_offset(r, map["at"], context);
+  return ref;
+}
+
+/// A point map {body, at} of an element or a crush gauge.
+PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, const std::string& context) {
+  r.require_map(p, context);
+  r.check_keys(p, kPointKeys, context);
+  return read_body_point(r, p, model, context);
+}
+
 std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, const Model& model) {
   r.require_map(node, "each element");
   const std::string name = r.name(r.required(node, "name", "element"), "element name");
@@ -643,26 +646,7 @@ std::unique_ptr<Element> read_element(const Reader& r, const YAML::Node& node, c
   const YAML::Node points = r.required(node, "points", context);
   r.require_list(points, context + ": points");
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const YAML::Node p = points[i];
-    const std::string pc = context + ": point " + std::to_string(i + 1);
-    r.require_map(p, pc);
-    r.check_keys(p, kPointKeys, pc);
-    const YAML::Node body_node = r.required(p, "body", pc);
-    const std::string body = r.text(body_node, pc + ": body");
-    const auto index = model.find_body(body);
-    if (!index) {
-      std::vector<std::string> names{"ground"};
-      for (const Body& b : model.bodies()) names.push_back(b.name);
-      r.fail(body_node, pc + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
-    }
-    PointRef ref;
-    ref.body = *index;
-    if (p["at"]) {
-      const auto at = r.numbers(p["at"], 2, pc + ": at");
-      ref.sx = at[0] * r.scale().length;
-      ref.sy = at[1] * r.scale().length;
-    }
-    spec.points.push_back(ref);
+    spec.points.push_back(read_point(r, points[i], model, context + ": point " + std::to_string(i + 1)));
   }
   if (spec.points.size() != element_type->points)
     throw InputError(spec.where.prefix() + context + " needs exactly " + std::to_string(element_type->points) +
@@ -723,42 +707,16 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
   if (type == "force") load.kind = Load::Kind::Force;
   else if (type == "moment") load.kind = Load::Kind::Moment;
   else r.fail(node["type"], "load: unknown type '" + type + "'; use force or moment");
-  const auto index = model.find_body(body);
-  if (!index) {
-    std::vector<std::string> names;
-    for (const Body& b : model.bodies()) names.push_back(b.name);
-    r.fail(node["body"], context + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
-  }
-  if (*index == kGround) r.fail(node["body"], context + ": a load on the ground does nothing; name a body");
-  load.body = *index;
+  load.body = body_index(r, node["body"], body, model, context, "a load on the ground does nothing; name a body");
   if (node["at"]) {
     if (load.kind == Load::Kind::Moment) r.fail(node["at"], context + ": a moment has no point; remove 'at'");
-    const auto at = r.numbers(node["at"], 2, context + ": at");
-    load.sx = at[0] * r.scale().length;
-    load.sy = at[1] * r.scale().length;
+    std::tie(load.sx, load.sy) = read_offset(r, node["at"], context);
   }
   load.value = read_load_value(r, r.required(node, "value", context), load.kind == Load::Kind::Force ? 2 : 1, context);
   const double unit = load.kind == Load::Kind::Force ? r.scale().force : r.scale().force * r.scale().length;
   for (auto& value : load.value.values)
     for (double& component : value) component *= unit;
   return load;
-}
-
-PointRef read_point(const Reader& r, const YAML::Node& p, const Model& model, const std::string& context) {
-  r.require_map(p, context);
-  r.check_keys(p, kPointKeys, context);
-  const YAML::Node body_node = r.required(p, "body", context);
-  const std::string body = r.text(body_node, context + ": body");
-  const auto index = model.find_body(body);
-  if (!index) r.fail(body_node, context + ": unknown body '" + body + "'");
-  PointRef ref;
-  ref.body = *index;
-  if (p["at"]) {
-    const auto at = r.numbers(p["at"], 2, context + ": at");
-    ref.sx = at[0] * r.scale().length;
-    ref.sy = at[1] * r.scale().length;
-  }
-  return ref;
 }
 
 void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
@@ -773,26 +731,14 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
     r.check_keys(item, kOutputKeys, context);
     OutputPoint output;
     output.where = r.at(item);
-    const YAML::Node body_node = r.required(item, "body", context);
-    const std::string body = r.text(body_node, context + ": body");
-    const auto index = model.find_body(body);
-    if (!index) {
-      std::vector<std::string> names;
-      for (const Body& b : model.bodies()) names.push_back(b.name);
-      r.fail(body_node, context + ": unknown body '" + body + "'" + suggestion(body, names) + "; bodies are: " + join(names));
-    }
-    if (*index == kGround) r.fail(body_node, context + ": the ground does not move; name a body");
-    output.point.body = *index;
-    if (item["at"]) {
-      const auto at = r.numbers(item["at"], 2, context + ": at");
-      output.point.sx = at[0] * r.scale().length;
-      output.point.sy = at[1] * r.scale().length;
-    }
+    output.point = read_body_point(r, item, model, context, "the ground does not move; name a body");
+    const std::string body = item["body"].Scalar();
+    const int index = output.point.body;
     if (item["name"]) {
       output.name = r.name(item["name"], context + ": name");
     } else {
       int k = 1;
-      for (const OutputPoint& o : model.output_points) k += o.point.body == *index;
+      for (const OutputPoint& o : model.run_spec.output_points) k += o.point.body == index;
       output.name = body + "_point" + std::to_string(k);
     }
     if (std::find(taken.begin(), taken.end(), output.name) != taken.end())
@@ -812,14 +758,14 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
       }
       if (list.size() == 0) r.fail(list, context + ": quantities is empty; list position, velocity and/or acceleration");
     }
-    model.output_points.push_back(output);
+    model.run_spec.output_points.push_back(output);
   }
 }
 
 void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
   r.require_map(node, "responses");
   r.check_keys(node, kResponseKeys, "responses");
-  ResponseSettings& s = model.responses;
+  ResponseSettings& s = model.run_spec.responses;
   if (node["crush_gauges"]) {
     r.require_list(node["crush_gauges"], "responses: crush_gauges");
     for (std::size_t i = 0; i < node["crush_gauges"].size(); ++i) {
@@ -860,7 +806,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     s.anticlimber = r.text(node["anticlimber"], "responses: anticlimber");
     const auto& elements = model.elements();
     const auto it = std::find_if(elements.begin(), elements.end(), [&](const auto& e) { return e->name() == s.anticlimber; });
-    if (it == elements.end() || (*it)->type() != "anticlimber")
+    if (it == elements.end() || !is_anticlimber_type((*it)->type()))
       r.fail(node["anticlimber"], "responses: 'anticlimber: " + s.anticlimber + "' must name an element of type anticlimber");
     s.vertical_yield_force = positive("vertical_yield_force");
     if (s.vertical_yield_force) *s.vertical_yield_force *= r.scale().force;
@@ -905,7 +851,7 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   if (node["integrator"]) {
     const std::string name = r.text(node["integrator"], "simulation: integrator");
     const std::optional<IntegratorKind> kind = integrator_from_name(name);
-    if (!kind) r.fail(node["integrator"], "simulation: integrator must be auto, ida or euler, not '" + name + "'");
+    if (!kind) r.fail(node["integrator"], "simulation: integrator must be " + integrator_names_text() + ", not '" + name + "'");
     s.integrator = *kind;
   }
   const auto positive = [&](const char* key) -> std::optional<double> {
@@ -914,7 +860,10 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
     if (!(value > 0.0)) r.fail(node[key], std::string("simulation: ") + key + " must be positive");
     return value;
   };
-  if (auto v = positive("rtol")) s.rtol = *v;
+  if (node["rtol"]) {
+    s.rtol = r.number(node["rtol"], "simulation: rtol");
+    if (const std::string problem = rtol_problem(s.rtol, "simulation: rtol"); !problem.empty()) r.fail(node["rtol"], problem);
+  }
   s.atol = positive("atol");
   const Reader::UnitScale& unit = r.scale();
   if (s.atol) *s.atol *= unit.length;
@@ -1005,6 +954,11 @@ OpenBracket unclosed_bracket(const std::string& text, std::size_t end) {
   return open.empty() ? OpenBracket{} : open.back();
 }
 
+ScenarioSectionReader& scenario_section_reader() {
+  static ScenarioSectionReader reader = nullptr;  // a function's static: set from another file's static initialiser
+  return reader;
+}
+
 Model build(const YAML::Node& root, Reader& r) {
   if (!root.IsMap()) r.fail(root, "a model file must be a YAML map with keys railcrash, name, units, bodies, elements, simulation");
   r.check_keys(root, kTopKeys, "model");
@@ -1051,17 +1005,12 @@ Model build(const YAML::Node& root, Reader& r) {
   if (root["responses"]) read_responses(r, root["responses"], model);
   if (root["outputs"]) read_outputs(r, root["outputs"], model);
   if (root["scenario"]) {
-    model.scenario = read_scenario_section(root["scenario"], model, [&r](const YAML::Node& node, const std::string& message) { r.fail(node, message); });
-    if (r.scale().length != 1.0) {  // its limits are lengths, speeds and decelerations
-      auto scaled = std::make_shared<ScenarioCriteria>(*model.scenario);
-      for (double* value : {&scaled->closing_speed, &scaled->deceleration_limit, &scaled->survival_limit, &scaled->override_limit,
-                            &scaled->wheel_lift_limit})
-        *value *= r.scale().length;
-      for (ScenarioCriteria::Zone& zone : scaled->survival_zones) zone.stroke *= r.scale().length;
-      model.scenario = scaled;
-    }
+    if (!scenario_section_reader())
+      r.fail(root["scenario"], "scenario: this program reads no scenario sections (the scenario layer is not linked in); remove the section");
+    model.run_spec.scenario = scenario_section_reader()(root["scenario"], model, r.scale().length,
+                                                        [&r](const YAML::Node& node, const std::string& message) { r.fail(node, message); });
   }
-  read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.simulation);
+  read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.run_spec.simulation);
   return model;
 }
 
@@ -1256,6 +1205,11 @@ ExpandedModel expand_model_file(const std::string& path, const std::vector<std::
   emitter << unshared_copy(root);  // (the expansion shares keys: no anchors in the text)
   out.text = "# " + path + " with its car types and trains expanded (railcrash expand)\n" + std::string(emitter.c_str()) + "\n";
   return out;
+}
+
+bool set_scenario_section_reader(ScenarioSectionReader reader) {
+  scenario_section_reader() = reader;
+  return true;
 }
 
 std::vector<std::string> model_file_keys() {

@@ -360,7 +360,7 @@ std::map<std::string, SectionKeys> section_keys() {
   };
   s["simulation"] = {
       {"t_end", {number("end time of the run [s]", Range::Positive), true}},
-      {"integrator", {one_of_words({"auto", "ida", "euler"},
+      {"integrator", {one_of_words(integrator_names(),
                                    "auto (default: IDA, handing the run to Euler where Euler is clearly the cheaper at "
                                    "the same resolution), ida (SUNDIALS IDA, BDF with KLU) or euler (explicit Euler with "
                                    "penalty constraints, as IITRAIN)")}},

@@ -28,15 +28,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-void check_keys(const std::string& path, const YAML::Node& map, const std::set<std::string>& allowed, const std::string& context) {
-  std::string list;
-  for (const std::string& k : allowed) list += (list.empty() ? "" : ", ") + k;
-  for (const auto& entry : map) {
-    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-    if (!allowed.count(key)) yaml_error(path, entry.first, context + ": unknown key '" + key + "' (allowed: " + list + ")");
-  }
-}
-
 std::string scalar_text(const std::string& path, const YAML::Node& node, const std::string& context) {
   if (!node || !node.IsScalar() || node.Scalar().empty()) yaml_error(path, node, context + " must be a word");
   return node.Scalar();
@@ -176,7 +167,7 @@ ReadingsPlan load_readings(const std::string& path) {
   const YAML::Node root = load_yaml_file(path, "readings file");
   if (!root.IsMap() || !root["reading_study"])
     yaml_error(path, root, "a readings file starts with 'reading_study: 1' and lists 'readings:' (see `railcrash readings --help`)");
-  check_keys(path, root, {"reading_study", "description", "combinations", "readings"}, "readings file");
+  check_yaml_keys(path, root, {"reading_study", "description", "combinations", "readings"}, "readings file");
   if (!root["reading_study"].IsScalar() || root["reading_study"].Scalar() != "1")
     yaml_error(path, root["reading_study"], "reading_study must be 1");
   ReadingsPlan plan;
@@ -193,7 +184,7 @@ ReadingsPlan load_readings(const std::string& path) {
   std::set<std::string> names;
   for (const YAML::Node& node : list) {
     if (!node.IsMap()) yaml_error(path, node, "each reading is a map with name, description and levels");
-    check_keys(path, node, {"name", "description", "levels"}, "reading");
+    check_yaml_keys(path, node, {"name", "description", "levels"}, "reading");
     Reading reading;
     reading.name = scalar_text(path, node["name"], "reading: name");
     reading.line = yaml_line(node);
@@ -206,7 +197,7 @@ ReadingsPlan load_readings(const std::string& path) {
     std::set<std::string> level_names;
     for (const YAML::Node& l : levels) {
       if (!l.IsMap()) yaml_error(path, l, context + ": each level is a map {name, set}");
-      check_keys(path, l, {"name", "set", "scale"}, context + " level");
+      check_yaml_keys(path, l, {"name", "set", "scale"}, context + " level");
       ReadingLevel level;
       level.name = scalar_text(path, l["name"], context + ": level name");
       level.line = yaml_line(l);
@@ -232,7 +223,7 @@ ReadingsPlan load_readings(const std::string& path) {
           std::vector<std::pair<std::string, double>> scales;
           for (const YAML::Node& item : entry.second) {
             if (!item.IsMap() || !item["key"]) yaml_error(path, item, where + ": each entry is {key: MODEL.KEY, power: P}");
-            check_keys(path, item, {"key", "power"}, where);
+            check_yaml_keys(path, item, {"key", "power"}, where);
             double power = 1.0;
             if (item["power"]) {
               try {
@@ -619,9 +610,9 @@ CombinationIntegrators combination_integrators(const SensitivityResult& study) {
   bool seen[3] = {false, false, false};
   const auto add = [&](const SensitivityRun& run) {
     const std::string& method = run.integrator.method;
-    seen[0] = seen[0] || method == "ida";
-    seen[1] = seen[1] || method == "euler";
-    if (method != "ida+euler") return;
+    const char* names[3] = {integrator_name(IntegratorKind::Ida), integrator_name(IntegratorKind::Euler), kIdaThenEulerMethod};
+    for (int k = 0; k < 3; ++k) seen[k] = seen[k] || method == names[k];
+    if (method != kIdaThenEulerMethod) return;
     seen[2] = true;
     ++used.handed_over_runs;
     if (std::isnan(used.earliest.euler_from_t) || run.integrator.euler_from_t < used.earliest.euler_from_t) used.earliest = run.integrator;
@@ -629,7 +620,7 @@ CombinationIntegrators combination_integrators(const SensitivityResult& study) {
   add(study.base);
   for (const SensitivityRun& run : study.runs) add(run);
   for (const SensitivityRun& run : study.second_order_runs) add(run);
-  const char* names[3] = {"ida", "euler", "ida+euler"};
+  const char* names[3] = {integrator_name(IntegratorKind::Ida), integrator_name(IntegratorKind::Euler), kIdaThenEulerMethod};
   for (int k = 0; k < 3; ++k)
     if (seen[k]) used.methods += (used.methods.empty() ? "" : " ") + std::string(names[k]);
   return used;

@@ -16,8 +16,8 @@ ResponseTracker::ResponseTracker(const DaeSystem& system, const ResponseSettings
   const auto& elements = system.model().elements();
   for (std::size_t e = 0; e < elements.size(); ++e)
     if (elements[e]->name() == settings.anticlimber) anticlimber_element_ = static_cast<int>(e);
-  const auto* anticlimber =
-      anticlimber_element_ < 0 ? nullptr : dynamic_cast<const Anticlimber*>(elements[static_cast<std::size_t>(anticlimber_element_)].get());
+  const Anticlimber* anticlimber =
+      anticlimber_element_ < 0 ? nullptr : as_anticlimber(*elements[static_cast<std::size_t>(anticlimber_element_)]);
   if (!anticlimber)
     throw InputError(SourceLocation{system.model().file, 0}.prefix() + "responses: 'anticlimber: " + settings.anticlimber +
                      "' must name an element of type anticlimber");

@@ -387,7 +387,7 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
   const std::size_t output_count = system_.output_names().size();
   if (timeseries_) write_row_tail(*timeseries_, outputs, output_count);
   track_extrema(t, y, lambda, outputs, FreshOutputs{});
-  if (!system_.model().output_points.empty()) {
+  if (!system_.model().run_spec.output_points.empty()) {
     output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
     if (timeseries_) write_row_tail(*timeseries_, point_values_);
   }
@@ -400,7 +400,7 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
     for (int i = 0; i < n; ++i)
       for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2}) row_.push_back(y[k]);
     row_.insert(row_.end(), outputs, outputs + output_count);
-    if (!system_.model().output_points.empty()) row_.insert(row_.end(), point_values_.begin(), point_values_.end());
+    if (!system_.model().run_spec.output_points.empty()) row_.insert(row_.end(), point_values_.begin(), point_values_.end());
     for (std::size_t column = 0; column < columns_.size(); ++column) columns_[column].push_back(row_[column]);
     if (hdf5_) {
       hdf5_->append(hdf5_tables_.timeseries, row_.data());

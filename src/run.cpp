@@ -128,10 +128,13 @@ class ProgressObserver : public RunObserver {
 }  // namespace
 
 void apply_overrides(Model& model, const RunOverrides& o) {
-  SimulationSettings& s = model.simulation;
+  SimulationSettings& s = model.run_spec.simulation;
   if (o.integrator) s.integrator = *o.integrator;
   if (o.t_end) s.t_end = checked_positive(*o.t_end, "--t-end");
-  if (o.rtol) s.rtol = checked_positive(*o.rtol, "--rtol");
+  if (o.rtol) {
+    if (const std::string problem = rtol_problem(*o.rtol, "--rtol"); !problem.empty()) throw InputError(problem);
+    s.rtol = *o.rtol;
+  }
   if (o.atol) s.atol = checked_positive(*o.atol, "--atol");
   if (o.dt) s.dt = checked_positive(*o.dt, "--dt");
   if (o.output_interval) s.output_interval = checked_positive(*o.output_interval, "--output-interval");
@@ -177,7 +180,7 @@ void set_output_memory_limit(double bytes) { g_output_memory_limit = bytes; }
 double output_memory_limit() { return g_output_memory_limit.load(); }
 
 double output_memory_estimate(const DaeSystem& system, bool keep_in_memory) {
-  const SimulationSettings& s = system.model().simulation;
+  const SimulationSettings& s = system.model().run_spec.simulation;
   const double rows = std::floor(s.t_end / output_interval_of(s)) + 2.0;                     // [rows]
   double per_row = 20.0 * static_cast<double>(system.model().body_count()) + 16.0;            // [bytes]
   if (keep_in_memory) per_row += 8.0 * static_cast<double>(timeseries_columns(system).size());
@@ -191,7 +194,7 @@ namespace {
 void require_output_memory(const DaeSystem& system, bool keep_in_memory) {
   const double limit = output_memory_limit(), estimate = output_memory_estimate(system, keep_in_memory);
   if (!(limit > 0.0) || estimate <= limit) return;
-  const SimulationSettings& s = system.model().simulation;
+  const SimulationSettings& s = system.model().run_spec.simulation;
   const double rows = std::floor(s.t_end / output_interval_of(s)) + 2.0;
   char text[640];
   std::snprintf(text, sizeof text,
@@ -223,21 +226,21 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
   std::unique_ptr<ResponseTracker> responses;
   std::vector<RunObserver*> observers;
   RunReport report;
-  report.integrator = integrator_name(model.simulation.integrator);
+  report.integrator = integrator_name(model.run_spec.simulation.integrator);
   if (!out_dir.empty() || keep_in_memory) {
     require_output_memory(system, keep_in_memory);  // before the writer starts
     observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory, format)).get());
     writer->write_running_summary(report.integrator);
   }
-  if (model.responses.defined())
-    observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.responses)).get());
+  if (model.run_spec.responses.defined())
+    observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.run_spec.responses)).get());
   std::unique_ptr<ScenarioTracker> scenario;
-  if (model.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *model.scenario)).get());
-  ProgressObserver observer(system, observers, model.simulation.t_end, show_progress);
+  if (model.run_spec.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *model.run_spec.scenario)).get());
+  ProgressObserver observer(system, observers, model.run_spec.simulation.t_end, show_progress);
   std::unique_ptr<Integrator> integrator;
   try {
     try {
-      integrator = make_integrator(system, model.simulation);
+      integrator = make_integrator(system, model.run_spec.simulation);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
@@ -246,7 +249,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     if (integrator) {
       integrator->time_phases(time_phases);
       try {
-        report.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), observer, stop);
+        report.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), observer, stop);
       } catch (const std::bad_alloc&) {  // the summary says why the run ended, not "running"
         report.outcome.ok = false;
         report.outcome.t_reached = writer ? writer->last_sample_time() : 0.0;

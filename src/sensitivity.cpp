@@ -145,11 +145,7 @@ std::array<double, 3> response_triple(const std::string& path, const YAML::Node&
 void load_reference(const std::string& path, const YAML::Node& node, SensitivityDesign& design) {
   if (!node.IsMap() || !node["base"])
     yaml_error(path, node, "'reference' needs at least 'base: [R1, R2, R3]' (the published run 0)");
-  for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
-    if (key != "source" && key != "base" && key != "first_order" && key != "second_order" && key != "ranking")
-      yaml_error(path, entry.first, "reference: unknown key '" + key + "' (allowed: source, base, first_order, second_order, ranking)");
-  }
+  check_yaml_keys(path, node, {"source", "base", "first_order", "second_order", "ranking"}, "reference");
   PublishedResults reference;
   if (node["source"]) reference.source = node["source"].as<std::string>();
   reference.base = response_triple(path, node["base"], "reference: base");
@@ -299,7 +295,7 @@ SensitivityRun run_one(const std::string& model_path, const CheckedYamlText& mod
   const auto start = std::chrono::steady_clock::now();
   try {
     const Model model = load_model_text(model_text, model_path, job_settings(design, job, base_settings));
-    if (!model.responses.defined())
+    if (!model.run_spec.responses.defined())
       throw InputError(model_path + ": a parameter study needs a 'responses' section (R1-R3) in the model");
     const RunReport report = run_model(model, "", control.stop_flag());
     run.ok = report.outcome.ok;  // a run that finished just as the limit passed still counts

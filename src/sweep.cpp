@@ -207,12 +207,7 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
   const YAML::Node root = load_yaml_file(path, "plan file");
   if (!root.IsMap() || !root["sweep"]) yaml_error(path, root, "a plan file starts with 'sweep: 1'");
   static const std::vector<std::string> kKeys{"sweep", "design", "samples", "seed", "set", "factors", "runs", "responses"};
-  for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
-    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end())
-      yaml_error(path, entry.first, "unknown key '" + key + "'" + suggestion(key, kKeys) +
-                                        " (a plan has sweep, design, samples, seed, set, factors, runs, responses)");
-  }
+  check_yaml_keys(path, root, kKeys, "plan");
   SweepPlan plan;
   plan.path = path;
   if (!root["design"]) yaml_error(path, root, "give a design: full_factorial, one_at_a_time, latin_hypercube, monte_carlo or runs");
@@ -246,11 +241,7 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
     factor.key = f["key"].Scalar();
     factor.line = yaml_line(f);
     const std::string context = "factor '" + factor.key + "'";
-    for (const auto& entry : f) {
-      const std::string key = entry.first.as<std::string>();
-      if (key != "key" && key != "scale" && key != "levels" && key != "distribution")
-        yaml_error(path, entry.first, context + ": unknown key '" + key + "' (a factor has key, scale, levels, distribution)");
-    }
+    check_yaml_keys(path, f, {"key", "scale", "levels", "distribution"}, context);
     for (const SweepFactor& other : plan.factors)
       if (other.key == factor.key) yaml_error(path, f["key"], context + " is listed twice");
     if (f["scale"]) {
@@ -330,7 +321,7 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
       if (!plan.runs[r][f].empty()) check(plan.factors[f], plan.runs[r][f], plan.run_lines[r]);
   if (plan.responses.empty()) {
     const Model model = load_model_text(model_text, model_path, plan.settings);
-    if (model.responses.defined()) plan.responses = {"R1", "R2", "R3"};
+    if (model.run_spec.responses.defined()) plan.responses = {"R1", "R2", "R3"};
     plan.responses.push_back("energy.relative_balance_error");
   }
   return plan;

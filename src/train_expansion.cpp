@@ -71,11 +71,7 @@ const std::vector<std::string> kCouplingKeys = {"type", "gap"};
 const std::vector<std::string> kConnectionKeys = {"name", "type", "ends"};
 const std::vector<std::string> kEndPointKeys = {"end", "at"};
 
-std::string join(const std::vector<std::string>& words) {
-  std::string out;
-  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
-  return out;
-}
+std::string join(const std::vector<std::string>& words) { return join_words(words); }
 
 /// Shortest text that reads back as the same double.
 std::string number_text(double value) {
@@ -112,13 +108,7 @@ class Checker {
   }
   void keys(const YAML::Node& node, const std::vector<std::string>& allowed, const std::string& what) const {
     map(node, what);
-    std::set<std::string> seen;
-    for (const auto& entry : node) {
-      const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "";
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        fail(entry.first, what + ": unknown key '" + key + "'" + suggestion(key, allowed) + "; allowed keys: " + join(allowed));
-      if (!seen.insert(key).second) fail(entry.first, what + ": key '" + key + "' is given twice; keep only one");
-    }
+    if (const auto problem = yaml_keys_problem(node, allowed, what)) fail(problem->where, problem->message);
   }
   const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& what) const {
     const YAML::Node node = map[key];

@@ -4,7 +4,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -139,6 +141,56 @@ YAML::Node load_yaml_file(const std::string& path, const std::string& what) {
   } catch (const YAML::ParserException& e) {
     throw InputError(SourceLocation{path, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "not valid YAML: " + e.msg);
   }
+}
+
+namespace {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> previous(b.size() + 1), current(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(previous, current);
+  }
+  return previous[b.size()];
+}
+
+}  // namespace
+
+std::string suggestion(const std::string& word, const std::vector<std::string>& known) {
+  std::string best;
+  std::size_t best_distance = 3;
+  for (const auto& k : known) {
+    const std::size_t d = edit_distance(word, k);
+    if (d < best_distance) { best_distance = d; best = k; }
+  }
+  return best.empty() ? "" : " (did you mean '" + best + "'?)";
+}
+
+std::string join_words(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+std::optional<YamlKeyProblem> yaml_keys_problem(const YAML::Node& map, const std::vector<std::string>& allowed,
+                                                const std::string& context) {
+  const std::string prefix = context.empty() ? "" : context + ": ";
+  std::set<std::string> seen;
+  for (const auto& entry : map) {
+    if (!entry.first.IsScalar()) return YamlKeyProblem{entry.first, prefix + "keys must be plain words; allowed keys: " + join_words(allowed)};
+    const std::string key = entry.first.Scalar();
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+      return YamlKeyProblem{entry.first, prefix + "unknown key '" + key + "'" + suggestion(key, allowed) + "; allowed keys: " + join_words(allowed)};
+    if (!seen.insert(key).second) return YamlKeyProblem{entry.first, prefix + "key '" + key + "' is given twice; keep only one"};
+  }
+  return std::nullopt;
+}
+
+void check_yaml_keys(const std::string& path, const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) {
+  if (const auto problem = yaml_keys_problem(map, allowed, context)) yaml_error(path, problem->where, problem->message);
 }
 
 }  // namespace railcrash

@@ -67,7 +67,7 @@ RunOutcome simulate(DaeSystem& system, double output_interval) {
   struct Quiet : RunObserver {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
-  RunOutcome outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval, observer);
+  RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, output_interval, observer);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   return outcome;

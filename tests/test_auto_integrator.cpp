@@ -33,13 +33,13 @@ struct SampleTimes : RunObserver {
 
 IdaSettings ida_settings(const Model& model) {
   IdaSettings ida;
-  ida.rtol = model.simulation.rtol;
-  ida.atol = model.simulation.atol;
+  ida.rtol = model.run_spec.simulation.rtol;
+  ida.atol = model.run_spec.simulation.atol;
   return ida;
 }
 
 EulerSettings euler_settings(const Model& model) {
-  const SimulationSettings& s = model.simulation;
+  const SimulationSettings& s = model.run_spec.simulation;
   return {s.dt, s.force_dt, s.penalty, s.max_steps};
 }
 
@@ -88,8 +88,8 @@ TEST_CASE("auto keeps IDA on the report's two-car crash and gives IDA's result b
   const Model auto_model = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=auto"});
   DaeSystem ida_system(ida_model), auto_system(auto_model);
   SampleTimes a, b;
-  const RunOutcome by_ida = make_integrator(ida_system, ida_model.simulation)->run(0.02, 0.001, a);
-  const RunOutcome by_auto = make_integrator(auto_system, auto_model.simulation)->run(0.02, 0.001, b);
+  const RunOutcome by_ida = make_integrator(ida_system, ida_model.run_spec.simulation)->run(0.02, 0.001, a);
+  const RunOutcome by_auto = make_integrator(auto_system, auto_model.run_spec.simulation)->run(0.02, 0.001, b);
   REQUIRE(by_ida.ok);
   REQUIRE(by_auto.ok);
   INFO(by_auto.stats.hand_over_reason);
@@ -122,9 +122,9 @@ TEST_CASE("auto keeps IDA where Euler cannot run the model and says why", "[inte
 }
 
 TEST_CASE("a model that names no integrator runs with auto and a model may name it", "[integrators][auto][model_io]") {
-  CHECK(testing::model_from_text(oscillator(1.0)).simulation.integrator == IntegratorKind::Auto);
-  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: auto")).simulation.integrator == IntegratorKind::Auto);
-  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: euler")).simulation.integrator == IntegratorKind::Euler);
+  CHECK(testing::model_from_text(oscillator(1.0)).run_spec.simulation.integrator == IntegratorKind::Auto);
+  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: auto")).run_spec.simulation.integrator == IntegratorKind::Auto);
+  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: euler")).run_spec.simulation.integrator == IntegratorKind::Euler);
   CHECK_THROWS_WITH(testing::model_from_text(oscillator(1.0, ", integrator: rk4")),
                     Catch::Contains("integrator must be auto, ida or euler, not 'rk4'"));
   for (const IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Euler, IntegratorKind::Auto})
@@ -159,7 +159,7 @@ TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and
   const Model ida_model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.05", "simulation.atol=1e-16"});
   DaeSystem ida_system(ida_model);
   SampleTimes ida_samples;
-  const RunOutcome by_ida = make_integrator(ida_system, ida_model.simulation)->run(0.05, 0.001, ida_samples);
+  const RunOutcome by_ida = make_integrator(ida_system, ida_model.run_spec.simulation)->run(0.05, 0.001, ida_samples);
   REQUIRE_FALSE(by_ida.ok);
   CHECK_THAT(by_ida.message, Catch::Contains("IDA_ERR_FAIL"));
   // "IDA failed at t = T with ...": auto's IDA takes the same steps up to T.
@@ -170,7 +170,7 @@ TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and
   const Model auto_model = load_model(file, {"simulation.integrator=auto", "simulation.t_end=0.05", "simulation.atol=1e-16"});
   DaeSystem auto_system(auto_model);
   SampleTimes auto_samples;
-  const RunOutcome outcome = make_integrator(auto_system, auto_model.simulation)->run(0.05, 0.001, auto_samples);
+  const RunOutcome outcome = make_integrator(auto_system, auto_model.run_spec.simulation)->run(0.05, 0.001, auto_samples);
   INFO(outcome.message);
   INFO(outcome.stats.hand_over_reason);
   REQUIRE(outcome.ok);

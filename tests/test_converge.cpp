@@ -65,7 +65,7 @@ Trace run_by_hand(const std::string& path, const std::string& column, const std:
   Trace trace;
   TraceObserver observer(system, column, trace);
   const RunOutcome outcome =
-      make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval_of(model.simulation), observer);
+      make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), observer);
   REQUIRE(outcome.ok);
   return trace;
 }
@@ -329,7 +329,7 @@ TEST_CASE("convergence study: max_crush and the peak forces take the same column
       return columns;
     };
     const auto columns = [&](std::size_t q) { return std::set<int>(plan.quantities[q].columns.begin(), plan.quantities[q].columns.end()); };
-    const bool from_responses = model.responses.crush_from_anticlimber || !model.responses.crush_gauges.empty();
+    const bool from_responses = model.run_spec.responses.crush_from_anticlimber || !model.run_spec.responses.crush_gauges.empty();
     CHECK(plan.quantities[0].from_responses == from_responses);
     CHECK(columns(0) == (from_responses ? std::set<int>{}
                                         : by_type({{"crush_spring", "crush"}, {"anticlimber", "horizontal_deformation"}})));

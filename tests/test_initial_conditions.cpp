@@ -126,8 +126,8 @@ TEST_CASE("static equilibrium settles a body onto its wheels before the run", "[
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     Model model = testing::model_from_text(text);
-    model.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
-    model.simulation.dt = 2e-5;
+    model.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    model.run_spec.simulation.dt = 2e-5;
     DaeSystem system(model);
     const RunOutcome o = testing::simulate(system);
     // Both wheels close and pass their breakpoint while settling, at t = 0.

@@ -120,10 +120,10 @@ TEST_CASE("Gershgorin bound for large models is safe and close for a long chain"
 TEST_CASE("Euler refuses a step above the stability limit unless forced, then reports divergence", "[integrators]") {
   Model model = testing::model_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3"));
   DaeSystem system(model);
-  CHECK_THROWS_WITH(make_integrator(system, model.simulation),
+  CHECK_THROWS_WITH(make_integrator(system, model.run_spec.simulation),
                     Catch::Contains("above the stability limit") && Catch::Contains("0.2"));
-  model.simulation.force_dt = true;
-  auto integrator = make_integrator(system, model.simulation);
+  model.run_spec.simulation.force_dt = true;
+  auto integrator = make_integrator(system, model.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = integrator->run(200.0, 1.0, observer);
   CHECK_FALSE(outcome.ok);
@@ -136,14 +136,14 @@ TEST_CASE("Euler needs positive inertia", "[integrators]") {
       "railcrash: 1\nname: p\nunits: SI\nbodies:\n  - {name: dot, mass: 1, inertia: 0, position: [0, 0]}\n"
       "simulation: {t_end: 1, integrator: euler}\n");
   DaeSystem system(model);
-  CHECK_THROWS_WITH(make_integrator(system, model.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
+  CHECK_THROWS_WITH(make_integrator(system, model.run_spec.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
 }
 
 TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
     Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
     DaeSystem system(model);
-    auto run = make_integrator(system, model.simulation);
+    auto run = make_integrator(system, model.run_spec.simulation);
     CountingObserver observer;
     const RunOutcome outcome = run->run(1.0, 0.25, observer);
     REQUIRE(outcome.ok);
@@ -158,7 +158,7 @@ TEST_CASE("every sample hands the observer the element outputs of that sample's 
     Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
     DaeSystem system(model);
     REQUIRE(system.output_names() == std::vector<std::string>{"spring.force", "spring.deformation", "damper.force", "damper.rate"});
-    auto run = make_integrator(system, model.simulation);
+    auto run = make_integrator(system, model.run_spec.simulation);
     OscillatorOutputCheck observer;
     REQUIRE(run->run(1.0, 0.05, observer).ok);
     CHECK(observer.samples == 21);
@@ -169,7 +169,7 @@ TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
     Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
     DaeSystem system(model);
-    auto run = make_integrator(system, model.simulation);
+    auto run = make_integrator(system, model.run_spec.simulation);
     std::atomic<bool> stop{false};
     StopAfter observer;
     observer.stop = &stop;
@@ -185,15 +185,15 @@ TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizin
   // exactly 1000 steps: refused at max_steps 999, accepted at 1000.
   Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, ", integrator: euler, dt: 1e-300"));
   DaeSystem tiny_step(model);
-  CHECK_THROWS_WITH(make_integrator(tiny_step, model.simulation),
+  CHECK_THROWS_WITH(make_integrator(tiny_step, model.run_spec.simulation),
                     Catch::Contains("needs 1e+300 steps to reach t_end = 1, more than --max-steps 10000000") &&
                         Catch::Contains("use a larger dt (above 1e-07)"));
-  model.simulation.dt = 1e-3;
-  model.simulation.max_steps = 999;
+  model.run_spec.simulation.dt = 1e-3;
+  model.run_spec.simulation.max_steps = 999;
   DaeSystem system(model);
-  CHECK_THROWS_WITH(make_integrator(system, model.simulation), Catch::Contains("needs 1000 steps"));
-  model.simulation.max_steps = 1000;
-  auto run = make_integrator(system, model.simulation);
+  CHECK_THROWS_WITH(make_integrator(system, model.run_spec.simulation), Catch::Contains("needs 1000 steps"));
+  model.run_spec.simulation.max_steps = 1000;
+  auto run = make_integrator(system, model.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(1.0, 0.5, observer);
   CHECK(outcome.ok);
@@ -207,9 +207,9 @@ TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizin
 
 TEST_CASE("IDA stops at max_steps as a failed run that says so", "[integrators]") {
   Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0));
-  model.simulation.max_steps = 20;
+  model.run_spec.simulation.max_steps = 20;
   DaeSystem system(model);
-  auto run = make_integrator(system, model.simulation);
+  auto run = make_integrator(system, model.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(1.0, 0.01, observer);
   CHECK_FALSE(outcome.ok);
@@ -241,7 +241,7 @@ TEST_CASE("a run whose element output is not finite fails naming the element", "
 TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
   const Model model = testing::model_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
   DaeSystem system(model);
-  auto run = make_integrator(system, model.simulation);
+  auto run = make_integrator(system, model.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(3.0, 0.1, observer);
   REQUIRE(outcome.ok);
@@ -290,7 +290,7 @@ TEST_CASE("Euler's divergence names the penalty joint with the largest violation
       "points: [{body: ground, at: [0, 0]}, {body: bob, at: [-1, 0]}]}\n"
       "simulation: {t_end: 10, integrator: euler, dt: 5.0e-3, force_dt: true, output_interval: 0.01}\n");
   DaeSystem system(model);
-  auto integrator = make_integrator(system, model.simulation);
+  auto integrator = make_integrator(system, model.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = integrator->run(10.0, 0.01, observer);
   CHECK_FALSE(outcome.ok);
@@ -391,9 +391,9 @@ TEST_CASE("an observer that wants the forces gets them from the outputs' sweep, 
   cases.push_back({load_model(barrier, {}), IntegratorKind::Ida, 0.02, 1e-3});
   for (Case& c : cases) {
     INFO(c.model.name << (c.integrator == IntegratorKind::Ida ? " under ida" : " under euler"));
-    c.model.simulation.integrator = c.integrator;
+    c.model.run_spec.simulation.integrator = c.integrator;
     DaeSystem system(c.model);
-    auto run = make_integrator(system, c.model.simulation);
+    auto run = make_integrator(system, c.model.run_spec.simulation);
     SampleForcesCheck observer(system);
     REQUIRE(run->run(c.t_end, c.interval, observer).ok);
     CHECK(observer.samples == 0);  // every sample came with the forces

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -232,13 +233,13 @@ TEST_CASE("a valid SI model loads with its bodies, elements, loads and settings"
   CHECK(moment.value.at(50.0)[0] == -10.0);         // held after the last row
   CHECK(moment.value.at(1.5)[1] == 0.0);
 
-  CHECK(model.simulation.t_end == 2.0);
-  CHECK(model.simulation.integrator == IntegratorKind::Euler);
-  CHECK(model.simulation.dt == 1.0e-4);
-  CHECK(model.simulation.output_interval == 0.01);
-  CHECK(model.simulation.rtol == 1e-6);  // default
-  CHECK_FALSE(model.simulation.atol.has_value());
-  CHECK_FALSE(model.simulation.force_dt);
+  CHECK(model.run_spec.simulation.t_end == 2.0);
+  CHECK(model.run_spec.simulation.integrator == IntegratorKind::Euler);
+  CHECK(model.run_spec.simulation.dt == 1.0e-4);
+  CHECK(model.run_spec.simulation.output_interval == 0.01);
+  CHECK(model.run_spec.simulation.rtol == 1e-6);  // default
+  CHECK_FALSE(model.run_spec.simulation.atol.has_value());
+  CHECK_FALSE(model.run_spec.simulation.force_dt);
 }
 
 TEST_CASE("a tabulated force takes [t, Fx, Fy] and [t, [Fx, Fy]] rows", "[model_io]") {
@@ -265,11 +266,11 @@ TEST_CASE("the verification slider-crank file loads", "[model_io]") {
   CHECK(model.elements().size() == 5);
   CHECK(model.constraint_rows() == 5);  // pin 2 + pin 2 + sliding pin 1
   CHECK(model.loads().size() == 1);
-  CHECK(model.simulation.t_end == 10.0);
-  CHECK(model.simulation.integrator == IntegratorKind::Ida);
-  REQUIRE(model.simulation.atol.has_value());
-  CHECK(*model.simulation.atol == 1.0e-7);
-  CHECK(model.simulation.output_interval == 0.4);
+  CHECK(model.run_spec.simulation.t_end == 10.0);
+  CHECK(model.run_spec.simulation.integrator == IntegratorKind::Ida);
+  REQUIRE(model.run_spec.simulation.atol.has_value());
+  CHECK(*model.run_spec.simulation.atol == 1.0e-7);
+  CHECK(model.run_spec.simulation.output_interval == 0.4);
 }
 
 TEST_CASE("a missing model file is an InputError naming the path", "[model_io]") {
@@ -326,20 +327,20 @@ TEST_CASE("gravity: SI default, [0, 0] switches it off, any vector is taken as g
 TEST_CASE("overrides given with --set change the model before it is checked", "[model_io]") {
   const Model model =
       load_model_text(kBase, "test.yaml", {"simulation.t_end=0.5", "bodies.bob.mass=2", "elements.spring.stiffness=200"});
-  CHECK(model.simulation.t_end == 0.5);
+  CHECK(model.run_spec.simulation.t_end == 0.5);
   CHECK(model.bodies()[0].mass == 2.0);
   CHECK(model.bodies()[1].mass == 3.0);  // untouched
   const auto* spring = dynamic_cast<const LinearSpring*>(model.elements()[0].get());
   REQUIRE(spring != nullptr);
   CHECK(spring->stiffness == 200.0);
   CHECK(*spring->free_length == 1.5);
-  CHECK(model.simulation.dt == 1.0e-4);  // the rest of the section stays
+  CHECK(model.run_spec.simulation.dt == 1.0e-4);  // the rest of the section stays
 
   const Model more = load_model_text(kBase, "test.yaml", {"gravity=[0, 0]", "simulation.integrator=ida", "simulation.rtol=1e-8",
                                                           "bodies.cart.position=[5, 0]", "elements.slide.axis=[0, 1]"});
   CHECK(more.gravity_y == 0.0);
-  CHECK(more.simulation.integrator == IntegratorKind::Ida);
-  CHECK(more.simulation.rtol == 1e-8);
+  CHECK(more.run_spec.simulation.integrator == IntegratorKind::Ida);
+  CHECK(more.run_spec.simulation.rtol == 1e-8);
   CHECK(more.bodies()[1].x == 5.0);
   const auto* slide = dynamic_cast<const SliderJoint*>(more.elements()[2].get());
   REQUIRE(slide != nullptr);
@@ -348,7 +349,7 @@ TEST_CASE("overrides given with --set change the model before it is checked", "[
 
   // A simulation section may come entirely from the command line.
   const Model no_section = load_model_text(kHeader + kBodies, "test.yaml", {"simulation.t_end=3"});
-  CHECK(no_section.simulation.t_end == 3.0);
+  CHECK(no_section.run_spec.simulation.t_end == 3.0);
 }
 
 TEST_CASE("the run command's options go through --set's path, after it, and are named in messages", "[model_io]") {
@@ -363,10 +364,10 @@ TEST_CASE("the run command's options go through --set's path, after it, and are 
   CHECK(settings.size() == 4);
   // Applied after --set: the option wins over a --set of the same key.
   const Model model = load_model(path.string(), {"simulation.t_end=9"}, settings);
-  CHECK(model.simulation.t_end == 0.25);
-  CHECK(model.simulation.integrator == IntegratorKind::Ida);
-  CHECK(model.simulation.max_steps == 500);
-  CHECK(model.simulation.force_dt);
+  CHECK(model.run_spec.simulation.t_end == 0.25);
+  CHECK(model.run_spec.simulation.integrator == IntegratorKind::Ida);
+  CHECK(model.run_spec.simulation.max_steps == 500);
+  CHECK(model.run_spec.simulation.force_dt);
   // A bad value is reported with the option as the user wrote it, not a file line.
   RunOverrides bad;
   bad.t_end = -1.5;
@@ -384,7 +385,7 @@ TEST_CASE("the run command's options go through --set's path, after it, and are 
 }
 
 TEST_CASE("simulation: max_steps in a model file bounds the steps and must be a whole number of at least 1", "[model_io]") {
-  CHECK(load_model_text(edit(kBase, "simulation:\n", "simulation:\n  max_steps: 1234\n"), "test.yaml").simulation.max_steps == 1234);
+  CHECK(load_model_text(edit(kBase, "simulation:\n", "simulation:\n  max_steps: 1234\n"), "test.yaml").run_spec.simulation.max_steps == 1234);
   const std::string fractional = edit(kBase, "simulation:\n", "simulation:\n  max_steps: 2.5\n");
   CHECK_THAT(load_error(fractional),
              Contains("test.yaml:" + std::to_string(line_of(fractional, "max_steps: 2.5")) + ": simulation: max_steps must be a whole number"));
@@ -459,7 +460,7 @@ TEST_CASE("a model variant is its base model with the keys it sets changed", "[m
   CHECK(model.gravity_y == 0.0);
   CHECK(model.bodies()[0].mass == Approx(3.0));   // 1 x 3
   CHECK(model.bodies()[1].mass == 3.0);            // the base's
-  CHECK(model.simulation.t_end == 0.25);           // --set still applies, after the variant
+  CHECK(model.run_spec.simulation.t_end == 0.25);           // --set still applies, after the variant
   const Model base = load_model(write_file("ok", "base.yaml", kBase));
   CHECK(base.elements().size() == model.elements().size());
 }
@@ -1120,4 +1121,65 @@ TEST_CASE("a name longer than 256 characters is refused at load with its file an
   CHECK(name_length_problem("body name", umlauts).empty());
   CHECK_THAT(name_length_problem("body name", umlauts + "x"), Contains("257 characters long"));
   CHECK(name_length_problem("body name", std::string(kMaxNameLength, 'b')).empty());
+}
+
+TEST_CASE("every body point (an element's, a load's, a crush gauge's, an output's) names an unknown body alike", "[model_io]") {
+  // One reading of a point's body and offset: before, a crush gauge's point said only "unknown body".
+  const std::string gauge = "responses:\n  reference_crush: 1.0\n  crush_gauges:\n"
+                            "    - {name: g, points: [{body: bobb, at: [0, 0]}, {body: cart, at: [0.5, 0]}]}\n";
+  std::string text = kBase + gauge;
+  expect_error("crush gauge point body", text, line_of(text, "bobb"),
+               {"responses: crush gauge 1: point 1: unknown body 'bobb' (did you mean 'bob'?); bodies are: ground, bob, cart"});
+  text = edit(kBase, "{body: bob, at: [0, 0]}", "{body: bobb, at: [0, 0]}");
+  expect_error("element point body", text, line_of(text, "bobb"),
+               {"element 'spring' (linear_spring): point 1: unknown body 'bobb' (did you mean 'bob'?); bodies are: ground, bob, cart"});
+  // Where the ground will not do, it is not offered.
+  text = kBase + "outputs:\n  - {body: cartt, at: [0.5, 0]}\n";
+  expect_error("output body", text, line_of(text, "cartt"),
+               {"outputs: item 1: unknown body 'cartt' (did you mean 'cart'?); bodies are: bob, cart"});
+  text = edit(kBase, "    body: cart\n", "    body: kart\n");
+  expect_error("load body", text, line_of(text, "kart"),
+               {"moment load on 'kart': unknown body 'kart' (did you mean 'cart'?); bodies are: bob, cart"});
+  text = kBase + "outputs:\n  - {body: ground}\n";
+  expect_error("output on ground", text, line_of(text, "ground}"), {"outputs: item 1: the ground does not move; name a body"});
+  // The offsets are read the same way: the gauge's second point at the spring's end on the cart.
+  const Model model = load_model_text(kBase + "responses:\n  reference_crush: 1.0\n  crush_gauges:\n"
+                                              "    - {name: g, points: [{body: bob, at: [0.25, -1]}, {body: cart, at: [0.5, 0]}]}\n",
+                                      "test.yaml");
+  const CrushGauge& g = model.run_spec.responses.crush_gauges.at(0);
+  CHECK(g.front.body == 0);
+  CHECK(g.front.sx == 0.25);
+  CHECK(g.front.sy == -1.0);
+  CHECK(g.rear.body == 1);
+  CHECK(g.rear.sx == model.elements()[0]->point(1).sx);
+}
+
+TEST_CASE("every check of rtol gives the one message, naming where the value came from", "[model_io]") {
+  const std::string message = " must be a positive number (the relative tolerance; typical: 1e-6), not ";
+  CHECK(rtol_problem(1e-6, "rtol").empty());
+  CHECK(rtol_problem(0.0, "rtol") == "rtol" + message + "0");
+  CHECK(rtol_problem(-1e-3, "--rtol") == "--rtol" + message + "-0.001");
+  CHECK_FALSE(rtol_problem(std::numeric_limits<double>::infinity(), "rtol").empty());
+  CHECK_FALSE(rtol_problem(std::numeric_limits<double>::quiet_NaN(), "rtol").empty());
+  std::string text = edit(kBase, "  dt: 1.0e-4\n", "  dt: 1.0e-4\n  rtol: -1\n");
+  expect_error("model file", text, line_of(text, "rtol"), {"simulation: rtol" + message + "-1"});
+  CHECK(load_error(kBase, {"simulation.rtol=0"}) == "test.yaml: --set 'simulation.rtol=0': simulation: rtol" + message + "0");
+  Model model = load_model_text(kBase, "test.yaml");
+  RunOverrides overrides;
+  overrides.rtol = -2.0;
+  CHECK_THROWS_WITH(apply_overrides(model, overrides), "--rtol" + message + "-2");
+}
+
+TEST_CASE("the integrators' names come from one table: auto, ida, euler", "[model_io]") {
+  CHECK(integrator_names() == std::vector<std::string>{"auto", "ida", "euler"});
+  CHECK(integrator_names_text() == "auto, ida or euler");
+  CHECK(integrator_names_text("\"") == "\"auto\", \"ida\" or \"euler\"");
+  for (const IntegratorName& entry : kIntegratorNames) {
+    CHECK(std::string(integrator_name(entry.kind)) == entry.name);
+    CHECK(integrator_from_name(entry.name) == entry.kind);
+  }
+  CHECK_FALSE(integrator_from_name("IDA"));
+  CHECK_FALSE(integrator_from_name("ida+euler"));
+  const std::string text = edit(kBase, "integrator: euler", "integrator: rk4");
+  expect_error("model file", text, line_of(text, "rk4"), {"simulation: integrator must be auto, ida or euler, not 'rk4'"});
 }

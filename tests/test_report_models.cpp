@@ -33,7 +33,7 @@ TEST_CASE("final two-car model as printed: the first 10 ms from the tabulated ge
   // At 616 in/s they close after 3.75 / 616 s, a little later because the couplers push the
   // struck car first (within 25 %).
   const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml", {"simulation.t_end=0.01"});
-  REQUIRE_FALSE(model.simulation.static_equilibrium);
+  REQUIRE_FALSE(model.run_spec.simulation.static_equilibrium);
   const RunOutcome ida = testing::simulate(model, 1e-3);
   check_energy(ida, 1e-5);
   bool contact = false;
@@ -55,7 +55,7 @@ TEST_CASE("final two-car model, corrected variant: settled, the first 10 ms", "[
   // a little later because the couplers push the struck car first (within 25 %).
   const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car_corrected.yaml",
                                  {"simulation.t_end=0.01", "simulation.static_equilibrium=true"});
-  REQUIRE(model.simulation.static_equilibrium);
+  REQUIRE(model.run_spec.simulation.static_equilibrium);
   const RunOutcome ida = testing::simulate(model, 1e-3);
   check_energy(ida, 1e-5);
   CHECK(ida.stats.settling_steps > 0);
@@ -103,7 +103,7 @@ TEST_CASE("final two-car model, corrected variant: settled and without its impac
     }
   } still;
   still.nq = system.body_unknowns();
-  const RunOutcome o = make_integrator(system, model.simulation)->run(0.1, 1e-3, still);
+  const RunOutcome o = make_integrator(system, model.run_spec.simulation)->run(0.1, 1e-3, still);
   REQUIRE(o.ok);
   CHECK(o.stats.settling_steps > 0);
   CHECK(still.largest_move < 1e-6);   // [in]

@@ -119,8 +119,8 @@ TEST_CASE("peak deceleration and crush of the crush-impact case match the closed
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     Model model = crush_model("");
-    model.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
-    model.simulation.dt = 2e-6;
+    model.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    model.run_spec.simulation.dt = 2e-6;
     const RunReport report = run_model(model, temporary_folder(std::string("peaks_") + integrator));
     REQUIRE(report.outcome.ok);
     REQUIRE(report.acceleration_peaks.size() == 1);
@@ -152,7 +152,7 @@ TEST_CASE("peak acceleration of a pendulum released from the horizontal includes
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     Model model = testing::model_from_text(text);
-    model.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    model.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
     const RunReport report = run_model(model, temporary_folder(std::string("pendulum_") + integrator));
     REQUIRE(report.outcome.ok);
     const AccelerationPeaks& p = report.acceleration_peaks.at(0);

@@ -232,7 +232,7 @@ TEST_CASE("summary.json says running while the run goes and a vanished folder st
   observer.folder = dir;
   observer.look_at = 3;
   observer.remove_at = 100;  // t = 0.099
-  const RunOutcome outcome = make_integrator(system, model.simulation)->run(10.0, 0.001, observer);
+  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(10.0, 0.001, observer);
   CHECK_THAT(observer.summary_mid_run, Catch::Contains("\"status\": \"running\"") && Catch::Contains("\"integrator\": \"ida\""));
   CHECK_FALSE(outcome.ok);
   CHECK_THAT(outcome.message, Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
@@ -258,7 +258,7 @@ TEST_CASE("with the default folder check a vanished folder stops the run or fail
   observer.folder = dir;
   observer.look_at = 3;
   observer.remove_at = 100;
-  const RunOutcome outcome = make_integrator(system, model.simulation)->run(10.0, 0.001, observer);
+  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(10.0, 0.001, observer);
   const std::string summary = writer.write_summary(outcome, "ida");
   CHECK_THAT(writer.failure(), Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
   if (!outcome.ok) {  // the periodic check came first (a slow machine)
@@ -324,8 +324,8 @@ TEST_CASE("an element output's peak between two output rows does not depend on t
     std::vector<double> peaks;
     for (const double output_interval : {0.01, 1.0e-5}) {
       Model model = testing::model_from_text(text);
-      model.simulation.integrator = integrator;
-      model.simulation.output_interval = output_interval;
+      model.run_spec.simulation.integrator = integrator;
+      model.run_spec.simulation.output_interval = output_interval;
       const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
       REQUIRE(report.outcome.ok);
       peaks.push_back(summary_peak(report.summary_json, "spring.force"));
@@ -430,12 +430,12 @@ TEST_CASE("a car's largest crush is of one instant, its interface elements evalu
   for (const char* scenario : {"scenario2_barrier_cars", "scenario1_barrier_cars"}) {
     INFO(scenario);
     Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/" + scenario + ".yaml");
-    model.simulation.integrator = IntegratorKind::Ida;
+    model.run_spec.simulation.integrator = IntegratorKind::Ida;
     DaeSystem system(model);
     ResultWriter writer("", system);
     CrushWitness witness(system, writer);
     const RunOutcome outcome =
-        make_integrator(system, model.simulation)->run(model.simulation.t_end, output_interval_of(model.simulation), witness);
+        make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), witness);
     REQUIRE(outcome.ok);
     CHECK(witness.fresh_mismatches == 0);
     CHECK(witness.partial_calls > 100);  // located mode changes, each with one element's outputs

@@ -269,6 +269,20 @@ TEST_CASE("sweep plans: an unknown key, a level of the wrong type and an empty d
              Catch::StartsWith(files.plan + ":5:") && Catch::Contains("a response is a name"));
 }
 
+TEST_CASE("sweep plans: a misspelt or repeated key is named with the closest key and the allowed ones", "[sweep]") {
+  // The plan's keys go through the one YAML key check (before: a repeated key was taken, a factor's key had no suggestion).
+  Files files;
+  const std::string factor = "  - {key: simulation.t_end, levels: [0.1]}\n";
+  CHECK(files.error_of_plan("sweep: 1\ndesing: full_factorial\nfactors:\n" + factor) ==
+        files.plan + ":2: plan: unknown key 'desing' (did you mean 'design'?); allowed keys: sweep, design, samples, seed, set, "
+                     "factors, runs, responses");
+  CHECK(files.error_of_plan("sweep: 1\ndesign: full_factorial\ndesign: one_at_a_time\nfactors:\n" + factor) ==
+        files.plan + ":3: plan: key 'design' is given twice; keep only one");
+  CHECK(files.error_of_plan("sweep: 1\ndesign: full_factorial\nfactors:\n  - {key: simulation.t_end, level: [0.1]}\n") ==
+        files.plan + ":4: factor 'simulation.t_end': unknown key 'level' (did you mean 'levels'?); allowed keys: key, scale, "
+                     "levels, distribution");
+}
+
 TEST_CASE("sweep: R1 of each run against the closed-form crush, and 1 and 2 jobs and a resume give the same rows", "[sweep]") {
   Files files;
   files.write_plan("sweep: 1\ndesign: full_factorial\nfactors:\n"

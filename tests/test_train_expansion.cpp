@@ -281,7 +281,7 @@ TEST_CASE("settings address a car type (every instance) or one instance, the typ
   CHECK_THROWS_WITH(load_model_text(kTrainModel, path, {"car_types.coche.bodies.body.mass=1"}),
                     Contains("the model has no 'coche' in 'car_types' (did you mean 'coach'?)"));
   // Flat models and flat keys are untouched.
-  CHECK(load_model_text(kTrainModel, path, {"simulation.t_end=0.2"}).simulation.t_end == 0.2);
+  CHECK(load_model_text(kTrainModel, path, {"simulation.t_end=0.2"}).run_spec.simulation.t_end == 0.2);
 }
 
 TEST_CASE("mm-t-s-N models equal the same model in SI", "[trains][units]") {

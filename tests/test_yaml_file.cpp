@@ -131,9 +131,28 @@ TEST_CASE("a model text checked once (a sweep's runs) is refused and read exactl
     const Model direct = load_model_text(valid, "model.yaml", settings);
     const Model from_checked = load_model_text(checked, "model.yaml", settings);
     CHECK(from_checked.bodies()[0].mass == direct.bodies()[0].mass);
-    CHECK(from_checked.simulation.t_end == direct.simulation.t_end);
+    CHECK(from_checked.run_spec.simulation.t_end == direct.run_spec.simulation.t_end);
   }
   CHECK(load_model_text(checked, "model.yaml", {"bodies.bob.mass=2.5"}).bodies()[0].mass == 2.5);
   CHECK_THAT(error_of([&] { (void)load_model_text(checked, "model.yaml", {"description=&a [*a]"}); }),
              StartsWith("model.yaml: --set 'description=&a [*a]'") && Contains("an alias refers to the node that contains it"));
+}
+
+TEST_CASE("one check of a YAML map's keys: unknown (with the closest key and the list), repeated, not a word", "[yaml_file]") {
+  const std::vector<std::string> allowed{"limit", "source", "bodies"};
+  CHECK_FALSE(yaml_keys_problem(YAML::Load("{limit: 1, source: EN, bodies: [a]}"), allowed, "section"));
+  const YAML::Node typo = YAML::Load("limit: 1\nsourse: EN\n");
+  const auto unknown = yaml_keys_problem(typo, allowed, "mean_deceleration");
+  REQUIRE(unknown);
+  CHECK(unknown->message == "mean_deceleration: unknown key 'sourse' (did you mean 'source'?); allowed keys: limit, source, bodies");
+  CHECK(yaml_line(unknown->where) == 2);
+  const auto twice = yaml_keys_problem(YAML::Load("limit: 1\nsource: EN\nlimit: 2\n"), allowed, "override");
+  REQUIRE(twice);
+  CHECK(twice->message == "override: key 'limit' is given twice; keep only one");
+  CHECK(yaml_line(twice->where) == 3);
+  const auto not_a_word = yaml_keys_problem(YAML::Load("? [a, b]\n: 1\n"), allowed, "plan");
+  REQUIRE(not_a_word);
+  CHECK(not_a_word->message == "plan: keys must be plain words; allowed keys: limit, source, bodies");
+  CHECK_THROWS_WITH(check_yaml_keys("plan.yaml", typo, allowed, "plan"),
+                    "plan.yaml:2: plan: unknown key 'sourse' (did you mean 'source'?); allowed keys: limit, source, bodies");
 }

@@ -51,7 +51,7 @@ struct AutoSettings {
 class AutoIntegrator : public IdaIntegrator {
  public:
   AutoIntegrator(DaeSystem& system, IdaSettings ida, EulerSettings euler, AutoSettings rule = {});
-  const char* name() const override { return "auto"; }
+  const char* name() const override { return integrator_name(IntegratorKind::Auto); }
 
  protected:
   void start(double t_end) override;

@@ -106,6 +106,13 @@ struct RoleOfOutput {
 using ForceBlock = std::array<std::array<double, 6>, 6>;  // d f(slot, comp) / d (slot, comp)
 constexpr int kMaxConstraintRows = 3;
 
+/// The model file's type of the anticlimber (elements/anticlimber.hpp), the element the
+/// responses' R2, the scenarios' override criterion and the consists' interfaces are measured
+/// at. Every "is this an anticlimber" asks is_anticlimber_type (of a type name, or an element's
+/// type()) or as_anticlimber (elements/anticlimber.hpp: the element as one).
+inline constexpr const char* kAnticlimberType = "anticlimber";
+inline bool is_anticlimber_type(const std::string& type) { return type == kAnticlimberType; }
+
 class Element {
  public:
   Element(std::string name, std::string type, std::vector<PointRef> points, SourceLocation where);

@@ -50,7 +50,7 @@ class EulerIntegrator : public Integrator {
   /// quadratures there, in the element modes the system holds now, with the given step.
   EulerIntegrator(DaeSystem& system, EulerSettings settings, Step step, double t0, const std::vector<double>& y,
                   const std::vector<double>& quadratures);
-  const char* name() const override { return "euler"; }
+  const char* name() const override { return integrator_name(IntegratorKind::Euler); }
 
   /// Step actually used and the stability limit (valid after construction).
   double step() const { return dt_; }

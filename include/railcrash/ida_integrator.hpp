@@ -43,7 +43,7 @@ class IdaIntegrator : public Integrator {
  public:
   IdaIntegrator(DaeSystem& system, IdaSettings settings);
   ~IdaIntegrator() override;
-  const char* name() const override { return "ida"; }
+  const char* name() const override { return integrator_name(IntegratorKind::Ida); }
 
   struct Impl;
 

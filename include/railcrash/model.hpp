@@ -1,4 +1,5 @@
-// The model: bodies, elements, loads and run settings.
+// The model: bodies, elements and loads (the physical model), and the run's settings in a
+// RunSpec beside them (run_spec.hpp).
 //
 // Build, then finalize: a Model is edited (add_body / add_element / add_load) until
 // finalize(); then topology and the layout of the unknowns are frozen. Unknowns are
@@ -17,6 +18,7 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/error.hpp"
+#include "railcrash/run_spec.hpp"
 
 namespace railcrash {
 
@@ -54,83 +56,6 @@ struct Load {
   SourceLocation where;
 };
 
-/// What the report's response parameters R1-R3 are measured on (responses.hpp).
-struct CrushGauge {
-  std::string name;
-  PointRef front, rear;  // two points along one car
-};
-
-struct ResponseSettings {
-  std::vector<CrushGauge> crush_gauges;
-  bool total_crush = true;                    // R1 uses the sum over gauges (else the largest)
-  bool crush_from_anticlimber = false;        // R1 uses the anticlimber's largest horizontal deformation
-  double reference_crush = 0.0;               // [length] maximum "safe" crush
-  std::string anticlimber;                    // element whose vertical force and override make R2
-  std::optional<double> vertical_yield_force; // [force] default: the anticlimber's own
-  double reference_velocity = 0.0;            // [length/time] velocity that fails the collision post
-  /// When R2's relative horizontal velocity is taken after an override. The report (Section
-  /// 4.1): "at the time the end sill of the overriding car hits the collision post of the
-  /// other car".
-  ///   CollisionPost  the first time after the override that the anticlimber's horizontal
-  ///                  deformation (the faces' approach since they first touched, which goes on
-  ///                  after the faces have passed each other) reaches collision_post_distance;
-  ///   Override       at the override event itself (before issue 40; a labelled variant).
-  enum class OverrideVelocityAt { CollisionPost, Override };
-  OverrideVelocityAt override_velocity_at = OverrideVelocityAt::CollisionPost;
-  double collision_post_distance = 0.0;       // [length] default: reference_crush (the report's
-                                              // "distance from the anticlimber to the collision post")
-  /// Over which part of the run R2's largest vertical force is taken (a reading; the report
-  /// says only "maximum vertical force at anticlimbers"):
-  ///   WholeRun          every output sample of the run;
-  ///   UntilLargestCrush until the anticlimber's horizontal law first unloads (the cars have
-  ///                     reached their common speed and begin to move apart);
-  ///   UntilSeparation   until the anticlimber faces first separate.
-  enum class VerticalForceWindow { WholeRun, UntilLargestCrush, UntilSeparation };
-  VerticalForceWindow vertical_force_window = VerticalForceWindow::WholeRun;
-  bool defined() const { return !crush_gauges.empty() || !anticlimber.empty(); }
-};
-
-/// An output request (the model file's `outputs:`): the motion of a point on a body, written
-/// to timeseries.csv as <name>.x,<name>.y (position), <name>.vx,<name>.vy (velocity),
-/// <name>.ax,<name>.ay (acceleration) after the element columns (results/output_points.hpp).
-struct OutputPoint {
-  std::string name;          // column prefix; default <body>_point<k>
-  PointRef point;            // a body (not ground) and the offset from its centre of mass [length]
-  bool position = true, velocity = true, acceleration = true;
-  SourceLocation where;
-};
-
-/// ida: IDA + KLU on the DAE; euler: the report's explicit Euler with penalty joints; auto:
-/// IDA, handing the run to Euler where Euler is the cheaper (auto_integrator.hpp).
-enum class IntegratorKind { Ida, Euler, Auto };
-
-/// The integrator's name in model files, options and outputs ("ida", "euler", "auto").
-const char* integrator_name(IntegratorKind kind);
-/// The integrator of a name, or nullopt for a name that is none of them.
-std::optional<IntegratorKind> integrator_from_name(const std::string& name);
-
-struct SimulationSettings {
-  double t_end = 1.0;               // [time]
-  IntegratorKind integrator = IntegratorKind::Auto;
-  double rtol = 1e-6;               // ida: relative tolerance
-  std::optional<double> atol;       // ida: absolute tolerance on lengths [length]; default derived from the model
-  double dt = 0.0;                  // euler: step [time]; 0 = 0.5 x stability limit
-  double output_interval = 0.0;     // [time]; 0 = t_end / 500
-  bool force_dt = false;            // euler: accept a step above the stability limit
-  bool static_equilibrium = false;  // settle the bodies under gravity and loads at t = 0 first
-  Element::PenaltyOverrides penalty;  // euler: model-wide penalty settings
-  long max_steps = 10000000;        // [steps] either integrator may take; the run fails beyond (run --max-steps)
-};
-
-/// The most output rows a run may write: t_end / output_interval above it is refused.
-constexpr double kMaxOutputRows = 1e6;  // [rows]
-
-/// Why the settings' output rows exceed kMaxOutputRows ("" when they do not), with the figure
-/// and the smallest output_interval that fits.
-std::string output_rows_problem(const SimulationSettings& settings);
-
-struct ScenarioCriteria;  // scenario/criteria.hpp
-
 /// A model file read to build a model and the SHA-256 of the text read (a run's provenance).
 struct ModelSource {
   std::string path;
@@ -150,10 +75,7 @@ class Model {
   UnitSystem units = UnitSystem::SI;  // of the numbers held here
   std::string file_units;             // the model file's `units` ("mm-t-s-N" is converted to SI when read)
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
-  SimulationSettings simulation;
-  ResponseSettings responses;
-  std::vector<OutputPoint> output_points;
-  std::shared_ptr<const ScenarioCriteria> scenario;  // the `scenario:` section, if any
+  RunSpec run_spec;  // the run's settings (simulation, responses, outputs, scenario): run_spec.hpp
 
   int add_body(Body body);
   Element& add_element(std::unique_ptr<Element> element);

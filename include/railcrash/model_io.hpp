@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +20,23 @@ class ZeroScaledError : public InputError {
  public:
   using InputError::InputError;
 };
+
+/// Throws an InputError naming the file and line of `where` (and the setting it came from):
+/// how a section reader outside model_io reports a problem.
+using SectionFail = std::function<void(const YAML::Node& where, const std::string& message)>;
+
+/// Reads and checks a model file's `scenario:` section against the model's bodies and elements;
+/// `length_scale` converts the file's lengths to the model's (mm-t-s-N: 1e-3, else 1). The
+/// scenario layer supplies it (scenario/criteria.cpp registers read_scenario_section when the
+/// program starts), so the model layer reads the run's settings without depending on scenarios.
+using ScenarioSectionReader = std::shared_ptr<const ScenarioCriteria> (*)(const YAML::Node& section, const Model& model,
+                                                                          double length_scale, const SectionFail& fail);
+/// Registers the reader of the `scenario:` section (a model with one is refused without it).
+/// Returns true, to initialise a static with. scenario/criteria.cpp registers it from a static
+/// initialiser, which runs whenever that file is linked: every program that runs models links it
+/// (run.cpp uses its ScenarioTracker); a program linking librailcrash.a that only loads models
+/// names read_scenario_section itself (tests/fuzz/fuzz_model.cpp).
+bool set_scenario_section_reader(ScenarioSectionReader reader);
 
 /// Reads and checks a model file; the model comes back finalized.
 Model load_model(const std::string& path);
@@ -62,8 +81,6 @@ std::vector<std::string> model_file_keys();
 /// loader's own lists: `railcrash schema` (model_schema.hpp) builds the JSON Schema from them.
 std::vector<std::pair<std::string, std::vector<std::string>>> model_file_sections();
 
-/// " (did you mean 'x'?)" when a word of `known` is close to `word` (edit distance < 3), else "".
-std::string suggestion(const std::string& word, const std::vector<std::string>& known);
 
 /// The longest name the loader takes, in characters (UTF-8 code points): of the model, a body,
 /// an element, an output point, a crush gauge, a car type, a car, a train, a connection. Names

@@ -5,8 +5,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "railcrash/error.hpp"
 
@@ -59,6 +61,27 @@ inline YAML::Node flow_pair(double a, double b) {
   n.SetStyle(YAML::EmitterStyle::Flow);
   return n;
 }
+
+/// " (did you mean 'x'?)" when a word of `known` is close to `word` (edit distance < 3), else "".
+std::string suggestion(const std::string& word, const std::vector<std::string>& known);
+/// "a, b, c".
+std::string join_words(const std::vector<std::string>& words);
+
+/// What is wrong with a key of a YAML map, and the node to name in the message.
+struct YamlKeyProblem {
+  YAML::Node where;
+  std::string message;
+};
+/// The one check of a map's keys, for every YAML input (model files, car types, scenario
+/// sections, plan, design and readings files): each key a plain word, one of `allowed`, and
+/// given once. The problem's message: "CONTEXT: unknown key 'k' (did you mean 'x'?); allowed
+/// keys: a, b, c", "CONTEXT: key 'k' is given twice; keep only one" or "CONTEXT: keys must be
+/// plain words; allowed keys: ...". nullopt when the keys are right.
+std::optional<YamlKeyProblem> yaml_keys_problem(const YAML::Node& map, const std::vector<std::string>& allowed,
+                                                const std::string& context);
+/// yaml_keys_problem for a file read without a model reader: InputError "path:line: ...".
+void check_yaml_keys(const std::string& path, const YAML::Node& map, const std::vector<std::string>& allowed,
+                     const std::string& context);
 
 /// The 1-based line of a node (0: unknown).
 inline int yaml_line(const YAML::Node& node) { return node && !node.Mark().is_null() ? node.Mark().line + 1 : 0; }

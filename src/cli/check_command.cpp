@@ -86,7 +86,7 @@ int check_model(const std::string& path, const std::vector<std::string>& setting
     const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
-  std::printf("simulation t_end %g, integrator %s\n", model.simulation.t_end, integrator_name(model.simulation.integrator));
+  std::printf("simulation t_end %g, integrator %s\n", model.run_spec.simulation.t_end, integrator_name(model.run_spec.simulation.integrator));
   return 0;
 }
 

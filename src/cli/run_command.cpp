@@ -118,7 +118,7 @@ class RunCommand final : public Command {
     CLI::App* command = program.add_subcommand("run", "run a model and write DIR/timeseries.csv, events.csv, summary.json");
     command->add_option("model", model_path_, "model file (YAML)")->required();
     command->add_option("--integrator", integrator_, "auto, ida or euler (default: the model's; a model that names none: auto)")
-        ->check(CLI::IsMember({"auto", "ida", "euler"}));
+        ->check(CLI::IsMember(railcrash::integrator_names()));
     t_end_option_ = command->add_option("--t-end", t_end_, "end time");
     // --t-end, --atol, --dt, --output-interval and --max-steps go to the model's simulation keys,
     // whose check refuses a non-finite or out-of-range value naming the model file (model_io.cpp).

@@ -398,7 +398,7 @@ void register_anticlimber_elements(ElementRegistry& registry) {
                         "hold: the vertical and torsional interlock holds while the horizontal law unloads; release: "
                         "it lets go then and re-seats at reloading",
                         Shape::Word});
-  registry.add({"anticlimber", "15", 2, "P1 on body 1, P2 on body 2: the centres of the two anticlimber faces",
+  registry.add({kAnticlimberType, "15", 2, "P1 on body 1, P2 on body 2: the centres of the two anticlimber faces",
                 "Two impacting anticlimber faces: measured in body 1's frame, open until the faces touch, then "
                 "interlocked, with three independent bilinear elastic-plastic laws with kinematic hardening "
                 "(horizontal in compression only, vertical and torsional both ways). Events for yield, unloading, "

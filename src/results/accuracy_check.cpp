@@ -21,7 +21,7 @@ AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integ
   facts.relative_balance_error = relative_balance_error(EnergyBalance::between(outcome.initial_energy, outcome.final_energy));
   facts.max_constraint_residual = outcome.max_constraint_residual;
   facts.units = units;
-  facts.euler_ran = integrator == "euler" || outcome.stats.handed_over_at >= 0.0;
+  facts.euler_ran = integrator == integrator_name(IntegratorKind::Euler) || outcome.stats.handed_over_at >= 0.0;
   facts.euler_step = outcome.stats.last_step;
   return facts;
 }

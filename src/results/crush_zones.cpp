@@ -27,7 +27,7 @@ std::optional<DeclaredCurve> declared_curve(const Element& element) {
     curve.unloading_stiffness = spring->unloading_stiffness;
     return curve;
   }
-  if (const auto* anticlimber = dynamic_cast<const Anticlimber*>(&element)) {
+  if (const Anticlimber* anticlimber = as_anticlimber(element)) {
     const ElasticPlasticLaw& h = anticlimber->horizontal;
     const double yield = h.rupture_deflection ? std::min(h.yield_deflection, *h.rupture_deflection) : h.yield_deflection;
     curve.deformation = {0.0, yield};

@@ -55,7 +55,7 @@ Provenance run_provenance(const Model& model, const std::string& run_id) {
   p.command_line = command_line();
   p.model_files = model.sources;
   p.settings = model.settings;
-  p.simulation = model.simulation;
+  p.simulation = model.run_spec.simulation;
   return p;
 }
 

@@ -30,14 +30,7 @@ class SectionReader {
 
   void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
     if (!map.IsMap()) fail(map, context + " must be a map of keys (key: value)");
-    for (const auto& entry : map) {
-      const std::string key = entry.first.Scalar();
-      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(entry.first, context + ": unknown key '" + key + "'; allowed keys: " + list);
-      }
-    }
+    if (const auto problem = yaml_keys_problem(map, allowed, context)) fail(problem->where, problem->message);
   }
 
   YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
@@ -101,7 +94,8 @@ double distance(const double* y, int a, int b) {
 
 }  // namespace
 
-std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, const SectionFail& fail) {
+std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, double length_scale,
+                                                              const SectionFail& fail) {
   const SectionReader r(model, fail);
   r.only_keys(section, {"standard", "number", "category", "closing_speed", "mean_deceleration", "survival_space", "override"},
               "the section");
@@ -175,7 +169,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
     r.fail(override_node, "override: give 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface); "
                           "only scenario 3 (an obstacle) has no interface");
   if (override_node["interface"]) {
-    c->interface_element = r.element(override_node["interface"], "override: interface", "anticlimber");
+    c->interface_element = r.element(override_node["interface"], "override: interface", kAnticlimberType);
   } else if (override_node["bodies"]) {
     const auto bodies = r.list(override_node["bodies"], "override: bodies");
     if (bodies.size() != 2) r.fail(override_node["bodies"], "override: bodies must name two bodies [A, B]");
@@ -201,8 +195,17 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
   } else if (override_node["wheel_lift_limit"] || override_node["wheel_lift_source"]) {
     r.fail(override_node, "override: 'wheel_lift_limit' and 'wheel_lift_source' belong to 'wheels' (wheel_rail elements), which this scenario has not");
   }
+  if (length_scale != 1.0) {  // its limits are lengths, speeds and decelerations
+    for (double* value : {&c->closing_speed, &c->deceleration_limit, &c->survival_limit, &c->override_limit, &c->wheel_lift_limit})
+      *value *= length_scale;
+    for (ScenarioCriteria::Zone& zone : c->survival_zones) zone.stroke *= length_scale;
+  }
   return c;
 }
+
+namespace {
+[[maybe_unused]] const bool kScenarioSectionReaderRegistered = set_scenario_section_reader(&read_scenario_section);
+}  // namespace
 
 double filtered_mean_deceleration(const std::vector<double>& times, const std::vector<double>& vx, double cfc, bool* complete) {
   const double interval = cfc::typical_interval(times);

@@ -173,7 +173,7 @@ YAML::Node identical_pair(const Template& t) {
     copy["points"][1] = mirrored(e["points"][0]);
     for (const char* key : {"horizontal_stiffness", "free_length", "coupler_height"})
       if (copy["type"].as<std::string>() == "coupler_end" && copy[key]) copy[key] = flow_pair(e[key][0].as<double>(), e[key][0].as<double>());
-    if (copy["type"].as<std::string>() == "anticlimber") copy["initial_misalignment"] = 0.0;
+    if (is_anticlimber_type(copy["type"].as<std::string>())) copy["initial_misalignment"] = 0.0;
     elements.push_back(copy);
   }
   root["bodies"] = bodies;
@@ -681,7 +681,7 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
   // The two fronts start touching (both at x = 0), so an anticlimber cannot tell from the
   // geometry which way its faces look: end 1 (the striking train's, at the smaller x) faces +x.
   for (YAML::Node e : doc["elements"])
-    if (e["name"] && starts_with(e["name"].Scalar(), "impact.") && e["type"].Scalar() == "anticlimber" && !e["facing"]) e["facing"] = 1;
+    if (e["name"] && starts_with(e["name"].Scalar(), "impact.") && is_anticlimber_type(e["type"].Scalar()) && !e["facing"]) e["facing"] = 1;
   doc["name"] = "scenario trains";  // replaced below
   YAML::Emitter emitter;
   emitter << doc;
@@ -768,8 +768,8 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
       if (!e["name"] || !starts_with(e["name"].Scalar(), "impact.")) continue;
       const std::string type = e["type"].Scalar();
       const auto positive = [&](const char* key) { return e[key] && e[key].as<double>() > 0.0; };
-      if (type == "anticlimber") trains.interface_element = e["name"].Scalar();
-      vertical = vertical || type == "anticlimber" || (type == "coupler_end" && positive("friction")) ||
+      if (is_anticlimber_type(type)) trains.interface_element = e["name"].Scalar();
+      vertical = vertical || is_anticlimber_type(type) || (type == "coupler_end" && positive("friction")) ||
                  (type == "coupling" && (positive("friction") || positive("vertical_stiffness")));
     }
     if (!vertical && offset > 0.0)

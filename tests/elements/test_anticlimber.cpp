@@ -126,8 +126,8 @@ Run simulate(const Model& model) {
   DaeSystem system(model);
   Run run;
   run.samples.size = system.size();
-  auto integrator = make_integrator(system, model.simulation);
-  run.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), run.samples);
+  auto integrator = make_integrator(system, model.run_spec.simulation);
+  run.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), run.samples);
   REQUIRE(run.outcome.ok);
   run.final_mode = system.modes().as<Anticlimber::State>(0);
   return run;

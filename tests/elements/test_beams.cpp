@@ -152,10 +152,10 @@ class Quiet : public RunObserver {
 Run simulate(const std::string& yaml) {
   const Model model = testing::model_from_text(yaml);
   DaeSystem system(model);
-  auto integrator = make_integrator(system, model.simulation);
+  auto integrator = make_integrator(system, model.run_spec.simulation);
   Quiet quiet;
   Run run;
-  run.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), quiet);
+  run.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), quiet);
   INFO("run message: " << run.outcome.message);
   REQUIRE(run.outcome.ok);
   const BodyState s = split(system, run.outcome.y);

@@ -122,7 +122,7 @@ Run run(DaeSystem& system) {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
   Run r;
-  r.outcome = make_integrator(system, model.simulation)->run(model.simulation.t_end, model.simulation.t_end / 4.0, observer);
+  r.outcome = make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, model.run_spec.simulation.t_end / 4.0, observer);
   INFO(r.outcome.message);
   REQUIRE(r.outcome.ok);
   r.x = r.outcome.y[0];

@@ -258,12 +258,12 @@ TEST_CASE("Euler: a second run of one integrator starts from the same modes and 
   // contact again with no crush history, as the first did.
   const Model model = testing::model_from_text(impact(10.0, 0.0, "euler"));
   DaeSystem system(model);
-  const std::unique_ptr<Integrator> euler = make_integrator(system, model.simulation);
+  const std::unique_ptr<Integrator> euler = make_integrator(system, model.run_spec.simulation);
   struct Quiet : RunObserver {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
-  const RunOutcome first = euler->run(model.simulation.t_end, 0.01, observer);
-  const RunOutcome second = euler->run(model.simulation.t_end, 0.01, observer);
+  const RunOutcome first = euler->run(model.run_spec.simulation.t_end, 0.01, observer);
+  const RunOutcome second = euler->run(model.run_spec.simulation.t_end, 0.01, observer);
   REQUIRE(first.ok);
   REQUIRE(second.ok);
   REQUIRE(first.events.size() == 3);  // starts in contact: curve segment 2, unloading, separation

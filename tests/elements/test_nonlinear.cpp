@@ -85,9 +85,9 @@ struct Quiet : RunObserver {
 RunOutcome run(const std::string& yaml) {
   const Model model = testing::model_from_text(yaml);
   DaeSystem system(model);
-  auto integrator = make_integrator(system, model.simulation);
+  auto integrator = make_integrator(system, model.run_spec.simulation);
   Quiet quiet;
-  RunOutcome outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), quiet);
+  RunOutcome outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), quiet);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   return outcome;

@@ -16,12 +16,17 @@
 #include "railcrash/error.hpp"
 #include "railcrash/initial_conditions.hpp"
 #include "railcrash/model_io.hpp"
+#include "railcrash/scenario/criteria.hpp"
 
 namespace {
 
 /// What a fuzz input is called in messages (the loader reads no file of that name, but a
 /// `variant_of` is resolved against its folder: the working directory).
 constexpr const char* kInputLabel = "fuzz-input.yaml";
+
+// The loader reads `scenario:` sections through the reader the scenario layer registers; this
+// program uses nothing else of that layer, so it names the reader to link it (and fuzz it).
+[[maybe_unused]] const bool kScenarioReader = railcrash::set_scenario_section_reader(&railcrash::read_scenario_section);
 
 void exercise_model(const std::string& text) {
   using namespace railcrash;

@@ -67,7 +67,7 @@ TEST_CASE("a crush spring pushed at nearly constant speed absorbs the area under
   const Model model = testing::model_from_text(kPushedCrushSpring);
   DaeSystem system(model);
   ResultWriter writer("", system);
-  const RunOutcome outcome = make_integrator(system, model.simulation)->run(0.03, 0.001, writer);
+  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.03, 0.001, writer);
   REQUIRE(outcome.ok);
   const CrushZoneTracker& tracker = writer.crush_zones();
   REQUIRE(tracker.zones().size() == 1);
@@ -100,7 +100,7 @@ TEST_CASE("a crush zone between two cars counts half for each and the cars add u
   const Model model = testing::model_from_text(kTwoCars);
   DaeSystem system(model);
   ResultWriter writer("", system);
-  const RunOutcome outcome = make_integrator(system, model.simulation)->run(0.05, 0.001, writer);
+  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.05, 0.001, writer);
   REQUIRE(outcome.ok);
   const CrushZoneTracker& tracker = writer.crush_zones();
   REQUIRE(tracker.zones().size() == 2);  // the linear spring absorbs by no crushing

@@ -246,7 +246,7 @@ TEST_CASE("a table too wide for one compound type becomes a rows x columns matri
 TEST_CASE("a run that fails leaves timeseries.h5 closed and readable with the rows up to the failure",
           "[results][hdf5][faults]") {
   Model model = two_car_model(0.05);
-  model.simulation.max_steps = 150;  // IDA stops there: a failed run
+  model.run_spec.simulation.max_steps = 150;  // IDA stops there: a failed run
   const std::string dir = temporary_folder("failed");
   const RunReport report = run_model(model, dir, nullptr, false, false, OutputFormat::Hdf5);
   REQUIRE_FALSE(report.outcome.ok);

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "railcrash/elements/anticlimber.hpp"
 #include "railcrash/error.hpp"
 #include "railcrash/model_io.hpp"
 #include "railcrash/scenario/criteria.hpp"
@@ -117,7 +118,7 @@ TEST_CASE("scenario criteria: survival-space cars, excluded elements and the int
   const std::string gauges = "gauges: [{name: ab, front: a, rear: b}]";
   CHECK_THAT(error(with(text, gauges, "cars: [car_b]")), Catch::Contains("cases.yaml:35") && Catch::Contains("no body declares 'car: car_b'"));
   CHECK_THAT(error(with(text, gauges, "cars: [car_a], excluded: [face]")), Catch::Contains("excluded: no element named 'face'"));
-  CHECK_THAT(error(with(text, gauges, "limit: 1")), Catch::Contains("give 'cars: [..]'"));
+  CHECK_THAT(error(with(text, ", " + gauges, "")), Catch::Contains("give 'cars: [..]'"));
   // Only scenario 3 (an obstacle) goes without an interface, and then has no override limit.
   const std::string no_interface = with(text, "limit: 0.1, source: test, interface: faces, ", "");
   CHECK_THAT(error(no_interface), Catch::Contains("only scenario 3 (an obstacle) has no interface"));
@@ -145,4 +146,39 @@ TEST_CASE("scenario criteria: the section is checked with file:line messages", "
   } catch (const InputError& e) {
     CHECK_THAT(e.what(), Catch::Contains("cases.yaml:35") && Catch::Contains("no body named 'c'"));
   }
+}
+
+TEST_CASE("scenario criteria: a misspelt or repeated key is named with the closest key and the allowed ones", "[scenario]") {
+  // The section's keys go through the model file's one key check (before: no suggestion, a repeated key taken).
+  const std::string text = with(kTwoCarts, "wheels: [WHEELS]", "wheels: [faces]");
+  try {
+    load_model_text(with(text, "{limit: 49.0, source: test,", "{limit: 49.0, sorce: test,"), "cases.yaml");
+    FAIL("a misspelt key was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::StartsWith("cases.yaml:34: scenario: mean_deceleration: unknown key 'sorce' (did you mean 'source'?); "
+                                           "allowed keys: limit, cfc, source, bodies"));
+  }
+  try {
+    load_model_text(with(text, "{limit: 49.0, source: test,", "{limit: 49.0, limit: 50.0, source: test,"), "cases.yaml");
+    FAIL("a repeated key was accepted");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::StartsWith("cases.yaml:34: scenario: mean_deceleration: key 'limit' is given twice; keep only one"));
+  }
+}
+
+TEST_CASE("scenario criteria: an anticlimber is known by one check, of its type name or of the element", "[scenario]") {
+  std::string flat = kTwoCarts;
+  flat = flat.substr(0, flat.find("scenario:"));
+  flat = with(flat, "    face_height: 0.2\n", "    face_height: 0.2\n    facing: 1\n");  // the faces touch at the start
+  flat = with(flat, "simulation:", "  - {name: s, type: linear_spring, stiffness: 1.0, free_length: 3.0, points: [{body: a}, {body: b}]}\nsimulation:");
+  const Model model = load_model_text(flat, "cases.yaml");
+  REQUIRE(model.elements().size() == 2);
+  const Anticlimber* faces = as_anticlimber(*model.elements()[0]);
+  REQUIRE(faces != nullptr);
+  CHECK(faces->name() == "faces");
+  CHECK(faces->horizontal.elastic_stiffness == 1.0e7);
+  CHECK(as_anticlimber(*model.elements()[1]) == nullptr);
+  CHECK(is_anticlimber_type(model.elements()[0]->type()));
+  CHECK_FALSE(is_anticlimber_type(model.elements()[1]->type()));
+  CHECK_FALSE(is_anticlimber_type("Anticlimber"));
 }

@@ -53,7 +53,7 @@ struct Run {
   const std::vector<double>& operator[](const std::string& name) const { return report.series[column.at(name)]; }
 };
 Run run_in_memory(Model& model, double interval) {
-  model.simulation.output_interval = interval;
+  model.run_spec.simulation.output_interval = interval;
   Run run{run_model(model, "", nullptr, false, true), {}};
   REQUIRE(run.report.outcome.ok);
   for (std::size_t k = 0; k < run.report.columns.size(); ++k) run.column[run.report.columns[k]] = k;
@@ -79,11 +79,11 @@ TEST_CASE("scenario 1: two identical trains, mirrored, the standing one raised b
   ScenarioRequest q = report_car(1);
   q.cars = 2;
   const Model model = load_model_text(make_scenario_model(q), "scenario1.yaml");
-  REQUIRE(model.scenario);
+  REQUIRE(model.run_spec.scenario);
   CHECK(model.body_count() == 4 * 9);
   const double offset = 40.0 / 25.4;         // [in]
   const double half_speed = 36.0 / 3.6 / 0.0254 / 2.0;  // [in/s] 393.7 / 2
-  CHECK(model.scenario->closing_speed == Approx(393.700787));
+  CHECK(model.run_spec.scenario->closing_speed == Approx(393.700787));
   for (const char* part : {"coupler", "front_end", "center_body", "rear_body", "front_truck"})
     for (const char* car : {"1_", "2_"}) {
       const Body& s = body_named(model, std::string("s") + car + part);
@@ -96,11 +96,11 @@ TEST_CASE("scenario 1: two identical trains, mirrored, the standing one raised b
       CHECK(t.vx == Approx(-half_speed));
     }
   // 5 g in in/s^2 (standard gravity 386.088 in/s^2, as results.hpp's peaks in g).
-  CHECK(model.scenario->deceleration_limit == Approx(5.0 * 386.088));
-  CHECK(model.scenario->survival_gauges.size() == 4);
-  CHECK(model.scenario->wheels == std::vector<std::string>{"s1_front_truck_wheel_1", "s1_front_truck_wheel_2",
+  CHECK(model.run_spec.scenario->deceleration_limit == Approx(5.0 * 386.088));
+  CHECK(model.run_spec.scenario->survival_gauges.size() == 4);
+  CHECK(model.run_spec.scenario->wheels == std::vector<std::string>{"s1_front_truck_wheel_1", "s1_front_truck_wheel_2",
                                                            "t1_front_truck_wheel_1", "t1_front_truck_wheel_2"});
-  CHECK(model.scenario->interface_element == "anticlimber");
+  CHECK(model.run_spec.scenario->interface_element == "anticlimber");
 }
 
 TEST_CASE("scenario 2: the train into an 80 t wagon with side buffers", "[scenario]") {
@@ -110,7 +110,7 @@ TEST_CASE("scenario 2: the train into an 80 t wagon with side buffers", "[scenar
   CHECK(wagon.vx == 0.0);
   CHECK(body_named(model, "s1_center_body").vx == Approx(393.700787));
   CHECK_FALSE(model.find_body("t1_center_body"));
-  CHECK(model.scenario->interface_bodies == std::vector<std::string>{"s1_front_end", "wagon"});
+  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"s1_front_end", "wagon"});
 }
 
 TEST_CASE("scenario: bad requests name what is missing", "[scenario]") {
@@ -154,7 +154,7 @@ TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not
   q.t_end = 0.009;
   Model model = load_model_text(make_scenario_model(q), "symmetric.yaml");
   const Run run = run_in_memory(model, 0.0005);
-  const double closing_speed = model.scenario->closing_speed;
+  const double closing_speed = model.run_spec.scenario->closing_speed;
   double velocity_difference = 0.0, position_difference = 0.0;  // [in/s], [in] of mirrored bodies
   for (const Body& b : model.bodies()) {
     if (b.name[0] != 's') continue;
@@ -166,7 +166,7 @@ TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not
       for (std::size_t k = 0; k < s.size(); ++k) largest = std::max(largest, std::abs(s[k] + t[k]));
     }
   }
-  const double rtol = model.simulation.rtol;
+  const double rtol = model.run_spec.simulation.rtol;
   CHECK(velocity_difference <= 0.1 * rtol * closing_speed);
   CHECK(position_difference <= 0.1 * rtol * closing_speed * *q.t_end);
   // The collision did happen: the lead couplers have bounced back off each other.
@@ -253,11 +253,11 @@ TEST_CASE("scenario 1 from the barrier test's cars: the striking end found by ro
   CHECK_FALSE(element_named(model, "s_climb_limit"));
   REQUIRE(element_named(model, "front_faces"));
   CHECK(element_named(model, "front_faces")->type() == "coupler_end");
-  CHECK(model.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "t_lead_front"});
-  CHECK(model.scenario->wheels == std::vector<std::string>{"s_lead_truck_front_wheel_1", "s_lead_truck_front_wheel_2",
+  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "t_lead_front"});
+  CHECK(model.run_spec.scenario->wheels == std::vector<std::string>{"s_lead_truck_front_wheel_1", "s_lead_truck_front_wheel_2",
                                                            "t_lead_truck_front_wheel_1", "t_lead_truck_front_wheel_2"});
-  CHECK(model.scenario->survival_cars == std::vector<std::string>{"s_lead", "s_trail", "t_lead", "t_trail"});
-  CHECK(model.scenario->passenger_bodies == std::vector<std::string>{"s_lead_body", "s_trail_body", "t_lead_body", "t_trail_body"});
+  CHECK(model.run_spec.scenario->survival_cars == std::vector<std::string>{"s_lead", "s_trail", "t_lead", "t_trail"});
+  CHECK(model.run_spec.scenario->passenger_bodies == std::vector<std::string>{"s_lead_body", "s_trail_body", "t_lead_body", "t_trail_body"});
 }
 
 TEST_CASE("scenario 2 from the barrier test's cars: the buffers strike the front crush element's body", "[scenario]") {
@@ -265,8 +265,8 @@ TEST_CASE("scenario 2 from the barrier test's cars: the buffers strike the front
   q.t_end = 0.03;
   Model model = load_model_text(make_scenario_model(q), "scenario2_barrier.yaml");
   CHECK_FALSE(model.find_body("t_lead_body"));
-  CHECK(model.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "wagon"});
-  CHECK(model.scenario->survival_excluded == std::vector<std::string>{"wagon_buffers"});
+  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "wagon"});
+  CHECK(model.run_spec.scenario->survival_excluded == std::vector<std::string>{"wagon_buffers"});
   const Element* buffers = element_named(model, "wagon_buffers");
   REQUIRE(buffers);
   // On lead_front (c.g. at x = -30 in) at the face x = 0, 1060 mm above the rail (c.g. at 50 in).
@@ -300,7 +300,7 @@ TEST_CASE("scenario 3: the train into a deformable obstacle on a slider, no inte
   const Body& obstacle = body_named(model, "obstacle");
   CHECK(obstacle.mass * 386.088 == Approx(15000.0 / 0.45359237));  // 15 t
   CHECK(body_named(model, "s_lead_body").vx == Approx(110.0 / 3.6 / 0.0254));
-  CHECK_FALSE(model.scenario->has_interface());
+  CHECK_FALSE(model.run_spec.scenario->has_interface());
   const Run run = run_in_memory(model, 0.001);
   CHECK(run.report.summary_json.find("\"criterion\": \"override\"") == std::string::npos);
   CHECK(run.report.summary_json.find("\"criterion\": \"wheel_lift\", \"subject\": \"s_lead_truck_front_wheel_1\"") != std::string::npos);
@@ -361,9 +361,9 @@ TEST_CASE("scenario 1 of the barrier cars without offset is mirror-symmetric thr
   q.face_friction.reset();
   q.t_end = 0.05;
   Model model = load_model_text(make_scenario_model(q), "symmetric_barrier.yaml");
-  model.simulation.integrator = integrator;
+  model.run_spec.simulation.integrator = integrator;
   const Run run = run_in_memory(model, 0.0005);
-  const double closing_speed = model.scenario->closing_speed;
+  const double closing_speed = model.run_spec.scenario->closing_speed;
   double velocity_difference = 0.0;  // [in/s] of mirrored bodies
   for (const Body& b : model.bodies()) {
     if (b.name.rfind("s_", 0) != 0) continue;
@@ -395,7 +395,7 @@ TEST_CASE("a survival-space car's crush is the sum of its crush elements at one 
   // The rows (every output interval) see no more than the criterion, and almost as much. The
   // run summary's car_crush is the car's shortening instead (results.hpp "Car crush").
   Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/scenario1_barrier_cars.yaml");
-  const Run run = run_in_memory(model, model.simulation.output_interval);
+  const Run run = run_in_memory(model, model.run_spec.simulation.output_interval);
   const DaeSystem system(model);
   for (const CarCrush& car : cars_of(system)) {
     INFO("car " << car.car);

@@ -176,8 +176,8 @@ TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the 
   const auto y_of = [&](const std::string& name) { return model.bodies()[static_cast<std::size_t>(*model.find_body(name))].y; };
   CHECK(y_of("standing.car1.body") - y_of("striking.car1.body") == Approx(0.040).epsilon(1e-9));  // mm-t-s-N read as SI
   CHECK(y_of("standing.car3.bogie_rear") - y_of("striking.car3.bogie_rear") == Approx(0.040).epsilon(1e-9));
-  REQUIRE(model.scenario);
-  const ScenarioCriteria& c = *model.scenario;
+  REQUIRE(model.run_spec.scenario);
+  const ScenarioCriteria& c = *model.run_spec.scenario;
   CHECK(c.interface_element == "impact.anticlimber");
   CHECK(c.survival_cars.size() == 6);
   CHECK(c.passenger_bodies.size() == 6);
@@ -185,7 +185,7 @@ TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the 
   ScenarioRequest per_car = emu3(1, "emu3_unit_collision.yaml");
   per_car.passenger_bodies.clear();
   const Model heaviest = load_model_text(make_scenario_model(per_car), "s1.yaml");
-  CHECK(heaviest.scenario->passenger_bodies == c.passenger_bodies);
+  CHECK(heaviest.run_spec.scenario->passenger_bodies == c.passenger_bodies);
   CHECK(c.rail_supports == std::vector<std::string>{"striking.car1.bogie_front_rail", "standing.car1.bogie_front_rail"});
   CHECK(c.closing_speed == Approx(10.0));  // 36 km/h in m/s
   CHECK(c.survival_limit == Approx(0.05));
@@ -200,8 +200,8 @@ TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the 
   ScenarioRequest q = emu3(1, "emu3_unit_collision.yaml");
   q.crush_zones = {"cab_car.front_crush"};
   const Model declared = load_model_text(make_scenario_model(q), "s1.yaml");
-  for (const auto& zone : declared.scenario->survival_zones) CHECK(zone.stroke == Approx(0.95).epsilon(1e-12));
-  CHECK(declared.scenario->survival_zones.size() == 4);
+  for (const auto& zone : declared.run_spec.scenario->survival_zones) CHECK(zone.stroke == Approx(0.95).epsilon(1e-12));
+  CHECK(declared.run_spec.scenario->survival_zones.size() == 4);
 }
 
 TEST_CASE("scenario 1 from car types: the 40 mm offset acts through the anticlimber's interlock", "[scenario]") {
@@ -243,8 +243,8 @@ TEST_CASE("scenario from car types: what is missing is named", "[scenario]") {
 
 TEST_CASE("scenario 2 from car types: the wagon meets the unit's front end", "[scenario]") {
   Model model = load_model_text(make_scenario_model(emu3(2, "emu3_wall.yaml")), "s2.yaml");
-  REQUIRE(model.scenario);
-  CHECK(model.scenario->interface_bodies == std::vector<std::string>{"striking.car1.front_end", "wagon"});
+  REQUIRE(model.run_spec.scenario);
+  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"striking.car1.front_end", "wagon"});
   CHECK(model.bodies()[static_cast<std::size_t>(*model.find_body("wagon"))].mass == Approx(80000.0));
-  CHECK(model.scenario->survival_cars.size() == 3);
+  CHECK(model.run_spec.scenario->survival_cars.size() == 3);
 }

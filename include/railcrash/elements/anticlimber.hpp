@@ -357,4 +357,9 @@ class Anticlimber : public ForceElement<Anticlimber> {
   State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
+/// The element as an anticlimber, or nullptr when its type is another (is_anticlimber_type).
+inline const Anticlimber* as_anticlimber(const Element& element) {
+  return is_anticlimber_type(element.type()) ? &dynamic_cast<const Anticlimber&>(element) : nullptr;
+}
+
 }  // namespace railcrash

@@ -53,6 +53,7 @@
 #include <vector>
 
 #include "railcrash/integrator.hpp"
+#include "railcrash/model_io.hpp"
 #include "railcrash/results.hpp"
 
 namespace YAML {
@@ -102,10 +103,12 @@ struct ScenarioCriteria {
   bool has_interface() const { return !interface_element.empty() || !interface_bodies.empty(); }
 };
 
-/// Reads and checks a `scenario:` section against the model's bodies and elements. `fail`
-/// throws an InputError naming the file and line of the node (model_io's reader).
-using SectionFail = std::function<void(const YAML::Node& where, const std::string& message)>;
-std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, const SectionFail& fail);
+/// Reads and checks a `scenario:` section against the model's bodies and elements, its lengths,
+/// speeds and decelerations times `length_scale` (the file's units to the model's). `fail`
+/// throws an InputError naming the file and line of the node (model_io's reader). Registered
+/// with model_io as its ScenarioSectionReader.
+std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, double length_scale,
+                                                              const SectionFail& fail);
 
 /// One criterion's outcome.
 struct CriterionResult {
