@@ -140,7 +140,7 @@ TEST_CASE("IDA runs a unit whose only forces at t = 0 are round-off: they set no
   const Model model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.1"});
   DaeSystem system(model);
   SampleTimes samples;
-  const RunOutcome outcome = make_integrator(system, model.simulation)->run(0.1, 0.001, samples);
+  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.1, 0.001, samples);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   double momentum = 0.0;  // [kg m/s]

@@ -340,7 +340,7 @@ TEST_CASE("crush spring crushed through its free length stops the run naming it 
     struct Quiet : RunObserver {
       void sample(double, const double*, const double*, const double*, const double*) override {}
     } observer;
-    const RunOutcome outcome = make_integrator(system, model.simulation)->run(0.2, 0.001, observer);
+    const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.2, 0.001, observer);
     INFO(outcome.message);
     CHECK_FALSE(outcome.ok);
     CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: crush_spring 'crush' is crushed through its whole length at t = "));
