@@ -61,8 +61,8 @@ BarrierRun run_barrier(const std::vector<std::string>& overrides, Model& model) 
   BarrierRun run;
   run.output_names = system.output_names();
   BarrierRecorder recorder(system, run);
-  auto integrator = make_integrator(system, model.simulation);
-  run.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), recorder);
+  auto integrator = make_integrator(system, model.run_spec.simulation);
+  run.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), recorder);
   REQUIRE(run.outcome.ok);
   return run;
 }
@@ -335,7 +335,7 @@ TEST_CASE("two-car barrier test: longitudinal figures within the source's measur
 
   // Explicit Euler below its stability limit: the same longitudinal figures within 2 %.
   const BarrierRun euler = run_barrier({"simulation.integrator=euler"}, euler_model);
-  REQUIRE(euler.outcome.stats.stability_limit > euler_model.simulation.dt);
+  REQUIRE(euler.outcome.stats.stability_limit > euler_model.run_spec.simulation.dt);
   const Figures e = figures_of(euler, euler_model);
   const auto agree = [](const std::string& quantity, double reference, double value) {
     row("Euler dt=5e-6 vs IDA: " + quantity, reference, value, 0.02, "%.7g");

@@ -55,8 +55,8 @@ Trajectory simulate(const std::string& name, const std::vector<std::string>& ove
   Trajectory trajectory;
   Recorder recorder(trajectory);
   recorder.size = system.size();
-  auto integrator = make_integrator(system, model.simulation);
-  trajectory.outcome = integrator->run(model.simulation.t_end, output_interval_of(model.simulation), recorder);
+  auto integrator = make_integrator(system, model.run_spec.simulation);
+  trajectory.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), recorder);
   REQUIRE(trajectory.outcome.ok);
   return trajectory;
 }
