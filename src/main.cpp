@@ -236,10 +236,10 @@ int report_command(const std::string& run_dir, double cfc, double force_cfc = 60
 }
 
 int run_command(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
-                const std::string& out_dir, bool with_report, bool quiet, railcrash::OutputFormat format, bool timings) {
+                const std::string& out_dir, bool with_report, bool quiet, const std::string& format, bool timings) {
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
-  if (format == OutputFormat::Hdf5) require_hdf5();
+  require_output_format(format);
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   // The folder is this run's: locked against a second writer, then an earlier run's files go
   // (the writer would remove them too), said here.
@@ -322,8 +322,7 @@ int run_command(const std::string& path, const std::vector<std::string>& setting
                   "", aliased.c_str());
   }
   std::printf("results in %s/ (%s, summary.json, model.json), run id %s\n", out_dir.c_str(),
-              format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
-                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv",
+              output_format(format).files,
               report.run_id.c_str());
   if (with_report) report_command(out_dir, 60.0);
   return o.ok ? 0 : 1;
@@ -596,10 +595,9 @@ int main(int argc, char** argv) {
   bool with_report = false;
   run->add_flag("--report", with_report, "also write DIR/report.html (as `railcrash report DIR`)");
   std::string output_format = "csv";
-  run->add_option("--format", output_format,
-                  "csv, or hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Binary output\")")
+  run->add_option("--format", output_format, railcrash::output_format_help())
       ->capture_default_str()
-      ->check(CLI::IsMember({"csv", "hdf5"}));
+      ->check(CLI::IsMember(railcrash::file_output_format_names()));
   bool quiet = false;
   run->add_flag("--quiet", quiet, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
   bool timings = false;
@@ -891,8 +889,7 @@ int main(int argc, char** argv) {
     if (*output_option) overrides.output_interval = output_interval;
     if (*max_steps_option) overrides.max_steps = max_steps;
     railcrash::set_output_memory_limit(max_output_memory_gb * 1e9);
-    return run_command(model_path, settings, overrides, out_dir, with_report, quiet,
-                       output_format == "hdf5" ? railcrash::OutputFormat::Hdf5 : railcrash::OutputFormat::Csv, timings);
+    return run_command(model_path, settings, overrides, out_dir, with_report, quiet, output_format, timings);
   } catch (const railcrash::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

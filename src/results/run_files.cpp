@@ -97,7 +97,7 @@ void write_model_geometry(const DaeSystem& system, const std::string& path, cons
   if (!out) throw InputError("cannot write " + path);
 }
 
-EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile* file) : system_(system), file_(file) {
+EnergyWriter::EnergyWriter(const DaeSystem& system) : system_(system) {
   const Model& model = system.model();
   for (const auto& e : model.elements()) {
     auto it = std::find(types_.begin(), types_.end(), e->type());
@@ -109,9 +109,6 @@ EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile* file) : system
   columns_ = {"t", "kinetic", "elastic", "gravity", "external_work", "dissipated"};
   for (const std::string& type : types_) columns_.push_back("dissipated." + type);
   columns_.push_back("integration_drift");
-  if (!file_) return;
-  for (std::size_t k = 0; k < columns_.size(); ++k) file_->text((k ? "," : "") + columns_[k]);
-  file_->character('\n');
 }
 
 void EnergyWriter::sample(double t, const double* y, const double* quadratures) {
@@ -145,12 +142,6 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   row_.assign({t, kinetic, elastic, gravity, load_work, dissipated});
   row_.insert(row_.end(), dissipated_.begin(), dissipated_.end());
   row_.push_back(drift);
-  if (!file_) return;
-  for (std::size_t k = 0; k < row_.size(); ++k) {
-    if (k > 0) file_->character(',');
-    file_->number(row_[k]);
-  }
-  file_->character('\n');
 }
 
 }  // namespace railcrash
