@@ -14,11 +14,11 @@ std::unique_ptr<OutputSink> make_memory_sink();  // src/results/memory_sink.cpp
 
 const std::vector<OutputFormat>& output_formats() {
   static const std::vector<OutputFormat> formats = {
-      {"csv", true, "csv", "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv", nullptr,
-       make_csv_sink},
+      {"csv", true, "csv", "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv",
+       {"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv", "energy_zones.csv"}, nullptr, make_csv_sink},
       {"hdf5", true, "hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Binary output\")",
-       "timeseries.h5: timeseries, events, accelerations, energy", require_hdf5, make_hdf5_sink},
-      {"memory", false, "", "", nullptr, make_memory_sink},
+       "timeseries.h5: timeseries, events, accelerations, energy", {"timeseries.h5"}, require_hdf5, make_hdf5_sink},
+      {"memory", false, "", "", {}, nullptr, make_memory_sink},
   };
   return formats;
 }

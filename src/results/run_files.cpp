@@ -8,13 +8,21 @@
 #include <sstream>
 
 #include "railcrash/results.hpp"
+#include "railcrash/results/output_sink.hpp"
 
 namespace railcrash {
 
 const std::vector<std::string>& run_folder_files() {
-  static const std::vector<std::string> names = {"timeseries.csv", "events.csv",   "accelerations.csv", "energy.csv",
-                                                 "timeseries.h5",  "summary.json", "summary.json.tmp",  "model.json",
-                                                 "report.html",    "energy_zones.csv"};
+  static const std::vector<std::string> names = [] {
+    // In the order the messages have always named them; then the files of a format registered since.
+    std::vector<std::string> files = {"timeseries.csv", "events.csv",   "accelerations.csv", "energy.csv",
+                                      "timeseries.h5",  "summary.json", "summary.json.tmp",  "model.json",
+                                      "report.html",    "energy_zones.csv"};
+    for (const OutputFormat& format : output_formats())
+      for (const std::string& file : format.folder_files)
+        if (std::find(files.begin(), files.end(), file) == files.end()) files.push_back(file);
+    return files;
+  }();
   return names;
 }
 

@@ -3,6 +3,7 @@
 // CSV files and to memory alike. On a model in SI: two 40 t cars on a crush zone and a draft gear.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include "railcrash/results/crush_zones.hpp"
 #include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/provenance.hpp"
+#include "railcrash/results/run_files.hpp"
 #include "railcrash/run.hpp"
 
 namespace fs = std::filesystem;
@@ -71,6 +73,12 @@ TEST_CASE("Output formats: csv, hdf5 and memory are registered, and --format tak
   CHECK(output_format_help() == "csv, or hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Binary output\")");
   CHECK(std::string(output_format("csv").files) ==
         "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv");
+  // A run owns every file a format writes: an earlier run's are removed (run_folder_files).
+  for (const OutputFormat& format : output_formats())
+    for (const std::string& file : format.folder_files)
+      CHECK(std::count(run_folder_files().begin(), run_folder_files().end(), file) == 1);
+  CHECK(output_format("hdf5").folder_files == std::vector<std::string>{"timeseries.h5"});
+  CHECK(output_format("memory").folder_files.empty());
   CHECK_THROWS_WITH(output_format("parquet"), "no output format 'parquet'; the formats are csv, hdf5, memory");
   CHECK_NOTHROW(require_output_format("csv"));
   REQUIRE(make_output_sink("memory") != nullptr);

@@ -9,7 +9,9 @@
 //           (src/results/memory_sink.cpp; api.hpp)
 // `railcrash run --format NAME` takes the registered sinks that write files; the library's
 // runs take "memory". A new format is one new file (its sink and its make function) and one
-// row in the table of src/results/output_formats.cpp (and the file in CMakeLists.txt).
+// row in the table of src/results/output_formats.cpp (and the file in CMakeLists.txt's
+// railcrash_output_sinks); the row names the files it writes, which a run then owns
+// (results/run_files.hpp run_folder_files: an earlier run's are removed).
 //
 // What the writer keeps for itself, whatever the sinks: summary.json, model.json, the folder
 // lock and the check that the folder still exists. A sink's failed write (file and the OS's
@@ -83,6 +85,7 @@ struct OutputFormat {
   bool writes_files;       // false: kept in memory, not a --format
   const char* help;        // --format's help text for it
   const char* files;       // what `railcrash run` says the folder holds
+  std::vector<std::string> folder_files;  // the files it writes into the run folder (results/run_files.hpp run_folder_files)
   void (*require)();       // throws InputError saying how to get the format when this build has none (nullptr: always there)
   std::unique_ptr<OutputSink> (*make)();
 };

@@ -31,9 +31,10 @@ namespace railcrash {
 /// Throws InputError if it cannot be written.
 void write_model_geometry(const DaeSystem& system, const std::string& path, const std::string& run_id = "");
 
-/// The files a run writes into its folder (either output format) and `railcrash report` adds:
-/// timeseries.csv, events.csv, accelerations.csv, energy.csv, timeseries.h5, summary.json (and
-/// its summary.json.tmp), model.json, report.html. A run owns them: it starts by removing those
+/// The files a run writes into its folder (any output format: the formats' folder_files,
+/// results/output_sink.hpp) and `railcrash report` adds: timeseries.csv, events.csv,
+/// accelerations.csv, energy.csv, timeseries.h5, summary.json (and its summary.json.tmp),
+/// model.json, report.html, energy_zones.csv. A run owns them: it starts by removing those
 /// an earlier run left (remove_earlier_run_files), so that its folder never mixes two runs.
 const std::vector<std::string>& run_folder_files();
 
