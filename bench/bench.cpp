@@ -162,7 +162,7 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
     apply_overrides(model, overrides);
     const double cpu_start = cpu_seconds();
     const auto wall_start = std::chrono::steady_clock::now();
-    const RunReport report = run_model(model, "", nullptr, false, false, OutputFormat::Csv, /*time_phases=*/true);
+    const RunReport report = run_model(model, "", nullptr, false, false, "csv", /*time_phases=*/true);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     const double cpu = cpu_seconds() - cpu_start;
     const RunStatistics& s = report.outcome.stats;

@@ -107,7 +107,7 @@ Results run(const Model& model, const RunSettings& settings, const std::atomic<b
   overrides.force_dt = settings.force_dt;
   apply_overrides(loaded, overrides);
 
-  RunReport report = run_model(loaded, "", stop, false, true, OutputFormat::Csv, settings.timings);
+  RunReport report = run_model(loaded, "", stop, false, /*keep_in_memory=*/true, "csv", settings.timings);
   Results results;
   results.columns = std::move(report.columns);
   results.values = std::move(report.series);

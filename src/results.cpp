@@ -284,61 +284,46 @@ std::vector<std::string> timeseries_columns(const DaeSystem& system) {
   return names;
 }
 
-ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory, OutputFormat format)
-    : system_(system), directory_(directory), provenance_(run_provenance(system.model(), new_run_id())), format_(format),
+ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory,
+                           const std::string& format)
+    : system_(system), directory_(directory), provenance_(run_provenance(system.model(), new_run_id())),
       last_flush_(std::chrono::steady_clock::now()), running_summary_(last_flush_) {
-  const std::vector<std::string> names = timeseries_columns(system);
+  const Model& model = system.model();
+  const bool si = model.units == UnitSystem::SI;
+  const std::string length = si ? "m" : "in";
+  OutputLayout layout;
+  layout.directory = directory;
+  layout.model = &model;
+  layout.provenance = &provenance_;
   std::vector<std::string> acceleration_names{"t"};
-  for (const Body& b : system.model().bodies())
+  for (const Body& b : model.bodies())
     for (const char* q : {"ax", "ay", "alpha"}) acceleration_names.push_back(b.name + "." + q);
+  energy_ = std::make_unique<EnergyWriter>(system);
+  layout.tables = {OutputTableLayout{"timeseries", timeseries_columns(system),
+                                     "x, y: " + length + "; theta: rad; vx, vy: " + length +
+                                         "/s; omega: rad/s; element outputs: the file's units"},
+                   OutputTableLayout{"accelerations", acceleration_names, si ? "m/s^2, rad/s^2" : "in/s^2, rad/s^2"},
+                   OutputTableLayout{"energy", energy_->columns(), si ? "J" : "in*lbf"}};
   if (!directory.empty()) {
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) throw InputError("cannot create the output folder '" + directory + "': " + error.message());
     folder_lock_ = std::make_unique<FolderLock>(directory);  // (throws: another process writes there)
     removed_files_ = remove_earlier_run_files(directory);  // the folder holds this run's files only
-    if (format == OutputFormat::Hdf5) hdf5_ = std::make_unique<Hdf5File>(directory + "/timeseries.h5");  // (throws)
-    using CsvFile = std::pair<std::unique_ptr<BufferedFile>*, const char*>;
-    const std::vector<CsvFile> csv_files =
-        hdf5_ ? std::vector<CsvFile>{}
-              : std::vector<CsvFile>{{&timeseries_, "timeseries.csv"}, {&events_, "events.csv"},
-                                     {&accelerations_file_, "accelerations.csv"}, {&energy_file_, "energy.csv"}};
-    for (auto [file, name] : csv_files) {
-      *file = std::make_unique<BufferedFile>(directory + "/" + name);
-      if (!(*file)->is_open())
-        throw InputError("cannot write into the output folder '" + directory + "': " + name + ": " + std::strerror((*file)->error()));
-      (*file)->text(provenance_comment(provenance_));  // every CSV file's first line
-    }
+    sinks_.push_back(make_output_sink(format));
+    sinks_.back()->begin(layout);  // (throws: the files cannot be made)
     write_model_geometry(system, directory + "/model.json", provenance_.run_id);  // (throws: before the folder is held open)
     folder_descriptor_ = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (folder_descriptor_ < 0) throw InputError("cannot open the output folder '" + directory + "': " + std::strerror(errno));
-    energy_ = std::make_unique<EnergyWriter>(system, energy_file_.get());
-    if (hdf5_) {
-      const Model& model = system.model();
-      const bool si = model.units == UnitSystem::SI;
-      hdf5_->attribute("railcrash_version", provenance_.version);
-      hdf5_->attribute("run_id", provenance_.run_id);
-      hdf5_->attribute("provenance", provenance_json(provenance_));
-      hdf5_->attribute("model", model.name);
-      hdf5_->attribute("model_file", model.file);
-      hdf5_->attribute("units", std::string(unit_system_name(model.units)) + ": length " + (si ? "m" : "in") +
-                                    ", time s, angle rad, force " + (si ? "N" : "lbf") + ", energy " + (si ? "J" : "in*lbf"));
-      const std::string length = si ? "m" : "in";
-      hdf5_tables_.timeseries = hdf5_->add_table("timeseries", names, "x, y: " + length + "; theta: rad; vx, vy: " + length +
-                                                                          "/s; omega: rad/s; element outputs: the file's units");
-      hdf5_tables_.accelerations = hdf5_->add_table("accelerations", acceleration_names, si ? "m/s^2, rad/s^2" : "in/s^2, rad/s^2");
-      hdf5_tables_.energy = hdf5_->add_table("energy", energy_->columns(), si ? "J" : "in*lbf");
-      hdf5_tables_.events = hdf5_->add_event_table("events");
-      if (!hdf5_->flush()) throw InputError(hdf5_->error());
-    } else {
-      for (std::size_t k = 0; k < acceleration_names.size(); ++k) accelerations_file_->text((k ? "," : "") + acceleration_names[k]);
-      accelerations_file_->character('\n');
-      for (std::size_t k = 0; k < names.size(); ++k) timeseries_->text((k ? "," : "") + names[k]);
-      timeseries_->character('\n');
-      events_->text("t,element,event,value\n");
-    }
   }
-  if (keep_in_memory) columns_.resize(names.size());
+  if (keep_in_memory) {
+    sinks_.push_back(make_output_sink("memory"));
+    sinks_.back()->begin(layout);
+    kept_columns_ = sinks_.back()->kept_columns();
+  }
+  for (const std::unique_ptr<OutputSink>& sink : sinks_)
+    for (std::size_t k = 0; k < kOutputTableCount; ++k) table_taken_[k] = table_taken_[k] || sink->takes(static_cast<OutputTable>(k));
+  if (!table_taken_[static_cast<std::size_t>(OutputTable::Energy)]) energy_.reset();  // (its rows cost a sweep over the elements)
   const std::size_t body_count = static_cast<std::size_t>(system.model().body_count());
   vx_.assign(body_count, {});
   ax_.assign(body_count, {});
@@ -376,47 +361,32 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
                                  const double* outputs) {
   const int n = system_.model().body_count();
   const int nq = 3 * n;
-  if (timeseries_) {
-    timeseries_->number(t);
-    for (int i = 0; i < n; ++i)
-      for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2}) {
-        timeseries_->character(',');
-        timeseries_->number(y[k]);
-      }
-  }
   const std::size_t output_count = system_.output_names().size();
-  if (timeseries_) write_row_tail(*timeseries_, outputs, output_count);
   track_extrema(t, y, lambda, outputs, FreshOutputs{});
-  if (!system_.model().run_spec.output_points.empty()) {
-    output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
-    if (timeseries_) write_row_tail(*timeseries_, point_values_);
-  }
-  if (timeseries_) {
-    timeseries_->character('\n');
-    row_ends_.emplace_back(timeseries_->appended(), t);
-  }
-  if (!columns_.empty() || hdf5_) {  // the row, in the order of the CSV columns
+  if (!system_.model().run_spec.output_points.empty()) output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
+  const auto taken = [&](OutputTable table) { return table_taken_[static_cast<std::size_t>(table)]; };
+  const auto hand_on = [&](OutputTable table, const double* values) {
+    for (const std::unique_ptr<OutputSink>& sink : sinks_)
+      if (sink->takes(table)) sink->row(table, values);
+  };
+  if (taken(OutputTable::Timeseries)) {  // in the order of the columns (timeseries_columns)
     row_.assign(1, t);
     for (int i = 0; i < n; ++i)
       for (const int k : {3 * i, 3 * i + 1, 3 * i + 2, nq + 3 * i, nq + 3 * i + 1, nq + 3 * i + 2}) row_.push_back(y[k]);
     row_.insert(row_.end(), outputs, outputs + output_count);
-    if (!system_.model().run_spec.output_points.empty()) row_.insert(row_.end(), point_values_.begin(), point_values_.end());
-    for (std::size_t column = 0; column < columns_.size(); ++column) columns_[column].push_back(row_[column]);
-    if (hdf5_) {
-      hdf5_->append(hdf5_tables_.timeseries, row_.data());
-      row_.assign(1, t);
-      row_.insert(row_.end(), acceleration_.begin(), acceleration_.end());
-      hdf5_->append(hdf5_tables_.accelerations, row_.data());
-    }
+    row_.insert(row_.end(), point_values_.begin(), point_values_.end());
+    hand_on(OutputTable::Timeseries, row_.data());
   }
-  if (accelerations_file_) {
-    accelerations_file_->number(t);
-    write_row_tail(*accelerations_file_, acceleration_);
-    accelerations_file_->character('\n');
+  if (taken(OutputTable::Accelerations)) {
+    row_.assign(1, t);
+    row_.insert(row_.end(), acceleration_.begin(), acceleration_.end());
+    hand_on(OutputTable::Accelerations, row_.data());
   }
-  if (energy_) energy_->sample(t, y, quadratures);
+  if (energy_) {
+    energy_->sample(t, y, quadratures);
+    hand_on(OutputTable::Energy, energy_->row().data());
+  }
   crush_zones_->sample(y, quadratures);
-  if (hdf5_) hdf5_->append(hdf5_tables_.energy, energy_->row().data());
   // The mean over the interval since the last sample, from velocities in double precision.
   const double span = sample_times_.empty() ? 0.0 : t - sample_times_.back();
   if (span > 0.0) mean_times_.push_back(sample_times_.back() + 0.5 * span);
@@ -504,39 +474,9 @@ void ResultWriter::fail(const std::string& what, int error_number) {
 }
 
 void ResultWriter::check_files(bool flush, bool look_at_folder) {
-  const std::pair<BufferedFile*, const char*> files[] = {{timeseries_.get(), "timeseries.csv"},
-                                                         {events_.get(), "events.csv"},
-                                                         {accelerations_file_.get(), "accelerations.csv"},
-                                                         {energy_file_.get(), "energy.csv"}};
-  const bool failed_before = !failure_.empty();
-  bool all_written = true;
-  for (const auto& [file, name] : files) {
-    if (!file) continue;
-    if (flush) file->flush();
-    if (file->error() != 0) {
-      fail("cannot write " + directory_ + "/" + name, file->error());
-      all_written = false;
-    }
-  }
-  if (hdf5_) {
-    if (flush) hdf5_->flush();
-    if (failure_.empty()) failure_ = hdf5_->error();
-    all_written = all_written && hdf5_->error().empty();
-  }
-  if (timeseries_) {  // the rows whose last byte the OS has
-    for (; !row_ends_.empty() && row_ends_.front().first <= timeseries_->written(); row_ends_.pop_front()) {
-      ++rows_on_disk_;
-      t_on_disk_ = row_ends_.front().second;
-    }
-  } else if (hdf5_ && flush && all_written && failure_.empty()) {  // every row so far is in the file
-    rows_on_disk_ = sample_times_.size();
-    t_on_disk_ = sample_times_.empty() ? -1.0 : sample_times_.back();
-  }
-  if (!failed_before && !failure_.empty() && !all_written) {  // say what the files hold, not what was computed
-    const std::string file = timeseries_ ? "timeseries.csv" : "timeseries.h5";
-    failure_ += rows_on_disk_ == 0 ? "; " + file + " holds no output row"
-                                   : "; " + file + " holds the first " + std::to_string(rows_on_disk_) +
-                                         " rows whole, up to t = " + json_number(t_on_disk_) + " (the rows after it were lost)";
+  for (const std::unique_ptr<OutputSink>& sink : sinks_) {
+    const std::string failed = sink->check(flush);  // (the first failure, with what the files hold)
+    if (failure_.empty()) failure_ = failed;
   }
   // One fstat of the open folder (no path lookup): a removed folder (no links left) stops the
   // run. Not at every sample: a system call per row was 11 % of a slider-crank run with 1 ms
@@ -575,32 +515,11 @@ bool ResultWriter::replace_summary(const std::string& text) {
   return true;
 }
 
-void ResultWriter::write_energy_zones() {
-  const std::string path = directory_ + "/energy_zones.csv";
-  std::ofstream out(path, std::ios::binary);
-  out << provenance_comment(provenance_) << crush_zones_->csv();
-  out.flush();
-  if (!out) fail("cannot write " + path, errno);
-}
-
 void ResultWriter::event(const EventRecord& record, const double*) {
-  if (hdf5_) {
-    hdf5_->append_event(hdf5_tables_.events, record.t, record.element, record.what, record.value);
-    return;
+  for (const std::unique_ptr<OutputSink>& sink : sinks_) {
+    const std::string failed = sink->event(record);
+    if (failure_.empty()) failure_ = failed;
   }
-  if (!events_) return;  // in memory, the events are the run outcome's
-  std::string element = record.element, what = record.what;
-  for (std::string* text : {&element, &what})
-    if (text->find_first_of(",\"") != std::string::npos) {
-      std::string quoted = "\"";
-      for (char c : *text) quoted += (c == '"') ? std::string("\"\"") : std::string(1, c);
-      *text = quoted + "\"";
-    }
-  events_->number(record.t);
-  events_->text("," + element + "," + what + ",");
-  events_->number(record.value);
-  events_->character('\n');
-  if (events_->error() != 0) fail("cannot write " + directory_ + "/events.csv", events_->error());
 }
 
 std::vector<FilteredAccelerations> ResultWriter::filtered_accelerations() const {
@@ -657,7 +576,11 @@ std::string ResultWriter::write_summary(const RunOutcome& outcome, const std::st
   if (!directory_.empty() && failure_.empty()) check_files(/*flush=*/true, /*look_at_folder=*/true);
   const std::string text = summary_text(outcome, outcome.ok ? "ok" : "failed", integrator, extra_json);
   if (!directory_.empty()) replace_summary(text);  // also after a failed CSV write: the summary may still fit
-  if (!directory_.empty() && !hdf5_) write_energy_zones();
+  if (!directory_.empty())
+    for (const std::unique_ptr<OutputSink>& sink : sinks_) {
+      const std::string failed = sink->finish(*crush_zones_);
+      if (failure_.empty()) failure_ = failed;
+    }
   return text;
 }
 
@@ -680,13 +603,7 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     j << "  \"integrator_used\": {\"method\": " << json_string(s.handed_over_at >= 0.0 ? "ida+euler" : "ida")
       << ", \"euler_from_t\": " << (s.handed_over_at >= 0.0 ? json_number(s.handed_over_at) : "null")
       << ", \"reason\": " << json_string(s.hand_over_reason) << "},\n";
-  if (hdf5_)  // (the CSV files are the default: their summary is as it always was)
-    j << "  \"output\": {\"format\": " << json_string(output_format_name(format_))
-      << ", \"files\": [\"timeseries.h5\"], \"datasets\": [\"timeseries\", \"accelerations\", \"energy\", \"events\"]"
-      // The rows the file held whole at its last flush that succeeded (a kill after it leaves
-      // them readable; rows after them may be missing or zero).
-      << ", \"valid_rows\": " << rows_on_disk_ << ", \"valid_to_t\": " << json_number(t_on_disk_ < 0.0 ? 0.0 : t_on_disk_)
-      << "},\n";
+  for (const std::unique_ptr<OutputSink>& sink : sinks_) j << sink->summary_entry();  // (none for the CSV files)
   j << "  \"units\": {\"system\": " << json_string(unit_system_name(model.units)) << ", \"length\": "
     << json_string(si ? "m" : "in") << ", \"time\": \"s\", \"force\": " << json_string(si ? "N" : "lbf")
     << ", \"mass\": " << json_string(si ? "kg" : "lbf*s^2/in") << ", \"angle\": \"rad\", \"energy\": "

@@ -220,7 +220,7 @@ std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationS
 }
 
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
-                    bool keep_in_memory, OutputFormat format, bool time_phases) {
+                    bool keep_in_memory, const std::string& format, bool time_phases) {
   DaeSystem system(model);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;

@@ -119,7 +119,7 @@ namespace {
 /// energy.csv's row at the end of a run, computed as the run folder's writer computes it:
 /// the first sample at the start state (quadratures zero), the second at the run's end.
 std::vector<double> energy_row(DaeSystem& system, const RunOutcome& o, std::vector<std::string>& columns) {
-  EnergyWriter writer(system, nullptr);
+  EnergyWriter writer(system);
   const std::vector<double> start = system.initial_state();
   const std::vector<double> no_work(static_cast<std::size_t>(system.quadrature_count()), 0.0);
   const ElementStates::Snapshot final_modes = system.modes().snapshot();

@@ -325,7 +325,7 @@ TEST_CASE("a timed run's phases add up to its wall time, each where its work is"
   std::filesystem::remove_all(dir);
   const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
                                  {"simulation.t_end=0.2"});
-  const RunReport timed = run_model(model, dir, nullptr, false, false, OutputFormat::Csv, /*time_phases=*/true);
+  const RunReport timed = run_model(model, dir, nullptr, false, false, "csv", /*time_phases=*/true);
   REQUIRE(timed.outcome.ok);
   const RunStatistics& s = timed.outcome.stats;
   REQUIRE(s.phases_timed);
@@ -352,7 +352,7 @@ TEST_CASE("a timed run's phases add up to its wall time, each where its work is"
   // Euler's phases: its force sweeps and mode changes; no Jacobian, no linear solver.
   const Model euler = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
                                  {"simulation.t_end=0.05", "simulation.integrator=euler"});
-  const RunReport explicit_run = run_model(euler, "", nullptr, false, false, OutputFormat::Csv, true);
+  const RunReport explicit_run = run_model(euler, "", nullptr, false, false, "csv", true);
   REQUIRE(explicit_run.outcome.stats.phases_timed);
   const auto& e = explicit_run.outcome.stats.phase_seconds;
   CHECK(e[static_cast<std::size_t>(Phase::Residual)] > 0.0);

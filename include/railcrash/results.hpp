@@ -9,7 +9,8 @@
 // both sides of every event and the output samples, with their times:
 // {"max", "t_max", "min", "t_min"} (a contact's penetration: max; its gap: min; README).
 // In memory (the library's runs, api.hpp): the timeseries.csv columns as vectors and the
-// summary.json text; no folder is needed.
+// summary.json text; no folder is needed. The writer computes each row once and hands it to
+// the run's output sinks (results/output_sink.hpp: csv, hdf5, memory), which format and keep it.
 //
 // Peak accelerations: every body's acceleration v' at every output sample, from its
 // equations of motion  M v' = f(t, q, v) - G^T lambda  (lambda: IDA's multipliers, or the
@@ -36,7 +37,7 @@
 // change, mean deceleration; results/crash_pulse.hpp) as "collision". The filter needs a
 // sample rate of at least 2 x 2.0775 CFC; below 10 CFC the summary says the sampling is too coarse.
 // The run folder also gets model.json, accelerations.csv and energy.csv (results/run_files.hpp).
-// With OutputFormat::Hdf5 the four per-row CSV files (timeseries, events, accelerations, energy)
+// With the output format hdf5 the four per-row CSV files (timeseries, events, accelerations, energy)
 // are datasets of one file instead, DIR/timeseries.h5 (results/hdf5_file.hpp); summary.json's
 // "output" then names the format, file and datasets.
 //
@@ -78,7 +79,7 @@
 #include "railcrash/integrator.hpp"
 #include "railcrash/results/crash_pulse.hpp"
 #include "railcrash/results/crush_zones.hpp"
-#include "railcrash/results/hdf5_file.hpp"
+#include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/provenance.hpp"
 
 namespace railcrash {
@@ -229,11 +230,12 @@ class SummarySchedule {
 class ResultWriter : public RunObserver {
  public:
   /// Creates DIR, removes the files an earlier run left in it (run_files.hpp: removed_files()),
-  /// and creates the CSV files, each with its provenance line (results/provenance.hpp) and its
-  /// header, or timeseries.h5 (DIR empty: no files). With
-  /// keep_in_memory, every sample is also kept as one value per timeseries column.
+  /// and begins the sink of the output format named (results/output_sink.hpp: "csv", each CSV
+  /// file with its provenance line (results/provenance.hpp) and its header; "hdf5":
+  /// timeseries.h5) (DIR empty: no files). With keep_in_memory, every sample is also kept as
+  /// one value per timeseries column (the sink "memory").
   ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory = false,
-               OutputFormat format = OutputFormat::Csv);
+               const std::string& format = "csv");
   ~ResultWriter() override;
   ResultWriter(const ResultWriter&) = delete;
   ResultWriter& operator=(const ResultWriter&) = delete;
@@ -254,10 +256,10 @@ class ResultWriter : public RunObserver {
   /// Writes summary.json with "status": "running" (t_reached and peaks so far; stats and
   /// energy come at the end); sample() replaces it every few seconds of wall time.
   void write_running_summary(const std::string& integrator);
-  /// Flushes the CSV files and writes summary.json when there is a folder (call once, at the
+  /// Flushes the sinks' files and writes summary.json when there is a folder (call once, at the
   /// end, whatever the outcome); returns its text. Every summary.json is written to a
   /// temporary file in the folder and renamed over the old one, so the file is always whole.
-  /// A failed write (also of an earlier CSV row) sets failure().
+  /// A failed write (also of an earlier row) sets failure().
   std::string write_summary(const RunOutcome& outcome, const std::string& integrator, const std::string& extra_json = "");
   const std::string& directory() const { return directory_; }
   /// This run's provenance (results/provenance.hpp): its id, program, model files and settings.
@@ -265,7 +267,7 @@ class ResultWriter : public RunObserver {
   /// The files of an earlier run that the constructor removed from the folder (run_files.hpp).
   const std::vector<std::string>& removed_files() const { return removed_files_; }
   /// The kept samples (keep_in_memory): columns[k] is timeseries column k over the samples.
-  std::vector<std::vector<double>>& columns() { return columns_; }
+  std::vector<std::vector<double>>& columns() { return kept_columns_ ? *kept_columns_ : no_columns_; }
   /// Peaks so far, per body in model order.
   const std::vector<AccelerationPeaks>& acceleration_peaks() const { return acceleration_peaks_; }
   /// Largest crush of each car so far.
@@ -284,17 +286,17 @@ class ResultWriter : public RunObserver {
  private:
   /// What sample() does once acceleration_ holds the body accelerations at the sample.
   void record_sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs);
-  /// Writes DIR/energy_zones.csv: the provenance line, then CrushZoneTracker::csv().
-  void write_energy_zones();
 
   const DaeSystem& system_;
   std::string directory_;
   Provenance provenance_;
   std::unique_ptr<FolderLock> folder_lock_;  // the folder is this run's alone while it writes (null without a folder)
   std::vector<std::string> removed_files_;  // of an earlier run, removed by the constructor
-  std::unique_ptr<BufferedFile> timeseries_, events_;  // null without a folder
+  std::vector<std::unique_ptr<OutputSink>> sinks_;   // where the rows go: the folder's format, then memory
+  std::array<bool, kOutputTableCount> table_taken_{};  // by some sink: a table none takes is not computed
+  std::vector<std::vector<double>>* kept_columns_ = nullptr;  // the memory sink's, per timeseries column
+  std::vector<std::vector<double>> no_columns_;             // columns() without a memory sink
   int folder_descriptor_ = -1;                          // the open folder, to notice its removal
-  std::vector<std::vector<double>> columns_;  // in memory, per timeseries column
   // Signed largest and smallest value of each element output, and when [time].
   std::vector<double> output_max_, output_min_;
   std::vector<double> t_output_max_, t_output_min_;
@@ -304,15 +306,9 @@ class ResultWriter : public RunObserver {
   std::vector<CarCrush> cars_;
   bool car_lengths_measured_ = false;  // each car's L(0) taken from the first state shown
   std::vector<double> crush_scratch_;  // outputs of a car's crush elements evaluated at an event (car_crush_at)
-  std::unique_ptr<BufferedFile> accelerations_file_, energy_file_;
-  std::unique_ptr<EnergyWriter> energy_;
+  std::unique_ptr<EnergyWriter> energy_;  // energy rows (when a sink takes them)
   std::unique_ptr<CrushZoneTracker> crush_zones_;  // energy per crush zone (summary.json, energy_zones.csv)
-  OutputFormat format_ = OutputFormat::Csv;
-  std::unique_ptr<Hdf5File> hdf5_;  // --format hdf5: in place of the four CSV files
-  struct Hdf5Tables {
-    int timeseries = -1, accelerations = -1, energy = -1, events = -1;
-  } hdf5_tables_;
-  std::vector<double> row_;  // one timeseries (or accelerations) row, for memory and HDF5
+  std::vector<double> row_;  // one timeseries (or accelerations) row, handed to the sinks
   double cfc_ = 60.0;
   std::vector<double> sample_times_;                  // [time]
   // Per body, per sample, for the filtered peaks and collision pulses at the end; in single
@@ -335,11 +331,6 @@ class ResultWriter : public RunObserver {
   bool folder_checked_ = false;                          // by a sample
   std::string integrator_;                               // for the running summary
   double t_last_sample_ = 0.0;                           // [time]
-  // The rows the OS has whole: timeseries.csv's rows up to its bytes written; timeseries.h5's
-  // rows at its last flush that succeeded.
-  std::size_t rows_on_disk_ = 0;
-  double t_on_disk_ = -1.0;                              // [time] the last of them (-1: none)
-  std::deque<std::pair<std::uint64_t, double>> row_ends_;  // timeseries.csv: byte after each row not yet written, its t
   std::string failure_;                                  // first failed write, with the OS's reason
 
   /// Peaks of the element outputs and the cars' largest crush, with the outputs at t.
@@ -348,8 +339,8 @@ class ResultWriter : public RunObserver {
                            const std::string& extra_json) const;
   /// Writes text to DIR/summary.json through a temporary file and a rename; false (and failure_ set) on error.
   bool replace_summary(const std::string& text);
-  /// Checks the CSV files' error flags (and flushes them with `flush`) and, with
-  /// `look_at_folder`, that the folder still exists.
+  /// Checks the sinks' writes (and flushes them with `flush`) and, with `look_at_folder`, that
+  /// the folder still exists.
   void check_files(bool flush, bool look_at_folder);
   void fail(const std::string& what, int error_number);
 };

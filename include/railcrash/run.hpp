@@ -70,7 +70,8 @@ void set_output_memory_limit(double bytes);
 double output_memory_limit();
 
 /// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files;
-/// OutputFormat::Hdf5: timeseries.h5 in place of the per-row CSV files, results/hdf5_file.hpp);
+/// format: a registered output format that writes files, results/output_sink.hpp: "hdf5" writes
+/// timeseries.h5 in place of the per-row CSV files);
 /// with keep_in_memory the same results also come back in the report.
 /// Input errors throw InputError before anything runs (also an output whose memory estimate is
 /// above output_memory_limit(), with the figures and what lowers it); solver failures come back
@@ -78,7 +79,7 @@ double output_memory_limit();
 /// time_phases: the run's wall time split by phase (RunStatistics::phase_seconds; summary.json's
 /// stats.seconds; `railcrash run --timings`).
 RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
-                    bool show_progress = false, bool keep_in_memory = false, OutputFormat format = OutputFormat::Csv,
+                    bool show_progress = false, bool keep_in_memory = false, const std::string& format = "csv",
                     bool time_phases = false);
 
 }  // namespace railcrash

@@ -11,6 +11,7 @@
 #include "railcrash/model_io.hpp"
 #include "railcrash/results/accuracy_check.hpp"
 #include "railcrash/results/cfc_filter.hpp"
+#include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/run_files.hpp"
 #include "railcrash/run.hpp"
 
@@ -19,10 +20,10 @@ namespace railcrash::cli {
 namespace {
 
 int run_and_print(const std::string& path, const std::vector<std::string>& settings, const railcrash::RunOverrides& overrides,
-                    const std::string& out_dir, bool with_report, bool quiet, railcrash::OutputFormat format, bool timings) {
+                    const std::string& out_dir, bool with_report, bool quiet, const std::string& format, bool timings) {
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
-  if (format == OutputFormat::Hdf5) require_hdf5();
+  require_output_format(format);
   Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
   // The folder is this run's: locked against a second writer, then an earlier run's files go
   // (the writer would remove them too), said here.
@@ -105,8 +106,7 @@ int run_and_print(const std::string& path, const std::vector<std::string>& setti
                   "", aliased.c_str());
   }
   std::printf("results in %s/ (%s, summary.json, model.json), run id %s\n", out_dir.c_str(),
-              format == OutputFormat::Hdf5 ? "timeseries.h5: timeseries, events, accelerations, energy"
-                                           : "timeseries.csv, events.csv, accelerations.csv, energy.csv, energy_zones.csv",
+              output_format(format).files,
               report.run_id.c_str());
   if (with_report) write_run_report(out_dir, 60.0);
   return o.ok ? 0 : 1;
@@ -134,10 +134,9 @@ class RunCommand final : public Command {
     add_out_folder_option(*command, out_dir_);
     add_set_option(*command, settings_);
     command->add_flag("--report", with_report_, "also write DIR/report.html (as `railcrash report DIR`)");
-    command->add_option("--format", output_format_,
-                        "csv, or hdf5: DIR/timeseries.h5 in place of the per-row CSV files (README \"Binary output\")")
+    command->add_option("--format", output_format_, output_format_help())
         ->capture_default_str()
-        ->check(CLI::IsMember({"csv", "hdf5"}));
+        ->check(CLI::IsMember(file_output_format_names()));
     command->add_flag("--quiet", quiet_, "no progress (a bar on a terminal, else a line every 5 s, on stderr)");
     command->add_option("--max-output-memory", max_output_memory_gb_,
                         "refuse a run whose output would keep more memory than this [GB] until its end (0: no limit)")
@@ -159,7 +158,7 @@ class RunCommand final : public Command {
     if (*max_steps_option_) overrides_.max_steps = max_steps_;
     set_output_memory_limit(max_output_memory_gb_ * 1e9);
     return run_and_print(model_path_, settings_, overrides_, out_dir_, with_report_, quiet_,
-                         output_format_ == "hdf5" ? OutputFormat::Hdf5 : OutputFormat::Csv, timings_);
+                         output_format_, timings_);
   }
 
  private:

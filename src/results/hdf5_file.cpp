@@ -18,8 +18,6 @@
 
 namespace railcrash {
 
-const char* output_format_name(OutputFormat format) { return format == OutputFormat::Hdf5 ? "hdf5" : "csv"; }
-
 void require_hdf5() {
   if (!hdf5_available())
     throw InputError("--format hdf5: this railcrash was built without HDF5; install Debian's libhdf5-dev "

@@ -8,13 +8,21 @@
 #include <sstream>
 
 #include "railcrash/results.hpp"
+#include "railcrash/results/output_sink.hpp"
 
 namespace railcrash {
 
 const std::vector<std::string>& run_folder_files() {
-  static const std::vector<std::string> names = {"timeseries.csv", "events.csv",   "accelerations.csv", "energy.csv",
-                                                 "timeseries.h5",  "summary.json", "summary.json.tmp",  "model.json",
-                                                 "report.html",    "energy_zones.csv"};
+  static const std::vector<std::string> names = [] {
+    // In the order the messages have always named them; then the files of a format registered since.
+    std::vector<std::string> files = {"timeseries.csv", "events.csv",   "accelerations.csv", "energy.csv",
+                                      "timeseries.h5",  "summary.json", "summary.json.tmp",  "model.json",
+                                      "report.html",    "energy_zones.csv"};
+    for (const OutputFormat& format : output_formats())
+      for (const std::string& file : format.folder_files)
+        if (std::find(files.begin(), files.end(), file) == files.end()) files.push_back(file);
+    return files;
+  }();
   return names;
 }
 
@@ -97,7 +105,7 @@ void write_model_geometry(const DaeSystem& system, const std::string& path, cons
   if (!out) throw InputError("cannot write " + path);
 }
 
-EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile* file) : system_(system), file_(file) {
+EnergyWriter::EnergyWriter(const DaeSystem& system) : system_(system) {
   const Model& model = system.model();
   for (const auto& e : model.elements()) {
     auto it = std::find(types_.begin(), types_.end(), e->type());
@@ -109,9 +117,6 @@ EnergyWriter::EnergyWriter(const DaeSystem& system, BufferedFile* file) : system
   columns_ = {"t", "kinetic", "elastic", "gravity", "external_work", "dissipated"};
   for (const std::string& type : types_) columns_.push_back("dissipated." + type);
   columns_.push_back("integration_drift");
-  if (!file_) return;
-  for (std::size_t k = 0; k < columns_.size(); ++k) file_->text((k ? "," : "") + columns_[k]);
-  file_->character('\n');
 }
 
 void EnergyWriter::sample(double t, const double* y, const double* quadratures) {
@@ -145,12 +150,6 @@ void EnergyWriter::sample(double t, const double* y, const double* quadratures) 
   row_.assign({t, kinetic, elastic, gravity, load_work, dissipated});
   row_.insert(row_.end(), dissipated_.begin(), dissipated_.end());
   row_.push_back(drift);
-  if (!file_) return;
-  for (std::size_t k = 0; k < row_.size(); ++k) {
-    if (k > 0) file_->character(',');
-    file_->number(row_[k]);
-  }
-  file_->character('\n');
 }
 
 }  // namespace railcrash

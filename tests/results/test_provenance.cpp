@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "railcrash/model_io.hpp"
+#include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/results/run_files.hpp"
 #include "railcrash/run.hpp"
@@ -152,12 +153,12 @@ TEST_CASE("A run removes the files an earlier run left in its folder and nothing
   fs::create_symlink("notes.txt", dir / "summary.json.tmp");  // a link in a file's place is not the run's to remove
 
   // The HDF5 run where the CSV run was (the case of the issue), or a CSV run where an HDF5 run left its file.
-  const OutputFormat format = hdf5_available() ? OutputFormat::Hdf5 : OutputFormat::Csv;
-  if (format == OutputFormat::Csv) write(dir / "timeseries.h5", "an earlier HDF5 run's file");
+  const std::string format = hdf5_available() ? "hdf5" : "csv";
+  if (format == "csv") write(dir / "timeseries.h5", "an earlier HDF5 run's file");
   const DaeSystem system(model);
   const ResultWriter writer(dir.string(), system, false, format);
   const std::vector<std::string> expected =
-      format == OutputFormat::Hdf5
+      format == "hdf5"
           ? std::vector<std::string>{"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv", "summary.json", "model.json",
                                      "report.html", "energy_zones.csv"}
           : std::vector<std::string>{"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv", "timeseries.h5",
@@ -167,7 +168,7 @@ TEST_CASE("A run removes the files an earlier run left in its folder and nothing
   CHECK(fs::is_symlink(dir / "summary.json.tmp"));
   CHECK_FALSE(fs::exists(dir / "report.html"));
   CHECK_FALSE(fs::exists(dir / "summary.json"));
-  if (format == OutputFormat::Hdf5)
+  if (format == "hdf5")
     for (const char* name : {"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv"}) CHECK_FALSE(fs::exists(dir / name));
   else
     CHECK_FALSE(fs::exists(dir / "timeseries.h5"));

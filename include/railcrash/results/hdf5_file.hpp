@@ -1,4 +1,4 @@
-// The run folder's binary output (`railcrash run --format hdf5`): DIR/timeseries.h5, one HDF5
+// The run folder's binary output (`railcrash run --format hdf5`, src/results/hdf5_sink.cpp): DIR/timeseries.h5, one HDF5
 // file in place of the per-row CSV files, for large runs. Each table is one dataset, chunked and
 // extendible along its rows, filled in blocks of rows as the run goes (the run is never held in
 // memory):
@@ -30,12 +30,6 @@
 #include <vector>
 
 namespace railcrash {
-
-/// Files of a run folder: the CSV files, or timeseries.h5 in place of the per-row ones.
-enum class OutputFormat { Csv, Hdf5 };
-
-/// "csv" or "hdf5".
-const char* output_format_name(OutputFormat format);
 
 /// Whether this build writes HDF5 (CMake found libhdf5-dev).
 bool hdf5_available();

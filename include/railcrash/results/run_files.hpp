@@ -24,7 +24,6 @@
 #include <vector>
 
 #include "railcrash/dae_system.hpp"
-#include "railcrash/results/buffered_file.hpp"
 
 namespace railcrash {
 
@@ -32,9 +31,10 @@ namespace railcrash {
 /// Throws InputError if it cannot be written.
 void write_model_geometry(const DaeSystem& system, const std::string& path, const std::string& run_id = "");
 
-/// The files a run writes into its folder (either output format) and `railcrash report` adds:
-/// timeseries.csv, events.csv, accelerations.csv, energy.csv, timeseries.h5, summary.json (and
-/// its summary.json.tmp), model.json, report.html. A run owns them: it starts by removing those
+/// The files a run writes into its folder (any output format: the formats' folder_files,
+/// results/output_sink.hpp) and `railcrash report` adds: timeseries.csv, events.csv,
+/// accelerations.csv, energy.csv, timeseries.h5, summary.json (and its summary.json.tmp),
+/// model.json, report.html, energy_zones.csv. A run owns them: it starts by removing those
 /// an earlier run left (remove_earlier_run_files), so that its folder never mixes two runs.
 const std::vector<std::string>& run_folder_files();
 
@@ -44,10 +44,10 @@ const std::vector<std::string>& run_folder_files();
 /// cannot be removed.
 std::vector<std::string> remove_earlier_run_files(const std::string& directory);
 
-/// Computes energy.csv's row at every sample and writes it to file (with the header first), if any.
+/// Computes energy.csv's row at every sample (the output sinks write it: results/output_sink.hpp).
 class EnergyWriter {
  public:
-  EnergyWriter(const DaeSystem& system, BufferedFile* file);
+  explicit EnergyWriter(const DaeSystem& system);
   void sample(double t, const double* y, const double* quadratures);
   /// energy.csv's column names.
   const std::vector<std::string>& columns() const { return columns_; }
@@ -56,7 +56,6 @@ class EnergyWriter {
 
  private:
   const DaeSystem& system_;
-  BufferedFile* file_;                   // null: rows in row() only
   std::vector<std::string> columns_;
   std::vector<double> row_;
   std::vector<std::string> types_;       // element types, in first-appearance order
