@@ -617,6 +617,56 @@ const Element& DaeSystem::constraint_owner(int row) const {
   return *model_.elements()[static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)])];
 }
 
+std::string DaeSystem::element_label(int e, const char* noun) const {
+  const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
+  return el.where().prefix() + noun + " '" + el.name() + "' (" + el.type() + ")";
+}
+
+bool DaeSystem::constraint_element_failed(int e) const {
+  const auto index = static_cast<std::size_t>(e);
+  return model_.elements()[index]->constraint_count() > 0 && element_failed(index);
+}
+
+std::vector<double> DaeSystem::body_angle_lengths() const {
+  const double length = model_.length_scale();
+  std::vector<double> size(static_cast<std::size_t>(model_.body_count()), 0.0);
+  for (int i = 0; i < model_.body_count(); ++i) {
+    const Body& b = model_.bodies()[static_cast<std::size_t>(i)];
+    if (b.mass > 0.0 && b.inertia > 0.0) size[static_cast<std::size_t>(i)] = std::sqrt(b.inertia / b.mass);
+  }
+  for (const auto& element : model_.elements())
+    for (const PointRef& p : element->points())
+      if (p.body != kGround) {
+        double& r = size[static_cast<std::size_t>(p.body)];
+        r = std::max(r, std::hypot(p.sx, p.sy));
+      }
+  for (double& r : size) r = r > 0.0 ? std::min(std::max(r, 1e-3 * length), length) : length;
+  return size;
+}
+
+std::vector<double> DaeSystem::constraint_row_inverse_mass_bounds() const {
+  // (Taken at the start only, (G M^-1 G^T)_rr would let a penalty sized from it outrun the
+  // step once the bodies turn.)
+  std::vector<double> inverse_effective_mass(static_cast<std::size_t>(constraint_rows()), 0.0);
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    for (int row = 0; row < el.constraint_count(); ++row) {
+      double inverse = 0.0;
+      for (int slot = 0; slot < 2; ++slot) {
+        const int b = el.slot_body(slot);
+        if (b == kGround) continue;
+        const Body& body = model_.bodies()[static_cast<std::size_t>(b)];
+        double arm = 0.0;
+        for (std::size_t p = 0; p < el.points().size(); ++p)
+          if (el.point_slot(static_cast<int>(p)) == slot) arm = std::max(arm, std::hypot(el.points()[p].sx, el.points()[p].sy));
+        inverse += el.constraint_row_is_rotational(row) ? 1.0 / body.inertia : 1.0 / body.mass + arm * arm / body.inertia;
+      }
+      inverse_effective_mass[static_cast<std::size_t>(model_.constraint_offset(e) + row)] = inverse;
+    }
+  }
+  return inverse_effective_mass;
+}
+
 std::string DaeSystem::unknown_name(int k) const {
   const int nq = body_unknowns();
   const int m = constraint_rows();

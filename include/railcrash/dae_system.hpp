@@ -149,6 +149,27 @@ class DaeSystem {
   double constraint_residual(const double* q, std::vector<double>& phi) const;
   /// Element owning constraint row `row`.
   const Element& constraint_owner(int row) const;
+  /// Index of the element owning constraint row `row`.
+  int constraint_row_owner(int row) const { return constraint_row_owner_[static_cast<std::size_t>(row)]; }
+
+  // ---- what integrators ask about the elements, without reading them ----
+  int element_count() const { return static_cast<int>(model_.elements().size()); }
+  /// Element e in messages: "model.yaml:20: element 'pin' (revolute)" (`noun` for "element").
+  std::string element_label(int e, const char* noun = "element") const;
+  /// True once element e, an element with constraint rows, has failed: its equations changed
+  /// (lambda = mu = 0), so an integrator cannot go on across the change.
+  bool constraint_element_failed(int e) const;
+  /// The length over which each body's angle counts, for angular tolerances: an angle error
+  /// d_theta moves the body's points by r d_theta. r is the larger of the body's radius of
+  /// gyration and its farthest connection point, kept within [1e-3, 1] x the model's length
+  /// scale; a point mass without connections gets the length scale. One entry per body.
+  std::vector<double> body_angle_lengths() const;
+  /// Per constraint row, an upper bound of 1 / (its effective mass) over all orientations of
+  /// its bodies: a translational row moves body b's point at distance a_b from its centre, so
+  /// 1 / m_eff <= sum 1/m_b + a_b^2/J_b; an angle row gives sum 1/J_b [1/mass] or [1/inertia].
+  std::vector<double> constraint_row_inverse_mass_bounds() const;
+  /// The penalty keys of the element owning constraint row `row` (explicit Euler's penalties).
+  const Element::PenaltyOverrides& constraint_row_penalty(int row) const { return constraint_owner(row).penalty(); }
   /// Unknown k of y in the model's terms, with file:line: "model.yaml:7: body 'cab' vx",
   /// "model.yaml:20: element 'pin' (revolute) multiplier of its constraint row 1".
   std::string unknown_name(int k) const;
@@ -201,6 +222,11 @@ class DaeSystem {
 
   // ---- modes and events ----
   int root_count() const { return root_count_; }
+  /// How many root functions element e has (its roots are root_offset(e) onwards).
+  int element_root_count(int e) const {
+    const auto next = static_cast<std::size_t>(e) + 1;
+    return (next < root_offset_.size() ? root_offset_[next] : root_count_) - root_offset_[static_cast<std::size_t>(e)];
+  }
   /// All elements' root functions at y, in element order. With `outputs`
   /// (output_names().size()), every element's outputs at y as well, from the same evaluation of
   /// its local state (IDA's one sweep after a step; outputs(y, y's multipliers) gives the same).

@@ -57,6 +57,7 @@ struct Crossing {
   int element = 0;
   int local = 0;       // the root's index within its element
   int generation = 0;  // the element's mode changes in this step when it was found
+  int direction = -1;  // -1: fell through zero; +1: rose through it (seen only on a step known at its end alone)
 };
 
 /// The element modes' bookkeeping of a run in progress (see the file's comment).
@@ -91,18 +92,13 @@ class ModeTracker {
   // ---- the mode changes of the current step ----
   /// A new step: no element has changed mode in it yet.
   void begin_step() { changed_.clear(), change_count_.clear(), change_time_.clear(); }
-  /// Commits element e's root `local` falling through zero at (t, y), appending the event.
-  /// True when the element changed mode (then record_change(e, t) has been called).
-  bool commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events);
+  /// Commits element e's root `local` falling through zero (direction -1; +1: rising through
+  /// it) at (t, y), appending the event. True when the element changed mode (then
+  /// record_change(e, t) has been called).
+  bool commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events, int direction = -1);
   /// Element e changed mode at t: its roots are ordinary again (a new mode), and the change
   /// counts for this step.
   void record_change(int e, double t);
-  /// At a step's end, known there alone (Euler): commits every root that fired (direction as
-  /// EventLocator::step_end_crossings gives it) at (t, y), appending the events; true when any
-  /// mode changed.
-  bool commit_all(double t, const double* y, const std::vector<int>& direction, std::vector<EventRecord>& events) {
-    return system_.commit_roots(t, y, direction.data(), events);
-  }
   /// At a (re)start at (t, y, y'): commits the roots that sit on their mode's boundary and are
   /// about to leave it (DaeSystem::commit_boundary_roots); changed_elements as there.
   bool commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
@@ -165,6 +161,10 @@ class EventLocator {
   /// one that rose from < 0 to >= 0, else 0. True when any did.
   static bool step_end_crossings(const std::vector<double>& before, const std::vector<double>& after,
                                  std::vector<int>& direction);
+  /// The same rule into the queue: every root that fired between before (the roots at the
+  /// step's start) and after (at its end, t1), as a crossing at t1 with its direction, in root
+  /// order. True when any did.
+  bool queue_step_end_crossings(double t1, const std::vector<double>& before, const std::vector<double>& after);
 
  private:
   const DaeSystem& system_;
