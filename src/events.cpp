@@ -82,8 +82,43 @@ void ModeTracker::scan(double t_n, const double* y, std::vector<Crossing>& cross
   }
 }
 
+bool ModeTracker::commit_element(int e, int local, int direction, double t, const double* y,
+                                 std::vector<EventRecord>& events) {
+  const Element& el = *system_.model().elements()[static_cast<std::size_t>(e)];
+  Element::Event event;
+  if (!el.commit(local, direction, t, system_.element_state(e, y), system_.element_multipliers(e, y),
+                 system_.modes().of(static_cast<std::size_t>(e)), event))
+    return false;
+  events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
+  return true;
+}
+
+bool ModeTracker::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                               std::vector<char>* changed_elements) {
+  bool changed = false;
+  for (int e = 0; e < system_.element_count(); ++e) {
+    if (changed_elements && (*changed_elements)[static_cast<std::size_t>(e)]) continue;
+    const int offset = system_.root_offset(e);
+    for (int k = 0; k < system_.element_root_count(e); ++k) {
+      const int d = direction[offset + k];
+      if (d == 0 || !commit_element(e, k, d, t, y, events)) continue;
+      changed = true;
+      if (changed_elements) (*changed_elements)[static_cast<std::size_t>(e)] = 1;
+      break;  // the element's other roots belonged to the mode it just left
+    }
+  }
+  return changed;
+}
+
+bool ModeTracker::commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
+                                  std::vector<char>* changed_elements) {
+  std::vector<int> direction;
+  return system_.boundary_roots_leaving(t, y, yp, direction) &&
+         commit_roots(t, y, direction.data(), events, changed_elements);
+}
+
 bool ModeTracker::commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events, int direction) {
-  if (!system_.commit_element_root(e, local, direction, t, y, events)) return false;
+  if (!commit_element(e, local, direction, t, y, events)) return false;
   record_change(e, t);
   return true;
 }

@@ -14,9 +14,10 @@
 // The same element code also gives the plain generalized forces for explicit integration,
 // with constraints replaced by penalty spring-dampers.
 //
-// A DaeSystem is one run's view of an immutable Model: it owns the run's ElementStates. Its
+// A DaeSystem is one run's view of an immutable Model: it holds the run's ElementStates. Its
 // const methods (residual, Jacobian, forces, roots, outputs, energy) read the element modes
-// and change nothing; the commit methods and reset_modes() are the only ones that change them.
+// and change nothing. The modes change only through the mode tracker's commits (events.hpp:
+// ModeTracker), which write them through modes(), and reset_modes().
 #pragma once
 
 #include <array>
@@ -231,13 +232,6 @@ class DaeSystem {
   /// (output_names().size()), every element's outputs at y as well, from the same evaluation of
   /// its local state (IDA's one sweep after a step; outputs(y, y's multipliers) gives the same).
   void roots(double t, const double* y, double* g, double* outputs = nullptr) const;
-  /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
-  /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
-  /// any mode changed (Euler and the static settle; IDA commits element by element).
-  /// With `changed_elements` (one flag per element): flagged elements are left alone and the
-  /// ones that change are flagged, so that no element changes mode twice at one instant.
-  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                    std::vector<char>* changed_elements = nullptr);
   /// Element-level access for integrators that locate events element by element.
   int root_offset(int e) const { return root_offset_[static_cast<std::size_t>(e)]; }
   /// Element owning root k.
@@ -246,10 +240,12 @@ class DaeSystem {
   void element_roots(int e, double t, const double* y, double* g) const;
   /// The unknowns element e reads: its bodies' positions and velocities and its multipliers.
   const std::vector<int>& element_unknowns(int e) const { return element_unknowns_[static_cast<std::size_t>(e)]; }
-  /// Commits element e's root `local` (direction -1: it fell through zero) at y; appends the
-  /// event. Returns true when the element changed mode.
-  bool commit_element_root(int e, int local, int direction, double t, const double* y,
-                           std::vector<EventRecord>& events);
+  /// Element e's local state at y (its bodies' poses and velocities, its mode) and its
+  /// multipliers in y (null when it has no constraint rows): what its commit reads.
+  ElementState<double> element_state(int e, const double* y) const {
+    return local_state(static_cast<std::size_t>(e), y, y + body_unknowns());
+  }
+  const double* element_multipliers(int e, const double* y) const;
   /// What element e alone contributes at y: its generalized forces on its two body slots (force
   /// elements, and joint friction from the multipliers in y; not the constraint rows) and the
   /// power delivered to it (its work quadrature's rate). Lets an integrator judge a mode change
@@ -260,20 +256,19 @@ class DaeSystem {
     double power = 0.0;                         // [force*length/time]
   };
   ElementLoad element_load(int e, double t, const double* y) const;
-  /// At a (re)start: commits the roots that sit on their mode's boundary and are about to
-  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y'
-  /// (roots that fire within h are taken as simultaneous with the restart), and roots
-  /// already negative (the state is outside its mode, e.g. after the initial assembly moved
-  /// it). Elements switch a small band past their boundaries (1e-14 to 1e-12 of their size),
-  /// so a state exactly on a boundary has a small positive root that the look-ahead sees
-  /// cross; IDA itself would leave a root that is exactly zero inactive. Returns true when a
-  /// mode changed. `changed_elements` as in commit_roots (repeated passes at one restart).
-  bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
-                             std::vector<char>* changed_elements = nullptr);
+  /// At a (re)start at (t, y, y'): the roots that sit on their mode's boundary and are about to
+  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y' (roots
+  /// that fire within h are taken as simultaneous with the restart), and roots already
+  /// negative (the state is outside its mode, e.g. after the initial assembly moved it):
+  /// direction[k] = -1 for each (root_count() entries), else 0; true when any. Elements switch
+  /// a small band past their boundaries (1e-14 to 1e-12 of their size), so a state exactly on a
+  /// boundary has a small positive root that the look-ahead sees cross; IDA itself would leave
+  /// a root that is exactly zero inactive. ModeTracker::commit_boundary commits them.
+  bool boundary_roots_leaving(double t, const double* y, const double* yp, std::vector<int>& direction) const;
   /// Puts every element back in its starting mode.
   void reset_modes();
-  /// The run's element modes and histories: evaluations read them, only the commits above
-  /// change them; snapshot() / restore() go back to an earlier state.
+  /// The run's element modes and histories: evaluations read them, only the mode tracker's
+  /// commits (events.hpp) change them; snapshot() / restore() go back to an earlier state.
   const ElementStates& modes() const { return modes_; }
   ElementStates& modes() { return modes_; }
 
