@@ -617,6 +617,56 @@ const Element& DaeSystem::constraint_owner(int row) const {
   return *model_.elements()[static_cast<std::size_t>(constraint_row_owner_[static_cast<std::size_t>(row)])];
 }
 
+std::string DaeSystem::element_label(int e, const char* noun) const {
+  const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
+  return el.where().prefix() + noun + " '" + el.name() + "' (" + el.type() + ")";
+}
+
+bool DaeSystem::constraint_element_failed(int e) const {
+  const auto index = static_cast<std::size_t>(e);
+  return model_.elements()[index]->constraint_count() > 0 && element_failed(index);
+}
+
+std::vector<double> DaeSystem::body_angle_lengths() const {
+  const double length = model_.length_scale();
+  std::vector<double> size(static_cast<std::size_t>(model_.body_count()), 0.0);
+  for (int i = 0; i < model_.body_count(); ++i) {
+    const Body& b = model_.bodies()[static_cast<std::size_t>(i)];
+    if (b.mass > 0.0 && b.inertia > 0.0) size[static_cast<std::size_t>(i)] = std::sqrt(b.inertia / b.mass);
+  }
+  for (const auto& element : model_.elements())
+    for (const PointRef& p : element->points())
+      if (p.body != kGround) {
+        double& r = size[static_cast<std::size_t>(p.body)];
+        r = std::max(r, std::hypot(p.sx, p.sy));
+      }
+  for (double& r : size) r = r > 0.0 ? std::min(std::max(r, 1e-3 * length), length) : length;
+  return size;
+}
+
+std::vector<double> DaeSystem::constraint_row_inverse_mass_bounds() const {
+  // (Taken at the start only, (G M^-1 G^T)_rr would let a penalty sized from it outrun the
+  // step once the bodies turn.)
+  std::vector<double> inverse_effective_mass(static_cast<std::size_t>(constraint_rows()), 0.0);
+  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
+    const Element& el = *model_.elements()[e];
+    for (int row = 0; row < el.constraint_count(); ++row) {
+      double inverse = 0.0;
+      for (int slot = 0; slot < 2; ++slot) {
+        const int b = el.slot_body(slot);
+        if (b == kGround) continue;
+        const Body& body = model_.bodies()[static_cast<std::size_t>(b)];
+        double arm = 0.0;
+        for (std::size_t p = 0; p < el.points().size(); ++p)
+          if (el.point_slot(static_cast<int>(p)) == slot) arm = std::max(arm, std::hypot(el.points()[p].sx, el.points()[p].sy));
+        inverse += el.constraint_row_is_rotational(row) ? 1.0 / body.inertia : 1.0 / body.mass + arm * arm / body.inertia;
+      }
+      inverse_effective_mass[static_cast<std::size_t>(model_.constraint_offset(e) + row)] = inverse;
+    }
+  }
+  return inverse_effective_mass;
+}
+
 std::string DaeSystem::unknown_name(int k) const {
   const int nq = body_unknowns();
   const int m = constraint_rows();
@@ -844,17 +894,9 @@ void DaeSystem::element_roots(int e, double t, const double* y, double* g) const
   el.roots(t, local_state(static_cast<std::size_t>(e), y, y + nq), element_lambda, g);
 }
 
-bool DaeSystem::commit_element_root(int e, int local, int direction, double t, const double* y,
-                                    std::vector<EventRecord>& events) {
-  const Element& el = *model_.elements()[static_cast<std::size_t>(e)];
-  const int nq = body_unknowns();
-  const double* element_lambda =
-      el.constraint_count() > 0 ? y + 2 * nq + model_.constraint_offset(static_cast<std::size_t>(e)) : nullptr;
-  Element::Event event;
+const double* DaeSystem::element_multipliers(int e, const double* y) const {
   const auto index = static_cast<std::size_t>(e);
-  if (!el.commit(local, direction, t, local_state(index, y, y + nq), element_lambda, modes_.of(index), event)) return false;
-  events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
-  return true;
+  return model_.elements()[index]->constraint_count() > 0 ? y + 2 * body_unknowns() + model_.constraint_offset(index) : nullptr;
 }
 
 DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y) const {
@@ -872,32 +914,7 @@ DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y)
   return load;
 }
 
-bool DaeSystem::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                             std::vector<char>* changed_elements) {
-  const int nq = body_unknowns();
-  const double* lambda = y + 2 * nq;
-  bool changed = false;
-  for (std::size_t e = 0; e < model_.elements().size(); ++e) {
-    const Element& el = *model_.elements()[e];
-    if (changed_elements && (*changed_elements)[e]) continue;
-    for (int k = 0; k < el.root_count(); ++k) {
-      const int d = direction[root_offset_[e] + k];
-      if (d == 0) continue;
-      const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
-      Element::Event event;
-      if (el.commit(k, d, t, local_state(e, y, y + nq), element_lambda, modes_.of(e), event)) {
-        changed = true;
-        if (changed_elements) (*changed_elements)[e] = 1;
-        events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
-        break;  // the element's other roots belonged to the mode it just left
-      }
-    }
-  }
-  return changed;
-}
-
-bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
-                                      std::vector<char>* changed_elements) {
+bool DaeSystem::boundary_roots_leaving(double t, const double* y, const double* yp, std::vector<int>& direction) const {
   if (root_count_ == 0) return false;
   std::vector<double> g(static_cast<std::size_t>(root_count_)), ahead(g.size());
   roots(t, y, g.data());
@@ -912,14 +929,14 @@ bool DaeSystem::commit_boundary_roots(double t, const double* y, const double* y
     y_ahead[static_cast<std::size_t>(nq + k)] += h * yp[nq + k];
   }
   roots(t + h, y_ahead.data(), ahead.data());
-  std::vector<int> direction(g.size(), 0);
+  direction.assign(g.size(), 0);
   bool any = false;
   for (std::size_t k = 0; k < g.size(); ++k)
     if (g[k] < 0.0 || ahead[k] < 0.0) {
       direction[k] = -1;
       any = true;
     }
-  return any && commit_roots(t, y, direction.data(), events, changed_elements);
+  return any;
 }
 
 void DaeSystem::reset_modes() { modes_.reset(); }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "railcrash/event_loop.hpp"
 #include "railcrash/initial_conditions.hpp"
 
 namespace railcrash {
@@ -68,35 +69,15 @@ PenaltyRows EulerIntegrator::make_penalty(const DaeSystem& system, const Element
   PenaltyRows rows;
   rows.stiffness.assign(static_cast<std::size_t>(m), 0.0);
   rows.damping.assign(static_cast<std::size_t>(m), 0.0);
-  // Effective mass of each row, bounded over all orientations of the bodies: a translational
-  // row moves body b's point at distance a_b from its centre, so 1 / m_eff <= sum 1/m_b + a_b^2/J_b;
-  // an angle row gives sum 1/J_b. (Taken at the start only, (G M^-1 G^T)_rr would let the
-  // penalty outrun the step once the bodies turn.)
-  std::vector<double> inverse_effective_mass(static_cast<std::size_t>(m), 0.0);
-  const Model& model = system.model();
-  for (std::size_t e = 0; e < model.elements().size(); ++e) {
-    const Element& el = *model.elements()[e];
-    for (int row = 0; row < el.constraint_count(); ++row) {
-      double inverse = 0.0;
-      for (int slot = 0; slot < 2; ++slot) {
-        const int b = el.slot_body(slot);
-        if (b == kGround) continue;
-        const Body& body = model.bodies()[static_cast<std::size_t>(b)];
-        double arm = 0.0;
-        for (std::size_t p = 0; p < el.points().size(); ++p)
-          if (el.point_slot(static_cast<int>(p)) == slot) arm = std::max(arm, std::hypot(el.points()[p].sx, el.points()[p].sy));
-        inverse += el.constraint_row_is_rotational(row) ? 1.0 / body.inertia : 1.0 / body.mass + arm * arm / body.inertia;
-      }
-      inverse_effective_mass[static_cast<std::size_t>(model.constraint_offset(e) + row)] = inverse;
-    }
-  }
+  // Effective mass of each row, bounded over all orientations of the bodies
+  // (DaeSystem::constraint_row_inverse_mass_bounds).
+  const std::vector<double> inverse_effective_mass = system.constraint_row_inverse_mass_bounds();
   const double rate = kPenaltyStepAngle / dt;
   for (int r = 0; r < m; ++r) {
     const auto row = static_cast<std::size_t>(r);
-    const Element& owner = system.constraint_owner(r);
     const bool rotational = system.constraint_row_is_rotational(r);
     const double effective_mass = 1.0 / inverse_effective_mass[row];
-    const auto& own = owner.penalty();
+    const Element::PenaltyOverrides& own = system.constraint_row_penalty(r);
     const std::optional<double> k = rotational ? (own.rotational_stiffness ? own.rotational_stiffness : global.rotational_stiffness)
                                                : (own.stiffness ? own.stiffness : global.stiffness);
     const std::optional<double> c = rotational ? (own.rotational_damping ? own.rotational_damping : global.rotational_damping)
@@ -243,7 +224,6 @@ void EulerIntegrator::begin(double t0, bool run_start) {
   const int root_count = system_.root_count();
   modes.previous().assign(static_cast<std::size_t>(root_count), 0.0);
   modes.now() = modes.previous();
-  direction_.assign(modes.previous().size(), 0);
   if (run_start) report_events(start_events_, y_.data());
   if (root_count > 0 && run_start) {
     // A state that starts exactly on a mode boundary and moves out of the mode (same rule as IDA's restart).
@@ -286,6 +266,26 @@ void EulerIntegrator::sweep() {
   outputs_current_ = true;
 }
 
+/// Euler's decisions about the mode changes at its step's end (event_loop.hpp): the observers
+/// look at the old modes there; after a change, the step's end is swept again in the new modes
+/// (forces, roots into the mode tracker's now(), outputs) and the events reported.
+class EulerEventHandler final : public EventHandler {
+ public:
+  explicit EulerEventHandler(EulerIntegrator& euler) : euler_(euler) {}
+  void before_change(const Crossing& c, const double* y_at_event) override { euler_.observe_before_event(c.t, y_at_event); }
+  bool goes_on_across(const Crossing& /*c*/, const double* /*y_at_event*/, const std::vector<EventRecord>& /*events*/) override {
+    return false;  // (not asked on a step known at its end alone)
+  }
+  void restart_at(const Crossing& /*c*/, const double* /*y_at_event*/) override {
+    ++euler_.stats().reinitializations;
+    euler_.sweep();
+    euler_.report_events(euler_.events_, euler_.y_.data());
+  }
+
+ private:
+  EulerIntegrator& euler_;
+};
+
 // The loop runs on time: step k ends at t0 + k dt (no drift), the last one at t_end exactly.
 double EulerIntegrator::advance(double t_end) {
   const int nq = system_.body_unknowns();
@@ -311,20 +311,16 @@ double EulerIntegrator::advance(double t_end) {
   sweep();  // the next step's forces, this state's roots (into the mode tracker's now()) and outputs
   ModeTracker& modes = mode_tracker();
   if (modes.root_count() > 0) {
-    // The step is known at its end alone: crossings are committed there, all at once.
-    if (EventLocator::step_end_crossings(modes.previous(), modes.now(), direction_)) {
+    // The step is known at its end alone: the event loop commits its crossings there, all at once.
+    EventLocator& locator = event_locator();
+    if (locator.queue_step_end_crossings(t_, modes.previous(), modes.now())) {
       const PhaseClock::Scope timed(phase_clock(), Phase::Events);
       EulerStep step(*this, t_start, t_);
-      const double* y_end = step.state_at(step.t1());
-      observe_before_event(t_, y_end);
-      events_.clear();
-      if (modes.commit_all(t_, y_end, direction_, events_)) {
-        ++stats().reinitializations;
-        sweep();  // forces, roots and outputs in the new modes
-      }
-      report_events(events_, y_.data());
+      EulerEventHandler handler(*this);
+      commit_crossings(step, step.state_at(step.t1()), modes, locator, handler, 0.0, events_);
+    } else {
+      modes.end_step();
     }
-    modes.end_step();
   }
   return t_;
 }
@@ -363,10 +359,9 @@ std::string EulerIntegrator::divergence_advice(const std::vector<double>& last_g
     if (violation > worst_violation) worst_violation = violation, worst = r;
   }
   if (worst < 0) return text.str();
-  const Element& joint = system_.constraint_owner(worst);
   text << "; the largest joint violation at the last good sample (t = " << t_last_good << ") is " << worst_violation
-       << " (length units) in " << joint.where().prefix() << "joint '" << joint.name() << "' (" << joint.type()
-       << "), likely the penalty that went unstable: give it (or the model) penalty_stiffness / penalty_damping "
+       << " (length units) in " << system_.element_label(system_.constraint_row_owner(worst), "joint")
+       << ", likely the penalty that went unstable: give it (or the model) penalty_stiffness / penalty_damping "
           "for its present arms and masses, or a smaller dt";
   return text.str();
 }

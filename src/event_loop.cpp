@@ -16,7 +16,7 @@ void queue_new_mode_crossings(StepInterpolant& step, const double* y_end, ModeTr
   const double t_n = step.t1();
   std::vector<double>& g_now = modes.now();
   const int offset = system.root_offset(c.element);
-  const int count = system.model().elements()[static_cast<std::size_t>(c.element)]->root_count();
+  const int count = system.element_root_count(c.element);
   const int generation = modes.changes_of(c.element);
   system.element_roots(c.element, t_n, y_end, g_now.data() + offset);
   for (int j = 0; j < count; ++j) {
@@ -40,10 +40,34 @@ void queue_new_mode_crossings(StepInterpolant& step, const double* y_end, ModeTr
   }
 }
 
+/// A step known at its end alone (not dense): every queued crossing at t1, all at once, in root
+/// order; an element changes mode once (its other roots belonged to the mode it left). The
+/// handler sees the old modes once (before_change, the first crossing) and, when any mode
+/// changed, restarts once at t1 (restart_at: the step's end in the new modes).
+bool commit_at_step_end(const double* y_end, ModeTracker& modes, EventLocator& locator, EventHandler& handler,
+                        std::vector<EventRecord>& events) {
+  const std::vector<Crossing>& crossings = locator.queue();
+  modes.begin_step();
+  const Crossing first = crossings.front();
+  handler.before_change(first, y_end);
+  events.clear();
+  bool changed = false;
+  for (const Crossing& c : crossings) {
+    if (modes.changes_of(c.element) > 0) continue;
+    if (!modes.commit(c.element, c.local, c.t, y_end, events, c.direction)) continue;
+    changed = true;
+    handler.committed(c);
+  }
+  if (changed) handler.restart_at(first, y_end);
+  modes.end_step();
+  return changed;
+}
+
 }  // namespace
 
 bool commit_crossings(StepInterpolant& step, const double* y_end, ModeTracker& modes, EventLocator& locator,
                       EventHandler& handler, double tolerance, std::vector<EventRecord>& events) {
+  if (!step.dense()) return commit_at_step_end(y_end, modes, locator, handler, events);
   std::vector<Crossing>& crossings = locator.queue();
   modes.begin_step();
   bool restart_now = false;

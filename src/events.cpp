@@ -6,15 +6,6 @@
 
 namespace railcrash {
 
-namespace {
-
-/// How many root functions element e has (its roots are DaeSystem::root_offset(e) onwards).
-int root_count_of(const DaeSystem& system, int e) {
-  return system.model().elements()[static_cast<std::size_t>(e)]->root_count();
-}
-
-}  // namespace
-
 // ---- ModeTracker ----
 
 ModeTracker::ModeTracker(DaeSystem& system, std::vector<double> unknown_floor) : system_(system) {
@@ -49,7 +40,7 @@ double ModeTracker::root_noise(int e, int local, double t, const double* y) {
   // Only the element's own unknowns are read (y_probe_ has the model's size, the rest unused):
   // clearing the whole vector per call cost O(N) per crossing in a train.
   for (const int i : unknowns) y_probe_[static_cast<std::size_t>(i)] = y[i];
-  const int count = root_count_of(system_, e);
+  const int count = system_.element_root_count(e);
   g_element_.resize(static_cast<std::size_t>(count));
   g_probe_.resize(static_cast<std::size_t>(count));
   system_.element_roots(e, t, y_probe_.data(), g_element_.data());
@@ -91,15 +82,50 @@ void ModeTracker::scan(double t_n, const double* y, std::vector<Crossing>& cross
   }
 }
 
-bool ModeTracker::commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events) {
-  if (!system_.commit_element_root(e, local, -1, t, y, events)) return false;
+bool ModeTracker::commit_element(int e, int local, int direction, double t, const double* y,
+                                 std::vector<EventRecord>& events) {
+  const Element& el = *system_.model().elements()[static_cast<std::size_t>(e)];
+  Element::Event event;
+  if (!el.commit(local, direction, t, system_.element_state(e, y), system_.element_multipliers(e, y),
+                 system_.modes().of(static_cast<std::size_t>(e)), event))
+    return false;
+  events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
+  return true;
+}
+
+bool ModeTracker::commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                               std::vector<char>* changed_elements) {
+  bool changed = false;
+  for (int e = 0; e < system_.element_count(); ++e) {
+    if (changed_elements && (*changed_elements)[static_cast<std::size_t>(e)]) continue;
+    const int offset = system_.root_offset(e);
+    for (int k = 0; k < system_.element_root_count(e); ++k) {
+      const int d = direction[offset + k];
+      if (d == 0 || !commit_element(e, k, d, t, y, events)) continue;
+      changed = true;
+      if (changed_elements) (*changed_elements)[static_cast<std::size_t>(e)] = 1;
+      break;  // the element's other roots belonged to the mode it just left
+    }
+  }
+  return changed;
+}
+
+bool ModeTracker::commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
+                                  std::vector<char>* changed_elements) {
+  std::vector<int> direction;
+  return system_.boundary_roots_leaving(t, y, yp, direction) &&
+         commit_roots(t, y, direction.data(), events, changed_elements);
+}
+
+bool ModeTracker::commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events, int direction) {
+  if (!commit_element(e, local, direction, t, y, events)) return false;
   record_change(e, t);
   return true;
 }
 
 void ModeTracker::record_change(int e, double t) {
   const int offset = system_.root_offset(e);
-  const int count = root_count_of(system_, e);
+  const int count = system_.element_root_count(e);
   for (int j = 0; j < count; ++j) on_boundary_[static_cast<std::size_t>(offset + j)] = 0;  // a new mode
   const auto seen = std::find(changed_.begin(), changed_.end(), e);
   if (seen == changed_.end()) {
@@ -119,7 +145,7 @@ int ModeTracker::changes_of(int e) const {
 }
 
 std::vector<char> ModeTracker::changed_at(double t) const {
-  std::vector<char> flags(system_.model().elements().size(), 0);
+  std::vector<char> flags(static_cast<std::size_t>(system_.element_count()), 0);
   for (std::size_t k = 0; k < changed_.size(); ++k)
     if (change_time_[k] == t) flags[static_cast<std::size_t>(changed_[k])] = 1;
   return flags;
@@ -129,7 +155,7 @@ void ModeTracker::refresh_changed(double t_n, const double* y) {
   for (const int e : changed_) system_.element_roots(e, t_n, y, now_.data() + system_.root_offset(e));
   for (const int e : changed_) {
     const int offset = system_.root_offset(e);
-    const int count = root_count_of(system_, e);
+    const int count = system_.element_root_count(e);
     for (int k = offset; k < offset + count; ++k)
       if (on_boundary_[static_cast<std::size_t>(k)] && now_[static_cast<std::size_t>(k)] <= 0.0)
         now_[static_cast<std::size_t>(k)] = std::numeric_limits<double>::min();
@@ -144,7 +170,7 @@ EventLocator::EventLocator(const DaeSystem& system) : system_(system) {
 
 double EventLocator::root_at(StepInterpolant& step, int e, int local, double t) {
   step.unknowns_at(system_.element_unknowns(e), t, y_local_.data());
-  g_element_.resize(static_cast<std::size_t>(root_count_of(system_, e)));
+  g_element_.resize(static_cast<std::size_t>(system_.element_root_count(e)));
   system_.element_roots(e, t, y_local_.data(), g_element_.data());
   return g_element_[static_cast<std::size_t>(local)];
 }
@@ -183,7 +209,7 @@ const double* EventLocator::event_state(StepInterpolant& step, Crossing& c, doub
   const double t_n = step.t1();
   double t_event = c.t;
   const double* y_at_event = step.state_at(t_event);
-  g_element_.resize(static_cast<std::size_t>(root_count_of(system_, c.element)));
+  g_element_.resize(static_cast<std::size_t>(system_.element_root_count(c.element)));
   system_.element_roots(c.element, t_event, y_at_event, g_element_.data());
   double g_event = g_element_[static_cast<std::size_t>(c.local)];
   const double mismatch = g_event > 0.0 ? g_event - root_at(step, c.element, c.local, c.t) : 0.0;
@@ -204,15 +230,33 @@ void EventLocator::insert_after(std::size_t index, const Crossing& c) {
                 c);
 }
 
+namespace {
+
+/// Euler's rule for a root between a step's start (g0) and end (g1): -1 for a fall from >= 0 to
+/// < 0, +1 for a rise from < 0 to >= 0, else 0.
+int step_end_direction(double g0, double g1) { return (g0 >= 0.0 && g1 < 0.0) ? -1 : (g0 < 0.0 && g1 >= 0.0) ? 1 : 0; }
+
+}  // namespace
+
 bool EventLocator::step_end_crossings(const std::vector<double>& before, const std::vector<double>& after,
                                       std::vector<int>& direction) {
   bool fired = false;
   for (std::size_t k = 0; k < after.size(); ++k) {
-    const double g0 = before[k], g1 = after[k];
-    direction[k] = (g0 >= 0.0 && g1 < 0.0) ? -1 : (g0 < 0.0 && g1 >= 0.0) ? 1 : 0;
+    direction[k] = step_end_direction(before[k], after[k]);
     fired = fired || direction[k] != 0;
   }
   return fired;
+}
+
+bool EventLocator::queue_step_end_crossings(double t1, const std::vector<double>& before, const std::vector<double>& after) {
+  queue_.clear();
+  for (std::size_t k = 0; k < after.size(); ++k) {
+    const int direction = step_end_direction(before[k], after[k]);
+    if (direction == 0) continue;
+    const int owner = system_.root_owner(static_cast<int>(k));
+    queue_.push_back({t1, owner, static_cast<int>(k) - system_.root_offset(owner), 0, direction});
+  }
+  return !queue_.empty();
 }
 
 }  // namespace railcrash

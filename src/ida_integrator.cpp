@@ -46,34 +46,10 @@ std::string flag_name(int flag) {
 void restart_state(ModeTracker& modes, double t, std::vector<double>& y, std::vector<double>& yp,
                    std::vector<EventRecord>& events, std::vector<char>& changed_elements, ConsistentRatesCache& rates_cache) {
   const DaeSystem& system = modes.system();
-  changed_elements.resize(system.model().elements().size(), 0);
+  changed_elements.resize(static_cast<std::size_t>(system.element_count()), 0);
   consistent_rates(system, t, y, yp, &rates_cache);
   for (int pass = 0; pass < 10 && modes.commit_boundary(t, y.data(), yp.data(), events, &changed_elements); ++pass)
     consistent_rates(system, t, y, yp, &rates_cache);
-}
-
-/// The length over which each body's angle counts, for its angular tolerances: an angle error
-/// d_theta moves the body's points by r d_theta, so the angle gets the length tolerance over r.
-/// r is the larger of the body's radius of gyration and its farthest connection point (so no
-/// point the elements use moves by more than the length tolerance), kept within
-/// [1e-3, 1] x the model's length scale; a point mass without connections gets the length scale.
-/// (With the model's length for every body, as before, a 16-in front end's pitch was held about
-/// 100 times tighter than its translation, and its pitch rate limited most of IDA's steps.)
-std::vector<double> body_sizes(const Model& model) {
-  const double length = model.length_scale();
-  std::vector<double> size(static_cast<std::size_t>(model.body_count()), 0.0);
-  for (int i = 0; i < model.body_count(); ++i) {
-    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
-    if (b.mass > 0.0 && b.inertia > 0.0) size[static_cast<std::size_t>(i)] = std::sqrt(b.inertia / b.mass);
-  }
-  for (const auto& element : model.elements())
-    for (const PointRef& p : element->points())
-      if (p.body != kGround) {
-        double& r = size[static_cast<std::size_t>(p.body)];
-        r = std::max(r, std::hypot(p.sx, p.sy));
-      }
-  for (double& r : size) r = r > 0.0 ? std::min(std::max(r, 1e-3 * length), length) : length;
-  return size;
 }
 
 }  // namespace
@@ -453,7 +429,11 @@ void IdaIntegrator::start(double t_end) {
     const std::vector<double> ids = system_.differential_ids();
     std::copy(ids.begin(), ids.end(), N_VGetArrayPointer(impl.ids));
     double* atol = N_VGetArrayPointer(impl.atol);
-    const std::vector<double> size = body_sizes(model);
+    // An angle gets the length tolerance over its body's angle length (no point the elements
+    // use moves by more than the length tolerance). With the model's length for every body, as
+    // before, a 16-in front end's pitch was held about 100 times tighter than its translation,
+    // and its pitch rate limited most of IDA's steps.
+    const std::vector<double> size = system_.body_angle_lengths();
     for (int i = 0; i < model.body_count(); ++i) {
       const double radius = size[static_cast<std::size_t>(i)];
       atol[3 * i] = atol[3 * i + 1] = atol_length;
@@ -696,8 +676,7 @@ bool IdaIntegrator::lag_within_tolerance(int e, const std::array<DaeSystem::Elem
   const double rtol = impl.rtol;
   const double* atol = N_VGetArrayPointer(impl.atol);
   const double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
-  const Element& el = *system_.model().elements()[static_cast<std::size_t>(e)];
-  if (el.constraint_count() > 0 && system_.element_failed(static_cast<std::size_t>(e))) return false;
+  if (system_.constraint_element_failed(e)) return false;
   const double lag = t_n - t_event;
   const DaeSystem::ElementLoad after_event = system_.element_load(e, t_event, y_at_event);
   const DaeSystem::ElementLoad after_n = system_.element_load(e, t_n, y_n);
@@ -749,22 +728,20 @@ void IdaIntegrator::check_start(const double* y, const double* yp, const double*
 
 std::string IdaIntegrator::largest_force_on(int k, const double* y) const {
   const int body = k / 3, component = k % 3;
-  const Model& model = system_.model();
   double largest = 0.0;
-  const Element* source = nullptr;
-  for (std::size_t e = 0; e < model.elements().size(); ++e) {
-    const DaeSystem::ElementLoad load = system_.element_load(static_cast<int>(e), 0.0, y);
+  int source = -1;
+  for (int e = 0; e < system_.element_count(); ++e) {
+    const DaeSystem::ElementLoad load = system_.element_load(e, 0.0, y);
     for (std::size_t slot = 0; slot < 2; ++slot) {
       if (load.body[slot] != body) continue;
       const Pose<double>& f = load.force[slot];
       const double value = std::abs(component == 0 ? f.x : component == 1 ? f.y : f.theta);
-      if (value > largest) largest = value, source = model.elements()[e].get();
+      if (value > largest) largest = value, source = e;
     }
   }
-  if (!source) return "";
+  if (source < 0) return "";
   std::ostringstream text;
-  text << "; the largest force on it, " << largest << ", comes from " << source->where().prefix() << "element '"
-       << source->name() << "' (" << source->type() << ")";
+  text << "; the largest force on it, " << largest << ", comes from " << system_.element_label(source);
   return text.str();
 }
 

@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "railcrash/events.hpp"
+
 namespace railcrash {
 
 namespace {
@@ -305,6 +307,7 @@ bool follow_modes(DaeSystem& system, const std::vector<double>& y, std::vector<E
   if (count == 0) return false;
   std::vector<double> g(count);
   std::vector<int> direction(count);
+  ModeTracker modes(system);
   bool changed = false;
   for (int pass = 0; pass < 50; ++pass) {
     system.roots(0.0, y.data(), g.data());
@@ -313,7 +316,7 @@ bool follow_modes(DaeSystem& system, const std::vector<double>& y, std::vector<E
       direction[k] = g[k] < 0.0 ? -1 : 0;
       outside = outside || direction[k] != 0;
     }
-    if (!outside || !system.commit_roots(0.0, y.data(), direction.data(), events)) break;
+    if (!outside || !modes.commit_roots(0.0, y.data(), direction.data(), events)) break;
     changed = true;
   }
   return changed;

@@ -247,3 +247,67 @@ TEST_CASE("the event loop commits a located crossing and goes on across it or re
     }
   }
 }
+
+namespace {
+
+/// A step known at its end alone (explicit Euler's): the state at t1 = 0.1, whatever t.
+class StepEndOnly final : public StepInterpolant {
+ public:
+  explicit StepEndOnly(std::vector<double> y_end) : y_(std::move(y_end)) {}
+  double t0() const override { return 0.0; }
+  double t1() const override { return 0.1; }
+  bool dense() const override { return false; }
+  const double* state_at(double /*t*/) override { return y_.data(); }
+  void unknowns_at(const std::vector<int>& unknowns, double /*t*/, double* y) override {
+    for (const int i : unknowns) y[i] = y_[static_cast<std::size_t>(i)];
+  }
+  void rates_at(double /*t*/, double* yp) override { std::fill(yp, yp + y_.size(), 0.0); }
+
+ private:
+  std::vector<double> y_;
+};
+
+}  // namespace
+
+TEST_CASE("the event loop commits a step known at its end alone there, all at once, and restarts once", "[events]") {
+  // The ball starts at x = 2 (open contact, root x - 1 = 1) and ends the step at x = 0.99,
+  // inside the circle: its root fell to -0.01 and the contact closes at the step's end, t1.
+  const Model model = ball_and_circle(2.0, -1.0);
+  DaeSystem system(model);
+  ModeTracker modes(system);
+  EventLocator locator(system);
+  std::vector<double> y_start = system.initial_state();
+  system.roots(0.0, y_start.data(), modes.previous().data());
+  std::vector<double> y_end = y_start;
+  y_end[0] = 0.99;
+  system.roots(0.1, y_end.data(), modes.now().data());
+  REQUIRE(modes.now()[0] == Approx(-0.01));
+  REQUIRE(locator.queue_step_end_crossings(0.1, modes.previous(), modes.now()));
+  REQUIRE(locator.queue().size() == 1);
+  CHECK(locator.queue()[0].t == 0.1);
+  CHECK(locator.queue()[0].element == 0);
+  CHECK(locator.queue()[0].local == 0);
+  CHECK(locator.queue()[0].direction == -1);
+
+  StepEndOnly step(y_end);
+  RecordingHandler handler(false);
+  std::vector<EventRecord> events;
+  CHECK(commit_crossings(step, step.state_at(0.1), modes, locator, handler, 0.0, events));
+  CHECK(handler.before_times == std::vector<double>{0.1});  // the old modes, seen once at t1
+  CHECK(handler.x_at_event == std::vector<double>{0.99});
+  CHECK(handler.commits == 1);
+  CHECK(handler.reported == 0);  // never asked to go on across: the step's end is all there is
+  CHECK(handler.restart_times == std::vector<double>{0.1});
+  REQUIRE(events.size() == 1);
+  CHECK(events[0].t == 0.1);
+  CHECK(events[0].element == "bump");
+  // The step is done (now() became previous()); the contact is closed: its root is the
+  // penetration, 0.01.
+  std::vector<double> g(static_cast<std::size_t>(system.root_count()));
+  system.roots(0.1, y_end.data(), g.data());
+  CHECK(g[0] == Approx(0.01));
+
+  // Nothing fired: no queue (the caller ends the step itself).
+  CHECK_FALSE(locator.queue_step_end_crossings(0.2, g, g));
+  CHECK(locator.queue().empty());
+}

@@ -14,9 +14,10 @@
 // The same element code also gives the plain generalized forces for explicit integration,
 // with constraints replaced by penalty spring-dampers.
 //
-// A DaeSystem is one run's view of an immutable Model: it owns the run's ElementStates. Its
+// A DaeSystem is one run's view of an immutable Model: it holds the run's ElementStates. Its
 // const methods (residual, Jacobian, forces, roots, outputs, energy) read the element modes
-// and change nothing; the commit methods and reset_modes() are the only ones that change them.
+// and change nothing. The modes change only through the mode tracker's commits (events.hpp:
+// ModeTracker), which write them through modes(), and reset_modes().
 #pragma once
 
 #include <array>
@@ -149,6 +150,27 @@ class DaeSystem {
   double constraint_residual(const double* q, std::vector<double>& phi) const;
   /// Element owning constraint row `row`.
   const Element& constraint_owner(int row) const;
+  /// Index of the element owning constraint row `row`.
+  int constraint_row_owner(int row) const { return constraint_row_owner_[static_cast<std::size_t>(row)]; }
+
+  // ---- what integrators ask about the elements, without reading them ----
+  int element_count() const { return static_cast<int>(model_.elements().size()); }
+  /// Element e in messages: "model.yaml:20: element 'pin' (revolute)" (`noun` for "element").
+  std::string element_label(int e, const char* noun = "element") const;
+  /// True once element e, an element with constraint rows, has failed: its equations changed
+  /// (lambda = mu = 0), so an integrator cannot go on across the change.
+  bool constraint_element_failed(int e) const;
+  /// The length over which each body's angle counts, for angular tolerances: an angle error
+  /// d_theta moves the body's points by r d_theta. r is the larger of the body's radius of
+  /// gyration and its farthest connection point, kept within [1e-3, 1] x the model's length
+  /// scale; a point mass without connections gets the length scale. One entry per body.
+  std::vector<double> body_angle_lengths() const;
+  /// Per constraint row, an upper bound of 1 / (its effective mass) over all orientations of
+  /// its bodies: a translational row moves body b's point at distance a_b from its centre, so
+  /// 1 / m_eff <= sum 1/m_b + a_b^2/J_b; an angle row gives sum 1/J_b [1/mass] or [1/inertia].
+  std::vector<double> constraint_row_inverse_mass_bounds() const;
+  /// The penalty keys of the element owning constraint row `row` (explicit Euler's penalties).
+  const Element::PenaltyOverrides& constraint_row_penalty(int row) const { return constraint_owner(row).penalty(); }
   /// Unknown k of y in the model's terms, with file:line: "model.yaml:7: body 'cab' vx",
   /// "model.yaml:20: element 'pin' (revolute) multiplier of its constraint row 1".
   std::string unknown_name(int k) const;
@@ -201,17 +223,15 @@ class DaeSystem {
 
   // ---- modes and events ----
   int root_count() const { return root_count_; }
+  /// How many root functions element e has (its roots are root_offset(e) onwards).
+  int element_root_count(int e) const {
+    const auto next = static_cast<std::size_t>(e) + 1;
+    return (next < root_offset_.size() ? root_offset_[next] : root_count_) - root_offset_[static_cast<std::size_t>(e)];
+  }
   /// All elements' root functions at y, in element order. With `outputs`
   /// (output_names().size()), every element's outputs at y as well, from the same evaluation of
   /// its local state (IDA's one sweep after a step; outputs(y, y's multipliers) gives the same).
   void roots(double t, const double* y, double* g, double* outputs = nullptr) const;
-  /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k,
-  /// 0 for roots that did not fire); appends what happened to `events`. Returns true when
-  /// any mode changed (Euler and the static settle; IDA commits element by element).
-  /// With `changed_elements` (one flag per element): flagged elements are left alone and the
-  /// ones that change are flagged, so that no element changes mode twice at one instant.
-  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
-                    std::vector<char>* changed_elements = nullptr);
   /// Element-level access for integrators that locate events element by element.
   int root_offset(int e) const { return root_offset_[static_cast<std::size_t>(e)]; }
   /// Element owning root k.
@@ -220,10 +240,12 @@ class DaeSystem {
   void element_roots(int e, double t, const double* y, double* g) const;
   /// The unknowns element e reads: its bodies' positions and velocities and its multipliers.
   const std::vector<int>& element_unknowns(int e) const { return element_unknowns_[static_cast<std::size_t>(e)]; }
-  /// Commits element e's root `local` (direction -1: it fell through zero) at y; appends the
-  /// event. Returns true when the element changed mode.
-  bool commit_element_root(int e, int local, int direction, double t, const double* y,
-                           std::vector<EventRecord>& events);
+  /// Element e's local state at y (its bodies' poses and velocities, its mode) and its
+  /// multipliers in y (null when it has no constraint rows): what its commit reads.
+  ElementState<double> element_state(int e, const double* y) const {
+    return local_state(static_cast<std::size_t>(e), y, y + body_unknowns());
+  }
+  const double* element_multipliers(int e, const double* y) const;
   /// What element e alone contributes at y: its generalized forces on its two body slots (force
   /// elements, and joint friction from the multipliers in y; not the constraint rows) and the
   /// power delivered to it (its work quadrature's rate). Lets an integrator judge a mode change
@@ -234,20 +256,19 @@ class DaeSystem {
     double power = 0.0;                         // [force*length/time]
   };
   ElementLoad element_load(int e, double t, const double* y) const;
-  /// At a (re)start: commits the roots that sit on their mode's boundary and are about to
-  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y'
-  /// (roots that fire within h are taken as simultaneous with the restart), and roots
-  /// already negative (the state is outside its mode, e.g. after the initial assembly moved
-  /// it). Elements switch a small band past their boundaries (1e-14 to 1e-12 of their size),
-  /// so a state exactly on a boundary has a small positive root that the look-ahead sees
-  /// cross; IDA itself would leave a root that is exactly zero inactive. Returns true when a
-  /// mode changed. `changed_elements` as in commit_roots (repeated passes at one restart).
-  bool commit_boundary_roots(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
-                             std::vector<char>* changed_elements = nullptr);
+  /// At a (re)start at (t, y, y'): the roots that sit on their mode's boundary and are about to
+  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y' (roots
+  /// that fire within h are taken as simultaneous with the restart), and roots already
+  /// negative (the state is outside its mode, e.g. after the initial assembly moved it):
+  /// direction[k] = -1 for each (root_count() entries), else 0; true when any. Elements switch
+  /// a small band past their boundaries (1e-14 to 1e-12 of their size), so a state exactly on a
+  /// boundary has a small positive root that the look-ahead sees cross; IDA itself would leave
+  /// a root that is exactly zero inactive. ModeTracker::commit_boundary commits them.
+  bool boundary_roots_leaving(double t, const double* y, const double* yp, std::vector<int>& direction) const;
   /// Puts every element back in its starting mode.
   void reset_modes();
-  /// The run's element modes and histories: evaluations read them, only the commits above
-  /// change them; snapshot() / restore() go back to an earlier state.
+  /// The run's element modes and histories: evaluations read them, only the mode tracker's
+  /// commits (events.hpp) change them; snapshot() / restore() go back to an earlier state.
   const ElementStates& modes() const { return modes_; }
   ElementStates& modes() { return modes_; }
 

@@ -62,6 +62,7 @@ class EulerIntegrator : public Integrator {
                                          const PenaltyRows* penalty);
 
  private:
+  friend class EulerEventHandler;  // (euler_integrator.cpp) Euler's side of the event loop
   /// Euler's step for the event layer: known at its end alone (not dense), the state there.
   class EulerStep final : public StepInterpolant {
    public:
@@ -121,7 +122,6 @@ class EulerIntegrator : public Integrator {
   std::vector<double> force_, rates_, lambda_, inverse_mass_;
   std::vector<double> outputs_;             // element outputs at y_ (sweep())
   bool outputs_current_ = false;            // outputs_ belong to y_ and the present modes
-  std::vector<int> direction_;              // roots that fired in the last step (EventLocator::step_end_crossings)
   std::vector<EventRecord> events_;
   double t_ = 0.0;  // [time]
   double t0_ = 0.0;  // [time] where this integrator's steps began (0, or where it took over a run)

@@ -1,10 +1,13 @@
-// The loop over a step's located crossings (issue 37 item 5), written once for every dense
-// integrator: each crossing of the EventLocator's queue, in time order, is moved to a state at
-// or below zero (EventLocator::event_state), committed through the ModeTracker, and then either
-// gone on across (the integrator keeps its step's end; the element's new mode may end within
-// the step too: those crossings are located and queued) or restarted at. What depends on the
-// integrator (its samples before the change, whether it can go on across one, its restart)
-// is an EventHandler's.
+// The loop over a step's crossings (issue 37 item 5), written once for every integrator. Its
+// policy follows the step (StepInterpolant::dense):
+// * dense (IDA): each crossing of the EventLocator's queue, in time order, is moved to a state
+//   at or below zero (EventLocator::event_state), committed through the ModeTracker, and then
+//   either gone on across (the integrator keeps its step's end; the element's new mode may end
+//   within the step too: those crossings are located and queued) or restarted at;
+// * known at its end alone (Euler): every crossing (EventLocator::queue_step_end_crossings) is
+//   committed at the step's end, all at once, and the integrator restarts there once.
+// What depends on the integrator (its samples before the change, whether it can go on across
+// one, its restart) is an EventHandler's.
 #pragma once
 
 #include <vector>
@@ -38,6 +41,11 @@ class EventHandler {
 /// 20 times within the step forces a restart. Returns true when the integrator restarted
 /// (the step ends there); otherwise the changed elements' roots at t1 are refreshed and the
 /// step is done (ModeTracker::end_step).
+/// On a step known at its end alone (not dense; the queue from queue_step_end_crossings, the
+/// tolerance unused): the handler's before_change once (the first crossing), every crossing
+/// committed at t1 with its direction (an element once), committed() for each that changed a
+/// mode and then restart_at once, and the step is done (ModeTracker::end_step; the handler's
+/// restart has put the new modes' roots at t1 into modes.now()). Returns true when a mode changed.
 bool commit_crossings(StepInterpolant& step, const double* y_end, ModeTracker& modes, EventLocator& locator,
                       EventHandler& handler, double tolerance, std::vector<EventRecord>& events);
 

@@ -8,8 +8,10 @@
 // * ModeTracker: the run's bookkeeping of element modes across steps: the root functions at
 //   the step's start and end, the roots resting on their mode's boundary (carried as +0 until
 //   clearly below zero), and which elements changed mode in the current step, how often and
-//   when. Its commits are the only place an integrator changes element modes; the modes
-//   themselves stay in the DaeSystem (initial_conditions.cpp's settle commits through it too).
+//   when; and every commit of a mode change (the elements' commit, with the event's record):
+//   the only place the element modes change (initial_conditions.cpp's settle commits through
+//   it too). The modes themselves (ElementStates) are still held by the DaeSystem, which only
+//   reads them.
 // * EventLocator: the queue of crossings of the current step in time order, the location of a
 //   root that fell through zero (Illinois on the interpolant, only the element's unknowns
 //   interpolated), and the nudge that moves a located time forward until the interpolated
@@ -17,12 +19,12 @@
 //
 // Roots are positive inside their mode (element.hpp): a fall through zero leaves the mode.
 //
-// What an integrator still does itself: take its step and give its StepInterpolant; a dense
-// one answers an EventHandler (event_loop.hpp: commit_crossings, the loop over a step's
-// crossings): whether it goes on across a change (IDA's lag test) and its restart. Euler
-// commits at its step's end. Not yet here: the element modes themselves (ElementStates) still
-// live in the DaeSystem, whose commit methods the tracker calls; the integrators still read
-// the model's elements for their tolerances (IDA's body sizes) and penalties (Euler).
+// What an integrator still does itself: take its step, give its StepInterpolant and answer an
+// EventHandler (event_loop.hpp: commit_crossings, the loop over a step's crossings): whether it
+// goes on across a change (IDA's lag test) and its restart; Euler's steps are known at their
+// end alone, so the loop commits there. The integrators ask the DaeSystem, never an element.
+// Not yet here: the element modes themselves (ElementStates) are still held by the DaeSystem
+// (DaeSystem::modes(), reset_modes(); Euler and the settle take snapshots of them there).
 #pragma once
 
 #include <vector>
@@ -57,6 +59,7 @@ struct Crossing {
   int element = 0;
   int local = 0;       // the root's index within its element
   int generation = 0;  // the element's mode changes in this step when it was found
+  int direction = -1;  // -1: fell through zero; +1: rose through it (seen only on a step known at its end alone)
 };
 
 /// The element modes' bookkeeping of a run in progress (see the file's comment).
@@ -91,24 +94,25 @@ class ModeTracker {
   // ---- the mode changes of the current step ----
   /// A new step: no element has changed mode in it yet.
   void begin_step() { changed_.clear(), change_count_.clear(), change_time_.clear(); }
-  /// Commits element e's root `local` falling through zero at (t, y), appending the event.
-  /// True when the element changed mode (then record_change(e, t) has been called).
-  bool commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events);
+  /// Commits element e's root `local` falling through zero (direction -1; +1: rising through
+  /// it) at (t, y), appending the event. True when the element changed mode (then
+  /// record_change(e, t) has been called).
+  bool commit(int e, int local, double t, const double* y, std::vector<EventRecord>& events, int direction = -1);
   /// Element e changed mode at t: its roots are ordinary again (a new mode), and the change
   /// counts for this step.
   void record_change(int e, double t);
-  /// At a step's end, known there alone (Euler): commits every root that fired (direction as
-  /// EventLocator::step_end_crossings gives it) at (t, y), appending the events; true when any
-  /// mode changed.
-  bool commit_all(double t, const double* y, const std::vector<int>& direction, std::vector<EventRecord>& events) {
-    return system_.commit_roots(t, y, direction.data(), events);
-  }
+  /// Commits the mode changes of the roots that fired (direction[k] = +1 / -1 for root k, 0 for
+  /// roots that did not fire) at (t, y); appends what happened to `events`. Returns true when
+  /// any mode changed (the static settle and the restarts; the step's bookkeeping above is left
+  /// alone). With `changed_elements` (one flag per element): flagged elements are left alone
+  /// and the ones that change are flagged, so that no element changes mode twice at one instant.
+  bool commit_roots(double t, const double* y, const int* direction, std::vector<EventRecord>& events,
+                    std::vector<char>* changed_elements = nullptr);
   /// At a (re)start at (t, y, y'): commits the roots that sit on their mode's boundary and are
-  /// about to leave it (DaeSystem::commit_boundary_roots); changed_elements as there.
+  /// about to leave it (DaeSystem::boundary_roots_leaving); changed_elements as in commit_roots
+  /// (repeated passes at one restart).
   bool commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
-                       std::vector<char>* changed_elements = nullptr) {
-    return system_.commit_boundary_roots(t, y, yp, events, changed_elements);
-  }
+                       std::vector<char>* changed_elements = nullptr);
   /// How often element e changed mode in this step.
   int changes_of(int e) const;
   /// One flag per element: 1 for the elements whose last change in this step was at t.
@@ -124,6 +128,9 @@ class ModeTracker {
   void end_step() { std::swap(previous_, now_); }
 
  private:
+  /// Element e's root `local` crossing in `direction` at (t, y): its commit; appends the event.
+  bool commit_element(int e, int local, int direction, double t, const double* y, std::vector<EventRecord>& events);
+
   DaeSystem& system_;
   std::vector<double> unknown_floor_;
   std::vector<double> previous_, now_;
@@ -165,6 +172,10 @@ class EventLocator {
   /// one that rose from < 0 to >= 0, else 0. True when any did.
   static bool step_end_crossings(const std::vector<double>& before, const std::vector<double>& after,
                                  std::vector<int>& direction);
+  /// The same rule into the queue: every root that fired between before (the roots at the
+  /// step's start) and after (at its end, t1), as a crossing at t1 with its direction, in root
+  /// order. True when any did.
+  bool queue_step_end_crossings(double t1, const std::vector<double>& before, const std::vector<double>& after);
 
  private:
   const DaeSystem& system_;

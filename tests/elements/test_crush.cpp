@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "railcrash/elements/crush.hpp"
+#include "railcrash/events.hpp"
 #include "railcrash/run.hpp"
 #include "support.hpp"
 
@@ -237,7 +238,7 @@ TEST_CASE("the run's element states: a snapshot restored undoes a commit and its
   std::vector<double> yp(y.size(), 0.0), before(y.size()), after(y.size());
   std::vector<EventRecord> events;
   const int past_first_point[3] = {0, 0, -1};
-  system.commit_roots(0.0, y.data(), past_first_point, events);
+  ModeTracker(system).commit_roots(0.0, y.data(), past_first_point, events);
   REQUIRE(c.state().segment == 1);  // on the plateau
   system.residual(0.0, y.data(), yp.data(), before.data());
   const ElementStates::Snapshot loading = system.modes().snapshot();
