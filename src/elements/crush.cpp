@@ -8,7 +8,7 @@
 namespace railcrash {
 
 CrushSpring::CrushSpring(ElementSpec& spec)
-    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+    : HybridElement(spec.name, spec.type, spec.points, spec.where),
       unloading_stiffness(spec.parameters->value("unloading_stiffness")),
       tension_stiffness(spec.parameters->number("tension_stiffness")),
       free_length(spec.parameters->number("free_length")) {
@@ -84,11 +84,8 @@ void CrushSpring::enter_mode_at(State& st, double crush, double rate) const {
 }
 
 void CrushSpring::initialize(const ElementState<double>& initial) {
-  const double length = line_geometry(*this, initial).length;
-  if (length == 0.0)
-    throw InputError(where().prefix() + "crush_spring '" + name() +
-                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
-  if (!free_length) free_length = length;
+  require_direction(*this, initial);
+  if (!free_length) free_length = line_geometry(*this, initial).length;
   initial_state_ = State{};
   enter_mode_at(initial_state_, crush_of(initial), crush_rate_of(initial));
   if (initial_state_.mode == Mode::Loading && crush_of(initial) > 0.0)
@@ -112,9 +109,8 @@ void CrushSpring::stiffest_force_jacobian(double, const ElementState<double>& s,
   ad::extract_forces(fd, f, df_dq, df_dv);
 }
 
-void CrushSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
+void CrushSpring::roots_in(const State& st, const ElementState<double>& s, double* g) const {
   const double crush = crush_of(s);
-  const State& st = mode_as<State>(s);
   g[0] = g[1] = g[2] = 1.0;
   switch (st.mode) {
     case Mode::Loading: {
@@ -134,10 +130,9 @@ void CrushSpring::roots(double, const ElementState<double>& s, const double*, do
   }
 }
 
-bool CrushSpring::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
-                         Event& event) const {
+bool CrushSpring::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+                            Event& event) const {
   const double crush = crush_of(s);
-  State& st = *static_cast<State*>(mode);
   switch (st.mode) {
     case Mode::Loading:
       if (direction > 0) return false;
