@@ -67,7 +67,8 @@ class DrivenElement {
 
 /// The R1 test model (SI): a 1000 kg car end at 2 m/s into an anticlimber fixed to ground
 /// (elastic to 0.01 m at 1e7 N/m, then 1e5 N/m), with a responses section (reference crush
-/// 0.02 m), simulated to t_end.
+/// 0.02 m), simulated to t_end: tests/models/anticlimber_r1.yaml (which the Python and shell
+/// tests read too) with its end time replaced.
 std::string anticlimber_r1_model_text(double t_end);
 
 /// Positions and velocities of a DAE state.

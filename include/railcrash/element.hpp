@@ -9,8 +9,9 @@
 // * Constraint elements (joints) give m equations Phi(q) = 0 (m <= 3). G = dPhi/dq and the
 //   second derivatives needed for d(G^T lambda)/dq come from nested AD of the same Phi code.
 //
-// Concrete elements derive from ForceElement<Derived> or ConstraintElement<Derived> and
-// write their law once, as a template over the scalar type.
+// Concrete elements derive from ForceElement<Derived> (HybridElement<Derived>, elements/hybrid.hpp,
+// for a piecewise law with modes) or ConstraintElement<Derived> and write their law once, as a
+// template over the scalar type.
 //
 // Piecewise laws (contact, yield, unloading, bottoming, rupture, ...) are hybrid: between
 // events the element is in a fixed mode and its law is smooth. The element exposes root

@@ -102,7 +102,7 @@ ElasticPlasticLaw make_law(ParameterReader& p, const std::string& direction, std
 
 }  // namespace
 
-Anticlimber::Anticlimber(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+Anticlimber::Anticlimber(ElementSpec& spec) : HybridElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
   length = p.number("length");
   facing = p.number("facing");
@@ -304,14 +304,12 @@ void Anticlimber::initialize(const ElementState<double>& initial) {
   }
 }
 
-void Anticlimber::roots(double, const ElementState<double>& s, const double*, double* g) const {
-  const State& st = mode_as<State>(s);
+void Anticlimber::roots_in(const State& st, const ElementState<double>& s, double* g) const {
   roots_of(st, deformations(st, s), g);
 }
 
-bool Anticlimber::commit(int index, int direction, double t, const ElementState<double>& s, const double*, void* mode,
-                         Event& event) const {
-  State& st = *static_cast<State*>(mode);
+bool Anticlimber::commit_in(State& st, int index, int direction, double t, const ElementState<double>& s,
+                            Event& event) const {
   if (direction > 0 || !active(st, index)) return false;
   const Deformations k = deformations(st, s);
   double g[kRootCount];
@@ -413,8 +411,7 @@ void register_anticlimber_elements(ElementRegistry& registry) {
                 [](ElementSpec& s) { return std::make_unique<Anticlimber>(s); }});
 }
 
-void Anticlimber::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                          ForceBlock& df_dv) const {
+Anticlimber::State Anticlimber::stiffest_mode(const ElementState<double>& s) const {
   State stiffest = mode_as<State>(s);
   const Kinematics<double> k = kinematics(s);
   stiffest.contact = Contact::Engaged;
@@ -424,8 +421,7 @@ void Anticlimber::stiffest_force_jacobian(double t, const ElementState<double>& 
   stiffest.torsional = torsional.fresh();
   stiffest.vertical_reference = k.vertical;
   stiffest.torsional_reference = k.rotation;
-  std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
+  return stiffest;
 }
 
 }  // namespace railcrash

@@ -122,7 +122,7 @@ TaperedBeam::TaperedBeam(ElementSpec& spec)
 // ---- the common law ----------------------------------------------------------------------
 
 BeamElement::BeamElement(ElementSpec& spec, BeamMaterial beam_material)
-    : ForceElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {}
+    : HybridElement(spec.name, spec.type, spec.points, spec.where), material(beam_material) {}
 
 void BeamElement::initialize(const ElementState<double>& initial) {
   if (point_slot(0) == point_slot(1))
@@ -193,8 +193,7 @@ double BeamElement::stress(const std::array<double, 3>& force) const {
                    std::abs(force[2]) / section_.plastic_section_modulus[1]});
 }
 
-void BeamElement::roots(double, const ElementState<double>& s, const double*, double* g) const {
-  const State& st = mode_as<State>(s);
+void BeamElement::roots_in(const State& st, const ElementState<double>& s, double* g) const {
   g[0] = g[1] = g[2] = g[3] = 1.0;
   if (st.failed) return;
   std::array<double, 3> force{}, offset{}, rate{};
@@ -211,9 +210,8 @@ void BeamElement::roots_from(const State& st, const std::array<double, 3>& force
   g[3] = 1.0 - stress(force) / material.ultimate_stress;
 }
 
-bool BeamElement::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
-                         Event& event) const {
-  State& st = *static_cast<State*>(mode);
+bool BeamElement::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+                            Event& event) const {
   if (st.failed || direction > 0) return false;
   std::array<double, 3> force{}, offset{};
   evaluate(s, force, offset);
@@ -238,14 +236,11 @@ bool BeamElement::commit(int index, int direction, double, const ElementState<do
   return true;
 }
 
-void BeamElement::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                          ForceBlock& df_dv) const {
-  // Elastic in every component is the stiffest mode (plastic slopes are E_t / E times smaller).
+BeamElement::State BeamElement::stiffest_mode(const ElementState<double>& s) const {
   State elastic = mode_as<State>(s);
   elastic.sign = {0, 0, 0};
   elastic.failed = false;
-  std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, in_mode(s, elastic), f, df_dq, df_dv);
+  return elastic;
 }
 
 double BeamElement::potential_energy(const ElementState<double>& s) const {

@@ -6,7 +6,7 @@
 namespace railcrash {
 
 SurfaceContact::SurfaceContact(ElementSpec& spec, bool wheel_rail)
-    : ForceElement(spec.name, spec.type, spec.points, spec.where), wheel_rail_(wheel_rail) {
+    : HybridElement(spec.name, spec.type, spec.points, spec.where), wheel_rail_(wheel_rail) {
   ParameterReader& p = *spec.parameters;
   stiffness = p.value("stiffness");
   damping = p.value("damping");
@@ -81,8 +81,7 @@ void SurfaceContact::initialize(const ElementState<double>& initial) {
   enter_mode(initial_state_, k.penetration, k.rate);
 }
 
-void SurfaceContact::roots(double, const ElementState<double>& s, const double*, double* g) const {
-  const State& st = mode_as<State>(s);
+void SurfaceContact::roots_in(const State& st, const ElementState<double>& s, double* g) const {
   const Kinematics<double> k = kinematics(s);
   g[0] = g[1] = g[2] = 1.0;
   switch (st.mode) {
@@ -101,9 +100,8 @@ void SurfaceContact::roots(double, const ElementState<double>& s, const double*,
   }
 }
 
-bool SurfaceContact::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
-                            Event& event) const {
-  State& st = *static_cast<State*>(mode);
+bool SurfaceContact::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+                               Event& event) const {
   if (direction > 0) return false;  // every root above is written to fall through 0
   const Kinematics<double> k = kinematics(s);
   switch (st.mode) {
@@ -139,11 +137,8 @@ bool SurfaceContact::commit(int index, int direction, double, const ElementState
   return false;
 }
 
-void SurfaceContact::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                             ForceBlock& df_dv) const {
-  const State stiffest{Mode::Contact, stiffness_above > stiffness ? 1 : 0};
-  std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
+SurfaceContact::State SurfaceContact::stiffest_mode(const ElementState<double>& /*s*/) const {
+  return State{Mode::Contact, stiffness_above > stiffness ? 1 : 0};
 }
 
 double SurfaceContact::potential_energy(const ElementState<double>& s) const {

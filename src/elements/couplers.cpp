@@ -378,7 +378,7 @@ constexpr int kFractureRoot = AxialHysteresis::kRoots + 1;
 const char* const kGearSegments[] = {"bottomed", "off bottom"};
 }  // namespace
 
-DraftGear::DraftGear(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+DraftGear::DraftGear(ElementSpec& spec) : HybridElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
   initial_stiffness = p.value("initial_stiffness");
   travel = p.value("travel");
@@ -412,11 +412,8 @@ DraftGear::Kinematics DraftGear::kinematics(const ElementState<double>& s) const
 }
 
 void DraftGear::initialize(const ElementState<double>& initial) {
-  const double length = line_geometry(*this, initial).length;
-  if (length == 0.0)
-    throw InputError(where().prefix() + "draft_gear '" + name() +
-                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
-  if (!free_length) free_length = length;
+  require_direction(*this, initial);
+  if (!free_length) free_length = line_geometry(*this, initial).length;
   const Kinematics k = kinematics(initial);
   State& st = initial_state_;
   st = State{};
@@ -453,7 +450,7 @@ void DraftGear::roots_at(const State& st, const Kinematics& k, double* g) const 
   }
 }
 
-void DraftGear::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(mode_as<State>(s), kinematics(s), g); }
+void DraftGear::roots_in(const State& st, const ElementState<double>& s, double* g) const { roots_at(st, kinematics(s), g); }
 
 void DraftGear::apply(State& st, int index, const Kinematics& k, Event& event) const {
   const double force = gear_force(st, k.d);
@@ -488,21 +485,18 @@ void DraftGear::apply(State& st, int index, const Kinematics& k, Event& event) c
   }
 }
 
-bool DraftGear::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
-                       Event& event) const {
+bool DraftGear::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+                          Event& event) const {
   const Kinematics k = kinematics(s);
-  State& st = *static_cast<State*>(mode);
   return commit_crossing<kRoots>(
       index, direction, [&](double* g) { roots_at(st, k, g); }, [&](int i, Event& e) { apply(st, i, k, e); }, event);
 }
 
-void DraftGear::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                        ForceBlock& df_dv) const {
+DraftGear::State DraftGear::stiffest_mode(const ElementState<double>& /*s*/) const {
   // Stiffest: the transition stiffness (>= every slope), e.g. the neutral stick line.
   State neutral{};
   neutral.law.mode = AxialHysteresis::Mode::Neutral;
-  std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, in_mode(s, neutral), f, df_dq, df_dv);
+  return neutral;
 }
 
 double DraftGear::potential_energy(const ElementState<double>& s) const {
@@ -525,7 +519,7 @@ void DraftGear::outputs(const ElementState<double>& s, const double*, double* ou
 
 // ---- coupler_end -------------------------------------------------------------------------
 
-CouplerEnd::CouplerEnd(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+CouplerEnd::CouplerEnd(ElementSpec& spec) : HybridElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
   const auto stiffness = p.vector("horizontal_stiffness", 2);
   const auto lengths = p.vector("free_length", 2);
@@ -620,7 +614,7 @@ void CouplerEnd::roots_at(const State& st, const Kinematics& k, double* g) const
   if (shear_load && active(st) && st.band == DeadBand::Mode::Below) g[kShearRoot] = *shear_load + face_tension(st, k.h);
 }
 
-void CouplerEnd::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(mode_as<State>(s), kinematics(s), g); }
+void CouplerEnd::roots_in(const State& st, const ElementState<double>& s, double* g) const { roots_at(st, kinematics(s), g); }
 
 void CouplerEnd::apply(State& st, int index, const Kinematics& k, Event& event) const {
   if (index == kShearRoot) {
@@ -687,20 +681,16 @@ void CouplerEnd::apply_lossy(State& st, int index, const Kinematics& k, Event& e
   }
 }
 
-bool CouplerEnd::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
-                        Event& event) const {
+bool CouplerEnd::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+                           Event& event) const {
   const Kinematics k = kinematics(s);
-  State& st = *static_cast<State*>(mode);
   return commit_crossing<kRoots>(
       index, direction, [&](double* g) { roots_at(st, k, g); }, [&](int i, Event& e) { apply(st, i, k, e); }, event);
 }
 
-void CouplerEnd::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                         ForceBlock& df_dv) const {
+CouplerEnd::State CouplerEnd::stiffest_mode(const ElementState<double>& s) const {
   // The steeper unloading line if any.
-  const State stiffest{DeadBand::Mode::Below, true, false, lossy(), mode_as<State>(s).peak, false};
-  std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
+  return State{DeadBand::Mode::Below, true, false, lossy(), mode_as<State>(s).peak, false};
 }
 
 double CouplerEnd::potential_energy(const ElementState<double>& s) const {
@@ -726,7 +716,7 @@ void CouplerEnd::outputs(const ElementState<double>& s, const double*, double* o
 
 // ---- coupling ----------------------------------------------------------------------------
 
-Coupling::Coupling(ElementSpec& spec) : ForceElement(spec.name, spec.type, spec.points, spec.where) {
+Coupling::Coupling(ElementSpec& spec) : HybridElement(spec.name, spec.type, spec.points, spec.where) {
   ParameterReader& p = *spec.parameters;
   const double kind_value = p.value("kind");
   const auto curve = p.table("curve", 2);
@@ -829,7 +819,7 @@ void Coupling::roots_at(const State& st, const Kinematics& k, double* g) const {
   vertical_.roots(st.vertical, k.w, g + AxialHysteresis::kRoots);
 }
 
-void Coupling::roots(double, const ElementState<double>& s, const double*, double* g) const { roots_at(mode_as<State>(s), kinematics(s), g); }
+void Coupling::roots_in(const State& st, const ElementState<double>& s, double* g) const { roots_at(st, kinematics(s), g); }
 
 void Coupling::apply(State& st, int index, const Kinematics& k, Event& event) const {
   if (index < AxialHysteresis::kRoots) {
@@ -844,16 +834,14 @@ void Coupling::apply(State& st, int index, const Kinematics& k, Event& event) co
   event = {what, k.w, EventKind::Kink};
 }
 
-bool Coupling::commit(int index, int direction, double, const ElementState<double>& s, const double*, void* mode,
-                      Event& event) const {
+bool Coupling::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+                         Event& event) const {
   const Kinematics k = kinematics(s);
-  State& st = *static_cast<State*>(mode);
   return commit_crossing<kRoots>(
       index, direction, [&](double* g) { roots_at(st, k, g); }, [&](int i, Event& e) { apply(st, i, k, e); }, event);
 }
 
-void Coupling::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                       ForceBlock& df_dv) const {
+Coupling::State Coupling::stiffest_mode(const ElementState<double>& s) const {
   // Horizontal: the transition line (K_t >= every slope); vertical: beyond the slack.
   State stiffest = mode_as<State>(s);
   const Kinematics k = kinematics(s);
@@ -861,8 +849,7 @@ void Coupling::stiffest_force_jacobian(double t, const ElementState<double>& s, 
   stiffest.horizontal.mode = AxialHysteresis::Mode::Transition;
   stiffest.horizontal.x0 = law_.side_deflection(stiffest.horizontal, k.u);
   if (vertical_stiffness > 0.0) stiffest.vertical = DeadBand::Mode::Above;
-  std::array<Pose<double>, 2> f{};
-  add_force_jacobian(t, in_mode(s, stiffest), f, df_dq, df_dv);
+  return stiffest;
 }
 
 double Coupling::potential_energy(const ElementState<double>& s) const {

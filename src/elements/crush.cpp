@@ -10,7 +10,7 @@
 namespace railcrash {
 
 CrushSpring::CrushSpring(ElementSpec& spec)
-    : ForceElement(spec.name, spec.type, spec.points, spec.where),
+    : HybridElement(spec.name, spec.type, spec.points, spec.where),
       unloading_stiffness(spec.parameters->value("unloading_stiffness")),
       tension_stiffness(spec.parameters->number("tension_stiffness")),
       free_length(spec.parameters->number("free_length")) {
@@ -86,10 +86,8 @@ void CrushSpring::enter_mode_at(State& st, double crush, double rate) const {
 }
 
 void CrushSpring::initialize(const ElementState<double>& initial) {
+  require_direction(*this, initial);
   const double length = line_geometry(*this, initial).length;
-  if (length == 0.0)
-    throw InputError(where().prefix() + "crush_spring '" + name() +
-                     "': its two points coincide in the initial configuration, so it has no direction; move them apart");
   if (!free_length) free_length = length;
   {  // the initial direction P1 -> P2 in body 1's frame (the points-meet root)
     const Vec2<double> d = line_geometry(*this, initial).d;
@@ -127,9 +125,8 @@ double CrushSpring::points_meet_gap(const ElementState<double>& s) const {
   return dot(line_geometry(*this, s).d, axis) - kPointsMeetFraction * *free_length;
 }
 
-void CrushSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
+void CrushSpring::roots_in(const State& st, const ElementState<double>& s, double* g) const {
   const double crush = crush_of(s);
-  const State& st = mode_as<State>(s);
   g[0] = g[1] = g[2] = 1.0;
   g[kPointsMeetRoot] = points_meet_gap(s);
   switch (st.mode) {
@@ -150,12 +147,11 @@ void CrushSpring::roots(double, const ElementState<double>& s, const double*, do
   }
 }
 
-bool CrushSpring::commit(int index, int direction, double t, const ElementState<double>& s, const double*, void* mode,
-                         Event& event) const {
+bool CrushSpring::commit_in(State& st, int index, int direction, double t, const ElementState<double>& s,
+                            Event& event) const {
   const double crush = crush_of(s);
-  State& st = *static_cast<State*>(mode);
-  // Checked whatever root fired: Euler commits one root per element and step, and the step
-  // that carries P2 past P1 may also reverse the crush rate (root 0, first in line).
+  // Checked whatever root fired: a step known at its end alone (Euler's) commits one root per
+  // element, and the step that carries P2 past P1 may also reverse the crush rate (root 0, first).
   if (points_meet_gap(s) < 0.0 || (index == kPointsMeetRoot && direction < 0)) {
     // No mode goes on from here: the run stops with what it has (Integrator::run keeps the
     // samples up to now and takes this as the run's message; not a step failure, so auto does

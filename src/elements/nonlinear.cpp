@@ -92,7 +92,7 @@ int PiecewiseLinearLaw::segment_at(double x, int direction) const {
 
 template <class Derived>
 PiecewiseLineElement<Derived>::PiecewiseLineElement(ElementSpec& spec, int fracture_sides)
-    : ForceElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {}
+    : HybridElement<Derived>(spec.name, spec.type, spec.points, spec.where), fracture_sides_(fracture_sides) {}
 
 template <class Derived>
 void PiecewiseLineElement<Derived>::set_law(PiecewiseLinearLaw law) {
@@ -122,8 +122,7 @@ void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initi
 }
 
 template <class Derived>
-void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s, const double*, double* g) const {
-  const SegmentMode& m = mode_as<SegmentMode>(s);
+void PiecewiseLineElement<Derived>::roots_in(const SegmentMode& m, const ElementState<double>& s, double* g) const {
   for (int k = 0; k < root_count(); ++k) g[k] = 1.0;
   if (m.broken) return;
   const double x = measure_of(s);
@@ -138,9 +137,8 @@ void PiecewiseLineElement<Derived>::roots(double, const ElementState<double>& s,
 }
 
 template <class Derived>
-bool PiecewiseLineElement<Derived>::commit(int index, int direction, double, const ElementState<double>& s,
-                                           const double*, void* mode, Element::Event& event) const {
-  SegmentMode& m = *static_cast<SegmentMode*>(mode);
+bool PiecewiseLineElement<Derived>::commit_in(SegmentMode& m, int index, int direction, double,
+                                              const ElementState<double>& s, Element::Event& event) const {
   if (m.broken) return false;
   const double x = measure_of(s);
   if (index >= 2) {  // fracture roots: leave when they fall through zero
@@ -171,13 +169,11 @@ double PiecewiseLineElement<Derived>::law_integral(const ElementState<double>& s
 }
 
 template <class Derived>
-void PiecewiseLineElement<Derived>::stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq,
-                                                            ForceBlock& df_dv) const {
+SegmentMode PiecewiseLineElement<Derived>::stiffest_mode(const ElementState<double>& /*s*/) const {
   SegmentMode steepest;  // unbroken, on the segment of the largest |slope|
   for (int k = 1; k < law_.segment_count(); ++k)
     if (std::abs(law_.segment(k).slope) > std::abs(law_.segment(steepest.segment).slope)) steepest.segment = k;
-  std::array<Pose<double>, 2> f{};
-  this->add_force_jacobian(t, in_mode(s, steepest), f, df_dq, df_dv);
+  return steepest;
 }
 
 template <class Derived>
@@ -195,14 +191,6 @@ int sign_of(double value) { return (value > 0.0) - (value < 0.0); }
 double length_rate(const ElementState<double>& s, const Element& e) {
   const LineGeometry<double> g = line_geometry(e, s);
   return dot(g.d, g.d_rate) / g.length;
-}
-
-/// The line elements need a direction: their points must not coincide at the start.
-void require_direction(const Element& e, const ElementState<double>& initial) {
-  if (line_geometry(e, initial).length == 0.0)
-    throw InputError(e.where().prefix() + e.type() + " '" + e.name() +
-                     "': its two points coincide in the initial configuration, so it has no direction; move them apart" +
-                     (e.type() == "special_spring" ? " or give it an axis" : ""));
 }
 
 /// slope_1 (required), slope_2 and breakpoint (together or neither), all >= 0.

@@ -6,6 +6,12 @@
 
 namespace railcrash {
 
+void require_direction(const Element& e, const ElementState<double>& initial) {
+  if (line_geometry(e, initial).length == 0.0)
+    throw InputError(e.where().prefix() + e.type() + " '" + e.name() +
+                     "': its two points coincide in the initial configuration, so it has no direction; move them apart" +
+                     (e.type() == "special_spring" ? " or give it an axis" : ""));
+}
 
 LinearSpring::LinearSpring(ElementSpec& spec)
     : ForceElement(spec.name, spec.type, spec.points, spec.where),

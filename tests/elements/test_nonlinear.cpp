@@ -93,6 +93,25 @@ RunOutcome run(const std::string& yaml) {
   return outcome;
 }
 
+/// The single element of the axial model `a` at its initial state: its outputs (law value, x),
+/// the generalized forces on the body and its stored energy.
+struct AtStart {
+  std::vector<double> out = std::vector<double>(2, 0.0);
+  std::vector<double> f = std::vector<double>(3, 0.0);
+  double energy = 0.0;
+};
+AtStart at_start(const Axial& a) {
+  const Model model = testing::model_from_text(axial_yaml(a));
+  DaeSystem system(model);
+  const std::vector<double> y = system.initial_state();
+  AtStart r;
+  system.generalized_forces(0.0, y.data(), y.data() + 3, r.f.data());
+  system.outputs(y.data(), nullptr, r.out.data());
+  const Element& e = *model.elements().front();
+  r.energy = e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0)));
+  return r;
+}
+
 /// Position and velocity of the single body along its axis at the end of a run.
 double final_position(const RunOutcome& o, bool vertical = false) { return o.y[vertical ? 1 : 0]; }
 double final_velocity(const RunOutcome& o, bool vertical = false) { return o.y[vertical ? 4 : 3]; }
@@ -347,19 +366,13 @@ TEST_CASE("nonlinear_spring force and energy follow both branches past both brea
       Axial a = axial("nonlinear_spring", kSpringParameters);
       a.position = (flip ? -1.0 : 1.0) * (1.0 + p.deformation);
       a.simulation = ida(1.0);
-      const Model model = testing::model_from_text(axial_yaml(a));
-      DaeSystem system(model);
-      const std::vector<double> y = system.initial_state();
-      std::vector<double> f(3, 0.0), out(2, 0.0);
-      system.generalized_forces(0.0, y.data(), y.data() + 3, f.data());
-      system.outputs(y.data(), nullptr, out.data());
+      const auto [out, f, energy_at_start] = at_start(a);
       CHECK(out[0] == Approx(p.tension).epsilon(1e-12));
       CHECK(out[1] == Approx(p.deformation).epsilon(1e-12));
       // Tension pulls the body towards the ground point.
       CHECK(f[0] == Approx((flip ? 1.0 : -1.0) * -(-p.tension)).epsilon(1e-12));
       CHECK(f[1] == Approx(0.0).margin(1e-12));
-      const Element& e = *model.elements().front();
-      CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0))) == Approx(p.energy).epsilon(1e-12));
+      CHECK(energy_at_start == Approx(p.energy).epsilon(1e-12));
     }
   }
 }
@@ -372,17 +385,11 @@ TEST_CASE("nonlinear_dashpot force follows both branches past both switch veloci
     Axial a = axial("nonlinear_dashpot", kDashpotParameters);
     a.velocity = rate;  // body at +1 on x: its velocity is the rate of length
     a.simulation = ida(1.0);
-    const Model model = testing::model_from_text(axial_yaml(a));
-    DaeSystem system(model);
-    const std::vector<double> y = system.initial_state();
-    std::vector<double> f(3, 0.0), out(2, 0.0);
-    system.generalized_forces(0.0, y.data(), y.data() + 3, f.data());
-    system.outputs(y.data(), nullptr, out.data());
+    const auto [out, f, energy_at_start] = at_start(a);
     CHECK(out[0] == Approx(tension).epsilon(1e-12));
     CHECK(out[1] == Approx(rate).epsilon(1e-12));
     CHECK(f[0] == Approx(-tension).epsilon(1e-12));
-    const Element& e = *model.elements().front();
-    CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0))) == 0.0);
+    CHECK(energy_at_start == 0.0);
   }
 }
 
@@ -395,12 +402,7 @@ TEST_CASE("special_spring acts one way only: compression (kind 1) or tension (ki
       Axial a = axial("special_spring", special_parameters(kind));
       a.position = kind == 1 ? 1.0 - deflection : 1.0 + deflection;
       a.simulation = ida(1.0);
-      const Model model = testing::model_from_text(axial_yaml(a));
-      DaeSystem system(model);
-      const std::vector<double> y = system.initial_state();
-      std::vector<double> f(3, 0.0), out(2, 0.0);
-      system.generalized_forces(0.0, y.data(), y.data() + 3, f.data());
-      system.outputs(y.data(), nullptr, out.data());
+      const auto [out, f, energy_at_start] = at_start(a);
       CHECK(out[0] == Approx(force).margin(1e-12));
       CHECK(out[1] == Approx(deflection).epsilon(1e-12));
       // kind 1 pushes the body away from the ground point (+x), kind 2 pulls it back (-x).
@@ -410,8 +412,7 @@ TEST_CASE("special_spring acts one way only: compression (kind 1) or tension (ki
                             : deflection <= 0.02
                                 ? 5.0 * deflection + 1000.0 * deflection * deflection
                                 : 0.5 + 45.0 * (deflection - 0.02) + 10000.0 * std::pow(deflection - 0.02, 2);
-      const Element& e = *model.elements().front();
-      CHECK(e.potential_energy(gather_state(e, y.data(), y.data() + 3, system.modes().of(0))) == Approx(energy).margin(1e-12));
+      CHECK(energy_at_start == Approx(energy).margin(1e-12));
     }
   }
 }

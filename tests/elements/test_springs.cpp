@@ -417,20 +417,42 @@ std::vector<double> join(const BodyState& s) {
 
 }  // namespace
 
-TEST_CASE("linear_spring outputs tension-positive force and deformation", "[elements]") {
-  for (const Ends ends : kAllEnds) {
-    INFO(ends_name(ends));
-    const Model model = testing::model_from_text(element_model("linear_spring", linear_spring_parameters(), ends));
-    DaeSystem system(model);
-    const Layout l = layout(ends);
-    CHECK(system.output_names() == std::vector<std::string>{"e.force", "e.deformation"});
-    at_several_states(system, [&](const BodyState& s) {
-      const double deformation = distance(s.q, l) - kFreeLength;
-      const std::vector<double> out = element_outputs(system, join(s));
-      CHECK(out[0] == Approx(kStiffness * deformation).epsilon(1e-12).margin(1e-12));
-      CHECK(out[1] == Approx(deformation).epsilon(1e-12).margin(1e-12));
-    });
-  }
+TEST_CASE("spring and dashpot outputs are the force or moment and the quantity it is proportional to", "[elements]") {
+  // Each type's outputs: (coefficient x quantity, quantity), the quantity from the hand
+  // kinematics above, at several states of every arrangement of ends.
+  struct OutputCase {
+    const char* type;
+    std::string parameters;
+    std::vector<std::string> names;
+    double coefficient;                                    // stiffness or damping of the type
+    double (*quantity)(const BodyState& s, const Layout& l);  // what the second output is
+    double tolerance;                                      // relative and absolute
+  };
+  const OutputCase cases[] = {
+      {"linear_spring", linear_spring_parameters(), {"e.force", "e.deformation"}, kStiffness,
+       [](const BodyState& s, const Layout& l) { return distance(s.q, l) - kFreeLength; }, 1e-12},
+      // The rate of length comes from central differences of the hand-computed length.
+      {"linear_dashpot", linear_dashpot_parameters(), {"e.force", "e.rate"}, kDamping,
+       [](const BodyState& s, const Layout& l) { return length_rate(s.q, s.v, l); }, 1e-8},
+      {"torsional_spring", torsional_spring_parameters(), {"e.moment", "e.rotation"}, kTorsionalStiffness,
+       [](const BodyState& s, const Layout& l) { return relative_angle(s.q, l) - kFreeAngle; }, 1e-12},
+      {"torsional_dashpot", torsional_dashpot_parameters(), {"e.moment", "e.rate"}, kTorsionalDamping,
+       [](const BodyState& s, const Layout& l) { return relative_rate(s.v, l); }, 1e-12},
+  };
+  for (const OutputCase& c : cases)
+    for (const Ends ends : kAllEnds) {
+      INFO(c.type << " " << ends_name(ends));
+      const Model model = testing::model_from_text(element_model(c.type, c.parameters, ends));
+      DaeSystem system(model);
+      const Layout l = layout(ends);
+      CHECK(system.output_names() == c.names);
+      at_several_states(system, [&](const BodyState& s) {
+        const double quantity = c.quantity(s, l);
+        const std::vector<double> out = element_outputs(system, join(s));
+        CHECK(out[0] == Approx(c.coefficient * quantity).epsilon(c.tolerance).margin(c.tolerance));
+        CHECK(out[1] == Approx(quantity).epsilon(c.tolerance).margin(c.tolerance));
+      });
+    }
 }
 
 TEST_CASE("linear_spring output force is positive when stretched and negative when compressed", "[elements]") {
@@ -452,53 +474,4 @@ TEST_CASE("linear_spring output force is positive when stretched and negative wh
   CHECK(out_compressed[1] == Approx(-0.5));
   // A stretched spring pulls the body back towards the ground point.
   CHECK(forces(stretched_system, split(stretched_system, stretched_system.initial_state()))[0] == Approx(-5.0));
-}
-
-TEST_CASE("linear_dashpot outputs force and rate of length", "[elements]") {
-  for (const Ends ends : kAllEnds) {
-    INFO(ends_name(ends));
-    const Model model = testing::model_from_text(element_model("linear_dashpot", linear_dashpot_parameters(), ends));
-    DaeSystem system(model);
-    const Layout l = layout(ends);
-    CHECK(system.output_names() == std::vector<std::string>{"e.force", "e.rate"});
-    at_several_states(system, [&](const BodyState& s) {
-      const double rate = length_rate(s.q, s.v, l);
-      const std::vector<double> out = element_outputs(system, join(s));
-      CHECK(out[0] == Approx(kDamping * rate).epsilon(1e-8).margin(1e-8));
-      CHECK(out[1] == Approx(rate).epsilon(1e-8).margin(1e-8));
-    });
-  }
-}
-
-TEST_CASE("torsional_spring outputs moment and rotation", "[elements]") {
-  for (const Ends ends : kAllEnds) {
-    INFO(ends_name(ends));
-    const Model model = testing::model_from_text(element_model("torsional_spring", torsional_spring_parameters(), ends));
-    DaeSystem system(model);
-    const Layout l = layout(ends);
-    CHECK(system.output_names() == std::vector<std::string>{"e.moment", "e.rotation"});
-    at_several_states(system, [&](const BodyState& s) {
-      const double rotation = relative_angle(s.q, l) - kFreeAngle;
-      const std::vector<double> out = element_outputs(system, join(s));
-      CHECK(out[0] == Approx(kTorsionalStiffness * rotation).epsilon(1e-12).margin(1e-12));
-      CHECK(out[1] == Approx(rotation).epsilon(1e-12).margin(1e-12));
-    });
-  }
-}
-
-TEST_CASE("torsional_dashpot outputs moment and relative angular velocity", "[elements]") {
-  for (const Ends ends : kAllEnds) {
-    INFO(ends_name(ends));
-    const Model model =
-        testing::model_from_text(element_model("torsional_dashpot", torsional_dashpot_parameters(), ends));
-    DaeSystem system(model);
-    const Layout l = layout(ends);
-    CHECK(system.output_names() == std::vector<std::string>{"e.moment", "e.rate"});
-    at_several_states(system, [&](const BodyState& s) {
-      const double rate = relative_rate(s.v, l);
-      const std::vector<double> out = element_outputs(system, join(s));
-      CHECK(out[0] == Approx(kTorsionalDamping * rate).epsilon(1e-12).margin(1e-12));
-      CHECK(out[1] == Approx(rate).epsilon(1e-12).margin(1e-12));
-    });
-  }
 }

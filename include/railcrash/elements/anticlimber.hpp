@@ -169,6 +169,7 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/element_registry.hpp"
+#include "railcrash/elements/hybrid.hpp"
 
 namespace railcrash {
 
@@ -215,7 +216,7 @@ struct ElasticPlasticLaw {
   double elastic_energy(const State& st, double d) const;
 };
 
-class Anticlimber : public ForceElement<Anticlimber> {
+class Anticlimber : public HybridElement<Anticlimber> {
  public:
   explicit Anticlimber(ElementSpec& spec);
 
@@ -309,12 +310,11 @@ class Anticlimber : public ForceElement<Anticlimber> {
   /// start apart have no stiffness at t = 0, and Euler's stability limit must see the
   /// stiffness they will meet with (without it, a 1e9 N/m face between 1 t car ends ran
   /// above its limit).
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  State stiffest_mode(const ElementState<double>& s) const;
   void initialize(const ElementState<double>& initial) override;
   int root_count() const override { return kRootCount; }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override {
     return {"horizontal_force",      "vertical_force",         "moment",          "horizontal_deformation",

@@ -94,6 +94,7 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/element_registry.hpp"
+#include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
 
 namespace railcrash {
@@ -116,7 +117,7 @@ struct BeamSection {
 
 /// Both beam types: the co-rotational elastic-plastic law above. The section comes from
 /// the derived type's parameters.
-class BeamElement : public ForceElement<BeamElement> {
+class BeamElement : public HybridElement<BeamElement> {
  public:
   BeamMaterial material;
 
@@ -221,11 +222,11 @@ class BeamElement : public ForceElement<BeamElement> {
   void initialize(const ElementState<double>& initial) override;
   bool applies_moment() const override { return true; }
   int root_count() const override { return 4; }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
   bool failed(const void* mode) const override { return static_cast<const State*>(mode)->failed; }
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  /// Elastic in every component (plastic slopes are E_t / E times smaller).
+  State stiffest_mode(const ElementState<double>& s) const;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override;
   void outputs(const ElementState<double>& s, const double* lambda, double* out) const override;

@@ -32,10 +32,11 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/element_registry.hpp"
+#include "railcrash/elements/hybrid.hpp"
 
 namespace railcrash {
 
-class SurfaceContact : public ForceElement<SurfaceContact> {
+class SurfaceContact : public HybridElement<SurfaceContact> {
  public:
   /// Reads the common parameters; `wheel_rail` selects the wheel-rail form of the surface.
   SurfaceContact(ElementSpec& spec, bool wheel_rail);
@@ -111,10 +112,10 @@ class SurfaceContact : public ForceElement<SurfaceContact> {
 
   void initialize(const ElementState<double>& initial) override;
   int root_count() const override { return 3; }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
+  /// In contact, on the stiffer of the two slopes.
+  State stiffest_mode(const ElementState<double>& s) const;
   double potential_energy(const ElementState<double>& s) const override;
   /// The wall or barrier surface (none for wheel_rail: the animation draws the rail itself).
   std::optional<GroundSurface> ground_surface() const override;

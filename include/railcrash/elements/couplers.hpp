@@ -175,6 +175,7 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/element_registry.hpp"
+#include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
 
 namespace railcrash {
@@ -207,21 +208,6 @@ struct PiecewiseLinear {
   double at(double x) const { return on_segment(segment_of(x), x); }
   double max_slope() const;
 };
-
-/// Offset r2 - r1 of the element's two points and its rate, in global axes.
-template <class T>
-struct PointOffset {
-  Vec2<T> d, d_rate;
-};
-template <class T>
-PointOffset<T> point_offset(const Element& e, const ElementState<T>& s) {
-  const PointRef& p1 = e.point(0);
-  const PointRef& p2 = e.point(1);
-  const auto k1 = static_cast<std::size_t>(e.point_slot(0));
-  const auto k2 = static_cast<std::size_t>(e.point_slot(1));
-  return {point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy),
-          point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy) - point_velocity(s.v[k1], s.rotation[k1], p1.sx, p1.sy)};
-}
 
 /// Hysteretic force-deflection law along one axis (see the header comment).
 class AxialHysteresis {
@@ -323,7 +309,7 @@ struct DeadBand {
 
 // ---- the elements -----------------------------------------------------------------------
 
-class DraftGear : public ForceElement<DraftGear> {
+class DraftGear : public HybridElement<DraftGear> {
  public:
   explicit DraftGear(ElementSpec& spec);
 
@@ -368,10 +354,9 @@ class DraftGear : public ForceElement<DraftGear> {
   void initialize(const ElementState<double>& initial) override;
   static constexpr int kRoots = AxialHysteresis::kRoots + 2;  // + pin shear, fracture
   int root_count() const override { return kRoots; }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
+  State stiffest_mode(const ElementState<double>& s) const;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "compression"}; }
   /// In the crash load path, but not a coupler force: the force between coupler and car body.
@@ -392,7 +377,7 @@ class DraftGear : public ForceElement<DraftGear> {
   State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
-class CouplerEnd : public ForceElement<CouplerEnd> {
+class CouplerEnd : public HybridElement<CouplerEnd> {
  public:
   explicit CouplerEnd(ElementSpec& spec);
 
@@ -453,10 +438,9 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   static constexpr int kShearRoot = DeadBand::kRoots + 1;
   static constexpr int kRoots = DeadBand::kRoots + 2;  // + vertical overlap, face shear
   int root_count() const override { return kRoots; }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
+  State stiffest_mode(const ElementState<double>& s) const;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"normal_force", "friction_force", "gap"}; }
   /// The gap is no deformation: the report shows the force without a loop.
@@ -485,7 +469,7 @@ class CouplerEnd : public ForceElement<CouplerEnd> {
   State initial_state_;  // the mode a run starts in (from the initial configuration)
 };
 
-class Coupling : public ForceElement<Coupling> {
+class Coupling : public HybridElement<Coupling> {
  public:
   explicit Coupling(ElementSpec& spec);
 
@@ -522,10 +506,9 @@ class Coupling : public ForceElement<Coupling> {
   void initialize(const ElementState<double>& initial) override;
   static constexpr int kRoots = AxialHysteresis::kRoots + DeadBand::kRoots;
   int root_count() const override { return kRoots; }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
+  State stiffest_mode(const ElementState<double>& s) const;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override {
     return {"horizontal_force", "deflection", "vertical_force", "vertical_offset", "friction_force"};

@@ -35,11 +35,12 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/element_registry.hpp"
+#include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
 
 namespace railcrash {
 
-class CrushSpring : public ForceElement<CrushSpring> {
+class CrushSpring : public HybridElement<CrushSpring> {
  public:
   explicit CrushSpring(ElementSpec& spec);
 
@@ -87,9 +88,8 @@ class CrushSpring : public ForceElement<CrushSpring> {
   int root_count() const override { return 4; }
   /// Root 3's value: P2's distance from P1 along the turned initial direction, less the margin [length].
   double points_meet_gap(const ElementState<double>& s) const;
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Event& event) const override;
+  void roots_in(const State& st, const ElementState<double>& s, double* g) const;
+  bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
   void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
   double potential_energy(const ElementState<double>& s) const override;
   std::vector<std::string> output_names() const override { return {"force", "crush", "permanent_crush"}; }

@@ -83,6 +83,7 @@
 
 #include "railcrash/element.hpp"
 #include "railcrash/element_registry.hpp"
+#include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
 
 namespace railcrash {
@@ -186,17 +187,18 @@ struct SegmentMode {
 ///   void prepare(const ElementState<double>& initial);     checks and defaults from the initial configuration
 ///   Element::Event segment_event(int from, int to, double x) const;
 template <class Derived>
-class PiecewiseLineElement : public ForceElement<Derived> {
+class PiecewiseLineElement : public HybridElement<Derived> {
  public:
   std::optional<double> fracture_load;  // [force]; none: never breaks
 
   const PiecewiseLinearLaw& law() const { return law_; }
+  using State = SegmentMode;
   RAILCRASH_ELEMENT_MODE(SegmentMode, initial_mode_)
 
   int root_count() const override { return 2 + fracture_roots(); }
-  void roots(double t, const ElementState<double>& s, const double* lambda, double* g) const override;
-  bool commit(int index, int direction, double t, const ElementState<double>& s, const double* lambda, void* mode,
-              Element::Event& event) const override;
+  void roots_in(const SegmentMode& m, const ElementState<double>& s, double* g) const;
+  bool commit_in(SegmentMode& m, int index, int direction, double t, const ElementState<double>& s,
+                 Element::Event& event) const;
   void initialize(const ElementState<double>& initial) override;
 
   /// Law value f in mode m (0 once broken).
@@ -211,7 +213,7 @@ class PiecewiseLineElement : public ForceElement<Derived> {
   /// On the law's steepest segment, unbroken, whatever the segment now: a spring that starts
   /// on a soft or open segment (a special spring's gap) meets its steeper ones later, and
   /// Euler's stability limit must see them.
-  void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
+  SegmentMode stiffest_mode(const ElementState<double>& s) const;
 
  protected:
   /// fracture_sides: 0 (no fracture_load), 1 (f reaching +fracture_load) or 2 (|f|).

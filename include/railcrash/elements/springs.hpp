@@ -24,6 +24,21 @@
 
 namespace railcrash {
 
+/// Offset r2 - r1 of the element's two points and its rate, in global axes.
+template <class T>
+struct PointOffset {
+  Vec2<T> d, d_rate;
+};
+template <class T>
+PointOffset<T> point_offset(const Element& e, const ElementState<T>& s) {
+  const PointRef& p1 = e.point(0);
+  const PointRef& p2 = e.point(1);
+  const auto k1 = static_cast<std::size_t>(e.point_slot(0));
+  const auto k2 = static_cast<std::size_t>(e.point_slot(1));
+  return {point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy),
+          point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy) - point_velocity(s.v[k1], s.rotation[k1], p1.sx, p1.sy)};
+}
+
 /// Geometry shared by the two-point line elements.
 template <class T>
 struct LineGeometry {
@@ -34,16 +49,17 @@ struct LineGeometry {
 
 template <class T>
 LineGeometry<T> line_geometry(const Element& e, const ElementState<T>& s) {
-  const PointRef& p1 = e.point(0);
-  const PointRef& p2 = e.point(1);
-  const auto k1 = static_cast<std::size_t>(e.point_slot(0));
-  const auto k2 = static_cast<std::size_t>(e.point_slot(1));
+  const PointOffset<T> offset = point_offset(e, s);
   LineGeometry<T> g;
-  g.d = point_position(s.q[k2], s.rotation[k2], p2.sx, p2.sy) - point_position(s.q[k1], s.rotation[k1], p1.sx, p1.sy);
-  g.d_rate = point_velocity(s.v[k2], s.rotation[k2], p2.sx, p2.sy) - point_velocity(s.v[k1], s.rotation[k1], p1.sx, p1.sy);
+  g.d = offset.d;
+  g.d_rate = offset.d_rate;
   g.length = sqrt(dot(g.d, g.d));
   return g;
 }
+
+/// A line element needs a direction: throws an InputError naming the element when its two points
+/// coincide in the initial configuration.
+void require_direction(const Element& e, const ElementState<double>& initial);
 
 /// Applies a force F2 at P2 and -F2 at P1.
 template <class T>
