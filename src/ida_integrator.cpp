@@ -267,7 +267,7 @@ struct IdaIntegrator::Impl {
     // changes each time): 170 restarts in the 0.25 s two-car crash cost a tenth of its steps
     // and half its Jacobians. It starts instead from a fraction of the step that crossed the
     // event, a scale the solution has just shown; an impact faster than that is met by IDA's
-    // error test, which cuts the step. The fraction is measured (bench/README.md, "The first
+    // error test, which cuts the step. The fraction is measured (bench/HISTORY.md, "The first
     // step after a restart"). The error test cuts at most 10 times, by 0.25 from the second
     // cut on, so the start stays within kReachableMultiple of IDA's own: the step before a
     // dropped ball touches a floor is its free flight's, 0.17 s, ten million times its first
@@ -512,7 +512,7 @@ class IdaEventHandler final : public EventHandler {
   bool goes_on_across(const Crossing& c, const double* y_at_event, const std::vector<EventRecord>& events) override {
     // A kink (the element says its force is continuous, and it is at the event state) needs
     // no restart when the lag is within tolerance: IDA goes on with its order and history. A
-    // jump always restarts (bench/README.md, "Kinks are not jumps").
+    // jump always restarts (bench/HISTORY.md, "Kinks are not jumps").
     const bool kink = events.size() == 1 && events.front().kink &&
                       ida_.lag_within_tolerance(c.element, before_, c.t, y_at_event, t_n_, y_n_, quad_n_, 1.0, 0.0);
     if (!(kink && ida_.lag_within_tolerance(c.element, before_, c.t, y_at_event, t_n_, y_n_, quad_n_))) return false;

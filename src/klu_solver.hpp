@@ -6,7 +6,7 @@
 // then costs 16 bytes, index and value; with KLU's 32-bit interface (klu_*) it costs 12. The
 // algorithms are the same source compiled twice, so the factors, pivots and solutions are the
 // same bit for bit; only the memory a factorization and a solve stream through shrinks. On a
-// long consist that memory outgrows the cache (bench/README.md, "Where a long consist's time
+// long consist that memory outgrows the cache (bench/HISTORY.md, "Where a long consist's time
 // goes, phase by phase"), where bytes are time.
 //
 // The solver also does what railcrash used to patch into SUNLinSol_KLU:

@@ -9,7 +9,7 @@
 //   run the model (a body without inertia, a dt above the stability limit, more steps than
 //   --max-steps), IDA keeps the run and the reason says why.
 // * Cost in force sweeps (one evaluation of every element's force law), from the phase
-//   timings of the benchmark models (bench/README.md, "integrator: auto"): an Euler step 1.1;
+//   timings of the benchmark models (bench/HISTORY.md, "integrator: auto"): an Euler step 1.1;
 //   an IDA step 6 (its Newton residuals and solves, a share of the Jacobians and
 //   factorizations, the step's sweep of roots and outputs; 6-11 measured, the lowest taken so
 //   that the rule errs towards keeping IDA); an IDA restart 10 more.
@@ -22,7 +22,7 @@
 //         coarser steps than IDA's error control needs. On the SI multiple-unit examples
 //         IDA's mean step is a third to a seventh of Euler's stable step, and Euler there is
 //         up to 16 % off in a trailing car's crush and 7-16 % in the energy the crush zones
-//         absorb (bench/README.md, "integrator: auto"): cheaper, but not at the same
+//         absorb (bench/HISTORY.md, "integrator: auto"): cheaper, but not at the same
 //         accuracy, so IDA keeps those runs.
 // * Euler goes on from IDA's state at the end of that step, in the element modes reached, and
 //   never hands the run back.

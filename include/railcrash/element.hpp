@@ -299,7 +299,7 @@ class Element {
   /// a residual, Jacobian or step sweep reads. Those sweeps run through every element at every
   /// evaluation, and their cost per element grows once a long train's elements pass this VM's
   /// 7-8 MiB: 256 unused bytes added to each element made the 200 + 200-car consist's
-  /// residual calls 1.8x dearer (bench/README.md, "Elements without their description").
+  /// residual calls 1.8x dearer (bench/HISTORY.md, "Elements without their description").
   struct Description {
     std::string name;
     std::string type;

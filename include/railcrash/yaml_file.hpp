@@ -36,7 +36,7 @@ YAML::Node load_yaml_text(const std::string& text, const std::string& path);
 
 /// A YAML text that has passed check_yaml_structure, checked when it is made. A sweep builds
 /// every run's model from one text: walking its structure again for each run was 1.3 % of a
-/// sweep run of the two-car crash (bench/README.md, "Sweeps").
+/// sweep run of the two-car crash (bench/HISTORY.md, "Sweeps").
 class CheckedYamlText {
  public:
   /// Checks `text` (InputError or YAML::ParserException as check_yaml_structure).

@@ -4,7 +4,7 @@
 // libhdf5_serial.so.103 brings in libcurl and libcrypto (its read-only S3 driver) and, through
 // them, 20-odd more libraries (GnuTLS, Kerberos, LDAP, SSH, ...): linked in the ordinary way, the
 // dynamic loader mapped and relocated them all before main, most of the CPU time of a short
-// railcrash run (bench/README.md "Start-up"). So nothing links it: this file
+// railcrash run (bench/HISTORY.md "Start-up"). So nothing links it: this file
 // defines the HDF5 functions and the four global identifiers that hdf5_file.cpp uses, with the
 // signatures of <hdf5.h> (the compiler checks them), and each forwards to the library's own,
 // found with dlopen/dlsym on the first call. The identifiers (H5T_NATIVE_DOUBLE_g, ...) are read

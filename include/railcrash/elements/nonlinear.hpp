@@ -66,7 +66,7 @@
 // Starting exactly on a breakpoint: with a nonzero rate of x the run starts in the segment x
 // moves into; with none (at rest, and always for the dashpot, whose x' is an acceleration)
 // in the lower segment. A root exactly zero at a (re)start is then committed by the
-// integrators' look-ahead (DaeSystem::commit_boundary_roots) when the motion leaves the
+// integrators' look-ahead (ModeTracker::commit_boundary) when the motion leaves the
 // segment, so the element follows the branch the motion actually takes.
 //
 // Limitations: a mass at rest on a preloaded special spring with a weight below the preload
@@ -96,7 +96,7 @@ namespace railcrash {
 /// that holds the law comes from the elements' own pool (src/element.cpp), so the numbers read
 /// at every residual sit next to the element's other data. Held in std::vectors on the
 /// loader's heap they were one more scattered cache line per element and evaluation, and
-/// 100 + 100 and 200 + 200-car consists took about a fifth more CPU (bench/README.md,
+/// 100 + 100 and 200 + 200-car consists took about a fifth more CPU (bench/HISTORY.md,
 /// "Curves inside the element"). The segments' names, read only for events, stay on the heap.
 class PiecewiseLinearLaw {
  public:
