@@ -2,7 +2,7 @@
 # SOURCE_DIR: "abc1234def56" or "abc1234def56-dirty" when tracked files differ from it, "" when the
 # sources are not a git checkout (a release tarball) or git is missing. Run at every build (the
 # target railcrash_build_commit); the header is rewritten only when the text changes, so only
-# src/version.cpp is compiled again after a commit.
+# src/core/version.cpp is compiled again after a commit.
 set(commit "")
 find_package(Git QUIET)
 if(GIT_FOUND)

@@ -3,7 +3,7 @@
 # find_package(railcrash) reads:
 #   P/bin/railcrash (and railcrash-mpi, the MPI build it runs for a sweep under mpirun)
 #   P/lib/librailcrash.so.0.1, librailcrash.a
-#   P/include/railcrash/api.hpp, error.hpp
+#   P/include/railcrash/api.hpp, core/error.hpp
 #   P/lib/cmake/railcrash/railcrashConfig.cmake (targets railcrash::railcrash, railcrash::railcrash_static)
 # Debian packages (cpack -G DEB): railcrash (program and shared library), railcrash-dev
 # (headers, static library, CMake package) and python3-railcrash (when the module is built).
@@ -19,8 +19,8 @@ install(TARGETS railcrash_shared EXPORT railcrashTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT development)
 install(TARGETS railcrash_core EXPORT railcrashTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development)
-install(FILES include/railcrash/api.hpp include/railcrash/error.hpp
-  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/railcrash COMPONENT development)
+install(FILES include/railcrash/api.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/railcrash COMPONENT development)
+install(FILES include/railcrash/core/error.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/railcrash/core COMPONENT development)
 install(EXPORT railcrashTargets NAMESPACE railcrash:: DESTINATION ${RAILCRASH_CMAKE_DIR} COMPONENT development)
 configure_package_config_file(cmake/railcrashConfig.cmake.in ${CMAKE_CURRENT_BINARY_DIR}/railcrashConfig.cmake
   INSTALL_DESTINATION ${RAILCRASH_CMAKE_DIR})

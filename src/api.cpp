@@ -9,11 +9,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/results.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/results.hpp"
 #include "railcrash/results/accuracy_check.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 
 #ifndef RAILCRASH_VERSION
 #error "RAILCRASH_VERSION must be defined by the build"

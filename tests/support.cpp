@@ -9,8 +9,8 @@
 
 #include <catch2/catch.hpp>
 
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
 
 namespace railcrash::testing {
 

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/model_io.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/model/model_io.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};

@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "railcrash/api.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 #include <yaml-cpp/yaml.h>
 

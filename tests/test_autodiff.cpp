@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "railcrash/autodiff.hpp"
+#include "railcrash/core/autodiff.hpp"
 
 using namespace railcrash;
 

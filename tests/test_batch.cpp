@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "railcrash/batch.hpp"
+#include "railcrash/studies/batch.hpp"
 
 using namespace railcrash;
 

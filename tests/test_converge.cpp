@@ -8,10 +8,10 @@
 #include <fstream>
 #include <set>
 
-#include "railcrash/converge.hpp"
-#include "railcrash/model_io.hpp"
+#include "railcrash/studies/converge.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/results/cfc_filter.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 
 using namespace railcrash;
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model_io.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run_files.hpp"
 #include "support.hpp"
 

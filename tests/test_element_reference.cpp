@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <string>
 
-#include "railcrash/element_reference.hpp"
+#include "railcrash/model/element_reference.hpp"
 
 using namespace railcrash;
 

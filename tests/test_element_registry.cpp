@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element_registry.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

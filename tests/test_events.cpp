@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/event_loop.hpp"
-#include "railcrash/events.hpp"
+#include "railcrash/solver/event_loop.hpp"
+#include "railcrash/solver/events.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -5,11 +5,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "railcrash/euler_integrator.hpp"
-#include "railcrash/ida_integrator.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/results.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/solver/euler_integrator.hpp"
+#include "railcrash/solver/ida_integrator.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <string>
 
-#include "railcrash/model_io.hpp"
-#include "railcrash/model_schema.hpp"
-#include "railcrash/train_expansion.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/model/model_schema.hpp"
+#include "railcrash/model/train_expansion.hpp"
 
 using namespace railcrash;
 

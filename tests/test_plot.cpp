@@ -7,7 +7,7 @@
 #include <regex>
 #include <sstream>
 
-#include "railcrash/plot.hpp"
+#include "railcrash/results/plot.hpp"
 
 using namespace railcrash;
 

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <string>
 
-#include "railcrash/progress.hpp"
-#include "railcrash/version.hpp"
+#include "railcrash/core/progress.hpp"
+#include "railcrash/core/version.hpp"
 
 using railcrash::ProgressMeter;
 

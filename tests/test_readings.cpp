@@ -7,8 +7,8 @@
 #include <fstream>
 #include <optional>
 
-#include "railcrash/error.hpp"
-#include "railcrash/readings.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/studies/readings.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

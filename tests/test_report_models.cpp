@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "railcrash/initial_conditions.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -14,8 +14,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

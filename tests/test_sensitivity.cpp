@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model_io.hpp"
-#include "railcrash/sensitivity.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/studies/sensitivity.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -1,5 +1,5 @@
 // railcrash's compiled serial vector operations against SUNDIALS's own, bit for bit
-// (include/railcrash/serial_vector_ops.hpp): every coefficient case of the linear sum and the
+// (include/railcrash/solver/serial_vector_ops.hpp): every coefficient case of the linear sum and the
 // scale, every aliasing of the result with an operand, and the norms.
 #include <catch2/catch.hpp>
 
@@ -12,7 +12,7 @@
 #include <random>
 #include <vector>
 
-#include "railcrash/serial_vector_ops.hpp"
+#include "railcrash/solver/serial_vector_ops.hpp"
 
 namespace {
 

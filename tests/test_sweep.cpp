@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/error.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
-#include "railcrash/sweep.hpp"
-#include "railcrash/table_text.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
+#include "railcrash/studies/sweep.hpp"
+#include "railcrash/core/table_text.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -1,5 +1,5 @@
-// The shared whole-file writer (include/railcrash/whole_file.hpp) and the overflow-checked run
-// counting (include/railcrash/run_count.hpp), and the output folder lock (folder_lock.hpp).
+// The shared whole-file writer (include/railcrash/core/whole_file.hpp) and the overflow-checked run
+// counting (include/railcrash/studies/run_count.hpp), and the output folder lock (folder_lock.hpp).
 #include <catch2/catch.hpp>
 
 #include <fcntl.h>
@@ -15,10 +15,10 @@
 #include <sstream>
 #include <string>
 
-#include "railcrash/error.hpp"
-#include "railcrash/folder_lock.hpp"
-#include "railcrash/run_count.hpp"
-#include "railcrash/whole_file.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/core/folder_lock.hpp"
+#include "railcrash/studies/run_count.hpp"
+#include "railcrash/core/whole_file.hpp"
 
 using namespace railcrash;
 using Catch::Matchers::Contains;

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model_io.hpp"
-#include "railcrash/yaml_file.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/model/yaml_file.hpp"
 
 using namespace railcrash;
 using Catch::Matchers::Contains;

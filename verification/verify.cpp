@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
-#include "railcrash/readings.hpp"
-#include "railcrash/sensitivity.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
+#include "railcrash/studies/readings.hpp"
+#include "railcrash/studies/sensitivity.hpp"
 
 using namespace railcrash;
 
@@ -392,7 +392,7 @@ constexpr double kReachedGoals = 4.0;                      // R2 10 %, R3 5 %, R
 TEST_CASE("report reproduction: the shipped readings' whole study against Tables 11, 13 and 15-17", "[verification]") {
   // The report's final two-car model as shipped (printed values, the readings chosen by the
   // reading study: models/report/README.md) runs the report's whole 40-run study, scored as
-  // `railcrash readings` scores it (include/railcrash/readings.hpp). Each row compares with
+  // `railcrash readings` scores it (include/railcrash/studies/readings.hpp). Each row compares with
   // perfect agreement (the report's own value, every sign, rho 1, all five of the top five);
   // the tolerance is what this build reached (verification/report_comparison.md), so a change
   // that loses agreement fails here, and one that gains it passes.

@@ -36,7 +36,7 @@
 #include <variant>
 #include <vector>
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 
 namespace railcrash::api {
 

@@ -1,6 +1,6 @@
 // railcrash's subcommands. Each one lives in its own file (src/cli/<name>_command.cpp): it adds
 // its CLI11 subcommand and options, which write into the command object, and runs when the
-// command line names it. src/main.cpp only lists them, parses and dispatches.
+// command line names it. src/cli/main.cpp only lists them, parses and dispatches.
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -3,8 +3,8 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/batch.hpp"
-#include "railcrash/consist.hpp"
+#include "railcrash/studies/batch.hpp"
+#include "railcrash/scenarios/consist.hpp"
 
 namespace railcrash::cli {
 

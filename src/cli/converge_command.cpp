@@ -6,8 +6,8 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/batch.hpp"
-#include "railcrash/converge.hpp"
+#include "railcrash/studies/batch.hpp"
+#include "railcrash/studies/converge.hpp"
 
 namespace railcrash::cli {
 

@@ -4,10 +4,10 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/element_reference.hpp"
-#include "railcrash/element_registry.hpp"
-#include "railcrash/error.hpp"
-#include "railcrash/model_io.hpp"
+#include "railcrash/model/element_reference.hpp"
+#include "railcrash/model/element_registry.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/model/model_io.hpp"
 
 namespace railcrash::cli {
 

@@ -7,9 +7,9 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/readings.hpp"
-#include "railcrash/run_count.hpp"
-#include "railcrash/sensitivity.hpp"
+#include "railcrash/studies/readings.hpp"
+#include "railcrash/studies/run_count.hpp"
+#include "railcrash/studies/sensitivity.hpp"
 
 namespace railcrash::cli {
 

@@ -5,7 +5,7 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 #include "railcrash/report/report.hpp"
 
 namespace railcrash::cli {

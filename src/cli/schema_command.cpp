@@ -3,9 +3,9 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/batch.hpp"
-#include "railcrash/element_registry.hpp"
-#include "railcrash/model_schema.hpp"
+#include "railcrash/studies/batch.hpp"
+#include "railcrash/model/element_registry.hpp"
+#include "railcrash/model/model_schema.hpp"
 
 namespace railcrash::cli {
 

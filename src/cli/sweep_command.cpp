@@ -13,11 +13,11 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/batch.hpp"
-#include "railcrash/error.hpp"
-#include "railcrash/run_count.hpp"
-#include "railcrash/sweep.hpp"
-#include "railcrash/sweep_mpi.hpp"
+#include "railcrash/studies/batch.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/studies/run_count.hpp"
+#include "railcrash/studies/sweep.hpp"
+#include "railcrash/studies/sweep_mpi.hpp"
 
 namespace railcrash::cli {
 

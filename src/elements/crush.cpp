@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 #include <string>
 
 namespace railcrash {
@@ -31,7 +31,7 @@ CrushSpring::CrushSpring(ElementSpec& spec)
   // steepest slope; otherwise unloading would carry more force than crushing did and store more
   // energy than the work done on the element (a negative dissipation). Within 1e-9 of the
   // slope counts as equal (a curve and stiffness converted between units round differently; the
-  // scenario generator's check, src/scenario/en15227.cpp, allows the same).
+  // scenario generator's check, src/scenarios/en15227.cpp, allows the same).
   int steepest = 0;
   for (int k = 1; k + 1 < static_cast<int>(curve_crush.size()); ++k)
     if (segment_slope(k) > segment_slope(steepest)) steepest = k;

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element_registry.hpp"
 
 namespace railcrash {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element_registry.hpp"
 
 namespace railcrash {
 

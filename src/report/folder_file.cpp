@@ -11,7 +11,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 
 namespace railcrash::report {
 

@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 
 extern char** environ;
 

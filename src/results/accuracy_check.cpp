@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/integrator.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {
 

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "railcrash/whole_file.hpp"
+#include "railcrash/core/whole_file.hpp"
 
 // The fast path builds the twelve digits in a 128-bit integer whose lowest byte is the first
 // character: it needs unsigned __int128 and a little-endian machine. Elsewhere every number

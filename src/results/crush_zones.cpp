@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <sstream>
 
-#include "railcrash/element.hpp"
+#include "railcrash/model/element.hpp"
 #include "railcrash/elements/anticlimber.hpp"
 #include "railcrash/elements/couplers.hpp"
 #include "railcrash/elements/crush.hpp"
-#include "railcrash/results.hpp"
+#include "railcrash/results/results.hpp"
 
 namespace railcrash {
 

@@ -1,7 +1,7 @@
 // DIR/timeseries.h5 of `railcrash run --format hdf5` (see the header).
 #include "railcrash/results/hdf5_file.hpp"
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 
 #ifdef RAILCRASH_HDF5
 #include <hdf5.h>
@@ -13,7 +13,7 @@
 #include <deque>
 #include <type_traits>
 
-#include "railcrash/results.hpp"
+#include "railcrash/results/results.hpp"
 #endif
 
 namespace railcrash {

@@ -18,7 +18,7 @@
 #include <mutex>
 #include <string>
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 
 #ifndef RAILCRASH_HDF5_LIBRARY
 #error "RAILCRASH_HDF5_LIBRARY (the serial HDF5's soname, set by CMakeLists.txt) is not defined"

@@ -2,7 +2,7 @@
 // its make function in a file of its own.
 #include <string>
 
-#include "railcrash/error.hpp"
+#include "railcrash/core/error.hpp"
 #include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/output_sink.hpp"
 

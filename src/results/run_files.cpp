@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "railcrash/results.hpp"
+#include "railcrash/results/results.hpp"
 #include "railcrash/results/output_sink.hpp"
 
 namespace railcrash {

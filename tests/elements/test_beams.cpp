@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "railcrash/elements/beams.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -4,7 +4,7 @@
 #include <sstream>
 
 #include "railcrash/elements/contact.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

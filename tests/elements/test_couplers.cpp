@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "railcrash/elements/couplers.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

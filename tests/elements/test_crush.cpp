@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "railcrash/elements/crush.hpp"
-#include "railcrash/events.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/solver/events.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

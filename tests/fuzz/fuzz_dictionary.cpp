@@ -6,8 +6,8 @@
 #include <set>
 #include <string>
 
-#include "railcrash/element_registry.hpp"
-#include "railcrash/model_io.hpp"
+#include "railcrash/model/element_registry.hpp"
+#include "railcrash/model/model_io.hpp"
 
 namespace {
 

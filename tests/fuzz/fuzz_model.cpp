@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/error.hpp"
-#include "railcrash/initial_conditions.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/scenario/criteria.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/scenario_criteria.hpp"
 
 namespace {
 
@@ -24,7 +24,7 @@ namespace {
 /// `variant_of` is resolved against its folder: the working directory).
 constexpr const char* kInputLabel = "fuzz-input.yaml";
 
-// The loader reads `scenario:` sections through the reader the scenario layer registers; this
+// The loader reads `scenario:` sections through the reader results/scenario_criteria.cpp registers; this
 // program uses nothing else of that layer, so it names the reader to link it (and fuzz it).
 [[maybe_unused]] const bool kScenarioReader = railcrash::set_scenario_section_reader(&railcrash::read_scenario_section);
 

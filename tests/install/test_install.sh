@@ -11,7 +11,7 @@ trap 'rm -rf "$work"' EXIT
 prefix=$work/prefix
 
 cmake --install "$build" --prefix "$prefix" > "$work/install.log"
-for f in bin/railcrash include/railcrash/api.hpp include/railcrash/error.hpp lib/cmake/railcrash/railcrashConfig.cmake; do
+for f in bin/railcrash include/railcrash/api.hpp include/railcrash/core/error.hpp lib/cmake/railcrash/railcrashConfig.cmake; do
   [ -e "$prefix/$f" ] || { echo "not installed: $f"; exit 1; }
 done
 ls "$prefix"/lib*/librailcrash.a "$prefix"/lib*/librailcrash.so > /dev/null

@@ -15,13 +15,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "railcrash/error.hpp"
-#include "railcrash/model_io.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/report/folder_file.hpp"
 #include "railcrash/report/report.hpp"
 #include "railcrash/results/hdf5_file.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 
 namespace fs = std::filesystem;
 

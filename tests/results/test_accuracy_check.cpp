@@ -8,10 +8,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/model_io.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/results/accuracy_check.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 
 using namespace railcrash;
 

@@ -14,7 +14,7 @@
 #include <sstream>
 #include <string>
 
-#include "railcrash/results.hpp"
+#include "railcrash/results/results.hpp"
 #include "railcrash/results/buffered_file.hpp"
 
 using railcrash::BufferedFile;

@@ -7,10 +7,10 @@
 #include <sstream>
 #include <string>
 
-#include "railcrash/dae_system.hpp"
-#include "railcrash/integrator.hpp"
-#include "railcrash/results.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/integrator.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/results/run.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

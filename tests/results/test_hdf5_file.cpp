@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model_io.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/results/hdf5_file.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/results/run.hpp"
 
 #ifdef RAILCRASH_HDF5
 #include <hdf5.h>

@@ -10,9 +10,9 @@
 
 #include <unistd.h>
 
-#include "railcrash/error.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
 
 namespace fs = std::filesystem;
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "railcrash/scenario/en15227.hpp"
+#include "railcrash/scenarios/en15227.hpp"
 
 namespace railcrash::testing {
 

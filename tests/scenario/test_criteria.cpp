@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "railcrash/elements/anticlimber.hpp"
-#include "railcrash/error.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/scenario/criteria.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/scenario_criteria.hpp"
 
 using namespace railcrash;
 

@@ -10,11 +10,11 @@
 #include <regex>
 #include <string>
 
-#include "railcrash/error.hpp"
-#include "railcrash/model_io.hpp"
-#include "railcrash/run.hpp"
-#include "railcrash/scenario/criteria.hpp"
-#include "railcrash/scenario/en15227.hpp"
+#include "railcrash/core/error.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
+#include "railcrash/results/scenario_criteria.hpp"
+#include "railcrash/scenarios/en15227.hpp"
 #include "requests.hpp"
 
 using namespace railcrash;

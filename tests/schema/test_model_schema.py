@@ -248,9 +248,9 @@ def agree_on_text(binary, v, what, text, accepted, message=""):
 
 
 def scenario_keys_agree(v, source_dir):
-    """The scenario section's keys are described by hand in src/model_schema.cpp: they must be
-    the lists read_scenario_section (src/scenario/criteria.cpp) passes to only_keys."""
-    with open(os.path.join(source_dir, "src", "scenario", "criteria.cpp"), encoding="utf-8") as f:
+    """The scenario section's keys are described by hand in src/model/model_schema.cpp: they must be
+    the lists read_scenario_section (src/results/scenario_criteria.cpp) passes to only_keys."""
+    with open(os.path.join(source_dir, "src", "results", "scenario_criteria.cpp"), encoding="utf-8") as f:
         text = f.read()
     lists = re.findall(r'only_keys\(\w+,\s*\{([^}]*)\},\s*"([^"]*)"\)', text)
     scenario = v.schema["definitions"]["scenario"]

@@ -167,8 +167,8 @@
 #include <optional>
 #include <string>
 
-#include "railcrash/element.hpp"
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element.hpp"
+#include "railcrash/model/element_registry.hpp"
 #include "railcrash/elements/hybrid.hpp"
 
 namespace railcrash {

@@ -33,8 +33,8 @@
 #include <optional>
 #include <vector>
 
-#include "railcrash/element.hpp"
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element.hpp"
+#include "railcrash/model/element_registry.hpp"
 #include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
 

@@ -6,7 +6,7 @@
 
 #include <array>
 
-#include "railcrash/element.hpp"
+#include "railcrash/model/element.hpp"
 
 namespace railcrash {
 

@@ -81,8 +81,8 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/element.hpp"
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element.hpp"
+#include "railcrash/model/element_registry.hpp"
 #include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
 
@@ -93,7 +93,7 @@ namespace railcrash {
 ///
 /// The lines, breakpoints and integral constants are stored inside the object (at most
 /// kMaxSegments segments: the two-branch law has four, the special spring three): the element
-/// that holds the law comes from the elements' own pool (src/element.cpp), so the numbers read
+/// that holds the law comes from the elements' own pool (src/model/element.cpp), so the numbers read
 /// at every residual sit next to the element's other data. Held in std::vectors on the
 /// loader's heap they were one more scattered cache line per element and evaluation, and
 /// 100 + 100 and 200 + 200-car consists took about a fifth more CPU (bench/HISTORY.md,

@@ -19,8 +19,8 @@
 
 #include <optional>
 
-#include "railcrash/element.hpp"
-#include "railcrash/element_registry.hpp"
+#include "railcrash/model/element.hpp"
+#include "railcrash/model/element_registry.hpp"
 
 namespace railcrash {
 

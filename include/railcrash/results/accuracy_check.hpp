@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model.hpp"
+#include "railcrash/model/model.hpp"
 
 namespace railcrash {
 

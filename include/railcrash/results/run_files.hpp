@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/dae_system.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 namespace railcrash {
 

@@ -646,7 +646,7 @@
         }
       });
       var sc = summary.scenario;
-      if (sc) {  // EN 15227 criteria (scenario/criteria.hpp): one row per criterion and subject
+      if (sc) {  // EN 15227 criteria (results/scenario_criteria.hpp): one row per criterion and subject
         row(sc.standard + " scenario " + sc.number + " (" + sc.category + ")",
             (sc.pass ? "PASS" : "FAIL") + ": every criterion below" +
             ((sc.criteria || []).some(function (c) { return c.note; }) ? " (see the notes below)" : "") +
@@ -654,7 +654,7 @@
             sc.pass ? "status-ok" : "status-failed");
         (sc.criteria || []).forEach(function (c) {
           var g = c.criterion === "mean_deceleration";
-          // wheel unloading is (Q0 - Q) / Q0, a fraction of the static wheel load (scenario/criteria.hpp), not a length
+          // wheel unloading is (Q0 - Q) / Q0, a fraction of the static wheel load (results/scenario_criteria.hpp), not a length
           var unit = g ? " g" : c.criterion === "wheel_unloading" ? " of the static wheel load" : " " + lengthUnit;
           var value = g ? c.value_g : c.value, limit = g ? c.limit_g : c.limit;
           row(c.criterion.replace(/_/g, " ") + ": " + c.subject,

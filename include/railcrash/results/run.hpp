@@ -1,0 +1,85 @@
+// One run of a model: the command line's `run`, also used by the tests and verification.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "railcrash/solver/integrator.hpp"
+#include "railcrash/model/model.hpp"
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/results/outcomes.hpp"
+#include "railcrash/results/responses.hpp"
+#include "railcrash/results/results.hpp"
+
+namespace railcrash {
+
+/// Command-line settings that override the model's simulation section.
+struct RunOverrides {
+  std::optional<IntegratorKind> integrator;
+  std::optional<double> t_end, rtol, atol, dt, output_interval;
+  std::optional<long> max_steps;
+  bool force_dt = false;
+};
+
+/// The overrides as simulation.KEY=VALUE settings named by their options ("--t-end 2"): the
+/// command line's run options go through the loader's override path, as --set does
+/// (load_model(path, settings, options)), so they are checked, and their mistakes reported, alike.
+std::vector<OptionSetting> option_settings(const RunOverrides& overrides);
+
+/// Applies overrides (checked) to an already loaded model's simulation settings: for the
+/// library's and the studies' programmatic settings; the command line uses option_settings.
+void apply_overrides(Model& model, const RunOverrides& overrides);
+
+/// The integrator the model's settings ask for.
+std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings);
+
+/// Output interval actually used (the setting, or t_end / 500). (Inline: the loader's
+/// provenance uses it, and the fuzz target links the loader without the run's sources.)
+inline double output_interval_of(const SimulationSettings& settings) {
+  return settings.output_interval > 0.0 ? settings.output_interval : settings.t_end / 500.0;
+}
+
+struct RunReport {
+  RunOutcome outcome;
+  std::string integrator;
+  bool has_responses = false;  // the model has a responses section
+  Responses responses;         // R1-R3 and what they are made of
+  OutcomeSignature outcomes;   // the run's discrete outcome (outcomes.hpp; summary.json's "outcomes")
+  // From the result writer (empty when no output folder): per body, per car (results.hpp).
+  std::vector<AccelerationPeaks> acceleration_peaks;
+  std::vector<CarCrush> car_crush;
+  std::string summary_json;  // the text of summary.json (empty when neither a folder nor memory)
+  std::string run_id;        // the run's id in its files (results/provenance.hpp; empty when neither a folder nor memory)
+  // keep_in_memory: timeseries.csv in memory, column by column (events: outcome.events).
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> series;
+  std::vector<FilteredAccelerations> filtered_accelerations;  // CFC 60 peaks, collision pulses
+};
+
+/// The memory a run's output keeps until its end [bytes]: per row, 20 B per body (single-precision
+/// velocities and accelerations for the CFC filter and the collision pulses, results.hpp) and
+/// 16 B of times, and with keep_in_memory 8 B per timeseries column; rows = t_end /
+/// output_interval + 2. A vector that grows may briefly need half as much again.
+double output_memory_estimate(const DaeSystem& system, bool keep_in_memory);
+/// The limit run_model holds output_memory_estimate to [bytes] (default 4 GiB; 0: no limit).
+/// `railcrash run --max-output-memory GB` sets it for the process.
+void set_output_memory_limit(double bytes);
+double output_memory_limit();
+
+/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files;
+/// format: a registered output format that writes files, results/output_sink.hpp: "hdf5" writes
+/// timeseries.h5 in place of the per-row CSV files);
+/// with keep_in_memory the same results also come back in the report.
+/// Input errors throw InputError before anything runs (also an output whose memory estimate is
+/// above output_memory_limit(), with the figures and what lowers it); solver failures come back
+/// with ok = false, and so does running out of memory (std::bad_alloc: summary.json "failed").
+/// time_phases: the run's wall time split by phase (RunStatistics::phase_seconds; summary.json's
+/// stats.seconds; `railcrash run --timings`).
+RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
+                    bool show_progress = false, bool keep_in_memory = false, const std::string& format = "csv",
+                    bool time_phases = false);
+
+}  // namespace railcrash

@@ -1,0 +1,100 @@
+// IDA (SUNDIALS IDAS: IDA plus quadratures) on the GGL DAE with the KLU sparse solver.
+//
+// * Consistent start: position assembly and velocity projection (initial_conditions.hpp),
+//   then accelerations and multipliers from the acceleration-level system (consistent_rates;
+//   IDACalcIC cannot find them for the GGL form, see initial_conditions.hpp).
+// * Per-component absolute tolerances from the model's scales: lengths 0.1 rtol L (or the
+//   model's atol), angles that over L, velocities that times V / L, multipliers lambda
+//   min(1, 100 rtol) F and mu V (see the comment in run()), where L is
+//   the model's extent, F its largest initial generalized force and V the larger of its
+//   initial speeds and sqrt(2 E / M) with E = max(initial kinetic energy, F L).
+// * IDASetId marks q, v differential and lambda, mu algebraic; IDASetSuppressAlg keeps the
+//   algebraic unknowns out of the error test.
+// * Quadratures (kinetic-energy integral, load work, element work) with error control.
+// * Events: IDA takes one step at a time; after each step every root function is evaluated
+//   once and a root that fell through zero is located element by element on IDA's own
+//   interpolating polynomial (its Taylor form at t_n from IDAGetDky, evaluated only for the
+//   unknowns the element reads), so locating an event costs the same in any model size. The
+//   bookkeeping and the location are the event layer's (events.hpp: ModeTracker,
+//   EventLocator, owned by the run loop's Integrator); IDA gives it a StepInterpolant.
+//   Events are committed in time order; IDA goes on without a restart when the new law agrees
+//   with the old one over the rest of the step within the local tolerances (kinks), and
+//   restarts from consistent values at the event otherwise (jumps, joint failures).
+// * KLU: the symbolic analysis is kept across restarts, the pivot order across Jacobian
+//   updates while the pivot growth stays small (see ida_integrator.cpp).
+// * Every SUNDIALS return code is checked; failures become SolverError with the flag's name.
+//   Callbacks never let an exception into SUNDIALS: they store it and return -1.
+#pragma once
+
+#include <memory>
+
+#include "railcrash/solver/integrator.hpp"
+
+namespace railcrash {
+
+struct IdaSettings {
+  double rtol = 1e-6;
+  std::optional<double> atol;  // [length]
+  long max_steps_per_output = 500000;
+  long max_steps = 10000000;  // [steps] in the whole run; the run fails (not ok) beyond
+};
+
+class IdaIntegrator : public Integrator {
+ public:
+  IdaIntegrator(DaeSystem& system, IdaSettings settings);
+  ~IdaIntegrator() override;
+  const char* name() const override { return integrator_name(IntegratorKind::Ida); }
+
+  struct Impl;
+
+ protected:
+  // Integrator's steps (integrator.hpp).
+  void start(double t_end) override;
+  double advance(double t_end) override;
+  bool dense_output() const override { return true; }
+  void state_at(double t, std::vector<double>& y, std::vector<double>& quadratures) override;
+  const double* current_state() const override;
+  const double* current_outputs() const override { return outputs_current_ ? outputs_.data() : nullptr; }
+  void final_state(std::vector<double>& y, std::vector<double>& quadratures) override;
+  std::string step_limit_advice(double t_end) const override;
+  std::string divergence_phrase() const override { return "IDA's solution is not finite"; }
+  long max_steps() const override { return settings_.max_steps; }
+  void finish() override;
+  /// IDA's current time: after a failed step, the time of its last good state (state_at there).
+  double current_time() const;
+
+ private:
+  friend class IdaEventHandler;  // (ida_integrator.cpp) IDA's side of the event loop
+  /// Before the first step: InputError naming the element or body whose residual, Jacobian or
+  /// rates are not finite (or so large that IDA's norms overflow) at t = 0.
+  void check_start(const double* y, const double* yp, const double* atol, double t_end) const;
+  /// Why IDA failed, in the model's terms: a non-finite residual's element or body, a
+  /// singular configuration of the joints, the unknowns with the largest weighted errors.
+  std::string explain_failure(int flag);
+  /// IDA's next step (IDA_ONE_STEP, with one retry of a failed first step after a restart);
+  /// the time it reached. Throws StepFailure.
+  double take_step(double t_end);
+  /// After a step from t_step_start to t_n: its roots, and the crossings in it located and
+  /// committed in time order (events.hpp, event_loop.hpp: IDA's decisions are an
+  /// IdaEventHandler's); kinks within tolerance go on, a jump restarts at its event (then
+  /// true: the step's end is discarded).
+  bool handle_events(double t_step_start, double t_n, double t_end);
+  /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
+  /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
+  void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);
+  /// Whether element e's mode change at t_event (its load in the old modes `before`: at the
+  /// event and at t_n) leaves IDA's step to t_n within the local tolerances without a restart
+  /// (the lag test; see advance()). quadratures: at t_n.
+  bool lag_within_tolerance(int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
+                            const double* y_at_event, double t_n, const double* y_n, const double* quadratures,
+                            double weight_at_event = 0.5, double weight_at_n = 0.5) const;
+  /// "; the largest force on it, F, comes from FILE:LINE: element 'NAME' (TYPE)" for body unknown k at t = 0.
+  std::string largest_force_on(int k, const double* y) const;
+
+  IdaSettings settings_;
+  std::unique_ptr<Impl> impl_;  // SUNDIALS' objects of the run in progress
+  std::vector<double> outputs_;  // element outputs at the step's end, from the roots' sweep
+  bool outputs_current_ = false;  // outputs_ belong to current_state() and the present modes
+};
+
+}  // namespace railcrash

@@ -1,0 +1,106 @@
+#include "railcrash/solver/auto_integrator.hpp"
+
+#include <cstdio>
+
+namespace railcrash {
+
+AutoIntegrator::AutoIntegrator(DaeSystem& system, IdaSettings ida, EulerSettings euler, AutoSettings rule)
+    : IdaIntegrator(system, ida), rule_(rule), euler_settings_(euler) {}
+
+void AutoIntegrator::start(double t_end) {
+  IdaIntegrator::start(t_end);
+  steps_ = 0;
+  window_t_ = 0.0;
+  window_restarts_ = 0;
+  ida_cost_ = euler_cost_ = ida_mean_step_ = 0.0;
+  euler_step_.reset();
+  euler_refusal_.clear();
+  // Euler's step from the state IDA starts from (assembled and settled), as a plain Euler run
+  // would choose it.
+  const std::vector<double> y0(current_state(), current_state() + system_.size());
+  try {
+    EulerIntegrator::Step step = EulerIntegrator::choose_step(system_, y0, euler_settings_);
+    euler_refusal_ = EulerIntegrator::refusal(system_, step, euler_settings_, 0.0);
+    if (euler_refusal_.empty()) euler_step_ = std::move(step);
+  } catch (const InputError& e) {
+    euler_refusal_ = e.what();
+  }
+}
+
+std::unique_ptr<Integrator> AutoIntegrator::hand_over(double t, const double* /*y*/) {
+  if (!euler_step_) return nullptr;
+  if (++steps_ <= rule_.startup_steps) {
+    window_t_ = t;
+    window_restarts_ = stats().reinitializations;
+    return nullptr;
+  }
+  const double dt = euler_step_->dt;
+  const auto span_steps = static_cast<double>(steps_ - rule_.startup_steps);
+  ida_cost_ = rule_.ida_step_cost * span_steps +
+              rule_.ida_restart_cost * static_cast<double>(stats().reinitializations - window_restarts_);
+  euler_cost_ = rule_.euler_step_cost * (t - window_t_) / dt;
+  ida_mean_step_ = (t - window_t_) / span_steps;
+  if (t - window_t_ < rule_.min_span_steps * dt || stats().events < rule_.min_events ||
+      ida_cost_ <= rule_.margin * euler_cost_ || (rule_.require_resolution && ida_mean_step_ < dt))
+    return nullptr;
+  std::vector<double> state, quadratures;
+  state_for_successor(t, state, quadratures);
+  auto euler = std::make_unique<EulerIntegrator>(system_, euler_settings_, std::move(*euler_step_), t, state, quadratures);
+  euler_step_.reset();
+  char reason[400];
+  std::snprintf(reason, sizeof reason,
+                "IDA handed the run to Euler at t = %.6g: from t = %.6g its steps (mean %.4g) and restarts cost about "
+                "%.0f force sweeps, Euler's steps of %.4g about %.0f, after %ld mode changes",
+                t, window_t_, ida_mean_step_, ida_cost_, dt, euler_cost_, stats().events);
+  stats().handed_over_at = t;
+  stats().hand_over_reason = reason;
+  return euler;
+}
+
+std::unique_ptr<Integrator> AutoIntegrator::rescue(const std::string& failure, double* t) {
+  if (!euler_step_) return nullptr;
+  std::vector<double> state, quadratures;
+  double t_good = 0.0;
+  try {
+    t_good = current_time();
+    state_for_successor(t_good, state, quadratures);
+  } catch (const std::exception&) {
+    return nullptr;  // no good state to go on from: the run fails with IDA's message
+  }
+  const double dt = euler_step_->dt;
+  auto euler = std::make_unique<EulerIntegrator>(system_, euler_settings_, std::move(*euler_step_), t_good, state, quadratures);
+  euler_step_.reset();
+  stats().handed_over_at = t_good;
+  char head[200];
+  std::snprintf(head, sizeof head, "IDA failed; Euler (step %.4g) took the rest of the run from IDA's last good state at t = %.6g: ",
+                dt, t_good);
+  stats().hand_over_reason = head + failure;
+  *t = t_good;
+  return euler;
+}
+
+void AutoIntegrator::finish() {
+  IdaIntegrator::finish();
+  if (stats().handed_over_at >= 0.0) return;  // the reason of the hand-over stands
+  if (!euler_refusal_.empty()) {
+    stats().hand_over_reason = "IDA kept the run: Euler cannot run this model (" + euler_refusal_ + ")";
+    return;
+  }
+  if (steps_ <= rule_.startup_steps) {
+    stats().hand_over_reason = "IDA kept the run: it ended within IDA's first " + std::to_string(rule_.startup_steps) + " steps";
+    return;
+  }
+  const double dt = euler_step_ ? euler_step_->dt : 0.0;
+  const char* why = ida_cost_ <= rule_.margin * euler_cost_ ? "cheaper or not clearly dearer"
+                    : rule_.require_resolution && ida_mean_step_ < dt
+                        ? "dearer, but its steps are shorter than Euler's: Euler would resolve the motion less finely"
+                        : "dearer, but with too few mode changes for a crash run";
+  char reason[480];
+  std::snprintf(reason, sizeof reason,
+                "IDA kept the run: from t = %.6g its steps (mean %.4g) and restarts cost about %.0f force sweeps, Euler's "
+                "steps of %.4g about %.0f: IDA %s",
+                window_t_, ida_mean_step_, ida_cost_, dt, euler_cost_, why);
+  stats().hand_over_reason = reason;
+}
+
+}  // namespace railcrash

@@ -1,0 +1,171 @@
+#include "klu_solver.hpp"
+
+#include <klu.h>
+#include <nvector/nvector_serial.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+
+#include <algorithm>
+#include <string>
+
+#include "railcrash/solver/integrator.hpp"
+
+namespace railcrash {
+
+namespace {
+
+/// The solver's state, SUNLinearSolver::content.
+struct KluContent {
+  klu_common common;                // KLU's settings and statistics
+  klu_symbolic* symbolic = nullptr;  // ordering and block triangular form, kept between restarts
+  klu_numeric* numeric = nullptr;    // the last factorization
+  bool first_factorize = true;       // the next setup analyses and factors afresh
+  int size = 0;                      // rows and columns
+  std::vector<int> column_start;     // the matrix's pattern (CSC), 32-bit
+  std::vector<int> row_index;
+  PhaseClock* clock = nullptr;
+  int last_flag = SUNLS_SUCCESS;
+};
+
+KluContent& content_of(SUNLinearSolver solver) { return *static_cast<KluContent*>(solver->content); }
+
+SUNLinearSolver_Type klu_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
+
+SUNLinearSolver_ID klu_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+
+/// Called by IDA at the first solve after every IDAInit or IDAReInit. A symbolic analysis once
+/// made is kept (the pattern never changes); the next setup then refactors numerically, with
+/// the fall-back to a full factorization below.
+int klu_initialize(SUNLinearSolver solver) {
+  KluContent& klu = content_of(solver);
+  klu.first_factorize = klu.symbolic == nullptr;
+  klu.last_flag = SUNLS_SUCCESS;
+  return klu.last_flag;
+}
+
+/// A failed KLU call's flag for IDA: a singular matrix is recoverable (IDA cuts its step); no
+/// memory, or factors past 32-bit indices, are not (IDA stops with IDA_LSETUP_FAIL and
+/// klu_failure says why).
+int failure_flag(const KluContent& klu) {
+  return klu.common.status == KLU_SINGULAR ? SUNLS_PACKAGE_FAIL_REC : SUNLS_PACKAGE_FAIL_UNREC;
+}
+
+/// Analysis and a factorization with partial pivoting, from scratch.
+int analyse_and_factor(KluContent& klu, double* values) {
+  if (klu.symbolic == nullptr) {
+    klu.symbolic = klu_analyze(klu.size, klu.column_start.data(), klu.row_index.data(), &klu.common);
+    if (klu.symbolic == nullptr) return SUNLS_PACKAGE_FAIL_UNREC;
+  }
+  if (klu.numeric != nullptr) klu_free_numeric(&klu.numeric, &klu.common);
+  klu.numeric = klu_factor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, &klu.common);
+  return klu.numeric == nullptr ? failure_flag(klu) : SUNLS_SUCCESS;
+}
+
+/// Refactors with the previous pivot order while it stays sound, judged by KLU's reciprocal
+/// pivot growth (one pass over the matrix); factors afresh when the growth exceeds 1e8 or the
+/// refactorization fails.
+int klu_setup(SUNLinearSolver solver, SUNMatrix matrix) {
+  KluContent& klu = content_of(solver);
+  const PhaseClock::Scope timed(klu.clock, Phase::LinearSetup);
+  double* values = SUNSparseMatrix_Data(matrix);
+  if (klu.first_factorize || klu.numeric == nullptr) {
+    klu.last_flag = analyse_and_factor(klu, values);
+    klu.first_factorize = klu.last_flag != SUNLS_SUCCESS;
+    return klu.last_flag;
+  }
+  constexpr double kSmallestReciprocalGrowth = 1e-8;
+  if (klu_refactor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
+      klu_rgrowth(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
+      klu.common.rgrowth > kSmallestReciprocalGrowth) {
+    klu.last_flag = SUNLS_SUCCESS;
+    return klu.last_flag;
+  }
+  klu.last_flag = analyse_and_factor(klu, values);
+  return klu.last_flag;
+}
+
+/// x = A^-1 b with the last factorization.
+int klu_solve_vector(SUNLinearSolver solver, SUNMatrix, N_Vector x, N_Vector b, realtype) {
+  KluContent& klu = content_of(solver);
+  const PhaseClock::Scope timed(klu.clock, Phase::LinearSolve);
+  const double* from = N_VGetArrayPointer(b);
+  double* to = N_VGetArrayPointer(x);
+  if (to != from) std::copy(from, from + klu.size, to);
+  klu.last_flag = klu_solve(klu.symbolic, klu.numeric, klu.size, 1, to, &klu.common) ? SUNLS_SUCCESS : failure_flag(klu);
+  return klu.last_flag;
+}
+
+sunindextype klu_last_flag(SUNLinearSolver solver) { return content_of(solver).last_flag; }
+
+int klu_free(SUNLinearSolver solver) {
+  if (solver == nullptr) return SUNLS_SUCCESS;
+  if (solver->content != nullptr) {
+    KluContent* klu = &content_of(solver);
+    if (klu->numeric != nullptr) klu_free_numeric(&klu->numeric, &klu->common);
+    if (klu->symbolic != nullptr) klu_free_symbolic(&klu->symbolic, &klu->common);
+    delete klu;
+    solver->content = nullptr;
+  }
+  SUNLinSolFreeEmpty(solver);
+  return SUNLS_SUCCESS;
+}
+
+/// IDA zeroes its Jacobian matrix before each evaluation; SUNDIALS' sparse zero clears the
+/// index arrays too. The Jacobian function here overwrites every value and the pattern is fixed.
+int keep_matrix(SUNMatrix) { return 0; }
+
+}  // namespace
+
+SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index,
+                                PhaseClock* clock) {
+  SUNLinearSolver solver = SUNLinSolNewEmpty(context);
+  if (solver == nullptr) return nullptr;
+  auto* klu = new KluContent;
+  klu_defaults(&klu->common);
+  klu->common.ordering = 1;  // COLAMD, as SUNDIALS' KLU module (SUNKLU_ORDERING_DEFAULT)
+  klu->size = static_cast<int>(column_start.size()) - 1;
+  klu->column_start = column_start;
+  klu->row_index = row_index;
+  klu->clock = clock;
+  solver->content = klu;
+  solver->ops->gettype = &klu_type;
+  solver->ops->getid = &klu_id;
+  solver->ops->initialize = &klu_initialize;
+  solver->ops->setup = &klu_setup;
+  solver->ops->solve = &klu_solve_vector;
+  solver->ops->lastflag = &klu_last_flag;
+  solver->ops->free = &klu_free;
+  return solver;
+}
+
+long klu_factor_entries(SUNLinearSolver solver) {
+  const klu_numeric* numeric = content_of(solver).numeric;
+  return numeric == nullptr ? 0 : static_cast<long>(numeric->lnz) + numeric->unz + numeric->nzoff;
+}
+
+std::string klu_failure(SUNLinearSolver solver) {
+  const KluContent& klu = content_of(solver);
+  if (klu.last_flag == SUNLS_SUCCESS) return "";
+  switch (klu.common.status) {
+    case KLU_SINGULAR:
+      return "KLU found the Newton matrix singular at its last factorization (a joint or a mass the motion "
+             "cannot determine at that state)";
+    case KLU_OUT_OF_MEMORY:
+      return "KLU ran out of memory factoring the Newton matrix";
+    case KLU_TOO_LARGE:
+      return "the Newton matrix's factors exceed KLU's 32-bit indices (2^31 entries): the model is too large";
+    default:
+      return "KLU failed (status " + std::to_string(klu.common.status) + ")";
+  }
+}
+
+SUNMatrix make_klu_jacobian_matrix(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index) {
+  const auto size = static_cast<sunindextype>(column_start.size()) - 1;
+  SUNMatrix matrix = SUNSparseMatrix(size, size, static_cast<sunindextype>(row_index.size()), CSC_MAT, context);
+  if (matrix == nullptr) return nullptr;
+  std::copy(column_start.begin(), column_start.end(), SUNSparseMatrix_IndexPointers(matrix));
+  std::copy(row_index.begin(), row_index.end(), SUNSparseMatrix_IndexValues(matrix));
+  matrix->ops->zero = &keep_matrix;
+  return matrix;
+}
+
+}  // namespace railcrash
