@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "railcrash/core/error.hpp"
@@ -87,18 +88,20 @@ void CrushSpring::enter_mode_at(State& st, double crush, double rate) const {
 
 void CrushSpring::initialize(const ElementState<double>& initial) {
   require_direction(*this, initial);
-  const double length = line_geometry(*this, initial).length;
-  if (!free_length) free_length = length;
-  {  // the initial direction P1 -> P2 in body 1's frame (the points-meet root)
-    const Vec2<double> d = line_geometry(*this, initial).d;
-    const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(point_slot(0))];
-    reference_axis_ = {(r.cos * d.x + r.sin * d.y) / length, (-r.sin * d.x + r.cos * d.y) / length};
-  }
+  const LineGeometry<double> g = line_geometry(*this, initial);
+  if (!free_length) free_length = g.length;
+  // The initial direction P1 -> P2 in body 1's frame (the points-meet root).
+  const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(point_slot(0))];
+  reference_axis_ = {(r.cos * g.d.x + r.sin * g.d.y) / g.length, (-r.sin * g.d.x + r.cos * g.d.y) / g.length};
   initial_state_ = State{};
-  enter_mode_at(initial_state_, crush_of(initial), crush_rate_of(initial));
-  if (initial_state_.mode == Mode::Loading && crush_of(initial) > 0.0)
-    throw InputError(where().prefix() + "crush_spring '" + name() + "' starts crushed by " + std::to_string(crush_of(initial)) +
+  const double crush = crush_of(initial);
+  enter_mode_at(initial_state_, crush, crush_rate_of(initial));
+  if (initial_state_.mode == Mode::Loading && crush > 0.0) {
+    char crushed_by[32];
+    std::snprintf(crushed_by, sizeof crushed_by, "%.6g", crush);  // (round-off shows as such, not as 0.000000)
+    throw InputError(where().prefix() + "crush_spring '" + name() + "' starts crushed by " + crushed_by +
                      "; start it at or beyond its free_length (it has no crush history)");
+  }
 }
 
 void CrushSpring::stiffest_force_jacobian(double, const ElementState<double>& s, ForceBlock& df_dq,
