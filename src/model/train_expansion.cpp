@@ -545,9 +545,12 @@ class Expander {
           if (spec.name == "facing" && spec.unit == Unit::Choice && e["facing"] && p.mirror < 0)  // 1 | -1: which way a face looks
             edit_.set(element["facing"], -check_.number(e["facing"], what + ": facing"));
           if (spec.shape != Shape::Pair || !e[spec.name]) continue;
-          if (spec.unit == Unit::Direction && p.mirror < 0)
-            edit_.set(element[spec.name][0], -check_.pair(e[spec.name], what + ": " + spec.name)[0]);
-          if (spec.unit == Unit::Position) edit_.set(element[spec.name][0], p.x(check_.pair(e[spec.name], what + ": " + spec.name)[0]));
+          if (spec.unit != Unit::Direction && spec.unit != Unit::Position) continue;
+          // Checked before `element[spec.name][0]` is touched: indexing a scalar throws yaml-cpp's BadSubscript,
+          // and a function's arguments may be evaluated in either order (clang took the index first).
+          const double x = check_.pair(e[spec.name], what + ": " + spec.name)[0];
+          if (spec.unit == Unit::Direction && p.mirror < 0) edit_.set(element[spec.name][0], -x);
+          if (spec.unit == Unit::Position) edit_.set(element[spec.name][0], p.x(x));
         }
     return element;
   }
