@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model.hpp"
 #include "railcrash/results/results.hpp"
@@ -245,8 +246,9 @@ double static_load(const std::vector<double>& reaction) {
   return 0.0;
 }
 
-double largest_unloading(const std::vector<double>& reaction) {
-  const double q0 = static_load(reaction);
+double largest_unloading(const std::vector<double>& reaction) { return largest_unloading(reaction, static_load(reaction)); }
+
+double largest_unloading(const std::vector<double>& reaction, double q0) {
   if (q0 == 0.0) return reaction.empty() ? 0.0 : std::numeric_limits<double>::infinity();
   double lowest = 1.0;  // Q / Q0, from the first known reaction on
   const auto first = std::find_if(reaction.begin(), reaction.end(), [](double q) { return q != 0.0; });
@@ -334,7 +336,7 @@ void ScenarioTracker::step(double, const double* y, const double* lambda, const 
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
     if (fresh.has(wheel_columns_[k])) step_extremes_.lift[k] = std::max(step_extremes_.lift[k], -outputs[wheel_columns_[k]]);
   for (std::size_t k = 0; k < support_columns_.size(); ++k)
-    if (const double q0 = static_load(reaction_[k]); fresh.has(support_columns_[k]) && q0 != 0.0)
+    if (const double q0 = wheel_static_load(k); fresh.has(support_columns_[k]) && q0 != 0.0 && static_load(reaction_[k]) != 0.0)
       step_extremes_.lowest_load[k] = std::min(step_extremes_.lowest_load[k], outputs[support_columns_[k]] / q0);
 }
 
@@ -353,6 +355,29 @@ void ScenarioTracker::sample(double t, const double* y, const double*, const dou
   for (std::size_t k = 0; k < wheel_columns_.size(); ++k)
     penetration_[k].push_back(outputs[wheel_columns_[k]]);
   for (std::size_t k = 0; k < support_columns_.size(); ++k) reaction_[k].push_back(outputs[support_columns_[k]]);
+  if (times_.size() == 1) static_load_ = static_loads(t, y);
+}
+
+double ScenarioTracker::wheel_static_load(std::size_t k) const {
+  return k < static_load_.size() ? static_load_[k] : static_load(reaction_[k]);
+}
+
+std::vector<double> ScenarioTracker::static_loads(double t, const double* y) const {
+  // The rates and multipliers consistent with the sample's positions and velocities, as IDA
+  // starts from them (consistent_rates); the supports' reactions there.
+  std::vector<double> consistent(y, y + system_.size()), rates;
+  try {
+    consistent_rates(system_, t, consistent, rates);
+  } catch (const SolverError&) {
+    // No consistent multipliers (a zero-inertia body no joint holds: IDA could not start
+    // either): Q0 is the first non-zero sample, as before.
+    return {};
+  }
+  std::vector<double> outputs(system_.output_names().size(), 0.0);
+  system_.outputs(consistent.data(), consistent.data() + 2 * system_.body_unknowns(), outputs.data());
+  std::vector<double> loads;
+  for (const int column : support_columns_) loads.push_back(outputs[static_cast<std::size_t>(column)]);
+  return loads;
 }
 
 std::vector<CriterionResult> ScenarioTracker::results() const {
@@ -408,7 +433,7 @@ std::vector<CriterionResult> ScenarioTracker::results() const {
     CriterionResult r;
     r.criterion = "wheel_unloading";
     r.subject = criteria_.rail_supports[k];
-    r.value = std::max(largest_unloading(reaction_[k]), 1.0 - step_extremes_.lowest_load[k]);
+    r.value = std::max(largest_unloading(reaction_[k], wheel_static_load(k)), 1.0 - step_extremes_.lowest_load[k]);
     r.limit = 1.0;
     r.pass = r.value < r.limit;
     r.note = !std::isfinite(r.value) ? "no static wheel load at the start (no gravity?): unloading not measured"
