@@ -180,7 +180,7 @@ class RunTest(unittest.TestCase):
 
     def test_discrete_outcome_of_a_gear_that_fractures_or_not(self):
         # A 500 kg probe at 2 m/s into a draft gear: peak force sqrt(H^2 + 2 k (E - stick corner)),
-        # about 49.2 kN (tests/test_sensitivity.cpp gear_peak_force): a fracture load below it
+        # about 49.2 kN (tests/studies/test_sensitivity.cpp gear_peak_force): a fracture load below it
         # fractures, one above does not.
         def gear(fracture_load):
             return railcrash.from_yaml(

@@ -11,7 +11,7 @@
 // operations IDA calls every step. Each computes exactly what SUNDIALS 6.4.1's nvector_serial.c
 // computes (the same special cases of the coefficients, the same operations in the same order
 // on each element, sums accumulated in index order), so a run's numbers are unchanged to the
-// bit (tests/test_serial_vector_ops.cpp compares them with SUNDIALS's own). Clones inherit
+// bit (tests/solver/test_serial_vector_ops.cpp compares them with SUNDIALS's own). Clones inherit
 // the table (N_VClone copies it), so calling it on the vectors IDA is initialized with covers
 // every vector IDA makes from them. The fused and vector-array operations stay disabled, as
 // SUNDIALS's defaults are: IDA then composes them from these.

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "../src/solver/klu_solver.hpp"
+#include "../../src/solver/klu_solver.hpp"
 
 using namespace railcrash;
 
