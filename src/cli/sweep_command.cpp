@@ -39,10 +39,12 @@ namespace {
 #endif
 
 /// `sweep --dry-run`: the plan's run count and the levels of the runs listed, generated one at a
-/// time (a plan of any size under --max-runs 0), nothing run or written.
+/// time (a plan of any size under --max-runs 0), nothing run or written. Under a launcher only
+/// its first process prints them (and reports a bad plan): the others would print the same.
 int sweep_dry_run_command(const std::string& path, const std::string& plan_path, std::size_t max_runs,
                           std::vector<std::size_t> show_runs) {
   using namespace railcrash;
+  if (launched_by_mpi() && launcher_rank() != 0) return 0;
   const SweepPlan plan = load_sweep_plan(plan_path, path);
   require_sweep_run_count(plan, max_runs);
   const SweepRunGenerator generator(plan, path, read_model_text(path));

@@ -197,6 +197,12 @@ if [ -n "$mpirun" ]; then
   if [ $huge_status -ne 0 ] && [ "$(huge_rows)" -ge $((first_rows + 4)) ] && [ -z "$(levels_right "$tmp/huge/runs.csv")" ] &&
      [ "$(cut -d, -f1 "$tmp/huge/runs.csv" | sort -u | wc -l)" -eq $(($(huge_rows) + 1)) ]; then pass
   else fail "mpirun: 10^7 runs resumed: status $huge_status, $(huge_rows) rows, $(head -c 600 "$tmp/huge.out" "$tmp/huge.err")"; fi
+  # --dry-run under a launcher: the plan printed once, by the first process, not once per rank.
+  "$mpirun" --oversubscribe -np 2 "$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --dry-run > "$tmp/mpi_dry" 2> "$tmp/stderr"
+  status=$?
+  "$bin" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --dry-run > "$tmp/dry_alone"
+  if [ $status -eq 0 ] && cmp -s "$tmp/mpi_dry" "$tmp/dry_alone"; then pass
+  else fail "mpirun -np 2 --dry-run: status $status, printed $(grep -c 'runs$' "$tmp/mpi_dry") time(s): $(head -c 400 "$tmp/mpi_dry" "$tmp/stderr")"; fi
   # railcrash links no MPI and runs railcrash-mpi beside it under a launcher: without it, exit 2 saying so.
   mkdir "$tmp/alone" && cp "$bin" "$tmp/alone/railcrash"
   PMIX_RANK=0 "$tmp/alone/railcrash" sweep "$tmp/model.yaml" --plan "$tmp/plan.yaml" --out "$tmp/alone/out" > /dev/null 2> "$tmp/stderr"

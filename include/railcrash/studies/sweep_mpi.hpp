@@ -22,6 +22,15 @@ inline bool launched_by_mpi() {
   return false;
 }
 
+/// The process's rank as its launcher gives it (OMPI_COMM_WORLD_RANK, PMI_RANK, PMIX_RANK), 0
+/// when none does: for output that one process of the launch prints (sweep --dry-run), read
+/// before MPI is initialized.
+inline int launcher_rank() {
+  for (const char* variable : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+    if (const char* value = std::getenv(variable)) return std::atoi(value);
+  return 0;
+}
+
 /// Runs the sweep over the MPI ranks; returns the command's exit status (2: bad input, printed
 /// by rank 0 only). Calls MPI_Init and MPI_Finalize.
 int sweep_with_mpi(const std::string& model_path, const std::string& plan_path, const std::string& directory,
