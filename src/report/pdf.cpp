@@ -108,7 +108,7 @@ std::string print_pdf(const std::string& html_path, const PdfOptions& options) {
                                         // Virtual time runs the page's script and its charts' drawing to the end before printing.
                                         "--virtual-time-budget=" + std::to_string(options.virtual_time_budget_ms),
                                         "--run-all-compositor-stages-before-draw", "--no-pdf-header-footer",
-                                        "--print-to-pdf=" + part.string(), file_url(page)};
+                                        "--print-to-pdf=" + part.string(), file_url(page) + "#t=last"};
   if (::geteuid() == 0) arguments.insert(arguments.begin() + 1, "--no-sandbox");  // Chromium refuses to run as root with its sandbox
   std::vector<char*> argv;
   for (std::string& a : arguments) argv.push_back(a.data());

@@ -66,6 +66,9 @@ if (!forceAxis || forceAxis.y_label !== "kN") problems.push("the force plot's ax
 const follow = check.follow;
 if (!follow || follow.car !== "car1" || follow.cars !== 2 || follow.offsets_px.some((d) => Math.abs(d) > 1) || !(follow.zoom > 1.2))
   problems.push("following car1 does not keep it centred and larger: " + JSON.stringify(follow));
+// Opened without a time asked: the middle of the run.
+if (!check.opened || check.opened.asked !== null || Math.abs(check.opened.index - (check.frames.count - 1) / 2) > 1)
+  problems.push("the page does not open at the middle frame: " + JSON.stringify(check.opened));
 const jump = check.event_jump;
 if (!jump || Math.abs(jump.frame_t - jump.event_t) > jump.spacing || jump.current !== "current")
   problems.push("a click on an event does not move the animation to it: " + JSON.stringify(jump));
@@ -84,6 +87,21 @@ if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
 console.log("report ok: " + check.plots.length + " plots, " + check.frames.count + " frames");
 JS
 [ -s "$out/report_screenshot.png" ] || fail "no screenshot"
+
+# report.html#t=last opens at the run's last frame (what `report --pdf` prints: the final
+# deformed state), #t=SECONDS at the frame nearest to it.
+for asked in last 0.1; do
+  timeout 120 "$chromium" "${flags[@]}" --virtual-time-budget=5000 --dump-dom "$url#t=$asked" > "$tmp/dom_t.html" 2> "$tmp/chromium.log" ||
+    fail "chromium --dump-dom (#t=$asked)"
+  "$node" - "$tmp/dom_t.html" "$asked" <<'JS' || fail "the page opened at #t=$asked (above)"
+const fs = require("fs");
+const m = fs.readFileSync(process.argv[2], "utf8").match(/<div id="self-check"[^>]*>([^<]*)<\/div>/);
+const check = JSON.parse(m[1].replace(/&quot;/g, '"').replace(/&lt;/g, "<").replace(/&gt;/g, ">").replace(/&amp;/g, "&"));
+const o = check.opened, asked = process.argv[3], count = check.frames.count;
+const ok = asked === "last" ? o.index === count - 1 : Math.abs(o.t - Number(asked)) < 0.002 && o.index > 0 && o.index < count - 1;
+if (!o || o.asked !== asked || !ok) { console.log("opened at " + JSON.stringify(o) + " of " + count + " frames"); process.exit(1); }
+JS
+done
 
 # An EN 15227 scenario's criteria (issue 38's note): wheel unloading is a fraction of the static
 # wheel load, (Q0 - Q) / Q0, never labelled with a length unit.

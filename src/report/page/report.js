@@ -1412,7 +1412,13 @@
       followCar = "";
       view = null;
     }
-    setFrame(nearestFrame(0.5 * frames.t[frames.t.length - 1]));
+    // The page opens at the middle of the run, or where its address asks: report.html#t=last
+    // (the end: `railcrash report --pdf` prints that, the final deformed state) or #t=SECONDS.
+    var timeAsked = /^#t=(last|[0-9.eE+-]+)$/.exec(location.hash);
+    var opening = 0.5 * frames.t[frames.t.length - 1];
+    if (timeAsked) opening = timeAsked[1] === "last" ? frames.t[frames.t.length - 1] : Number(timeAsked[1]);
+    setFrame(isFinite(opening) ? nearestFrame(opening) : 0);
+    check.opened = {index: frameIndex, t: frames.t[frameIndex], asked: timeAsked ? timeAsked[1] : null};
     followFromAddress();
   }
   // report.html#crush-zones: the loops and the energy per crush zone alone (docs' screenshot, printing).
