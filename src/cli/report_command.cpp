@@ -49,7 +49,8 @@ class ReportCommand final : public Command {
     command->add_option("run_dir", run_dirs_, "run folder (the --out of `railcrash run`); two or more: the runs side by side, "
                                               "differences to the first")->required();
     command->add_option("--out", out_, "side by side only: the page's path (default: compare_<A>_<B>.html beside the first run folder)");
-    command->add_option("--cfc", cfc_, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000)")
+    cfc_option_ = command->add_option("--cfc", cfc_, "channel frequency class of the acceleration plots (SAE J211-1: 60, 180, 600, 1000); "
+                                                     "one run's report only")
         ->capture_default_str()->check(finite_number(60, 1000, false, false, "Hz"));
     command->add_option("--force-cfc", force_cfc_,
                         "channel frequency class of the element force plot (SAE J211-1 lists CFC 60 for barrier face forces); 0: unfiltered")
@@ -59,6 +60,10 @@ class ReportCommand final : public Command {
   }
 
   int run(char** /*argv*/) override {
+    if (run_dirs_.size() > 1 && cfc_option_->count() > 0)
+      throw InputError("report --cfc sets the acceleration plots of one run's report; the page of runs side by side has none "
+                       "(its acceleration table shows each run's summary.json peaks, CFC 60): leave out --cfc, or report each "
+                       "run on its own");
     if (run_dirs_.size() > 1) return compare_command(run_dirs_, out_, force_cfc_, pdf_);
     if (!out_.empty())
       throw InputError("report --out names the page of runs side by side (two run folders or more); the report of one run "
@@ -70,6 +75,7 @@ class ReportCommand final : public Command {
   std::vector<std::string> run_dirs_;
   std::string out_;
   double cfc_ = 60.0;
+  CLI::Option* cfc_option_ = nullptr;
   double force_cfc_ = 60.0;
   bool pdf_ = false;
 };

@@ -124,6 +124,12 @@ grep -q "share no column but t: they are runs of different models" "$tmp/refused
 # --out with one run folder; a folder that is not a run.
 "$bin" report "$tmp/base" --out "$tmp/one.html" > "$tmp/one.log" 2>&1 && fail "--out with one run folder was accepted"
 grep -q "report --out names the page of runs side by side" "$tmp/one.log" || { cat "$tmp/one.log"; fail "--out message"; }
+# --cfc sets one run's acceleration plots; the side-by-side page has none: refused, not ignored.
+"$bin" report "$tmp/base" "$tmp/faster" --cfc 180 --out "$tmp/cfc.html" > "$tmp/cfc.log" 2>&1
+status=$?
+[ $status -eq 2 ] || { cat "$tmp/cfc.log"; fail "--cfc with runs side by side: exit $status, expected 2"; }
+grep -q "report --cfc sets the acceleration plots of one run's report" "$tmp/cfc.log" || { cat "$tmp/cfc.log"; fail "--cfc message"; }
+[ -e "$tmp/cfc.html" ] && fail "a page was written with --cfc for runs side by side"
 mkdir "$tmp/empty"
 "$bin" report "$tmp/base" "$tmp/empty" > "$tmp/empty.log" 2>&1 && fail "a folder without results was accepted"
 grep -q "empty' has no timeseries.csv nor timeseries.h5" "$tmp/empty.log" || { cat "$tmp/empty.log"; fail "empty folder message"; }
