@@ -708,12 +708,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     if (s.crush_from_anticlimber && !node["anticlimber"])
       r.fail(node["crush"], "responses: crush: anticlimber needs 'anticlimber: <element name>'");
   }
-  const auto positive = [&](const char* key) -> std::optional<double> {
-    if (!node[key]) return std::nullopt;
-    const double value = r.number(node[key], std::string("responses: ") + key);
-    if (!(value > 0.0)) r.fail(node[key], std::string("responses: ") + key + " must be positive");
-    return value;
-  };
+  const auto positive = [&](const char* key) { return r.positive_key(node, key, "responses"); };
   if (!s.crush_gauges.empty() || s.crush_from_anticlimber) {
     if (!node["reference_crush"]) r.fail(node, "responses: crush gauges need 'reference_crush' (the maximum safe crush, R1 = crush / it)");
     s.reference_crush = *positive("reference_crush") * r.scale().length;
@@ -770,12 +765,7 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
     if (!kind) r.fail(node["integrator"], "simulation: integrator must be " + integrator_names_text() + ", not '" + name + "'");
     s.integrator = *kind;
   }
-  const auto positive = [&](const char* key) -> std::optional<double> {
-    if (!node[key]) return std::nullopt;
-    const double value = r.number(node[key], std::string("simulation: ") + key);
-    if (!(value > 0.0)) r.fail(node[key], std::string("simulation: ") + key + " must be positive");
-    return value;
-  };
+  const auto positive = [&](const char* key) { return r.positive_key(node, key, "simulation"); };
   if (node["rtol"]) {
     s.rtol = r.number(node["rtol"], "simulation: rtol");
     if (const std::string problem = rtol_problem(s.rtol, "simulation: rtol"); !problem.empty()) r.fail(node["rtol"], problem);

@@ -46,6 +46,14 @@ double YamlReader::number(const YAML::Node& node, const std::string& what) const
   return value;
 }
 
+std::optional<double> YamlReader::positive_key(const YAML::Node& map, const std::string& key, const std::string& section) const {
+  const YAML::Node node = map[key];
+  if (!node) return std::nullopt;
+  const double value = number(node, section + ": " + key);
+  if (!(value > 0.0)) fail(node, section + ": " + key + " must be positive");
+  return value;
+}
+
 std::vector<double> YamlReader::numbers(const YAML::Node& node, std::size_t size, const std::string& what) const {
   if (!node.IsSequence() || (size > 0 && node.size() != size)) {
     std::string shape = size == 2 ? "[a, b]" : "a list of numbers";

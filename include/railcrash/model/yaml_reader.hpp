@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ class YamlReader {
   /// A finite number: "WHAT must be a number (it is empty)", "... must be a number", "... must be a
   /// number, not 'x'", "... must be a finite number, not '.nan'".
   double number(const YAML::Node& node, const std::string& what) const;
+  /// map[key] as a positive number, nullopt when not given: "SECTION: KEY must be positive".
+  std::optional<double> positive_key(const YAML::Node& map, const std::string& key, const std::string& section) const;
   /// A list of numbers, of `size` entries when size > 0 ("WHAT must be a list of 2 numbers [a, b],
   /// not a list of 3"); its entries read as number(entry, "WHAT entry K").
   std::vector<double> numbers(const YAML::Node& node, std::size_t size, const std::string& what) const;
