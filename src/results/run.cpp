@@ -123,10 +123,11 @@ class ProgressObserver : public RunObserver {
 
 std::vector<OptionSetting> option_settings(const RunOverrides& o, OverrideSource source) {
   std::vector<OptionSetting> settings;
-  const auto add = [&](const char* key, const char* option, const std::string& value) {
+  // `flag`: the option takes no value (--force-dt).
+  const auto add = [&](const char* key, const char* option, const std::string& value, bool flag = false) {
     std::string label;
     switch (source) {
-      case OverrideSource::CommandLine: label = value == "true" ? option : std::string(option) + " " + value; break;
+      case OverrideSource::CommandLine: label = flag ? std::string(option) : std::string(option) + " " + value; break;
       case OverrideSource::RunSettings: label = std::string("RunSettings.") + key + " = " + value; break;
       case OverrideSource::ConvergeRun: label = std::string("converge run's ") + key + " " + value; break;
     }
@@ -147,7 +148,7 @@ std::vector<OptionSetting> option_settings(const RunOverrides& o, OverrideSource
   if (o.dt) add("dt", "--dt", number(*o.dt));
   if (o.output_interval) add("output_interval", "--output-interval", number(*o.output_interval));
   if (o.max_steps) add("max_steps", "--max-steps", std::to_string(*o.max_steps));
-  if (o.force_dt) add("force_dt", "--force-dt", "true");
+  if (o.force_dt) add("force_dt", "--force-dt", "true", /*flag=*/true);
   return settings;
 }
 
