@@ -15,13 +15,19 @@ using Catch::Matchers::StartsWith;
 
 namespace {
 
-std::string structure_error(const std::string& text) {
+/// The message of the InputError read() throws ("" when it throws none).
+template <class Read>
+std::string input_error(const Read& read) {
   try {
-    check_yaml_structure(text, "in.yaml");
+    read();
   } catch (const InputError& e) {
     return e.what();
   }
   return "";
+}
+
+std::string structure_error(const std::string& text) {
+  return input_error([&] { check_yaml_structure(text, "in.yaml"); });
 }
 
 /// A document whose list `level<k>` repeats `level<k-1>` `fan_out` times: it expands to
@@ -103,14 +109,7 @@ TEST_CASE("a ',' at the start of a document is refused at once, not parsed witho
 }
 
 TEST_CASE("a model text checked once (a sweep's runs) is refused and read exactly as load_model_text", "[yaml_file]") {
-  const auto error_of = [](const auto& load) -> std::string {
-    try {
-      load();
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  };
+  const auto error_of = [](const auto& load) { return input_error(load); };
   // Each refusal says what load_model_text says for the same text: an alias in its own
   // anchor, nesting past the limit, a bracket left open (the bracket's own line), bad YAML.
   for (const std::string& text :
@@ -161,14 +160,7 @@ TEST_CASE("one check of a YAML map's keys: unknown (with the closest key and the
 TEST_CASE("the one YAML reader: file and line on every message, each check worded once", "[yaml_file]") {
   const YAML::Node root = YAML::Load("a: 1.5\nb: x\nc: [1, 2, 3]\nd:\ne: .nan\nf: yes\ng: 'co,mma'\nh: -2\n");
   const YamlReader r("in.yaml");
-  const auto message = [](const auto& read) -> std::string {
-    try {
-      read();
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  };
+  const auto message = [](const auto& read) { return input_error(read); };
   CHECK(r.number(root["a"], "a") == 1.5);
   CHECK(message([&] { r.number(root["b"], "b"); }) == "in.yaml:2: b must be a number, not 'x'");
   CHECK(message([&] { r.number(root["c"], "c"); }) == "in.yaml:3: c must be a number");
