@@ -129,13 +129,13 @@ std::string source_commit(const std::string& source) {
 }
 
 /// The 2N-car consist built from the template, through a model file (so it is loaded like any other).
-Model load_consist(const std::string& template_path, int cars) {
+Model load_consist(const std::string& template_path, int cars, const RunOverrides& overrides = {}) {
   const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_consist_" + std::to_string(cars) + ".yaml");
   {
     std::ofstream out(file);
     out << make_consist_model(template_path, cars);
   }
-  Model model = load_model(file.string());
+  Model model = load_model(file.string(), {}, option_settings(overrides));
   std::filesystem::remove(file);
   return model;
 }
@@ -155,11 +155,10 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
   std::vector<std::array<double, kPhaseCount>> all_phases;           // their wall seconds by phase
   bool all_ok = true;
   for (const int n : cars) {
-    Model model = load_consist(template_path, n);
     RunOverrides overrides;
     overrides.t_end = t_end;
     overrides.output_interval = t_end / 100.0;
-    apply_overrides(model, overrides);
+    const Model model = load_consist(template_path, n, overrides);
     const double cpu_start = cpu_seconds();
     const auto wall_start = std::chrono::steady_clock::now();
     const RunReport report = run_model(model, "", nullptr, false, false, "csv", /*time_phases=*/true);

@@ -92,7 +92,6 @@ const std::vector<double>& Results::series(const std::string& column) const {
 
 Results run(const Model& model, const RunSettings& settings, const std::atomic<bool>* stop) {
   const auto& m = Access::impl(model);
-  railcrash::Model loaded = load_model_text(m.text, m.source, m.settings);
   RunOverrides overrides;
   if (settings.integrator) {
     overrides.integrator = integrator_from_name(*settings.integrator);
@@ -105,7 +104,9 @@ Results run(const Model& model, const RunSettings& settings, const std::atomic<b
   overrides.dt = settings.dt;
   overrides.output_interval = settings.output_interval;
   overrides.force_dt = settings.force_dt;
-  apply_overrides(loaded, overrides);
+  // Through the loader, as the command line's options: checked and listed in the provenance alike.
+  const railcrash::Model loaded =
+      load_model_text(m.text, m.source, m.settings, option_settings(overrides, OverrideSource::RunSettings));
 
   RunReport report = run_model(loaded, "", stop, false, /*keep_in_memory=*/true, "csv", settings.timings);
   Results results;

@@ -76,10 +76,9 @@ TEST_CASE("api: results in memory are the files railcrash run writes", "[api]") 
   REQUIRE(memory.ok());
 
   // The same run through run_model with a folder.
-  railcrash::Model loaded = railcrash::load_model(kTwoCar, {"simulation.t_end=0.02"});
   railcrash::RunOverrides overrides;
   overrides.rtol = 1e-4;
-  railcrash::apply_overrides(loaded, overrides);
+  const railcrash::Model loaded = railcrash::load_model(kTwoCar, {"simulation.t_end=0.02"}, railcrash::option_settings(overrides));
   const std::string dir =
       (std::filesystem::temp_directory_path() / ("railcrash_api_test_" + std::to_string(::getpid()))).string();
   std::filesystem::remove_all(dir);
@@ -294,7 +293,7 @@ TEST_CASE("api: errors name the file and line, the element or the key", "[api]")
   CHECK_THROWS_WITH(rc::run(model, bad), Catch::Contains("\"ida\" or \"euler\""));
   bad = {};
   bad.rtol = -1.0;
-  CHECK_THROWS_WITH(rc::run(model, bad), Catch::Contains("--rtol must be a positive number"));
+  CHECK_THROWS_WITH(rc::run(model, bad), Catch::StartsWith("RunSettings.rtol = -1: simulation: rtol must be a positive number"));
   bad = {};
   bad.t_end = 0.01;
   const rc::Results r = rc::run(model, bad);
@@ -324,4 +323,70 @@ TEST_CASE("api: one model run from several threads at once gives the runs done a
     CHECK(r.values == alone.values);
     CHECK(r.events.size() == alone.events.size());
   }
+}
+
+namespace {
+
+/// Two 40 t cars of a multiple unit joined by a draft gear (spring 10 kN/mm, damper 50 N s/mm),
+/// the first at 5 m/s, in the crash codes' mm-t-s-N: its lengths are mm, converted to SI when read.
+const std::string kDraftGearMm = R"(railcrash: 1
+name: two 40 t cars on a draft gear
+units: mm-t-s-N
+gravity: [0, 0]
+bodies:
+  - {name: car1, mass: 40, inertia: 2.0e9, position: [0, 0], velocity: [5000, 0], car: car1}
+  - {name: car2, mass: 40, inertia: 2.0e9, position: [25000, 0], car: car2}
+elements:
+  - {name: car1_rail, type: slider_joint, axis: [1, 0], points: [{body: ground}, {body: car1}]}
+  - {name: car2_rail, type: slider_joint, axis: [1, 0], points: [{body: ground, at: [25000, 0]}, {body: car2}]}
+  - {name: draft_gear, type: linear_spring, stiffness: 1.0e4, free_length: 25000, points: [{body: car1}, {body: car2}]}
+  - {name: draft_gear_damper, type: linear_dashpot, damping: 50, points: [{body: car1}, {body: car2}]}
+simulation:
+  t_end: 0.2
+  integrator: ida
+  rtol: 1.0e-3
+  output_interval: 0.002
+)";
+
+}  // namespace
+
+TEST_CASE("api: atol is in the model file's length unit, as simulation.atol and --atol are", "[api]") {
+  // atol 0.01 mm of an mm-t-s-N model: given as RunSettings, in the file and as --atol.
+  rc::RunSettings api_atol;
+  api_atol.atol = 0.01;
+  const rc::Results from_api = rc::run(rc::Model::from_yaml(kDraftGearMm, "draft_gear.yaml"), api_atol);
+  REQUIRE(from_api.ok());
+  const std::string with_file_atol = kDraftGearMm + "  atol: 0.01\n";
+  const rc::Results from_file = rc::run(rc::Model::from_yaml(with_file_atol, "draft_gear.yaml"));
+  REQUIRE(from_file.ok());
+  railcrash::RunOverrides command_line;
+  command_line.atol = 0.01;
+  const railcrash::RunReport from_option = railcrash::run_model(
+      railcrash::load_model_text(kDraftGearMm, "draft_gear.yaml", {}, railcrash::option_settings(command_line)), "", nullptr, false,
+      /*keep_in_memory=*/true);
+  REQUIRE(from_option.outcome.ok);
+  CHECK(from_api.columns == from_file.columns);
+  CHECK(from_api.values == from_file.values);  // the same doubles, every sample
+  CHECK(from_api.values == from_option.series);
+  CHECK(from_api.summary.steps == from_file.summary.steps);
+  // The tolerance matters on this run: read as metres (1000 times looser) the run differs.
+  rc::RunSettings metres;
+  metres.atol = 10.0;  // [mm] = 0.01 m
+  const rc::Results looser = rc::run(rc::Model::from_yaml(kDraftGearMm, "draft_gear.yaml"), metres);
+  REQUIRE(looser.ok());
+  CHECK(looser.values != from_api.values);
+}
+
+TEST_CASE("api: a run's settings are listed in its provenance and named by their field in messages", "[api]") {
+  const rc::Model model = rc::Model::from_yaml(kDraftGearMm, "draft_gear.yaml", {"simulation.t_end=0.05"});
+  rc::RunSettings settings;
+  settings.rtol = 1e-4;
+  settings.atol = 0.01;
+  const rc::Results r = rc::run(model, settings);
+  REQUIRE(r.ok());
+  CHECK_THAT(r.summary_json,
+             Catch::Contains("\"settings\": [\"simulation.t_end=0.05\", \"simulation.rtol=0.0001\", \"simulation.atol=0.01\"]"));
+  rc::RunSettings bad;
+  bad.atol = -1.0;
+  CHECK_THROWS_WITH(rc::run(model, bad), "draft_gear.yaml: RunSettings.atol = -1: simulation: atol must be positive");
 }

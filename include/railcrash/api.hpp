@@ -79,12 +79,16 @@ class Model {
   friend struct Access;
 };
 
-/// Integrator settings for one run; unset fields keep the model's simulation section.
+/// Integrator settings for one run; unset fields keep the model's simulation section. Each set
+/// field is applied as the command line's option is (simulation.KEY=VALUE through the loader:
+/// the same checks and messages, which name it "RunSettings.KEY = VALUE") and is listed in the
+/// run's provenance (summary_json's "settings").
 struct RunSettings {
   std::optional<std::string> integrator;      // "auto", "ida" or "euler"
   std::optional<double> t_end;                // [s]
   std::optional<double> rtol;                 // ida: relative tolerance
-  std::optional<double> atol;                 // ida: absolute tolerance on lengths [length]
+  std::optional<double> atol;                 // ida: absolute tolerance on lengths [the model file's length
+                                              // unit: mm for an mm-t-s-N model, as its simulation.atol and --atol]
   std::optional<double> dt;                   // euler: step [s]
   std::optional<double> output_interval;      // [s] time between samples
   bool force_dt = false;                      // euler: accept a step above the stability limit

@@ -116,7 +116,8 @@ def run(model, integrator=None, t_end=None, rtol=None, atol=None, dt=None, outpu
     """Runs a model (a Model, or a model file's path) and returns its Results, in memory.
 
     Unset arguments keep the model's simulation section. integrator: "auto", "ida" or "euler"
-    (auto: results.summary["integrator_used"] says which ran when, and why).
+    (auto: results.summary["integrator_used"] says which ran when, and why). atol is in the model
+    file's length unit (mm for an mm-t-s-N model), as its simulation.atol and --atol.
     timings: split the run's wall time by phase, as `railcrash run --timings`:
     results.summary["stats"]["seconds"] (residual, jacobian, linear_solve, ..., adding up to
     results.summary["stats"]["wall_seconds"]).

@@ -328,7 +328,7 @@ simulation: {t_end: 0.01, output_interval: 1.0e-3}
             railcrash.run(model, rtol="tight")
         with self.assertRaisesRegex(railcrash.InputError, "integrator"):
             railcrash.run(model, integrator="rk4")
-        with self.assertRaisesRegex(railcrash.InputError, "--rtol must be a positive number"):
+        with self.assertRaisesRegex(railcrash.InputError, r"RunSettings.rtol = -1: simulation: rtol must be a positive number"):
             railcrash.run(model, rtol=-1.0)
         with self.assertRaises(TypeError):
             railcrash.run(42)

@@ -17,6 +17,7 @@
 #include "railcrash/core/sha256.hpp"
 #include "railcrash/model/train_expansion.hpp"
 #include "railcrash/model/yaml_file.hpp"
+#include "railcrash/model/yaml_reader.hpp"
 
 namespace railcrash {
 
@@ -38,10 +39,11 @@ std::string name_length_problem(const std::string& what, const std::string& name
 
 namespace {
 
-/// Reads one model file, keeping the file name for every message.
-class Reader {
+/// Reads one model file, keeping the file name for every message (the checks: YamlReader); a
+/// node that came from a setting or a car type's copy is reported where it came from.
+class Reader : public YamlReader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
+  explicit Reader(std::string file) : YamlReader(std::move(file)) {}
 
   /// Marks `value` (and everything inside it) as coming from a setting: its line numbers
   /// belong to the setting, not to the file. `setting` is the prefix of the messages about it
@@ -106,16 +108,16 @@ class Reader {
   bool overridden(const YAML::Node& value) const { return from_override(value) != nullptr; }
 
   SourceLocation at(const YAML::Node& node) const {
-    if (!node.IsDefined() || from_override(node)) return {file_, 0};
+    if (!node.IsDefined() || from_override(node)) return {file(), 0};
     if (expansion_)
-      if (const TrainExpansion::Origin* origin = expansion_->origin(node)) return {file_, origin->line};
+      if (const TrainExpansion::Origin* origin = expansion_->origin(node)) return {file(), origin->line};
     if (node.IsNull())
       for (const auto& entry : empty_values_)
-        if (entry.first.is(node)) return {file_, entry.second};
-    if (node.Mark().is_null()) return {file_, 0};
-    return {file_, node.Mark().line + 1};
+        if (entry.first.is(node)) return {file(), entry.second};
+    if (node.Mark().is_null()) return {file(), 0};
+    return {file(), node.Mark().line + 1};
   }
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const override {
     if (const std::string* setting = from_override(node)) throw InputError(*setting + ": " + message);
     if (expansion_)  // a copy of a car type's text: its line, and the instance
       if (const TrainExpansion::Origin* origin = expansion_->origin(node)) throw InputError(at(node).prefix() + message + *origin->note);
@@ -149,91 +151,6 @@ class Reader {
   void set_scale(UnitScale scale) { scale_ = scale; }
   const UnitScale& scale() const { return scale_; }
 
-  void require_map(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsMap()) fail(node, what + " must be a map of keys (key: value)");
-  }
-  void require_list(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsSequence()) fail(node, what + " must be a list (lines starting with '- ')");
-  }
-
-  /// Rejects keys outside `allowed` (naming the closest allowed one) and repeated keys.
-  void check_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
-    if (const auto problem = yaml_keys_problem(map, allowed, context)) fail(problem->where, problem->message);
-  }
-
-  double number(const YAML::Node& node, const std::string& what) const {
-    if (node.IsNull()) fail(node, what + " must be a number (it is empty)");
-    if (!node.IsScalar()) fail(node, what + " must be a number");
-    double value = 0.0;
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(node, what + " must be a number, not '" + node.Scalar() + "'");
-    }
-    if (!std::isfinite(value)) fail(node, what + " must be a finite number, not '" + node.Scalar() + "'");
-    return value;
-  }
-
-  std::vector<double> numbers(const YAML::Node& node, std::size_t size, const std::string& what) const {
-    if (!node.IsSequence() || (size > 0 && node.size() != size)) {
-      std::string shape = size == 2 ? "[a, b]" : "a list of numbers";
-      fail(node, what + " must be " + (size > 0 ? "a list of " + std::to_string(size) + " numbers " + shape : shape) +
-                     (node.IsSequence() ? ", not a list of " + std::to_string(node.size()) : ""));
-    }
-    std::vector<double> out;
-    for (std::size_t i = 0; i < node.size(); ++i) out.push_back(number(node[i], what + " entry " + std::to_string(i + 1)));
-    return out;
-  }
-
-  bool boolean(const YAML::Node& node, const std::string& what) const {
-    try {
-      if (node.IsScalar()) return node.as<bool>();
-    } catch (const YAML::Exception&) {
-    }
-    fail(node, what + " must be true or false");
-  }
-
-  std::string text(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsScalar()) fail(node, what + " must be a word");
-    return node.Scalar();
-  }
-
-  /// A body or element name: it becomes CSV column headers, JSON keys and report text, so it may
-  /// not hold a comma, quote, backslash, <, >, &, a control character or invalid UTF-8.
-  std::string name(const YAML::Node& node, const std::string& what) const {
-    const std::string value = text(node, what);
-    if (value.empty()) fail(node, what + " must not be empty");
-    if (const std::string problem = name_length_problem(what, value); !problem.empty()) fail(node, problem);
-    for (std::size_t i = 0; i < value.size(); ++i) {
-      const unsigned char c = static_cast<unsigned char>(value[i]);
-      if (c < 0x20 || c == 0x7F || std::string(",\"'\\<>&").find(static_cast<char>(c)) != std::string::npos)
-        fail(node, what + " '" + printable(value) + "' holds the character " + (c < 0x20 || c == 0x7F ? "code " + std::to_string(c) : "'" + std::string(1, static_cast<char>(c)) + "'") +
-                       ", which would break the CSV, JSON and report files; use letters, digits, _ - . and spaces");
-      if (c >= 0x80) {
-        const std::size_t length = (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-        bool ok = length > 0 && i + length <= value.size();
-        for (std::size_t k = 1; ok && k < length; ++k) ok = (static_cast<unsigned char>(value[i + k]) >> 6) == 0x2;
-        if (!ok) fail(node, what + " '" + printable(value) + "' is not valid UTF-8 text; save the model file as UTF-8");
-        i += length - 1;
-      }
-    }
-    return value;
-  }
-
-  static std::string printable(const std::string& value) {
-    std::string out;
-    for (char c : value) out += (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F) ? '?' : c;
-    return out;
-  }
-
-  const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
-    const YAML::Node node = map[key];
-    if (!node) fail(map, context + ": missing required key '" + key + "'");
-    return node;
-  }
-
-  const std::string& file() const { return file_; }
-
  private:
   /// The --set setting `node` came from, or nullptr when it is from the file.
   const std::string* from_override(const YAML::Node& node) const {
@@ -243,7 +160,6 @@ class Reader {
     return nullptr;
   }
 
-  std::string file_;
   std::vector<std::pair<YAML::Node, std::string>> overridden_;
   std::vector<std::pair<YAML::Node, int>> empty_values_;
   std::unordered_set<int> walked_positions_;  // text positions of the lists and maps index_empty_values walked
@@ -792,12 +708,7 @@ void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
     if (s.crush_from_anticlimber && !node["anticlimber"])
       r.fail(node["crush"], "responses: crush: anticlimber needs 'anticlimber: <element name>'");
   }
-  const auto positive = [&](const char* key) -> std::optional<double> {
-    if (!node[key]) return std::nullopt;
-    const double value = r.number(node[key], std::string("responses: ") + key);
-    if (!(value > 0.0)) r.fail(node[key], std::string("responses: ") + key + " must be positive");
-    return value;
-  };
+  const auto positive = [&](const char* key) { return r.positive_key(node, key, "responses"); };
   if (!s.crush_gauges.empty() || s.crush_from_anticlimber) {
     if (!node["reference_crush"]) r.fail(node, "responses: crush gauges need 'reference_crush' (the maximum safe crush, R1 = crush / it)");
     s.reference_crush = *positive("reference_crush") * r.scale().length;
@@ -854,12 +765,7 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
     if (!kind) r.fail(node["integrator"], "simulation: integrator must be " + integrator_names_text() + ", not '" + name + "'");
     s.integrator = *kind;
   }
-  const auto positive = [&](const char* key) -> std::optional<double> {
-    if (!node[key]) return std::nullopt;
-    const double value = r.number(node[key], std::string("simulation: ") + key);
-    if (!(value > 0.0)) r.fail(node[key], std::string("simulation: ") + key + " must be positive");
-    return value;
-  };
+  const auto positive = [&](const char* key) { return r.positive_key(node, key, "simulation"); };
   if (node["rtol"]) {
     s.rtol = r.number(node["rtol"], "simulation: rtol");
     if (const std::string problem = rtol_problem(s.rtol, "simulation: rtol"); !problem.empty()) r.fail(node["rtol"], problem);
@@ -1149,12 +1055,12 @@ Model model_from_yaml(YAML::Node root, const std::string& text, const std::strin
   }
 }
 
+}  // namespace
+
 Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
   return model_from_yaml(parse_model_yaml(text, path), text, path, overrides, options);
 }
-
-}  // namespace
 
 CheckedYamlText check_model_text(std::string text, const std::string& path) {
   // A copy goes into the checked text: a parse error's message reads `text` (the open bracket).
@@ -1206,6 +1112,8 @@ ExpandedModel expand_model_file(const std::string& path, const std::vector<std::
   out.text = "# " + path + " with its car types and trains expanded (railcrash expand)\n" + std::string(emitter.c_str()) + "\n";
   return out;
 }
+
+double file_length_unit(const Model& model) { return model.file_units == kMillimetreTonne ? 1.0e-3 : 1.0; }
 
 bool set_scenario_section_reader(ScenarioSectionReader reader) {
   scenario_section_reader() = reader;

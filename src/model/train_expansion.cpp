@@ -15,6 +15,7 @@
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/model/yaml_file.hpp"
+#include "railcrash/model/yaml_reader.hpp"
 
 namespace railcrash {
 
@@ -91,30 +92,12 @@ std::vector<std::string> split(const std::string& text, char separator) {
   return parts;
 }
 
-int line_of(const YAML::Node& node) { return node.IsDefined() && !node.Mark().is_null() ? node.Mark().line + 1 : 0; }
-
-/// Reads the definitions with messages "file:line: ...".
-class Checker {
+/// Reads the definitions with messages "file:line: ..." (the shared checks: YamlReader). Its
+/// number, pair and word keep their own wording (the model reader's number adds "(it is empty)"
+/// and the text of a non-finite value; its pairs are "[a, b]" with entries "entry 1").
+class Checker : public YamlReader {
  public:
-  explicit Checker(const std::string& file) : file_(file) {}
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
-    throw InputError(SourceLocation{file_, line_of(node)}.prefix() + message);
-  }
-  void map(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsMap()) fail(node, what + " must be a map of keys (key: value)");
-  }
-  void list(const YAML::Node& node, const std::string& what) const {
-    if (!node.IsSequence()) fail(node, what + " must be a list (lines starting with '- ')");
-  }
-  void keys(const YAML::Node& node, const std::vector<std::string>& allowed, const std::string& what) const {
-    map(node, what);
-    if (const auto problem = yaml_keys_problem(node, allowed, what)) fail(problem->where, problem->message);
-  }
-  const YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& what) const {
-    const YAML::Node node = map[key];
-    if (!node) fail(map, what + ": missing required key '" + key + "'");
-    return node;
-  }
+  explicit Checker(const std::string& file) : YamlReader(file) {}
   double number(const YAML::Node& node, const std::string& what) const {
     double value = 0.0;
     try {
@@ -135,10 +118,6 @@ class Checker {
     if (const std::string problem = name_length_problem(what, node.Scalar()); !problem.empty()) fail(node, problem);
     return node.Scalar();
   }
-  const std::string& file() const { return file_; }
-
- private:
-  const std::string& file_;
 };
 
 /// A placement of car coordinates: global x = anchor + mirror * x, y unchanged.
@@ -191,7 +170,7 @@ class Editor {
     } else if (node.IsMap()) {
       const bool set = inside_setting || setting_of_(node);
       for (const auto& entry : node)
-        out.force_insert(shared_key(entry.first, line, set), copy(entry.second, line_of(entry.first) ? line_of(entry.first) : line, set));
+        out.force_insert(shared_key(entry.first, line, set), copy(entry.second, yaml_line(entry.first) ? yaml_line(entry.first) : line, set));
     }
     expansion_.add(out, line, note);
     if (!inside_setting)
@@ -207,7 +186,7 @@ class Editor {
   /// shared nodes as anchors and aliases: the expanded text is written from unshared_copy().
   YAML::Node shared_key(const YAML::Node& key, int fallback_line, bool inside_setting) {
     if (!key.IsScalar()) return copy(key, fallback_line, inside_setting);
-    if (registered_keys_.insert(&key.Scalar()).second) expansion_.add(key, line_of(key) ? line_of(key) : fallback_line, note);
+    if (registered_keys_.insert(&key.Scalar()).second) expansion_.add(key, yaml_line(key) ? yaml_line(key) : fallback_line, note);
     return key;
   }
 
@@ -274,28 +253,28 @@ class Expander {
   void run() {
     if (doc_["car_types"]) read_car_types(doc_["car_types"]);
     if (doc_["interface_types"]) {
-      check_.map(doc_["interface_types"], "interface_types");
+      check_.require_map(doc_["interface_types"], "interface_types");
       for (const auto& entry : doc_["interface_types"]) {
-        check_.keys(entry.second, kInterfaceTypeKeys, "interface type '" + entry.first.Scalar() + "'");
+        check_.check_map_keys(entry.second, kInterfaceTypeKeys, "interface type '" + entry.first.Scalar() + "'");
         interface_types_[entry.first.Scalar()] = entry.second;
-        interface_type_lines_[entry.first.Scalar()] = line_of(entry.first);
+        interface_type_lines_[entry.first.Scalar()] = yaml_line(entry.first);
       }
     }
     if (doc_["trains"]) {
-      check_.list(doc_["trains"], "trains");
+      check_.require_list(doc_["trains"], "trains");
       for (const YAML::Node& train : doc_["trains"]) read_train(train);
     } else if (doc_["car_types"]) {
       check_.fail(doc_["car_types"], "car_types: no train places these cars; add a 'trains:' list (README \"Car types and trains\")");
     }
     if (doc_["connections"]) {
-      check_.list(doc_["connections"], "connections");
+      check_.require_list(doc_["connections"], "connections");
       for (const YAML::Node& connection : doc_["connections"]) read_connection(connection);
     }
     // The flat model: generated bodies and elements first, then the file's own.
     for (const char* section : {"bodies", "elements"}) {
       YAML::Node& generated = std::string(section) == "bodies" ? bodies_ : elements_;
       if (doc_[section]) {
-        check_.list(doc_[section], section);
+        check_.require_list(doc_[section], section);
         for (const YAML::Node& item : doc_[section]) generated.push_back(item);
       }
       root_[section] = generated;
@@ -307,31 +286,31 @@ class Expander {
 
  private:
   void read_car_types(const YAML::Node& types) {
-    check_.map(types, "car_types");
+    check_.require_map(types, "car_types");
     for (const auto& entry : types) {
       CarType type;
       type.name = check_.word(entry.first, "car type name");
       type.node = entry.second;
-      type.line = line_of(entry.first);
+      type.line = yaml_line(entry.first);
       const std::string what = "car type '" + type.name + "'";
-      check_.keys(type.node, kCarTypeKeys, what);
+      check_.check_map_keys(type.node, kCarTypeKeys, what);
       const YAML::Node bodies = check_.required(type.node, "bodies", what);
-      check_.list(bodies, what + ": bodies");
+      check_.require_list(bodies, what + ": bodies");
       std::map<std::string, YAML::Node> body_nodes;
       for (const YAML::Node& b : bodies) {
-        check_.map(b, what + ": each body");
+        check_.require_map(b, what + ": each body");
         const std::string name = check_.word(check_.required(b, "name", what + ": body"), what + ": body name");
         if (body_nodes.count(name)) check_.fail(b["name"], what + ": two bodies are named '" + name + "'");
         body_nodes[name] = b;
         type.body_names.push_back(name);
       }
-      if (type.node["elements"]) check_.list(type.node["elements"], what + ": elements");
+      if (type.node["elements"]) check_.require_list(type.node["elements"], what + ": elements");
       const YAML::Node interfaces = check_.required(type.node, "interfaces", what + " (its front and rear ends)");
-      check_.keys(interfaces, {"front", "rear"}, what + ": interfaces");
+      check_.check_map_keys(interfaces, {"front", "rear"}, what + ": interfaces");
       for (const char* end : {"front", "rear"}) {
         const YAML::Node i = check_.required(interfaces, end, what + ": interfaces");
         const std::string iw = what + ": interface " + end;
-        check_.keys(i, kInterfaceKeys, iw);
+        check_.check_map_keys(i, kInterfaceKeys, iw);
         CarType::Interface& out = std::string(end) == "front" ? type.front : type.rear;
         const YAML::Node body_node = check_.required(i, "body", iw);
         out.body = check_.word(body_node, iw + ": body");
@@ -382,7 +361,7 @@ class Expander {
   }
 
   void read_train(const YAML::Node& train) {
-    check_.keys(train, kTrainKeys, "each train");
+    check_.check_map_keys(train, kTrainKeys, "each train");
     const std::string name = check_.word(check_.required(train, "name", "train"), "train name");
     const std::string what = "train '" + name + "'";
     if (!trains_.insert(name).second) check_.fail(train["name"], what + ": two trains have this name");
@@ -395,12 +374,12 @@ class Expander {
     }
     const double speed = train["speed"] ? check_.number(train["speed"], what + ": speed") : 0.0;
     const YAML::Node cars = check_.required(train, "cars", what);
-    check_.list(cars, what + ": cars");
+    check_.require_list(cars, what + ": cars");
     if (cars.size() == 0) check_.fail(cars, what + ": cars is empty; list at least one car {type: ...}");
     if (train["coupling"] && train["couplings"])
       check_.fail(train["couplings"], what + ": give either 'coupling' (for every gap) or 'couplings' (one per gap), not both");
     if (train["couplings"]) {
-      check_.list(train["couplings"], what + ": couplings");
+      check_.require_list(train["couplings"], what + ": couplings");
       if (train["couplings"].size() != cars.size() - 1)
         check_.fail(train["couplings"], what + ": couplings must list " + std::to_string(cars.size() - 1) +
                                             " couplings (one per gap between " + std::to_string(cars.size()) + " cars), not " +
@@ -414,7 +393,7 @@ class Expander {
     for (std::size_t k = 0; k < cars.size(); ++k) {
       const YAML::Node car = cars[k];
       const std::string cw = what + ": car " + std::to_string(k + 1);
-      check_.keys(car, kCarKeys, cw);
+      check_.check_map_keys(car, kCarKeys, cw);
       const CarType& type = car_type(check_.required(car, "type", cw), cw + ": type");
       const std::string car_name = car["name"] ? check_.word(car["name"], cw + ": name") : "car" + std::to_string(k + 1);
       if (!car_names.insert(car_name).second) check_.fail(car["name"] ? car["name"] : car, cw + ": two cars are named '" + car_name + "'");
@@ -429,7 +408,7 @@ class Expander {
       if (k > 0) {  // the coupling to the previous car, and this car's leading end behind it
         const YAML::Node coupling = train["couplings"] ? train["couplings"][k - 1] : train["coupling"];
         const std::string kw = what + ": coupling " + std::to_string(k);
-        check_.keys(coupling, kCouplingKeys, kw);
+        check_.check_map_keys(coupling, kCouplingKeys, kw);
         const double gap = coupling["gap"] ? check_.number(coupling["gap"], kw + ": gap") : 0.0;
         leading_x = previous.trailing.x - facing * gap;
       }
@@ -441,7 +420,7 @@ class Expander {
         const CarEnd& lower = facing > 0 ? placed.leading : previous.trailing;
         const CarEnd& upper = facing > 0 ? previous.trailing : placed.leading;
         join_ends(interface_type(type_node, kw + ": type"), name + ".coupling" + std::to_string(k), lower, upper,
-                  "coupling " + name + ".coupling" + std::to_string(k) + " (line " + std::to_string(line_of(coupling)) + ")");
+                  "coupling " + name + ".coupling" + std::to_string(k) + " (line " + std::to_string(yaml_line(coupling)) + ")");
       }
       previous = placed;
     }
@@ -455,12 +434,12 @@ class Expander {
     const CarType::Interface& trail = reversed ? type.front : type.rear;
     p.anchor = leading_x - p.mirror * lead.x;
     edit_.note = expansion_.note(" (car type '" + type.name + "', line " + std::to_string(type.line) + "; instance " + name +
-                                 ", line " + std::to_string(line_of(where)) + ")");
+                                 ", line " + std::to_string(yaml_line(where)) + ")");
     const int type_line = type.line;
     ExpandedCar summary{name, type.name, reversed, 0.0, 0.0, 0, 0};
     for (const YAML::Node& b : type.node["bodies"]) {
       YAML::Node body = edit_.copy(b, type_line);
-      const int line = line_of(b);
+      const int line = yaml_line(b);
       edit_.set(body["name"], name + "." + b["name"].Scalar());
       const std::string bw = "car type '" + type.name + "': body '" + b["name"].Scalar() + "'";
       const auto position = check_.pair(check_.required(b, "position", bw), bw + ": position");
@@ -513,9 +492,9 @@ class Expander {
   /// One element of a car type, placed.
   YAML::Node car_element(const CarType& type, const std::string& car, const YAML::Node& e, const Placement& p) {
     const std::string ew = "car type '" + type.name + "': element";
-    check_.map(e, ew);
+    check_.require_map(e, ew);
     const std::string element_name = check_.word(check_.required(e, "name", ew), ew + " name");
-    YAML::Node element = edit_.copy(e, line_of(e));
+    YAML::Node element = edit_.copy(e, yaml_line(e));
     edit_.set(element["name"], car + "." + element_name);
     const std::string what = "car type '" + type.name + "': element '" + element_name + "'";
     if (e["points"] && e["points"].IsSequence())
@@ -528,7 +507,7 @@ class Expander {
                                     : std::array<double, 2>{0.0, 0.0};
         if (body == "ground") {  // a point fixed in the world: car coordinates placed
           if (point["at"]) edit_.set(copied["at"][0], p.x(at[0]));
-          else edit_.insert(copied, "at", edit_.fresh_pair(p.x(0.0), 0.0, line_of(point)), line_of(point));
+          else edit_.insert(copied, "at", edit_.fresh_pair(p.x(0.0), 0.0, yaml_line(point)), yaml_line(point));
           continue;
         }
         if (std::find(type.body_names.begin(), type.body_names.end(), body) == type.body_names.end())
@@ -562,37 +541,37 @@ class Expander {
     edit_.note = expansion_.note(" (interface type '" + named_type.second + "', line " +
                                  std::to_string(interface_type_lines_[named_type.second]) + "; " + instance + ")");
     if (!type["elements"]) return;
-    check_.list(type["elements"], "interface type: elements");
+    check_.require_list(type["elements"], "interface type: elements");
     for (const YAML::Node& e : type["elements"]) {
-      check_.map(e, "interface type: each element");
+      check_.require_map(e, "interface type: each element");
       const std::string element_name = check_.word(check_.required(e, "name", "interface type: element"), "interface type: element name");
       const std::string what = "interface type: element '" + element_name + "'";
-      YAML::Node element = edit_.copy(e, line_of(e));
+      YAML::Node element = edit_.copy(e, yaml_line(e));
       edit_.set(element["name"], prefix + "." + element_name);
       const YAML::Node points = check_.required(e, "points", what);
-      check_.list(points, what + ": points");
+      check_.require_list(points, what + ": points");
       YAML::Node placed = edit_.make(YAML::EmitterStyle::Flow);
       for (std::size_t k = 0; k < points.size(); ++k) {
         const YAML::Node point = points[k];
         const std::string pw = what + ": point " + std::to_string(k + 1);
-        check_.keys(point, kEndPointKeys, pw + " (an interface point is {end: 1 | 2, at: [dx, dy]})");
+        check_.check_map_keys(point, kEndPointKeys, pw + " (an interface point is {end: 1 | 2, at: [dx, dy]})");
         const YAML::Node end_node = check_.required(point, "end", pw);
         const std::string end = check_.word(end_node, pw + ": end");
         if (end != "1" && end != "2") check_.fail(end_node, pw + ": end must be 1 (the end at smaller x) or 2");
         const CarEnd& at_end = end == "1" ? lower : upper;
         const auto offset = point["at"] ? check_.pair(point["at"], pw + ": at") : std::array<double, 2>{0.0, 0.0};
         YAML::Node out = edit_.make(YAML::EmitterStyle::Flow);
-        edit_.insert(out, "body", edit_.scalar(at_end.body, line_of(end_node)), line_of(point));
-        edit_.insert(out, "at", edit_.fresh_pair(at_end.sx + offset[0], at_end.sy + offset[1], line_of(point)), line_of(point));
-        placed.push_back(edit_.fresh(out, line_of(point)));
+        edit_.insert(out, "body", edit_.scalar(at_end.body, yaml_line(end_node)), yaml_line(point));
+        edit_.insert(out, "at", edit_.fresh_pair(at_end.sx + offset[0], at_end.sy + offset[1], yaml_line(point)), yaml_line(point));
+        placed.push_back(edit_.fresh(out, yaml_line(point)));
       }
-      element["points"] = edit_.fresh(placed, line_of(points));
+      element["points"] = edit_.fresh(placed, yaml_line(points));
       elements_.push_back(element);
     }
   }
 
   void read_connection(const YAML::Node& connection) {
-    check_.keys(connection, kConnectionKeys, "each connection");
+    check_.check_map_keys(connection, kConnectionKeys, "each connection");
     const std::string name = check_.word(check_.required(connection, "name", "connection"), "connection name");
     const std::string what = "connection '" + name + "'";
     const YAML::Node ends = check_.required(connection, "ends", what);
@@ -614,7 +593,7 @@ class Expander {
     }
     const bool swap = found[1].x < found[0].x;
     join_ends(interface_type(check_.required(connection, "type", what), what + ": type"), name, found[swap ? 1 : 0],
-              found[swap ? 0 : 1], "connection " + name + " (line " + std::to_string(line_of(connection)) + ")");
+              found[swap ? 0 : 1], "connection " + name + " (line " + std::to_string(yaml_line(connection)) + ")");
   }
 
   YAML::Node& root_;

@@ -26,12 +26,6 @@ std::string number_text(double value) {
   return text.str();
 }
 
-double checked_positive(double value, const char* option) {
-  if (!(value > 0.0) || !std::isfinite(value))
-    throw InputError(std::string(option) + " must be a positive number, not " + std::to_string(value));
-  return value;
-}
-
 /// Forwards samples to the writer and the response tracker (if any) and shows progress
 /// (progress.hpp: a bar on a terminal, a line every few seconds otherwise).
 /// Also checks every sample's element outputs: from the first non-finite one on, no sample is passed on.
@@ -127,31 +121,17 @@ class ProgressObserver : public RunObserver {
 
 }  // namespace
 
-void apply_overrides(Model& model, const RunOverrides& o) {
-  SimulationSettings& s = model.run_spec.simulation;
-  if (o.integrator) s.integrator = *o.integrator;
-  if (o.t_end) s.t_end = checked_positive(*o.t_end, "--t-end");
-  if (o.rtol) {
-    if (const std::string problem = rtol_problem(*o.rtol, "--rtol"); !problem.empty()) throw InputError(problem);
-    s.rtol = *o.rtol;
-  }
-  if (o.atol) s.atol = checked_positive(*o.atol, "--atol");
-  if (o.dt) s.dt = checked_positive(*o.dt, "--dt");
-  if (o.output_interval) s.output_interval = checked_positive(*o.output_interval, "--output-interval");
-  if (o.force_dt) s.force_dt = true;
-  const std::string rows_problem = output_rows_problem(s);
-  if (!rows_problem.empty())
-    throw InputError(SourceLocation{model.file, 0}.prefix() + "--output-interval / --t-end: " + rows_problem);
-  if (o.max_steps) {
-    if (*o.max_steps < 1) throw InputError("--max-steps must be at least 1, not " + std::to_string(*o.max_steps));
-    s.max_steps = *o.max_steps;
-  }
-}
-
-std::vector<OptionSetting> option_settings(const RunOverrides& o) {
+std::vector<OptionSetting> option_settings(const RunOverrides& o, OverrideSource source) {
   std::vector<OptionSetting> settings;
-  const auto add = [&](const char* key, const char* option, const std::string& value) {
-    settings.push_back({std::string("simulation.") + key + "=" + value, std::string(option) + " " + value});
+  // `flag`: the option takes no value (--force-dt).
+  const auto add = [&](const char* key, const char* option, const std::string& value, bool flag = false) {
+    std::string label;
+    switch (source) {
+      case OverrideSource::CommandLine: label = flag ? std::string(option) : std::string(option) + " " + value; break;
+      case OverrideSource::RunSettings: label = std::string("RunSettings.") + key + " = " + value; break;
+      case OverrideSource::ConvergeRun: label = std::string("converge run's ") + key + " " + value; break;
+    }
+    settings.push_back({std::string("simulation.") + key + "=" + value, label});
   };
   const auto number = [](double value) {  // the shortest text that reads back as the same double
     char text[40];
@@ -168,7 +148,7 @@ std::vector<OptionSetting> option_settings(const RunOverrides& o) {
   if (o.dt) add("dt", "--dt", number(*o.dt));
   if (o.output_interval) add("output_interval", "--output-interval", number(*o.output_interval));
   if (o.max_steps) add("max_steps", "--max-steps", std::to_string(*o.max_steps));
-  if (o.force_dt) settings.push_back({"simulation.force_dt=true", "--force-dt"});
+  if (o.force_dt) add("force_dt", "--force-dt", "true", /*flag=*/true);
   return settings;
 }
 

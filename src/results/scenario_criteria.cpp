@@ -13,6 +13,7 @@
 #include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model.hpp"
+#include "railcrash/model/yaml_reader.hpp"
 #include "railcrash/results/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/crash_pulse.hpp"
@@ -20,18 +21,17 @@
 namespace railcrash {
 namespace {
 
-class SectionReader {
+/// Reads the model's `scenario:` section (the shared checks: YamlReader; messages "scenario: ..."
+/// through the model reader's fail, which names the file and line or the setting). Its required,
+/// text and positive keep the section's own wording ("missing 'KEY'", "must be a word or a quoted
+/// text", "must be a positive number").
+class SectionReader : public YamlReader {
  public:
-  SectionReader(const Model& model, const SectionFail& fail) : model_(model), fail_(fail) {}
+  SectionReader(const Model& model, const SectionFail& fail) : YamlReader(model.file), model_(model), fail_(fail) {}
 
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const {
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const override {
     fail_(node, "scenario: " + message);
     throw InputError("scenario: " + message);  // fail_ throws; this keeps the promise of [[noreturn]]
-  }
-
-  void only_keys(const YAML::Node& map, const std::vector<std::string>& allowed, const std::string& context) const {
-    if (!map.IsMap()) fail(map, context + " must be a map of keys (key: value)");
-    if (const auto problem = yaml_keys_problem(map, allowed, context)) fail(problem->where, problem->message);
   }
 
   YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& context) const {
@@ -98,7 +98,7 @@ double distance(const double* y, int a, int b) {
 std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& section, const Model& model, double length_scale,
                                                               const SectionFail& fail) {
   const SectionReader r(model, fail);
-  r.only_keys(section, {"standard", "number", "category", "closing_speed", "mean_deceleration", "survival_space", "override"},
+  r.check_map_keys(section, {"standard", "number", "category", "closing_speed", "mean_deceleration", "survival_space", "override"},
               "the section");
   auto c = std::make_shared<ScenarioCriteria>();
   c->standard = r.text(r.required(section, "standard", "the section"), "standard");
@@ -110,7 +110,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
   c->closing_speed = r.positive(r.required(section, "closing_speed", "the section"), "closing_speed");
 
   const YAML::Node deceleration = r.required(section, "mean_deceleration", "the section");
-  r.only_keys(deceleration, {"limit", "cfc", "source", "bodies"}, "mean_deceleration");
+  r.check_map_keys(deceleration, {"limit", "cfc", "source", "bodies"}, "mean_deceleration");
   c->deceleration_limit = r.positive(r.required(deceleration, "limit", "mean_deceleration"), "mean_deceleration: limit");
   if (deceleration["cfc"]) c->cfc = r.positive(deceleration["cfc"], "mean_deceleration: cfc");
   c->deceleration_source = r.text(r.required(deceleration, "source", "mean_deceleration"), "mean_deceleration: source");
@@ -118,7 +118,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
     c->passenger_bodies.push_back(r.body(b, "mean_deceleration: bodies"));
 
   const YAML::Node survival = r.required(section, "survival_space", "the section");
-  r.only_keys(survival, {"limit", "source", "cars", "excluded", "zones", "gauges"}, "survival_space");
+  r.check_map_keys(survival, {"limit", "source", "cars", "excluded", "zones", "gauges"}, "survival_space");
   c->survival_limit = r.positive(r.required(survival, "limit", "survival_space"), "survival_space: limit");
   c->survival_source = r.text(r.required(survival, "source", "survival_space"), "survival_space: source");
   if (!survival["cars"] && !survival["gauges"])
@@ -141,7 +141,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
     }
   if (survival["zones"])
     for (const YAML::Node& z : r.list(survival["zones"], "survival_space: zones")) {
-      r.only_keys(z, {"element", "stroke"}, "survival_space: zone");
+      r.check_map_keys(z, {"element", "stroke"}, "survival_space: zone");
       const YAML::Node element = r.required(z, "element", "survival_space: zone");
       const std::string name = r.text(element, "survival_space: zone element");
       const auto& elements = model.elements();
@@ -152,7 +152,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
     }
   if (survival["gauges"])
   for (const YAML::Node& g : r.list(survival["gauges"], "survival_space: gauges")) {
-    r.only_keys(g, {"name", "front", "rear"}, "survival_space: gauge");
+    r.check_map_keys(g, {"name", "front", "rear"}, "survival_space: gauge");
     ScenarioCriteria::Gauge gauge;
     gauge.name = r.text(r.required(g, "name", "survival_space: gauge"), "survival_space: gauge name");
     gauge.front_body = r.body(r.required(g, "front", "survival_space: gauge " + gauge.name), "survival_space: gauge front");
@@ -162,7 +162,7 @@ std::shared_ptr<const ScenarioCriteria> read_scenario_section(const YAML::Node& 
   }
 
   const YAML::Node override_node = r.required(section, "override", "the section");
-  r.only_keys(override_node, {"limit", "source", "interface", "bodies", "wheel_lift_limit", "wheel_lift_source", "wheels", "rail_supports"},
+  r.check_map_keys(override_node, {"limit", "source", "interface", "bodies", "wheel_lift_limit", "wheel_lift_source", "wheels", "rail_supports"},
               "override");
   if (override_node["interface"] && override_node["bodies"])
     r.fail(override_node, "override: give either 'interface: <anticlimber element>' or 'bodies: [A, B]' (the two bodies meeting at the interface), not both");

@@ -12,6 +12,7 @@
 
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/yaml_file.hpp"
+#include "railcrash/model/yaml_reader.hpp"
 
 namespace railcrash {
 namespace {
@@ -20,13 +21,13 @@ struct Point2 {
   double x = 0.0, y = 0.0;  // [length]
 };
 
-class TemplateReader {
+/// Reads a two-car consist template: messages "FILE:LINE: consist template: ...".
+class TemplateReader : public YamlReader {
  public:
-  TemplateReader(std::string path, YAML::Node root) : path_(std::move(path)), root_(std::move(root)) {}
+  TemplateReader(std::string path, YAML::Node root) : YamlReader(std::move(path)), root_(std::move(root)) {}
 
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    SourceLocation where{path_, node.IsDefined() ? node.Mark().line + 1 : 0};
-    throw InputError(where.prefix() + "consist template: " + what);
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const override {
+    YamlReader::fail(node, "consist template: " + what);
   }
 
   const YAML::Node& root() const { return root_; }
@@ -54,7 +55,6 @@ class TemplateReader {
   }
 
  private:
-  std::string path_;
   YAML::Node root_;
 };
 

@@ -237,9 +237,9 @@ std::string format_number(double value) {
   return text;
 }
 
-/// The model of one run: the user's settings, then the run's integrator settings.
+/// The model of one run: the user's settings, then the run's integrator settings, through the
+/// loader's override path (as run's options).
 Model load_for_run(const ConvergePlan& plan, const std::string& method, double step, double rtol) {
-  Model model = load_model(plan.model_path, plan.options.settings);
   RunOverrides overrides;
   overrides.t_end = plan.t_end;
   overrides.output_interval = plan.output_interval;
@@ -249,11 +249,10 @@ Model load_for_run(const ConvergePlan& plan, const std::string& method, double s
   } else {
     overrides.integrator = IntegratorKind::Ida;
     // A model that sets atol gets it scaled with rtol, so a tighter run is tighter everywhere.
-    if (model.run_spec.simulation.atol) overrides.atol = *model.run_spec.simulation.atol * rtol / model.run_spec.simulation.rtol;
+    if (plan.model_atol) overrides.atol = *plan.model_atol * rtol / plan.model_rtol;
     overrides.rtol = rtol;
   }
-  apply_overrides(model, overrides);
-  return model;
+  return load_model(plan.model_path, plan.options.settings, option_settings(overrides, OverrideSource::ConvergeRun));
 }
 
 ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double step, double rtol,
@@ -579,6 +578,8 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   const Model model = load_model(model_path, options.settings, option_settings(overrides));
   plan.t_end = model.run_spec.simulation.t_end;
   plan.output_interval = output_interval_of(model.run_spec.simulation);
+  plan.model_rtol = model.run_spec.simulation.rtol;
+  if (const std::optional<double> atol = model.run_spec.simulation.atol) plan.model_atol = *atol / file_length_unit(model);
   plan.model_name = model.name;
   const bool si = model.units == UnitSystem::SI;
   plan.length_unit = si ? "m" : "in";

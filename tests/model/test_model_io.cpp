@@ -764,11 +764,10 @@ TEST_CASE("an output_interval that would give more than a million rows is refuse
                {"simulation: output_interval 1e-06 with t_end 2 gives 2e+06 output rows, more than the limit 1e+06",
                 "use output_interval >= 2e-06"});
   CHECK_NOTHROW(load_model_text(edit(kBase, "output_interval: 0.01", "output_interval: 2.0e-6"), "test.yaml"));
-  Model model = load_model_text(kBase, "test.yaml");
   RunOverrides longer;
   longer.t_end = 1e6;  // 1e8 rows at the model's 0.01
-  CHECK_THROWS_WITH(apply_overrides(model, longer), Catch::Contains("test.yaml: --output-interval / --t-end: output_interval "
-                                                                    "0.01 with t_end 1e+06 gives 1e+08 output rows"));
+  CHECK_THROWS_WITH(load_model_text(kBase, "test.yaml", {}, option_settings(longer)),
+                    Catch::Contains("test.yaml: --t-end 1000000: simulation: output_interval 0.01 with t_end 1e+06 gives 1e+08 output rows"));
 }
 
 TEST_CASE("a joint with all its points on one body or on ground is refused at load", "[model_io]") {
@@ -1164,10 +1163,12 @@ TEST_CASE("every check of rtol gives the one message, naming where the value cam
   std::string text = edit(kBase, "  dt: 1.0e-4\n", "  dt: 1.0e-4\n  rtol: -1\n");
   expect_error("model file", text, line_of(text, "rtol"), {"simulation: rtol" + message + "-1"});
   CHECK(load_error(kBase, {"simulation.rtol=0"}) == "test.yaml: --set 'simulation.rtol=0': simulation: rtol" + message + "0");
-  Model model = load_model_text(kBase, "test.yaml");
   RunOverrides overrides;
   overrides.rtol = -2.0;
-  CHECK_THROWS_WITH(apply_overrides(model, overrides), "--rtol" + message + "-2");
+  CHECK_THROWS_WITH(load_model_text(kBase, "test.yaml", {}, option_settings(overrides)),
+                    "test.yaml: --rtol -2: simulation: rtol" + message + "-2");
+  CHECK_THROWS_WITH(load_model_text(kBase, "test.yaml", {}, option_settings(overrides, OverrideSource::RunSettings)),
+                    "test.yaml: RunSettings.rtol = -2: simulation: rtol" + message + "-2");
 }
 
 TEST_CASE("the integrators' names come from one table: auto, ida, euler", "[model_io]") {

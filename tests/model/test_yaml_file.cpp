@@ -7,6 +7,7 @@
 
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/model/yaml_file.hpp"
+#include "railcrash/model/yaml_reader.hpp"
 
 using namespace railcrash;
 using Catch::Matchers::Contains;
@@ -14,13 +15,19 @@ using Catch::Matchers::StartsWith;
 
 namespace {
 
-std::string structure_error(const std::string& text) {
+/// The message of the InputError read() throws ("" when it throws none).
+template <class Read>
+std::string input_error(const Read& read) {
   try {
-    check_yaml_structure(text, "in.yaml");
+    read();
   } catch (const InputError& e) {
     return e.what();
   }
   return "";
+}
+
+std::string structure_error(const std::string& text) {
+  return input_error([&] { check_yaml_structure(text, "in.yaml"); });
 }
 
 /// A document whose list `level<k>` repeats `level<k-1>` `fan_out` times: it expands to
@@ -102,14 +109,7 @@ TEST_CASE("a ',' at the start of a document is refused at once, not parsed witho
 }
 
 TEST_CASE("a model text checked once (a sweep's runs) is refused and read exactly as load_model_text", "[yaml_file]") {
-  const auto error_of = [](const auto& load) -> std::string {
-    try {
-      load();
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  };
+  const auto error_of = [](const auto& load) { return input_error(load); };
   // Each refusal says what load_model_text says for the same text: an alias in its own
   // anchor, nesting past the limit, a bracket left open (the bracket's own line), bad YAML.
   for (const std::string& text :
@@ -155,4 +155,27 @@ TEST_CASE("one check of a YAML map's keys: unknown (with the closest key and the
   CHECK(not_a_word->message == "plan: keys must be plain words; allowed keys: limit, source, bodies");
   CHECK_THROWS_WITH(check_yaml_keys("plan.yaml", typo, allowed, "plan"),
                     "plan.yaml:2: plan: unknown key 'sourse' (did you mean 'source'?); allowed keys: limit, source, bodies");
+}
+
+TEST_CASE("the one YAML reader: file and line on every message, each check worded once", "[yaml_file]") {
+  const YAML::Node root = YAML::Load("a: 1.5\nb: x\nc: [1, 2, 3]\nd:\ne: .nan\nf: yes\ng: 'co,mma'\nh: -2\n");
+  const YamlReader r("in.yaml");
+  const auto message = [](const auto& read) { return input_error(read); };
+  CHECK(r.number(root["a"], "a") == 1.5);
+  CHECK(message([&] { r.number(root["b"], "b"); }) == "in.yaml:2: b must be a number, not 'x'");
+  CHECK(message([&] { r.number(root["c"], "c"); }) == "in.yaml:3: c must be a number");
+  CHECK(message([&] { r.number(root["e"], "e"); }) == "in.yaml:5: e must be a finite number, not '.nan'");
+  CHECK(message([&] { r.numbers(root["c"], 2, "c"); }) == "in.yaml:3: c must be a list of 2 numbers [a, b], not a list of 3");
+  CHECK(r.numbers(root["c"], 0, "c") == std::vector<double>{1.0, 2.0, 3.0});
+  CHECK(r.boolean(root["f"], "f"));
+  CHECK(message([&] { r.boolean(root["b"], "b"); }) == "in.yaml:2: b must be true or false");
+  CHECK(message([&] { r.required(root, "z", "the section"); }) == "in.yaml:1: the section: missing required key 'z'");
+  CHECK(message([&] { r.require_map(root["c"], "c"); }) == "in.yaml:3: c must be a map of keys (key: value)");
+  CHECK(message([&] { r.require_list(root["a"], "a"); }) == "in.yaml:1: a must be a list (lines starting with '- ')");
+  CHECK_THAT(message([&] { r.check_map_keys(root, {"a", "b", "c", "d", "e", "f", "g"}, "top"); }),
+             StartsWith("in.yaml:8: top: unknown key 'h'"));
+  CHECK(message([&] { r.name(root["g"], "body name"); }).find("in.yaml:7: body name 'co,mma' holds the character ','") == 0);
+  CHECK(r.positive_key(root, "a", "simulation") == 1.5);
+  CHECK_FALSE(r.positive_key(root, "z", "simulation"));
+  CHECK(message([&] { r.positive_key(root, "h", "simulation"); }) == "in.yaml:8: simulation: h must be positive");
 }

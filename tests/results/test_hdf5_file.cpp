@@ -32,12 +32,10 @@ std::string temporary_folder(const std::string& name) {
 }
 
 Model two_car_model(double t_end) {
-  Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
   RunOverrides overrides;
   overrides.t_end = t_end;
   overrides.output_interval = 1e-3;
-  apply_overrides(model, overrides);
-  return model;
+  return load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml", {}, option_settings(overrides));
 }
 
 }  // namespace

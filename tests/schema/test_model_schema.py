@@ -249,10 +249,10 @@ def agree_on_text(binary, v, what, text, accepted, message=""):
 
 def scenario_keys_agree(v, source_dir):
     """The scenario section's keys are described by hand in src/model/model_schema.cpp: they must be
-    the lists read_scenario_section (src/results/scenario_criteria.cpp) passes to only_keys."""
+    the lists read_scenario_section (src/results/scenario_criteria.cpp) passes to check_map_keys."""
     with open(os.path.join(source_dir, "src", "results", "scenario_criteria.cpp"), encoding="utf-8") as f:
         text = f.read()
-    lists = re.findall(r'only_keys\(\w+,\s*\{([^}]*)\},\s*"([^"]*)"\)', text)
+    lists = re.findall(r'check_map_keys\(\w+,\s*\{([^}]*)\},\s*"([^"]*)"\)', text)
     scenario = v.schema["definitions"]["scenario"]
     where = {"the section": scenario, "mean_deceleration": scenario["properties"]["mean_deceleration"],
              "survival_space": scenario["properties"]["survival_space"],
@@ -267,7 +267,7 @@ def scenario_keys_agree(v, source_dir):
             ok = False
             print(f"FAIL: scenario section '{context}': criteria.cpp allows {sorted(loader)}, the schema {sorted(schema)}")
     if len(lists) != len(where):
-        print(f"FAIL: criteria.cpp has {len(lists)} only_keys lists, the schema describes {len(where)} maps of the scenario section")
+        print(f"FAIL: criteria.cpp has {len(lists)} check_map_keys lists, the schema describes {len(where)} maps of the scenario section")
     if ok:
         print(f"ok: the scenario section's {len(lists)} key lists are the schema's")
     return ok

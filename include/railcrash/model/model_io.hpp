@@ -62,6 +62,13 @@ struct OptionSetting {
 };
 /// load_model with the --set settings first, then the command-line options' settings.
 Model load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options);
+/// load_model_text with the settings first, then the options' settings (the library's run).
+Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+                      const std::vector<OptionSetting>& options);
+
+/// The model file's length unit in the model's: 1e-3 (m) for an mm-t-s-N file, whose lengths are
+/// converted to SI when read; 1 otherwise. A setting's length (simulation.atol, --atol) is in it.
+double file_length_unit(const Model& model);
 
 /// A model file with its car types and trains expanded into flat bodies and elements
 /// (README "Car types and trains"), the settings applied: what `railcrash expand` writes.

@@ -16,22 +16,29 @@
 
 namespace railcrash {
 
-/// Command-line settings that override the model's simulation section.
+/// Settings that override the model's simulation section (the command line's run options, the
+/// library's RunSettings, converge's runs), applied through option_settings.
 struct RunOverrides {
   std::optional<IntegratorKind> integrator;
-  std::optional<double> t_end, rtol, atol, dt, output_interval;
+  std::optional<double> t_end, rtol, dt, output_interval;  // [s], -, [s], [s]
+  std::optional<double> atol;                               // [the model file's length unit], as simulation.atol
   std::optional<long> max_steps;
   bool force_dt = false;
 };
 
-/// The overrides as simulation.KEY=VALUE settings named by their options ("--t-end 2"): the
-/// command line's run options go through the loader's override path, as --set does
-/// (load_model(path, settings, options)), so they are checked, and their mistakes reported, alike.
-std::vector<OptionSetting> option_settings(const RunOverrides& overrides);
+/// Who gave the overrides: messages name each setting by it.
+enum class OverrideSource {
+  CommandLine,  // "--t-end 2", "--force-dt"
+  RunSettings,  // the library's api::RunSettings (and Python's run()): "RunSettings.t_end = 2"
+  ConvergeRun,  // a run of railcrash converge: "converge run's rtol 1e-05"
+};
 
-/// Applies overrides (checked) to an already loaded model's simulation settings: for the
-/// library's and the studies' programmatic settings; the command line uses option_settings.
-void apply_overrides(Model& model, const RunOverrides& overrides);
+/// The overrides as simulation.KEY=VALUE settings named by where they came from: every override
+/// goes through the loader's path, as --set does (load_model(path, settings, options),
+/// load_model_text(text, path, settings, options)), so they are checked, reported and listed in
+/// the run's provenance alike. Lengths (atol) are in the model file's length unit, as the file's
+/// own simulation.atol.
+std::vector<OptionSetting> option_settings(const RunOverrides& overrides, OverrideSource source = OverrideSource::CommandLine);
 
 /// The integrator the model's settings ask for.
 std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings);

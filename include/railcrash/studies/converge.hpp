@@ -173,6 +173,8 @@ struct ConvergePlan {
   std::vector<ConvergeQuantity> quantities;
   int headline = -1;
   double t_end = 0.0, output_interval = 0.0;  // [time]
+  double model_rtol = 0.0;                    // the model's own rtol (with the user's settings)
+  std::optional<double> model_atol;           // [the model file's length unit] its atol, if it sets one
   double element_stability_limit = 0.0;       // [time] Euler's limit from the elements alone, at the start
   double stability_limit = 0.0;               // [time] Euler's limit at dt_0, penalty joints included
   std::vector<double> euler_steps;            // [time]
