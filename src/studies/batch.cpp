@@ -167,8 +167,9 @@ class BatchSupervisor {
 };
 
 struct BatchAccess {
-  static void start(RunControl& run) {
+  static void start(RunControl& run, double run_time_limit) {
     const std::lock_guard<std::mutex> lock(run.mutex_);
+    run.run_time_limit_ = run_time_limit;
     run.stop_ = false;
     run.timed_out_ = false;
     run.interrupted_ = false;
@@ -201,7 +202,7 @@ void run_batch_stream(std::size_t most_runs, const std::function<std::optional<s
   };
   const auto worker = [&](RunControl& control) {
     for (std::optional<std::size_t> k = take(); k; k = take()) {
-      BatchAccess::start(control);
+      BatchAccess::start(control, options.run_time_limit);
       task(*k, control);
       BatchAccess::finish(control);
       // A run stopped by the caller's flag has a partial result; one that ended by itself
@@ -241,6 +242,12 @@ std::vector<BatchRunState> run_batch(std::size_t count, const std::function<void
         if (on_finished) on_finished(k, state);
       });
   return states;
+}
+
+std::string run_limit_message(double limit_seconds, double t_reached) {
+  char text[160];
+  std::snprintf(text, sizeof text, "stopped at the run time limit of %g s (--run-limit), at t = %.6g", limit_seconds, t_reached);
+  return text;
 }
 
 std::string IntegratorUsed::euler_from_t_text() const {

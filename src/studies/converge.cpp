@@ -280,8 +280,7 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
     run.ok = outcome.ok;
     run.message = outcome.message;
     if (timed_out && !outcome.ok)
-      run.message = "stopped at t = " + fmt("%.6g", outcome.t_reached) + " after the run time limit of " +
-                    fmt("%g", plan.options.run_time_limit) + " s (--run-timeout)";
+      run.message = run_limit_message(plan.options.run_time_limit, outcome.t_reached);
     run.stats = outcome.stats;
     run.events = outcome.events;
     if (accelerations) {

@@ -299,9 +299,7 @@ SensitivityRun run_one(const std::string& model_path, const CheckedYamlText& mod
       throw InputError(model_path + ": a parameter study needs a 'responses' section (R1-R3) in the model");
     const RunReport report = run_model(model, "", control.stop_flag());
     run.ok = report.outcome.ok;  // a run that finished just as the limit passed still counts
-    run.message = !run.ok && control.timed_out() ? "stopped at the run time limit of " + number_text(time_limit) + " s (t = " +
-                                        number_text(report.outcome.t_reached) + ")"
-                                  : report.outcome.message;
+    run.message = !run.ok && control.timed_out() ? run_limit_message(time_limit, report.outcome.t_reached) : report.outcome.message;
     run.responses = report.responses;
     run.outcomes = report.outcomes;
     run.integrator = integrator_used(report);

@@ -512,7 +512,7 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     row.outcomes = report.outcomes.text();
     row.branch = report.outcomes.order();
     row.integrator = integrator_used(report);
-    if (!report.outcome.ok && control.timed_out()) row.message = "stopped at the run time limit (t = " + exact(report.outcome.t_reached) + ")";
+    if (!report.outcome.ok && control.timed_out()) row.message = run_limit_message(control.run_time_limit(), report.outcome.t_reached);
     if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
     // railcrash's own summary, just written: YAML::Load without the structure check that
     // guards user files (that check was 45 % of reading it back, 1.2 % of a two-car sweep run).

@@ -564,3 +564,23 @@ TEST_CASE("sweep: runs.csv says which method each run used, and an older runs.cs
   CHECK(resumed_rows[2].at("integrator_used") == "ida+euler");
   CHECK(resumed_rows[0].at("t_reached") == rows[0].at("t_reached"));
 }
+
+TEST_CASE("sweep: a run its run time limit stops says so in the words of every study", "[sweep]") {
+  // A 1 kg mass ringing on a 1e8 N/m spring (period 0.63 ms) for 99 s at rtol 1e-9: some
+  // 160,000 periods, far beyond a 0.2 s limit. The message is the one converge and sensitivity
+  // give (run_limit_message; sweep said "stopped at the run time limit (t = ...)" without the limit).
+  Files files;
+  std::ofstream(files.model) << "railcrash: 1\nname: ringing bell\nunits: SI\ngravity: [0, 0]\n"
+                                "bodies:\n  - {name: bell, mass: 1, inertia: 1, position: [0, 1.001]}\n"
+                                "elements:\n  - {name: ringing, type: linear_spring, stiffness: 1.0e8, free_length: 0.998, "
+                                "points: [{body: ground, at: [0, 2]}, {body: bell, at: [0, 0]}]}\n"
+                                "simulation: {t_end: 99.0, integrator: ida, rtol: 1.0e-9, output_interval: 0.001}\n";
+  files.write_plan("sweep: 1\ndesign: full_factorial\nfactors:\n  - {key: bodies.bell.mass, levels: [1.0]}\nresponses: [status]\n");
+  SweepOptions options;
+  options.run_time_limit = 0.2;
+  const SweepResult result = run_sweep(files.model, load_sweep_plan(files.plan, files.model), files.dir + "/out", options);
+  REQUIRE(result.done() == 1);
+  const std::string& line = result.lines.begin()->second;
+  CHECK_THAT(line, Catch::Contains("stopped at the run time limit of 0.2 s (--run-limit), at t = "));
+  CHECK(run_limit_message(0.25, 0.0123456789) == "stopped at the run time limit of 0.25 s (--run-limit), at t = 0.0123457");
+}

@@ -32,6 +32,10 @@ struct IntegratorUsed {
 };
 IntegratorUsed integrator_used(const RunReport& report);
 
+/// What a study says of a run its run time limit stopped (every study alike): "stopped at the run
+/// time limit of LIMIT s (--run-limit), at t = T" (T: how far the run got, in the model's time unit).
+std::string run_limit_message(double limit_seconds, double t_reached);
+
 struct BatchOptions {
   int jobs = 1;                              // threads (at most one per run)
   double run_time_limit = 0.0;               // [s] wall time after which a run's stop flag rises (0: none)
@@ -47,6 +51,8 @@ class RunControl {
   bool timed_out() const { return timed_out_.load(); }
   /// The caller's stop flag raised it (the study was interrupted).
   bool interrupted() const { return interrupted_.load(); }
+  /// [s] the per-run wall limit the supervisor applies (0: none), for run_limit_message.
+  double run_time_limit() const { return run_time_limit_; }
 
  private:
   friend class BatchSupervisor;
@@ -54,6 +60,7 @@ class RunControl {
   std::atomic<bool> stop_{false};
   std::atomic<bool> timed_out_{false};
   std::atomic<bool> interrupted_{false};
+  double run_time_limit_ = 0.0;                // [s] set before each run (BatchOptions::run_time_limit)
   bool active_ = false;                        // guarded by mutex_, as start_
   std::chrono::steady_clock::time_point start_{};
   std::mutex mutex_;                           // the supervisor's checks against a run starting or ending
