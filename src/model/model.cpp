@@ -45,11 +45,11 @@ std::string integrator_names_text(const std::string& quote) {
   return text;
 }
 
-std::string rtol_problem(double rtol, const std::string& what) {
+std::string rtol_problem(double rtol, const std::string& what, const char* typical) {
   if (rtol > 0.0 && std::isfinite(rtol)) return "";
   char value[32];
   std::snprintf(value, sizeof value, "%g", rtol);
-  return what + " must be a positive number (the relative tolerance; typical: 1e-6), not " + value;
+  return what + " must be a positive number (the relative tolerance; typical: " + typical + "), not " + value;
 }
 
 std::string output_rows_problem(const SimulationSettings& settings) {

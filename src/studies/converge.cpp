@@ -555,7 +555,7 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
     throw InputError("--euler-safety must be between 0 and 1 (e.g. 0.8)");
   if (options.euler_first_step < 0.0 || !std::isfinite(options.euler_first_step))
     throw InputError("--euler-dt must be a positive step");
-  if (const std::string problem = rtol_problem(options.reference_rtol, "--reference-rtol"); !problem.empty()) throw InputError(problem);
+  if (const std::string problem = rtol_problem(options.reference_rtol, "--reference-rtol", "1e-9"); !problem.empty()) throw InputError(problem);
   for (double r : options.rtols)
     if (const std::string problem = rtol_problem(r, "--rtols: every tolerance"); !problem.empty()) throw InputError(problem);
   for (double r : options.rtols)

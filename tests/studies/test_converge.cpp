@@ -367,3 +367,17 @@ TEST_CASE("convergence study: a level counts only from the setting on which ever
   runs.front().ok = false;  // the rtol 1e-6 run
   CHECK(time_at_level(runs, 0, 1e-3).how == "extrapolated");
 }
+
+TEST_CASE("convergence study: a bad reference tolerance is refused offering a reference's value", "[converge]") {
+  // The one rtol message (rtol_problem), with the typical value a reference run wants: 1e-9, not
+  // a run's 1e-6 (the hint --reference-rtol had before the messages were made one).
+  ConvergeOptions options;
+  options.euler_runs = 0;
+  options.reference_rtol = -1e-9;
+  CHECK_THROWS_WITH(plan_convergence(case_path("damped_spring_mass"), options),
+                    "--reference-rtol must be a positive number (the relative tolerance; typical: 1e-9), not -1e-09");
+  options.reference_rtol = 1e-9;
+  options.rtols = {1e-3, 0.0};
+  CHECK_THROWS_WITH(plan_convergence(case_path("damped_spring_mass"), options),
+                    "--rtols: every tolerance must be a positive number (the relative tolerance; typical: 1e-6), not 0");
+}

@@ -104,8 +104,9 @@ struct SimulationSettings {
 /// "" when `rtol` is a relative tolerance IDA can use (positive and finite), else the one
 /// message about it: "WHAT must be a positive number (the relative tolerance; typical: 1e-6),
 /// not VALUE". Every check of an rtol asks it: the model file's simulation: rtol, --rtol, the
-/// API's run settings, a convergence study's tolerances and IDA's own.
-std::string rtol_problem(double rtol, const std::string& what);
+/// API's run settings, a convergence study's tolerances and IDA's own. `typical`: the value the
+/// message offers (a convergence study's reference wants a tight one: "1e-9").
+std::string rtol_problem(double rtol, const std::string& what, const char* typical = "1e-6");
 
 /// The most output rows a run may write: t_end / output_interval above it is refused.
 constexpr double kMaxOutputRows = 1e6;  // [rows]
