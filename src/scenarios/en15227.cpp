@@ -86,10 +86,7 @@ struct Template {
   YAML::Node anticlimber_node;
   std::vector<std::string> leading_wheels;  // the striking car's wheel_rail elements on its foremost wheel-carrying body
 
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    const int line = node.IsDefined() && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-    throw InputError(SourceLocation{path, line}.prefix() + "scenario train model: " + what);
-  }
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const { ScenarioModelReader(path).fail(node, what); }
   YAML::Node body(const std::string& name, const std::string& option = "") const {
     for (const YAML::Node& b : root["bodies"])
       if (b["name"] && b["name"].as<std::string>() == name) return b;
@@ -325,7 +322,7 @@ void template_trains(const ScenarioRequest& q, const Template& t, double closing
   trains.model["elements"] = kept_elements;
 }
 
-/// Trains from a model whose bodies declare their cars (scenario/train_unit.hpp): the striking
+/// Trains from a model whose bodies declare their cars (scenarios/train_unit.hpp): the striking
 /// train s_* is the model's unit, the standing one t_* its mirror image; their front faces meet
 /// at an uncoupled coupler_end (front_faces) with the given face stiffness and height.
 void unit_trains(const ScenarioRequest& q, const TrainUnit& unit, const Units& u, double closing_speed, double offset, Trains& trains) {
@@ -367,7 +364,7 @@ void unit_trains(const ScenarioRequest& q, const TrainUnit& unit, const Units& u
   trains.header << "# Train unit: every body of " << q.train_path << " (cars";
   for (const std::string& car : cars) trains.header << " " << car;
   trains.header << "), its front face at x = 0: the foremost point on " << unit.front_body << ", the front body of its front crush "
-                << "element " << unit.front_crush << " (scenario/train_unit.hpp).\n# Left out (the test's fixed surfaces):";
+                << "element " << unit.front_crush << " (scenarios/train_unit.hpp).\n# Left out (the test's fixed surfaces):";
   for (const std::string& name : unit.fixed_surface_contacts) trains.header << " " << name;
   if (unit.fixed_surface_contacts.empty()) trains.header << " none";
   trains.header << ".\n";
@@ -568,8 +565,7 @@ void resolve_zone_strokes(const YAML::Node& model_node, const std::string& path,
 bool is_car_type_model(const YAML::Node& root) { return root.IsMap() && root["trains"] && root["car_types"]; }
 
 [[noreturn]] void fail_at(const std::string& path, const YAML::Node& node, const std::string& what) {
-  const int line = node.IsDefined() && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-  throw InputError(SourceLocation{path, line}.prefix() + "scenario train model: " + what);
+  ScenarioModelReader(path).fail(node, what);
 }
 
 /// The names listed under `key` of a map (its keys), for messages.
@@ -799,7 +795,7 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
 }
 
 /// True for a two-car template of the consist generator (consist.hpp): car1_* bodies and the
-/// coupler_faces interface; any other model is read as a train unit (scenario/train_unit.hpp).
+/// coupler_faces interface; any other model is read as a train unit (scenarios/train_unit.hpp).
 bool is_two_car_template(const YAML::Node& root) {
   if (!root.IsMap() || !root["bodies"] || !root["bodies"].IsSequence() || !root["elements"] || !root["elements"].IsSequence()) return false;
   bool striking_car = false, coupler_faces = false;

@@ -56,10 +56,11 @@ YAML::Node transformed_node(const YAML::Node& node, const std::function<std::str
   return YAML::Clone(node);
 }
 
-void TrainUnit::fail(const YAML::Node& node, const std::string& what) const {
-  const int line = node.IsDefined() && !node.Mark().is_null() ? node.Mark().line + 1 : 0;
-  throw InputError(SourceLocation{path, line}.prefix() + "scenario train model: " + what);
+void ScenarioModelReader::fail(const YAML::Node& node, const std::string& message) const {
+  YamlReader::fail(node, "scenario train model: " + message);
 }
+
+void TrainUnit::fail(const YAML::Node& node, const std::string& what) const { ScenarioModelReader(path).fail(node, what); }
 
 YAML::Node TrainUnit::body(const std::string& name, const std::string& option) const {
   for (const YAML::Node& b : root["bodies"])

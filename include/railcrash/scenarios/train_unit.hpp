@@ -21,7 +21,17 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/model/yaml_reader.hpp"
+
 namespace railcrash {
+
+/// The reader of a scenario's train model (a unit's model file or a car template): the one YAML
+/// reader (model/yaml_reader.hpp) whose messages read "FILE:LINE: scenario train model: ...".
+class ScenarioModelReader : public YamlReader {
+ public:
+  using YamlReader::YamlReader;
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& message) const override;
+};
 
 struct TrainUnit {
   std::string path;
