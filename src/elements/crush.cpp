@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <sstream>
 
@@ -90,6 +91,18 @@ void CrushSpring::initialize(const ElementState<double>& initial) {
   require_direction(*this, initial);
   const LineGeometry<double> g = line_geometry(*this, initial);
   if (!free_length) free_length = g.length;
+  // A start crushed by no more than the round-off of its points' coordinates is a start at the
+  // free length, which then becomes the points' distance (as when it is not given): a model
+  // placed 1 km from the origin computed 0.8 m - 4.6e-14 m for points declared 0.8 m apart and
+  // was refused as "starts crushed" (tests/robustness/models/stiff_anticlimber_unit.yaml
+  // shifted by 1,000 m in x).
+  double coordinates = g.length;  // [length] the size of the numbers the distance came from
+  for (int slot = 0; slot < 2; ++slot)
+    coordinates += std::abs(initial.q[static_cast<std::size_t>(slot)].x) + std::abs(initial.q[static_cast<std::size_t>(slot)].y);
+  for (const PointRef& p : points()) coordinates += std::abs(p.sx) + std::abs(p.sy);
+  constexpr double kRoundOffUlps = 16.0;  // a sum of positions and offsets, a difference and a square root
+  const double crushed = *free_length - g.length;
+  if (crushed > 0.0 && crushed <= kRoundOffUlps * std::numeric_limits<double>::epsilon() * coordinates) free_length = g.length;
   // The initial direction P1 -> P2 in body 1's frame (the points-meet root).
   const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(point_slot(0))];
   reference_axis_ = {(r.cos * g.d.x + r.sin * g.d.y) / g.length, (-r.sin * g.d.x + r.cos * g.d.y) / g.length};

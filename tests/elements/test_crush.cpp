@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -352,4 +353,43 @@ TEST_CASE("crush spring crushed through its free length stops the run naming it 
     CHECK(outcome.t_reached > t_message - 0.0011);
     CHECK(outcome.stats.handed_over_at < 0.0);  // auto: not an IDA failure, no hand-over to Euler
   }
+}
+
+TEST_CASE("crush spring placed far from the origin: a start crushed by round-off is a start at the free length",
+          "[elements][crush]") {
+  // Points declared 0.8 m apart (body a at x = X with its point at +0.7 m, body b at X + 10 m with
+  // its point at -8.5 m). At X = 1000 m the distance computes as 0.8 m - 4.6e-14 m: the model was
+  // refused as "starts crushed by 4.55191e-14". Placed at X = 0 and X = 1000 m, a 100 kg car at
+  // 10 m/s into the zone crushes it alike.
+  const auto model_at = [](double x) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "railcrash: 1\nname: far crush\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      << "  - {name: a, mass: 100, inertia: 1, position: [" << x << ", 0], velocity: [10, 0]}\n"
+      << "  - {name: b, mass: 1000, inertia: 10, position: [" << x + 10.0 << ", 0]}\n"
+      << "elements:\n  - name: zone\n    type: crush_spring\n    free_length: 0.8\n"
+      << "    curve: [[0, 0], [0.01, 1.0e5], [0.8, 1.0e5]]\n    unloading_stiffness: 1.0e7\n"
+      << "    points: [{body: a, at: [0.7, 0]}, {body: b, at: [-8.5, 0]}]\n"
+      << "simulation: {t_end: 0.05, integrator: ida, rtol: 1e-9, output_interval: 0.001}\n";
+    return s.str();
+  };
+  const double crushed_by = 0.8 - ((1000.0 + 10.0 - 8.5) - (1000.0 + 0.7));
+  REQUIRE(crushed_by > 0.0);  // the round-off this case is about
+  double largest[2] = {0.0, 0.0};  // [m] the zone's largest crush output
+  for (int k = 0; k < 2; ++k) {
+    const Model model = testing::model_from_text(model_at(k == 0 ? 0.0 : 1000.0));
+    const RunReport report = run_model(model, "", nullptr, false, true);
+    REQUIRE(report.outcome.ok);
+    const auto column = std::find(report.columns.begin(), report.columns.end(), "zone.crush");
+    REQUIRE(column != report.columns.end());
+    for (const double crush : report.series[static_cast<std::size_t>(column - report.columns.begin())])
+      largest[k] = std::max(largest[k], crush);
+  }
+  // The relative motion's 4,545 J (reduced mass 100 x 1000 / 1100 kg at 10 m/s): 500 J in the
+  // first 10 mm, the rest at 1e5 N: 0.01 + 4,045 / 1e5 = 0.05045 m (the rows every 1 ms may
+  // miss the peak by a little).
+  const double reduced_mass = 100.0 * 1000.0 / 1100.0;  // [kg]
+  const double peak = 0.01 + (0.5 * reduced_mass * 100.0 - 500.0) / 1e5;
+  CHECK(largest[0] == Approx(peak).epsilon(2e-3));
+  CHECK(largest[1] == Approx(largest[0]).epsilon(1e-6));
 }
