@@ -47,14 +47,14 @@
 #include <sstream>
 #include <thread>
 
+#include "railcrash/model/model_io.hpp"
+#include "railcrash/model/train_expansion.hpp"
+#include "railcrash/results/buffered_file.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/results/run.hpp"
 #include "railcrash/scenarios/consist.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/integrator.hpp"
-#include "railcrash/model/model_io.hpp"
-#include "railcrash/model/train_expansion.hpp"
-#include "railcrash/results/results.hpp"
-#include "railcrash/results/buffered_file.hpp"
-#include "railcrash/results/run.hpp"
 #include "railcrash/studies/sensitivity.hpp"
 
 using namespace railcrash;

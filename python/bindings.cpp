@@ -18,9 +18,9 @@
 #include <tuple>
 
 #include "railcrash/api.hpp"
+#include "railcrash/core/table_text.hpp"
 #include "railcrash/studies/sensitivity.hpp"
 #include "railcrash/studies/sweep.hpp"
-#include "railcrash/core/table_text.hpp"
 
 namespace py = pybind11;
 namespace rc = railcrash::api;

@@ -10,11 +10,11 @@
 #include <sstream>
 
 #include "railcrash/core/json_text.hpp"
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/model/model_io.hpp"
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/accuracy_check.hpp"
+#include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 #ifndef RAILCRASH_VERSION
 #error "RAILCRASH_VERSION must be defined by the build"

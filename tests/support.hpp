@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/model/model.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/integrator.hpp"
-#include "railcrash/model/model.hpp"
 
 namespace railcrash::testing {
 

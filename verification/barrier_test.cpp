@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/plot.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 using namespace railcrash;
 

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/studies/readings.hpp"
 #include "railcrash/studies/sensitivity.hpp"
 

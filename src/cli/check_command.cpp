@@ -6,10 +6,10 @@
 
 #include "command.hpp"
 #include "common.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/euler_integrator.hpp"
 #include "railcrash/solver/initial_conditions.hpp"
-#include "railcrash/model/model_io.hpp"
 
 namespace railcrash::cli {
 

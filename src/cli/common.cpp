@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <thread>
 
-#include "railcrash/studies/run_count.hpp"  // kDefaultMaxRuns
 #include "railcrash/core/whole_file.hpp"
+#include "railcrash/studies/run_count.hpp"  // kDefaultMaxRuns
 
 namespace railcrash::cli {
 

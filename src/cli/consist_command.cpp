@@ -3,8 +3,8 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/studies/batch.hpp"
 #include "railcrash/scenarios/consist.hpp"
+#include "railcrash/studies/batch.hpp"
 
 namespace railcrash::cli {
 

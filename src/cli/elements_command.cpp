@@ -4,9 +4,9 @@
 
 #include "command.hpp"
 #include "common.hpp"
+#include "railcrash/core/error.hpp"
 #include "railcrash/model/element_reference.hpp"
 #include "railcrash/model/element_registry.hpp"
-#include "railcrash/core/error.hpp"
 #include "railcrash/model/model_io.hpp"
 
 namespace railcrash::cli {

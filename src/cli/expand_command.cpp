@@ -4,8 +4,8 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/studies/batch.hpp"
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/studies/batch.hpp"
 
 namespace railcrash::cli {
 

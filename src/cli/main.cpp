@@ -13,8 +13,8 @@
 
 #include "command.hpp"
 #include "railcrash/core/error.hpp"
-#include "railcrash/results/provenance.hpp"
 #include "railcrash/core/version.hpp"
+#include "railcrash/results/provenance.hpp"
 
 int main(int argc, char** argv) {
   using namespace railcrash::cli;

@@ -6,14 +6,14 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/core/folder_lock.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/accuracy_check.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/output_sink.hpp"
-#include "railcrash/results/run_files.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/results/run_files.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 namespace railcrash::cli {
 

@@ -11,9 +11,9 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/studies/batch.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/scenarios/en15227.hpp"
+#include "railcrash/studies/batch.hpp"
 
 namespace railcrash::cli {
 

@@ -3,9 +3,9 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/studies/batch.hpp"
 #include "railcrash/model/element_registry.hpp"
 #include "railcrash/model/model_schema.hpp"
+#include "railcrash/studies/batch.hpp"
 
 namespace railcrash::cli {
 

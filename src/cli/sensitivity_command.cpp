@@ -7,10 +7,10 @@
 
 #include "command.hpp"
 #include "common.hpp"
+#include "railcrash/core/whole_file.hpp"
 #include "railcrash/studies/readings.hpp"  // comparison_markdown
 #include "railcrash/studies/run_count.hpp"
 #include "railcrash/studies/sensitivity.hpp"
-#include "railcrash/core/whole_file.hpp"
 
 namespace railcrash::cli {
 

@@ -13,8 +13,8 @@
 
 #include "command.hpp"
 #include "common.hpp"
-#include "railcrash/studies/batch.hpp"
 #include "railcrash/core/error.hpp"
+#include "railcrash/studies/batch.hpp"
 #include "railcrash/studies/run_count.hpp"
 #include "railcrash/studies/sweep.hpp"
 #include "railcrash/studies/sweep_mpi.hpp"

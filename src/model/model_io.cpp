@@ -13,8 +13,8 @@
 #include <tuple>
 #include <unordered_set>
 
-#include "railcrash/model/element_registry.hpp"
 #include "railcrash/core/sha256.hpp"
+#include "railcrash/model/element_registry.hpp"
 #include "railcrash/model/train_expansion.hpp"
 #include "railcrash/model/yaml_file.hpp"
 #include "railcrash/model/yaml_reader.hpp"

@@ -11,8 +11,8 @@
 #include <sstream>
 #include <unordered_set>
 
-#include "railcrash/model/element_registry.hpp"
 #include "railcrash/core/error.hpp"
+#include "railcrash/model/element_registry.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/model/yaml_file.hpp"
 #include "railcrash/model/yaml_reader.hpp"

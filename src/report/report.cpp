@@ -17,16 +17,16 @@
 #include <nlohmann/json.hpp>
 
 #include "railcrash/core/error.hpp"
+#include "railcrash/core/table_text.hpp"
+#include "railcrash/core/whole_file.hpp"
 #include "railcrash/report/assets.hpp"
 #include "railcrash/report/decimate.hpp"
 #include "railcrash/report/folder_file.hpp"
 #include "railcrash/report/pdf.hpp"
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/provenance.hpp"
-#include "railcrash/core/table_text.hpp"
-#include "railcrash/core/whole_file.hpp"
+#include "railcrash/results/results.hpp"
 
 namespace railcrash::report {
 

@@ -6,8 +6,8 @@
 
 #include <Eigen/Core>
 
-#include "railcrash/report/assets.hpp"
 #include "railcrash/core/version.hpp"
+#include "railcrash/report/assets.hpp"
 
 #ifdef RAILCRASH_HDF5_LIBRARY
 #include <H5public.h>

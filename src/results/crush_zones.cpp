@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <sstream>
 
-#include "railcrash/model/element.hpp"
 #include "railcrash/elements/anticlimber.hpp"
 #include "railcrash/elements/couplers.hpp"
 #include "railcrash/elements/crush.hpp"
+#include "railcrash/model/element.hpp"
 #include "railcrash/results/results.hpp"
 
 namespace railcrash {

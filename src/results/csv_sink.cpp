@@ -8,13 +8,13 @@
 #include <memory>
 #include <utility>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/core/error.hpp"
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/buffered_file.hpp"
 #include "railcrash/results/crush_zones.hpp"
 #include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/provenance.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 namespace railcrash {
 

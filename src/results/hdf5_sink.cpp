@@ -2,13 +2,13 @@
 // accelerations, energy and events tables as datasets of one file (results/hdf5_file.hpp).
 #include <memory>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model.hpp"
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/provenance.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 namespace railcrash {
 

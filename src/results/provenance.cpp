@@ -3,9 +3,9 @@
 
 #include <random>
 
+#include "railcrash/core/version.hpp"
 #include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
-#include "railcrash/core/version.hpp"
 
 namespace railcrash {
 

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/output_sink.hpp"
+#include "railcrash/results/results.hpp"
 
 namespace railcrash {
 

@@ -10,15 +10,15 @@
 #include <map>
 #include <sstream>
 
-#include "railcrash/scenarios/consist.hpp"
-#include "railcrash/model/element.hpp"
 #include "railcrash/core/error.hpp"
+#include "railcrash/model/element.hpp"
 #include "railcrash/model/model.hpp"
 #include "railcrash/model/model_io.hpp"
-#include "railcrash/scenarios/train_unit.hpp"
-#include "railcrash/results/crush_zones.hpp"
 #include "railcrash/model/train_expansion.hpp"
 #include "railcrash/model/yaml_file.hpp"
+#include "railcrash/results/crush_zones.hpp"
+#include "railcrash/scenarios/consist.hpp"
+#include "railcrash/scenarios/train_unit.hpp"
 
 namespace railcrash {
 namespace {

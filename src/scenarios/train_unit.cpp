@@ -5,8 +5,8 @@
 #include <cmath>
 #include <map>
 
-#include "railcrash/model/element.hpp"
 #include "railcrash/core/error.hpp"
+#include "railcrash/model/element.hpp"
 #include "railcrash/model/model.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/model/yaml_file.hpp"

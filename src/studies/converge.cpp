@@ -10,16 +10,16 @@
 #include <limits>
 #include <sstream>
 
-#include "railcrash/studies/batch.hpp"
-#include "railcrash/solver/euler_integrator.hpp"
-#include "railcrash/solver/initial_conditions.hpp"
+#include "railcrash/core/whole_file.hpp"
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/outcomes.hpp"
 #include "railcrash/results/plot.hpp"
-#include "railcrash/core/whole_file.hpp"
 #include "railcrash/results/results.hpp"
-#include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/euler_integrator.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
+#include "railcrash/studies/batch.hpp"
 
 namespace railcrash {
 

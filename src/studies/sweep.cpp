@@ -22,16 +22,16 @@
 #include <set>
 #include <sstream>
 
-#include "railcrash/studies/batch.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/core/folder_lock.hpp"
-#include "railcrash/model/model_io.hpp"
-#include "railcrash/results/run.hpp"
-#include "railcrash/studies/run_count.hpp"
 #include "railcrash/core/table_text.hpp"
 #include "railcrash/core/version.hpp"
 #include "railcrash/core/whole_file.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/model/yaml_file.hpp"
+#include "railcrash/results/run.hpp"
+#include "railcrash/studies/batch.hpp"
+#include "railcrash/studies/run_count.hpp"
 
 namespace railcrash {
 

@@ -12,9 +12,9 @@
 
 #include "railcrash/core/error.hpp"
 #include "railcrash/core/folder_lock.hpp"
-#include "railcrash/model/model_io.hpp"
 #include "railcrash/core/table_text.hpp"
 #include "railcrash/core/whole_file.hpp"
+#include "railcrash/model/model_io.hpp"
 
 namespace railcrash {
 

@@ -17,8 +17,8 @@
 
 #include "railcrash/core/error.hpp"
 #include "railcrash/core/folder_lock.hpp"
-#include "railcrash/studies/run_count.hpp"
 #include "railcrash/core/whole_file.hpp"
+#include "railcrash/studies/run_count.hpp"
 
 using namespace railcrash;
 using Catch::Matchers::Contains;

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "railcrash/elements/anticlimber.hpp"
-#include "railcrash/solver/euler_integrator.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/euler_integrator.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "railcrash/elements/crush.hpp"
-#include "railcrash/solver/events.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/events.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

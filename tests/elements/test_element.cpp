@@ -8,12 +8,12 @@
 #include <set>
 #include <string>
 
-#include "railcrash/scenarios/consist.hpp"
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/elements/beams.hpp"
-#include "railcrash/results/run.hpp"
 #include "railcrash/model/element_registry.hpp"
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/results/run.hpp"
+#include "railcrash/scenarios/consist.hpp"
+#include "railcrash/solver/dae_system.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "railcrash/elements/nonlinear.hpp"
-#include "railcrash/solver/euler_integrator.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/euler_integrator.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/core/error.hpp"
-#include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/scenario_criteria.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
 
 namespace {
 

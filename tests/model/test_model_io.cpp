@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/elements/crush.hpp"
 #include "railcrash/elements/joints.hpp"
 #include "railcrash/elements/springs.hpp"
-#include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

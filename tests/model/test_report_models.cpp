@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/scenarios/consist.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/scenarios/consist.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -8,10 +8,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/accuracy_check.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 using namespace railcrash;
 

@@ -14,8 +14,8 @@
 #include <sstream>
 #include <string>
 
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/buffered_file.hpp"
+#include "railcrash/results/results.hpp"
 
 using railcrash::BufferedFile;
 

@@ -7,10 +7,10 @@
 #include <sstream>
 #include <string>
 
-#include "railcrash/solver/dae_system.hpp"
-#include "railcrash/solver/integrator.hpp"
 #include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/integrator.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -11,14 +11,14 @@
 
 #include <unistd.h>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/model/model_io.hpp"
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/crush_zones.hpp"
 #include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/provenance.hpp"
-#include "railcrash/results/run_files.hpp"
+#include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/results/run_files.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 namespace fs = std::filesystem;
 using namespace railcrash;

@@ -11,13 +11,13 @@
 
 #include <unistd.h>
 
+#include "railcrash/core/sha256.hpp"
+#include "railcrash/core/version.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/provenance.hpp"
-#include "railcrash/results/run_files.hpp"
 #include "railcrash/results/run.hpp"
-#include "railcrash/core/sha256.hpp"
-#include "railcrash/core/version.hpp"
+#include "railcrash/results/run_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace railcrash;

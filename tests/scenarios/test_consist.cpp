@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "railcrash/scenarios/consist.hpp"
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/results.hpp"
+#include "railcrash/scenarios/consist.hpp"
+#include "railcrash/solver/dae_system.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

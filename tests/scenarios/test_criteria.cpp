@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "railcrash/elements/anticlimber.hpp"
 #include "railcrash/core/error.hpp"
+#include "railcrash/elements/anticlimber.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/scenario_criteria.hpp"
 

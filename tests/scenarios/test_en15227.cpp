@@ -9,12 +9,12 @@
 #include <map>
 #include <regex>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
 #include "railcrash/results/scenario_criteria.hpp"
 #include "railcrash/scenarios/en15227.hpp"
+#include "railcrash/solver/dae_system.hpp"
 #include "requests.hpp"
 
 using namespace railcrash;

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "railcrash/solver/dae_system.hpp"
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/solver/dae_system.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "railcrash/solver/auto_integrator.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/auto_integrator.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

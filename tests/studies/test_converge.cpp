@@ -8,10 +8,10 @@
 #include <fstream>
 #include <set>
 
-#include "railcrash/studies/converge.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/studies/converge.hpp"
 
 using namespace railcrash;
 

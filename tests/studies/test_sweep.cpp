@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "railcrash/core/error.hpp"
+#include "railcrash/core/table_text.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
 #include "railcrash/studies/sweep.hpp"
-#include "railcrash/core/table_text.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

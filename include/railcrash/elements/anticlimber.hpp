@@ -167,9 +167,9 @@
 #include <optional>
 #include <string>
 
+#include "railcrash/elements/hybrid.hpp"
 #include "railcrash/model/element.hpp"
 #include "railcrash/model/element_registry.hpp"
-#include "railcrash/elements/hybrid.hpp"
 
 namespace railcrash {
 

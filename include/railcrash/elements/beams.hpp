@@ -92,10 +92,10 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model/element.hpp"
-#include "railcrash/model/element_registry.hpp"
 #include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
+#include "railcrash/model/element.hpp"
+#include "railcrash/model/element_registry.hpp"
 
 namespace railcrash {
 

@@ -30,9 +30,9 @@
 
 #include <optional>
 
+#include "railcrash/elements/hybrid.hpp"
 #include "railcrash/model/element.hpp"
 #include "railcrash/model/element_registry.hpp"
-#include "railcrash/elements/hybrid.hpp"
 
 namespace railcrash {
 

@@ -33,10 +33,10 @@
 #include <optional>
 #include <vector>
 
-#include "railcrash/model/element.hpp"
-#include "railcrash/model/element_registry.hpp"
 #include "railcrash/elements/hybrid.hpp"
 #include "railcrash/elements/springs.hpp"
+#include "railcrash/model/element.hpp"
+#include "railcrash/model/element_registry.hpp"
 
 namespace railcrash {
 

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model/element.hpp"
 #include "railcrash/core/error.hpp"
+#include "railcrash/model/element.hpp"
 #include "railcrash/model/run_spec.hpp"
 
 namespace railcrash {

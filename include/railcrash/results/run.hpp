@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/integrator.hpp"
 #include "railcrash/model/model.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/outcomes.hpp"
 #include "railcrash/results/responses.hpp"
 #include "railcrash/results/results.hpp"
+#include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {
 

@@ -58,8 +58,8 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/integrator.hpp"
 #include "railcrash/results/responses.hpp"
+#include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {
 

@@ -66,12 +66,12 @@
 #include <utility>
 #include <vector>
 
-#include "railcrash/studies/run_count.hpp"
 #include "railcrash/core/error.hpp"
-#include "railcrash/studies/batch.hpp"
+#include "railcrash/model/yaml_file.hpp"
 #include "railcrash/results/outcomes.hpp"
 #include "railcrash/results/responses.hpp"
-#include "railcrash/model/yaml_file.hpp"
+#include "railcrash/studies/batch.hpp"
+#include "railcrash/studies/run_count.hpp"
 
 namespace railcrash {
 

@@ -45,9 +45,9 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/model/yaml_file.hpp"
 #include "railcrash/studies/batch.hpp"
 #include "railcrash/studies/run_count.hpp"
-#include "railcrash/model/yaml_file.hpp"
 
 namespace railcrash {
 
