@@ -383,27 +383,16 @@ void ResultWriter::step(double t, const double* y, const double* lambda, const d
 
 void ResultWriter::track_extrema(double t, const double* y, const double* lambda, const double* outputs,
                                  const FreshOutputs& fresh) {
-  // Every column at every step: without branches (whether a column reaches a new extreme is
-  // not predictable across the columns), the compiler's vector compare and select; the same
-  // values and times as "if (value > max) max = value, t_max = t" (a NaN is never taken).
-  double* const max = output_max_.data();
-  double* const min = output_min_.data();
-  double* const t_max = t_output_max_.data();
-  double* const t_min = t_output_min_.data();
-  const auto take = [&](std::size_t k) {
-    const double value = outputs[k];
-    const bool above = value > max[k], below = value < min[k];
-    max[k] = above ? value : max[k];
-    t_max[k] = above ? t : t_max[k];
-    min[k] = below ? value : min[k];
-    t_min[k] = below ? t : t_min[k];
-  };
-  const std::size_t first = static_cast<std::size_t>(fresh.begin), end = fresh.end_within(output_max_.size());
-  if (fresh.marked == nullptr) {
-    for (std::size_t k = first; k < end; ++k) take(k);
-  } else {  // (never while this writer observes: it marks every column)
-    for (std::size_t k = first; k < end; ++k)
-      if (fresh.marked[k] != 0) take(k);
+  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(output_max_.size()); ++k) {
+    if (fresh.marked != nullptr && fresh.marked[k] == 0) continue;  // (never while this writer observes: it marks all)
+    if (outputs[k] > output_max_[k]) {
+      output_max_[k] = outputs[k];
+      t_output_max_[k] = t;
+    }
+    if (outputs[k] < output_min_[k]) {
+      output_min_[k] = outputs[k];
+      t_output_min_[k] = t;
+    }
   }
   // L(0) from the run's first state, after any static settle or assembly (results.hpp "Car crush").
   if (!car_lengths_measured_)
