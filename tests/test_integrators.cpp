@@ -541,3 +541,49 @@ TEST_CASE("the responses from a run that evaluates only their outputs per step e
   CHECK(all_evaluations[1] > 10000);
   CHECK(some_evaluations[0] == all_evaluations[0]);  // the anticlimber's: every step either way
 }
+
+TEST_CASE("an SI two-car crash under euler gives the same responses without a result writer, which reads only the anticlimber per step, as with one, which reads every output",
+          "[integrators][euler][output][responses]") {
+  // Two 40 t multiple-unit cars (a 38 t body and a 2 t end each), 8 m/s into a standing one:
+  // each end on a crush zone (1.2 MN plateau over 0.5 m) beside a draft gear, sliding on its
+  // body; the ends meet through an anticlimber (2 MN yield); no gravity.
+  const std::string text =
+      "railcrash: 1\nname: two 40 t cars, 8 m/s\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: a_body, car: a, mass: 38000, inertia: 1.2e6, position: [0.0, 1.4], velocity: [8.0, 0]}\n"
+      "  - {name: a_end, car: a, mass: 2000, inertia: 400, position: [10.4, 1.4], velocity: [8.0, 0]}\n"
+      "  - {name: b_end, car: b, mass: 2000, inertia: 400, position: [10.43, 1.4]}\n"
+      "  - {name: b_body, car: b, mass: 38000, inertia: 1.2e6, position: [20.8305, 1.4]}\n"
+      "elements:\n"
+      "  - {name: a_crush_zone, type: crush_spring, free_length: 0.4, curve: [[0, 0], [0.03, 1.2e6], [0.5, 1.2e6], [0.55, 2.5e6]],\n"
+      "     unloading_stiffness: 5.0e7, points: [{body: a_body, at: [10.0, 0]}, {body: a_end, at: [0, 0]}]}\n"
+      "  - {name: a_draft_gear, type: draft_gear, initial_stiffness: 4.0e6, travel: 0.07, stiffness_after_bottoming: 1.0e5,\n"
+      "     hysteresis_load: 8.0e4, transition_stiffness: 1.0e8, points: [{body: a_body, at: [10.0, -0.4]}, {body: a_end, at: [0, -0.4]}]}\n"
+      "  - {name: b_crush_zone, type: crush_spring, free_length: 0.4, curve: [[0, 0], [0.03, 1.2e6], [0.5, 1.2e6], [0.55, 2.5e6]],\n"
+      "     unloading_stiffness: 5.0e7, points: [{body: b_end, at: [0, 0]}, {body: b_body, at: [-10.0, 0]}]}\n"
+      "  - {name: b_draft_gear, type: draft_gear, initial_stiffness: 4.0e6, travel: 0.07, stiffness_after_bottoming: 1.0e5,\n"
+      "     hysteresis_load: 8.0e4, transition_stiffness: 1.0e8, points: [{body: b_end, at: [0, -0.4]}, {body: b_body, at: [-10.0, -0.4]}]}\n"
+      "  - {name: a_guide, type: slider_joint, axis: [1, 0], points: [{body: a_body, at: [10.0, 0]}, {body: a_end, at: [0, 0]}]}\n"
+      "  - {name: b_guide, type: slider_joint, axis: [1, 0], points: [{body: b_body, at: [-10.0, 0]}, {body: b_end, at: [0, 0]}]}\n"
+      "  - {name: anticlimber, type: anticlimber, points: [{body: a_end, at: [0, 0]}, {body: b_end, at: [0, 0]}],\n"
+      "     horizontal_elastic_stiffness: 8.0e8, horizontal_plastic_stiffness: 1.0e6, horizontal_yield_deflection: 0.0025,\n"
+      "     vertical_elastic_stiffness: 5.0e7, vertical_plastic_stiffness: 1.0e5, vertical_yield_deflection: 0.005,\n"
+      "     torsional_elastic_stiffness: 1.0e7, torsional_plastic_stiffness: 1.0e5, torsional_yield_deflection: 0.01,\n"
+      "     face_height: 0.3, length: 0.2}\n"
+      "responses: {crush: anticlimber, reference_crush: 0.01, anticlimber: anticlimber, reference_velocity: 8.0}\n"
+      "simulation: {t_end: 0.05, integrator: euler, dt: 2.0e-6, output_interval: 0.005}\n";
+  const Model model = testing::model_from_text(text);
+  const RunReport alone = run_model(model, "", nullptr);  // the responses alone (sensitivity's runs)
+  const RunReport with_writer = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);  // every column (the API's)
+  REQUIRE(alone.outcome.ok);
+  REQUIRE(with_writer.outcome.ok);
+  REQUIRE(alone.has_responses);
+  CHECK(alone.outcome.stats.steps == with_writer.outcome.stats.steps);
+  CHECK(alone.outcome.stats.steps > 1000);
+  CHECK(alone.responses.max_anticlimber_crush > 0.0025);  // past its yield
+  CHECK(alone.responses.max_anticlimber_crush == with_writer.responses.max_anticlimber_crush);
+  CHECK(alone.responses.max_vertical_force == with_writer.responses.max_vertical_force);
+  CHECK(alone.responses.r1 == with_writer.responses.r1);
+  CHECK(alone.responses.r2 == with_writer.responses.r2);
+  CHECK(alone.responses.r3 == with_writer.responses.r3);
+  CHECK(alone.outcome.y == with_writer.outcome.y);
+}
