@@ -244,19 +244,25 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
     powers[kPenaltyWork] = 0.0;
   }
   gravity_and_load_forces(t, q, f);
+  // What the sweep fills beside the forces, read once (the elements' calls are opaque: read in
+  // the loop, each would be loaded again for every element).
+  double* const roots = extras ? extras->roots : nullptr;
+  double* const all_outputs = extras ? extras->outputs : nullptr;
+  const char* const output_elements = extras ? extras->output_elements : nullptr;
+  const double* const y_lambda = extras ? extras->y_lambda : nullptr;
+  const bool sweep = roots != nullptr || all_outputs != nullptr;  // (an element with neither is not asked for them)
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     const ElementState<double> s = local_state(e, q, v);
     const int m = el.constraint_count();
-    double* outputs = extras && (extras->output_elements == nullptr || extras->output_elements[e] != 0) ? extras->outputs : nullptr;
-    const bool sweep = extras && (extras->roots || outputs);
-    if (sweep && m > 0) element_roots_and_outputs(e, t, s, extras->y_lambda, extras->roots, outputs);
+    double* const outputs = output_elements == nullptr || output_elements[e] != 0 ? all_outputs : nullptr;
+    if (sweep && m > 0) element_roots_and_outputs(e, t, s, y_lambda, roots, outputs);
     std::array<Pose<double>, 2> fe{};
     double* element_power = powers ? powers + kFirstElementWork + static_cast<int>(e) : nullptr;
     if (element_power) *element_power = 0.0;
     if (m == 0) {
       if (sweep)
-        element_force_roots_and_outputs(e, t, s, extras->y_lambda, fe, extras->roots, outputs);
+        element_force_roots_and_outputs(e, t, s, y_lambda, fe, roots, outputs);
       else
         el.add_force(t, s, fe);
       if (element_power) *element_power = power_into(fe, s);
