@@ -57,6 +57,11 @@ void ResponseTracker::step(double t, const double* y, const double*, const doubl
   track_collision_post(t, y, outputs, fresh);
 }
 
+void ResponseTracker::mark_step_columns(std::vector<char>& columns) const {
+  for (const int column : {vertical_force_column_, horizontal_deformation_column_})
+    if (column >= 0) columns[static_cast<std::size_t>(column)] = 1;
+}
+
 double ResponseTracker::relative_velocity(const double* y) const {
   const Element& e = *system_.model().elements()[static_cast<std::size_t>(anticlimber_element_)];
   const int nq = system_.body_unknowns();

@@ -383,7 +383,7 @@ void ResultWriter::step(double t, const double* y, const double* lambda, const d
 
 void ResultWriter::track_extrema(double t, const double* y, const double* lambda, const double* outputs,
                                  const FreshOutputs& fresh) {
-  for (std::size_t k = static_cast<std::size_t>(fresh.begin); k < fresh.end_within(output_max_.size()); ++k) {
+  const auto take = [&](std::size_t k) {
     if (outputs[k] > output_max_[k]) {
       output_max_[k] = outputs[k];
       t_output_max_[k] = t;
@@ -392,6 +392,13 @@ void ResultWriter::track_extrema(double t, const double* y, const double* lambda
       output_min_[k] = outputs[k];
       t_output_min_[k] = t;
     }
+  };
+  const std::size_t first = static_cast<std::size_t>(fresh.begin), end = fresh.end_within(output_max_.size());
+  if (fresh.marked == nullptr) {
+    for (std::size_t k = first; k < end; ++k) take(k);
+  } else {  // (never while this writer observes: it marks every column)
+    for (std::size_t k = first; k < end; ++k)
+      if (fresh.marked[k] != 0) take(k);
   }
   // L(0) from the run's first state, after any static settle or assembly (results.hpp "Car crush").
   if (!car_lengths_measured_)

@@ -62,6 +62,11 @@ class ProgressObserver : public RunObserver {
   bool observes_steps() const override {
     return std::any_of(next_.begin(), next_.end(), [](const RunObserver* o) { return o->observes_steps(); });
   }
+  /// The columns of every observer that takes steps.
+  void mark_step_columns(std::vector<char>& columns) const override {
+    for (const RunObserver* o : next_)
+      if (o->observes_steps()) o->mark_step_columns(columns);
+  }
   std::string failure() const override {
     for (const RunObserver* o : next_)
       if (std::string why = o->failure(); !why.empty()) return why;

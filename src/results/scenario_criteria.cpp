@@ -312,6 +312,18 @@ double ScenarioTracker::car_crush_now(std::size_t k, const double* outputs) cons
   return shared_crush(outputs, crush_of_cars_[k].columns, crush_of_cars_[k].shares, &allowed_[k]);
 }
 
+void ScenarioTracker::mark_step_columns(std::vector<char>& columns) const {
+  const auto mark = [&](int column) {
+    if (column >= 0) columns[static_cast<std::size_t>(column)] = 1;
+  };
+  for (const CarCrush& car : crush_of_cars_)
+    for (const int column : car.columns) mark(column);
+  mark(vertical_offset_column_);
+  mark(override_column_);
+  for (const int column : wheel_columns_) mark(column);
+  for (const int column : support_columns_) mark(column);
+}
+
 void ScenarioTracker::step(double, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) {
   if (times_.empty()) return;  // the references (L(0), the offset at 0) come from the first sample
   for (std::size_t k = 0; k < front_index_.size(); ++k)

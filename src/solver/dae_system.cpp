@@ -109,6 +109,7 @@ DaeSystem::DaeSystem(const Model& model) : model_(model), modes_(model) {
     mass_[static_cast<std::size_t>(3 * i + 1)] = b.mass;
     mass_[static_cast<std::size_t>(3 * i + 2)] = b.inertia;
   }
+  output_evaluations_.assign(model.elements().size(), 0);
   constraint_row_owner_.resize(static_cast<std::size_t>(model.constraint_rows()));
   row_is_rotational_.resize(static_cast<std::size_t>(model.constraint_rows()));
   for (std::size_t e = 0; e < model.elements().size(); ++e) {
@@ -243,18 +244,25 @@ void DaeSystem::generalized_forces(double t, const double* q, const double* v, d
     powers[kPenaltyWork] = 0.0;
   }
   gravity_and_load_forces(t, q, f);
+  // What the sweep fills beside the forces, read once (the elements' calls are opaque: read in
+  // the loop, each would be loaded again for every element).
+  double* const roots = extras ? extras->roots : nullptr;
+  double* const all_outputs = extras ? extras->outputs : nullptr;
+  const char* const output_elements = extras ? extras->output_elements : nullptr;
+  const double* const y_lambda = extras ? extras->y_lambda : nullptr;
+  const bool sweep = roots != nullptr || all_outputs != nullptr;  // (an element with neither is not asked for them)
   for (std::size_t e = 0; e < model_.elements().size(); ++e) {
     const Element& el = *model_.elements()[e];
     const ElementState<double> s = local_state(e, q, v);
     const int m = el.constraint_count();
-    const bool sweep = extras && (extras->roots || extras->outputs);
-    if (sweep && m > 0) element_roots_and_outputs(e, t, s, extras->y_lambda, extras->roots, extras->outputs);
+    double* const outputs = output_elements == nullptr || output_elements[e] != 0 ? all_outputs : nullptr;
+    if (sweep && m > 0) element_roots_and_outputs(e, t, s, y_lambda, roots, outputs);
     std::array<Pose<double>, 2> fe{};
     double* element_power = powers ? powers + kFirstElementWork + static_cast<int>(e) : nullptr;
     if (element_power) *element_power = 0.0;
     if (m == 0) {
       if (sweep)
-        element_force_roots_and_outputs(e, t, s, extras->y_lambda, fe, extras->roots, extras->outputs);
+        element_force_roots_and_outputs(e, t, s, y_lambda, fe, roots, outputs);
       else
         el.add_force(t, s, fe);
       if (element_power) *element_power = power_into(fe, s);
@@ -870,6 +878,7 @@ DaeSystem::ElementSlices DaeSystem::element_slices(std::size_t e, const double* 
   slices.lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(e) : nullptr;
   slices.g = g != nullptr && el.root_count() > 0 ? g + root_offset_[e] : nullptr;
   slices.outputs = outputs != nullptr && output_offset_[e] < output_end(e) ? outputs + output_offset_[e] : nullptr;
+  if (slices.outputs != nullptr) ++output_evaluations_[e];
   return slices;
 }
 
@@ -970,6 +979,7 @@ void DaeSystem::element_outputs(int e, const double* y, const double* lambda, do
   const auto k = static_cast<std::size_t>(e);
   const int first = output_offset_[k];
   if (first == output_end(k)) return;
+  ++output_evaluations_[k];
   const Element& el = *model_.elements()[k];
   const double* element_lambda = el.constraint_count() > 0 ? lambda + model_.constraint_offset(k) : nullptr;
   el.outputs(local_state(k, y, y + body_unknowns()), element_lambda, out + first);

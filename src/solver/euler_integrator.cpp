@@ -259,11 +259,14 @@ void EulerIntegrator::sweep() {
   DaeSystem::SweepExtras extras;
   extras.powers = rates_.data();
   extras.roots = mode_tracker().now().data();
-  extras.outputs = outputs_.data();
+  // The outputs the observers' step() reads (the rows evaluate all of theirs): none when no
+  // observer takes steps, else those of the elements step_output_elements() names.
+  extras.outputs = step_outputs_wanted() ? outputs_.data() : nullptr;
+  extras.output_elements = step_output_elements();
   extras.y_lambda = y_.data() + 2 * nq;  // the roots and outputs see y's multipliers, as roots(t, y) does
   const PhaseClock::Scope timed(phase_clock(), Phase::Residual);
   system_.generalized_forces(t_, y_.data(), y_.data() + nq, force_.data(), &penalty_, lambda_.data(), nullptr, &extras);
-  outputs_current_ = true;
+  outputs_current_ = extras.outputs != nullptr;
 }
 
 /// Euler's decisions about the mode changes at its step's end (event_loop.hpp): the observers

@@ -44,9 +44,11 @@ void Integrator::deliver_step(double t, const double* y, int element) {
   if (!observe_steps_) return;
   const PhaseClock::Scope timed(phase_clock(), Phase::Output);
   const double* lambda = y + 2 * system_.body_unknowns();
+  FreshOutputs step_fresh;  // the outputs every step evaluates: those of the elements the observer reads
+  step_fresh.marked = step_columns_.empty() ? nullptr : step_columns_.data();
   const double* ready = element < 0 && y == current_state() ? current_outputs() : nullptr;
   if (ready) {
-    observer_->step(t, y, lambda, ready, FreshOutputs{});
+    observer_->step(t, y, lambda, ready, step_fresh);
     return;
   }
   // At a located event only the changed element's outputs are evaluated again: evaluating all
@@ -59,10 +61,34 @@ void Integrator::deliver_step(double t, const double* y, int element) {
     system_.element_outputs(element, y, lambda, step_outputs_.data());
     const auto [begin, end] = system_.output_range(element);
     fresh = FreshOutputs{begin, end};
-  } else {
+  } else if (step_elements_.empty()) {
     system_.outputs(y, lambda, step_outputs_.data());
+  } else {
+    for (std::size_t e = 0; e < step_elements_.size(); ++e)
+      if (step_elements_[e] != 0) system_.element_outputs(static_cast<int>(e), y, lambda, step_outputs_.data());
+    fresh = step_fresh;
   }
   observer_->step(t, y, lambda, step_outputs_.data(), fresh);
+}
+
+void Integrator::choose_step_outputs() {
+  step_elements_.clear();
+  step_columns_.clear();
+  if (!observe_steps_) return;
+  const std::size_t element_count = system_.model().elements().size();
+  std::vector<char> marked(system_.output_names().size(), char{0});
+  observer_->mark_step_columns(marked);
+  std::vector<char> elements(element_count, char{0}), columns(marked.size(), char{0});
+  bool every_element = true;
+  for (std::size_t e = 0; e < element_count; ++e) {
+    const auto [begin, end] = system_.output_range(static_cast<int>(e));
+    elements[e] = std::any_of(marked.begin() + begin, marked.begin() + end, [](char m) { return m != 0; }) ? 1 : 0;
+    std::fill(columns.begin() + begin, columns.begin() + end, elements[e]);
+    every_element = every_element && (elements[e] != 0 || begin == end);
+  }
+  if (every_element) return;  // every output per step, as without marks
+  step_elements_ = std::move(elements);
+  step_columns_ = std::move(columns);
 }
 
 std::string Integrator::non_finite_entry(const double* y) const {
@@ -144,6 +170,8 @@ void Integrator::take_run_from(Integrator& previous) {
   phase_clock_ = previous.phase_clock_;
   previous.phase_clock_ = PhaseClock{};
   step_outputs_ = std::move(previous.step_outputs_);
+  step_elements_ = std::move(previous.step_elements_);
+  step_columns_ = std::move(previous.step_columns_);
   previous.observer_ = nullptr;
 }
 
@@ -153,6 +181,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   const auto wall_start = std::chrono::steady_clock::now();
   observer_ = &observer;
   observe_steps_ = observer.observes_steps();
+  choose_step_outputs();
   step_outputs_.assign(system_.output_names().size(), 0.0);
   sample_outputs_.assign(system_.output_names().size(), 0.0);
   observe_sample_forces_ = observer.wants_sample_forces();

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -8,6 +9,7 @@
 #include "railcrash/solver/euler_integrator.hpp"
 #include "railcrash/solver/ida_integrator.hpp"
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/results/responses.hpp"
 #include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
 #include "support.hpp"
@@ -410,4 +412,178 @@ TEST_CASE("an observer that wants the forces gets them from the outputs' sweep, 
     }
     CHECK(std::any_of(a.begin(), a.end(), [](const AccelerationPeaks& p) { return p.magnitude > 0.0; }));
   }
+}
+
+namespace {
+
+// A 2 kg mass between two springs from the ground along x, "tracked" (150 N/m) and "witness"
+// (50 N/m), both at their free length of 1 m, the mass moving at v0 = 1 m/s: x(t) - 1 =
+// (v0 / omega) sin(omega t) with omega = sqrt(200 / 2) = 10 rad/s; the tracked spring's force
+// peaks at k v0 sqrt(m / (k + k_witness)) = 150 * 0.1 = 15 N at t = pi / 20 = 0.157 s.
+std::string two_spring_oscillator(const std::string& simulation) {
+  return "railcrash: 1\nname: two springs\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+         "  - {name: mass, mass: 2.0, inertia: 0.1, position: [1.0, 0], velocity: [1.0, 0]}\nelements:\n"
+         "  - {name: tracked, type: linear_spring, stiffness: 150, free_length: 1.0, "
+         "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+         "  - {name: witness, type: linear_spring, stiffness: 50, free_length: 1.0, "
+         "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+         "simulation: {" + simulation + "}\n";
+}
+
+/// Reads one output column per step (tracked.force, column 0): the largest value over the
+/// steps, the same force computed from each step's state alone, and the largest over the rows.
+struct TrackedForcePeak : RunObserver {
+  double step_peak = -1e300, state_peak = -1e300, row_peak = -1e300;  // [N]
+  int steps = 0, rows = 0, witness_fresh = 0;
+  void sample(double, const double*, const double*, const double*, const double* outputs) override {
+    ++rows;
+    row_peak = std::max(row_peak, outputs[0]);
+  }
+  void step(double, const double* y, const double*, const double* outputs, const FreshOutputs& fresh) override {
+    ++steps;
+    if (fresh.has(0)) step_peak = std::max(step_peak, outputs[0]);
+    state_peak = std::max(state_peak, 150.0 * (std::abs(y[0]) - 1.0));  // the spring's length is |x| (y = 0)
+    if (fresh.has(2) || fresh.has(3)) ++witness_fresh;
+  }
+  bool observes_steps() const override { return true; }
+  void mark_step_columns(std::vector<char>& columns) const override { columns[0] = 1; }
+};
+
+/// Passes everything on to several observers (as the run's progress observer does).
+struct FanOut : RunObserver {
+  std::vector<RunObserver*> next;
+  void sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs) override {
+    for (RunObserver* o : next) o->sample(t, y, lambda, quadratures, outputs);
+  }
+  void event(const EventRecord& record, const double* y) override {
+    for (RunObserver* o : next) o->event(record, y);
+  }
+  void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override {
+    for (RunObserver* o : next) o->step(t, y, lambda, outputs, fresh);
+  }
+  bool observes_steps() const override { return true; }
+  void mark_step_columns(std::vector<char>& columns) const override {
+    for (const RunObserver* o : next)
+      if (o->observes_steps()) o->mark_step_columns(columns);
+  }
+};
+
+/// Takes steps and reads every column (RunObserver::mark_step_columns' default), as the
+/// result writer's peaks do.
+struct ReadsEveryColumn : RunObserver {
+  void sample(double, const double*, const double*, const double*, const double*) override {}
+  void step(double, const double*, const double*, const double*, const FreshOutputs&) override {}
+  bool observes_steps() const override { return true; }
+};
+
+}  // namespace
+
+TEST_CASE("per step euler evaluates only the outputs an observer reads: an untracked element's at the output rows alone, the tracked peak still caught between rows",
+          "[integrators][euler][output]") {
+  Model model = testing::model_from_text(two_spring_oscillator("t_end: 0.3, integrator: euler, dt: 1.0e-4"));
+  DaeSystem system(model);
+  REQUIRE(system.output_names() ==
+          std::vector<std::string>{"tracked.force", "tracked.deformation", "witness.force", "witness.deformation"});
+  auto run = make_integrator(system, model.run_spec.simulation);
+  TrackedForcePeak observer;
+  const RunOutcome outcome = run->run(0.3, 0.1, observer);  // rows at 0, 0.1, 0.2, 0.3 s; the peak at 0.157 s
+  REQUIRE(outcome.ok);
+  REQUIRE(outcome.stats.steps == 3000);
+  REQUIRE(observer.rows == 4);
+  // The witness spring's outputs: once per row (4), not at each of the 3,000 steps.
+  CHECK(system.output_evaluations(1) == observer.rows);
+  CHECK(observer.witness_fresh == 0);
+  // The tracked spring's: at every step (and at the start and the rows).
+  CHECK(system.output_evaluations(0) >= outcome.stats.steps);
+  CHECK(observer.steps >= outcome.stats.steps);
+  // Its peak is the per-step maximum of the force from the state, bit for bit the same
+  // arithmetic up to the length's square root, near the analytic 15 N (Euler's 1e-3 step
+  // angle), and well above the rows' largest (15 sin 2 = 13.6 N at 0.2 s).
+  CHECK(observer.step_peak == Approx(observer.state_peak).epsilon(1e-12));
+  CHECK(observer.step_peak == Approx(150.0 * 1.0 * std::sqrt(2.0 / 200.0)).epsilon(2e-3));
+  CHECK(observer.row_peak < 13.7);
+}
+
+TEST_CASE("the responses from a run that evaluates only their outputs per step equal those of one that evaluates all, under euler",
+          "[integrators][euler][output][responses]") {
+  // The R1 model (a 1000 kg car end at 2 m/s into an anticlimber) with a soft spring beside the
+  // anticlimber whose outputs no response reads.
+  std::string text = testing::anticlimber_r1_model_text(0.1);
+  const std::string spring =
+      "  - {name: beside, type: linear_spring, stiffness: 1.0e3, free_length: 1.0, "
+      "points: [{body: ground, at: [0, -1]}, {body: car, at: [0, 0]}]}\n";
+  text.insert(text.find("responses:"), spring);
+  const auto responses_json = [&](bool every_column) {
+    Model model = testing::model_from_text(text);
+    SimulationSettings settings = model.run_spec.simulation;
+    settings.integrator = IntegratorKind::Euler;
+    settings.dt = 1e-5;
+    DaeSystem system(model);
+    REQUIRE(model.elements().size() == 2);
+    auto run = make_integrator(system, settings);
+    ResponseTracker responses(system, model.run_spec.responses);
+    ReadsEveryColumn every;
+    FanOut observers;
+    observers.next = {&responses};
+    if (every_column) observers.next.push_back(&every);
+    REQUIRE(run->run(0.1, 0.02, observers).ok);  // rows at 0, 0.02, ..., 0.1 s
+    std::vector<long> evaluations;
+    for (std::size_t e = 0; e < model.elements().size(); ++e) evaluations.push_back(system.output_evaluations(static_cast<int>(e)));
+    return std::make_pair(responses.json(), evaluations);
+  };
+  const auto [some, some_evaluations] = responses_json(false);
+  const auto [all, all_evaluations] = responses_json(true);
+  CHECK(some == all);
+  CHECK(some.find("\"max_anticlimber_crush\": 0,") == std::string::npos);  // (the anticlimber was loaded)
+  // The spring beside it: at the 6 rows alone when only the responses read outputs per step,
+  // at every one of the 10,000 steps when an observer reads every column.
+  CHECK(some_evaluations[1] == 6);
+  CHECK(all_evaluations[1] > 10000);
+  CHECK(some_evaluations[0] == all_evaluations[0]);  // the anticlimber's: every step either way
+}
+
+TEST_CASE("an SI two-car crash under euler gives the same responses without a result writer, which reads only the anticlimber per step, as with one, which reads every output",
+          "[integrators][euler][output][responses]") {
+  // Two 40 t multiple-unit cars (a 38 t body and a 2 t end each), 8 m/s into a standing one:
+  // each end on a crush zone (1.2 MN plateau over 0.5 m) beside a draft gear, sliding on its
+  // body; the ends meet through an anticlimber (2 MN yield); no gravity.
+  const std::string text =
+      "railcrash: 1\nname: two 40 t cars, 8 m/s\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: a_body, car: a, mass: 38000, inertia: 1.2e6, position: [0.0, 1.4], velocity: [8.0, 0]}\n"
+      "  - {name: a_end, car: a, mass: 2000, inertia: 400, position: [10.4, 1.4], velocity: [8.0, 0]}\n"
+      "  - {name: b_end, car: b, mass: 2000, inertia: 400, position: [10.43, 1.4]}\n"
+      "  - {name: b_body, car: b, mass: 38000, inertia: 1.2e6, position: [20.8305, 1.4]}\n"
+      "elements:\n"
+      "  - {name: a_crush_zone, type: crush_spring, free_length: 0.4, curve: [[0, 0], [0.03, 1.2e6], [0.5, 1.2e6], [0.55, 2.5e6]],\n"
+      "     unloading_stiffness: 5.0e7, points: [{body: a_body, at: [10.0, 0]}, {body: a_end, at: [0, 0]}]}\n"
+      "  - {name: a_draft_gear, type: draft_gear, initial_stiffness: 4.0e6, travel: 0.07, stiffness_after_bottoming: 1.0e5,\n"
+      "     hysteresis_load: 8.0e4, transition_stiffness: 1.0e8, points: [{body: a_body, at: [10.0, -0.4]}, {body: a_end, at: [0, -0.4]}]}\n"
+      "  - {name: b_crush_zone, type: crush_spring, free_length: 0.4, curve: [[0, 0], [0.03, 1.2e6], [0.5, 1.2e6], [0.55, 2.5e6]],\n"
+      "     unloading_stiffness: 5.0e7, points: [{body: b_end, at: [0, 0]}, {body: b_body, at: [-10.0, 0]}]}\n"
+      "  - {name: b_draft_gear, type: draft_gear, initial_stiffness: 4.0e6, travel: 0.07, stiffness_after_bottoming: 1.0e5,\n"
+      "     hysteresis_load: 8.0e4, transition_stiffness: 1.0e8, points: [{body: b_end, at: [0, -0.4]}, {body: b_body, at: [-10.0, -0.4]}]}\n"
+      "  - {name: a_guide, type: slider_joint, axis: [1, 0], points: [{body: a_body, at: [10.0, 0]}, {body: a_end, at: [0, 0]}]}\n"
+      "  - {name: b_guide, type: slider_joint, axis: [1, 0], points: [{body: b_body, at: [-10.0, 0]}, {body: b_end, at: [0, 0]}]}\n"
+      "  - {name: anticlimber, type: anticlimber, points: [{body: a_end, at: [0, 0]}, {body: b_end, at: [0, 0]}],\n"
+      "     horizontal_elastic_stiffness: 8.0e8, horizontal_plastic_stiffness: 1.0e6, horizontal_yield_deflection: 0.0025,\n"
+      "     vertical_elastic_stiffness: 5.0e7, vertical_plastic_stiffness: 1.0e5, vertical_yield_deflection: 0.005,\n"
+      "     torsional_elastic_stiffness: 1.0e7, torsional_plastic_stiffness: 1.0e5, torsional_yield_deflection: 0.01,\n"
+      "     face_height: 0.3, length: 0.2}\n"
+      "responses: {crush: anticlimber, reference_crush: 0.01, anticlimber: anticlimber, reference_velocity: 8.0}\n"
+      "simulation: {t_end: 0.05, integrator: euler, dt: 2.0e-6, output_interval: 0.005}\n";
+  const Model model = testing::model_from_text(text);
+  const RunReport alone = run_model(model, "", nullptr);  // the responses alone (sensitivity's runs)
+  const RunReport with_writer = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);  // every column (the API's)
+  REQUIRE(alone.outcome.ok);
+  REQUIRE(with_writer.outcome.ok);
+  REQUIRE(alone.has_responses);
+  CHECK(alone.outcome.stats.steps == with_writer.outcome.stats.steps);
+  CHECK(alone.outcome.stats.steps > 1000);
+  CHECK(alone.responses.max_anticlimber_crush > 0.0025);  // past its yield
+  CHECK(alone.responses.max_anticlimber_crush == with_writer.responses.max_anticlimber_crush);
+  CHECK(alone.responses.max_vertical_force == with_writer.responses.max_vertical_force);
+  CHECK(alone.responses.r1 == with_writer.responses.r1);
+  CHECK(alone.responses.r2 == with_writer.responses.r2);
+  CHECK(alone.responses.r3 == with_writer.responses.r3);
+  CHECK(alone.outcome.y == with_writer.outcome.y);
 }

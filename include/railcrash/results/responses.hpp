@@ -63,6 +63,8 @@ class ResponseTracker : public RunObserver {
   /// The largest crush and forces from every accepted step and both sides of every event.
   void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
   bool observes_steps() const override { return true; }
+  /// The anticlimber's vertical force and horizontal deformation (the gauges read y alone).
+  void mark_step_columns(std::vector<char>& columns) const override;
   Responses result() const;
   /// The responses as a JSON object (for summary.json).
   std::string json() const;

@@ -247,7 +247,9 @@ class ResultWriter : public RunObserver {
   void sample_with_forces(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs,
                           const double* forces) override;
   void event(const EventRecord& record, const double* y) override;
-  /// Element output peaks and car crush from every accepted step and both sides of every event.
+  /// Element output peaks and car crush from every accepted step and both sides of every event:
+  /// every output column's (mark_step_columns' default), since the summary's peaks must not
+  /// depend on the output interval.
   void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
   bool observes_steps() const override { return true; }
   /// The first failed write (file and the OS's reason) or a vanished folder; "" while all is well.

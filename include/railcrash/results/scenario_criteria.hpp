@@ -153,6 +153,8 @@ class ScenarioTracker : public RunObserver {
   /// filters a uniform record).
   void step(double t, const double* y, const double* lambda, const double* outputs, const FreshOutputs& fresh) override;
   bool observes_steps() const override { return true; }
+  /// The survival cars' crush columns, the interface's offset and override, the wheels' and supports'.
+  void mark_step_columns(std::vector<char>& columns) const override;
   std::vector<CriterionResult> results() const;
   /// The scenario and its criteria as a JSON object (summary.json's "scenario").
   std::string json() const;

@@ -117,6 +117,9 @@ class DaeSystem {
     double* roots = nullptr;    // root_count(): what roots(t, y, roots) gives for y = (q, v, y_lambda)
     double* outputs = nullptr;  // output_names().size(): what outputs(y, y_lambda, outputs) gives
     const double* y_lambda = nullptr;  // the multipliers in y that the roots and outputs read
+    /// With `outputs`: per element, nonzero when its outputs are wanted (the others' places in
+    /// `outputs` are left as they were); null: every element's.
+    const char* output_elements = nullptr;
   };
   void generalized_forces(double t, const double* q, const double* v, double* f, const PenaltyRows* penalty = nullptr,
                           double* penalty_lambda = nullptr, const double* lambda = nullptr,
@@ -277,6 +280,10 @@ class DaeSystem {
   void outputs(const double* y, const double* lambda, double* out) const;
   /// Element e's outputs only, into their places in the whole array `out` (as outputs() fills it).
   void element_outputs(int e, const double* y, const double* lambda, double* out) const;
+  /// How many times element e's outputs have been evaluated by this system (outputs(),
+  /// element_outputs(), and the sweeps that fill outputs): what an integrator's per-step
+  /// output work costs, for the tests.
+  long output_evaluations(int e) const { return output_evaluations_[static_cast<std::size_t>(e)]; }
   /// Element e's columns of outputs(): first, one past the last.
   std::pair<int, int> output_range(int e) const {
     return {output_offset_[static_cast<std::size_t>(e)], output_end(static_cast<std::size_t>(e))};
@@ -336,6 +343,7 @@ class DaeSystem {
   // Mutable scratch of const evaluations; a DaeSystem belongs to one run on one thread.
   mutable std::vector<double> rotation_angle_;
   mutable std::vector<Rotation<double>> rotation_;
+  mutable std::vector<long> output_evaluations_;  // per element: output_evaluations()
 };
 
 }  // namespace railcrash

@@ -103,22 +103,27 @@ struct RunStatistics {
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
 };
 
-/// Which element outputs a RunObserver::step() call holds values of at its state: all of them
-/// (the end of an accepted step, a restart), or one element's alone (either side of that
+/// Which element outputs a RunObserver::step() call holds values of at its state: those of the
+/// elements the observer's step columns belong to (RunObserver::mark_step_columns: all of them
+/// when any observer asks for every column), or one element's alone (either side of that
 /// element's mode change located inside a step, where only its outputs are evaluated: every
 /// output at every such event made a train's cost grow as N^2). The other columns hold values
 /// from an earlier evaluation and must not be read.
 struct FreshOutputs {
   int begin = 0;                               // first evaluated column of DaeSystem::outputs
   int end = std::numeric_limits<int>::max();   // one past the last
-  bool has(int column) const { return column >= begin && column < end; }
+  /// Null: every column in [begin, end) is fresh; else only those marked nonzero here (one
+  /// entry per column of DaeSystem::outputs). Never set when an observer asked for every column.
+  const char* marked = nullptr;
+  bool has(int column) const { return column >= begin && column < end && (marked == nullptr || marked[column] != 0); }
   /// Whether every column of a sum over several outputs is fresh.
   bool has_all(const std::vector<int>& columns) const {
     for (const int column : columns)
       if (!has(column)) return false;
     return true;
   }
-  /// One past the last fresh column of an array of `count` columns.
+  /// One past the last fresh column of an array of `count` columns (with `marked` set, the
+  /// columns before it that are fresh are those has() names).
   std::size_t end_within(std::size_t count) const { return std::min(count, static_cast<std::size_t>(end)); }
 };
 
@@ -155,6 +160,14 @@ class RunObserver {
                     const FreshOutputs& /*fresh*/) {}
   /// True when step() does something: only then does the run loop evaluate the outputs per step.
   virtual bool observes_steps() const { return false; }
+  /// Marks (sets to 1) the columns of DaeSystem::outputs that step() reads; `columns` has one
+  /// entry per column. Asked once at the start of a run when observes_steps(). Per step, the
+  /// run loop evaluates only the outputs of the elements whose columns some observer marked
+  /// (an element's outputs come from one evaluation); every row still has all of them. The
+  /// default marks every column: an observer that tracks the extremes of all outputs (the
+  /// summary's peaks) keeps it; one that reads a few columns names them, so that the other
+  /// elements' outputs are not computed at every step.
+  virtual void mark_step_columns(std::vector<char>& columns) const { std::fill(columns.begin(), columns.end(), char{1}); }
   /// Why the observer cannot go on (a failed write: the OS's reason), "" while it can; the
   /// run loop stops at once when it is not empty.
   virtual std::string failure() const { return ""; }
@@ -273,6 +286,11 @@ class Integrator {
   /// Whether the observer takes every step's element outputs (an integrator that can compute
   /// them with other work hands them over through current_outputs()).
   bool step_outputs_wanted() const { return observe_steps_; }
+  /// Per element of the model, nonzero when some observer's step() reads one of its outputs
+  /// (RunObserver::mark_step_columns); null when every element's are read (or none, when
+  /// !step_outputs_wanted()). An integrator that hands over current_outputs() need compute
+  /// only these elements' outputs per step (DaeSystem::SweepExtras::output_elements).
+  const char* step_output_elements() const { return observe_steps_ && !step_elements_.empty() ? step_elements_.data() : nullptr; }
   /// The state and quadratures at t for a successor (hand_over): as state_at gives them.
   void state_for_successor(double t, std::vector<double>& y, std::vector<double>& quadratures) { state_at(t, y, quadratures); }
 
@@ -309,6 +327,12 @@ class Integrator {
   bool time_phases_ = false;         // time_phases()
   PhaseClock phase_clock_;
   std::vector<double> step_outputs_;  // element outputs at the last step
+  /// What the observer's step() reads, when it is not every element's outputs (else empty):
+  /// per element, whether its outputs are evaluated per step (step_output_elements()), and per
+  /// column of DaeSystem::outputs, whether it belongs to such an element (FreshOutputs::marked).
+  std::vector<char> step_elements_, step_columns_;
+  /// Sets step_elements_ and step_columns_ from the observer's mark_step_columns.
+  void choose_step_outputs();
 };
 
 /// Largest |Phi| tracker shared by the integrators.
