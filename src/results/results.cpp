@@ -1,5 +1,5 @@
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/accuracy_check.hpp"
+#include "railcrash/results/results.hpp"
 
 #include <algorithm>
 #include <fcntl.h>
@@ -17,12 +17,12 @@
 #include <map>
 #include <sstream>
 
+#include "railcrash/core/whole_file.hpp"
 #include "railcrash/results/buffered_file.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/output_points.hpp"
 #include "railcrash/results/provenance.hpp"
 #include "railcrash/results/run_files.hpp"
-#include "railcrash/core/whole_file.hpp"
 
 namespace railcrash {
 

@@ -8,13 +8,13 @@
 #include <new>
 #include <sstream>
 
+#include "railcrash/core/progress.hpp"
+#include "railcrash/results/responses.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/results/scenario_criteria.hpp"
 #include "railcrash/solver/auto_integrator.hpp"
 #include "railcrash/solver/euler_integrator.hpp"
 #include "railcrash/solver/ida_integrator.hpp"
-#include "railcrash/core/progress.hpp"
-#include "railcrash/results/responses.hpp"
-#include "railcrash/results/scenario_criteria.hpp"
-#include "railcrash/results/results.hpp"
 
 namespace railcrash {
 

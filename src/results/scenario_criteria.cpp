@@ -9,14 +9,14 @@
 #include <limits>
 #include <sstream>
 
-#include "railcrash/solver/dae_system.hpp"
-#include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/model.hpp"
 #include "railcrash/model/yaml_reader.hpp"
-#include "railcrash/results/results.hpp"
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/crash_pulse.hpp"
+#include "railcrash/results/results.hpp"
+#include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/initial_conditions.hpp"
 
 namespace railcrash {
 namespace {

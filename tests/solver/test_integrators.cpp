@@ -6,12 +6,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "railcrash/solver/euler_integrator.hpp"
-#include "railcrash/solver/ida_integrator.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/responses.hpp"
 #include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
+#include "railcrash/solver/euler_integrator.hpp"
+#include "railcrash/solver/ida_integrator.hpp"
 #include "support.hpp"
 
 using namespace railcrash;

@@ -76,12 +76,12 @@
 #include <vector>
 
 #include "railcrash/core/folder_lock.hpp"
-#include "railcrash/solver/integrator.hpp"
+#include "railcrash/core/json_text.hpp"  // json_string, valid_utf8
 #include "railcrash/results/crash_pulse.hpp"
 #include "railcrash/results/crush_zones.hpp"
 #include "railcrash/results/output_sink.hpp"
 #include "railcrash/results/provenance.hpp"
-#include "railcrash/core/json_text.hpp"  // json_string, valid_utf8
+#include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {
 

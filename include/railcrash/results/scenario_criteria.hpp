@@ -52,9 +52,9 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/solver/integrator.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/results.hpp"
+#include "railcrash/solver/integrator.hpp"
 
 namespace YAML {
 class Node;
