@@ -254,6 +254,11 @@ if (m[1] !== "ran" || check.errors.length) problems.push("wall: script errors " 
 const drawn = check.surfaces || [];
 if (drawn.length !== 1 || drawn[0].element !== "wall" || drawn[0].kind !== "line" || !drawn[0].on_canvas)
   problems.push("wall: not drawn on the canvas: " + JSON.stringify(drawn));
+// The unit's car bodies (points along the underframe and at the bogie pivots: 0.9 m over 24.4 m)
+// are drawn as boxes 0.15 of their length high, not as slivers; every body at least that.
+const outlines = check.body_outlines;
+if (!outlines || !(outlines.drawn_as_boxes >= 3) || !(outlines.thinnest_height_per_length >= 0.15 - 1e-12))
+  problems.push("wall: bodies drawn as slivers: " + JSON.stringify(outlines));
 if (problems.length) { console.log(problems.join("\n")); process.exit(1); }
 console.log("wall ok: drawn at " + JSON.stringify(drawn[0].point_px) + " px");
 JS

@@ -741,9 +741,27 @@
   var haveAnimation = frames && frames.t && frames.t.length > 0 && model && model.bodies;
   if (haveAnimation) {
     frames.bodies.forEach(function (name, k) { bodyIndex[name] = k; });
+    var thinBodies = 0, thinnest = Infinity;
     model.bodies.forEach(function (b) {
-      hulls.push(hull(b.points.concat([[0, 0]])));  // with the centre of mass: no flat outline of collinear points
+      var h = hull(b.points.concat([[0, 0]]));  // with the centre of mass: no flat outline of collinear points
+      // A long, flat outline (a multiple unit's car body: points along its underframe and at its
+      // bogie pivots, 0.9 m high over 24 m) would show as a sliver: such a body is drawn as the
+      // box around its outline, made kMinBodyAspect of its length high about the outline's middle.
+      var kMinBodyAspect = 0.15;
+      var xs = h.map(function (p) { return p[0]; }), ys = h.map(function (p) { return p[1]; });
+      var length = Math.max.apply(null, xs) - Math.min.apply(null, xs);
+      var height = Math.max.apply(null, ys) - Math.min.apply(null, ys);
+      if (length > 0 && height < kMinBodyAspect * length) {
+        var x0 = Math.min.apply(null, xs), x1 = Math.max.apply(null, xs);
+        var ym = 0.5 * (Math.max.apply(null, ys) + Math.min.apply(null, ys)), half = 0.5 * kMinBodyAspect * length;
+        h = [[x0, ym - half], [x1, ym - half], [x1, ym + half], [x0, ym + half]];
+        ++thinBodies;
+        height = 2 * half;
+      }
+      if (length > 0) thinnest = Math.min(thinnest, height / length);
+      hulls.push(h);
     });
+    check.body_outlines = {bodies: model.bodies.length, drawn_as_boxes: thinBodies, thinnest_height_per_length: thinnest};
     elements.forEach(function (e, k) {
       var values = frames.force[k];
       var peak = 0;
@@ -1065,7 +1083,7 @@
       });
     } else {
       box.appendChild(document.createTextNode("Element colour: |force| / its peak over the run, grey (0) to red (peak); " +
-                                              "thin lines: joints. Bodies: polygons of their connection points. Length unit: " + lengthUnit));
+                                              "thin lines: joints. Bodies: polygons of their connection points (a long, flat one: a box 0.15 of its length high). Length unit: " + lengthUnit));
     }
   }
   legend();
