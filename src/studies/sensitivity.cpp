@@ -182,12 +182,6 @@ void load_reference(const std::string& path, const YAML::Node& node, Sensitivity
   design.reference = std::move(reference);
 }
 
-std::string number_text(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-
 std::string parameter_value_text(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "P = %.6g", value);
