@@ -34,7 +34,9 @@
 //                                                          rejoins U going up -> loading;
 //                                                          meets Lw going down -> unloading,
 //                                                          or P = 0 first -> released (x > 0)
-//                                                          or leaves the side. (Where K_t
+//                                                          or leaves the side; each exit once
+//                                                          past its point AND moving that way
+//                                                          (x' > 0 up, x' < 0 down). (Where K_t
 //                                                          equals a curve's slope the line
 //                                                          runs parallel to it: a bottomed
 //                                                          gear stays elastic, solid.)
