@@ -27,7 +27,12 @@ def shipped_models():
     models = []
     for pattern in ("models/examples/*.yaml", "models/report/*.yaml", "models/barrier/*.yaml",
                     "models/scenarios/*.yaml", "tests/robustness/models/*.yaml"):
-        models += sorted(m for m in glob.glob(os.path.join(ROOT, pattern)) if not m.endswith("_plan.yaml"))
+        for path in sorted(glob.glob(os.path.join(ROOT, pattern))):
+            with open(path) as f:
+                text = f.read()
+            # Models and variants of one (not plans, designs or sweeps).
+            if any(line.startswith(("simulation:", "base:")) for line in text.splitlines()):
+                models.append(path)
     return [os.path.relpath(m, ROOT) for m in models]
 
 

@@ -131,13 +131,12 @@ void AxialHysteresis::roots(const State& st, double u, double rate, double* g) c
       break;
     case Mode::Transition: {
       // Leaves where the line rejoins U going up, or meets Lw / zero force going down: past
-      // the boundary AND moving that way. (A gear at rest on its reversal point is not back on
-      // U when x creeps a few 1e-14 past it while x' < 0: the constraints' position correction
-      // moves x without x'. Without the rate it chattered between loading and transition
-      // there: 1.15 million events in emu3_unit_collision at rtol 1e-3.)
+      // the boundary AND moving that way (hybrid.hpp). Without the rate a gear resting on its
+      // reversal point chattered between loading and transition there (x crept 1e-14 past it
+      // while x' < 0): 1.15 million events in emu3_unit_collision at rtol 1e-3.
       const double up = rejoin_upper(st.x0, st.f0);
-      if (std::isfinite(up)) g[0] = std::max(up - x + tolerance, -x_rate);
-      g[1] = std::max(x - std::max(rejoin_lower(st.x0, st.f0), st.x0 - st.f0 / kt) + tolerance, x_rate);
+      if (std::isfinite(up)) g[0] = position_root_moving_on(up - x + tolerance, x_rate);
+      g[1] = position_root_moving_on(x - std::max(rejoin_lower(st.x0, st.f0), st.x0 - st.f0 / kt) + tolerance, -x_rate);
       break;
     }
     case Mode::Unloading:

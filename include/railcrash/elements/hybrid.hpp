@@ -10,6 +10,16 @@
 
 namespace railcrash {
 
+/// A position root on a history law's way back (an elastic line rejoining a curve, a gap
+/// closing or opening): `distance` <= 0 once past the point, `rate` >= 0 moving across it. It is
+/// crossed only while moving on; moving back it stays positive whatever the position, since the
+/// constraints' position correction moves a deflection without its rate (a law resting on its
+/// reversal point chattered between its two modes at one instant: bench/event_storms.py). At
+/// rest (rate exactly 0: a static settle, a start at rest) the position alone decides.
+inline double position_root_moving_on(double distance, double rate) {
+  return rate == 0.0 ? distance : (distance > -rate ? distance : -rate);
+}
+
 /// Adapter for a hybrid force element (design.md section 3: a piecewise law, smooth within each
 /// mode, whose root functions say when to leave the mode). Derived writes its force law as for
 /// ForceElement, declares its mode and history as a trivially copyable `State` (its slot, with
