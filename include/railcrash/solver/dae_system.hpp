@@ -261,8 +261,8 @@ class DaeSystem {
   ElementLoad element_load(int e, double t, const double* y) const;
   /// At a (re)start at (t, y, y'): the roots that sit on their mode's boundary and are about to
   /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y' (t_end:
-  /// the run's end in its settings [time]; roots
-  /// that fire within h are taken as simultaneous with the restart), and roots already
+  /// the run's end in its settings [time]; roots that fire within h are taken as simultaneous
+  /// with the restart), and roots already
   /// negative (the state is outside its mode, e.g. after the initial assembly moved it):
   /// direction[k] = -1 for each (root_count() entries), else 0; true when any. Elements switch
   /// a small band past their boundaries (1e-14 to 1e-12 of their size), so a state exactly on a
