@@ -614,7 +614,10 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   };
   // The model's penalty settings, t_end and static settle (max_steps: Euler's default).
   const auto euler_settings = [&simulation](double dt, bool force_dt) {
-    EulerSettings settings{dt, force_dt, simulation.penalty};
+    EulerSettings settings;
+    settings.dt = dt;
+    settings.force_dt = force_dt;
+    settings.penalty = simulation.penalty;
     settings.run = {simulation.t_end, simulation.static_equilibrium};
     return settings;
   };
