@@ -1,7 +1,7 @@
 // The public interface (api.hpp) over the loader and run_model. A Model keeps the YAML text
-// and the settings, not the loaded model and run settings (LoadedModel): every run loads its own copy (as the sensitivity
-// study does), so runs of one Model from several threads never share anything (element modes
-// and histories live in each run's ElementStates, model.hpp).
+// and the settings, not the loaded model and its run settings (LoadedModel): every run loads
+// its own pair (as the sensitivity study does), so runs of one Model from several threads
+// never share anything (element modes and histories live in each run's ElementStates, model.hpp).
 #include "railcrash/api.hpp"
 
 #include <cmath>

@@ -143,6 +143,21 @@ TEST_CASE("Euler needs positive inertia", "[integrators]") {
   CHECK_THROWS_WITH(make_integrator(system, loaded.run_spec.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
 }
 
+TEST_CASE("Euler counts its steps to the t_end its settings give it, not the model file's", "[integrators]") {
+  // The file says t_end 1; Euler takes t_end from its settings (CommonRunSettings): at dt 1e-3
+  // it needs ceil(t_end / dt) steps, refused above max_steps.
+  const Model model = testing::model_from_text(oscillator(200.0, 0.0, 1.0));
+  DaeSystem system(model);
+  EulerSettings settings;
+  settings.dt = 1e-3;  // [s] below the stability limit 0.2 s
+  settings.max_steps = 100;
+  settings.run.t_end = 0.05;  // [s] 50 steps
+  CHECK_NOTHROW(EulerIntegrator(system, settings));
+  settings.run.t_end = 0.5;  // [s] 500 steps
+  CHECK_THROWS_WITH(EulerIntegrator(system, settings),
+                    Catch::Contains("needs 500 steps to reach t_end = 0.5, more than --max-steps 100"));
+}
+
 TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
     LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));

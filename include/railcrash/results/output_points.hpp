@@ -19,6 +19,7 @@ std::vector<std::string> output_point_columns(const std::vector<OutputPoint>& ou
 
 /// Their values at a state: q and v (3 per body: x, y, theta and their rates), acceleration
 /// (3 per body). `out` is resized to the number of columns.
-void output_point_values(const std::vector<OutputPoint>& output_points, const double* q, const double* v, const double* acceleration, std::vector<double>& out);
+void output_point_values(const std::vector<OutputPoint>& output_points, const double* q, const double* v, const double* acceleration,
+                         std::vector<double>& out);
 
 }  // namespace railcrash
