@@ -129,15 +129,15 @@ std::string source_commit(const std::string& source) {
 }
 
 /// The 2N-car consist built from the template, through a model file (so it is loaded like any other).
-Model load_consist(const std::string& template_path, int cars, const RunOverrides& overrides = {}) {
+LoadedModel load_consist(const std::string& template_path, int cars, const RunOverrides& overrides = {}) {
   const auto file = std::filesystem::temp_directory_path() / ("railcrash_bench_consist_" + std::to_string(cars) + ".yaml");
   {
     std::ofstream out(file);
     out << make_consist_model(template_path, cars);
   }
-  Model model = load_model(file.string(), {}, option_settings(overrides));
+  LoadedModel loaded = load_model(file.string(), {}, option_settings(overrides));
   std::filesystem::remove(file);
-  return model;
+  return loaded;
 }
 
 int consist_benchmark(const std::string& template_path, const std::vector<int>& cars, double t_end,
@@ -158,10 +158,11 @@ int consist_benchmark(const std::string& template_path, const std::vector<int>& 
     RunOverrides overrides;
     overrides.t_end = t_end;
     overrides.output_interval = t_end / 100.0;
-    const Model model = load_consist(template_path, n, overrides);
+    const LoadedModel loaded = load_consist(template_path, n, overrides);
+    const Model& model = loaded.model;
     const double cpu_start = cpu_seconds();
     const auto wall_start = std::chrono::steady_clock::now();
-    const RunReport report = run_model(model, "", nullptr, false, false, "csv", /*time_phases=*/true);
+    const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, false, "csv", /*time_phases=*/true);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     const double cpu = cpu_seconds() - cpu_start;
     const RunStatistics& s = report.outcome.stats;
@@ -260,7 +261,7 @@ int kernels_benchmark(const std::string& template_path, const std::vector<int>& 
   table << line;
   std::fputs(line, stdout);
   for (const int n : cars) {
-    const Model model = load_consist(template_path, n);
+    const Model model = load_consist(template_path, n).model;
     DaeSystem system(model);
     // Two states that differ in every body's angle by a round-off amount, evaluated in turn:
     // as in a run, every evaluation computes each body's rotation afresh (the cache in
@@ -433,10 +434,11 @@ class RowNumbers : public RunObserver {
 };
 
 int numbers_benchmark(const std::string& model_path, const std::string& results, const std::string& commit) {
-  Model model = load_model(model_path);
-  DaeSystem system(model);
+  const LoadedModel loaded = load_model(model_path);
+  const SimulationSettings& simulation = loaded.run_spec.simulation;
+  DaeSystem system(loaded.model);
   RowNumbers rows(system);
-  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, model.run_spec.simulation.output_interval, rows);
+  const RunOutcome outcome = make_integrator(system, simulation)->run(simulation.t_end, simulation.output_interval, rows);
   if (!outcome.ok) throw std::runtime_error("the run failed: " + outcome.message);
   const std::vector<double>& numbers = rows.numbers;
   std::vector<char> text(numbers.size() * 33);

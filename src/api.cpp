@@ -1,7 +1,7 @@
 // The public interface (api.hpp) over the loader and run_model. A Model keeps the YAML text
-// and the settings, not the loaded model: every run loads its own copy (as the sensitivity
-// study does), so runs of one Model from several threads never share anything (element modes
-// and histories live in each run's ElementStates, model.hpp).
+// and the settings, not the loaded model and its run settings (LoadedModel): every run loads
+// its own pair (as the sensitivity study does), so runs of one Model from several threads
+// never share anything (element modes and histories live in each run's ElementStates, model.hpp).
 #include "railcrash/api.hpp"
 
 #include <cmath>
@@ -38,7 +38,8 @@ struct Access {
 
   /// Loads (so every problem shows now) and keeps what the accessors report.
   static Model make(std::string text, std::string path, std::string source, std::vector<std::string> settings) {
-    const railcrash::Model loaded = load_model_text(text, source, settings);
+    const LoadedModel file = load_model_text(text, source, settings);
+    const railcrash::Model& loaded = file.model;
     auto impl = std::make_shared<Model::Impl>();
     impl->text = std::move(text);
     impl->path = std::move(path);
@@ -48,8 +49,8 @@ struct Access {
     impl->units = unit_system_name(loaded.units);
     for (const Body& b : loaded.bodies()) impl->bodies.push_back(b.name);
     for (const auto& e : loaded.elements()) impl->elements.emplace_back(e->name(), e->type());
-    impl->t_end = loaded.run_spec.simulation.t_end;
-    impl->columns = timeseries_columns(DaeSystem(loaded));
+    impl->t_end = file.run_spec.simulation.t_end;
+    impl->columns = timeseries_columns(DaeSystem(loaded), file.run_spec.output_points);
     return Model(std::move(impl));
   }
 };
@@ -112,9 +113,10 @@ Results run(const Model& model, const RunSettings& settings, const std::atomic<b
   // Through the loader, as the command line's options: checked and listed in the provenance alike.
   std::vector<OptionSetting> options = option_settings(overrides, OverrideSource::RunSettings);
   options.insert(options.begin(), unknown_integrator.begin(), unknown_integrator.end());
-  const railcrash::Model loaded = load_model_text(m.text, m.source, m.settings, options);
+  const LoadedModel file = load_model_text(m.text, m.source, m.settings, options);
+  const railcrash::Model& loaded = file.model;
 
-  RunReport report = run_model(loaded, "", stop, false, /*keep_in_memory=*/true, "csv", settings.timings);
+  RunReport report = run_model(loaded, file.run_spec, "", stop, false, /*keep_in_memory=*/true, "csv", settings.timings);
   Results results;
   results.columns = std::move(report.columns);
   results.values = std::move(report.series);

@@ -14,7 +14,9 @@
 
 namespace railcrash::testing {
 
-Model model_from_text(const std::string& yaml) { return load_model_text(yaml, "test.yaml"); }
+Model model_from_text(const std::string& yaml) { return load_model_text(yaml, "test.yaml").model; }
+
+LoadedModel loaded_from_text(const std::string& yaml) { return load_model_text(yaml, "test.yaml"); }
 
 double jacobian_error(const DaeSystem& system, double t, double cj, const std::vector<double>& y,
                       const std::vector<double>& yp, double* outside_pattern) {
@@ -59,17 +61,16 @@ double jacobian_error(const DaeSystem& system, double t, double cj, const std::v
   return worst;
 }
 
-RunOutcome simulate(const Model& model, double output_interval) {
-  DaeSystem system(model);
-  return simulate(system, output_interval);
+RunOutcome simulate(const LoadedModel& loaded, double output_interval) {
+  DaeSystem system(loaded.model);
+  return simulate(system, loaded.run_spec.simulation, output_interval);
 }
 
-RunOutcome simulate(DaeSystem& system, double output_interval) {
-  const Model& model = system.model();
+RunOutcome simulate(DaeSystem& system, const SimulationSettings& simulation, double output_interval) {
   struct Quiet : RunObserver {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
-  RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, output_interval, observer);
+  RunOutcome outcome = make_integrator(system, simulation)->run(simulation.t_end, output_interval, observer);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   return outcome;

@@ -6,13 +6,16 @@
 #include <vector>
 
 #include "railcrash/model/model.hpp"
+#include "railcrash/model/model_io.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/integrator.hpp"
 
 namespace railcrash::testing {
 
-/// Loads a model from YAML text (file name "test.yaml" in messages).
+/// Loads a model from YAML text (file name "test.yaml" in messages): the physical model alone.
 Model model_from_text(const std::string& yaml);
+/// The same with the run's settings beside it.
+LoadedModel loaded_from_text(const std::string& yaml);
 
 /// Largest relative difference between the assembled Jacobian dF/dy + cj dF/dy' and a
 /// central finite difference of the residual, at the given y, yp, beyond the difference
@@ -22,11 +25,12 @@ Model model_from_text(const std::string& yaml);
 double jacobian_error(const DaeSystem& system, double t, double cj, const std::vector<double>& y,
                       const std::vector<double>& yp, double* outside_pattern = nullptr);
 
-/// Runs the model with the integrator its settings ask for (no files, output every
+/// Runs the model with the integrator its run settings ask for (no files, output every
 /// output_interval) and requires success.
-RunOutcome simulate(const Model& model, double output_interval = 0.01);
-/// The same on a given system, whose element modes then hold the run's final ones.
-RunOutcome simulate(DaeSystem& system, double output_interval = 0.01);
+RunOutcome simulate(const LoadedModel& loaded, double output_interval = 0.01);
+/// The same on a given system (with the run's simulation settings), whose element modes then
+/// hold the run's final ones.
+RunOutcome simulate(DaeSystem& system, const SimulationSettings& simulation, double output_interval = 0.01);
 
 /// Puts element e of the system in mode st (State: the element's declared slot type).
 template <class State>

@@ -78,11 +78,11 @@ TEST_CASE("api: results in memory are the files railcrash run writes", "[api]") 
   // The same run through run_model with a folder.
   railcrash::RunOverrides overrides;
   overrides.rtol = 1e-4;
-  const railcrash::Model loaded = railcrash::load_model(kTwoCar, {"simulation.t_end=0.02"}, railcrash::option_settings(overrides));
+  const railcrash::LoadedModel loaded = railcrash::load_model(kTwoCar, {"simulation.t_end=0.02"}, railcrash::option_settings(overrides));
   const std::string dir =
       (std::filesystem::temp_directory_path() / ("railcrash_api_test_" + std::to_string(::getpid()))).string();
   std::filesystem::remove_all(dir);
-  const railcrash::RunReport report = railcrash::run_model(loaded, dir);
+  const railcrash::RunReport report = railcrash::run_model(loaded.model, loaded.run_spec, dir);
   REQUIRE(report.outcome.ok);
 
   std::ifstream csv(dir + "/timeseries.csv");
@@ -363,9 +363,10 @@ TEST_CASE("api: atol is in the model file's length unit, as simulation.atol and 
   REQUIRE(from_file.ok());
   railcrash::RunOverrides command_line;
   command_line.atol = 0.01;
-  const railcrash::RunReport from_option = railcrash::run_model(
-      railcrash::load_model_text(kDraftGearMm, "draft_gear.yaml", {}, railcrash::option_settings(command_line)), "", nullptr, false,
-      /*keep_in_memory=*/true);
+  const railcrash::LoadedModel with_option =
+      railcrash::load_model_text(kDraftGearMm, "draft_gear.yaml", {}, railcrash::option_settings(command_line));
+  const railcrash::RunReport from_option =
+      railcrash::run_model(with_option.model, with_option.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
   REQUIRE(from_option.outcome.ok);
   CHECK(from_api.columns == from_file.columns);
   CHECK(from_api.values == from_file.values);  // the same doubles, every sample

@@ -55,14 +55,15 @@ class BarrierRecorder : public RunObserver {
   BarrierRun& run_;
 };
 
-BarrierRun run_barrier(const std::vector<std::string>& overrides, Model& model) {
-  model = load_model(kModel, overrides);
-  DaeSystem system(model);
+BarrierRun run_barrier(const std::vector<std::string>& overrides, LoadedModel& loaded) {
+  loaded = load_model(kModel, overrides);
+  const SimulationSettings& simulation = loaded.run_spec.simulation;
+  DaeSystem system(loaded.model);
   BarrierRun run;
   run.output_names = system.output_names();
   BarrierRecorder recorder(system, run);
-  auto integrator = make_integrator(system, model.run_spec.simulation);
-  run.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), recorder);
+  auto integrator = make_integrator(system, simulation);
+  run.outcome = integrator->run(simulation.t_end, output_interval_of(simulation), recorder);
   REQUIRE(run.outcome.ok);
   return run;
 }
@@ -298,9 +299,9 @@ void write_plots(const Figures& f) {
 
 TEST_CASE("two-car barrier test: longitudinal figures within the source's measurements", "[verification][barrier]") {
   start_table();
-  Model ida_model, euler_model;
+  LoadedModel ida_model, euler_model;
   const BarrierRun ida = run_barrier({}, ida_model);
-  const Figures f = figures_of(ida, ida_model);
+  const Figures f = figures_of(ida, ida_model.model);
   write_plots(f);
 
   // Measured values: the source's Appendix ("Vehicle motions and forces") and Figure A-12.
@@ -336,7 +337,7 @@ TEST_CASE("two-car barrier test: longitudinal figures within the source's measur
   // Explicit Euler below its stability limit: the same longitudinal figures within 2 %.
   const BarrierRun euler = run_barrier({"simulation.integrator=euler"}, euler_model);
   REQUIRE(euler.outcome.stats.stability_limit > euler_model.run_spec.simulation.dt);
-  const Figures e = figures_of(euler, euler_model);
+  const Figures e = figures_of(euler, euler_model.model);
   const auto agree = [](const std::string& quantity, double reference, double value) {
     row("Euler dt=5e-6 vs IDA: " + quantity, reference, value, 0.02, "%.7g");
   };

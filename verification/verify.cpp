@@ -50,13 +50,14 @@ std::string case_path(const std::string& name) { return std::string(RAILCRASH_SO
 
 /// Runs verification/cases/<name>.yaml with optional KEY=VALUE overrides.
 Trajectory simulate(const std::string& name, const std::vector<std::string>& overrides = {}) {
-  const Model model = load_model(case_path(name), overrides);
-  DaeSystem system(model);
+  const LoadedModel loaded = load_model(case_path(name), overrides);
+  const SimulationSettings& simulation = loaded.run_spec.simulation;
+  DaeSystem system(loaded.model);
   Trajectory trajectory;
   Recorder recorder(trajectory);
   recorder.size = system.size();
-  auto integrator = make_integrator(system, model.run_spec.simulation);
-  trajectory.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), recorder);
+  auto integrator = make_integrator(system, simulation);
+  trajectory.outcome = integrator->run(simulation.t_end, output_interval_of(simulation), recorder);
   REQUIRE(trajectory.outcome.ok);
   return trajectory;
 }

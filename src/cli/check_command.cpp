@@ -17,7 +17,8 @@ namespace {
 
 int check_model(const std::string& path, const std::vector<std::string>& settings) {
   using namespace railcrash;
-  const Model model = load_model(path, settings);
+  const LoadedModel loaded = load_model(path, settings);
+  const Model& model = loaded.model;
   const DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   AssemblyReport assembly;
@@ -86,7 +87,8 @@ int check_model(const std::string& path, const std::vector<std::string>& setting
     const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
-  std::printf("simulation t_end %g, integrator %s\n", model.run_spec.simulation.t_end, integrator_name(model.run_spec.simulation.integrator));
+  const SimulationSettings& simulation = loaded.run_spec.simulation;
+  std::printf("simulation t_end %g, integrator %s\n", simulation.t_end, integrator_name(simulation.integrator));
   return 0;
 }
 

@@ -24,7 +24,8 @@ int run_and_print(const std::string& path, const std::vector<std::string>& setti
   using namespace railcrash;
   if (out_dir.empty()) throw InputError(path + ": --out is empty; give the output folder, e.g. --out results");
   require_output_format(format);
-  Model model = load_model(path, settings, option_settings(overrides));  // --set, then the run options
+  const LoadedModel loaded = load_model(path, settings, option_settings(overrides));  // --set, then the run options
+  const Model& model = loaded.model;
   // The folder is this run's: locked against a second writer, then an earlier run's files go
   // (the writer would remove them too), said here.
   const FolderLock folder_lock(out_dir);
@@ -35,7 +36,7 @@ int run_and_print(const std::string& path, const std::vector<std::string>& setti
     std::printf("removed the files of an earlier run from %s/: %s\n", out_dir.c_str(), names.c_str());
   }
   catch_interrupts();
-  const RunReport report = run_model(model, out_dir, &interrupted(), !quiet, /*keep_in_memory=*/false, format, timings);
+  const RunReport report = run_model(model, loaded.run_spec, out_dir, &interrupted(), !quiet, /*keep_in_memory=*/false, format, timings);
   const RunOutcome& o = report.outcome;
   const EnergyBalance energy = EnergyBalance::between(o.initial_energy, o.final_energy);
   std::printf("%s: %s with %s to t = %g in %.3g s (%ld steps, %ld residual evaluations)\n", model.name.c_str(),

@@ -637,7 +637,7 @@ Load read_load(const Reader& r, const YAML::Node& node, const Model& model) {
   return load;
 }
 
-void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
+void read_outputs(const Reader& r, const YAML::Node& node, const Model& model, std::vector<OutputPoint>& output_points) {
   r.require_list(node, "outputs");
   std::vector<std::string> taken;  // names whose columns exist already
   for (const Body& b : model.bodies()) taken.push_back(b.name);
@@ -656,7 +656,7 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
       output.name = r.name(item["name"], context + ": name");
     } else {
       int k = 1;
-      for (const OutputPoint& o : model.run_spec.output_points) k += o.point.body == index;
+      for (const OutputPoint& o : output_points) k += o.point.body == index;
       output.name = body + "_point" + std::to_string(k);
     }
     if (std::find(taken.begin(), taken.end(), output.name) != taken.end())
@@ -676,14 +676,13 @@ void read_outputs(const Reader& r, const YAML::Node& node, Model& model) {
       }
       if (list.size() == 0) r.fail(list, context + ": quantities is empty; list position, velocity and/or acceleration");
     }
-    model.run_spec.output_points.push_back(output);
+    output_points.push_back(output);
   }
 }
 
-void read_responses(const Reader& r, const YAML::Node& node, Model& model) {
+void read_responses(const Reader& r, const YAML::Node& node, const Model& model, ResponseSettings& s) {
   r.require_map(node, "responses");
   r.check_keys(node, kResponseKeys, "responses");
-  ResponseSettings& s = model.run_spec.responses;
   if (node["crush_gauges"]) {
     r.require_list(node["crush_gauges"], "responses: crush_gauges");
     for (std::size_t i = 0; i < node["crush_gauges"].size(); ++i) {
@@ -867,10 +866,12 @@ ScenarioSectionReader& scenario_section_reader() {
   return reader;
 }
 
-Model build(const YAML::Node& root, Reader& r) {
+LoadedModel build(const YAML::Node& root, Reader& r) {
   if (!root.IsMap()) r.fail(root, "a model file must be a YAML map with keys railcrash, name, units, bodies, elements, simulation");
   r.check_keys(root, kTopKeys, "model");
-  Model model;
+  LoadedModel loaded;
+  Model& model = loaded.model;
+  RunSpec& run_spec = loaded.run_spec;
   model.file = r.file();
   const YAML::Node version = r.required(root, "railcrash", "model (format version: add 'railcrash: 1')");
   if (r.number(version, "railcrash (format version)") != 1.0)
@@ -910,16 +911,16 @@ Model build(const YAML::Node& root, Reader& r) {
     r.require_list(root["loads"], "loads");
     for (std::size_t i = 0; i < root["loads"].size(); ++i) model.add_load(read_load(r, root["loads"][i], model));
   }
-  if (root["responses"]) read_responses(r, root["responses"], model);
-  if (root["outputs"]) read_outputs(r, root["outputs"], model);
+  if (root["responses"]) read_responses(r, root["responses"], model, run_spec.responses);
+  if (root["outputs"]) read_outputs(r, root["outputs"], model, run_spec.output_points);
   if (root["scenario"]) {
     if (!scenario_section_reader())
       r.fail(root["scenario"], "scenario: this program reads no scenario sections (the scenario layer is not linked in); remove the section");
-    model.run_spec.scenario = scenario_section_reader()(root["scenario"], model, r.scale().length,
-                                                        [&r](const YAML::Node& node, const std::string& message) { r.fail(node, message); });
+    run_spec.scenario = scenario_section_reader()(root["scenario"], model, r.scale().length,
+                                                  [&r](const YAML::Node& node, const std::string& message) { r.fail(node, message); });
   }
-  read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), model.run_spec.simulation);
-  return model;
+  read_simulation(r, r.required(root, "simulation", "model (add a simulation section with at least t_end)"), run_spec.simulation);
+  return loaded;
 }
 
 }  // namespace
@@ -1034,7 +1035,7 @@ void apply_settings(YAML::Node& root, const std::vector<VariantSetting>& setting
 }
 
 /// The model of a parsed model file (`root`, the text `text` read from `path`), with the settings applied.
-Model model_from_yaml(YAML::Node root, const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+LoadedModel model_from_yaml(YAML::Node root, const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
                       const std::vector<OptionSetting>& options) {
   std::string file = path;
   std::vector<VariantSetting> variant_settings;
@@ -1046,12 +1047,13 @@ Model model_from_yaml(YAML::Node root, const std::string& text, const std::strin
   if (root.IsMap() || root.IsNull())  // otherwise build() says what the file should look like
     apply_settings(root, all_settings(variant_settings, overrides, options, reader.file()), reader, expansion);
   try {
-    Model model = build(root, reader);
+    LoadedModel loaded = build(root, reader);
+    Model& model = loaded.model;
     model.sources = std::move(sources);
     model.settings = overrides;
     for (const OptionSetting& o : options) model.settings.push_back(o.setting);
     model.finalize();
-    return model;
+    return loaded;
   } catch (const YAML::Exception& e) {  // a check above missed a case: still an input error with a line
     throw InputError(SourceLocation{file, e.mark.is_null() ? 0 : e.mark.line + 1}.prefix() + "cannot read the model: " + e.msg);
   }
@@ -1059,8 +1061,8 @@ Model model_from_yaml(YAML::Node root, const std::string& text, const std::strin
 
 }  // namespace
 
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
-                      const std::vector<OptionSetting>& options) {
+LoadedModel load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+                            const std::vector<OptionSetting>& options) {
   return model_from_yaml(parse_model_yaml(text, path), text, path, overrides, options);
 }
 
@@ -1077,24 +1079,24 @@ std::vector<std::string> model_input_texts(const std::string& text, const std::s
   return texts;
 }
 
-Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides) {
+LoadedModel load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides) {
   // Checked when it was read; a parse error here would have been found then.
   return model_from_yaml(load_yaml_text(text), text.text(), path, overrides, {});
 }
 
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+LoadedModel load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
   return load_model_text(text, path, overrides, {});
 }
 
-Model load_model(const std::string& path, const std::vector<std::string>& overrides) {
+LoadedModel load_model(const std::string& path, const std::vector<std::string>& overrides) {
   return load_model_text(read_input_file(path, "model file"), path, overrides, {});
 }
 
-Model load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options) {
+LoadedModel load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options) {
   return load_model_text(read_input_file(path, "model file"), path, overrides, options);
 }
 
-Model load_model(const std::string& path) { return load_model(path, {}); }
+LoadedModel load_model(const std::string& path) { return load_model(path, {}); }
 
 ExpandedModel expand_model_file(const std::string& path, const std::vector<std::string>& overrides) {
   const std::string text = read_input_file(path, "model file");

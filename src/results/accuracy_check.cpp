@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "railcrash/model/run_spec.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/integrator.hpp"
 

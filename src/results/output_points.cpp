@@ -5,9 +5,9 @@
 
 namespace railcrash {
 
-std::vector<std::string> output_point_columns(const Model& model) {
+std::vector<std::string> output_point_columns(const std::vector<OutputPoint>& output_points) {
   std::vector<std::string> columns;
-  for (const OutputPoint& o : model.run_spec.output_points) {
+  for (const OutputPoint& o : output_points) {
     if (o.position) columns.insert(columns.end(), {o.name + ".x", o.name + ".y"});
     if (o.velocity) columns.insert(columns.end(), {o.name + ".vx", o.name + ".vy"});
     if (o.acceleration) columns.insert(columns.end(), {o.name + ".ax", o.name + ".ay"});
@@ -15,9 +15,10 @@ std::vector<std::string> output_point_columns(const Model& model) {
   return columns;
 }
 
-void output_point_values(const Model& model, const double* q, const double* v, const double* acceleration, std::vector<double>& out) {
+void output_point_values(const std::vector<OutputPoint>& output_points, const double* q, const double* v, const double* acceleration,
+                         std::vector<double>& out) {
   out.clear();
-  for (const OutputPoint& o : model.run_spec.output_points) {
+  for (const OutputPoint& o : output_points) {
     const int b = o.point.body;
     const double theta = q[3 * b + 2], omega = v[3 * b + 2], alpha = acceleration[3 * b + 2];
     const double c = std::cos(theta), s = std::sin(theta);

@@ -47,7 +47,7 @@ void set_command_line(int argc, const char* const* argv) {
 
 const std::string& command_line() { return kept_command_line(); }
 
-Provenance run_provenance(const Model& model, const std::string& run_id) {
+Provenance run_provenance(const Model& model, const SimulationSettings& simulation, const std::string& run_id) {
   Provenance p;
   p.run_id = run_id;
   p.version = version_number();
@@ -55,7 +55,7 @@ Provenance run_provenance(const Model& model, const std::string& run_id) {
   p.command_line = command_line();
   p.model_files = model.sources;
   p.settings = model.settings;
-  p.simulation = model.run_spec.simulation;
+  p.simulation = simulation;
   return p;
 }
 

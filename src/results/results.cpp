@@ -222,18 +222,19 @@ std::string json_number(double value) {
   return std::string(buffer, format_general12(buffer, value));  // printf's "%.12g", about 10x faster (buffered_file.hpp)
 }
 
-std::vector<std::string> timeseries_columns(const DaeSystem& system) {
+std::vector<std::string> timeseries_columns(const DaeSystem& system, const std::vector<OutputPoint>& output_points) {
   std::vector<std::string> names{"t"};
   for (const Body& b : system.model().bodies())
     for (const char* q : {"x", "y", "theta", "vx", "vy", "omega"}) names.push_back(b.name + "." + q);
   for (const std::string& name : system.output_names()) names.push_back(name);
-  for (const std::string& name : output_point_columns(system.model())) names.push_back(name);
+  for (const std::string& name : output_point_columns(output_points)) names.push_back(name);
   return names;
 }
 
-ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory,
+ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system, const RunSpec& run_spec, bool keep_in_memory,
                            const std::string& format)
-    : system_(system), directory_(directory), provenance_(run_provenance(system.model(), new_run_id())),
+    : system_(system), output_points_(run_spec.output_points), directory_(directory),
+      provenance_(run_provenance(system.model(), run_spec.simulation, new_run_id())),
       last_flush_(std::chrono::steady_clock::now()), running_summary_(last_flush_) {
   const Model& model = system.model();
   const bool si = model.units == UnitSystem::SI;
@@ -246,7 +247,7 @@ ResultWriter::ResultWriter(const std::string& directory, const DaeSystem& system
   for (const Body& b : model.bodies())
     for (const char* q : {"ax", "ay", "alpha"}) acceleration_names.push_back(b.name + "." + q);
   energy_ = std::make_unique<EnergyWriter>(system);
-  layout.tables = {OutputTableLayout{"timeseries", timeseries_columns(system),
+  layout.tables = {OutputTableLayout{"timeseries", timeseries_columns(system, output_points_),
                                      "x, y: " + length + "; theta: rad; vx, vy: " + length +
                                          "/s; omega: rad/s; element outputs: the file's units"},
                    OutputTableLayout{"accelerations", acceleration_names, si ? "m/s^2, rad/s^2" : "in/s^2, rad/s^2"},
@@ -310,7 +311,7 @@ void ResultWriter::record_sample(double t, const double* y, const double* lambda
   const int nq = 3 * n;
   const std::size_t output_count = system_.output_names().size();
   track_extrema(t, y, lambda, outputs, FreshOutputs{});
-  if (!system_.model().run_spec.output_points.empty()) output_point_values(system_.model(), y, y + nq, acceleration_.data(), point_values_);
+  if (!output_points_.empty()) output_point_values(output_points_, y, y + nq, acceleration_.data(), point_values_);
   const auto taken = [&](OutputTable table) { return table_taken_[static_cast<std::size_t>(table)]; };
   const auto hand_on = [&](OutputTable table, const double* values) {
     for (const std::unique_ptr<OutputSink>& sink : sinks_)

@@ -164,11 +164,11 @@ std::atomic<double> g_output_memory_limit{4.0 * 1024 * 1024 * 1024};  // [bytes]
 void set_output_memory_limit(double bytes) { g_output_memory_limit = bytes; }
 double output_memory_limit() { return g_output_memory_limit.load(); }
 
-double output_memory_estimate(const DaeSystem& system, bool keep_in_memory) {
-  const SimulationSettings& s = system.model().run_spec.simulation;
+double output_memory_estimate(const DaeSystem& system, const RunSpec& run_spec, bool keep_in_memory) {
+  const SimulationSettings& s = run_spec.simulation;
   const double rows = std::floor(s.t_end / output_interval_of(s)) + 2.0;                     // [rows]
   double per_row = 20.0 * static_cast<double>(system.model().body_count()) + 16.0;            // [bytes]
-  if (keep_in_memory) per_row += 8.0 * static_cast<double>(timeseries_columns(system).size());
+  if (keep_in_memory) per_row += 8.0 * static_cast<double>(timeseries_columns(system, run_spec.output_points).size());
   return rows * per_row;
 }
 
@@ -176,10 +176,10 @@ namespace {
 
 /// InputError when the run's output would keep more memory than the limit: the estimate, its
 /// parts and what lowers it.
-void require_output_memory(const DaeSystem& system, bool keep_in_memory) {
-  const double limit = output_memory_limit(), estimate = output_memory_estimate(system, keep_in_memory);
+void require_output_memory(const DaeSystem& system, const RunSpec& run_spec, bool keep_in_memory) {
+  const double limit = output_memory_limit(), estimate = output_memory_estimate(system, run_spec, keep_in_memory);
   if (!(limit > 0.0) || estimate <= limit) return;
-  const SimulationSettings& s = system.model().run_spec.simulation;
+  const SimulationSettings& s = run_spec.simulation;
   const double rows = std::floor(s.t_end / output_interval_of(s)) + 2.0;
   char text[640];
   std::snprintf(text, sizeof text,
@@ -194,38 +194,41 @@ void require_output_memory(const DaeSystem& system, bool keep_in_memory) {
 }  // namespace
 
 std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings) {
-  const EulerSettings euler{settings.dt, settings.force_dt, settings.penalty, settings.max_steps};
+  const CommonRunSettings run{settings.t_end, settings.static_equilibrium};
+  const EulerSettings euler{settings.dt, settings.force_dt, settings.penalty, settings.max_steps, run};
   if (settings.integrator == IntegratorKind::Euler) return std::make_unique<EulerIntegrator>(system, euler);
   IdaSettings ida;
   ida.rtol = settings.rtol;
   ida.atol = settings.atol;
   ida.max_steps = settings.max_steps;
+  ida.run = run;
   if (settings.integrator == IntegratorKind::Auto) return std::make_unique<AutoIntegrator>(system, ida, euler);
   return std::make_unique<IdaIntegrator>(system, ida);
 }
 
-RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop, bool show_progress,
-                    bool keep_in_memory, const std::string& format, bool time_phases) {
+RunReport run_model(const Model& model, const RunSpec& run_spec, const std::string& out_dir, const std::atomic<bool>* stop,
+                    bool show_progress, bool keep_in_memory, const std::string& format, bool time_phases) {
   DaeSystem system(model);
   std::unique_ptr<ResultWriter> writer;
   std::unique_ptr<ResponseTracker> responses;
   std::vector<RunObserver*> observers;
   RunReport report;
-  report.integrator = integrator_name(model.run_spec.simulation.integrator);
+  const SimulationSettings& simulation = run_spec.simulation;
+  report.integrator = integrator_name(simulation.integrator);
   if (!out_dir.empty() || keep_in_memory) {
-    require_output_memory(system, keep_in_memory);  // before the writer starts
-    observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, keep_in_memory, format)).get());
+    require_output_memory(system, run_spec, keep_in_memory);  // before the writer starts
+    observers.push_back((writer = std::make_unique<ResultWriter>(out_dir, system, run_spec, keep_in_memory, format)).get());
     writer->write_running_summary(report.integrator);
   }
-  if (model.run_spec.responses.defined())
-    observers.push_back((responses = std::make_unique<ResponseTracker>(system, model.run_spec.responses)).get());
+  if (run_spec.responses.defined())
+    observers.push_back((responses = std::make_unique<ResponseTracker>(system, run_spec.responses)).get());
   std::unique_ptr<ScenarioTracker> scenario;
-  if (model.run_spec.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *model.run_spec.scenario)).get());
-  ProgressObserver observer(system, observers, model.run_spec.simulation.t_end, show_progress);
+  if (run_spec.scenario) observers.push_back((scenario = std::make_unique<ScenarioTracker>(system, *run_spec.scenario)).get());
+  ProgressObserver observer(system, observers, simulation.t_end, show_progress);
   std::unique_ptr<Integrator> integrator;
   try {
     try {
-      integrator = make_integrator(system, model.run_spec.simulation);
+      integrator = make_integrator(system, simulation);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {  // a failed start (static settle): a failed run, with its summary
@@ -234,7 +237,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     if (integrator) {
       integrator->time_phases(time_phases);
       try {
-        report.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), observer, stop);
+        report.outcome = integrator->run(simulation.t_end, output_interval_of(simulation), observer, stop);
       } catch (const std::bad_alloc&) {  // the summary says why the run ended, not "running"
         report.outcome.ok = false;
         report.outcome.t_reached = writer ? writer->last_sample_time() : 0.0;
@@ -283,7 +286,7 @@ RunReport run_model(const Model& model, const std::string& out_dir, const std::a
     report.filtered_accelerations = writer->filtered_accelerations();
   }
   if (keep_in_memory) {
-    report.columns = timeseries_columns(system);
+    report.columns = timeseries_columns(system, run_spec.output_points);
     report.series = std::move(writer->columns());
   }
   return report;

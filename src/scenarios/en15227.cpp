@@ -115,7 +115,7 @@ Template read_template(const std::string& path) {
     t.fail(t.root["bodies"], "no striking car: the scenario builds its trains from the car declared (car: NAME) by the bodies named "
                              "car1_* (the car at x < 0 whose front faces x = 0), as in models/report/final_two_car.yaml");
   // The interface anticlimber and the leading wheels from the output roles and car declarations.
-  const Model model = load_model(path);
+  const Model model = load_model(path).model;
   const auto car_of = [&](int body) { return body == kGround ? std::string() : model.bodies()[static_cast<std::size_t>(body)].car; };
   double foremost = -1e300;  // [length] x of the striking car's foremost wheel-carrying body
   for (const auto& e : model.elements()) {
@@ -541,7 +541,7 @@ void resolve_zone_strokes(const YAML::Node& model_node, const std::string& path,
   copy["name"] = "scenario";
   YAML::Emitter emitter;
   emitter << copy;
-  const Model model = load_model_text(std::string(emitter.c_str()) + "\n", path);
+  const Model model = load_model_text(std::string(emitter.c_str()) + "\n", path).model;
   const double to_file = u.millimetre ? 1e3 : 1.0;  // the loaded model is in SI for mm-t-s-N files
   for (auto& [name, stroke] : trains.zones) {
     // (the name through an init-capture: clang refuses to capture a structured binding)
@@ -681,7 +681,7 @@ void car_type_trains(const ScenarioRequest& q, const YAML::Node& root, const Uni
   doc["name"] = "scenario trains";  // replaced below
   YAML::Emitter emitter;
   emitter << doc;
-  const Model model = load_model_text(std::string(emitter.c_str()) + "\n", path);
+  const Model model = load_model_text(std::string(emitter.c_str()) + "\n", path).model;
 
   const std::vector<std::string> train_names = standing_train ? std::vector<std::string>{striking, standing} : std::vector<std::string>{striking};
   for (const ExpandedCar& car : expansion.cars) trains.cars.push_back(car.name);

@@ -72,7 +72,7 @@ TrainUnit read_train_unit(const std::string& path, const YAML::Node& root) {
   TrainUnit unit;
   unit.path = path;
   unit.root = root;
-  const Model model = load_model(path);
+  const Model model = load_model(path).model;
   const auto car_of = [&](int body) { return body == kGround ? std::string() : model.bodies()[static_cast<std::size_t>(body)].car; };
   bool any_car = false;
   for (const Body& b : model.bodies()) any_car = any_car || !b.car.empty();

@@ -923,14 +923,14 @@ DaeSystem::ElementLoad DaeSystem::element_load(int e, double t, const double* y)
   return load;
 }
 
-bool DaeSystem::boundary_roots_leaving(double t, const double* y, const double* yp, std::vector<int>& direction) const {
+bool DaeSystem::boundary_roots_leaving(double t, const double* y, const double* yp, double t_end, std::vector<int>& direction) const {
   if (root_count_ == 0) return false;
   std::vector<double> g(static_cast<std::size_t>(root_count_)), ahead(g.size());
   roots(t, y, g.data());
   // Second-order Taylor step (q + h v + h^2 a / 2, v + h a): a body at rest on a boundary
   // leaves it through its acceleration alone. h is small against the run's time scale but
   // large enough for h^2 a / 2 to survive round-off in q.
-  const double h = 1e-6 * std::min(1.0, model_.run_spec.simulation.t_end);
+  const double h = 1e-6 * std::min(1.0, t_end);
   const int nq = body_unknowns();
   std::vector<double> y_ahead(y, y + size());
   for (int k = 0; k < nq; ++k) {

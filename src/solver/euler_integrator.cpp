@@ -90,14 +90,14 @@ PenaltyRows EulerIntegrator::make_penalty(const DaeSystem& system, const Element
 
 namespace {
 
-/// Why a step dt that needs more than max_steps steps from t0 to the model's t_end cannot run ("" when it can).
-std::string step_count_problem(const Model& model, double dt, long max_steps, double t0) {
-  const double steps_needed = std::ceil((model.run_spec.simulation.t_end - t0) / dt - 1e-9);  // [steps], a double: never overflows
+/// Why a step dt that needs more than max_steps steps from t0 to the run's t_end cannot run ("" when it can).
+std::string step_count_problem(const Model& model, double t_end, double dt, long max_steps, double t0) {
+  const double steps_needed = std::ceil((t_end - t0) / dt - 1e-9);  // [steps], a double: never overflows
   if (steps_needed <= static_cast<double>(max_steps)) return "";
   std::ostringstream msg;
   msg << SourceLocation{model.file, 0}.prefix() << "explicit Euler with dt = " << dt << " needs " << steps_needed
-      << " steps to reach t_end = " << model.run_spec.simulation.t_end << ", more than --max-steps " << max_steps
-      << "; use a larger dt (above " << model.run_spec.simulation.t_end / static_cast<double>(max_steps)
+      << " steps to reach t_end = " << t_end << ", more than --max-steps " << max_steps
+      << "; use a larger dt (above " << t_end / static_cast<double>(max_steps)
       << "), a shorter t_end, or raise --max-steps";
   return msg.str();
 }
@@ -125,7 +125,7 @@ EulerIntegrator::Step EulerIntegrator::choose_step(const DaeSystem& system, cons
   if (settings.dt > 0.0) {
     step.dt = settings.dt;
     // Before penalties sized for a dt that cannot run.
-    throw_if(step_count_problem(system.model(), step.dt, settings.max_steps, 0.0));
+    throw_if(step_count_problem(system.model(), settings.run.t_end, step.dt, settings.max_steps, 0.0));
     step.penalty = make_penalty(system, settings.penalty, step.dt);
     step.stability_limit = estimate_stability_limit(system, y, &step.penalty);
     return step;
@@ -133,7 +133,7 @@ EulerIntegrator::Step EulerIntegrator::choose_step(const DaeSystem& system, cons
   // Automatic: half the limit of the elements alone, then penalties for that step; shrink
   // once more if the penalties lowered the limit.
   const double physical_limit = estimate_stability_limit(system, y, nullptr);
-  step.dt = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * system.model().run_spec.simulation.t_end;
+  step.dt = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * settings.run.t_end;
   for (int pass = 0; pass < 20; ++pass) {
     step.penalty = make_penalty(system, settings.penalty, step.dt);
     step.stability_limit = estimate_stability_limit(system, y, &step.penalty);
@@ -153,13 +153,14 @@ std::string EulerIntegrator::refusal(const DaeSystem& system, const Step& step, 
         << " (e.g. --dt " << 0.5 * step.stability_limit << "), or --force-dt to run anyway";
     return msg.str();
   }
-  return step_count_problem(system.model(), step.dt, settings.max_steps, t0);
+  return step_count_problem(system.model(), settings.run.t_end, step.dt, settings.max_steps, t0);
 }
 
 EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings)
     : Integrator(system), settings_(settings) {
   throw_if(inertia_problem(system.model()));
-  const StartReport start = prepare_start(system, y0_, start_events_);
+  mode_tracker().set_run_end(settings_.run.t_end);
+  const StartReport start = prepare_start(system, y0_, start_events_, settings_.run.static_equilibrium);
   start_modes_ = system.modes().snapshot();
   assembly_correction_ = start.assembly.largest_position_change;
   settling_steps_ = start.equilibrium.steps;
@@ -175,6 +176,7 @@ EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings, Step
                                  const std::vector<double>& y, const std::vector<double>& quadratures)
     : Integrator(system), settings_(settings), dt_(step.dt), stability_limit_(step.stability_limit),
       penalty_(std::move(step.penalty)) {
+  mode_tracker().set_run_end(settings_.run.t_end);
   throw_if(refusal(system, Step{dt_, stability_limit_, {}}, settings_, t0));
   y_ = y;
   quadratures_ = quadratures;

@@ -113,7 +113,7 @@ bool ModeTracker::commit_roots(double t, const double* y, const int* direction, 
 bool ModeTracker::commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
                                   std::vector<char>* changed_elements) {
   std::vector<int> direction;
-  return system_.boundary_roots_leaving(t, y, yp, direction) &&
+  return system_.boundary_roots_leaving(t, y, yp, run_end_, direction) &&
          commit_roots(t, y, direction.data(), events, changed_elements);
 }
 

@@ -341,6 +341,7 @@ void IdaStepInterpolant::rates_at(double t, double* yp) {
 }
 
 IdaIntegrator::IdaIntegrator(DaeSystem& system, IdaSettings settings) : Integrator(system), settings_(settings) {
+  mode_tracker().set_run_end(settings_.run.t_end);
   if (const std::string problem = rtol_problem(settings_.rtol, "rtol"); !problem.empty()) throw InputError(problem);
 }
 
@@ -358,7 +359,7 @@ void IdaIntegrator::start(double t_end) {
   // ---- consistent positions and velocities ----
   std::vector<double> y0;
   std::vector<EventRecord> settling_events;
-  const StartReport start_report = prepare_start(system_, y0, settling_events);
+  const StartReport start_report = prepare_start(system_, y0, settling_events, settings_.run.static_equilibrium);
   stats().assembly_correction = start_report.assembly.largest_position_change;
   stats().settling_steps = start_report.equilibrium.steps;
   stats().settling_displacement = start_report.equilibrium.largest_position_change;

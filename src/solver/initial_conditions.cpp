@@ -651,12 +651,12 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
   return report;
 }
 
-StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events) {
+StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events, bool static_equilibrium) {
   StartReport report;
   system.reset_modes();
   y = system.initial_state();
   report.assembly = assemble_initial_state(system, y);
-  if (system.model().run_spec.simulation.static_equilibrium) {
+  if (static_equilibrium) {
     report.equilibrium = settle_static_equilibrium(system, y, events);
     const AssemblyReport projection = assemble_initial_state(system, y);
     report.assembly.largest_velocity_change = std::max(report.assembly.largest_velocity_change, projection.largest_velocity_change);

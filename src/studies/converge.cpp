@@ -54,11 +54,10 @@ std::vector<int> role_columns(const DaeSystem& system, OutputRole role) {
   return columns;
 }
 
-ConvergeQuantity resolve_quantity(const std::string& requested, const DaeSystem& system, const std::string& length_unit,
-                                  const std::string& force_unit) {
+ConvergeQuantity resolve_quantity(const std::string& requested, const DaeSystem& system, const ResponseSettings& responses,
+                                  const std::string& length_unit, const std::string& force_unit) {
   using Kind = ConvergeQuantity::Kind;
   const Model& model = system.model();
-  const ResponseSettings& responses = model.run_spec.responses;
   ConvergeQuantity q;
   q.name = requested;
   const std::string key = lower(requested);
@@ -239,7 +238,7 @@ std::string format_number(double value) {
 
 /// The model of one run: the user's settings, then the run's integrator settings, through the
 /// loader's override path (as run's options).
-Model load_for_run(const ConvergePlan& plan, const std::string& method, double step, double rtol) {
+LoadedModel load_for_run(const ConvergePlan& plan, const std::string& method, double step, double rtol) {
   RunOverrides overrides;
   overrides.t_end = plan.t_end;
   overrides.output_interval = plan.output_interval;
@@ -262,19 +261,20 @@ ConvergeRun run_one(const ConvergePlan& plan, const std::string& method, double 
   run.step = step;
   run.rtol = rtol;
   try {
-    const Model model = load_for_run(plan, method, step, rtol);
+    const LoadedModel loaded = load_for_run(plan, method, step, rtol);
+    const Model& model = loaded.model;
+    const SimulationSettings& simulation = loaded.run_spec.simulation;
     DaeSystem system(model);
     std::unique_ptr<ResponseTracker> responses;
-    if (model.run_spec.responses.defined()) responses = std::make_unique<ResponseTracker>(system, model.run_spec.responses);
+    if (loaded.run_spec.responses.defined()) responses = std::make_unique<ResponseTracker>(system, loaded.run_spec.responses);
     std::unique_ptr<ResultWriter> accelerations;
     if (std::any_of(plan.quantities.begin(), plan.quantities.end(),
                     [](const ConvergeQuantity& q) { return q.kind == ConvergeQuantity::Kind::PeakAcceleration; }))
-      accelerations = std::make_unique<ResultWriter>("", system);
+      accelerations = std::make_unique<ResultWriter>("", system, loaded.run_spec);
     Recorder recorder(system, run, responses.get(), accelerations.get());
     const auto start = Clock::now();
-    std::unique_ptr<Integrator> integrator = make_integrator(system, model.run_spec.simulation);
-    const RunOutcome outcome =
-        integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), recorder, control.stop_flag());
+    std::unique_ptr<Integrator> integrator = make_integrator(system, simulation);
+    const RunOutcome outcome = integrator->run(simulation.t_end, output_interval_of(simulation), recorder, control.stop_flag());
     const bool timed_out = control.timed_out();
     run.wall_seconds = seconds_since(start);
     run.ok = outcome.ok;
@@ -574,11 +574,13 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   RunOverrides overrides;  // converge's --t-end and --output-interval, through --set's path as in run
   overrides.t_end = options.t_end;
   overrides.output_interval = options.output_interval;
-  const Model model = load_model(model_path, options.settings, option_settings(overrides));
-  plan.t_end = model.run_spec.simulation.t_end;
-  plan.output_interval = output_interval_of(model.run_spec.simulation);
-  plan.model_rtol = model.run_spec.simulation.rtol;
-  if (const std::optional<double> atol = model.run_spec.simulation.atol) plan.model_atol = *atol / file_length_unit(model);
+  const LoadedModel loaded = load_model(model_path, options.settings, option_settings(overrides));
+  const Model& model = loaded.model;
+  const SimulationSettings& simulation = loaded.run_spec.simulation;
+  plan.t_end = simulation.t_end;
+  plan.output_interval = output_interval_of(simulation);
+  plan.model_rtol = simulation.rtol;
+  if (const std::optional<double> atol = simulation.atol) plan.model_atol = *atol / file_length_unit(model);
   plan.model_name = model.name;
   const bool si = model.units == UnitSystem::SI;
   plan.length_unit = si ? "m" : "in";
@@ -586,7 +588,7 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
 
   DaeSystem system(model);
   for (const std::string& name : options.quantities.empty() ? default_quantities() : options.quantities)
-    plan.quantities.push_back(resolve_quantity(name, system, plan.length_unit, plan.force_unit));
+    plan.quantities.push_back(resolve_quantity(name, system, loaded.run_spec.responses, plan.length_unit, plan.force_unit));
   for (std::size_t k = 0; k < plan.quantities.size(); ++k) {
     const ConvergeQuantity& q = plan.quantities[k];
     const bool named = !options.headline.empty() && lower(q.name) == lower(options.headline);
@@ -610,21 +612,30 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   const auto commensurate = [&](double dt) {
     return dt < plan.output_interval ? plan.output_interval / std::ceil(plan.output_interval / dt * (1.0 - 1e-12)) : dt;
   };
+  // The model's penalty settings, t_end and static settle (max_steps: Euler's default).
+  const auto euler_settings = [&simulation](double dt, bool force_dt) {
+    EulerSettings settings;
+    settings.dt = dt;
+    settings.force_dt = force_dt;
+    settings.penalty = simulation.penalty;
+    settings.run = {simulation.t_end, simulation.static_equilibrium};
+    return settings;
+  };
   double dt0 = options.euler_first_step;
   std::unique_ptr<EulerIntegrator> euler;
   if (dt0 > 0.0) {
-    euler = std::make_unique<EulerIntegrator>(system, EulerSettings{dt0, false, model.run_spec.simulation.penalty});
+    euler = std::make_unique<EulerIntegrator>(system, euler_settings(dt0, false));
   } else {
     // The elements' own limit at the start (what `railcrash check` prints), then the penalties.
     std::vector<double> y0 = system.initial_state();
     std::vector<EventRecord> start_events;
-    prepare_start(system, y0, start_events);
+    prepare_start(system, y0, start_events, simulation.static_equilibrium);
     plan.element_stability_limit = EulerIntegrator::estimate_stability_limit(system, y0, nullptr);
     if (!std::isfinite(plan.element_stability_limit))
       throw InputError("the model's elements give Euler no stability limit (no stiffness); give a first step with --euler-dt");
     dt0 = commensurate(options.euler_safety * plan.element_stability_limit);
     for (int pass = 0; pass < 10; ++pass) {
-      euler = std::make_unique<EulerIntegrator>(system, EulerSettings{dt0, true, model.run_spec.simulation.penalty});
+      euler = std::make_unique<EulerIntegrator>(system, euler_settings(dt0, true));
       if (dt0 <= euler->stability_limit()) break;
       dt0 = commensurate(options.euler_safety * euler->stability_limit());
     }
@@ -637,11 +648,11 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
   // steps is refused now, not when its run comes (after the others have run).
   const double smallest_step = plan.euler_steps.back();
   const double steps_needed = std::ceil(plan.t_end / smallest_step - 1e-9);  // [steps]
-  if (!(steps_needed <= static_cast<double>(model.run_spec.simulation.max_steps)))
+  if (!(steps_needed <= static_cast<double>(simulation.max_steps)))
     throw InputError(model_path + ": --euler-steps " + std::to_string(options.euler_runs) + " from dt " + format_number(dt0) +
                      " s goes down to " + fmt("%.4g", smallest_step) + " s, which needs " + fmt("%.4g", steps_needed) +
                      " steps to reach t_end = " + format_number(plan.t_end) + ", more than max_steps " +
-                     std::to_string(model.run_spec.simulation.max_steps) + "; use fewer --euler-steps, a larger --euler-dt or a shorter --t-end");
+                     std::to_string(simulation.max_steps) + "; use fewer --euler-steps, a larger --euler-dt or a shorter --t-end");
   // Time a short run at dt_0 for the cost per step (the same for every step size).
   NullObserver none;
   const double probe_end = std::min(plan.t_end, static_cast<double>(kProbeSteps) * dt0);
@@ -721,8 +732,8 @@ ConvergeResult run_convergence(const ConvergePlan& plan, const std::function<voi
                                                  : "no looser reference tried (it must stay 10x tighter than every run).";
   for (std::size_t k = 1; k < runs.size(); ++k) (runs[k].method == kEulerMethod ? result.euler : result.ida).push_back(runs[k]);
   // The model's response settings and body count, for the analysis.
-  const Model model = load_model(plan.model_path, plan.options.settings);
-  analyse(result, plan, model.run_spec.responses, model.body_count());
+  const LoadedModel loaded = load_model(plan.model_path, plan.options.settings);
+  analyse(result, plan, loaded.run_spec.responses, loaded.model.body_count());
   result.total_seconds = seconds_since(start);
   return result;
 }

@@ -288,10 +288,10 @@ SensitivityRun run_one(const std::string& model_path, const CheckedYamlText& mod
   run.factor = job.factor;
   const auto start = std::chrono::steady_clock::now();
   try {
-    const Model model = load_model_text(model_text, model_path, job_settings(design, job, base_settings));
-    if (!model.run_spec.responses.defined())
+    const LoadedModel loaded = load_model_text(model_text, model_path, job_settings(design, job, base_settings));
+    if (!loaded.run_spec.responses.defined())
       throw InputError(model_path + ": a parameter study needs a 'responses' section (R1-R3) in the model");
-    const RunReport report = run_model(model, "", control.stop_flag());
+    const RunReport report = run_model(loaded.model, loaded.run_spec, "", control.stop_flag());
     run.ok = report.outcome.ok;  // a run that finished just as the limit passed still counts
     run.message = !run.ok && control.timed_out() ? run_limit_message(time_limit, report.outcome.t_reached) : report.outcome.message;
     run.responses = report.responses;

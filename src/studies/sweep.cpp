@@ -301,8 +301,7 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
     std::vector<std::string> settings = plan.settings;
     try {
       settings.push_back(factor_setting(factor, level));
-      const Model model = load_model_text(model_text, model_path, settings);
-      (void)model;
+      (void)load_model_text(model_text, model_path, settings);
     } catch (const InputError& e) {
       throw InputError(SourceLocation{path, line}.prefix() + "factor '" + factor.key + "' at level '" + level + "': " + e.what());
     }
@@ -320,8 +319,8 @@ SweepPlan load_sweep_plan(const std::string& path, const std::string& model_path
     for (std::size_t f = 0; f < plan.factors.size(); ++f)
       if (!plan.runs[r][f].empty()) check(plan.factors[f], plan.runs[r][f], plan.run_lines[r]);
   if (plan.responses.empty()) {
-    const Model model = load_model_text(model_text, model_path, plan.settings);
-    if (model.run_spec.responses.defined()) plan.responses = {"R1", "R2", "R3"};
+    const LoadedModel loaded = load_model_text(model_text, model_path, plan.settings);
+    if (loaded.run_spec.responses.defined()) plan.responses = {"R1", "R2", "R3"};
     plan.responses.push_back("energy.relative_balance_error");
   }
   return plan;
@@ -505,8 +504,8 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
   row.responses.assign(plan.responses.size(), kNaN);
   const auto start = std::chrono::steady_clock::now();
   try {
-    const Model model = load_model_text(model_text, model_path, spec.settings);
-    const RunReport report = run_model(model, run_folder, control.stop_flag(), false, true);
+    const LoadedModel loaded = load_model_text(model_text, model_path, spec.settings);
+    const RunReport report = run_model(loaded.model, loaded.run_spec, run_folder, control.stop_flag(), false, true);
     row.status = report.outcome.ok ? "ok" : "failed";
     row.message = report.outcome.message;
     row.outcomes = report.outcomes.text();

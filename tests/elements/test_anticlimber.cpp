@@ -122,12 +122,13 @@ struct Run {
   Anticlimber::State final_mode;  // the anticlimber's (the model's first element) at the end
 };
 
-Run simulate(const Model& model) {
-  DaeSystem system(model);
+Run simulate(const LoadedModel& loaded) {
+  DaeSystem system(loaded.model);
   Run run;
   run.samples.size = system.size();
-  auto integrator = make_integrator(system, model.run_spec.simulation);
-  run.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), run.samples);
+  const SimulationSettings& simulation = loaded.run_spec.simulation;
+  auto integrator = make_integrator(system, simulation);
+  run.outcome = integrator->run(simulation.t_end, output_interval_of(simulation), run.samples);
   REQUIRE(run.outcome.ok);
   run.final_mode = system.modes().as<Anticlimber::State>(0);
   return run;
@@ -677,10 +678,11 @@ TEST_CASE("anticlimber contact fires at gap / closing speed", "[elements][anticl
           {"car1", 1e3, 1e3, 0.0, 0.0, angle, 0.0, 0.0, 0.0},
           {"car2", 2.0, 0.5, axis.x * start, axis.y * start, angle, -facing * speed * axis.x, -facing * speed * axis.y, 0.0}};
       const std::string sim = std::string("t_end: 0.1, integrator: ") + integrator + ", rtol: 1e-10, dt: 1e-6";
-      const Model model = testing::model_from_text(
+      const LoadedModel loaded = testing::loaded_from_text(
           model_yaml(bodies, Parameters{}, Point{"car1", facing * 0.5, 0.0}, Point{"car2", 0.0, 0.0}, sim));
+      const Model& model = loaded.model;
       REQUIRE(*anticlimber_of(model).facing == facing);
-      const Run run = simulate(model);
+      const Run run = simulate(loaded);
       const EventRecord* contact = find_event(run.outcome, "contact");
       INFO(event_list(run.outcome));
       REQUIRE(contact != nullptr);
@@ -708,8 +710,8 @@ TEST_CASE("anticlimber crush of a mass: yield, plastic flow, unloading and rebou
     INFO(integrator);
     const std::vector<BodySpec> bodies{{"b", mass, 1.0, gap, 0.0, 0.0, -speed, 0.0, 0.0}};
     const std::string sim = std::string("t_end: 0.15, integrator: ") + integrator + ", rtol: 1e-10, dt: 1e-6";
-    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim));
-    const Run run = simulate(model);
+    const LoadedModel loaded = testing::loaded_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim));
+    const Run run = simulate(loaded);
     const RunOutcome& o = run.outcome;
     INFO(event_list(o));
     REQUIRE(o.events.size() == 4);
@@ -753,8 +755,8 @@ TEST_CASE("two cars crush through the anticlimber with the reduced mass and cons
     const std::vector<BodySpec> bodies{{"car1", m1, 5.0, 0.0, 0.0, 0.0, speed, 0.0, 0.0},
                                        {"car2", m2, 9.0, 0.9 + gap, 0.0, 0.0, 0.0, 0.0, 0.0}};
     const std::string sim = std::string("t_end: 0.15, integrator: ") + integrator + ", rtol: 1e-10, dt: 1e-6";
-    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"car1", 0.4, 0.0}, Point{"car2", -0.5, 0.0}, sim));
-    const Run run = simulate(model);
+    const LoadedModel loaded = testing::loaded_from_text(model_yaml(bodies, p, Point{"car1", 0.4, 0.0}, Point{"car2", -0.5, 0.0}, sim));
+    const Run run = simulate(loaded);
     const RunOutcome& o = run.outcome;
     INFO(event_list(o));
     REQUIRE(find_event(o, "separation") != nullptr);
@@ -780,10 +782,10 @@ struct Drive {
 };
 constexpr double kHeavy = 1e9;  // [kg] and [kg m^2]
 
-Model driven_model(const Parameters& p, const Drive& drive, const std::string& integrator, double t_end) {
+LoadedModel driven_model(const Parameters& p, const Drive& drive, const std::string& integrator, double t_end) {
   const std::vector<BodySpec> bodies{{"car2", kHeavy, kHeavy, 0.1, 0.0, 0.0, -drive.u, drive.w, drive.omega}};
   const std::string sim = "t_end: " + number(t_end) + ", integrator: " + integrator + ", rtol: 1e-10, dt: 1e-5";
-  return testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"car2", 0.0, 0.0}, sim));
+  return testing::loaded_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"car2", 0.0, 0.0}, sim));
 }
 
 }  // namespace
@@ -816,8 +818,8 @@ TEST_CASE("anticlimber shear failure, bending failure then override under prescr
   for (const char* integrator : {"ida", "euler"}) {
     const bool ida = std::string(integrator) == "ida";
     INFO(integrator);
-    const Model model = driven_model(p, drive, integrator, 0.4);
-    const Run run = simulate(model);
+    const LoadedModel loaded = driven_model(p, drive, integrator, 0.4);
+    const Run run = simulate(loaded);
     const RunOutcome& o = run.outcome;
     INFO(event_list(o));
     REQUIRE(o.events.size() == std::size(expected));
@@ -833,7 +835,7 @@ TEST_CASE("anticlimber shear failure, bending failure then override under prescr
     CHECK(run.final_mode.override_time == Approx(0.36).epsilon(0).margin(time_tol));
     CHECK(run.final_mode.vertical.mode == Mode::Failed);
     CHECK(run.final_mode.torsional.mode == Mode::Failed);
-    DaeSystem system(model);
+    DaeSystem system(loaded.model);
     testing::set_mode(system, run.final_mode);
     const std::vector<double> out = element_outputs(system, o.y);
     CHECK(out[7] == 1.0);
@@ -856,8 +858,8 @@ TEST_CASE("anticlimber crushing failure at the horizontal rupture deflection end
       p.length = 0.5;
     else
       p.horizontal.rupture = 0.5;
-    const Model model = driven_model(p, Drive{1.0, 0.0, 0.0}, "ida", 0.7);
-    const Run run = simulate(model);
+    const LoadedModel loaded = driven_model(p, Drive{1.0, 0.0, 0.0}, "ida", 0.7);
+    const Run run = simulate(loaded);
     const RunOutcome& o = run.outcome;
     INFO(event_list(o));
     REQUIRE(o.events.size() == 3);
@@ -870,7 +872,7 @@ TEST_CASE("anticlimber crushing failure at the horizontal rupture deflection end
     CHECK_FALSE(Anticlimber::overridden(run.final_mode));
     CHECK(element_work(o) == Approx(6150.5).epsilon(2e-5));  // 50 + 1e4 * 0.49 + 1e4 * 0.49^2 / 2
     CHECK(bilinear_work(p.horizontal, 0.5) == Approx(6150.5).epsilon(1e-12));
-    DaeSystem system(model);
+    DaeSystem system(loaded.model);
     testing::set_mode(system, run.final_mode);
     const std::vector<double> out = element_outputs(system, o.y);
     CHECK(out[0] == 0.0);
@@ -884,9 +886,9 @@ TEST_CASE("anticlimber faces that miss each other override at contact", "[elemen
     Parameters p;
     p.misalignment = 0.25;  // above the face height 0.2
     const std::vector<BodySpec> bodies{{"b", 10.0, 1.0, 0.1, 0.0, 0.0, -1.0, 0.0, 0.0}};
-    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0},
+    const LoadedModel loaded = testing::loaded_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0},
                                                             std::string("t_end: 0.3, integrator: ") + integrator + ", dt: 1e-5"));
-    const Run run = simulate(model);
+    const Run run = simulate(loaded);
     INFO(event_list(run.outcome));
     REQUIRE(run.outcome.events.size() == 1);
     CHECK(run.outcome.events[0].what == "override");
@@ -905,9 +907,9 @@ TEST_CASE("anticlimber re-contact starts at the permanent crush and reloading at
   const Parameters p;
   const std::vector<BodySpec> bodies{{"b", 100.0, 1.0, 0.1, 0.0, 0.0, -2.0, 0.0, 0.0}};
   const std::string load = "  - {type: force, body: b, value: [[0, 0, 0], [1, -20000, 0]]}\n";
-  const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0},
+  const LoadedModel loaded = testing::loaded_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0},
                                                           "t_end: 0.6, rtol: 1e-10", "", load));
-  const Run run = simulate(model);
+  const Run run = simulate(loaded);
   const RunOutcome& o = run.outcome;
   INFO(event_list(o));
   const EventRecord* unloading = find_event(o, "horizontal unloading");
@@ -978,8 +980,8 @@ TEST_CASE("anticlimber crush under Euler converges to the closed form as the ste
   const auto rebound_error = [&](const std::string& integrator, double dt) {
     const std::vector<BodySpec> bodies{{"b", mass, 1.0, gap, 0.0, 0.0, -speed, 0.0, 0.0}};
     const std::string sim = "t_end: 0.15, integrator: " + integrator + ", rtol: 1e-10, dt: " + number(dt);
-    const Model model = testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim));
-    const Run run = simulate(model);
+    const LoadedModel loaded = testing::loaded_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim));
+    const Run run = simulate(loaded);
     return std::abs(run.outcome.y[3] - c.rebound_speed);
   };
   const double e1 = rebound_error("euler", 4e-5), e2 = rebound_error("euler", 1e-5), e3 = rebound_error("euler", 2.5e-6);
@@ -998,13 +1000,13 @@ namespace {
 /// A mass sliding up at 0.1 m/s hits the anticlimber at 2 m/s while a load (8 kN growing by
 /// 20 kN/s) presses it on: the faces crush, unload elastically from the largest crush and,
 /// pressed on by the growing load, reload onto the yield line without separating.
-Model pressed_sliding_mass(const std::string& interlock, const std::string& integrator, double t_end) {
+LoadedModel pressed_sliding_mass(const std::string& interlock, const std::string& integrator, double t_end) {
   Parameters p;
   p.interlock = interlock;
   const std::vector<BodySpec> bodies{{"b", 100.0, 1.0, 0.001, 0.0, 0.0, -1.5, 0.1, 0.0}};
   const std::string load = "  - {type: force, body: b, value: [[0, -6000, 0], [1, -26000, 0]]}\n";
   const std::string sim = "t_end: " + number(t_end) + ", integrator: " + integrator + ", rtol: 1e-10, dt: 1e-6, output_interval: 1e-4";
-  return testing::model_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim, "", load));
+  return testing::loaded_from_text(model_yaml(bodies, p, Point{"ground", 0.0, 0.0}, Point{"b", 0.0, 0.0}, sim, "", load));
 }
 
 }  // namespace
@@ -1019,8 +1021,8 @@ TEST_CASE("anticlimber interlock_while_unloading: hold keeps the vertical force 
   const double kv = p.vertical.elastic, omega_v = std::sqrt(kv / 100.0), t_end = 0.114;
   for (const char* integrator : {"ida", "euler"}) {
     const bool ida = std::string(integrator) == "ida";
-    const Model hold_model = pressed_sliding_mass("hold", integrator, t_end);
-    const Model release_model = pressed_sliding_mass("release", integrator, t_end);
+    const LoadedModel hold_model = pressed_sliding_mass("hold", integrator, t_end);
+    const LoadedModel release_model = pressed_sliding_mass("release", integrator, t_end);
     const Run hold = simulate(hold_model), release = simulate(release_model);
     INFO(integrator << "\nhold:\n" << event_list(hold.outcome) << "release:\n" << event_list(release.outcome));
     const char* const hold_events[] = {"contact", "horizontal yield", "horizontal unloading", "horizontal reloading"};
@@ -1074,7 +1076,7 @@ TEST_CASE("anticlimber interlock_while_unloading: hold keeps the vertical force 
     CHECK(std::abs(w_u) > 0.02);  // a real slide, so the re-seated interlock is loaded again
     const double y_end = y_r + w_u / omega_v * std::sin(omega_v * (t_end - t_reloading));
     CHECK(release.outcome.y[1] == Approx(y_end).epsilon(0).margin(ida ? 1e-8 : 1e-6));
-    DaeSystem system(release_model);
+    DaeSystem system(release_model.model);
     testing::set_mode(system, release.final_mode);
     const std::vector<double> out = element_outputs(system, release.outcome.y);
     CHECK(out[1] == Approx(kv * (release.outcome.y[1] - release.final_mode.vertical_reference)).epsilon(1e-12));

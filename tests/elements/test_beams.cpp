@@ -150,12 +150,13 @@ class Quiet : public RunObserver {
 };
 
 Run simulate(const std::string& yaml) {
-  const Model model = testing::model_from_text(yaml);
+  const LoadedModel loaded = testing::loaded_from_text(yaml);
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  auto integrator = make_integrator(system, model.run_spec.simulation);
+  auto integrator = make_integrator(system, loaded.run_spec.simulation);
   Quiet quiet;
   Run run;
-  run.outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), quiet);
+  run.outcome = integrator->run(loaded.run_spec.simulation.t_end, output_interval_of(loaded.run_spec.simulation), quiet);
   INFO("run message: " << run.outcome.message);
   REQUIRE(run.outcome.ok);
   const BodyState s = split(system, run.outcome.y);

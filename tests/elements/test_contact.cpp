@@ -26,7 +26,7 @@ std::string body_on(const std::string& element, double x, double y, double vx, d
 const std::string kFloor =
     "  - {name: floor, type: contact, line_point: [0, 0], line_normal: [0, 1], stiffness: 1.0e6, points: [{body: ball, at: [0, 0]}]}\n";
 
-RunOutcome run(const Model& model) { return testing::simulate(model); }
+RunOutcome run(const LoadedModel& loaded) { return testing::simulate(loaded); }
 
 }  // namespace
 
@@ -35,9 +35,9 @@ TEST_CASE("contact: a dropped ball touches the floor at sqrt(2h/g) and bounces b
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
-    const Model model = testing::model_from_text(
+    const LoadedModel loaded = testing::loaded_from_text(
         body_on(kFloor, 0.0, h, 0.0, 0.0, std::string("t_end: 0.6, rtol: 1e-10, dt: 1e-6, integrator: ") + integrator));
-    const RunOutcome o = run(model);
+    const RunOutcome o = run(loaded);
     REQUIRE(o.events.size() == 2);
     CHECK(o.events[0].what == "contact");
     CHECK(o.events[0].t == Approx(t_contact).margin(ida ? 1e-9 : 2e-6));
@@ -57,8 +57,8 @@ TEST_CASE("contact: a damped contact dissipates what the damper's work says", "[
   const std::string floor =
       "  - {name: floor, type: contact, line_point: [0, 0], line_normal: [0, 1], stiffness: 1.0e6, damping: 300, "
       "points: [{body: ball, at: [0, 0]}]}\n";
-  const Model model = testing::model_from_text(body_on(floor, 0.0, 1.0, 0.0, 0.0, "t_end: 0.6, rtol: 1e-10"));
-  const RunOutcome o = run(model);
+  const LoadedModel loaded = testing::loaded_from_text(body_on(floor, 0.0, 1.0, 0.0, 0.0, "t_end: 0.6, rtol: 1e-10"));
+  const RunOutcome o = run(loaded);
   const EnergyBalance e = EnergyBalance::between(o.initial_energy, o.final_energy);
   CHECK(std::abs(e.error()) < 1e-6 * 2.0 * kG);
   CHECK(e.dissipated > 0.1 * 2.0 * kG * 1.0);  // zeta = 300 / (2 sqrt(2e6)) = 0.106: a real loss
@@ -76,8 +76,8 @@ TEST_CASE("contact: Coulomb friction stops a sliding block at v^2 / (2 mu g)", "
       "  - {name: floor, type: contact, line_point: [0, 0], line_normal: [0, 1], stiffness: 1.0e6, friction: 0.5, "
       "friction_velocity: 1.0e-4, points: [{body: ball, at: [0, 0]}]}\n";
   // Starts resting on the floor at its static penetration m g / k.
-  const Model model = testing::model_from_text(body_on(floor, 0.0, -2.0 * kG / k, v0, 0.0, "t_end: 0.6, rtol: 1e-9"));
-  const RunOutcome o = run(model);
+  const LoadedModel loaded = testing::loaded_from_text(body_on(floor, 0.0, -2.0 * kG / k, v0, 0.0, "t_end: 0.6, rtol: 1e-9"));
+  const RunOutcome o = run(loaded);
   CHECK(o.events.empty());  // stays in contact all along
   CHECK(o.y[0] == Approx(v0 * v0 / (2.0 * mu * kG)).epsilon(1e-3));
   CHECK(std::abs(o.y[3]) < 1e-3);  // stopped
@@ -88,11 +88,11 @@ TEST_CASE("contact with a circle: outside and inside surfaces", "[elements][cont
     const std::string wall =
         "  - {name: wall, type: contact, circle_center: [2, 0], circle_radius: 1, stiffness: 1.0e5, "
         "points: [{body: ball, at: [0, 0]}]}\n";
-    const Model model = testing::model_from_text(
+    const LoadedModel loaded = testing::loaded_from_text(
         "railcrash: 1\nname: c\nunits: SI\ngravity: [0, 0]\nbodies:\n"
         "  - {name: ball, mass: 2.0, inertia: 0.01, position: [0, 0], velocity: [1, 0]}\nelements:\n" + wall +
         "simulation: {t_end: 1.2, rtol: 1e-10}\n");
-    const RunOutcome o = run(model);
+    const RunOutcome o = run(loaded);
     REQUIRE(!o.events.empty());
     CHECK(o.events[0].t == Approx(1.0).margin(1e-9));
   }
@@ -100,11 +100,11 @@ TEST_CASE("contact with a circle: outside and inside surfaces", "[elements][cont
     const std::string bowl =
         "  - {name: bowl, type: contact, circle_center: [0, 0], circle_radius: 1, inside: true, stiffness: 1.0e5, "
         "points: [{body: ball, at: [0, 0]}]}\n";
-    const Model model = testing::model_from_text(
+    const LoadedModel loaded = testing::loaded_from_text(
         "railcrash: 1\nname: c\nunits: SI\ngravity: [0, 0]\nbodies:\n"
         "  - {name: ball, mass: 2.0, inertia: 0.01, position: [0.5, 0], velocity: [1, 0]}\nelements:\n" + bowl +
         "simulation: {t_end: 0.6, rtol: 1e-10}\n");
-    const RunOutcome o = run(model);
+    const RunOutcome o = run(loaded);
     REQUIRE(o.events.size() >= 2);
     CHECK(o.events[0].t == Approx(0.5).margin(1e-9));
     CHECK(o.y[3] == Approx(-1.0).epsilon(1e-6));  // elastic bounce back
@@ -119,12 +119,12 @@ TEST_CASE("wheel_rail: two slopes, static deflection, and lift-off under a risin
   SECTION("resting under gravity it settles at the deflection where the force carries the weight") {
     // W = 2 g = 19.62 N: below the breakpoint force of 1000 N, so d = W / k1; with a 20 kN
     // extra load d = d_L + (W + 20000 - k1 d_L) / k2.
-    const Model light = testing::model_from_text(body_on(wheel, 0.0, 0.4, 0.0, 0.0, "t_end: 1.0, rtol: 1e-9"));
-    const RunOutcome a = run(light);
+    const LoadedModel light_loaded = testing::loaded_from_text(body_on(wheel, 0.0, 0.4, 0.0, 0.0, "t_end: 1.0, rtol: 1e-9"));
+    const RunOutcome a = run(light_loaded);
     CHECK(0.4 - a.y[1] == Approx(2.0 * kG / 1.0e6).epsilon(1e-4));
-    const Model heavy = testing::model_from_text(
+    const LoadedModel heavy_loaded = testing::loaded_from_text(
         body_on(wheel, 0.0, 0.4, 0.0, 0.0, "t_end: 1.0, rtol: 1e-9", "loads:\n  - {type: force, body: ball, value: [0, -20000]}\n"));
-    const RunOutcome b = run(heavy);
+    const RunOutcome b = run(heavy_loaded);
     const double expected = 0.001 + (2.0 * kG + 20000.0 - 1000.0) / 4.0e6;
     CHECK(0.4 - b.y[1] == Approx(expected).epsilon(1e-4));
     // It starts exactly touching the rail at rest: contact is committed at t = 0 (the state
@@ -137,10 +137,10 @@ TEST_CASE("wheel_rail: two slopes, static deflection, and lift-off under a risin
   SECTION("an upward pull rising at 100 N/s lifts the wheel off when it exceeds the weight") {
     // Static start at d = W / k1; lift-off when the pull reaches W (quasi-static: the
     // contact's own dynamics shift it by far less than the tolerance).
-    const Model model = testing::model_from_text(body_on(
+    const LoadedModel loaded = testing::loaded_from_text(body_on(
         wheel, 0.0, 0.4 - 2.0 * kG / 1.0e6, 0.0, 0.0, "t_end: 0.3, rtol: 1e-9",
         "loads:\n  - {type: force, body: ball, value: [[0, [0, 0]], [1, [0, 100]]]}\n"));
-    const RunOutcome o = run(model);
+    const RunOutcome o = run(loaded);
     REQUIRE(o.events.size() >= 2);
     // The contact force reaches zero first (the damper cannot pull), then the wheel leaves.
     CHECK(o.events[0].what == "wheel unloaded (damper would pull)");

@@ -119,13 +119,12 @@ struct Run {
   double x = 0.0, y = 0.0, vx = 0.0, vy = 0.0;  // the mass at t_end
 };
 
-Run run(DaeSystem& system) {
-  const Model& model = system.model();
+Run run(DaeSystem& system, const SimulationSettings& simulation) {
   struct Null : RunObserver {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
   Run r;
-  r.outcome = make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, model.run_spec.simulation.t_end / 4.0, observer);
+  r.outcome = make_integrator(system, simulation)->run(simulation.t_end, simulation.t_end / 4.0, observer);
   INFO(r.outcome.message);
   REQUIRE(r.outcome.ok);
   r.x = r.outcome.y[0];
@@ -135,9 +134,9 @@ Run run(DaeSystem& system) {
   return r;
 }
 
-Run run(const Model& model) {
-  DaeSystem system(model);
-  return run(system);
+Run run(const LoadedModel& loaded) {
+  DaeSystem system(loaded.model);
+  return run(system, loaded.run_spec.simulation);
 }
 
 /// A mass tied to ground by element `e`: the ground point at the origin, the mass's point at
@@ -366,9 +365,10 @@ TEST_CASE("draft_gear: a mass bounces off it in buff and in draft, closed form u
     for (const char* integrator : {"ida", "euler"}) {
       INFO((side > 0 ? "buff " : "draft ") << integrator);
       const bool ida = std::string(integrator) == "ida";
-      const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -side * v0, 0.0, t_end, integrator));
+      const LoadedModel loaded = testing::loaded_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -side * v0, 0.0, t_end, integrator));
+      const Model& model = loaded.model;
       DaeSystem system(model);
-      const Run r = run(system);
+      const Run r = run(system, loaded.run_spec.simulation);
       check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
       CHECK(r.vx == Approx(side * speed).epsilon(ida ? 1e-8 : 1e-3));
       CHECK(element_work(r.outcome) == Approx(area).epsilon(ida ? 1e-7 : 2e-3));
@@ -390,8 +390,8 @@ TEST_CASE("draft_gear: released gear returns to neutral at zero compression and 
   double d = 0.0, v = -speed;
   LinearPhase{kGearMass, 0.0, kGear.Kt}.advance(d, v, extra);
   REQUIRE(-kGear.Kt * d < kGear.H * (1.0 + kGear.k / (kGear.Kt - kGear.k)));  // still stuck
-  const Model model = testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -2.0, 0.0, t_neutral + extra, "ida"));
-  const Run r = run(model);
+  const LoadedModel loaded = testing::loaded_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -2.0, 0.0, t_neutral + extra, "ida"));
+  const Run r = run(loaded);
   check_events(r.outcome, expected, 1e-8, 1e-9);
   CHECK(r.x == Approx(1.0 - d).epsilon(1e-10));
   CHECK(r.vx == Approx(-v).epsilon(1e-7));
@@ -415,8 +415,8 @@ TEST_CASE("draft_gear: bottoms at exactly its travel", "[elements][couplers]") {
     for (const char* integrator : {"ida", "euler"}) {
       INFO(integrator << ", transition stiffness " << kt);
       const bool ida = std::string(integrator) == "ida";
-      const Model model = testing::model_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator));
-      const Run r = run(model);
+      const LoadedModel loaded = testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator));
+      const Run r = run(loaded);
       check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-5);
       REQUIRE(r.outcome.events.size() > 1);
       CHECK(r.outcome.events[1].value == Approx(g.s).margin(ida ? 1e-9 : 1e-5));
@@ -453,9 +453,10 @@ TEST_CASE("draft_gear: the pin shears at the pin shear load, travels, goes solid
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
-    const Model model = testing::model_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, -v0, 0.0, t_end, integrator));
+    const LoadedModel loaded = testing::loaded_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, -v0, 0.0, t_end, integrator));
+    const Model& model = loaded.model;
     DaeSystem system(model);
-    const Run r = run(system);
+    const Run r = run(system, loaded.run_spec.simulation);
     check_events(r.outcome, w.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 2e-3);
     // The pin lets go at the pin shear load, the gear breaks at the fracture load.
     REQUIRE(r.outcome.events.size() == 5);
@@ -478,8 +479,8 @@ TEST_CASE("draft_gear: in draft the pin does not shear, the gear fractures at th
   w.go(0.0, g.Kt, g.H / (g.Kt - g.k), "sliding (draft)", extension);
   w.go(g.H, g.k, g.s, "bottomed (draft)", extension);
   w.go(g.k * g.s + g.H - g.K * g.s, g.K, g.s + (fracture - g.U(g.s)) / g.K, "fracture", [&](double) { return fracture; });
-  const Model model = testing::model_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, v0, 0.0, w.t + 0.01, "ida"));
-  const Run r = run(model);
+  const LoadedModel loaded = testing::loaded_from_text(one_mass(gear_yaml(g, extra), kGearMass, 1.0, 0.0, v0, 0.0, w.t + 0.01, "ida"));
+  const Run r = run(loaded);
   check_events(r.outcome, w.events, 1e-8, 1e-9);
   CHECK(r.vx == Approx(w.v).epsilon(1e-8));
 }
@@ -497,11 +498,12 @@ TEST_CASE("draft_gear with the report's Table 5 values (in-lbf-s): rebound close
   const Walker w = gear_bounce(report, mass, v0, 1);
   REQUIRE(w.events[1].value < report.s);
   REQUIRE(w.events.size() == 4);
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       one_mass(element, mass, 1.0, 0.0, -v0, 0.0, w.t + 0.001, "ida", 1e-6, "in-lbf-s"));
+  const Model& model = loaded.model;
   const DraftGear& gear = gear_of(model);
   CHECK(gear.transition_stiffness == 320000.0);  // default: the stiffness after bottoming
-  const Run r = run(model);
+  const Run r = run(loaded);
   check_events(r.outcome, w.events, 1e-8, 1e-9);
   CHECK(r.vx == Approx(-w.v).epsilon(1e-8));
   CHECK(dissipated(r.outcome) == Approx(w.loop_area()).epsilon(1e-7));
@@ -511,7 +513,7 @@ TEST_CASE("draft_gear: explicit Euler converges to IDA as the step shrinks", "[e
   const Walker expected = gear_bounce(kGear, kGearMass, 5.0, 1);
   const double t_end = expected.t + 0.5 * (kGear.H / kGear.k) / -expected.v;
   const auto final_vx = [&](const std::string& integrator, double dt) {
-    return run(testing::model_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator, dt))).vx;
+    return run(testing::loaded_from_text(one_mass(gear_yaml(kGear), kGearMass, 1.0, 0.0, -5.0, 0.0, t_end, integrator, dt))).vx;
   };
   const double ida = final_vx("ida", 1e-6);
   CHECK(ida == Approx(-expected.v).epsilon(1e-8));
@@ -755,7 +757,7 @@ TEST_CASE("coupler_end: the gap closes at gap / speed, uncoupled faces never pul
     const double t_end = t_draft + half_period + 0.01;
     // Uncoupled: an elastic bounce, then the mass goes away for good at +v.
     {
-      const Run r = run(testing::model_from_text(
+      const Run r = run(testing::loaded_from_text(
           one_mass(coupler_end_yaml("    friction: 0.3\n"), m, kContact + gap, 0.0, -v, 0.0, t_end, integrator)));
       check_events(r.outcome, {{"contact", t_contact, 0.0}, {"separation", t_separation, 0.0}}, t_margin, ida ? 1e-9 : 1e-5);
       CHECK(r.vx == Approx(v).epsilon(ida ? 1e-8 : 1e-4));
@@ -763,7 +765,7 @@ TEST_CASE("coupler_end: the gap closes at gap / speed, uncoupled faces never pul
     }
     // Coupled with slack: caught in draft after the slack, pulled back at -v.
     {
-      const Run r = run(testing::model_from_text(one_mass(
+      const Run r = run(testing::loaded_from_text(one_mass(
           coupler_end_yaml("    coupled: true\n    total_horizontal_slack: " + num(slack) + "\n"), m, kContact + gap, 0.0, -v,
           0.0, t_end, integrator)));
       check_events(r.outcome,
@@ -815,7 +817,7 @@ TEST_CASE("coupler_end: a face pressed and sliding decelerates by the regularize
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
-    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml("    friction: 0.3\n    friction_velocity: 0.01\n"),
+    const Run r = run(testing::loaded_from_text(one_mass(coupler_end_yaml("    friction: 0.3\n    friction_velocity: 0.01\n"),
                                                           m, kContact - P / kFaceStiffness, 0.0, 0.0, v0, T, integrator, 1e-6,
                                                           "SI", load)));
     CHECK(r.outcome.events.empty());
@@ -835,7 +837,7 @@ TEST_CASE("coupler_end: contact ends when the faces lose vertical overlap", "[el
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
-    const Run r = run(testing::model_from_text(
+    const Run r = run(testing::loaded_from_text(
         one_mass(coupler_end_yaml(), m, x0, y0, 0.0, vy, T, integrator, 1e-6, "SI", load)));
     check_events(r.outcome, {{"vertical overlap lost", t_lost, 0.3}}, ida ? 1e-8 : 2e-6, ida ? 1e-9 : 2e-6);
     CHECK(r.x == Approx(x0 - 0.5 * P / m * (T - t_lost) * (T - t_lost)).epsilon(ida ? 1e-8 : 1e-4));
@@ -887,7 +889,7 @@ TEST_CASE("coupler_end: faces touching at rest at the start: a load closes them,
   for (const double sign : {-1.0, 1.0}) {
     INFO((sign < 0 ? "pushed" : "pulled"));
     const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(sign * P) + ", 0]}\n";
-    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml(), m, kContact, 0.0, 0.0, 0.0, T, "ida", 1e-6, "SI", load)));
+    const Run r = run(testing::loaded_from_text(one_mass(coupler_end_yaml(), m, kContact, 0.0, 0.0, 0.0, T, "ida", 1e-6, "SI", load)));
     if (sign < 0) {
       REQUIRE(r.outcome.events.size() == 1);
       CHECK(r.outcome.events[0].what == "contact");
@@ -949,10 +951,11 @@ TEST_CASE("coupler_end restitution: a mass hitting the faces rebounds at e times
     for (const char* integrator : {"ida", "euler"}) {
       INFO("e = " << e << ", " << integrator);
       const bool ida = std::string(integrator) == "ida";
-      const Model model = testing::model_from_text(one_mass(coupler_end_yaml("    restitution: " + num(e) + "\n"), m,
+      const LoadedModel loaded = testing::loaded_from_text(one_mass(coupler_end_yaml("    restitution: " + num(e) + "\n"), m,
                                                             kContact + gap, 0.0, -v, 0.0, t_end, integrator));
+      const Model& model = loaded.model;
       DaeSystem system(model);
-      const Run r = run(system);
+      const Run r = run(system, loaded.run_spec.simulation);
       check_events(r.outcome, {{"contact", t_contact, 0.0}, {"unloading", t_unloading, -peak}, {"separation", t_separation, -set}},
                    ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
       // Euler (dt 1e-6) sees each switch up to one step late, but the force is continuous at
@@ -986,7 +989,7 @@ TEST_CASE("coupler_end restitution: faces touching at rest, pushed by a load: re
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
-    const Run r = run(testing::model_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), m, kContact, 0.0, 0.0, 0.0,
+    const Run r = run(testing::loaded_from_text(one_mass(coupler_end_yaml("    restitution: 0.5\n"), m, kContact, 0.0, 0.0, 0.0,
                                                           t_end, integrator, 1e-6, "SI", load)));
     std::ostringstream seen;
     for (const EventRecord& ev : r.outcome.events) seen << ev.t << " " << ev.what << " " << ev.value << "\n";
@@ -1108,11 +1111,12 @@ TEST_CASE("coupler_end shear_load: the faces shear off at the stated force and c
     for (const char* integrator : {"ida", "euler"}) {
       INFO("restitution " << e << ", " << integrator);
       const bool ida = std::string(integrator) == "ida";
-      const Model model = testing::model_from_text(
+      const LoadedModel loaded = testing::loaded_from_text(
           one_mass(coupler_end_yaml("    friction: 0.3\n    restitution: " + std::string(e) + "\n    shear_load: " + num(S) + "\n"),
                    m, kContact + gap, 0.0, -v, 0.0, t_end, integrator));
+      const Model& model = loaded.model;
       DaeSystem system(model);
-      const Run r = run(system);
+      const Run r = run(system, loaded.run_spec.simulation);
       // Euler sees the shear one step late: the force overshoots S by at most k v dt (0.36 here).
       check_events(r.outcome, {{"contact", t_contact, 0.0}, {"face shear failure", t_shear, S}}, ida ? 1e-8 : 3e-6,
                    ida ? 1e-9 : 1e-4);
@@ -1200,8 +1204,8 @@ TEST_CASE("coupling kind 1: slack, loading curve, unloading at a fraction of it,
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
     const bool ida = std::string(integrator) == "ida";
-    const Model model = testing::model_from_text(one_mass(coupling_kind1(factor, slack), m, 1.0, 0.0, -v0, 0.0, t_end, integrator));
-    const Run r = run(model);
+    const LoadedModel loaded = testing::loaded_from_text(one_mass(coupling_kind1(factor, slack), m, 1.0, 0.0, -v0, 0.0, t_end, integrator));
+    const Run r = run(loaded);
     check_events(r.outcome, expected.events, ida ? 1e-8 : 3e-6, ida ? 1e-9 : 1e-5);
     CHECK(r.vx == Approx(speed).epsilon(ida ? 1e-8 : 1e-3));
     CHECK(element_work(r.outcome) == Approx(expected.loop_area()).epsilon(ida ? 1e-7 : 2e-3));
@@ -1219,7 +1223,7 @@ TEST_CASE("coupling kind 2: separate loading and unloading curves, closed form",
                               "\n    unloading_curve: " + table(unloading) + "\n    transition_stiffness: " + num(kt) +
                               "\n    horizontal_slack: " + num(slack) + "\n";
   const double t_end = expected.t + 0.5 * slack / -expected.v;
-  const Run r = run(testing::model_from_text(one_mass(element, m, 1.0, 0.0, -v0, 0.0, t_end, "ida")));
+  const Run r = run(testing::loaded_from_text(one_mass(element, m, 1.0, 0.0, -v0, 0.0, t_end, "ida")));
   check_events(r.outcome, expected.events, 1e-8, 1e-9);
   CHECK(r.vx == Approx(-expected.v).epsilon(1e-8));
   CHECK(dissipated(r.outcome) == Approx(expected.loop_area()).epsilon(1e-7));
@@ -1234,7 +1238,7 @@ TEST_CASE("coupling without slack passes through zero force into draft", "[eleme
   double x = 0.0, v = -expected.v;
   LinearPhase{m, 0.0, 1.0e7}.advance(x, v, extra);
   const std::string element = coupling_kind1(0.5, 0.0, "    transition_stiffness: " + num(kt) + "\n");
-  const Run r = run(testing::model_from_text(one_mass(element, m, 1.0, 0.0, -v0, 0.0, expected.t + extra, "ida")));
+  const Run r = run(testing::loaded_from_text(one_mass(element, m, 1.0, 0.0, -v0, 0.0, expected.t + extra, "ida")));
   check_events(r.outcome, expected.events, 1e-8, 1e-9);
   CHECK(r.x == Approx(1.0 + x).epsilon(1e-9));
   CHECK(r.vx == Approx(v).epsilon(1e-7));
@@ -1253,7 +1257,7 @@ TEST_CASE("coupling without slack, at rest at zero deflection: either direction 
   for (const double sign : {-1.0, 1.0}) {
     INFO((sign < 0 ? "pushed into buff" : "pulled into draft"));
     const std::string load = "loads:\n  - {type: force, body: mass, at: [0, 0], value: [" + num(sign * P) + ", 0]}\n";
-    const Run r = run(testing::model_from_text(one_mass(coupling_kind1(0.5, 0.0), m, 1.0, 0.0, 0.0, 0.0, T, "ida", 1e-6, "SI", load)));
+    const Run r = run(testing::loaded_from_text(one_mass(coupling_kind1(0.5, 0.0), m, 1.0, 0.0, 0.0, 0.0, T, "ida", 1e-6, "SI", load)));
     REQUIRE(r.outcome.events.size() == 1);
     CHECK(r.outcome.events[0].what == (sign < 0 ? "back on the loading curve (buff)" : "through zero force to draft"));
     CHECK(r.outcome.events[0].t < 1e-4);
@@ -1303,7 +1307,7 @@ TEST_CASE("coupling vertical: slack, flexibility and misalignment, with friction
     // Horizontally in the slack (no horizontal force, so no friction); vertical speed 0.5 up.
     const double m = 100.0, vy = 0.5, y0 = 0.0;
     const double t_up = (0.5 * sv - (y0 + e)) / vy, half_period = kPi * std::sqrt(m / kv);
-    const Run r = run(testing::model_from_text(one_mass(element(0.02), m, 1.0, y0, 0.0, vy, t_up + half_period + 0.01, "ida")));
+    const Run r = run(testing::loaded_from_text(one_mass(element(0.02), m, 1.0, y0, 0.0, vy, t_up + half_period + 0.01, "ida")));
     check_events(r.outcome,
                  {{"vertical slack taken up (head L above)", t_up, 0.5 * sv},
                   {"vertical slack", t_up + half_period, 0.5 * sv}},

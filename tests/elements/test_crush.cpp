@@ -33,9 +33,9 @@ struct Run {
   double final_vx = 0.0;
 };
 
-Run run(DaeSystem& system) {
+Run run(DaeSystem& system, const SimulationSettings& simulation) {
   Run r;
-  r.outcome = testing::simulate(system);
+  r.outcome = testing::simulate(system, simulation);
   r.final_vx = r.outcome.y[3];
   return r;
 }
@@ -50,9 +50,10 @@ TEST_CASE("crush spring: mass into an elastic-perfectly-plastic structure, close
   const double speed = 10.0, gap = 0.5;
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    const Model model = testing::model_from_text(impact(speed, gap, integrator));
+    const LoadedModel loaded = testing::loaded_from_text(impact(speed, gap, integrator));
+    const Model& model = loaded.model;
     DaeSystem system(model);
-    const Run r = run(system);
+    const Run r = run(system, loaded.run_spec.simulation);
     const bool ida = std::string(integrator) == "ida";
     const double tolerance = ida ? 1e-7 : 2e-4;
     REQUIRE(r.outcome.events.size() == 4);
@@ -78,9 +79,10 @@ TEST_CASE("crush spring: its mode changes are kinks, continuous in force at the 
   // that at the event state and may go on without a restart where the lag allows it.
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    const Model model = testing::model_from_text(impact(10.0, 0.5, integrator));
+    const LoadedModel loaded = testing::loaded_from_text(impact(10.0, 0.5, integrator));
+    const Model& model = loaded.model;
     DaeSystem system(model);
-    const Run r = run(system);
+    const Run r = run(system, loaded.run_spec.simulation);
     REQUIRE(r.outcome.ok);
     REQUIRE(r.outcome.events.size() == 4);
     for (const EventRecord& e : r.outcome.events) {
@@ -280,14 +282,15 @@ TEST_CASE("the run's element states: a snapshot restored undoes a commit and its
 TEST_CASE("Euler: a second run of one integrator starts from the same modes and repeats the first", "[elements][crush]") {
   // The first run ends separated with a permanent crush of 0.045; the second must start in
   // contact again with no crush history, as the first did.
-  const Model model = testing::model_from_text(impact(10.0, 0.0, "euler"));
+  const LoadedModel loaded = testing::loaded_from_text(impact(10.0, 0.0, "euler"));
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  const std::unique_ptr<Integrator> euler = make_integrator(system, model.run_spec.simulation);
+  const std::unique_ptr<Integrator> euler = make_integrator(system, loaded.run_spec.simulation);
   struct Quiet : RunObserver {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
-  const RunOutcome first = euler->run(model.run_spec.simulation.t_end, 0.01, observer);
-  const RunOutcome second = euler->run(model.run_spec.simulation.t_end, 0.01, observer);
+  const RunOutcome first = euler->run(loaded.run_spec.simulation.t_end, 0.01, observer);
+  const RunOutcome second = euler->run(loaded.run_spec.simulation.t_end, 0.01, observer);
   REQUIRE(first.ok);
   REQUIRE(second.ok);
   REQUIRE(first.events.size() == 3);  // starts in contact: curve segment 2, unloading, separation
@@ -326,9 +329,10 @@ simulation: {t_end: 0.05, integrator: ida, rtol: 1e-9, output_interval: 0.001}
     INFO(integrator);
     std::string model_text = text;
     model_text.replace(model_text.find("integrator: ida"), 15, std::string("integrator: ") + integrator + ", dt: 1e-6");
-    const Model model = testing::model_from_text(model_text);
+    const LoadedModel loaded = testing::loaded_from_text(model_text);
+    const Model& model = loaded.model;
     DaeSystem system(model);
-    const RunOutcome outcome = testing::simulate(system);
+    const RunOutcome outcome = testing::simulate(system, loaded.run_spec.simulation);
     REQUIRE(outcome.ok);
     const EventRecord* zone_contact = nullptr;
     for (const EventRecord& e : outcome.events)
@@ -359,12 +363,13 @@ TEST_CASE("crush spring crushed through its free length stops the run naming it 
   const double t_meet = gap / speed + t_y + (v_y - std::sqrt(v_y * v_y - 2.0 * a * plastic)) / a;  // [s] 0.0375
   for (const char* integrator : {"ida", "euler", "auto"}) {
     INFO(integrator);
-    const Model model = testing::model_from_text(impact(speed, gap, integrator));
+    const LoadedModel loaded = testing::loaded_from_text(impact(speed, gap, integrator));
+    const Model& model = loaded.model;
     DaeSystem system(model);
     struct Quiet : RunObserver {
       void sample(double, const double*, const double*, const double*, const double*) override {}
     } observer;
-    const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.2, 0.001, observer);
+    const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.2, 0.001, observer);
     INFO(outcome.message);
     CHECK_FALSE(outcome.ok);
     CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: crush_spring 'crush' is crushed through its whole length at t = "));
@@ -399,8 +404,9 @@ TEST_CASE("crush spring placed far from the origin: a start crushed by round-off
   REQUIRE(crushed_by > 0.0);  // the round-off this case is about
   double largest[2] = {0.0, 0.0};  // [m] the zone's largest crush output
   for (int k = 0; k < 2; ++k) {
-    const Model model = testing::model_from_text(model_at(k == 0 ? 0.0 : 1000.0));
-    const RunReport report = run_model(model, "", nullptr, false, true);
+    const LoadedModel loaded = testing::loaded_from_text(model_at(k == 0 ? 0.0 : 1000.0));
+    const Model& model = loaded.model;
+    const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, true);
     REQUIRE(report.outcome.ok);
     const auto column = std::find(report.columns.begin(), report.columns.end(), "zone.crush");
     REQUIRE(column != report.columns.end());

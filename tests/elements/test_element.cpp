@@ -41,7 +41,7 @@ TEST_CASE("every element type's output roles name one of its outputs, each role 
   std::vector<Model> models;
   for (const char* file : {"models/report/final_two_car.yaml", "models/report/preliminary_car.yaml",
                            "models/barrier/two_car_barrier.yaml", "models/examples/coupled_cars.yaml"})
-    models.push_back(load_model(source_path(file)));
+    models.push_back(load_model(source_path(file)).model);
   models.push_back(testing::model_from_text(kOtherTypes));
   std::set<std::string> checked;
   for (const Model& model : models)
@@ -66,7 +66,7 @@ TEST_CASE("every element type's output roles name one of its outputs, each role 
 
 TEST_CASE("the roles say which outputs are crush, contact, coupler and interlock forces", "[roles]") {
   // What the run summary, converge, the responses and the report selected by type before.
-  const Model model = load_model(source_path("models/report/final_two_car.yaml"));
+  const Model model = load_model(source_path("models/report/final_two_car.yaml")).model;
   const auto role_of = [&](const std::string& type, OutputRole role) {
     for (const auto& e : model.elements())
       if (e->type() == type) return e->output_with_role(role);
@@ -90,7 +90,7 @@ TEST_CASE("a long train's elements lie side by side in memory, not one per page 
   // Loaded from a model file, each element object used to sit on its own 4 KiB page among the
   // parser's allocations (a median 2.9 KiB between consecutive elements; bench/HISTORY.md).
   // From the element pool (element.cpp) they fill the pages they occupy.
-  const Model model = load_model_text(make_consist_model(source_path("models/report/final_two_car.yaml"), 20), "consist.yaml");
+  const Model model = load_model_text(make_consist_model(source_path("models/report/final_two_car.yaml"), 20), "consist.yaml").model;
   REQUIRE(model.elements().size() == 1200);
   // Under AddressSanitizer elements come from the ordinary heap (its redzones and quarantine
   // decide the layout): only the count above is checked there.
@@ -110,16 +110,16 @@ TEST_CASE("every element's roots_and_outputs and force_roots_and_outputs equal i
   // law once for all (the beams) must give what the separate calls give, in every mode: the
   // two-car crash is run first so its beams, springs and contacts hold the modes of a crash
   // (plastic hinges among them), then every element is compared at random states.
-  std::vector<Model> models;
+  std::vector<LoadedModel> models;
   for (const char* file : {"models/report/final_two_car.yaml", "models/report/preliminary_car.yaml",
                            "models/barrier/two_car_barrier.yaml", "models/examples/coupled_cars.yaml"})
     models.push_back(load_model(source_path(file), {"simulation.t_end=0.15"}));
-  models.push_back(testing::model_from_text(kOtherTypes));
+  models.push_back(testing::loaded_from_text(kOtherTypes));
   std::mt19937 rng(7);
   int compared = 0, compared_forces = 0, loaded_beams = 0, plastic_beams = 0, failed_beams = 0;
   for (std::size_t m = 0; m < models.size(); ++m) {
-    DaeSystem system(models[m]);
-    if (m == 0) REQUIRE(testing::simulate(system, 0.05).ok);  // the crash, to its t_end
+    DaeSystem system(models[m].model);
+    if (m == 0) REQUIRE(testing::simulate(system, models[m].run_spec.simulation, 0.05).ok);  // the crash, to its t_end
     const int nq = system.body_unknowns();
     for (int sample = 0; sample < 3; ++sample) {
       // A beam in each mode family: as the run left it, then plastic in all three components,

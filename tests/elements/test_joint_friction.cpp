@@ -12,7 +12,7 @@ namespace {
 
 const double kG = 9.81;
 
-RunOutcome run(const Model& model) { return testing::simulate(model); }
+RunOutcome run(const LoadedModel& loaded) { return testing::simulate(loaded); }
 
 // A 3 kg block on a horizontal ground slider (friction mu, slider length 0.5 m), pushed
 // off at v0; P2 is its centre of mass, so the lock carries no moment and N = m g.
@@ -43,7 +43,7 @@ TEST_CASE("slider friction stops a block at v0^2 / (2 mu g) under both integrato
   const double mu = 0.4, v0 = 2.0;
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    const RunOutcome o = run(testing::model_from_text(slider(mu, v0, integrator)));
+    const RunOutcome o = run(testing::loaded_from_text(slider(mu, v0, integrator)));
     CHECK(o.y[0] == Approx(v0 * v0 / (2.0 * mu * kG)).epsilon(2e-3));
     CHECK(std::abs(o.y[3]) < 1e-3);
     // Everything it had is dissipated by the joint's friction.
@@ -58,7 +58,7 @@ TEST_CASE("pin friction decelerates a spinning disc at muR m g / J", "[elements]
   const double stop_time = w0 * j / (friction_radius * m * kG);  // 3.19 s
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    const RunOutcome o = run(testing::model_from_text(wheel(friction_radius, w0, integrator)));
+    const RunOutcome o = run(testing::loaded_from_text(wheel(friction_radius, w0, integrator)));
     // Constant deceleration until it stops: angle w0^2 / (2 alpha), then at rest.
     const double alpha = w0 / stop_time;
     CHECK(o.y[2] == Approx(w0 * w0 / (2.0 * alpha)).epsilon(2e-3));

@@ -83,11 +83,12 @@ struct Quiet : RunObserver {
 };
 
 RunOutcome run(const std::string& yaml) {
-  const Model model = testing::model_from_text(yaml);
+  const LoadedModel loaded = testing::loaded_from_text(yaml);
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  auto integrator = make_integrator(system, model.run_spec.simulation);
+  auto integrator = make_integrator(system, loaded.run_spec.simulation);
   Quiet quiet;
-  RunOutcome outcome = integrator->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), quiet);
+  RunOutcome outcome = integrator->run(loaded.run_spec.simulation.t_end, output_interval_of(loaded.run_spec.simulation), quiet);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   return outcome;

@@ -30,7 +30,7 @@ constexpr const char* kInputLabel = "fuzz-input.yaml";
 
 void exercise_model(const std::string& text) {
   using namespace railcrash;
-  const Model model = load_model_text(text, kInputLabel);
+  const Model model = load_model_text(text, kInputLabel).model;
   DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   const std::vector<double> yp(y.size(), 0.0);

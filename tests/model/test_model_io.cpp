@@ -150,7 +150,8 @@ std::string single_body_model(const std::string& body, const std::string& elemen
 // ---------------------------------------------------------------------------------------
 
 TEST_CASE("a valid SI model loads with its bodies, elements, loads and settings", "[model_io]") {
-  const Model model = testing::model_from_text(kBase);
+  const LoadedModel loaded = testing::loaded_from_text(kBase);
+  const Model& model = loaded.model;
   CHECK(model.finalized());
   CHECK(model.name == "io test model");
   CHECK(model.file == "test.yaml");
@@ -233,13 +234,13 @@ TEST_CASE("a valid SI model loads with its bodies, elements, loads and settings"
   CHECK(moment.value.at(50.0)[0] == -10.0);         // held after the last row
   CHECK(moment.value.at(1.5)[1] == 0.0);
 
-  CHECK(model.run_spec.simulation.t_end == 2.0);
-  CHECK(model.run_spec.simulation.integrator == IntegratorKind::Euler);
-  CHECK(model.run_spec.simulation.dt == 1.0e-4);
-  CHECK(model.run_spec.simulation.output_interval == 0.01);
-  CHECK(model.run_spec.simulation.rtol == 1e-6);  // default
-  CHECK_FALSE(model.run_spec.simulation.atol.has_value());
-  CHECK_FALSE(model.run_spec.simulation.force_dt);
+  CHECK(loaded.run_spec.simulation.t_end == 2.0);
+  CHECK(loaded.run_spec.simulation.integrator == IntegratorKind::Euler);
+  CHECK(loaded.run_spec.simulation.dt == 1.0e-4);
+  CHECK(loaded.run_spec.simulation.output_interval == 0.01);
+  CHECK(loaded.run_spec.simulation.rtol == 1e-6);  // default
+  CHECK_FALSE(loaded.run_spec.simulation.atol.has_value());
+  CHECK_FALSE(loaded.run_spec.simulation.force_dt);
 }
 
 TEST_CASE("a tabulated force takes [t, Fx, Fy] and [t, [Fx, Fy]] rows", "[model_io]") {
@@ -254,7 +255,8 @@ TEST_CASE("a tabulated force takes [t, Fx, Fy] and [t, [Fx, Fy]] rows", "[model_
 }
 
 TEST_CASE("the verification slider-crank file loads", "[model_io]") {
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  const Model& model = loaded.model;
   CHECK(model.name == "SUNDIALS GGL slider-crank (idasSlCrank_dns)");
   CHECK(model.gravity_x == 0.0);
   CHECK(model.gravity_y == 0.0);
@@ -266,11 +268,11 @@ TEST_CASE("the verification slider-crank file loads", "[model_io]") {
   CHECK(model.elements().size() == 5);
   CHECK(model.constraint_rows() == 5);  // pin 2 + pin 2 + sliding pin 1
   CHECK(model.loads().size() == 1);
-  CHECK(model.run_spec.simulation.t_end == 10.0);
-  CHECK(model.run_spec.simulation.integrator == IntegratorKind::Ida);
-  REQUIRE(model.run_spec.simulation.atol.has_value());
-  CHECK(*model.run_spec.simulation.atol == 1.0e-7);
-  CHECK(model.run_spec.simulation.output_interval == 0.4);
+  CHECK(loaded.run_spec.simulation.t_end == 10.0);
+  CHECK(loaded.run_spec.simulation.integrator == IntegratorKind::Ida);
+  REQUIRE(loaded.run_spec.simulation.atol.has_value());
+  CHECK(*loaded.run_spec.simulation.atol == 1.0e-7);
+  CHECK(loaded.run_spec.simulation.output_interval == 0.4);
 }
 
 TEST_CASE("a missing model file is an InputError naming the path", "[model_io]") {
@@ -325,22 +327,23 @@ TEST_CASE("gravity: SI default, [0, 0] switches it off, any vector is taken as g
 }
 
 TEST_CASE("overrides given with --set change the model before it is checked", "[model_io]") {
-  const Model model =
-      load_model_text(kBase, "test.yaml", {"simulation.t_end=0.5", "bodies.bob.mass=2", "elements.spring.stiffness=200"});
-  CHECK(model.run_spec.simulation.t_end == 0.5);
+  const LoadedModel loaded = load_model_text(kBase, "test.yaml", {"simulation.t_end=0.5", "bodies.bob.mass=2", "elements.spring.stiffness=200"});
+  const Model& model = loaded.model;
+  CHECK(loaded.run_spec.simulation.t_end == 0.5);
   CHECK(model.bodies()[0].mass == 2.0);
   CHECK(model.bodies()[1].mass == 3.0);  // untouched
   const auto* spring = dynamic_cast<const LinearSpring*>(model.elements()[0].get());
   REQUIRE(spring != nullptr);
   CHECK(spring->stiffness == 200.0);
   CHECK(*spring->free_length == 1.5);
-  CHECK(model.run_spec.simulation.dt == 1.0e-4);  // the rest of the section stays
+  CHECK(loaded.run_spec.simulation.dt == 1.0e-4);  // the rest of the section stays
 
-  const Model more = load_model_text(kBase, "test.yaml", {"gravity=[0, 0]", "simulation.integrator=ida", "simulation.rtol=1e-8",
+  const LoadedModel more_loaded = load_model_text(kBase, "test.yaml", {"gravity=[0, 0]", "simulation.integrator=ida", "simulation.rtol=1e-8",
                                                           "bodies.cart.position=[5, 0]", "elements.slide.axis=[0, 1]"});
+  const Model& more = more_loaded.model;
   CHECK(more.gravity_y == 0.0);
-  CHECK(more.run_spec.simulation.integrator == IntegratorKind::Ida);
-  CHECK(more.run_spec.simulation.rtol == 1e-8);
+  CHECK(more_loaded.run_spec.simulation.integrator == IntegratorKind::Ida);
+  CHECK(more_loaded.run_spec.simulation.rtol == 1e-8);
   CHECK(more.bodies()[1].x == 5.0);
   const auto* slide = dynamic_cast<const SliderJoint*>(more.elements()[2].get());
   REQUIRE(slide != nullptr);
@@ -348,8 +351,8 @@ TEST_CASE("overrides given with --set change the model before it is checked", "[
   CHECK(slide->axis_y == 1.0);
 
   // A simulation section may come entirely from the command line.
-  const Model no_section = load_model_text(kHeader + kBodies, "test.yaml", {"simulation.t_end=3"});
-  CHECK(no_section.run_spec.simulation.t_end == 3.0);
+  const LoadedModel no_section_loaded = load_model_text(kHeader + kBodies, "test.yaml", {"simulation.t_end=3"});
+  CHECK(no_section_loaded.run_spec.simulation.t_end == 3.0);
 }
 
 TEST_CASE("the run command's options go through --set's path, after it, and are named in messages", "[model_io]") {
@@ -363,11 +366,11 @@ TEST_CASE("the run command's options go through --set's path, after it, and are 
   const std::vector<OptionSetting> settings = option_settings(options);
   CHECK(settings.size() == 4);
   // Applied after --set: the option wins over a --set of the same key.
-  const Model model = load_model(path.string(), {"simulation.t_end=9"}, settings);
-  CHECK(model.run_spec.simulation.t_end == 0.25);
-  CHECK(model.run_spec.simulation.integrator == IntegratorKind::Ida);
-  CHECK(model.run_spec.simulation.max_steps == 500);
-  CHECK(model.run_spec.simulation.force_dt);
+  const LoadedModel loaded = load_model(path.string(), {"simulation.t_end=9"}, settings);
+  CHECK(loaded.run_spec.simulation.t_end == 0.25);
+  CHECK(loaded.run_spec.simulation.integrator == IntegratorKind::Ida);
+  CHECK(loaded.run_spec.simulation.max_steps == 500);
+  CHECK(loaded.run_spec.simulation.force_dt);
   // A bad value is reported with the option as the user wrote it, not a file line.
   RunOverrides bad;
   bad.t_end = -1.5;
@@ -452,7 +455,8 @@ TEST_CASE("a model variant is its base model with the keys it sets changed", "[m
                                          "railcrash: 1\nvariant_of: base.yaml\nname: stiffer\n"
                                          "set:\n  elements.spring.stiffness: 250   # why\n  gravity: [0, 0]\n"
                                          "  bodies.bob.mass*: 3\n");
-  const Model model = load_model(variant, {"simulation.t_end=0.25"});
+  const LoadedModel loaded = load_model(variant, {"simulation.t_end=0.25"});
+  const Model& model = loaded.model;
   CHECK(model.name == "stiffer");
   const auto* spring = dynamic_cast<const LinearSpring*>(model.elements()[0].get());
   REQUIRE(spring != nullptr);
@@ -460,8 +464,8 @@ TEST_CASE("a model variant is its base model with the keys it sets changed", "[m
   CHECK(model.gravity_y == 0.0);
   CHECK(model.bodies()[0].mass == Approx(3.0));   // 1 x 3
   CHECK(model.bodies()[1].mass == 3.0);            // the base's
-  CHECK(model.run_spec.simulation.t_end == 0.25);           // --set still applies, after the variant
-  const Model base = load_model(write_file("ok", "base.yaml", kBase));
+  CHECK(loaded.run_spec.simulation.t_end == 0.25);           // --set still applies, after the variant
+  const Model base = load_model(write_file("ok", "base.yaml", kBase)).model;
   CHECK(base.elements().size() == model.elements().size());
 }
 
@@ -493,8 +497,8 @@ TEST_CASE("model variant errors name the variant's line or the base file", "[mod
 
 TEST_CASE("the report's corrected final model is the printed one with three proposals", "[model_io]") {
   const std::string folder = std::string(RAILCRASH_SOURCE_DIR) + "/models/report/";
-  const Model printed = load_model(folder + "final_two_car.yaml");
-  const Model corrected = load_model(folder + "final_two_car_corrected.yaml");
+  const Model printed = load_model(folder + "final_two_car.yaml").model;
+  const Model corrected = load_model(folder + "final_two_car_corrected.yaml").model;
   const auto body = [](const Model& m, const std::string& name) {
     for (const Body& b : m.bodies())
       if (b.name == name) return b;
@@ -885,7 +889,7 @@ TEST_CASE("a properly constrained model assembles", "[model_io]") {
   const AssemblyReport report = assemble_initial_state(system, y);
   CHECK(report.largest_position_change < 1e-12);
 
-  const Model crank = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  const Model crank = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml").model;
   DaeSystem crank_system(crank);
   std::vector<double> yc = crank_system.initial_state();
   CHECK_NOTHROW(assemble_initial_state(crank_system, yc));
@@ -1033,33 +1037,33 @@ const CrushSpring& crush_spring(const Model& model, std::size_t index) {
 
 TEST_CASE("an edit changes exactly the key it names, also where an alias shares the value", "[model_io]") {
   const std::vector<double> soft{0.0, 1.5e6, 1.5e6}, stiff{0.0, 3.0e6, 3.0e6};
-  const Model as_written = load_model_text(kSharedValuesModel, "shared.yaml");
+  const Model as_written = load_model_text(kSharedValuesModel, "shared.yaml").model;
   CHECK(crush_spring(as_written, 0).curve_force == soft);
   CHECK(crush_spring(as_written, 1).curve_force == soft);
   CHECK(as_written.bodies()[1].vx == -5.0);
 
   SECTION("KEY=VALUE on a shared list") {
-    const Model model = load_model_text(kSharedValuesModel, "shared.yaml", {"elements.crush_a.curve=[[0, 0], [0.01, 3.0e6], [0.6, 3.0e6]]"});
+    const Model model = load_model_text(kSharedValuesModel, "shared.yaml", {"elements.crush_a.curve=[[0, 0], [0.01, 3.0e6], [0.6, 3.0e6]]"}).model;
     CHECK(crush_spring(model, 0).curve_force == stiff);
     CHECK(crush_spring(model, 1).curve_force == soft);
   }
   SECTION("KEY*=FACTOR on a shared number") {
-    const Model model = load_model_text(kSharedValuesModel, "shared.yaml", {"elements.crush_b.unloading_stiffness*=2"});
+    const Model model = load_model_text(kSharedValuesModel, "shared.yaml", {"elements.crush_b.unloading_stiffness*=2"}).model;
     CHECK(crush_spring(model, 0).unloading_stiffness == 4.0e8);
     CHECK(crush_spring(model, 1).unloading_stiffness == 8.0e8);
   }
   SECTION("KEY=VALUE and KEY[i] on a shared body velocity") {
-    const Model whole = load_model_text(kSharedValuesModel, "shared.yaml", {"bodies.car_a.velocity=[-6, 0]"});
+    const Model whole = load_model_text(kSharedValuesModel, "shared.yaml", {"bodies.car_a.velocity=[-6, 0]"}).model;
     CHECK(whole.bodies()[0].vx == -6.0);
     CHECK(whole.bodies()[1].vx == -5.0);
-    const Model entry = load_model_text(kSharedValuesModel, "shared.yaml", {"bodies.car_b.velocity[0]=-4", "bodies.car_b.velocity[0]*=0.5"});
+    const Model entry = load_model_text(kSharedValuesModel, "shared.yaml", {"bodies.car_b.velocity[0]=-4", "bodies.car_b.velocity[0]*=0.5"}).model;
     CHECK(entry.bodies()[0].vx == -5.0);
     CHECK(entry.bodies()[1].vx == -2.0);
     CHECK(entry.bodies()[1].vy == 0.0);
   }
   SECTION("an entry of a shared table, and a second edit below the first") {
     const Model model = load_model_text(kSharedValuesModel, "shared.yaml",
-                                        {"elements.crush_a.curve[2]=[0.8, 1.5e6]", "elements.crush_a.curve[1][1]=2.0e6"});
+                                        {"elements.crush_a.curve[2]=[0.8, 1.5e6]", "elements.crush_a.curve[1][1]=2.0e6"}).model;
     CHECK(crush_spring(model, 0).curve_crush == std::vector<double>{0.0, 0.01, 0.8});
     CHECK(crush_spring(model, 0).curve_force == std::vector<double>{0.0, 2.0e6, 1.5e6});
     CHECK(crush_spring(model, 1).curve_crush == std::vector<double>{0.0, 0.01, 0.6});
@@ -1070,7 +1074,7 @@ TEST_CASE("an edit changes exactly the key it names, also where an alias shares 
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "base.yaml") << kSharedValuesModel;
     std::ofstream(dir / "variant.yaml") << "railcrash: 1\nvariant_of: base.yaml\nset:\n  elements.crush_b.curve: [[0, 0], [0.01, 3.0e6], [0.6, 3.0e6]]\n";
-    const Model model = load_model((dir / "variant.yaml").string());
+    const Model model = load_model((dir / "variant.yaml").string()).model;
     std::filesystem::remove_all(dir);
     CHECK(crush_spring(model, 0).curve_force == soft);
     CHECK(crush_spring(model, 1).curve_force == stiff);
@@ -1080,7 +1084,7 @@ TEST_CASE("an edit changes exactly the key it names, also where an alias shares 
 TEST_CASE("KEY[i] settings name an entry of a list: each applies to the document as the settings before it left it", "[model_io]") {
   const std::string model_text = kHeader + "gravity: [0, -9.81]\n" + kBodies + kElements + kLoads + kSimulation;
   const Model model = load_model_text(model_text, "test.yaml", {"bodies.cart.velocity=[3, 0.5]", "bodies.cart.velocity[0]=2",
-                                                                "bodies.cart.velocity[1]*=4", "gravity[1]=-1.62"});
+                                                                "bodies.cart.velocity[1]*=4", "gravity[1]=-1.62"}).model;
   const auto cart = std::find_if(model.bodies().begin(), model.bodies().end(), [](const Body& b) { return b.name == "cart"; });
   REQUIRE(cart != model.bodies().end());
   CHECK(cart->vx == 2.0);
@@ -1142,10 +1146,11 @@ TEST_CASE("every body point (an element's, a load's, a crush gauge's, an output'
   text = kBase + "outputs:\n  - {body: ground}\n";
   expect_error("output on ground", text, line_of(text, "ground}"), {"outputs: item 1: the ground does not move; name a body"});
   // The offsets are read the same way: the gauge's second point at the spring's end on the cart.
-  const Model model = load_model_text(kBase + "responses:\n  reference_crush: 1.0\n  crush_gauges:\n"
+  const LoadedModel loaded = load_model_text(kBase + "responses:\n  reference_crush: 1.0\n  crush_gauges:\n"
                                               "    - {name: g, points: [{body: bob, at: [0.25, -1]}, {body: cart, at: [0.5, 0]}]}\n",
                                       "test.yaml");
-  const CrushGauge& g = model.run_spec.responses.crush_gauges.at(0);
+  const Model& model = loaded.model;
+  const CrushGauge& g = loaded.run_spec.responses.crush_gauges.at(0);
   CHECK(g.front.body == 0);
   CHECK(g.front.sx == 0.25);
   CHECK(g.front.sy == -1.0);

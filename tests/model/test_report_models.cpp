@@ -16,8 +16,8 @@ using namespace railcrash;
 namespace {
 
 RunOutcome run_report_model(const std::string& file, const std::vector<std::string>& settings) {
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/" + file, settings);
-  return testing::simulate(model, 1e-3);
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/" + file, settings);
+  return testing::simulate(loaded, 1e-3);
 }
 
 void check_energy(const RunOutcome& o, double tolerance) {
@@ -32,9 +32,9 @@ TEST_CASE("final two-car model as printed: the first 10 ms from the tabulated ge
   // The file's own start: the tabulated geometry, anticlimber faces 3.75 in apart (reading 18).
   // At 616 in/s they close after 3.75 / 616 s, a little later because the couplers push the
   // struck car first (within 25 %).
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml", {"simulation.t_end=0.01"});
-  REQUIRE_FALSE(model.run_spec.simulation.static_equilibrium);
-  const RunOutcome ida = testing::simulate(model, 1e-3);
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml", {"simulation.t_end=0.01"});
+  REQUIRE_FALSE(loaded.run_spec.simulation.static_equilibrium);
+  const RunOutcome ida = testing::simulate(loaded, 1e-3);
   check_energy(ida, 1e-5);
   bool contact = false;
   for (const EventRecord& e : ida.events)
@@ -53,16 +53,17 @@ TEST_CASE("final two-car model, corrected variant: settled, the first 10 ms", "[
   // the loaded car has no equilibrium the settle finds: models/report/README.md). The
   // anticlimber gap at t = 0 is then -horizontal_deformation; the faces close after gap / 616 s,
   // a little later because the couplers push the struck car first (within 25 %).
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car_corrected.yaml",
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car_corrected.yaml",
                                  {"simulation.t_end=0.01", "simulation.static_equilibrium=true"});
-  REQUIRE(model.run_spec.simulation.static_equilibrium);
-  const RunOutcome ida = testing::simulate(model, 1e-3);
+  const Model& model = loaded.model;
+  REQUIRE(loaded.run_spec.simulation.static_equilibrium);
+  const RunOutcome ida = testing::simulate(loaded, 1e-3);
   check_energy(ida, 1e-5);
   CHECK(ida.stats.settling_steps > 0);
   std::vector<double> y0;
   std::vector<EventRecord> settling;
   DaeSystem system(model);
-  prepare_start(system, y0, settling);
+  prepare_start(system, y0, settling, loaded.run_spec.simulation.static_equilibrium);
   std::vector<double> out(system.output_names().size());
   system.outputs(y0.data(), y0.data() + 2 * system.body_unknowns(), out.data());
   const auto column = std::find(system.output_names().begin(), system.output_names().end(), "anticlimber.horizontal_deformation");
@@ -87,7 +88,8 @@ TEST_CASE("final two-car model, corrected variant: settled and without its impac
   for (const char* body : {"coupler", "yoke", "draft_housing", "front_end", "bolster_body", "front_truck", "center_body",
                            "rear_body", "rear_truck"})
     settings.push_back(std::string("bodies.car1_") + body + ".velocity=[0, 0]");
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car_corrected.yaml", settings);
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car_corrected.yaml", settings);
+  const Model& model = loaded.model;
   DaeSystem system(model);
   struct Stillness : RunObserver {
     std::vector<double> start;
@@ -103,7 +105,7 @@ TEST_CASE("final two-car model, corrected variant: settled and without its impac
     }
   } still;
   still.nq = system.body_unknowns();
-  const RunOutcome o = make_integrator(system, model.run_spec.simulation)->run(0.1, 1e-3, still);
+  const RunOutcome o = make_integrator(system, loaded.run_spec.simulation)->run(0.1, 1e-3, still);
   REQUIRE(o.ok);
   CHECK(o.stats.settling_steps > 0);
   CHECK(still.largest_move < 1e-6);   // [in]

@@ -136,7 +136,7 @@ TEST_CASE("the expanded text mirrors a reversed car's directions and lists the c
   CHECK(axis_x.at("unitA.car1.guide") == 1.0);
   CHECK(axis_x.at("unitA.car3.guide") == -1.0);
   // The written model loads to the same bodies.
-  const Model again = load_model_text(expanded.text, "expanded.yaml");
+  const Model again = load_model_text(expanded.text, "expanded.yaml").model;
   const Model model = testing::model_from_text(kTrainModel);
   REQUIRE(again.body_count() == model.body_count());
   for (std::size_t i = 0; i < model.bodies().size(); ++i) {
@@ -174,8 +174,10 @@ simulation:
   t_end: 0.05
 )";
   two_cars += "loads:\n  - {type: force, body: unitA.car1.nose, value: [[0, [0, 0]], [0.01, [-2.0e3, 0]]]}\n";
-  const Model expanded = testing::model_from_text(two_cars);
-  const Model by_hand = testing::model_from_text(flat);
+  const LoadedModel expanded_loaded = testing::loaded_from_text(two_cars);
+  const Model& expanded = expanded_loaded.model;
+  const LoadedModel by_hand_loaded = testing::loaded_from_text(flat);
+  const Model& by_hand = by_hand_loaded.model;
   REQUIRE(expanded.body_count() == by_hand.body_count());
   for (std::size_t i = 0; i < by_hand.bodies().size(); ++i) {
     const Body &a = expanded.bodies()[i], &b = by_hand.bodies()[i];
@@ -200,7 +202,7 @@ simulation:
     }
   }
   // The parameters: the two runs (the nose pushed in, crushing and moving the train) agree.
-  const RunOutcome run_expanded = testing::simulate(expanded, 0.01), run_by_hand = testing::simulate(by_hand, 0.01);
+  const RunOutcome run_expanded = testing::simulate(expanded_loaded, 0.01), run_by_hand = testing::simulate(by_hand_loaded, 0.01);
   REQUIRE(run_expanded.y.size() == run_by_hand.y.size());
   for (std::size_t i = 0; i < run_by_hand.y.size(); ++i) CHECK(run_expanded.y[i] == Approx(run_by_hand.y[i]).margin(1e-9));
   CHECK(run_by_hand.y[1 * 3] < 9.5 + 2.0 * 0.05 - 1e-4);  // the nose did move back on car1: the crush acted
@@ -264,16 +266,16 @@ TEST_CASE("settings address a car type (every instance) or one instance, the typ
     return out;
   };
   const std::string path = "trains.yaml";
-  CHECK(masses(load_model_text(kTrainModel, path, {"car_types.coach.bodies.body.mass=2000"})) == std::vector<double>{2000, 2000, 2000});
-  CHECK(masses(load_model_text(kTrainModel, path, {"unitA.mid.body.mass=3000"})) == std::vector<double>{1000, 3000, 1000});
+  CHECK(masses(load_model_text(kTrainModel, path, {"car_types.coach.bodies.body.mass=2000"}).model) == std::vector<double>{2000, 2000, 2000});
+  CHECK(masses(load_model_text(kTrainModel, path, {"unitA.mid.body.mass=3000"}).model) == std::vector<double>{1000, 3000, 1000});
   // The instance's setting given first still applies after the type's.
-  CHECK(masses(load_model_text(kTrainModel, path, {"unitA.mid.body.mass=3000", "car_types.coach.bodies.body.mass*=1.5"})) ==
+  CHECK(masses(load_model_text(kTrainModel, path, {"unitA.mid.body.mass=3000", "car_types.coach.bodies.body.mass*=1.5"}).model) ==
         std::vector<double>{1500, 3000, 1500});
-  CHECK(masses(load_model_text(kTrainModel, path, {"unitA.car3.body.mass*=2"})) == std::vector<double>{1000, 1000, 2000});
+  CHECK(masses(load_model_text(kTrainModel, path, {"unitA.car3.body.mass*=2"}).model) == std::vector<double>{1000, 1000, 2000});
   // A type's geometry changes every instance's place.
-  const Model longer = load_model_text(kTrainModel, path, {"car_types.coach.interfaces.rear.at=[-5.5, 0]"});
+  const Model longer = load_model_text(kTrainModel, path, {"car_types.coach.interfaces.rear.at=[-5.5, 0]"}).model;
   CHECK(body(longer, "unitA.mid.body").x == Approx(-3.7));  // car1's rear 1 further back
-  CHECK(load_model_text(kTrainModel, path, {"trains.unitA.speed=3"}).bodies()[0].vx == 3.0);
+  CHECK(load_model_text(kTrainModel, path, {"trains.unitA.speed=3"}).model.bodies()[0].vx == 3.0);
   // A bad value is named by its setting.
   CHECK_THROWS_WITH(load_model_text(kTrainModel, path, {"car_types.coach.elements.crush.unloading_stiffness=-5"}),
                     Contains("trains.yaml: --set 'car_types.coach.elements.crush.unloading_stiffness=-5': element 'unitA.car1.crush'") &&
@@ -305,7 +307,8 @@ TEST_CASE("mm-t-s-N models equal the same model in SI", "[trains][units]") {
                               "  - {type: moment, body: unitA.mid.body, value: 50}\n";
   const std::string load_mm = "loads:\n  - {type: force, body: unitA.car1.nose, at: [100, 0], value: [[0, [0, 0]], [0.01, [-2.0e3, -100]]]}\n"
                               "  - {type: moment, body: unitA.mid.body, value: 5.0e4}\n";
-  const Model a = testing::model_from_text(si + load_si), b = testing::model_from_text(mm + load_mm);
+  const LoadedModel a_loaded = testing::loaded_from_text(si + load_si), b_loaded = testing::loaded_from_text(mm + load_mm);
+  const Model &a = a_loaded.model, &b = b_loaded.model;
   CHECK(b.units == UnitSystem::SI);
   CHECK(b.file_units == "mm-t-s-N");
   CHECK(b.gravity_y == Approx(-9.80665));
@@ -316,7 +319,7 @@ TEST_CASE("mm-t-s-N models equal the same model in SI", "[trains][units]") {
     CHECK(b.bodies()[i].vx == Approx(a.bodies()[i].vx).epsilon(1e-14));
   }
   CHECK(b.loads()[1].value.values[0][0] == Approx(50.0).epsilon(1e-14));  // 5e4 N mm = 50 N m
-  const RunOutcome ra = testing::simulate(a, 0.01), rb = testing::simulate(b, 0.01);
+  const RunOutcome ra = testing::simulate(a_loaded, 0.01), rb = testing::simulate(b_loaded, 0.01);
   REQUIRE(ra.y.size() == rb.y.size());
   for (std::size_t i = 0; i < ra.y.size(); ++i) CHECK(rb.y[i] == Approx(ra.y[i]).epsilon(1e-7).margin(1e-10));
   CHECK(rb.final_energy.kinetic == Approx(ra.final_energy.kinetic).epsilon(1e-7));
@@ -332,12 +335,13 @@ TEST_CASE("the example models of modern units load and run", "[trains][examples]
     for (std::string line; std::getline(file, line); ++lines) illustrative = illustrative || line.find("ILLUSTRATIVE") != std::string::npos;
     CHECK(lines <= 200);
     CHECK(illustrative);
-    const Model model = load_model(path, {"simulation.t_end=0.01"});
+    const LoadedModel loaded = load_model(path, {"simulation.t_end=0.01"});
+    const Model& model = loaded.model;
     CHECK(model.body_count() >= 15);
     std::size_t cars = 0;
     for (const Body& b : model.bodies()) cars += b.name.size() > 5 && b.name.substr(b.name.size() - 5) == ".body";
     CHECK(cars >= 3);
-    const RunReport report = run_model(model, "");  // as `railcrash run` (assembly, settling, run)
+    const RunReport report = run_model(model, loaded.run_spec, "");  // as `railcrash run` (assembly, settling, run)
     INFO(report.outcome.message);
     CHECK(report.outcome.ok);
   }
@@ -350,8 +354,9 @@ TEST_CASE("two identical units meeting head on stay mirror images of each other"
   // twin in unitB keep x_A + x_B = 0.05 m + 10 m/s t and y_A = y_B through the crash.
   const std::string path = std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/emu3_unit_collision.yaml";
   const double t_end = 0.12;  // [s] the cab fronts crush from 5 ms on
-  const Model model = load_model(path, {"simulation.t_end=0.12"});
-  const RunReport report = run_model(model, "");
+  const LoadedModel loaded = load_model(path, {"simulation.t_end=0.12"});
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, "");
   REQUIRE(report.outcome.ok);
   REQUIRE(report.outcome.t_reached == Approx(t_end));
   const std::vector<double>& y = report.outcome.y;
@@ -377,7 +382,7 @@ TEST_CASE("two identical units meeting head on stay mirror images of each other"
 
 TEST_CASE("consist makes a model's trains N cars long, repeating its cars in turn", "[trains][consist]") {
   const std::string text = make_consist_model(YAML::Load(kTrainModel), "three.yaml", 5);
-  const Model model = load_model_text(text, "consist.yaml");
+  const Model model = load_model_text(text, "consist.yaml").model;
   REQUIRE(model.body_count() == 10);
   // Cars 1-3 as listed (the third reversed), then car4 = car1 and car5 = the named middle car,
   // each 8.5 long over its ends with 0.2 between: car k's front at 10 - (k - 1) 8.7.

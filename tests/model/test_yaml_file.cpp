@@ -128,12 +128,14 @@ TEST_CASE("a model text checked once (a sweep's runs) is refused and read exactl
   const CheckedYamlText checked = check_model_text(valid, "model.yaml");
   CHECK(checked.text() == valid);
   for (const std::vector<std::string>& settings : {std::vector<std::string>{}, std::vector<std::string>{"bodies.bob.mass=2.5"}}) {
-    const Model direct = load_model_text(valid, "model.yaml", settings);
-    const Model from_checked = load_model_text(checked, "model.yaml", settings);
+    const LoadedModel direct_loaded = load_model_text(valid, "model.yaml", settings);
+    const Model& direct = direct_loaded.model;
+    const LoadedModel from_checked_loaded = load_model_text(checked, "model.yaml", settings);
+    const Model& from_checked = from_checked_loaded.model;
     CHECK(from_checked.bodies()[0].mass == direct.bodies()[0].mass);
-    CHECK(from_checked.run_spec.simulation.t_end == direct.run_spec.simulation.t_end);
+    CHECK(from_checked_loaded.run_spec.simulation.t_end == direct_loaded.run_spec.simulation.t_end);
   }
-  CHECK(load_model_text(checked, "model.yaml", {"bodies.bob.mass=2.5"}).bodies()[0].mass == 2.5);
+  CHECK(load_model_text(checked, "model.yaml", {"bodies.bob.mass=2.5"}).model.bodies()[0].mass == 2.5);
   CHECK_THAT(error_of([&] { (void)load_model_text(checked, "model.yaml", {"description=&a [*a]"}); }),
              StartsWith("model.yaml: --set 'description=&a [*a]'") && Contains("an alias refers to the node that contains it"));
 }

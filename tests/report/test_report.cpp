@@ -38,8 +38,9 @@ std::string slurp(const fs::path& path) {
 fs::path small_run(const std::string& name, const std::string& format = "csv") {
   const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  const railcrash::Model model = railcrash::load_model(std::string(RAILCRASH_SOURCE_DIR) + "/tests/report/two_car.yaml");
-  const railcrash::RunReport run = railcrash::run_model(model, dir.string(), nullptr, false, false, format);
+  const railcrash::LoadedModel loaded = railcrash::load_model(std::string(RAILCRASH_SOURCE_DIR) + "/tests/report/two_car.yaml");
+  const railcrash::Model& model = loaded.model;
+  const railcrash::RunReport run = railcrash::run_model(model, loaded.run_spec, dir.string(), nullptr, false, false, format);
   REQUIRE(run.outcome.ok);
   return dir;
 }

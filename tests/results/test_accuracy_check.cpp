@@ -81,8 +81,9 @@ TEST_CASE("a user's SI unit run by Euler's default step is warned about and the 
   const std::string path = std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/emu3_unit_collision.yaml";
   for (const std::string integrator : {"euler", "ida"}) {
     CAPTURE(integrator);
-    const Model model = load_model(path, {"simulation.integrator=" + integrator});
-    const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+    const LoadedModel loaded = load_model(path, {"simulation.integrator=" + integrator});
+    const Model& model = loaded.model;
+    const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
     REQUIRE(report.outcome.ok);
     const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
     // The share from summary.json's own energy figures, computed here.
@@ -108,9 +109,10 @@ TEST_CASE("a user's SI unit run by Euler's default step is warned about and the 
 }
 
 TEST_CASE("the report's car run by Euler at its printed step is within the limits", "[unit][accuracy]") {
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/preliminary_car.yaml",
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/preliminary_car.yaml",
                                  {"simulation.integrator=euler"});
-  const RunReport report = run_model(model, "", nullptr, false, true);
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, true);
   REQUIRE(report.outcome.ok);
   const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
   CHECK(std::abs(summary["energy"]["relative_balance_error"].get<double>()) < 0.001);  // measured 0.025 %

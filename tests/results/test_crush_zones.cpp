@@ -64,10 +64,11 @@ std::string file_text(const std::string& path) {
 }  // namespace
 
 TEST_CASE("a crush spring pushed at nearly constant speed absorbs the area under its curve up to its crush", "[results][crush_zones]") {
-  const Model model = testing::model_from_text(kPushedCrushSpring);
+  const LoadedModel loaded = testing::loaded_from_text(kPushedCrushSpring);
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  ResultWriter writer("", system);
-  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.03, 0.001, writer);
+  ResultWriter writer("", system, loaded.run_spec);
+  const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.03, 0.001, writer);
   REQUIRE(outcome.ok);
   const CrushZoneTracker& tracker = writer.crush_zones();
   REQUIRE(tracker.zones().size() == 1);
@@ -97,10 +98,11 @@ TEST_CASE("a crush spring pushed at nearly constant speed absorbs the area under
 }
 
 TEST_CASE("a crush zone between two cars counts half for each and the cars add up to the total", "[results][crush_zones]") {
-  const Model model = testing::model_from_text(kTwoCars);
+  const LoadedModel loaded = testing::loaded_from_text(kTwoCars);
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  ResultWriter writer("", system);
-  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.05, 0.001, writer);
+  ResultWriter writer("", system, loaded.run_spec);
+  const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.05, 0.001, writer);
   REQUIRE(outcome.ok);
   const CrushZoneTracker& tracker = writer.crush_zones();
   REQUIRE(tracker.zones().size() == 2);  // the linear spring absorbs by no crushing
@@ -127,8 +129,9 @@ TEST_CASE("a crush zone between two cars counts half for each and the cars add u
 TEST_CASE("energy_zones.csv and summary.json give the energy per crush zone and per car of one run", "[results][crush_zones]") {
   const auto dir = (std::filesystem::temp_directory_path() / "railcrash_test_energy_zones").string();
   std::filesystem::remove_all(dir);
-  const Model model = testing::model_from_text(kPushedCrushSpring);
-  const RunReport report = run_model(model, dir);
+  const LoadedModel loaded = testing::loaded_from_text(kPushedCrushSpring);
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, dir);
   REQUIRE(report.outcome.ok);
   const std::string summary = file_text(dir + "/summary.json");
   const std::string csv = file_text(dir + "/energy_zones.csv");

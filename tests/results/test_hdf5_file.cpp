@@ -31,7 +31,7 @@ std::string temporary_folder(const std::string& name) {
   return path.string();
 }
 
-Model two_car_model(double t_end) {
+LoadedModel two_car_model(double t_end) {
   RunOverrides overrides;
   overrides.t_end = t_end;
   overrides.output_interval = 1e-3;
@@ -45,7 +45,8 @@ Model two_car_model(double t_end) {
 TEST_CASE("without HDF5, --format hdf5 is an input error that says how to get it", "[results][hdf5]") {
   CHECK_FALSE(hdf5_available());
   const std::string dir = temporary_folder("absent");
-  CHECK_THROWS_WITH(run_model(two_car_model(0.001), dir, nullptr, false, false, "hdf5"),
+  const LoadedModel loaded = two_car_model(0.001);
+  CHECK_THROWS_WITH(run_model(loaded.model, loaded.run_spec, dir, nullptr, false, false, "hdf5"),
                     Catch::Contains("built without HDF5") && Catch::Contains("libhdf5-dev"));
   std::filesystem::remove_all(dir);
 }
@@ -136,10 +137,11 @@ void check_table_matches_csv(hid_t file, const std::string& name, const std::str
 
 TEST_CASE("timeseries.h5 holds the CSV files' tables, every value and name alike", "[results][hdf5]") {
   REQUIRE(hdf5_available());
-  const Model model = two_car_model(0.02);  // 21 rows of 390 columns, wheel contact events at t = 0
+  const LoadedModel loaded = two_car_model(0.02);
+  const Model& model = loaded.model;  // 21 rows of 390 columns, wheel contact events at t = 0
   const std::string csv_dir = temporary_folder("csv"), hdf5_dir = temporary_folder("h5");
-  const RunReport csv_run = run_model(model, csv_dir);
-  const RunReport hdf5_run = run_model(model, hdf5_dir, nullptr, false, false, "hdf5");
+  const RunReport csv_run = run_model(model, loaded.run_spec, csv_dir);
+  const RunReport hdf5_run = run_model(model, loaded.run_spec, hdf5_dir, nullptr, false, false, "hdf5");
   REQUIRE(csv_run.outcome.ok);
   REQUIRE(hdf5_run.outcome.ok);
   for (const char* csv_file : {"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv"})
@@ -243,10 +245,10 @@ TEST_CASE("a table too wide for one compound type becomes a rows x columns matri
 
 TEST_CASE("a run that fails leaves timeseries.h5 closed and readable with the rows up to the failure",
           "[results][hdf5][faults]") {
-  Model model = two_car_model(0.05);
-  model.run_spec.simulation.max_steps = 150;  // IDA stops there: a failed run
+  LoadedModel loaded = two_car_model(0.05);
+  loaded.run_spec.simulation.max_steps = 150;  // IDA stops there: a failed run
   const std::string dir = temporary_folder("failed");
-  const RunReport report = run_model(model, dir, nullptr, false, false, "hdf5");
+  const RunReport report = run_model(loaded.model, loaded.run_spec, dir, nullptr, false, false, "hdf5");
   REQUIRE_FALSE(report.outcome.ok);
   const Id file(H5Fopen((dir + "/timeseries.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
   const Id timeseries(H5Dopen2(file.id, "timeseries", H5P_DEFAULT));
@@ -268,7 +270,8 @@ TEST_CASE("a write that fails mid-run stops the run with the file and the OS's r
   limit.rlim_cur = 200 * 1024;
   const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails instead of killing
   REQUIRE(setrlimit(RLIMIT_FSIZE, &limit) == 0);
-  const RunReport report = run_model(two_car_model(0.1), dir, nullptr, false, false, "hdf5");
+  const LoadedModel loaded = two_car_model(0.1);
+  const RunReport report = run_model(loaded.model, loaded.run_spec, dir, nullptr, false, false, "hdf5");
   setrlimit(RLIMIT_FSIZE, &old_limit);
   std::signal(SIGXFSZ, old_handler);
   CHECK_FALSE(report.outcome.ok);

@@ -39,8 +39,9 @@ std::map<std::string, std::vector<double>> read_columns(const fs::path& path) {
 fs::path run_text(const std::string& yaml, const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("railcrash_outputs_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  const railcrash::Model model = railcrash::load_model_text(yaml, "outputs.yaml");
-  REQUIRE(railcrash::run_model(model, dir.string()).outcome.ok);
+  const railcrash::LoadedModel loaded = railcrash::load_model_text(yaml, "outputs.yaml");
+  const railcrash::Model& model = loaded.model;
+  REQUIRE(railcrash::run_model(model, loaded.run_spec, dir.string()).outcome.ok);
   return dir;
 }
 

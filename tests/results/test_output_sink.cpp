@@ -88,7 +88,7 @@ TEST_CASE("Output formats: csv, hdf5 and memory are registered, and --format tak
 
 TEST_CASE("CSV sink: each row as printf's %.12g after the provenance line and the header, events quoted") {
   const fs::path dir = fresh_folder("csv");
-  const Model model = load_model_text(kTwoCars, "two_cars.yaml");
+  const Model model = load_model_text(kTwoCars, "two_cars.yaml").model;
   Provenance provenance;
   provenance.run_id = "0123456789abcdef0123456789abcdef";
   OutputLayout layout;
@@ -116,10 +116,11 @@ TEST_CASE("CSV sink: each row as printf's %.12g after the provenance line and th
 
 TEST_CASE("Output sinks: a run's rows go to the CSV files and to memory alike, on two 40 t SI cars") {
   const fs::path dir = fresh_folder("run");
-  const Model model = load_model_text(kTwoCars, "two_cars.yaml");
-  const RunReport report = run_model(model, dir.string(), nullptr, false, /*keep_in_memory=*/true);
+  const LoadedModel loaded = load_model_text(kTwoCars, "two_cars.yaml");
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, dir.string(), nullptr, false, /*keep_in_memory=*/true);
   REQUIRE(report.outcome.ok);
-  REQUIRE(report.columns == timeseries_columns(DaeSystem(model)));
+  REQUIRE(report.columns == timeseries_columns(DaeSystem(model), loaded.run_spec.output_points));
   REQUIRE(report.series.size() == report.columns.size());
   CHECK(report.series[0].size() == 51);  // t = 0, 0.001, ..., 0.05
   // timeseries.csv after its provenance line and header, as the kept columns print.

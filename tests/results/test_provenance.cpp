@@ -108,10 +108,11 @@ TEST_CASE("Every file of a run carries its run id and provenance, with both file
   const fs::path models = fresh_folder("models");
   write(models / "multiple_unit.yaml", kMultipleUnit);
   write(models / "softer.yaml", kVariant);
-  const Model model = load_model((models / "softer.yaml").string(), {"simulation.t_end=0.03"},
+  const LoadedModel loaded = load_model((models / "softer.yaml").string(), {"simulation.t_end=0.03"},
                                  {{"simulation.output_interval=0.002", "--output-interval 0.002"}});
+  const Model& model = loaded.model;
   const fs::path dir = fresh_folder("files");
-  const RunReport run = run_model(model, dir.string());
+  const RunReport run = run_model(model, loaded.run_spec, dir.string());
   REQUIRE(run.outcome.ok);
   REQUIRE(std::regex_match(run.run_id, std::regex("[0-9a-f]{32}")));
 
@@ -135,7 +136,7 @@ TEST_CASE("Every file of a run carries its run id and provenance, with both file
   CHECK_THAT(slurp(dir / "model.json"), Catch::StartsWith("{\n  \"format\": 1,\n  \"run_id\": \"" + run.run_id + "\",\n"));
 
   // Another run of the same model has another id.
-  const RunReport again = run_model(model, dir.string());
+  const RunReport again = run_model(model, loaded.run_spec, dir.string());
   CHECK(again.run_id != run.run_id);
   CHECK(run_id_in(slurp(dir / "summary.json")) == again.run_id);
   fs::remove_all(dir);
@@ -145,9 +146,10 @@ TEST_CASE("Every file of a run carries its run id and provenance, with both file
 TEST_CASE("A run removes the files an earlier run left in its folder and nothing else", "[results][provenance]") {
   const fs::path models = fresh_folder("owner_model");
   write(models / "multiple_unit.yaml", kMultipleUnit);
-  const Model model = load_model((models / "multiple_unit.yaml").string(), {"simulation.t_end=0.01"});
+  const LoadedModel loaded = load_model((models / "multiple_unit.yaml").string(), {"simulation.t_end=0.01"});
+  const Model& model = loaded.model;
   const fs::path dir = fresh_folder("owner");
-  REQUIRE(run_model(model, dir.string()).outcome.ok);
+  REQUIRE(run_model(model, loaded.run_spec, dir.string()).outcome.ok);
   write(dir / "report.html", "a report of the earlier run");
   write(dir / "notes.txt", "the user's own file");
   fs::create_symlink("notes.txt", dir / "summary.json.tmp");  // a link in a file's place is not the run's to remove
@@ -156,7 +158,7 @@ TEST_CASE("A run removes the files an earlier run left in its folder and nothing
   const std::string format = hdf5_available() ? "hdf5" : "csv";
   if (format == "csv") write(dir / "timeseries.h5", "an earlier HDF5 run's file");
   const DaeSystem system(model);
-  const ResultWriter writer(dir.string(), system, false, format);
+  const ResultWriter writer(dir.string(), system, loaded.run_spec, false, format);
   const std::vector<std::string> expected =
       format == "hdf5"
           ? std::vector<std::string>{"timeseries.csv", "events.csv", "accelerations.csv", "energy.csv", "summary.json", "model.json",

@@ -15,20 +15,20 @@ namespace {
 
 // The crush-impact case (a 100 kg mass crushing an elastic-perfectly-plastic structure:
 // largest crush 0.055 m after a 0.5 m gap) with a crush gauge from the anchor to the mass.
-Model crush_model(const std::string& responses) {
+LoadedModel crush_model(const std::string& responses) {
   std::ifstream in(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/crush_impact.yaml");
   std::stringstream text;
   text << in.rdbuf() << responses;
-  return testing::model_from_text(text.str());
+  return testing::loaded_from_text(text.str());
 }
 
 }  // namespace
 
 TEST_CASE("R1 is the largest shortening of the crush gauges over the reference crush", "[responses]") {
-  const Model model = crush_model(
+  const LoadedModel loaded = crush_model(
       "responses:\n  crush_gauges:\n    - {name: structure, points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
       "  reference_crush: 0.5\n");
-  const RunReport report = run_model(model, "");
+  const RunReport report = run_model(loaded.model, loaded.run_spec, "");
   REQUIRE(report.outcome.ok);
   REQUIRE(report.has_responses);
   // Gauge from 1.5 m down to 1 - 0.055 m: shortening 0.555 m (the gap plus the crush),
@@ -40,10 +40,10 @@ TEST_CASE("R1 is the largest shortening of the crush gauges over the reference c
 }
 
 TEST_CASE("R3 is the larger of R1 and R2 while both are below one", "[responses]") {
-  const Model model = crush_model(
+  const LoadedModel loaded = crush_model(
       "responses:\n  crush_gauges:\n    - {name: structure, points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
       "  reference_crush: 2.0\n");
-  const RunReport report = run_model(model, "");
+  const RunReport report = run_model(loaded.model, loaded.run_spec, "");
   CHECK(report.responses.r1 == Approx(0.555 / 2.0).margin(1e-4));
   CHECK(report.responses.r3 == Approx(report.responses.r1));
 }
@@ -63,8 +63,9 @@ TEST_CASE("R2 from the anticlimber: vertical force over yield, or 1 + relative s
       "    face_height: 0.1\n    points: [{body: ground, at: [0, 0]}, {body: car, at: [0, 0]}]\n"
       "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n  override_velocity_at: override\n"
       "simulation: {t_end: 0.5, rtol: 1e-8, output_interval: 0.0005}\n";
-  const Model model = testing::model_from_text(text);
-  const RunReport report = run_model(model, "");
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, "");
   REQUIRE(report.outcome.ok);
   const Responses& r = report.responses;
   CHECK(r.vertical_yield_force == Approx(1.0e4));
@@ -92,7 +93,8 @@ TEST_CASE("R1 from the anticlimber's crush: a car end into a fixed anticlimber, 
   // 1000 kg at 2 m/s: elastic to 0.01 m (500 J), then 1e5 N + 1e5 N/m beyond: the remaining
   // 1500 J give u^2 + 2u - 0.03 = 0, u = sqrt(1.03) - 1, largest crush 0.01 + u.
   const std::string text = testing::anticlimber_r1_model_text(0.2);
-  const RunReport report = run_model(testing::model_from_text(text), "");
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const RunReport report = run_model(loaded.model, loaded.run_spec, "");
   REQUIRE(report.outcome.ok);
   const double crush = 0.01 + std::sqrt(1.03) - 1.0;
   CHECK(report.responses.max_anticlimber_crush == Approx(crush).epsilon(1e-5));
@@ -118,17 +120,17 @@ TEST_CASE("peak deceleration and crush of the crush-impact case match the closed
   // largest crush 0.055 m (crush_impact.yaml). The mass is one car: its body declares `car: car`.
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    Model model = crush_model("");
-    model.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
-    model.run_spec.simulation.dt = 2e-6;
-    const RunReport report = run_model(model, temporary_folder(std::string("peaks_") + integrator));
+    LoadedModel loaded = crush_model("");
+    loaded.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    loaded.run_spec.simulation.dt = 2e-6;
+    const RunReport report = run_model(loaded.model, loaded.run_spec, temporary_folder(std::string("peaks_") + integrator));
     REQUIRE(report.outcome.ok);
     REQUIRE(report.acceleration_peaks.size() == 1);
     const AccelerationPeaks& p = report.acceleration_peaks[0];
     CHECK(p.x == Approx(1000.0).epsilon(1e-6));
     CHECK(p.magnitude == Approx(1000.0).epsilon(1e-6));
     CHECK(p.y == Approx(0.0).margin(1e-9));
-    CHECK(p.magnitude / standard_gravity(model) == Approx(1000.0 / 9.80665).epsilon(1e-6));
+    CHECK(p.magnitude / standard_gravity(loaded.model) == Approx(1000.0 / 9.80665).epsilon(1e-6));
     REQUIRE(report.car_crush.size() == 1);
     CHECK(report.car_crush[0].car == "car");
     CHECK(report.car_crush[0].max_crush == Approx(0.055).epsilon(5e-3));
@@ -151,9 +153,10 @@ TEST_CASE("peak acceleration of a pendulum released from the horizontal includes
   const double expected = 2.0 * g * m * length * length / (inertia + m * length * length);
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    Model model = testing::model_from_text(text);
-    model.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
-    const RunReport report = run_model(model, temporary_folder(std::string("pendulum_") + integrator));
+    LoadedModel loaded = testing::loaded_from_text(text);
+    Model& model = loaded.model;
+    loaded.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    const RunReport report = run_model(model, loaded.run_spec, temporary_folder(std::string("pendulum_") + integrator));
     REQUIRE(report.outcome.ok);
     const AccelerationPeaks& p = report.acceleration_peaks.at(0);
     CHECK(p.magnitude == Approx(expected).epsilon(std::string(integrator) == "ida" ? 1e-4 : 1e-2));
@@ -186,7 +189,8 @@ TEST_CASE("R2's window: the whole run, until the largest crush or until separati
                                   "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n  collision_post_distance: 1.0\n" +
                                   (window.empty() ? std::string() : "  vertical_force_window: " + window + "\n") +
                                   "simulation: {t_end: 0.08, rtol: 1e-9, output_interval: 1.0e-5}\n";
-    const RunReport report = run_model(testing::model_from_text(text), "");
+    const LoadedModel loaded = testing::loaded_from_text(text);
+    const RunReport report = run_model(loaded.model, loaded.run_spec, "");
     REQUIRE(report.outcome.ok);
     REQUIRE_FALSE(report.responses.overridden);
     return report.responses.max_vertical_force;
@@ -232,7 +236,8 @@ RunReport override_run(const std::string& responses_extra) {
       "loads:\n  - {type: force, body: car, at: [0, 0], value: [1000, 0]}\n"
       "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n" + responses_extra +
       "simulation: {t_end: 2.5, rtol: 1e-9, output_interval: 0.001}\n";
-  const RunReport report = run_model(testing::model_from_text(text), "");
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const RunReport report = run_model(loaded.model, loaded.run_spec, "");
   REQUIRE(report.outcome.ok);
   REQUIRE(report.responses.overridden);
   return report;
@@ -298,7 +303,8 @@ double largest_vertical_force(const std::string& car_point_y, const std::string&
       "    points: [{body: ground, at: [0, 0]}, {body: car, at: [-0.5, " + car_point_y + "]}]\n"
       "responses:\n  anticlimber: ac\n  reference_velocity: 4.0\n  collision_post_distance: 1.0\n"
       "simulation: {t_end: 0.06, rtol: 1e-9, output_interval: 0.0005}\n";
-  const RunReport report = run_model(testing::model_from_text(text), "");
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const RunReport report = run_model(loaded.model, loaded.run_spec, "");
   REQUIRE(report.outcome.ok);
   REQUIRE_FALSE(report.responses.overridden);
   return report.responses.max_vertical_force;

@@ -113,16 +113,17 @@ TEST_CASE("a model whose bodies declare no car has no per-car crush, and its sum
   for (const auto& [from, to] : {std::pair<std::string, std::string>{"striker_", "car1_"}, {"struck_", "car2_"}})
     for (std::size_t at = named.find(from); at != std::string::npos; at = named.find(from, at)) named.replace(at, from.size(), to);
   for (const std::string& yaml : {text, named}) {
-    const Model model = testing::model_from_text(yaml);
+    const LoadedModel loaded = testing::loaded_from_text(yaml);
+    const Model& model = loaded.model;
     CHECK(cars_of(DaeSystem(model)).empty());
-    const RunReport report = run_model(model, temporary_folder("no_cars"));
+    const RunReport report = run_model(model, loaded.run_spec, temporary_folder("no_cars"));
     REQUIRE(report.outcome.ok);
     CHECK(report.car_crush.empty());
     CHECK_THAT(report.summary_json, Catch::Contains("\"car_crush\": {}") && Catch::Contains("\"cars_note\": \"no body declares a car"));
   }
   // With cars declared the note is gone and each car has its row.
-  const RunReport report =
-      run_model(testing::model_from_text(two_car_text("car: striking, ", "car: struck, ")), temporary_folder("cars"));
+  const LoadedModel with_cars = testing::loaded_from_text(two_car_text("car: striking, ", "car: struck, "));
+  const RunReport report = run_model(with_cars.model, with_cars.run_spec, temporary_folder("cars"));
   REQUIRE(report.outcome.ok);
   CHECK_THAT(report.summary_json, !Catch::Contains("cars_note") &&
                                       Catch::Contains("\"striking\": {\"max_crush\": ") &&
@@ -134,7 +135,7 @@ TEST_CASE("the barrier model's two cars are summarised separately", "[results]")
   // car's trail_*; the shared coupler belongs to neither. Its crush elements are crush
   // springs: lead_crush and lead_draft_sill within the leading car, trail_draft_sill within
   // the trailing one.
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml");
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml").model;
   DaeSystem system(model);
   const std::vector<CarCrush> cars = cars_of(system);
   REQUIRE(cars.size() == 2);
@@ -170,14 +171,15 @@ TEST_CASE("a failed write stops the run at once with the OS reason and the rows 
   // are opened without following links.
   const std::string dir = temporary_folder("full_disk");
   std::filesystem::create_directories(dir);
-  const Model model = testing::model_from_text(spring_mass_text(10.0));
+  const LoadedModel loaded = testing::loaded_from_text(spring_mass_text(10.0));
+  const Model& model = loaded.model;
   rlimit old_limit{};
   REQUIRE(::getrlimit(RLIMIT_FSIZE, &old_limit) == 0);
   rlimit small = old_limit;
   small.rlim_cur = 32 * 1024;
   const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
-  const RunReport report = run_model(model, dir);
+  const RunReport report = run_model(model, loaded.run_spec, dir);
   ::setrlimit(RLIMIT_FSIZE, &old_limit);
   std::signal(SIGXFSZ, old_handler);
   CHECK_FALSE(report.outcome.ok);
@@ -213,8 +215,9 @@ TEST_CASE("a link planted under a result file's name is refused, not written thr
   std::filesystem::create_directories(dir);
   { std::ofstream(dir + "/../planted_link_target.txt") << "precious\n"; }
   std::filesystem::create_symlink("../planted_link_target.txt", dir + "/timeseries.csv");
-  const Model model = testing::model_from_text(spring_mass_text(0.05));
-  CHECK_THROWS_WITH(run_model(model, dir), Catch::Contains("timeseries.csv: Too many levels of symbolic links"));
+  const LoadedModel loaded = testing::loaded_from_text(spring_mass_text(0.05));
+  const Model& model = loaded.model;
+  CHECK_THROWS_WITH(run_model(model, loaded.run_spec, dir), Catch::Contains("timeseries.csv: Too many levels of symbolic links"));
   CHECK(file_text(dir + "/../planted_link_target.txt") == "precious\n");
   std::filesystem::remove(dir + "/../planted_link_target.txt");
   std::filesystem::remove_all(dir);
@@ -222,9 +225,10 @@ TEST_CASE("a link planted under a result file's name is refused, not written thr
 
 TEST_CASE("summary.json says running while the run goes and a vanished folder stops the run", "[results][faults]") {
   const std::string dir = temporary_folder("vanishing");
-  const Model model = testing::model_from_text(spring_mass_text(10.0));
+  const LoadedModel loaded = testing::loaded_from_text(spring_mass_text(10.0));
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  ResultWriter writer(dir, system);
+  ResultWriter writer(dir, system, loaded.run_spec);
   writer.set_folder_check_interval(std::chrono::steady_clock::duration::zero());  // look at every sample
   writer.write_running_summary("ida");
   FolderRemover observer;
@@ -232,7 +236,7 @@ TEST_CASE("summary.json says running while the run goes and a vanished folder st
   observer.folder = dir;
   observer.look_at = 3;
   observer.remove_at = 100;  // t = 0.099
-  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(10.0, 0.001, observer);
+  const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(10.0, 0.001, observer);
   CHECK_THAT(observer.summary_mid_run, Catch::Contains("\"status\": \"running\"") && Catch::Contains("\"integrator\": \"ida\""));
   CHECK_FALSE(outcome.ok);
   CHECK_THAT(outcome.message, Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
@@ -250,15 +254,16 @@ TEST_CASE("with the default folder check a vanished folder stops the run or fail
   // (10,000 samples of a spring-mass take some 0.1 s) finishes its steps, and the final
   // summary finds the folder gone.
   const std::string dir = temporary_folder("vanishing_later");
-  const Model model = testing::model_from_text(spring_mass_text(10.0));
+  const LoadedModel loaded = testing::loaded_from_text(spring_mass_text(10.0));
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  ResultWriter writer(dir, system);
+  ResultWriter writer(dir, system, loaded.run_spec);
   FolderRemover observer;
   observer.writer = &writer;
   observer.folder = dir;
   observer.look_at = 3;
   observer.remove_at = 100;
-  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(10.0, 0.001, observer);
+  const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(10.0, 0.001, observer);
   const std::string summary = writer.write_summary(outcome, "ida");
   CHECK_THAT(writer.failure(), Catch::Contains("the output folder " + dir + " is gone: No such file or directory"));
   if (!outcome.ok) {  // the periodic check came first (a slow machine)
@@ -271,8 +276,9 @@ TEST_CASE("with the default folder check a vanished folder stops the run or fail
 
 TEST_CASE("a finished run's summary.json replaces the running one and leaves no temporary file", "[results][faults]") {
   const std::string dir = temporary_folder("finished");
-  const Model model = testing::model_from_text(spring_mass_text(0.05));
-  const RunReport report = run_model(model, dir);
+  const LoadedModel loaded = testing::loaded_from_text(spring_mass_text(0.05));
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, dir);
   REQUIRE(report.outcome.ok);
   const std::string summary = file_text(dir + "/summary.json");
   CHECK(summary == report.summary_json);
@@ -323,10 +329,11 @@ TEST_CASE("an element output's peak between two output rows does not depend on t
   for (const IntegratorKind integrator : {IntegratorKind::Ida, IntegratorKind::Euler}) {
     std::vector<double> peaks;
     for (const double output_interval : {0.01, 1.0e-5}) {
-      Model model = testing::model_from_text(text);
-      model.run_spec.simulation.integrator = integrator;
-      model.run_spec.simulation.output_interval = output_interval;
-      const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+      LoadedModel loaded = testing::loaded_from_text(text);
+      Model& model = loaded.model;
+      loaded.run_spec.simulation.integrator = integrator;
+      loaded.run_spec.simulation.output_interval = output_interval;
+      const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
       REQUIRE(report.outcome.ok);
       peaks.push_back(summary_peak(report.summary_json, "spring.force"));
     }
@@ -347,9 +354,10 @@ TEST_CASE("the barrier model's crush-element peak is its force-crush curve's pea
   // crush, which it passes at about 12 ms; its 1 ms rows alone saw 1.651e6 lbf.
   std::vector<double> peaks, crush;
   for (const double output_interval : {1.0e-3, 1.0e-5}) {
-    const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
+    const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
                                    {"simulation.t_end=0.03", "simulation.output_interval=" + std::to_string(output_interval)});
-    const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+    const Model& model = loaded.model;
+    const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
     REQUIRE(report.outcome.ok);
     peaks.push_back(summary_peak(report.summary_json, "lead_crush.force"));
     crush.push_back(report.car_crush.at(0).max_crush);
@@ -429,13 +437,14 @@ TEST_CASE("a car's largest crush is of one instant, its interface elements evalu
   // length from the state alone, at every instant the writer is shown.
   for (const char* scenario : {"scenario2_barrier_cars", "scenario1_barrier_cars"}) {
     INFO(scenario);
-    Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/" + scenario + ".yaml");
-    model.run_spec.simulation.integrator = IntegratorKind::Ida;
+    LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/" + scenario + ".yaml");
+    Model& model = loaded.model;
+    loaded.run_spec.simulation.integrator = IntegratorKind::Ida;
     DaeSystem system(model);
-    ResultWriter writer("", system);
+    ResultWriter writer("", system, loaded.run_spec);
     CrushWitness witness(system, writer);
     const RunOutcome outcome =
-        make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), witness);
+        make_integrator(system, loaded.run_spec.simulation)->run(loaded.run_spec.simulation.t_end, output_interval_of(loaded.run_spec.simulation), witness);
     REQUIRE(outcome.ok);
     CHECK(witness.fresh_mismatches == 0);
     CHECK(witness.partial_calls > 100);  // located mode changes, each with one element's outputs
@@ -501,8 +510,9 @@ TEST_CASE("each car of the report's two-car model crushes by its own shortening,
   // rows every 0.5 ms: its maxima lie at or just above the rows'. Measured from the front end's
   // centre of gravity instead of its face the two cars crush 20.79 and 20.59 in: the face, 13 in
   // below that centre, moves back a little more as the front end pitches.
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
-  const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
   REQUIRE(report.outcome.ok);
   REQUIRE(report.car_crush.size() == 2);
   const std::vector<double>& deformation = series_of(report, "anticlimber.horizontal_deformation");
@@ -565,8 +575,8 @@ TEST_CASE("two SI cars whose crush zones differ in stiffness crush F / k each un
   }
   for (const bool zones_are_crush_springs : {true, false}) {
     INFO((zones_are_crush_springs ? "crush springs" : "linear springs"));
-    const RunReport report = run_model(testing::model_from_text(zones_are_crush_springs ? crush_zones : structure), "",
-                                       nullptr, false, /*keep_in_memory=*/true);
+    const LoadedModel loaded = testing::loaded_from_text(zones_are_crush_springs ? crush_zones : structure);
+    const RunReport report = run_model(loaded.model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
     REQUIRE(report.outcome.ok);
     REQUIRE(report.car_crush.size() == 2);
     for (int c = 0; c < 2; ++c) {
@@ -590,7 +600,8 @@ TEST_CASE("an output's peaks are its signed largest and smallest values with the
       "  - {name: wall, type: contact, stiffness: 3.673e6, line_point: [0, 0], line_normal: [-1, 0], points: [{body: car, at: [0, 0]}]}\n"
       "simulation: {t_end: 0.36, output_interval: 0.001}\n";
   const std::string folder = temporary_folder("signed_peaks");
-  const RunReport report = run_model(testing::model_from_text(text), folder);
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const RunReport report = run_model(loaded.model, loaded.run_spec, folder);
   REQUIRE(report.outcome.ok);
   const YAML::Node peak = YAML::LoadFile(folder + "/summary.json")["peaks"]["wall.penetration"];
   REQUIRE(peak);

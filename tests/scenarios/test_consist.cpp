@@ -38,7 +38,7 @@ double output_of(const DaeSystem& system, const std::vector<double>& y, const st
 }  // namespace
 
 TEST_CASE("consist: three cars per side keep the template's cars, shifted by the car length", "[consist]") {
-  const Model pair = load_model(kTemplate);
+  const Model pair = load_model(kTemplate).model;
   const Model train = testing::model_from_text(make_consist_model(kTemplate, 3));
   REQUIRE(train.body_count() == 3 * pair.body_count());
   // Every template element per car, the two interface elements once, two couplings per extra car.

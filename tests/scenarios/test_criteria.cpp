@@ -171,7 +171,7 @@ TEST_CASE("scenario criteria: an anticlimber is known by one check, of its type 
   flat = flat.substr(0, flat.find("scenario:"));
   flat = with(flat, "    face_height: 0.2\n", "    face_height: 0.2\n    facing: 1\n");  // the faces touch at the start
   flat = with(flat, "simulation:", "  - {name: s, type: linear_spring, stiffness: 1.0, free_length: 3.0, points: [{body: a}, {body: b}]}\nsimulation:");
-  const Model model = load_model_text(flat, "cases.yaml");
+  const Model model = load_model_text(flat, "cases.yaml").model;
   REQUIRE(model.elements().size() == 2);
   const Anticlimber* faces = as_anticlimber(*model.elements()[0]);
   REQUIRE(faces != nullptr);

@@ -52,9 +52,9 @@ struct Run {
   std::map<std::string, std::size_t> column;
   const std::vector<double>& operator[](const std::string& name) const { return report.series[column.at(name)]; }
 };
-Run run_in_memory(Model& model, double interval) {
-  model.run_spec.simulation.output_interval = interval;
-  Run run{run_model(model, "", nullptr, false, true), {}};
+Run run_in_memory(LoadedModel& loaded, double interval) {
+  loaded.run_spec.simulation.output_interval = interval;
+  Run run{run_model(loaded.model, loaded.run_spec, "", nullptr, false, true), {}};
   REQUIRE(run.report.outcome.ok);
   for (std::size_t k = 0; k < run.report.columns.size(); ++k) run.column[run.report.columns[k]] = k;
   return run;
@@ -78,12 +78,13 @@ void check_momentum_through_the_collision(const Model& model, const Run& run) {
 TEST_CASE("scenario 1: two identical trains, mirrored, the standing one raised by the offset", "[scenario]") {
   ScenarioRequest q = report_car(1);
   q.cars = 2;
-  const Model model = load_model_text(make_scenario_model(q), "scenario1.yaml");
-  REQUIRE(model.run_spec.scenario);
+  const LoadedModel loaded = load_model_text(make_scenario_model(q), "scenario1.yaml");
+  const Model& model = loaded.model;
+  REQUIRE(loaded.run_spec.scenario);
   CHECK(model.body_count() == 4 * 9);
   const double offset = 40.0 / 25.4;         // [in]
   const double half_speed = 36.0 / 3.6 / 0.0254 / 2.0;  // [in/s] 393.7 / 2
-  CHECK(model.run_spec.scenario->closing_speed == Approx(393.700787));
+  CHECK(loaded.run_spec.scenario->closing_speed == Approx(393.700787));
   for (const char* part : {"coupler", "front_end", "center_body", "rear_body", "front_truck"})
     for (const char* car : {"1_", "2_"}) {
       const Body& s = body_named(model, std::string("s") + car + part);
@@ -96,21 +97,22 @@ TEST_CASE("scenario 1: two identical trains, mirrored, the standing one raised b
       CHECK(t.vx == Approx(-half_speed));
     }
   // 5 g in in/s^2 (standard gravity 386.088 in/s^2, as results.hpp's peaks in g).
-  CHECK(model.run_spec.scenario->deceleration_limit == Approx(5.0 * 386.088));
-  CHECK(model.run_spec.scenario->survival_gauges.size() == 4);
-  CHECK(model.run_spec.scenario->wheels == std::vector<std::string>{"s1_front_truck_wheel_1", "s1_front_truck_wheel_2",
+  CHECK(loaded.run_spec.scenario->deceleration_limit == Approx(5.0 * 386.088));
+  CHECK(loaded.run_spec.scenario->survival_gauges.size() == 4);
+  CHECK(loaded.run_spec.scenario->wheels == std::vector<std::string>{"s1_front_truck_wheel_1", "s1_front_truck_wheel_2",
                                                            "t1_front_truck_wheel_1", "t1_front_truck_wheel_2"});
-  CHECK(model.run_spec.scenario->interface_element == "anticlimber");
+  CHECK(loaded.run_spec.scenario->interface_element == "anticlimber");
 }
 
 TEST_CASE("scenario 2: the train into an 80 t wagon with side buffers", "[scenario]") {
-  const Model model = load_model_text(make_scenario_model(report_car(2)), "scenario2.yaml");
+  const LoadedModel loaded = load_model_text(make_scenario_model(report_car(2)), "scenario2.yaml");
+  const Model& model = loaded.model;
   const Body& wagon = body_named(model, "wagon");
   CHECK(wagon.mass * 386.088 == Approx(80000.0 / 0.45359237));  // weight 176,370 lbf
   CHECK(wagon.vx == 0.0);
   CHECK(body_named(model, "s1_center_body").vx == Approx(393.700787));
   CHECK_FALSE(model.find_body("t1_center_body"));
-  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"s1_front_end", "wagon"});
+  CHECK(loaded.run_spec.scenario->interface_bodies == std::vector<std::string>{"s1_front_end", "wagon"});
 }
 
 TEST_CASE("scenario: bad requests name what is missing", "[scenario]") {
@@ -152,9 +154,10 @@ TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not
   ScenarioRequest q = report_car(1);
   q.offset = 0.0;
   q.t_end = 0.009;
-  Model model = load_model_text(make_scenario_model(q), "symmetric.yaml");
-  const Run run = run_in_memory(model, 0.0005);
-  const double closing_speed = model.run_spec.scenario->closing_speed;
+  LoadedModel loaded = load_model_text(make_scenario_model(q), "symmetric.yaml");
+  Model& model = loaded.model;
+  const Run run = run_in_memory(loaded, 0.0005);
+  const double closing_speed = loaded.run_spec.scenario->closing_speed;
   double velocity_difference = 0.0, position_difference = 0.0;  // [in/s], [in] of mirrored bodies
   for (const Body& b : model.bodies()) {
     if (b.name[0] != 's') continue;
@@ -166,7 +169,7 @@ TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not
       for (std::size_t k = 0; k < s.size(); ++k) largest = std::max(largest, std::abs(s[k] + t[k]));
     }
   }
-  const double rtol = model.run_spec.simulation.rtol;
+  const double rtol = loaded.run_spec.simulation.rtol;
   CHECK(velocity_difference <= 0.1 * rtol * closing_speed);
   CHECK(position_difference <= 0.1 * rtol * closing_speed * *q.t_end);
   // The collision did happen: the lead couplers have bounced back off each other.
@@ -177,8 +180,9 @@ TEST_CASE("scenario 1 without offset is mirror-symmetric: the interface does not
 TEST_CASE("scenario 2 conserves the longitudinal momentum", "[scenario]") {
   ScenarioRequest q = report_car(2);
   q.t_end = 0.03;
-  Model model = load_model_text(make_scenario_model(q), "momentum.yaml");
-  const Run run = run_in_memory(model, 0.001);
+  LoadedModel loaded = load_model_text(make_scenario_model(q), "momentum.yaml");
+  const Model& model = loaded.model;
+  const Run run = run_in_memory(loaded, 0.001);
   check_momentum_through_the_collision(model, run);
   const std::size_t last = run["t"].size() - 1;
 
@@ -230,8 +234,9 @@ const Element* element_named(const Model& model, const std::string& name) {
 }  // namespace
 
 TEST_CASE("scenario 1 from the barrier test's cars: the striking end found by roles, the unit mirrored", "[scenario]") {
-  const Model source = load_model(kBarrierCars);
-  const Model model = load_model_text(make_scenario_model(barrier_cars(1)), "scenario1_barrier.yaml");
+  const Model source = load_model(kBarrierCars).model;
+  const LoadedModel loaded = load_model_text(make_scenario_model(barrier_cars(1)), "scenario1_barrier.yaml");
+  const Model& model = loaded.model;
   CHECK(model.body_count() == 2 * source.body_count());
   const double offset = 40.0 / 25.4;                    // [in]
   const double half_speed = 36.0 / 3.6 / 0.0254 / 2.0;  // [in/s]
@@ -253,27 +258,28 @@ TEST_CASE("scenario 1 from the barrier test's cars: the striking end found by ro
   CHECK_FALSE(element_named(model, "s_climb_limit"));
   REQUIRE(element_named(model, "front_faces"));
   CHECK(element_named(model, "front_faces")->type() == "coupler_end");
-  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "t_lead_front"});
-  CHECK(model.run_spec.scenario->wheels == std::vector<std::string>{"s_lead_truck_front_wheel_1", "s_lead_truck_front_wheel_2",
+  CHECK(loaded.run_spec.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "t_lead_front"});
+  CHECK(loaded.run_spec.scenario->wheels == std::vector<std::string>{"s_lead_truck_front_wheel_1", "s_lead_truck_front_wheel_2",
                                                            "t_lead_truck_front_wheel_1", "t_lead_truck_front_wheel_2"});
-  CHECK(model.run_spec.scenario->survival_cars == std::vector<std::string>{"s_lead", "s_trail", "t_lead", "t_trail"});
-  CHECK(model.run_spec.scenario->passenger_bodies == std::vector<std::string>{"s_lead_body", "s_trail_body", "t_lead_body", "t_trail_body"});
+  CHECK(loaded.run_spec.scenario->survival_cars == std::vector<std::string>{"s_lead", "s_trail", "t_lead", "t_trail"});
+  CHECK(loaded.run_spec.scenario->passenger_bodies == std::vector<std::string>{"s_lead_body", "s_trail_body", "t_lead_body", "t_trail_body"});
 }
 
 TEST_CASE("scenario 2 from the barrier test's cars: the buffers strike the front crush element's body", "[scenario]") {
   ScenarioRequest q = barrier_cars(2);
   q.t_end = 0.03;
-  Model model = load_model_text(make_scenario_model(q), "scenario2_barrier.yaml");
+  LoadedModel loaded = load_model_text(make_scenario_model(q), "scenario2_barrier.yaml");
+  Model& model = loaded.model;
   CHECK_FALSE(model.find_body("t_lead_body"));
-  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "wagon"});
-  CHECK(model.run_spec.scenario->survival_excluded == std::vector<std::string>{"wagon_buffers"});
+  CHECK(loaded.run_spec.scenario->interface_bodies == std::vector<std::string>{"s_lead_front", "wagon"});
+  CHECK(loaded.run_spec.scenario->survival_excluded == std::vector<std::string>{"wagon_buffers"});
   const Element* buffers = element_named(model, "wagon_buffers");
   REQUIRE(buffers);
   // On lead_front (c.g. at x = -30 in) at the face x = 0, 1060 mm above the rail (c.g. at 50 in).
   CHECK(buffers->point(0).body == *model.find_body("s_lead_front"));
   CHECK(buffers->point(0).sx == Approx(30.0));
   CHECK(buffers->point(0).sy == Approx(1060.0 / 25.4 - 50.0));
-  const Run run = run_in_memory(model, 0.001);
+  const Run run = run_in_memory(loaded, 0.001);
   check_momentum_through_the_collision(model, run);
   const std::size_t last = run["t"].size() - 1;
   // Survival space of the lead car: its own crush elements (the front crush structure and the
@@ -296,12 +302,13 @@ TEST_CASE("scenario 3: the train into a deformable obstacle on a slider, no inte
   q.obstacle_unloading_stiffness = 50.0;
   q.obstacle_height = 1000.0;
   q.t_end = 0.02;
-  Model model = load_model_text(make_scenario_model(q), "scenario3_barrier.yaml");
+  LoadedModel loaded = load_model_text(make_scenario_model(q), "scenario3_barrier.yaml");
+  Model& model = loaded.model;
   const Body& obstacle = body_named(model, "obstacle");
   CHECK(obstacle.mass * 386.088 == Approx(15000.0 / 0.45359237));  // 15 t
   CHECK(body_named(model, "s_lead_body").vx == Approx(110.0 / 3.6 / 0.0254));
-  CHECK_FALSE(model.run_spec.scenario->has_interface());
-  const Run run = run_in_memory(model, 0.001);
+  CHECK_FALSE(loaded.run_spec.scenario->has_interface());
+  const Run run = run_in_memory(loaded, 0.001);
   CHECK(run.report.summary_json.find("\"criterion\": \"override\"") == std::string::npos);
   CHECK(run.report.summary_json.find("\"criterion\": \"wheel_lift\", \"subject\": \"s_lead_truck_front_wheel_1\"") != std::string::npos);
   CHECK(run["obstacle.vx"].back() > 0.0);  // struck and pushed ahead
@@ -360,10 +367,11 @@ TEST_CASE("scenario 1 of the barrier cars without offset is mirror-symmetric thr
   // trains' vertical slip into a force (0.36 in/s apart at 50 ms with IDA at friction 0.3).
   q.face_friction.reset();
   q.t_end = 0.05;
-  Model model = load_model_text(make_scenario_model(q), "symmetric_barrier.yaml");
-  model.run_spec.simulation.integrator = integrator;
-  const Run run = run_in_memory(model, 0.0005);
-  const double closing_speed = model.run_spec.scenario->closing_speed;
+  LoadedModel loaded = load_model_text(make_scenario_model(q), "symmetric_barrier.yaml");
+  Model& model = loaded.model;
+  loaded.run_spec.simulation.integrator = integrator;
+  const Run run = run_in_memory(loaded, 0.0005);
+  const double closing_speed = loaded.run_spec.scenario->closing_speed;
   double velocity_difference = 0.0;  // [in/s] of mirrored bodies
   for (const Body& b : model.bodies()) {
     if (b.name.rfind("s_", 0) != 0) continue;
@@ -394,8 +402,9 @@ TEST_CASE("a survival-space car's crush is the sum of its crush elements at one 
   // (car_elements_crush_at): 4.793597 in against the 4.793594 in where every column is fresh.
   // The rows (every output interval) see no more than the criterion, and almost as much. The
   // run summary's car_crush is the car's shortening instead (results.hpp "Car crush").
-  Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/scenario1_barrier_cars.yaml");
-  const Run run = run_in_memory(model, model.run_spec.simulation.output_interval);
+  LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/scenarios/scenario1_barrier_cars.yaml");
+  Model& model = loaded.model;
+  const Run run = run_in_memory(loaded, loaded.run_spec.simulation.output_interval);
   const DaeSystem system(model);
   for (const CarCrush& car : cars_of(system)) {
     INFO("car " << car.car);

@@ -71,8 +71,9 @@ struct Outcome {
 };
 
 Outcome run_text(const std::string& text) {
-  Model model = load_model_text(text, "case.yaml");
-  Outcome out{run_model(model, "", nullptr, false, true), {}};
+  LoadedModel loaded = load_model_text(text, "case.yaml");
+  Model& model = loaded.model;
+  Outcome out{run_model(model, loaded.run_spec, "", nullptr, false, true), {}};
   REQUIRE(out.report.outcome.ok);
   for (std::size_t k = 0; k < out.report.columns.size(); ++k) out.column[out.report.columns[k]] = k;
   return out;
@@ -172,20 +173,21 @@ scenario:
 }
 
 TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the anticlimber and the zones", "[scenario]") {
-  Model model = load_model_text(make_scenario_model(emu3(1, "emu3_unit_collision.yaml")), "s1.yaml");
+  LoadedModel loaded = load_model_text(make_scenario_model(emu3(1, "emu3_unit_collision.yaml")), "s1.yaml");
+  Model& model = loaded.model;
   const auto y_of = [&](const std::string& name) { return model.bodies()[static_cast<std::size_t>(*model.find_body(name))].y; };
   CHECK(y_of("standing.car1.body") - y_of("striking.car1.body") == Approx(0.040).epsilon(1e-9));  // mm-t-s-N read as SI
   CHECK(y_of("standing.car3.bogie_rear") - y_of("striking.car3.bogie_rear") == Approx(0.040).epsilon(1e-9));
-  REQUIRE(model.run_spec.scenario);
-  const ScenarioCriteria& c = *model.run_spec.scenario;
+  REQUIRE(loaded.run_spec.scenario);
+  const ScenarioCriteria& c = *loaded.run_spec.scenario;
   CHECK(c.interface_element == "impact.anticlimber");
   CHECK(c.survival_cars.size() == 6);
   CHECK(c.passenger_bodies.size() == 6);
   // Without --passenger-bodies, each car's heaviest body: its car body.
   ScenarioRequest per_car = emu3(1, "emu3_unit_collision.yaml");
   per_car.passenger_bodies.clear();
-  const Model heaviest = load_model_text(make_scenario_model(per_car), "s1.yaml");
-  CHECK(heaviest.run_spec.scenario->passenger_bodies == c.passenger_bodies);
+  const LoadedModel heaviest_loaded = load_model_text(make_scenario_model(per_car), "s1.yaml");
+  CHECK(heaviest_loaded.run_spec.scenario->passenger_bodies == c.passenger_bodies);
   CHECK(c.rail_supports == std::vector<std::string>{"striking.car1.bogie_front_rail", "standing.car1.bogie_front_rail"});
   CHECK(c.closing_speed == Approx(10.0));  // 36 km/h in m/s
   CHECK(c.survival_limit == Approx(0.05));
@@ -199,9 +201,9 @@ TEST_CASE("scenario 1 from a model with car types: both trains, the offset, the 
   // Without a stroke, a zone's is the end of its declared curve: the cab front's last point, 950 mm.
   ScenarioRequest q = emu3(1, "emu3_unit_collision.yaml");
   q.crush_zones = {"cab_car.front_crush"};
-  const Model declared = load_model_text(make_scenario_model(q), "s1.yaml");
-  for (const auto& zone : declared.run_spec.scenario->survival_zones) CHECK(zone.stroke == Approx(0.95).epsilon(1e-12));
-  CHECK(declared.run_spec.scenario->survival_zones.size() == 4);
+  const LoadedModel declared_loaded = load_model_text(make_scenario_model(q), "s1.yaml");
+  for (const auto& zone : declared_loaded.run_spec.scenario->survival_zones) CHECK(zone.stroke == Approx(0.95).epsilon(1e-12));
+  CHECK(declared_loaded.run_spec.scenario->survival_zones.size() == 4);
 }
 
 TEST_CASE("scenario 1 from car types: the 40 mm offset acts through the anticlimber's interlock", "[scenario]") {
@@ -212,8 +214,9 @@ TEST_CASE("scenario 1 from car types: the 40 mm offset acts through the anticlim
   q.t_end = 0.1;
   const auto override_of = [&](double offset) {
     q.offset = offset;
-    Model model = load_model_text(make_scenario_model(q), "s1.yaml");
-    Outcome out{run_model(model, "", nullptr, false, true), {}};
+    LoadedModel loaded = load_model_text(make_scenario_model(q), "s1.yaml");
+    Model& model = loaded.model;
+    Outcome out{run_model(model, loaded.run_spec, "", nullptr, false, true), {}};
     REQUIRE(out.report.outcome.ok);
     return out.criterion("override", "impact.anticlimber");
   };
@@ -242,11 +245,12 @@ TEST_CASE("scenario from car types: what is missing is named", "[scenario]") {
 }
 
 TEST_CASE("scenario 2 from car types: the wagon meets the unit's front end", "[scenario]") {
-  Model model = load_model_text(make_scenario_model(emu3(2, "emu3_wall.yaml")), "s2.yaml");
-  REQUIRE(model.run_spec.scenario);
-  CHECK(model.run_spec.scenario->interface_bodies == std::vector<std::string>{"striking.car1.front_end", "wagon"});
+  LoadedModel loaded = load_model_text(make_scenario_model(emu3(2, "emu3_wall.yaml")), "s2.yaml");
+  Model& model = loaded.model;
+  REQUIRE(loaded.run_spec.scenario);
+  CHECK(loaded.run_spec.scenario->interface_bodies == std::vector<std::string>{"striking.car1.front_end", "wagon"});
   CHECK(model.bodies()[static_cast<std::size_t>(*model.find_body("wagon"))].mass == Approx(80000.0));
-  CHECK(model.run_spec.scenario->survival_cars.size() == 3);
+  CHECK(loaded.run_spec.scenario->survival_cars.size() == 3);
 }
 
 TEST_CASE("wheel unloading: Q0 is the static load at t = 0 under every integrator, not Euler's first penalty sample", "[scenario]") {

@@ -27,7 +27,7 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 using namespace railcrash;
 
 TEST_CASE("residual, Jacobian, roots and quadrature rates allocate no memory", "[dae][performance]") {
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml").model;
   DaeSystem system(model);
   std::vector<double> y = system.initial_state();
   std::vector<double> yp(y.size(), 0.0), r(y.size()), values(static_cast<std::size_t>(system.pattern().nonzeros()));

@@ -31,31 +31,31 @@ struct SampleTimes : RunObserver {
   void sample(double t, const double*, const double*, const double*, const double*) override { times.push_back(t); }
 };
 
-IdaSettings ida_settings(const Model& model) {
+IdaSettings ida_settings(const SimulationSettings& s) {
   IdaSettings ida;
-  ida.rtol = model.run_spec.simulation.rtol;
-  ida.atol = model.run_spec.simulation.atol;
+  ida.rtol = s.rtol;
+  ida.atol = s.atol;
+  ida.run = {s.t_end, s.static_equilibrium};
   return ida;
 }
 
-EulerSettings euler_settings(const Model& model) {
-  const SimulationSettings& s = model.run_spec.simulation;
-  return {s.dt, s.force_dt, s.penalty, s.max_steps};
+EulerSettings euler_settings(const SimulationSettings& s) {
+  return {s.dt, s.force_dt, s.penalty, s.max_steps, {s.t_end, s.static_equilibrium}};
 }
 
 }  // namespace
 
 TEST_CASE("IDA hands a run to Euler that goes on from its state with the run's samples and counters", "[integrators][auto]") {
   const double dt = 1e-4, t_end = 2.0, interval = 0.01;  // [s]
-  const Model model = testing::model_from_text(oscillator(t_end, ", dt: 1e-4"));
-  DaeSystem system(model);
+  const LoadedModel loaded = testing::loaded_from_text(oscillator(t_end, ", dt: 1e-4"));
+  DaeSystem system(loaded.model);
   AutoSettings rule;  // a hand-over at the first chance: after IDA's sixth step
   rule.startup_steps = 5;
   rule.min_events = 0;
   rule.min_span_steps = 0.0;
   rule.margin = 0.0;
   rule.require_resolution = false;
-  AutoIntegrator integrator(system, ida_settings(model), euler_settings(model), rule);
+  AutoIntegrator integrator(system, ida_settings(loaded.run_spec.simulation), euler_settings(loaded.run_spec.simulation), rule);
   SampleTimes observer;
   const RunOutcome outcome = integrator.run(t_end, interval, observer);
   REQUIRE(outcome.ok);
@@ -84,12 +84,14 @@ TEST_CASE("IDA hands a run to Euler that goes on from its state with the run's s
 
 TEST_CASE("auto keeps IDA on the report's two-car crash and gives IDA's result bit for bit", "[integrators][auto]") {
   const std::string file = source_path("models/report/final_two_car.yaml");
-  const Model ida_model = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=ida"});
-  const Model auto_model = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=auto"});
+  const LoadedModel ida_loaded = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=ida"});
+  const Model& ida_model = ida_loaded.model;
+  const LoadedModel auto_loaded = load_model(file, {"simulation.t_end=0.02", "simulation.integrator=auto"});
+  const Model& auto_model = auto_loaded.model;
   DaeSystem ida_system(ida_model), auto_system(auto_model);
   SampleTimes a, b;
-  const RunOutcome by_ida = make_integrator(ida_system, ida_model.run_spec.simulation)->run(0.02, 0.001, a);
-  const RunOutcome by_auto = make_integrator(auto_system, auto_model.run_spec.simulation)->run(0.02, 0.001, b);
+  const RunOutcome by_ida = make_integrator(ida_system, ida_loaded.run_spec.simulation)->run(0.02, 0.001, a);
+  const RunOutcome by_auto = make_integrator(auto_system, auto_loaded.run_spec.simulation)->run(0.02, 0.001, b);
   REQUIRE(by_ida.ok);
   REQUIRE(by_auto.ok);
   INFO(by_auto.stats.hand_over_reason);
@@ -103,9 +105,9 @@ TEST_CASE("auto keeps IDA on the report's two-car crash and gives IDA's result b
 TEST_CASE("auto keeps IDA on an SI multiple-unit crash whose IDA steps are shorter than Euler's", "[integrators][auto]") {
   // bench/HISTORY.md "integrator: auto": Euler at its own step is cheaper here but 3-11 % off in
   // the energy the crush zones absorb; IDA's mean step is a sixth of Euler's.
-  const Model model = load_model(source_path("models/examples/emu_two_car_crush_zones.yaml"),
+  const LoadedModel loaded = load_model(source_path("models/examples/emu_two_car_crush_zones.yaml"),
                                  {"simulation.integrator=auto", "simulation.output_interval=0.01"});
-  const RunOutcome outcome = testing::simulate(model, 0.01);
+  const RunOutcome outcome = testing::simulate(loaded, 0.01);
   INFO(outcome.stats.hand_over_reason);
   CHECK(outcome.stats.handed_over_at < 0.0);
   CHECK_THAT(outcome.stats.hand_over_reason, Catch::Contains("shorter than Euler's"));
@@ -113,8 +115,8 @@ TEST_CASE("auto keeps IDA on an SI multiple-unit crash whose IDA steps are short
 
 TEST_CASE("auto keeps IDA where Euler cannot run the model and says why", "[integrators][auto]") {
   // dt 1 s is above the oscillator's stability limit 2 / omega = 0.2 s.
-  const Model model = testing::model_from_text(oscillator(1.0, ", integrator: auto, dt: 1.0"));
-  const RunOutcome outcome = testing::simulate(model, 0.1);
+  const LoadedModel loaded = testing::loaded_from_text(oscillator(1.0, ", integrator: auto, dt: 1.0"));
+  const RunOutcome outcome = testing::simulate(loaded, 0.1);
   INFO(outcome.stats.hand_over_reason);
   CHECK(outcome.stats.handed_over_at < 0.0);
   CHECK_THAT(outcome.stats.hand_over_reason,
@@ -122,9 +124,9 @@ TEST_CASE("auto keeps IDA where Euler cannot run the model and says why", "[inte
 }
 
 TEST_CASE("a model that names no integrator runs with auto and a model may name it", "[integrators][auto][model_io]") {
-  CHECK(testing::model_from_text(oscillator(1.0)).run_spec.simulation.integrator == IntegratorKind::Auto);
-  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: auto")).run_spec.simulation.integrator == IntegratorKind::Auto);
-  CHECK(testing::model_from_text(oscillator(1.0, ", integrator: euler")).run_spec.simulation.integrator == IntegratorKind::Euler);
+  CHECK(testing::loaded_from_text(oscillator(1.0)).run_spec.simulation.integrator == IntegratorKind::Auto);
+  CHECK(testing::loaded_from_text(oscillator(1.0, ", integrator: auto")).run_spec.simulation.integrator == IntegratorKind::Auto);
+  CHECK(testing::loaded_from_text(oscillator(1.0, ", integrator: euler")).run_spec.simulation.integrator == IntegratorKind::Euler);
   CHECK_THROWS_WITH(testing::model_from_text(oscillator(1.0, ", integrator: rk4")),
                     Catch::Contains("integrator must be auto, ida or euler, not 'rk4'"));
   for (const IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Euler, IntegratorKind::Auto})
@@ -137,10 +139,11 @@ TEST_CASE("IDA runs a unit whose only forces at t = 0 are round-off: they set no
   // and IDA stopped with IDA_CONV_FAIL at 4.5 ms (d2514da); the kinetic scale now takes over.
   // x-momentum, 81,700 kg x 12 m/s, has no outside force to change it.
   const std::string file = source_path("tests/robustness/models/stiff_anticlimber_unit.yaml");
-  const Model model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.1"});
+  const LoadedModel loaded = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.1"});
+  const Model& model = loaded.model;
   DaeSystem system(model);
   SampleTimes samples;
-  const RunOutcome outcome = make_integrator(system, model.run_spec.simulation)->run(0.1, 0.001, samples);
+  const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.1, 0.001, samples);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   double momentum = 0.0;  // [kg m/s]
@@ -156,10 +159,11 @@ TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and
   // 81,700 kg x 12 m/s for the moving unit, stays what it was through IDA's part, the hand-over
   // and Euler's part (Euler's internal forces are equal and opposite at every step).
   const std::string file = source_path("tests/robustness/models/stiff_anticlimber_unit.yaml");
-  const Model ida_model = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.05", "simulation.atol=1e-16"});
+  const LoadedModel ida_loaded = load_model(file, {"simulation.integrator=ida", "simulation.t_end=0.05", "simulation.atol=1e-16"});
+  const Model& ida_model = ida_loaded.model;
   DaeSystem ida_system(ida_model);
   SampleTimes ida_samples;
-  const RunOutcome by_ida = make_integrator(ida_system, ida_model.run_spec.simulation)->run(0.05, 0.001, ida_samples);
+  const RunOutcome by_ida = make_integrator(ida_system, ida_loaded.run_spec.simulation)->run(0.05, 0.001, ida_samples);
   REQUIRE_FALSE(by_ida.ok);
   CHECK_THAT(by_ida.message, Catch::Contains("IDA_ERR_FAIL"));
   // "IDA failed at t = T with ...": auto's IDA takes the same steps up to T.
@@ -167,10 +171,11 @@ TEST_CASE("auto hands a run IDA fails on to Euler from IDA's last good state and
   REQUIRE(at != std::string::npos);
   const double t_failed = std::stod(by_ida.message.substr(at + 18));
 
-  const Model auto_model = load_model(file, {"simulation.integrator=auto", "simulation.t_end=0.05", "simulation.atol=1e-16"});
+  const LoadedModel auto_loaded = load_model(file, {"simulation.integrator=auto", "simulation.t_end=0.05", "simulation.atol=1e-16"});
+  const Model& auto_model = auto_loaded.model;
   DaeSystem auto_system(auto_model);
   SampleTimes auto_samples;
-  const RunOutcome outcome = make_integrator(auto_system, auto_model.run_spec.simulation)->run(0.05, 0.001, auto_samples);
+  const RunOutcome outcome = make_integrator(auto_system, auto_loaded.run_spec.simulation)->run(0.05, 0.001, auto_samples);
   INFO(outcome.message);
   INFO(outcome.stats.hand_over_reason);
   REQUIRE(outcome.ok);

@@ -14,7 +14,7 @@
 using namespace railcrash;
 
 TEST_CASE("slider-crank Jacobian matches central differences at random states", "[dae]") {
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml").model;
   DaeSystem system(model);
   std::mt19937 rng(7);
   for (int trial = 0; trial < 5; ++trial) {
@@ -60,7 +60,7 @@ TEST_CASE("a non-finite law is traced to the element or body it comes from, with
 TEST_CASE("the quadratures' sweep gives the roots and outputs of roots() bit for bit, and the same rates", "[dae]") {
   // IdaIntegrator takes a step's roots and outputs from this sweep (QuadratureSweep): any
   // difference from roots() would change where events are found.
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml").model;
   DaeSystem system(model);
   REQUIRE(system.root_count() > 0);
   REQUIRE(!system.output_names().empty());
@@ -89,7 +89,7 @@ TEST_CASE("the forces at new reactions equal generalized_forces bit for bit, wit
   // consistent_rates iterates on the reactions that the joints' friction depends on; it keeps the
   // forces that do not depend on them (DaeSystem::ForcesAtReactions). A restart's rates, and so
   // every run with joint friction, must not move by a bit.
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
+  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml").model;
   DaeSystem system(model);
   const int nq = system.body_unknowns();
   const int m = system.constraint_rows();
@@ -160,9 +160,10 @@ TEST_CASE("a conservative model dissipates nothing and its energy error is named
       "simulation: {t_end: 2, rtol: 1e-6, dt: 4.0e-3, integrator: ";
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    const Model model = testing::model_from_text(text + integrator + "}\n");
+    const LoadedModel loaded = testing::loaded_from_text(text + integrator + "}\n");
+    const Model& model = loaded.model;
     DaeSystem system(model);
-    const RunOutcome o = testing::simulate(system);
+    const RunOutcome o = testing::simulate(system, loaded.run_spec.simulation);
     const EnergyBalance e = EnergyBalance::between(o.initial_energy, o.final_energy);
     const double initial = 0.5 * 40000.0 * 9.0 + 0.5 * 40000.0 * 0.25;
     REQUIRE(e.initial_total == Approx(initial).epsilon(1e-12));
@@ -208,10 +209,11 @@ TEST_CASE("a damped spring-mass dissipates the integral of c v^2 in its dashpot,
       "simulation: {t_end: 1, rtol: 1e-10, dt: 1.0e-5, integrator: ";
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    const Model model = testing::model_from_text(text + integrator + "}\n");
+    const LoadedModel loaded = testing::loaded_from_text(text + integrator + "}\n");
+    const Model& model = loaded.model;
     const bool ida = std::string(integrator) == "ida";
     DaeSystem system(model);
-    const RunOutcome o = testing::simulate(system);
+    const RunOutcome o = testing::simulate(system, loaded.run_spec.simulation);
     const EnergyBalance e = EnergyBalance::between(o.initial_energy, o.final_energy);
     CHECK(e.dissipated == Approx(damper_work).epsilon(ida ? 1e-7 : 1e-4));
     std::vector<std::string> columns;

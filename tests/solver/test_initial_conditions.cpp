@@ -103,9 +103,10 @@ TEST_CASE("consistent rates give the joint force and acceleration of Newton's la
 }
 
 TEST_CASE("a free body with zero inertia makes the equations singular, with a clear message", "[initial]") {
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: p\nunits: SI\nbodies:\n  - {name: dot, mass: 1, inertia: 0, position: [0, 0]}\n"
       "simulation: {t_end: 1}\n");
+  const Model& model = loaded.model;
   DaeSystem system(model);
   std::vector<double> y = system.initial_state(), yp;
   CHECK_THROWS_WITH(consistent_rates(system, 0.0, y, yp), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
@@ -125,11 +126,12 @@ TEST_CASE("static equilibrium settles a body onto its wheels before the run", "[
   const double weight = 1000.0 * 9.80665;
   for (const char* integrator : {"ida", "euler"}) {
     INFO(integrator);
-    Model model = testing::model_from_text(text);
-    model.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
-    model.run_spec.simulation.dt = 2e-5;
+    LoadedModel loaded = testing::loaded_from_text(text);
+    Model& model = loaded.model;
+    loaded.run_spec.simulation.integrator = std::string(integrator) == "ida" ? IntegratorKind::Ida : IntegratorKind::Euler;
+    loaded.run_spec.simulation.dt = 2e-5;
     DaeSystem system(model);
-    const RunOutcome o = testing::simulate(system);
+    const RunOutcome o = testing::simulate(system, loaded.run_spec.simulation);
     // Both wheels close and pass their breakpoint while settling, at t = 0.
     REQUIRE(o.events.size() >= 4);
     for (const EventRecord& e : o.events) {
@@ -151,13 +153,13 @@ TEST_CASE("static equilibrium settles a body onto its wheels before the run", "[
 }
 
 TEST_CASE("static equilibrium reports a body that nothing holds", "[initial]") {
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: stone, mass: 1, inertia: 1, position: [0, 1]}\n"
       "simulation: {t_end: 1, static_equilibrium: true}\n");
-  DaeSystem system(model);
+  DaeSystem system(loaded.model);
   std::vector<double> y;
   std::vector<EventRecord> events;
-  CHECK_THROWS_WITH(prepare_start(system, y, events), Catch::Contains("no static equilibrium"));
+  CHECK_THROWS_WITH(prepare_start(system, y, events, loaded.run_spec.simulation.static_equilibrium), Catch::Contains("no static equilibrium"));
 }
 
 TEST_CASE("a settle that fails names the body, the direction, the value and what pushes there, not gravity",
@@ -166,7 +168,7 @@ TEST_CASE("a settle that fails names the body, the direction, the value and what
   // and a constant 50 N load along x that nothing resists: no equilibrium. The message must
   // name the x row of 'block' (line 5), its value, the load (line 9), and must not blame gravity
   // (it has no x component); the joint, which pushes 0 in x, is not listed among the pushes.
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: s\nunits: SI\nbodies:\n"
       "  - {name: block, mass: 100, inertia: 1, position: [0, 1]}\n"
       "elements:\n"
@@ -174,12 +176,12 @@ TEST_CASE("a settle that fails names the body, the direction, the value and what
       "loads:\n"
       "  - {type: force, body: block, at: [0, 0], value: [50, 0]}\n"
       "simulation: {t_end: 1, static_equilibrium: true}\n");
-  DaeSystem system(model);
+  DaeSystem system(loaded.model);
   std::vector<double> y;
   std::vector<EventRecord> events;
   std::string message = "no error";
   try {
-    prepare_start(system, y, events);
+    prepare_start(system, y, events, loaded.run_spec.simulation.static_equilibrium);
   } catch (const SolverError& e) {
     message = e.what();
   }
@@ -200,30 +202,30 @@ TEST_CASE("a settle ends at the round-off of the forces that meet at a body, not
   // static equilibrium"); within 1e-10 of the forces that meet at that row it is balanced.
   // Equilibrium: x moves by 1.3e-5 / 3e12 m (nothing), y sags by W / (T1 / L1 + T2 / L2) =
   // 9.80665 / 1e12 m.
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: bob, mass: 1, inertia: 1, position: [0, 0]}\n"
       "elements:\n"
       "  - {name: left, type: linear_spring, stiffness: 1.0e12, free_length: 0.5, points: [{body: ground, at: [-1, 0]}, {body: bob, at: [0, 0]}]}\n"
       "  - {name: right, type: linear_spring, stiffness: 2.0e12, free_length: 0.75, points: [{body: ground, at: [1, 0]}, {body: bob, at: [0, 0]}]}\n"
       "  - {name: weak, type: linear_spring, stiffness: 1.0e-5, free_length: 3.7, points: [{body: ground, at: [5, 0]}, {body: bob, at: [0, 0]}]}\n"
       "simulation: {t_end: 1, static_equilibrium: true}\n");
-  DaeSystem system(model);
+  DaeSystem system(loaded.model);
   std::vector<double> y;
   std::vector<EventRecord> events;
-  REQUIRE_NOTHROW(prepare_start(system, y, events));
+  REQUIRE_NOTHROW(prepare_start(system, y, events, loaded.run_spec.simulation.static_equilibrium));
   CHECK(std::abs(y[0]) < 1e-15);
   CHECK(y[1] == Approx(-9.80665 / 1.0e12).epsilon(1e-6));
 }
 
 TEST_CASE("a settle that fails in y lists gravity among what pushes there", "[initial]") {
   // A free 2 kg stone: gravity (-19.6133 N in y) is the one push, and the message says so.
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: s\nunits: SI\nbodies:\n  - {name: stone, mass: 2, inertia: 1, position: [0, 1]}\n"
       "simulation: {t_end: 1, static_equilibrium: true}\n");
-  DaeSystem system(model);
+  DaeSystem system(loaded.model);
   std::vector<double> y;
   std::vector<EventRecord> events;
-  CHECK_THROWS_WITH(prepare_start(system, y, events),
+  CHECK_THROWS_WITH(prepare_start(system, y, events, loaded.run_spec.simulation.static_equilibrium),
                     Catch::Contains("the largest unbalanced force is -19.6133 in y on test.yaml:5: body 'stone'") &&
                         Catch::Contains("On that body in y: gravity -19.6133."));
 }
@@ -246,11 +248,12 @@ TEST_CASE("static equilibrium settles onto the kink of a stop spring", "[initial
       "  - {name: guide, type: linear_spring, stiffness: 1.0e5, free_length: 1.0, "
       "points: [{body: ground, at: [-1, 1.0]}, {body: block, at: [0, 0]}]}\n"
       "simulation: {t_end: 0.1, static_equilibrium: true, rtol: 1e-8}\n";
-  const Model model = testing::model_from_text(text);
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const Model& model = loaded.model;
   DaeSystem system(model);
   std::vector<double> y;
   std::vector<EventRecord> events;
-  const StartReport start = prepare_start(system, y, events);
+  const StartReport start = prepare_start(system, y, events, loaded.run_spec.simulation.static_equilibrium);
   CHECK(start.equilibrium.steps > 0);
   CHECK(start.equilibrium.residual_force < 1e-6);
   CHECK(y[1] == Approx(1.0).margin(1e-9));
@@ -261,7 +264,7 @@ TEST_CASE("static equilibrium settles onto the kink of a stop spring", "[initial
   const auto stop_force = std::find(names.begin(), names.end(), "stop.force");
   REQUIRE(stop_force != names.end());
   CHECK(std::abs(out[static_cast<std::size_t>(stop_force - names.begin())]) < 1e-2);  // [N]
-  const RunOutcome o = testing::simulate(model);
+  const RunOutcome o = testing::simulate(loaded);
   CHECK(o.y[1] == Approx(1.0).margin(1e-8));
   CHECK(std::abs(o.y[4]) < 1e-6);
 }
@@ -299,8 +302,8 @@ TEST_CASE("a parallelogram four-bar lying flat is a singular configuration that 
 TEST_CASE("consistent rates with a kept ordering equal those without one, bit for bit", "[initial]") {
   // The IDA integrator keeps the LU ordering between restarts (ConsistentRatesCache): reused
   // while the matrix pattern is the same, made again when it is not.
-  const Model two_car = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml");
-  const Model slider_crank = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml");
+  const Model two_car = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/report/final_two_car.yaml").model;
+  const Model slider_crank = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/verification/cases/slider_crank.yaml").model;
   DaeSystem two_car_system(two_car), slider_crank_system(slider_crank);
   REQUIRE(two_car_system.constraint_rows() > 0);
   REQUIRE(slider_crank_system.constraint_rows() > 0);

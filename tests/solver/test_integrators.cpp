@@ -62,7 +62,7 @@ struct StopAfter : RunObserver {
 /// system's own evaluation at the sample's state, bit for bit, and feeds two in-memory result
 /// writers, one with the run loop's forces and one through sample(), which evaluates its own.
 struct SampleForcesCheck : RunObserver {
-  explicit SampleForcesCheck(const DaeSystem& s) : system(s), with_forces("", s), without_forces("", s) {}
+  SampleForcesCheck(const DaeSystem& s, const RunSpec& run_spec) : system(s), with_forces("", s, run_spec), without_forces("", s, run_spec) {}
   const DaeSystem& system;
   ResultWriter with_forces, without_forces;
   int samples = 0, samples_with_forces = 0, mismatches = 0;
@@ -120,12 +120,13 @@ TEST_CASE("Gershgorin bound for large models is safe and close for a long chain"
 }
 
 TEST_CASE("Euler refuses a step above the stability limit unless forced, then reports divergence", "[integrators]") {
-  Model model = testing::model_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3"));
+  LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3"));
+  Model& model = loaded.model;
   DaeSystem system(model);
-  CHECK_THROWS_WITH(make_integrator(system, model.run_spec.simulation),
+  CHECK_THROWS_WITH(make_integrator(system, loaded.run_spec.simulation),
                     Catch::Contains("above the stability limit") && Catch::Contains("0.2"));
-  model.run_spec.simulation.force_dt = true;
-  auto integrator = make_integrator(system, model.run_spec.simulation);
+  loaded.run_spec.simulation.force_dt = true;
+  auto integrator = make_integrator(system, loaded.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = integrator->run(200.0, 1.0, observer);
   CHECK_FALSE(outcome.ok);
@@ -134,18 +135,35 @@ TEST_CASE("Euler refuses a step above the stability limit unless forced, then re
 }
 
 TEST_CASE("Euler needs positive inertia", "[integrators]") {
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: p\nunits: SI\nbodies:\n  - {name: dot, mass: 1, inertia: 0, position: [0, 0]}\n"
       "simulation: {t_end: 1, integrator: euler}\n");
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  CHECK_THROWS_WITH(make_integrator(system, model.run_spec.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
+  CHECK_THROWS_WITH(make_integrator(system, loaded.run_spec.simulation), Catch::Contains("'dot'") && Catch::Contains("zero inertia"));
+}
+
+TEST_CASE("Euler counts its steps to the t_end its settings give it, not the model file's", "[integrators]") {
+  // The file says t_end 1; Euler takes t_end from its settings (CommonRunSettings): at dt 1e-3
+  // it needs ceil(t_end / dt) steps, refused above max_steps.
+  const Model model = testing::model_from_text(oscillator(200.0, 0.0, 1.0));
+  DaeSystem system(model);
+  EulerSettings settings;
+  settings.dt = 1e-3;  // [s] below the stability limit 0.2 s
+  settings.max_steps = 100;
+  settings.run.t_end = 0.05;  // [s] 50 steps
+  CHECK_NOTHROW(EulerIntegrator(system, settings));
+  settings.run.t_end = 0.5;  // [s] 500 steps
+  CHECK_THROWS_WITH(EulerIntegrator(system, settings),
+                    Catch::Contains("needs 500 steps to reach t_end = 0.5, more than --max-steps 100"));
 }
 
 TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
-    Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    Model& model = loaded.model;
     DaeSystem system(model);
-    auto run = make_integrator(system, model.run_spec.simulation);
+    auto run = make_integrator(system, loaded.run_spec.simulation);
     CountingObserver observer;
     const RunOutcome outcome = run->run(1.0, 0.25, observer);
     REQUIRE(outcome.ok);
@@ -157,10 +175,11 @@ TEST_CASE("both integrators sample at t = 0, every output interval and t_end", "
 
 TEST_CASE("every sample hands the observer the element outputs of that sample's state", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
-    Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    Model& model = loaded.model;
     DaeSystem system(model);
     REQUIRE(system.output_names() == std::vector<std::string>{"spring.force", "spring.deformation", "damper.force", "damper.rate"});
-    auto run = make_integrator(system, model.run_spec.simulation);
+    auto run = make_integrator(system, loaded.run_spec.simulation);
     OscillatorOutputCheck observer;
     REQUIRE(run->run(1.0, 0.05, observer).ok);
     CHECK(observer.samples == 21);
@@ -169,9 +188,10 @@ TEST_CASE("every sample hands the observer the element outputs of that sample's 
 
 TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
   for (const char* integrator : {"ida", "euler"}) {
-    Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 1.0, 1.0, std::string(", integrator: ") + integrator + ", dt: 1e-3"));
+    Model& model = loaded.model;
     DaeSystem system(model);
-    auto run = make_integrator(system, model.run_spec.simulation);
+    auto run = make_integrator(system, loaded.run_spec.simulation);
     std::atomic<bool> stop{false};
     StopAfter observer;
     observer.stop = &stop;
@@ -185,17 +205,18 @@ TEST_CASE("an interrupted run stops early and says so", "[integrators]") {
 TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizing penalties", "[integrators]") {
   // t_end 1 at dt 1e-300 needs 1e300 steps (a long step count would overflow); dt 1e-3 needs
   // exactly 1000 steps: refused at max_steps 999, accepted at 1000.
-  Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0, ", integrator: euler, dt: 1e-300"));
+  LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 1.0, 1.0, ", integrator: euler, dt: 1e-300"));
+  Model& model = loaded.model;
   DaeSystem tiny_step(model);
-  CHECK_THROWS_WITH(make_integrator(tiny_step, model.run_spec.simulation),
+  CHECK_THROWS_WITH(make_integrator(tiny_step, loaded.run_spec.simulation),
                     Catch::Contains("needs 1e+300 steps to reach t_end = 1, more than --max-steps 10000000") &&
                         Catch::Contains("use a larger dt (above 1e-07)"));
-  model.run_spec.simulation.dt = 1e-3;
-  model.run_spec.simulation.max_steps = 999;
+  loaded.run_spec.simulation.dt = 1e-3;
+  loaded.run_spec.simulation.max_steps = 999;
   DaeSystem system(model);
-  CHECK_THROWS_WITH(make_integrator(system, model.run_spec.simulation), Catch::Contains("needs 1000 steps"));
-  model.run_spec.simulation.max_steps = 1000;
-  auto run = make_integrator(system, model.run_spec.simulation);
+  CHECK_THROWS_WITH(make_integrator(system, loaded.run_spec.simulation), Catch::Contains("needs 1000 steps"));
+  loaded.run_spec.simulation.max_steps = 1000;
+  auto run = make_integrator(system, loaded.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(1.0, 0.5, observer);
   CHECK(outcome.ok);
@@ -208,10 +229,11 @@ TEST_CASE("Euler refuses a dt that needs more than max_steps steps, before sizin
 }
 
 TEST_CASE("IDA stops at max_steps as a failed run that says so", "[integrators]") {
-  Model model = testing::model_from_text(oscillator(200.0, 1.0, 1.0));
-  model.run_spec.simulation.max_steps = 20;
+  LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 1.0, 1.0));
+  Model& model = loaded.model;
+  loaded.run_spec.simulation.max_steps = 20;
   DaeSystem system(model);
-  auto run = make_integrator(system, model.run_spec.simulation);
+  auto run = make_integrator(system, loaded.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(1.0, 0.01, observer);
   CHECK_FALSE(outcome.ok);
@@ -223,7 +245,7 @@ TEST_CASE("IDA stops at max_steps as a failed run that says so", "[integrators]"
 TEST_CASE("a run whose element output is not finite fails naming the element", "[integrators]") {
   // The point at 1e308 is 2.7e308 from the circle's centre: the penetration overflows to -inf
   // while the contact stays open (no force, so the motion itself stays finite).
-  const Model model = testing::model_from_text(
+  const LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: far\nunits: SI\ngravity: [0, 0]\nbodies:\n"
       "  - {name: ball, mass: 2, inertia: 0.1, position: [1.0e308, 0], velocity: [1, 0]}\n"
       "  - {name: anchor, mass: 1, inertia: 0.1, position: [2, 0]}\nelements:\n"
@@ -232,7 +254,8 @@ TEST_CASE("a run whose element output is not finite fails naming the element", "
       "points: [{body: ground, at: [0, 0]}, {body: anchor, at: [0, 0]}]}\n"
       "  - {name: bump, type: contact, circle_center: [-1.7e308, 0], circle_radius: 1, stiffness: 1.0e6, "
       "points: [{body: ball, at: [0, 0]}]}\nsimulation: {t_end: 0.1, output_interval: 0.01}\n");
-  const RunReport report = run_model(model, "", nullptr, false);
+  const Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, "", nullptr, false);
   CHECK_FALSE(report.outcome.ok);
   CHECK_THAT(report.outcome.message, Catch::Contains("element 'bump' (contact): its output 'penetration' is -inf at t = 0"));
   // That sample and every later one is held back: nothing non-finite reaches the files.
@@ -241,9 +264,10 @@ TEST_CASE("a run whose element output is not finite fails naming the element", "
 }
 
 TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost", "[integrators]") {
-  const Model model = testing::model_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
+  const LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 4.0, 3.0, ", rtol: 1e-9"));
+  const Model& model = loaded.model;
   DaeSystem system(model);
-  auto run = make_integrator(system, model.run_spec.simulation);
+  auto run = make_integrator(system, loaded.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = run->run(3.0, 0.1, observer);
   REQUIRE(outcome.ok);
@@ -258,8 +282,9 @@ TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost
 TEST_CASE("run_model writes timeseries, events and summary, also for a failed run", "[integrators]") {
   const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_test_results").string();
   std::filesystem::remove_all(dir);
-  Model model = testing::model_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3, force_dt: true, output_interval: 1"));
-  const RunReport report = run_model(model, dir);
+  LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3, force_dt: true, output_interval: 1"));
+  Model& model = loaded.model;
+  const RunReport report = run_model(model, loaded.run_spec, dir);
   CHECK_FALSE(report.outcome.ok);
   std::ifstream csv(dir + "/timeseries.csv");
   std::string header;
@@ -285,14 +310,15 @@ TEST_CASE("Euler's divergence names the penalty joint with the largest violation
   // A 1 m pendulum on a pin joint with penalty stiffness 1e6 N/m: the row's effective mass
   // 1 / (1/1 + 1^2/0.01) = 1/101 kg gives w = 1e4 rad/s, stable below about 2e-4 s; forced to
   // run at 5e-3 s it diverges through the joint.
-  Model model = testing::model_from_text(
+  LoadedModel loaded = testing::loaded_from_text(
       "railcrash: 1\nname: pendulum\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
       "  - {name: bob, mass: 1, inertia: 0.01, position: [1, 0]}\nelements:\n"
       "  - {name: hinge, type: pin_joint, penalty_stiffness: 1.0e6, "
       "points: [{body: ground, at: [0, 0]}, {body: bob, at: [-1, 0]}]}\n"
       "simulation: {t_end: 10, integrator: euler, dt: 5.0e-3, force_dt: true, output_interval: 0.01}\n");
+  Model& model = loaded.model;
   DaeSystem system(model);
-  auto integrator = make_integrator(system, model.run_spec.simulation);
+  auto integrator = make_integrator(system, loaded.run_spec.simulation);
   CountingObserver observer;
   const RunOutcome outcome = integrator->run(10.0, 0.01, observer);
   CHECK_FALSE(outcome.ok);
@@ -306,9 +332,10 @@ TEST_CASE("IDA at rtol 1e-9 runs the barrier crash through and agrees with rtol 
   // multipliers' Newton iteration never converged (IDA_CONV_FAIL, h = 1e-16); the restart is now
   // retried once with a first step of a tenth of the step before the event.
   const std::string path = std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml";
-  const Model tight = load_model(path, {"simulation.rtol=1e-9"});
-  const Model loose = load_model(path, {"simulation.rtol=1e-8"});
-  const RunOutcome a = testing::simulate(tight, 0.01), b = testing::simulate(loose, 0.01);
+  const LoadedModel tight_loaded = load_model(path, {"simulation.rtol=1e-9"});
+  const Model& tight = tight_loaded.model;
+  const LoadedModel loose_loaded = load_model(path, {"simulation.rtol=1e-8"});
+  const RunOutcome a = testing::simulate(tight_loaded, 0.01), b = testing::simulate(loose_loaded, 0.01);
   REQUIRE(a.ok);
   const DaeSystem system(tight);
   double largest = 0.0;  // [in] largest difference of a body position at the end
@@ -325,9 +352,10 @@ TEST_CASE("a timed run's phases add up to its wall time, each where its work is"
   // roots, located mode changes and restarts (the wall contact, the dampers).
   const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_test_phases").string();
   std::filesystem::remove_all(dir);
-  const Model model = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
+  const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
                                  {"simulation.t_end=0.2"});
-  const RunReport timed = run_model(model, dir, nullptr, false, false, "csv", /*time_phases=*/true);
+  const Model& model = loaded.model;
+  const RunReport timed = run_model(model, loaded.run_spec, dir, nullptr, false, false, "csv", /*time_phases=*/true);
   REQUIRE(timed.outcome.ok);
   const RunStatistics& s = timed.outcome.stats;
   REQUIRE(s.phases_timed);
@@ -352,9 +380,10 @@ TEST_CASE("a timed run's phases add up to its wall time, each where its work is"
                                 Catch::Contains("\"factor_nonzeros\": " + std::to_string(s.factor_nonzeros)));
 
   // Euler's phases: its force sweeps and mode changes; no Jacobian, no linear solver.
-  const Model euler = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
+  const LoadedModel euler_loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
                                  {"simulation.t_end=0.05", "simulation.integrator=euler"});
-  const RunReport explicit_run = run_model(euler, "", nullptr, false, false, "csv", true);
+  const Model& euler = euler_loaded.model;
+  const RunReport explicit_run = run_model(euler, euler_loaded.run_spec, "", nullptr, false, false, "csv", true);
   REQUIRE(explicit_run.outcome.stats.phases_timed);
   const auto& e = explicit_run.outcome.stats.phase_seconds;
   CHECK(e[static_cast<std::size_t>(Phase::Residual)] > 0.0);
@@ -363,7 +392,7 @@ TEST_CASE("a timed run's phases add up to its wall time, each where its work is"
   CHECK(explicit_run.outcome.stats.factor_nonzeros == 0);
 
   // Untimed (the default): no phase figures, none in summary.json.
-  const RunReport untimed = run_model(model, dir);
+  const RunReport untimed = run_model(model, loaded.run_spec, dir);
   CHECK_FALSE(untimed.outcome.stats.phases_timed);
   for (const double x : untimed.outcome.stats.phase_seconds) CHECK(x == 0.0);
   CHECK_THAT(untimed.summary_json, !Catch::Contains("\"seconds\""));
@@ -383,20 +412,20 @@ TEST_CASE("an observer that wants the forces gets them from the outputs' sweep, 
       "simulation: {t_end: 0.3, dt: 1e-4}\n";
   const std::string barrier = std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml";
   struct Case {
-    Model model;
+    LoadedModel loaded;
     IntegratorKind integrator;
     double t_end, interval;
   };
   std::vector<Case> cases;
   for (const IntegratorKind integrator : {IntegratorKind::Ida, IntegratorKind::Euler})
-    cases.push_back({testing::model_from_text(slider), integrator, 0.3, 0.01});
+    cases.push_back({testing::loaded_from_text(slider), integrator, 0.3, 0.01});
   cases.push_back({load_model(barrier, {}), IntegratorKind::Ida, 0.02, 1e-3});
   for (Case& c : cases) {
-    INFO(c.model.name << (c.integrator == IntegratorKind::Ida ? " under ida" : " under euler"));
-    c.model.run_spec.simulation.integrator = c.integrator;
-    DaeSystem system(c.model);
-    auto run = make_integrator(system, c.model.run_spec.simulation);
-    SampleForcesCheck observer(system);
+    INFO(c.loaded.model.name << (c.integrator == IntegratorKind::Ida ? " under ida" : " under euler"));
+    c.loaded.run_spec.simulation.integrator = c.integrator;
+    DaeSystem system(c.loaded.model);
+    auto run = make_integrator(system, c.loaded.run_spec.simulation);
+    SampleForcesCheck observer(system, c.loaded.run_spec);
     REQUIRE(run->run(c.t_end, c.interval, observer).ok);
     CHECK(observer.samples == 0);  // every sample came with the forces
     CHECK(observer.samples_with_forces == static_cast<int>(std::lround(c.t_end / c.interval)) + 1);
@@ -480,11 +509,12 @@ struct ReadsEveryColumn : RunObserver {
 
 TEST_CASE("per step euler evaluates only the outputs an observer reads: an untracked element's at the output rows alone, the tracked peak still caught between rows",
           "[integrators][euler][output]") {
-  Model model = testing::model_from_text(two_spring_oscillator("t_end: 0.3, integrator: euler, dt: 1.0e-4"));
+  LoadedModel loaded = testing::loaded_from_text(two_spring_oscillator("t_end: 0.3, integrator: euler, dt: 1.0e-4"));
+  Model& model = loaded.model;
   DaeSystem system(model);
   REQUIRE(system.output_names() ==
           std::vector<std::string>{"tracked.force", "tracked.deformation", "witness.force", "witness.deformation"});
-  auto run = make_integrator(system, model.run_spec.simulation);
+  auto run = make_integrator(system, loaded.run_spec.simulation);
   TrackedForcePeak observer;
   const RunOutcome outcome = run->run(0.3, 0.1, observer);  // rows at 0, 0.1, 0.2, 0.3 s; the peak at 0.157 s
   REQUIRE(outcome.ok);
@@ -514,14 +544,15 @@ TEST_CASE("the responses from a run that evaluates only their outputs per step e
       "points: [{body: ground, at: [0, -1]}, {body: car, at: [0, 0]}]}\n";
   text.insert(text.find("responses:"), spring);
   const auto responses_json = [&](bool every_column) {
-    Model model = testing::model_from_text(text);
-    SimulationSettings settings = model.run_spec.simulation;
+    LoadedModel loaded = testing::loaded_from_text(text);
+    Model& model = loaded.model;
+    SimulationSettings settings = loaded.run_spec.simulation;
     settings.integrator = IntegratorKind::Euler;
     settings.dt = 1e-5;
     DaeSystem system(model);
     REQUIRE(model.elements().size() == 2);
     auto run = make_integrator(system, settings);
-    ResponseTracker responses(system, model.run_spec.responses);
+    ResponseTracker responses(system, loaded.run_spec.responses);
     ReadsEveryColumn every;
     FanOut observers;
     observers.next = {&responses};
@@ -571,9 +602,10 @@ TEST_CASE("an SI two-car crash under euler gives the same responses without a re
       "     face_height: 0.3, length: 0.2}\n"
       "responses: {crush: anticlimber, reference_crush: 0.01, anticlimber: anticlimber, reference_velocity: 8.0}\n"
       "simulation: {t_end: 0.05, integrator: euler, dt: 2.0e-6, output_interval: 0.005}\n";
-  const Model model = testing::model_from_text(text);
-  const RunReport alone = run_model(model, "", nullptr);  // the responses alone (sensitivity's runs)
-  const RunReport with_writer = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);  // every column (the API's)
+  const LoadedModel loaded = testing::loaded_from_text(text);
+  const Model& model = loaded.model;
+  const RunReport alone = run_model(model, loaded.run_spec, "", nullptr);  // the responses alone (sensitivity's runs)
+  const RunReport with_writer = run_model(model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);  // every column (the API's)
   REQUIRE(alone.outcome.ok);
   REQUIRE(with_writer.outcome.ok);
   REQUIRE(alone.has_responses);

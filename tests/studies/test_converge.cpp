@@ -60,12 +60,13 @@ class TraceObserver : public RunObserver {
 };
 
 Trace run_by_hand(const std::string& path, const std::string& column, const std::vector<std::string>& settings) {
-  const Model model = load_model(path, settings);
+  const LoadedModel loaded = load_model(path, settings);
+  const Model& model = loaded.model;
   DaeSystem system(model);
   Trace trace;
   TraceObserver observer(system, column, trace);
   const RunOutcome outcome =
-      make_integrator(system, model.run_spec.simulation)->run(model.run_spec.simulation.t_end, output_interval_of(model.run_spec.simulation), observer);
+      make_integrator(system, loaded.run_spec.simulation)->run(loaded.run_spec.simulation.t_end, output_interval_of(loaded.run_spec.simulation), observer);
   REQUIRE(outcome.ok);
   return trace;
 }
@@ -317,7 +318,8 @@ TEST_CASE("convergence study: max_crush and the peak forces take the same column
     const std::string path = std::string(RAILCRASH_SOURCE_DIR) + file;
     INFO(path);
     const ConvergePlan plan = plan_convergence(path, options);
-    const Model model = load_model(path);
+    const LoadedModel loaded = load_model(path);
+    const Model& model = loaded.model;
     DaeSystem system(model);
     const auto by_type = [&](const std::vector<std::pair<std::string, std::string>>& type_outputs) {
       std::set<int> columns;
@@ -329,7 +331,7 @@ TEST_CASE("convergence study: max_crush and the peak forces take the same column
       return columns;
     };
     const auto columns = [&](std::size_t q) { return std::set<int>(plan.quantities[q].columns.begin(), plan.quantities[q].columns.end()); };
-    const bool from_responses = model.run_spec.responses.crush_from_anticlimber || !model.run_spec.responses.crush_gauges.empty();
+    const bool from_responses = loaded.run_spec.responses.crush_from_anticlimber || !loaded.run_spec.responses.crush_gauges.empty();
     CHECK(plan.quantities[0].from_responses == from_responses);
     CHECK(columns(0) == (from_responses ? std::set<int>{}
                                         : by_type({{"crush_spring", "crush"}, {"anticlimber", "horizontal_deformation"}})));

@@ -140,8 +140,8 @@ TEST_CASE("central differences and a subset of parameters", "[sensitivity]") {
 
 TEST_CASE("scaling overrides multiply a model number", "[sensitivity]") {
   Files files;
-  const Model model = load_model(files.model, {"elements.ac.horizontal_yield_deflection*=1.5", "simulation.t_end*=2"});
-  CHECK(model.run_spec.simulation.t_end == Approx(0.3));
+  const LoadedModel loaded = load_model(files.model, {"elements.ac.horizontal_yield_deflection*=1.5", "simulation.t_end*=2"});
+  CHECK(loaded.run_spec.simulation.t_end == Approx(0.3));
   CHECK_THROWS_WITH(load_model(files.model, {"elements.ac.face_height*=x"}), Catch::Contains("KEY*=FACTOR"));
   CHECK_THROWS_AS(load_model(files.model, {"elements.ac.horizontal_yield_deflection=0", "elements.ac.horizontal_yield_deflection*=1.2"}),
                   ZeroScaledError);

@@ -530,7 +530,8 @@ TEST_CASE("sweep: runs.csv says which method each run used, and an older runs.cs
   const SweepResult result = run_sweep(ball, plan, files.dir + "/methods", options);
   REQUIRE(result.done() == 4);
   // The hand-over time from the same run made outside the sweep (summary.json's integrator_used).
-  const RunReport auto_run = run_model(load_model(ball, {"simulation.integrator=auto"}), "");
+  const LoadedModel auto_ball = load_model(ball, {"simulation.integrator=auto"});
+  const RunReport auto_run = run_model(auto_ball.model, auto_ball.run_spec, "");
   REQUIRE(auto_run.outcome.stats.handed_over_at > 0.0);
   const auto rows = csv_rows(files.dir + "/methods/runs.csv");
   REQUIRE(rows.size() == 4);

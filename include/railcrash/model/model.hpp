@@ -1,5 +1,5 @@
-// The model: bodies, elements and loads (the physical model), and the run's settings in a
-// RunSpec beside them (run_spec.hpp).
+// The model: bodies, elements and loads (the physical model). The run's settings are not part
+// of it: they are a RunSpec beside it (run_spec.hpp; the loader returns both, model_io.hpp).
 //
 // Build, then finalize: a Model is edited (add_body / add_element / add_load) until
 // finalize(); then topology and the layout of the unknowns are frozen. Unknowns are
@@ -18,7 +18,6 @@
 
 #include "railcrash/core/error.hpp"
 #include "railcrash/model/element.hpp"
-#include "railcrash/model/run_spec.hpp"
 
 namespace railcrash {
 
@@ -75,7 +74,6 @@ class Model {
   UnitSystem units = UnitSystem::SI;  // of the numbers held here
   std::string file_units;             // the model file's `units` ("mm-t-s-N" is converted to SI when read)
   double gravity_x = 0.0, gravity_y = -9.80665;  // [length/time^2]
-  RunSpec run_spec;  // the run's settings (simulation, responses, outputs, scenario): run_spec.hpp
 
   int add_body(Body body);
   Element& add_element(std::unique_ptr<Element> element);

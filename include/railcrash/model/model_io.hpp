@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "railcrash/model/model.hpp"
+#include "railcrash/model/run_spec.hpp"
 #include "railcrash/model/train_expansion.hpp"
 #include "railcrash/model/yaml_file.hpp"
 
@@ -38,17 +39,23 @@ using ScenarioSectionReader = std::shared_ptr<const ScenarioCriteria> (*)(const 
 /// names read_scenario_section itself (tests/fuzz/fuzz_model.cpp).
 bool set_scenario_section_reader(ScenarioSectionReader reader);
 
+/// What a model file describes: the physical model and, beside it, the run's settings.
+struct LoadedModel {
+  Model model;       // the physical model (bodies, elements, loads), finalized
+  RunSpec run_spec;  // the run's settings (simulation, responses, outputs, scenario)
+};
+
 /// Reads and checks a model file; the model comes back finalized.
-Model load_model(const std::string& path);
+LoadedModel load_model(const std::string& path);
 /// Same, from text (path is only used in messages). `overrides` are KEY=VALUE settings
 /// applied before finalize (e.g. "simulation.t_end=0.5", "bodies.bob.mass=2").
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
-Model load_model(const std::string& path, const std::vector<std::string>& overrides);
+LoadedModel load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
+LoadedModel load_model(const std::string& path, const std::vector<std::string>& overrides);
 /// A model file's text, its YAML structure checked (InputError "path:line: ..." as load_model
 /// gives for the same text); the runs of a sweep then load it without walking it again.
 CheckedYamlText check_model_text(std::string text, const std::string& path);
 /// load_model_text of a checked text.
-Model load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides);
+LoadedModel load_model_text(const CheckedYamlText& text, const std::string& path, const std::vector<std::string>& overrides);
 
 /// The texts of the files a model reads, in order: `text` itself (the model file at `path`) and,
 /// for a variant (README "Model variants"), its base model's. A sweep's run hash covers them all.
@@ -61,10 +68,10 @@ struct OptionSetting {
   std::string option;
 };
 /// load_model with the --set settings first, then the command-line options' settings.
-Model load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options);
+LoadedModel load_model(const std::string& path, const std::vector<std::string>& overrides, const std::vector<OptionSetting>& options);
 /// load_model_text with the settings first, then the options' settings (the library's run).
-Model load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
-                      const std::vector<OptionSetting>& options);
+LoadedModel load_model_text(const std::string& text, const std::string& path, const std::vector<std::string>& overrides,
+                            const std::vector<OptionSetting>& options);
 
 /// The model file's length unit in the model's: 1e-3 (m) for an mm-t-s-N file, whose lengths are
 /// converted to SI when read; 1 otherwise. A setting's length (simulation.atol, --atol) is in it.

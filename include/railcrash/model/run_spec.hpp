@@ -1,7 +1,8 @@
 // A run's settings, apart from the physical model (model.hpp): how long and with which
 // integrator (simulation), what the responses R1-R3 are measured on, which body points are
 // written, and the scenario's criteria. The model file's `simulation:`, `responses:`,
-// `outputs:` and `scenario:` sections; a Model carries one as `run_spec`.
+// `outputs:` and `scenario:` sections; the loader returns one beside the Model (model_io.hpp:
+// LoadedModel), and the run-level functions take the two side by side.
 #pragma once
 
 #include <memory>

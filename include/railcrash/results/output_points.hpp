@@ -1,4 +1,4 @@
-// The model's output points (`outputs:`, model.hpp) in timeseries.csv: the position, velocity
+// The run's output points (`outputs:`, model/run_spec.hpp) in timeseries.csv: the position, velocity
 // and acceleration of a point fixed on a body, from the body's state and its accelerations
 // (results.hpp: v' from the equations of motion with IDA's multipliers, or with the penalty
 // forces of the step Euler just took):
@@ -10,15 +10,16 @@
 #include <string>
 #include <vector>
 
-#include "railcrash/model/model.hpp"
+#include "railcrash/model/run_spec.hpp"
 
 namespace railcrash {
 
-/// Column names of the output points, in model order: <name>.x,<name>.y, .vx,.vy, .ax,.ay as asked.
-std::vector<std::string> output_point_columns(const Model& model);
+/// Column names of the output points, in their order: <name>.x,<name>.y, .vx,.vy, .ax,.ay as asked.
+std::vector<std::string> output_point_columns(const std::vector<OutputPoint>& output_points);
 
 /// Their values at a state: q and v (3 per body: x, y, theta and their rates), acceleration
 /// (3 per body). `out` is resized to the number of columns.
-void output_point_values(const Model& model, const double* q, const double* v, const double* acceleration, std::vector<double>& out);
+void output_point_values(const std::vector<OutputPoint>& output_points, const double* q, const double* v, const double* acceleration,
+                         std::vector<double>& out);
 
 }  // namespace railcrash

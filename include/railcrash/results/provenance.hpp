@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "railcrash/model/model.hpp"
+#include "railcrash/model/run_spec.hpp"
 
 namespace railcrash {
 
@@ -41,8 +42,8 @@ void set_command_line(int argc, const char* const* argv);
 /// The arguments kept, each quoted for a POSIX shell where it needs to be ("" when never set).
 const std::string& command_line();
 
-/// The provenance of a run of `model` with the id `run_id`.
-Provenance run_provenance(const Model& model, const std::string& run_id);
+/// The provenance of a run of `model` with the run's simulation settings and the id `run_id`.
+Provenance run_provenance(const Model& model, const SimulationSettings& simulation, const std::string& run_id);
 
 /// The record as one line of JSON: {"run_id": ..., "version": ..., "commit": ..., "command_line": ...,
 /// "model_files": [{"path": ..., "sha256": ...}], "settings": [...], "simulation": {...}}.

@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/model/run_spec.hpp"
 #include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {

@@ -1,7 +1,7 @@
 // Run results, written to disk as the run goes, kept in memory, or both:
 //   DIR/timeseries.csv  t, then <body>.x,<body>.y,<body>.theta,<body>.vx,<body>.vy,<body>.omega for
 //                       every body in file order, then <element>.<quantity> columns, then the
-//                       output points' columns (results/output_points.hpp), if the model asks
+//                       output points' columns (results/output_points.hpp), if the run asks
 //   DIR/events.csv      t,element,event,value
 //   DIR/summary.json    status, message, t_reached, integrator, units, stats, energy, peaks,
 //                       peak_accelerations, car_crush (and responses, when the model has them)
@@ -195,8 +195,9 @@ struct RoleColumn {
 /// Every output playing `role`, in element order.
 std::vector<RoleColumn> columns_with_role(const DaeSystem& system, OutputRole role);
 
-/// Column names of timeseries.csv: t, the six body columns per body, the element outputs.
-std::vector<std::string> timeseries_columns(const DaeSystem& system);
+/// Column names of timeseries.csv: t, the six body columns per body, the element outputs, the
+/// output points' columns (the run's RunSpec::output_points).
+std::vector<std::string> timeseries_columns(const DaeSystem& system, const std::vector<OutputPoint>& output_points);
 class EnergyWriter;
 class BufferedFile;
 
@@ -234,8 +235,9 @@ class ResultWriter : public RunObserver {
   /// and begins the sink of the output format named (results/output_sink.hpp: "csv", each CSV
   /// file with its provenance line (results/provenance.hpp) and its header; "hdf5":
   /// timeseries.h5) (DIR empty: no files). With keep_in_memory, every sample is also kept as
-  /// one value per timeseries column (the sink "memory").
-  ResultWriter(const std::string& directory, const DaeSystem& system, bool keep_in_memory = false,
+  /// one value per timeseries column (the sink "memory"). run_spec: the run's settings (its
+  /// simulation settings go into the provenance, its output points into the timeseries).
+  ResultWriter(const std::string& directory, const DaeSystem& system, const RunSpec& run_spec, bool keep_in_memory = false,
                const std::string& format = "csv");
   ~ResultWriter() override;
   ResultWriter(const ResultWriter&) = delete;
@@ -291,6 +293,7 @@ class ResultWriter : public RunObserver {
   void record_sample(double t, const double* y, const double* lambda, const double* quadratures, const double* outputs);
 
   const DaeSystem& system_;
+  std::vector<OutputPoint> output_points_;  // the run's (RunSpec::output_points)
   std::string directory_;
   Provenance provenance_;
   std::unique_ptr<FolderLock> folder_lock_;  // the folder is this run's alone while it writes (null without a folder)

@@ -40,7 +40,7 @@ enum class OverrideSource {
 /// own simulation.atol.
 std::vector<OptionSetting> option_settings(const RunOverrides& overrides, OverrideSource source = OverrideSource::CommandLine);
 
-/// The integrator the model's settings ask for.
+/// The integrator the run's simulation settings ask for.
 std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationSettings& settings);
 
 /// Output interval actually used (the setting, or t_end / 500). (Inline: the loader's
@@ -70,13 +70,13 @@ struct RunReport {
 /// velocities and accelerations for the CFC filter and the collision pulses, results.hpp) and
 /// 16 B of times, and with keep_in_memory 8 B per timeseries column; rows = t_end /
 /// output_interval + 2. A vector that grows may briefly need half as much again.
-double output_memory_estimate(const DaeSystem& system, bool keep_in_memory);
+double output_memory_estimate(const DaeSystem& system, const RunSpec& run_spec, bool keep_in_memory);
 /// The limit run_model holds output_memory_estimate to [bytes] (default 4 GiB; 0: no limit).
 /// `railcrash run --max-output-memory GB` sets it for the process.
 void set_output_memory_limit(double bytes);
 double output_memory_limit();
 
-/// Runs the model and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files;
+/// Runs the model with the run's settings (run_spec) and writes DIR/timeseries.csv, events.csv, summary.json (DIR empty: no files;
 /// format: a registered output format that writes files, results/output_sink.hpp: "hdf5" writes
 /// timeseries.h5 in place of the per-row CSV files);
 /// with keep_in_memory the same results also come back in the report.
@@ -85,7 +85,7 @@ double output_memory_limit();
 /// with ok = false, and so does running out of memory (std::bad_alloc: summary.json "failed").
 /// time_phases: the run's wall time split by phase (RunStatistics::phase_seconds; summary.json's
 /// stats.seconds; `railcrash run --timings`).
-RunReport run_model(const Model& model, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
+RunReport run_model(const Model& model, const RunSpec& run_spec, const std::string& out_dir, const std::atomic<bool>* stop = nullptr,
                     bool show_progress = false, bool keep_in_memory = false, const std::string& format = "csv",
                     bool time_phases = false);
 

@@ -260,14 +260,15 @@ class DaeSystem {
   };
   ElementLoad element_load(int e, double t, const double* y) const;
   /// At a (re)start at (t, y, y'): the roots that sit on their mode's boundary and are about to
-  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y' (roots
-  /// that fire within h are taken as simultaneous with the restart), and roots already
+  /// leave it, judged by a second-order look-ahead of h = 1e-6 min(1, t_end) along y' (t_end:
+  /// the run's end in its settings [time]; roots that fire within h are taken as simultaneous
+  /// with the restart), and roots already
   /// negative (the state is outside its mode, e.g. after the initial assembly moved it):
   /// direction[k] = -1 for each (root_count() entries), else 0; true when any. Elements switch
   /// a small band past their boundaries (1e-14 to 1e-12 of their size), so a state exactly on a
   /// boundary has a small positive root that the look-ahead sees cross; IDA itself would leave
   /// a root that is exactly zero inactive. ModeTracker::commit_boundary commits them.
-  bool boundary_roots_leaving(double t, const double* y, const double* yp, std::vector<int>& direction) const;
+  bool boundary_roots_leaving(double t, const double* y, const double* yp, double t_end, std::vector<int>& direction) const;
   /// Puts every element back in its starting mode.
   void reset_modes();
   /// The run's element modes and histories: evaluations read them, only the mode tracker's

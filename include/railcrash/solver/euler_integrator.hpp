@@ -17,6 +17,7 @@
 // above by Gershgorin's theorem (a safe, possibly pessimistic limit).
 #pragma once
 
+#include "railcrash/model/run_spec.hpp"  // the integrators' names (IntegratorKind)
 #include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {
@@ -25,7 +26,8 @@ struct EulerSettings {
   double dt = 0.0;          // [time]; 0 = half the stability limit
   bool force_dt = false;    // run even when dt exceeds the stability limit
   Element::PenaltyOverrides penalty;  // model-wide defaults (a joint's own keys win)
-  long max_steps = 10000000;          // [steps]; a t_end that needs more is refused
+  long max_steps = 10000000;          // [steps]; a t_end (run.t_end) that needs more is refused
+  CommonRunSettings run;              // t_end, static_equilibrium
 };
 
 class EulerIntegrator : public Integrator {

@@ -113,6 +113,9 @@ class ModeTracker {
   /// (repeated passes at one restart).
   bool commit_boundary(double t, const double* y, const double* yp, std::vector<EventRecord>& events,
                        std::vector<char>* changed_elements = nullptr);
+  /// The run's t_end in its settings [time] (default 1): commit_boundary's look-ahead is
+  /// 1e-6 min(1, t_end) (DaeSystem::boundary_roots_leaving). Each integrator sets it from its settings.
+  void set_run_end(double t_end) { run_end_ = t_end; }
   /// How often element e changed mode in this step.
   int changes_of(int e) const;
   /// One flag per element: 1 for the elements whose last change in this step was at t.
@@ -132,6 +135,7 @@ class ModeTracker {
   bool commit_element(int e, int local, int direction, double t, const double* y, std::vector<EventRecord>& events);
 
   DaeSystem& system_;
+  double run_end_ = 1.0;  // [time] set_run_end
   std::vector<double> unknown_floor_;
   std::vector<double> previous_, now_;
   std::vector<char> on_boundary_;

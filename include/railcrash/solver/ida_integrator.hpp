@@ -28,6 +28,7 @@
 
 #include <memory>
 
+#include "railcrash/model/run_spec.hpp"  // the integrators' names (IntegratorKind), rtol_problem
 #include "railcrash/solver/integrator.hpp"
 
 namespace railcrash {
@@ -37,6 +38,7 @@ struct IdaSettings {
   std::optional<double> atol;  // [length]
   long max_steps_per_output = 500000;
   long max_steps = 10000000;  // [steps] in the whole run; the run fails (not ok) beyond
+  CommonRunSettings run;      // t_end, static_equilibrium
 };
 
 class IdaIntegrator : public Integrator {

@@ -103,9 +103,9 @@ struct StartReport {
 };
 
 /// The state a run starts from: every element in its starting mode, the model's coordinates
-/// with the joints assembled, then (simulation.static_equilibrium) settled under gravity
-/// with the model's velocities projected onto the joints.
-StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events);
+/// with the joints assembled, then (static_equilibrium: the run's simulation.static_equilibrium)
+/// settled under gravity with the model's velocities projected onto the joints.
+StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events, bool static_equilibrium);
 
 /// Throws InputError when the constraint rows are linearly dependent at q, naming them.
 void check_constraint_rank(const DaeSystem& system, const double* q);

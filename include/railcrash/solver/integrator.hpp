@@ -186,6 +186,14 @@ struct RunOutcome {
   std::vector<EventRecord> events;       // every committed mode change, in order
 };
 
+/// What every integrator takes from the run's simulation settings (SimulationSettings,
+/// model/run_spec.hpp) beside its own: given to it explicitly, never read through the model.
+struct CommonRunSettings {
+  double t_end = 1.0;               // [time] the run's end in its settings: the time scale of the look-ahead off a
+                                    // mode boundary (ModeTracker::set_run_end), Euler's step count check and fallback step
+  bool static_equilibrium = false;  // settle the bodies under gravity and loads at t = 0 first (prepare_start)
+};
+
 /// The run loop both integrators share (Drake's IntegrateTo over DoStep): run() starts the
 /// integrator, forwards its mode changes to the observer, samples the state at the output
 /// times, checks after every accepted step that the state is finite, obeys the stop flag and
