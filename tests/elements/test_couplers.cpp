@@ -699,8 +699,8 @@ TEST_CASE("draft_gear: a 3-car unit's gears at rtol 1e-3 do not chatter on their
   // Before the rate condition on the transition line's exits: 1,153,628 events and 30 s of
   // wall time here (IDA restarted at each), against 301 events and 709 steps now.
   const std::string path = std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/emu3_unit_collision.yaml";
-  const Model model = load_model(path, {"simulation.integrator=ida", "simulation.rtol=1e-3"});
-  const RunReport report = run_model(model, "", nullptr, false, /*keep_in_memory=*/true);
+  const LoadedModel loaded = load_model(path, {"simulation.integrator=ida", "simulation.rtol=1e-3"});
+  const RunReport report = run_model(loaded.model, loaded.run_spec, "", nullptr, false, /*keep_in_memory=*/true);
   REQUIRE(report.outcome.ok);
   const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
   CHECK(summary["stats"]["events"].get<int>() < 1000);
