@@ -9,6 +9,8 @@
 #include <random>
 #include <regex>
 #include <sstream>
+#include <system_error>
+#include <vector>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -34,10 +36,22 @@ std::string slurp(const fs::path& path) {
   return text.str();
 }
 
+/// The run folders small_run made, removed when the test program ends (the tests read them
+/// after small_run returns; each name holds the process id, so they would pile up in /tmp).
+struct RunFolders {
+  std::vector<fs::path> made;
+  ~RunFolders() {
+    std::error_code ignored;
+    for (const fs::path& dir : made) fs::remove_all(dir, ignored);
+  }
+};
+RunFolders run_folders;
+
 /// A fresh run folder of the small two-car crash (tests/report/two_car.yaml), CSV files or timeseries.h5.
 fs::path small_run(const std::string& name, const std::string& format = "csv") {
   const fs::path dir = fs::temp_directory_path() / ("railcrash_report_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
+  run_folders.made.push_back(dir);
   const railcrash::LoadedModel loaded = railcrash::load_model(std::string(RAILCRASH_SOURCE_DIR) + "/tests/report/two_car.yaml");
   const railcrash::Model& model = loaded.model;
   const railcrash::RunReport run = railcrash::run_model(model, loaded.run_spec, dir.string(), nullptr, false, false, format);
