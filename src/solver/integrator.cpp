@@ -30,10 +30,26 @@ const std::array<double, kPhaseCount>& PhaseClock::stop() {
 }
 
 void Integrator::report_events(const std::vector<EventRecord>& events, const double* y, int element) {
-  for (const EventRecord& record : events) observer_->event(record, y);
+  for (const EventRecord& record : events) {
+    observer_->event(record, y);
+    if (chatter_.record(record)) throw SolverError(chatter_message(record));
+  }
   if (!events.empty()) deliver_step(events.front().t, y, element);
   outcome_.events.insert(outcome_.events.end(), events.begin(), events.end());
   outcome_.stats.events += static_cast<long>(events.size());
+}
+
+std::string Integrator::chatter_message(const EventRecord& last) const {
+  std::string where, type;
+  for (const auto& e : system_.model().elements())
+    if (e->name() == last.element) where = e->where().prefix(), type = " (" + e->type() + ")";
+  std::ostringstream text;
+  text << where << "element '" << last.element << "'" << type << " changed mode " << chatter_.count()
+       << " times in a row at one instant (t = " << chatter_.first_time() << " s, all within "
+       << last.t - chatter_.first_time() << " s; the last: \"" << last.what << "\"): it chatters on the boundary between two of its modes and the run would not end. The results "
+       << "up to here are kept. Another --rtol or --integrator euler may pass it; please report the model: a law that "
+       << "chatters is railcrash's defect, not the model's";
+  return text.str();
 }
 
 void Integrator::observe_before_event(double t, const double* y, int element) {
@@ -187,6 +203,7 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
   observe_sample_forces_ = observer.wants_sample_forces();
   sample_forces_.assign(observe_sample_forces_ ? static_cast<std::size_t>(system_.body_unknowns()) : 0, 0.0);
   t_end_ = t_end;
+  chatter_ = ChatterGuard(t_end, chatter_limit_);
   output_interval_ = output_interval;
   output_index_ = 1;
   t_sampled_ = 0.0;

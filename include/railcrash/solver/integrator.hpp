@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/solver/chatter_guard.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/events.hpp"
 
@@ -214,6 +215,9 @@ class Integrator {
   /// Integrates from 0 to t_end, sampling every output_interval; stops early (ok = false,
   /// message says why) on failure or when *stop becomes true. Input errors throw InputError.
   RunOutcome run(double t_end, double output_interval, RunObserver& observer, const std::atomic<bool>* stop = nullptr);
+  /// How many changes of one element in a row at one instant stop a run (chatter_guard.hpp;
+  /// default ChatterGuard::kLimit). Tests set a smaller one.
+  void set_chatter_limit(long changes) { chatter_limit_ = changes; }
   /// Whether run() splits its wall time by Phase (RunStatistics::phase_seconds). Off by
   /// default: two clock readings per phase entered cost 0-2 % of a run (bench/timings_overhead.py).
   void time_phases(bool on) { time_phases_ = on; }
@@ -279,6 +283,8 @@ class Integrator {
   /// element: the one element that changed (its outputs are evaluated afresh for step(); the
   /// others keep their values of the last step: they did not change mode), -1: any number.
   void report_events(const std::vector<EventRecord>& events, const double* y, int element = -1);
+  /// Why the run stopped when the chatter guard tripped on `last` (names the element and its line).
+  std::string chatter_message(const EventRecord& last) const;
   /// The state at t (y: q, v, multipliers) in the modes before a mode change about to be
   /// committed there, for the observer's step() (a rupture's last force, say).
   void observe_before_event(double t, const double* y, int element = -1);
@@ -322,6 +328,8 @@ class Integrator {
   RunOutcome outcome_;
   RunObserver* observer_ = nullptr;
   double t_end_ = 0.0;
+  ChatterGuard chatter_{1.0};  // the run's events, against an element chattering at one instant (reset by run)
+  long chatter_limit_ = ChatterGuard::kLimit;
   double output_interval_ = 0.0;
   long output_index_ = 1;       // next output time: output_index_ * output_interval_
   double t_sampled_ = 0.0;      // last sample
