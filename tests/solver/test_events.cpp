@@ -175,7 +175,7 @@ TEST_CASE("the mode tracker carries a root at zero as on its boundary, commits a
   // A new step forgets the changes; the system's modes go back with a snapshot.
   modes.begin_step();
   CHECK(modes.changes_of(0) == 0);
-  system.modes().restore(before);
+  modes.restore(before);
   system.roots(0.1, y.data(), g.data());
   CHECK(g[0] == Approx(-0.01));  // open again: the distance from the circle
 }
