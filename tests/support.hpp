@@ -8,6 +8,7 @@
 #include "railcrash/model/model.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/solver/dae_system.hpp"
+#include "railcrash/solver/events.hpp"
 #include "railcrash/solver/integrator.hpp"
 
 namespace railcrash::testing {
@@ -32,39 +33,45 @@ RunOutcome simulate(const LoadedModel& loaded, double output_interval = 0.01);
 /// hold the run's final ones.
 RunOutcome simulate(DaeSystem& system, const SimulationSettings& simulation, double output_interval = 0.01);
 
-/// Puts element e of the system in mode st (State: the element's declared slot type).
+/// The system's element modes to write by hand (an element test commits an element directly or
+/// sets its mode), through a ModeTracker of the system: their one writer. The reference is the
+/// system's (it outlives the tracker).
+inline ElementStates& modes_to_write(DaeSystem& system) { return ModeTracker(system).modes(); }
+
+/// Puts element e of the system in mode st (State: the element's declared slot type), through
+/// a ModeTracker (the one writer of a system's modes).
 template <class State>
 void set_mode(DaeSystem& system, const State& st, std::size_t e = 0) {
-  system.modes().as<State>(e) = st;
+  modes_to_write(system).as<State>(e) = st;
 }
 
 /// Element `index` of a system's model driven by hand (element tests): reads and writes its
-/// slot in the system's ElementStates.
+/// slot in the system's ElementStates (through a ModeTracker of the system, their one writer).
 template <class E>
 class DrivenElement {
  public:
   using State = typename E::State;
   DrivenElement(DaeSystem& system, std::size_t index)
-      : system_(&system), index_(index), element_(dynamic_cast<const E&>(*system.model().elements()[index])) {}
+      : modes_(system), index_(index), element_(dynamic_cast<const E&>(*system.model().elements()[index])) {}
 
   const E& element() const { return element_; }
   const E* operator->() const { return &element_; }
-  State& state() const { return system_->modes().template as<State>(index_); }
+  State& state() const { return modes_.modes().template as<State>(index_); }
   void set_state(const State& st) const { state() = st; }
   /// Back to the mode the element starts a run in.
-  void reset_modes() const { element_.write_start_mode(system_->modes().of(index_)); }
+  void reset_modes() const { element_.write_start_mode(modes_.modes().of(index_)); }
   /// The element's local state at (q, v) with its mode.
   ElementState<double> at(const double* q, const double* v) const {
-    return gather_state(element_, q, v, system_->modes().of(index_));
+    return gather_state(element_, q, v, modes_.modes().of(index_));
   }
   bool commit(int root, int direction, double t, ElementState<double> s, const double* lambda,
               Element::Event& event) const {
-    s.mode = system_->modes().of(index_);
-    return element_.commit(root, direction, t, s, lambda, system_->modes().of(index_), event);
+    s.mode = modes_.modes().of(index_);
+    return element_.commit(root, direction, t, s, lambda, modes_.modes().of(index_), event);
   }
 
  private:
-  DaeSystem* system_;
+  mutable ModeTracker modes_;  // the writer of the system's modes
   std::size_t index_;
   const E& element_;
 };

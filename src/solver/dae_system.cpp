@@ -948,8 +948,6 @@ bool DaeSystem::boundary_roots_leaving(double t, const double* y, const double* 
   return any;
 }
 
-void DaeSystem::reset_modes() { modes_.reset(); }
-
 ElementState<double> DaeSystem::local_state(std::size_t e, const double* q, const double* v) const {
   return gather_state(*model_.elements()[e], q, v, modes_.of(e),
                       [this](int b, double theta) -> const Rotation<double>& { return body_rotation(b, theta); });

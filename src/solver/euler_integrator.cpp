@@ -161,7 +161,7 @@ EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings)
   throw_if(inertia_problem(system.model()));
   mode_tracker().set_run_end(settings_.run.t_end);
   const StartReport start = prepare_start(system, y0_, start_events_, settings_.run.static_equilibrium);
-  start_modes_ = system.modes().snapshot();
+  start_modes_ = mode_tracker().snapshot();
   assembly_correction_ = start.assembly.largest_position_change;
   settling_steps_ = start.equilibrium.steps;
   settling_displacement_ = start.equilibrium.largest_position_change;
@@ -197,7 +197,7 @@ void EulerIntegrator::start(double /*t_end*/) {
   y_ = y0_;
   quadratures_.assign(static_cast<std::size_t>(system_.quadrature_count()), 0.0);
   // Modes as prepared (and settled) in the constructor; a second run starts from them too.
-  system_.modes().restore(start_modes_);
+  mode_tracker().restore(start_modes_);
   begin(0.0, true);
 }
 

@@ -87,7 +87,7 @@ bool ModeTracker::commit_element(int e, int local, int direction, double t, cons
   const Element& el = *system_.model().elements()[static_cast<std::size_t>(e)];
   Element::Event event;
   if (!el.commit(local, direction, t, system_.element_state(e, y), system_.element_multipliers(e, y),
-                 system_.modes().of(static_cast<std::size_t>(e)), event))
+                 system_.modes_.of(static_cast<std::size_t>(e)), event))
     return false;
   events.push_back({t, el.name(), event.what, event.value, event.kind == Element::EventKind::Kink});
   return true;

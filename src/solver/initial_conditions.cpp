@@ -302,12 +302,12 @@ namespace {
 /// Puts every element in the mode its state y belongs to: commits the roots that are
 /// negative (outside their mode), repeatedly, since one commit moves a piecewise law by one
 /// segment. Returns true when a mode changed.
-bool follow_modes(DaeSystem& system, const std::vector<double>& y, std::vector<EventRecord>& events) {
+bool follow_modes(ModeTracker& modes, const std::vector<double>& y, std::vector<EventRecord>& events) {
+  const DaeSystem& system = modes.system();
   const std::size_t count = static_cast<std::size_t>(system.root_count());
   if (count == 0) return false;
   std::vector<double> g(count);
   std::vector<int> direction(count);
-  ModeTracker modes(system);
   bool changed = false;
   for (int pass = 0; pass < 50; ++pass) {
     system.roots(0.0, y.data(), g.data());
@@ -499,8 +499,9 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
   std::vector<double> r(static_cast<std::size_t>(n));
 
   // Every element in the mode of the starting state (a spring assembled past a breakpoint).
+  ModeTracker modes(system);  // the settle's every write of the element modes
   std::vector<EventRecord> changes;
-  follow_modes(system, y, changes);
+  follow_modes(modes, y, changes);
   for (EventRecord& e : changes) e.what = "static equilibrium: " + e.what;
   events.insert(events.end(), changes.begin(), changes.end());
 
@@ -588,10 +589,10 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
     for (int k = 0; k < m; ++k) trial[static_cast<std::size_t>(2 * nq + k)] += delta[nq + k];
     // The trial state on the joints, with every element in the mode the trial state is in
     // (from the modes and histories of y, restored when the step is rejected).
-    const ElementStates::Snapshot modes_at_y = system.modes().snapshot();
+    const ElementStates::Snapshot modes_at_y = modes.snapshot();
     changes.clear();
     const bool on_joints = project_positions(system, trial);
-    if (on_joints) follow_modes(system, trial, changes);
+    if (on_joints) follow_modes(modes, trial, changes);
     double work = 0.0, next = 0.0;
     if (on_joints) {
       const std::vector<double> r_here = r;  // residual at y (from the Newton right-hand side)
@@ -611,7 +612,7 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
     const bool accept = on_joints && std::isfinite(next) &&
                         (work > work_noise || (work >= -work_noise && next <= current));
     if (!accept) {
-      system.modes().restore(modes_at_y);  // back to the modes and histories of y
+      modes.restore(modes_at_y);  // back to the modes and histories of y
       current = unbalance(y, nullptr);
       if ((step *= 0.25) < smallest_step) break;
       continue;
@@ -653,7 +654,7 @@ EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<doubl
 
 StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events, bool static_equilibrium) {
   StartReport report;
-  system.reset_modes();
+  ModeTracker(system).reset_modes();
   y = system.initial_state();
   report.assembly = assemble_initial_state(system, y);
   if (static_equilibrium) {

@@ -948,26 +948,26 @@ TEST_CASE("anticlimber commit engages a fresh interlock after a separation and i
   };
   Element::Event event;
   // Still apart: the contact root is positive, nothing to commit.
-  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.0, state_at(0.01, 0.03, -1.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.0, state_at(0.01, 0.03, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   // A rising crossing never leaves a mode.
-  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, 1, 0.0, state_at(0.0, 0.03, -1.0), nullptr, system.modes().of(0), event));
-  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, 1, 0.0, state_at(0.0, 0.03, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "contact");
   CHECK(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Engaged);
   CHECK(system.modes().as<Anticlimber::State>(0).vertical_reference == Approx(0.04).epsilon(1e-15));  // y + misalignment
   // A root of the open mode is no longer active.
-  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(0.0, 0.03, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   // Faces open again (d_h < 0): separation through the horizontal law's lower bound.
-  REQUIRE(ac.commit(Anticlimber::kHorizontalRoots + 1, -1, 0.2, state_at(0.001, 0.05, 1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(ac.commit(Anticlimber::kHorizontalRoots + 1, -1, 0.2, state_at(0.001, 0.05, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "separation");
   CHECK(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Open);
   // Re-contact higher up: the interlock takes the new offset as its reference.
-  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.3, state_at(0.0, 0.08, -1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.3, state_at(0.0, 0.08, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(system.modes().as<Anticlimber::State>(0).vertical_reference == Approx(0.09).epsilon(1e-15));
   // An Euler step that lands beyond yield in one go: contact and yield in one commit.
-  system.reset_modes();
+  ModeTracker(system).reset_modes();
   REQUIRE(system.modes().as<Anticlimber::State>(0).contact == Anticlimber::Contact::Open);
-  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(-0.02, 0.03, -1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(ac.commit(Anticlimber::kContactRoot, -1, 0.1, state_at(-0.02, 0.03, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "contact, horizontal yield");
   CHECK(event.value == Approx(0.02).epsilon(1e-12));
   CHECK(system.modes().as<Anticlimber::State>(0).horizontal.mode == Mode::PlasticUp);

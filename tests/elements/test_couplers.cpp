@@ -600,44 +600,44 @@ TEST_CASE("draft_gear: reloading, rejoining the loading curve, and crossings com
   REQUIRE(system.modes().as<DraftGear::State>(0).law.mode == M::Neutral);
   Element::Event event;
   const double x1 = g.H / (g.Kt - g.k);
-  CHECK_FALSE(gear.commit(0, -1, 0.0, at(0.5 * x1, 1.0), nullptr, system.modes().of(0), event));  // not crossed: stale
-  CHECK_FALSE(gear.commit(0, 1, 0.0, at(2.0 * x1, 1.0), nullptr, system.modes().of(0), event));   // upward crossings never leave a mode
-  CHECK(gear.commit(0, -1, 0.0, at(x1, 1.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(0.5 * x1, 1.0), nullptr, testing::modes_to_write(system).of(0), event));  // not crossed: stale
+  CHECK_FALSE(gear.commit(0, 1, 0.0, at(2.0 * x1, 1.0), nullptr, testing::modes_to_write(system).of(0), event));   // upward crossings never leave a mode
+  CHECK(gear.commit(0, -1, 0.0, at(x1, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "sliding (buff)");
   // Reversal at 0.03, partial unloading to the lower line, reloading at 0.025.
-  CHECK(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, system.modes().of(0), event));
+  CHECK(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "reversal (buff)");
   CHECK(force(0.0295) == Approx(g.U(0.03) - g.Kt * 0.0005));
   const double meet = 0.03 - 2.0 * g.H / (g.Kt - g.k);
   // (Position roots switch a band of 1e-12 x travel past their boundary: step just past it.)
   const double past = 1e-12;
-  CHECK(gear.commit(1, -1, 0.0, at(meet - past, -1.0), nullptr, system.modes().of(0), event));
+  CHECK(gear.commit(1, -1, 0.0, at(meet - past, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "unloading (buff)");
   CHECK(force(0.026) == Approx(g.Lw(0.026)));
-  CHECK(gear.commit(0, -1, 0.0, at(0.025, 1.0), nullptr, system.modes().of(0), event));
+  CHECK(gear.commit(0, -1, 0.0, at(0.025, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "reloading (buff)");
   CHECK(force(0.026) == Approx(g.Lw(0.025) + g.Kt * 0.001));
   // Elastic back up until the line meets k x + H again, 2 H / (Kt - k) further on.
   const double rejoin = 0.025 + 2.0 * g.H / (g.Kt - g.k);
-  CHECK_FALSE(gear.commit(0, -1, 0.0, at(rejoin - 1e-6, 1.0), nullptr, system.modes().of(0), event));
-  CHECK(gear.commit(0, -1, 0.0, at(rejoin + past, 1.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(rejoin - 1e-6, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
+  CHECK(gear.commit(0, -1, 0.0, at(rejoin + past, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "back on the loading curve (buff)");
   CHECK(force(0.04) == Approx(g.U(0.04)));
   // An Euler step that goes past several boundaries (breakaway, then the reversal): each
   // change is applied in one commit.
-  system.reset_modes();
-  CHECK(gear.commit(0, -1, 0.0, at(0.03, -1.0), nullptr, system.modes().of(0), event));
+  ModeTracker(system).reset_modes();
+  CHECK(gear.commit(0, -1, 0.0, at(0.03, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "sliding (buff), reversal (buff)");
   CHECK(system.modes().as<DraftGear::State>(0).law.mode == M::Transition);
   CHECK(force(0.03) == Approx(g.U(0.03)));
-  system.reset_modes();
-  CHECK(gear.commit(0, -1, 0.0, at(0.06, 1.0), nullptr, system.modes().of(0), event));
+  ModeTracker(system).reset_modes();
+  CHECK(gear.commit(0, -1, 0.0, at(0.06, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "sliding (buff)");
   CHECK(system.modes().as<DraftGear::State>(0).law.segment == 1);  // on the bottomed part
   CHECK(force(0.06) == Approx(g.U(0.06)));
   // Bottomed, the transition stiffness equals K: the gear unloads along its loading line
   // (solid, the friction does not slip) until it is back off the bottom.
-  CHECK(gear.commit(0, -1, 0.0, at(0.06, 0.0), nullptr, system.modes().of(0), event));
+  CHECK(gear.commit(0, -1, 0.0, at(0.06, 0.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(force(0.055) == Approx(g.U(0.055)));
   double g_roots[DraftGear::kRoots];
   gear.roots(0.0, at(0.055, -1.0), nullptr, g_roots);
@@ -659,8 +659,8 @@ TEST_CASE("draft_gear: past a boundary but moving back is no crossing (a gear re
   const Gear& g = kGear;
   Element::Event event;
   // Loaded to 0.03 and reversed there: the transition line starts on the loading curve.
-  REQUIRE(gear.commit(0, -1, 0.0, at(0.03, 1.0), nullptr, system.modes().of(0), event));
-  REQUIRE(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, system.modes().of(0), event));
+  REQUIRE(gear.commit(0, -1, 0.0, at(0.03, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
+  REQUIRE(gear.commit(0, -1, 0.0, at(0.03, 0.0), nullptr, testing::modes_to_write(system).of(0), event));
   REQUIRE(event.what == "reversal (buff)");
   REQUIRE(system.modes().as<DraftGear::State>(0).law.mode == M::Transition);
   // 1e-10 m past the reversal point (10^4 times the roots' band) while unloading at 1 nm/s: the
@@ -670,28 +670,28 @@ TEST_CASE("draft_gear: past a boundary but moving back is no crossing (a gear re
   double roots[DraftGear::kRoots];
   gear.roots(0.0, at(creep, -1e-9), nullptr, roots);
   CHECK(roots[0] > 0.0);
-  CHECK_FALSE(gear.commit(0, -1, 0.0, at(creep, -1e-9), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(gear.commit(0, -1, 0.0, at(creep, -1e-9), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(system.modes().as<DraftGear::State>(0).law.mode == M::Transition);
   // Moving up, or at rest (a static settle: the position alone decides), the same point is
   // back on the loading curve, and the force is U's.
   gear.roots(0.0, at(creep, 0.0), nullptr, roots);
   CHECK(roots[0] < 0.0);
-  CHECK(gear.commit(0, -1, 0.0, at(creep, 1e-3), nullptr, system.modes().of(0), event));
+  CHECK(gear.commit(0, -1, 0.0, at(creep, 1e-3), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "back on the loading curve (buff)");
   CHECK(system.modes().as<DraftGear::State>(0).law.mode == M::Loading);
   // The mirror: reloaded from the lower curve at 0.025, the line meets it again going down
   // only while moving down.
-  REQUIRE(gear.commit(0, -1, 0.0, at(0.04, 0.0), nullptr, system.modes().of(0), event));  // reversal at 0.04
+  REQUIRE(gear.commit(0, -1, 0.0, at(0.04, 0.0), nullptr, testing::modes_to_write(system).of(0), event));  // reversal at 0.04
   const double meet = 0.04 - 2.0 * g.H / (g.Kt - g.k);
-  REQUIRE(gear.commit(1, -1, 0.0, at(meet - 1e-12, -1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(gear.commit(1, -1, 0.0, at(meet - 1e-12, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   REQUIRE(event.what == "unloading (buff)");
-  REQUIRE(gear.commit(0, -1, 0.0, at(0.025, 0.0), nullptr, system.modes().of(0), event));
+  REQUIRE(gear.commit(0, -1, 0.0, at(0.025, 0.0), nullptr, testing::modes_to_write(system).of(0), event));
   REQUIRE(event.what == "reloading (buff)");
   const double below = 0.025 - 1e-10;
   gear.roots(0.0, at(below, 1e-9), nullptr, roots);
   CHECK(roots[1] > 0.0);
-  CHECK_FALSE(gear.commit(1, -1, 0.0, at(below, 1e-9), nullptr, system.modes().of(0), event));
-  CHECK(gear.commit(1, -1, 0.0, at(below, -1e-3), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(gear.commit(1, -1, 0.0, at(below, 1e-9), nullptr, testing::modes_to_write(system).of(0), event));
+  CHECK(gear.commit(1, -1, 0.0, at(below, -1e-3), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "unloading (buff)");
 }
 
@@ -865,20 +865,20 @@ TEST_CASE("coupler_end: overlap regained with the faces past each other gives no
   CHECK(force_x(0.08, 0.5) == 0.0);
   Element::Event event;
   // Coming down into overlap while horizontally 0.02 past contact: blocked.
-  CHECK(e.commit(2, -1, 0.0, state_at(0.08, 0.29, 0.0), nullptr, system.modes().of(0), event));
+  CHECK(e.commit(2, -1, 0.0, state_at(0.08, 0.29, 0.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "vertical overlap regained, faces past each other");
   CHECK(system.modes().as<CouplerEnd::State>(0).blocked);
   CHECK(force_x(0.08, 0.2) == 0.0);
   // A stale crossing (a root that is positive in the current mode) changes nothing.
-  CHECK_FALSE(e.commit(2, -1, 0.0, state_at(0.08, 0.1, 0.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(e.commit(2, -1, 0.0, state_at(0.08, 0.1, 0.0), nullptr, testing::modes_to_write(system).of(0), event));
   // Moving apart past the contact spacing: clear, then a new approach makes contact.
-  CHECK(e.commit(0, -1, 0.0, state_at(0.1 + 1e-9, 0.1, 1.0), nullptr, system.modes().of(0), event));
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1 + 1e-9, 0.1, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "faces clear");
   CHECK_FALSE(system.modes().as<CouplerEnd::State>(0).blocked);
-  CHECK(e.commit(0, -1, 0.0, state_at(0.1 - 1e-9, 0.1, -1.0), nullptr, system.modes().of(0), event));
+  CHECK(e.commit(0, -1, 0.0, state_at(0.1 - 1e-9, 0.1, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "contact");
   CHECK(force_x(0.09, 0.1) == Approx(kFaceStiffness * 0.01));
-  system.reset_modes();
+  ModeTracker(system).reset_modes();
   CHECK_FALSE(system.modes().as<CouplerEnd::State>(0).overlapping);
 }
 
@@ -1026,7 +1026,7 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   };
   Element::Event event;
   const auto crossing = [&](int index, double delta, double delta_rate) {
-    return end.commit(index, -1, 0.0, state_at(delta, delta_rate), nullptr, system.modes().of(0), event);
+    return end.commit(index, -1, 0.0, state_at(delta, delta_rate), nullptr, testing::modes_to_write(system).of(0), event);
   };
   CHECK(push(0.01) == 0.0);
   REQUIRE(crossing(0, 1e-9, 1.0));
@@ -1060,7 +1060,7 @@ TEST_CASE("coupler_end restitution: a set face reloads along its unloading line 
   REQUIRE(crossing(0, 0.03, -0.1));
   CHECK(end.permanent_set(system.modes().as<CouplerEnd::State>(0)) == Approx(0.03 * (1.0 - e * e)));
   CHECK(push(0.025) == Approx(ku * (0.025 - 0.0225)));
-  system.reset_modes();
+  ModeTracker(system).reset_modes();
   CHECK(system.modes().as<CouplerEnd::State>(0).peak == 0.0);
   CHECK(push(0.01) == 0.0);
 }
@@ -1080,20 +1080,20 @@ TEST_CASE("coupler_end restitution: loss of overlap while loading keeps the set,
     return gather_state(end, y.data(), y.data() + 3, system.modes().of(0));
   };
   Element::Event event;
-  REQUIRE(end.commit(0, -1, 0.0, state_at(1e-9, 0.0, 1.0), nullptr, system.modes().of(0), event));
-  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(peak, 0.3 + 1e-9, 1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(1e-9, 0.0, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
+  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(peak, 0.3 + 1e-9, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "vertical overlap lost");
   CHECK(end.permanent_set(system.modes().as<CouplerEnd::State>(0)) == Approx(set));
   // Back into overlap with the faces deeper than the set: blocked, no force, clear at the set.
-  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(0.018, 0.1, -1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(end.commit(CouplerEnd::kOverlapRoot, -1, 0.0, state_at(0.018, 0.1, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "vertical overlap regained, faces past each other");
   std::array<Pose<double>, 2> f{};
   end.add_force(0.0, state_at(0.018, 0.1, 0.0), f);
   CHECK(f[1].x == 0.0);
-  CHECK_FALSE(end.commit(0, -1, 0.0, state_at(set + 1e-6, 0.1, -1.0), nullptr, system.modes().of(0), event));
-  REQUIRE(end.commit(0, -1, 0.0, state_at(set - 1e-9, 0.1, -1.0), nullptr, system.modes().of(0), event));
+  CHECK_FALSE(end.commit(0, -1, 0.0, state_at(set + 1e-6, 0.1, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(set - 1e-9, 0.1, -1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "faces clear");
-  REQUIRE(end.commit(0, -1, 0.0, state_at(set + 1e-9, 0.1, 1.0), nullptr, system.modes().of(0), event));
+  REQUIRE(end.commit(0, -1, 0.0, state_at(set + 1e-9, 0.1, 1.0), nullptr, testing::modes_to_write(system).of(0), event));
   CHECK(event.what == "contact");
   CHECK(system.modes().as<CouplerEnd::State>(0).unloading);
 }

@@ -270,7 +270,7 @@ TEST_CASE("the run's element states: a snapshot restored undoes a commit and its
   Element::Event event;
   REQUIRE(c.commit(0, -1, 0.0, c.at(y.data(), y.data() + 3), nullptr, event));  // unloading from 0.03
   REQUIRE(c.state().permanent_crush == Approx(0.02));
-  system.modes().restore(loading);
+  ModeTracker(system).restore(loading);
   CHECK(c.state().mode == CrushSpring::Mode::Loading);
   CHECK(c.state().segment == 1);
   CHECK(c.state().permanent_crush == 0.0);

@@ -122,10 +122,11 @@ std::vector<double> energy_row(DaeSystem& system, const RunOutcome& o, std::vect
   EnergyWriter writer(system);
   const std::vector<double> start = system.initial_state();
   const std::vector<double> no_work(static_cast<std::size_t>(system.quadrature_count()), 0.0);
-  const ElementStates::Snapshot final_modes = system.modes().snapshot();
-  system.reset_modes();  // the start state in the modes a run starts in
+  ModeTracker modes(system);
+  const ElementStates::Snapshot final_modes = modes.snapshot();
+  modes.reset_modes();  // the start state in the modes a run starts in
   writer.sample(0.0, start.data(), no_work.data());
-  system.modes().restore(final_modes);
+  modes.restore(final_modes);
   writer.sample(o.t_reached, o.y.data(), o.quadratures.data());
   columns = writer.columns();
   return writer.row();

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "railcrash/solver/event_loop.hpp"
@@ -175,9 +177,53 @@ TEST_CASE("the mode tracker carries a root at zero as on its boundary, commits a
   // A new step forgets the changes; the system's modes go back with a snapshot.
   modes.begin_step();
   CHECK(modes.changes_of(0) == 0);
-  system.modes().restore(before);
+  modes.restore(before);
   system.roots(0.1, y.data(), g.data());
   CHECK(g[0] == Approx(-0.01));  // open again: the distance from the circle
+}
+
+namespace {
+
+// Whether a DaeSystem has a member reset_modes() (issue 37 item 5: it must not).
+template <class System, class = void>
+struct HasResetModes : std::false_type {};
+template <class System>
+struct HasResetModes<System, std::void_t<decltype(std::declval<System&>().reset_modes())>> : std::true_type {};
+
+}  // namespace
+
+TEST_CASE("the DaeSystem only reads the element modes and every write goes through a ModeTracker", "[events]") {
+  // A non-const system gives its modes read-only and has no reset of them (at e8c6869 modes()
+  // gave them writable and reset_modes() was the system's: this does not compile there).
+  static_assert(std::is_same_v<decltype(std::declval<DaeSystem&>().modes()), const ElementStates&>);
+  static_assert(!HasResetModes<DaeSystem>::value);
+  static_assert(HasResetModes<ModeTracker>::value);
+
+  // The ball starts on the circle (open); at x = 0.99 the open contact's root, x - 1, is -0.01.
+  const Model model = ball_and_circle(1.0, 0.0);
+  DaeSystem system(model);
+  std::vector<double> y = system.initial_state();
+  y[0] = 0.99;
+  std::vector<double> g(static_cast<std::size_t>(system.root_count()));
+  system.roots(0.0, y.data(), g.data());
+  REQUIRE(g[0] == Approx(-0.01));
+  // One tracker commits the closing, another (the settle's, a second run's) resets and restores:
+  // the system's evaluations follow every write, whichever tracker made it.
+  ModeTracker run(system);
+  std::vector<EventRecord> events;
+  REQUIRE(run.commit(0, 0, 0.0, y.data(), events));
+  const ElementStates::Snapshot closed = run.snapshot();
+  system.roots(0.0, y.data(), g.data());
+  CHECK(g[0] == Approx(0.01));  // closed: the penetration
+  ModeTracker other(system);
+  other.reset_modes();
+  system.roots(0.0, y.data(), g.data());
+  CHECK(g[0] == Approx(-0.01));  // open again: the start mode
+  CHECK(&run.modes() == &other.modes());
+  CHECK(&system.modes() == &std::as_const(run).modes());
+  other.restore(closed);
+  system.roots(0.0, y.data(), g.data());
+  CHECK(g[0] == Approx(0.01));
 }
 
 namespace {

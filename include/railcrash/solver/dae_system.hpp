@@ -14,10 +14,13 @@
 // The same element code also gives the plain generalized forces for explicit integration,
 // with constraints replaced by penalty spring-dampers.
 //
-// A DaeSystem is one run's view of an immutable Model: it holds the run's ElementStates. Its
-// const methods (residual, Jacobian, forces, roots, outputs, energy) read the element modes
-// and change nothing. The modes change only through the mode tracker's commits (events.hpp:
-// ModeTracker), which write them through modes(), and reset_modes().
+// A DaeSystem is one run's view of an immutable Model and a const evaluator of it: every public
+// method that evaluates (residual, Jacobian, forces, roots, outputs, energy) is const, reads the
+// run's element modes and histories (ElementStates, modes()) and changes nothing, and no public
+// member changes the modes. The storage of the modes sits beside the evaluator (one per system,
+// so the settle's, the integrator's and a test's trackers of one system share it and it lives as
+// long as the system), but it is written only by the mode-tracking side (events.hpp:
+// ModeTracker, a friend): its commits, its reset to the start modes and its snapshot restore.
 #pragma once
 
 #include <array>
@@ -269,12 +272,9 @@ class DaeSystem {
   /// boundary has a small positive root that the look-ahead sees cross; IDA itself would leave
   /// a root that is exactly zero inactive. ModeTracker::commit_boundary commits them.
   bool boundary_roots_leaving(double t, const double* y, const double* yp, double t_end, std::vector<int>& direction) const;
-  /// Puts every element back in its starting mode.
-  void reset_modes();
-  /// The run's element modes and histories: evaluations read them, only the mode tracker's
-  /// commits (events.hpp) change them; snapshot() / restore() go back to an earlier state.
+  /// The run's element modes and histories, as the evaluations read them. Only a ModeTracker
+  /// (events.hpp) changes them: its commits, reset_modes(), restore().
   const ElementStates& modes() const { return modes_; }
-  ElementStates& modes() { return modes_; }
 
   /// Element output columns "<element>.<quantity>" and their values at y.
   const std::vector<std::string>& output_names() const { return output_names_; }
@@ -327,8 +327,10 @@ class DaeSystem {
   };
   ElementSlices element_slices(std::size_t e, const double* lambda, double* g, double* outputs) const;
 
+  friend class ModeTracker;  // the only writer of modes_
+
   const Model& model_;
-  ElementStates modes_;  // the run's element modes and histories (the only state a DaeSystem changes)
+  ElementStates modes_;  // the run's element modes and histories: read here, written only by ModeTracker
   std::vector<double> mass_;  // 3n diagonal of M
   SparsePattern pattern_;
   std::vector<int> slots_;    // value slot of every addition, in assembly order

@@ -8,10 +8,11 @@
 // * ModeTracker: the run's bookkeeping of element modes across steps: the root functions at
 //   the step's start and end, the roots resting on their mode's boundary (carried as +0 until
 //   clearly below zero), and which elements changed mode in the current step, how often and
-//   when; and every commit of a mode change (the elements' commit, with the event's record):
-//   the only place the element modes change (initial_conditions.cpp's settle commits through
-//   it too). The modes themselves (ElementStates) are still held by the DaeSystem, which only
-//   reads them.
+//   when; and every write of the element modes and histories (ElementStates): each commit of a
+//   mode change (the elements' commit, with the event's record), the reset to the start modes
+//   and the return to a snapshot (initial_conditions.cpp's start and settle, Euler's restart of
+//   a second run, all write through it). The modes' storage sits beside the DaeSystem (one per
+//   system, shared by every tracker of it), which only reads it: the tracker is its one writer.
 // * EventLocator: the queue of crossings of the current step in time order, the location of a
 //   root that fell through zero (Illinois on the interpolant, only the element's unknowns
 //   interpolated), and the nudge that moves a located time forward until the interpolated
@@ -22,9 +23,8 @@
 // What an integrator still does itself: take its step, give its StepInterpolant and answer an
 // EventHandler (event_loop.hpp: commit_crossings, the loop over a step's crossings): whether it
 // goes on across a change (IDA's lag test) and its restart; Euler's steps are known at their
-// end alone, so the loop commits there. The integrators ask the DaeSystem, never an element.
-// Not yet here: the element modes themselves (ElementStates) are still held by the DaeSystem
-// (DaeSystem::modes(), reset_modes(); Euler and the settle take snapshots of them there).
+// end alone, so the loop commits there. The integrators ask the DaeSystem, never an element,
+// and change the element modes only through a ModeTracker.
 #pragma once
 
 #include <vector>
@@ -72,6 +72,17 @@ class ModeTracker {
 
   const DaeSystem& system() const { return system_; }
   int root_count() const { return system_.root_count(); }
+
+  // ---- the run's element modes and histories (what the system's evaluations read) ----
+  const ElementStates& modes() const { return system_.modes_; }
+  /// Written directly: an element test setting a mode by hand (the run writes through the
+  /// members below and the commits).
+  ElementStates& modes() { return system_.modes_; }
+  /// Puts every element back in the mode it starts a run in.
+  void reset_modes() { system_.modes_.reset(); }
+  /// Every element's mode and history now, to go back to with restore().
+  ElementStates::Snapshot snapshot() const { return system_.modes_.snapshot(); }
+  void restore(const ElementStates::Snapshot& snapshot) { system_.modes_.restore(snapshot); }
   /// Root functions at the start of the current step (previous) and at its end (now).
   std::vector<double>& previous() { return previous_; }
   std::vector<double>& now() { return now_; }

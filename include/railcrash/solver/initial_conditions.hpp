@@ -90,8 +90,9 @@ struct EquilibriumReport {
 /// the residual norm must fall instead (Newton's last, quadratic steps). The work of the
 /// residual needs no energy function, so non-conservative laws (hysteresis, plasticity)
 /// take part as they stand. A rejected step puts the elements back in the modes of the
-/// current state; a history change (yield, fracture) committed at a rejected trial state
-/// stays, unlogged (none in the report's models).
+/// current state (a snapshot restored through a ModeTracker, the modes' one writer); a
+/// history change (yield, fracture) committed at a rejected trial state stays, unlogged (none
+/// in the report's models).
 /// A model with several equilibria reaches the one this damped descent leads to.
 /// Throws SolverError when it does not settle.
 EquilibriumReport settle_static_equilibrium(DaeSystem& system, std::vector<double>& y,
@@ -102,9 +103,10 @@ struct StartReport {
   EquilibriumReport equilibrium;
 };
 
-/// The state a run starts from: every element in its starting mode, the model's coordinates
-/// with the joints assembled, then (static_equilibrium: the run's simulation.static_equilibrium)
-/// settled under gravity with the model's velocities projected onto the joints.
+/// The state a run starts from: every element in its starting mode (ModeTracker::reset_modes),
+/// the model's coordinates with the joints assembled, then (static_equilibrium: the run's
+/// simulation.static_equilibrium) settled under gravity with the model's velocities projected
+/// onto the joints.
 StartReport prepare_start(DaeSystem& system, std::vector<double>& y, std::vector<EventRecord>& events, bool static_equilibrium);
 
 /// Throws InputError when the constraint rows are linearly dependent at q, naming them.
