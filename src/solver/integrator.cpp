@@ -171,6 +171,8 @@ void Integrator::take_run_from(Integrator& previous) {
   outcome_ = std::move(previous.outcome_);
   observer_ = previous.observer_;
   t_end_ = previous.t_end_;
+  chatter_ = std::move(previous.chatter_);  // the run's guard goes on (its t_end, its limit, its counts)
+  chatter_limit_ = previous.chatter_limit_;
   output_interval_ = previous.output_interval_;
   output_index_ = previous.output_index_;
   t_sampled_ = previous.t_sampled_;

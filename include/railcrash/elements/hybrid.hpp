@@ -4,6 +4,7 @@
 // own State and none repeats the untyped slot handling.
 #pragma once
 
+#include <algorithm>
 #include <array>
 
 #include "railcrash/model/element.hpp"
@@ -17,7 +18,7 @@ namespace railcrash {
 /// reversal point chattered between its two modes at one instant: bench/event_storms.py). At
 /// rest (rate exactly 0: a static settle, a start at rest) the position alone decides.
 inline double position_root_moving_on(double distance, double rate) {
-  return rate == 0.0 ? distance : (distance > -rate ? distance : -rate);
+  return rate == 0.0 ? distance : std::max(distance, -rate);
 }
 
 /// Adapter for a hybrid force element (design.md section 3: a piecewise law, smooth within each
