@@ -456,7 +456,7 @@ const std::vector<std::string> kResponseKeys = {"crush_gauges", "crush", "refere
                                                 "collision_post_distance"};
 const std::vector<std::string> kCrushGaugeKeys = {"name", "points"};
 const std::vector<std::string> kVariantKeys = {"railcrash", "variant_of", "name", "description", "set"};
-const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "dt", "output_interval", "force_dt", "max_steps",
+const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "position_tolerance", "dt", "output_interval", "force_dt", "max_steps",
                                                   "static_equilibrium",
                                                   "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
                                                   "penalty_rotational_damping"};
@@ -774,6 +774,15 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
   s.atol = positive("atol");
   const Reader::UnitScale& unit = r.scale();
   if (s.atol) *s.atol *= unit.length;
+  if (node["position_tolerance"]) {
+    const std::string how = r.text(node["position_tolerance"], "simulation: position_tolerance");
+    if (how == "absolute") {
+      s.position_tolerance = PositionTolerance::Absolute;
+    } else if (how != "relative") {
+      r.fail(node["position_tolerance"], "simulation: position_tolerance must be relative (rtol |q| + atol, the default) "
+                                         "or absolute (atol alone, whatever the distance from the origin), not '" + how + "'");
+    }
+  }
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
   const std::string rows_problem = output_rows_problem(s);

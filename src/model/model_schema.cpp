@@ -366,6 +366,10 @@ std::map<std::string, SectionKeys> section_keys() {
                                    "penalty constraints, as IITRAIN)")}},
       {"rtol", {number("ida: relative tolerance", Range::Positive)}},
       {"atol", {number("ida: absolute tolerance of lengths (" + kLength + "); default from the model's size", Range::Positive)}},
+      {"position_tolerance", {one_of_words({"relative", "absolute"},
+                                           "ida: relative (default: rtol |q| + atol, atol 0.1 rtol x the model's size) or "
+                                           "absolute (atol alone, default rtol x the speed scale over the model's highest "
+                                           "frequency; README \"Position tolerances\")")}},
       {"dt", {number("euler: time step [s]", Range::Positive)}},
       {"output_interval", {number("time between output rows [s]", Range::Positive)}},
       {"force_dt", {flag("euler: run with dt even above the stability limit")}},

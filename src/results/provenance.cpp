@@ -75,8 +75,10 @@ std::string provenance_json(const Provenance& p) {
   if (euler)
     j += ", \"dt\": " + (s.dt > 0.0 ? json_number(s.dt) : "\"0.5 x stability limit\"") +
          ", \"force_dt\": " + (s.force_dt ? "true" : "false");
-  if (ida)
+  if (ida) {
     j += ", \"rtol\": " + json_number(s.rtol) + ", \"atol\": " + (s.atol ? json_number(*s.atol) : "\"from the model\"");
+    if (s.position_tolerance == PositionTolerance::Absolute) j += ", \"position_tolerance\": \"absolute\"";
+  }
   j += std::string(", \"static_equilibrium\": ") + (s.static_equilibrium ? "true" : "false") + "}}";
   return j;
 }

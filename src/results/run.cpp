@@ -200,6 +200,7 @@ std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationS
   IdaSettings ida;
   ida.rtol = settings.rtol;
   ida.atol = settings.atol;
+  ida.position_tolerance = settings.position_tolerance;
   ida.max_steps = settings.max_steps;
   ida.run = run;
   if (settings.integrator == IntegratorKind::Auto) return std::make_unique<AutoIntegrator>(system, ida, euler);

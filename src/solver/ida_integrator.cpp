@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "klu_solver.hpp"
+#include "railcrash/solver/euler_integrator.hpp"  // (its stability limit: the model's highest frequency)
 #include "railcrash/solver/event_loop.hpp"
 #include "railcrash/solver/events.hpp"
 #include "railcrash/solver/initial_conditions.hpp"
@@ -28,6 +29,28 @@ namespace {
 // more than kReachableMultiple times IDA's own first step (advance(), restart_first_step()).
 constexpr double kRestartStepFraction = 0.3;
 constexpr double kReachableMultiple = 1e4;
+
+/// The model's size for the absolute position tolerance: the diagonal of the box around its
+/// bodies and its ground points, or an element's largest offset on a body if that is more.
+/// (Model::length_scale counts a ground point's distance from the origin as an offset: 10 km
+/// along the track a model was 10 km long.)
+double origin_free_length(const Model& model) {
+  double min_x = model.bodies().front().x, max_x = min_x, min_y = model.bodies().front().y, max_y = min_y;
+  const auto include = [&](double x, double y) {
+    min_x = std::min(min_x, x), max_x = std::max(max_x, x), min_y = std::min(min_y, y), max_y = std::max(max_y, y);
+  };
+  for (const Body& b : model.bodies()) include(b.x, b.y);
+  double offset = 0.0;
+  for (const auto& element : model.elements())
+    for (const PointRef& p : element->points()) {
+      if (p.body == kGround)
+        include(p.sx, p.sy);
+      else
+        offset = std::max(offset, std::hypot(p.sx, p.sy));
+    }
+  const double length = std::max(std::hypot(max_x - min_x, max_y - min_y), offset);
+  return length > 0.0 ? length : 1.0;
+}
 
 std::string flag_name(int flag) {
   char* name = IDAGetReturnFlagName(flag);
@@ -120,6 +143,29 @@ struct IdaIntegrator::Impl {
   // The first trial state whose residual was not finite (cleared before every step).
   double non_finite_t = 0.0;
   std::vector<double> non_finite_y, non_finite_yp;
+
+  // The error test's tolerance of unknown i is relative[i] |y_i| + atol_i: relative is rtol,
+  // or 0 for positions and angles held to an absolute tolerance (position_tolerance).
+  std::vector<double> relative;
+
+  double tolerance(std::size_t i, double value) const {
+    return relative[i] * std::abs(value) + N_VGetArrayPointer(atol)[i];
+  }
+
+  /// IDA's error weights (IDAWFtolerances): 1 / tolerance(i, y_i). Never throws.
+  static int error_weights(N_Vector y_now, N_Vector weights, void* user) noexcept {
+    const auto* self = static_cast<const Impl*>(user);
+    const double* values = N_VGetArrayPointer(y_now);
+    const double* absolute = N_VGetArrayPointer(self->atol);
+    double* w = N_VGetArrayPointer(weights);
+    const std::size_t n = self->relative.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double tol = self->relative[i] * std::abs(values[i]) + absolute[i];
+      if (!(tol > 0.0)) return -1;  // (IDA stops with IDA_ILL_INPUT; start() makes every atol_i positive)
+      w[i] = 1.0 / tol;
+    }
+    return 0;
+  }
 
   explicit Impl(const DaeSystem& s) : system(s) {}
   ~Impl() {
@@ -240,12 +286,11 @@ struct IdaIntegrator::Impl {
     const double* values = N_VGetArrayPointer(y);
     const double* rates = N_VGetArrayPointer(yp);
     const double* differential = N_VGetArrayPointer(ids);
-    const double* absolute = N_VGetArrayPointer(atol);
     const sunindextype n = N_VGetLength(y);
     double sum = 0.0;
     for (sunindextype i = 0; i < n; ++i) {
       if (!(differential[i] > 0.0)) continue;
-      const double weighted = rates[i] / (rtol * std::abs(values[i]) + absolute[i]);
+      const double weighted = rates[i] / tolerance(static_cast<std::size_t>(i), values[i]);
       sum += weighted * weighted;
     }
     const double norm = std::sqrt(sum / static_cast<double>(n));
@@ -365,7 +410,8 @@ void IdaIntegrator::start(double t_end) {
   stats().settling_displacement = start_report.equilibrium.largest_position_change;
 
   // ---- scales for the tolerances ----
-  const double length = model.length_scale();
+  const bool absolute_positions = settings_.position_tolerance == PositionTolerance::Absolute;
+  const double length = absolute_positions ? origin_free_length(model) : model.length_scale();
   std::vector<double> f0(static_cast<std::size_t>(nq), 0.0);
   system_.generalized_forces(0.0, y0.data(), y0.data() + nq, f0.data());
   double force_scale = 0.0, speed = 0.0, total_mass = 0.0;
@@ -394,8 +440,38 @@ void IdaIntegrator::start(double t_end) {
   if (!(speed > 0.0)) speed = length / t_end;
   if (!(force_scale > 0.0)) force_scale = total_mass * speed * speed / length;
   const double rtol = settings_.rtol;
-  const double atol_length = settings_.atol ? *settings_.atol : 0.1 * rtol * length;
-  const double atol_speed = atol_length * speed / length;
+  // Positions (simulation: position_tolerance; README "Position tolerances"). Relative, the
+  // default: SUNDIALS' form, rtol |q| + atol, atol 0.1 rtol L unless the model gives one.
+  // Absolute: atol alone, and no part that grows with the distance from the model's origin or
+  // with the train's length; its default is rtol times the distance the speed scale V covers
+  // in 1 / omega, omega the model's highest natural frequency (its stiffest laws against its
+  // masses, as Euler's stability limit 2 / omega finds it), at most 0.1 rtol L: an error of
+  // that size in a position stores as much energy in the stiffest element as the speed
+  // tolerance rtol V carries in its mass. On a 3+3-car unit (L = 120 m, 1e9 N/m anticlimbers
+  // on 800 kg end structures, V = 10 m/s) that is 6.3 mm x rtol, where the relative form allows
+  // 12-60 mm x rtol: at rtol 1e-3 IDA's order-1 steps moved the crush zones' ends by up to
+  // 1.4 mm more than the motion's own, and the work of the 1.6 MN crush forces on that lost
+  // 2.3 % of the energy and 2.4 % of the largest crush (bench/HISTORY.md, "Positions held to
+  // an absolute tolerance").
+  const double position_rtol = absolute_positions ? 0.0 : rtol;
+  double atol_length = 0.1 * rtol * length;
+  if (settings_.atol) {
+    atol_length = *settings_.atol;
+  } else if (absolute_positions) {
+    const double stable_step = EulerIntegrator::estimate_stability_limit(system_, y0, nullptr);  // 2 / omega [time]
+    if (std::isfinite(stable_step) && stable_step > 0.0) atol_length = std::min(atol_length, rtol * speed * 0.5 * stable_step);
+    // Never below 1000 times the round-off of the largest coordinate: a model at rest has a
+    // speed scale of round-off, and IDA stopped at once with IDA_TOO_MUCH_ACC.
+    constexpr double kRoundOffMultiple = 1e3;
+    double largest_coordinate = 0.0;  // [length]
+    for (int i = 0; i < model.body_count(); ++i)
+      largest_coordinate = std::max({largest_coordinate, std::abs(y0[static_cast<std::size_t>(3 * i)]),
+                                     std::abs(y0[static_cast<std::size_t>(3 * i + 1)])});
+    atol_length = std::max(atol_length, kRoundOffMultiple * std::numeric_limits<double>::epsilon() * largest_coordinate);
+  }
+  // Velocities: the relative form's length tolerance times V / L (0.1 rtol V, or the model's
+  // atol times V / L), whichever form the positions take.
+  const double atol_speed = (settings_.atol ? *settings_.atol : 0.1 * rtol * length) * speed / length;
   // Multipliers stay out of the error test (IDASetSuppressAlg); their weights only enter the
   // Newton convergence test, where index-2 unknowns carry round-off amplified by 1/h. Weights
   // as tight as the differential ones make that test fail at small steps (seen on the
@@ -435,6 +511,8 @@ void IdaIntegrator::start(double t_end) {
     // before, a 16-in front end's pitch was held about 100 times tighter than its translation,
     // and its pitch rate limited most of IDA's steps.
     const std::vector<double> size = system_.body_angle_lengths();
+    impl.relative.assign(static_cast<std::size_t>(n), rtol);
+    std::fill(impl.relative.begin(), impl.relative.begin() + nq, position_rtol);
     for (int i = 0; i < model.body_count(); ++i) {
       const double radius = size[static_cast<std::size_t>(i)];
       atol[3 * i] = atol[3 * i + 1] = atol_length;
@@ -450,13 +528,16 @@ void IdaIntegrator::start(double t_end) {
     double* quad_atol = N_VGetArrayPointer(impl.quad_atol);
     for (int k = 0; k < nquad; ++k) quad_atol[k] = 0.1 * rtol * energy_scale;
     quad_atol[DaeSystem::kKineticIntegral] *= t_end;
-    check_start(y, yp, atol, t_end);
+    check_start(y, yp, t_end);
 
     impl.ida = impl.created(IDACreate(impl.context), "IDACreate");
     impl.check(IDASetErrHandlerFn(impl.ida, &Impl::error_handler, &impl), "IDASetErrHandlerFn");
     impl.check(IDAInit(impl.ida, &Impl::residual, 0.0, impl.y, impl.yp), "IDAInit");
     impl.check(IDASetUserData(impl.ida, &impl), "IDASetUserData");
-    impl.check(IDASVtolerances(impl.ida, rtol, impl.atol), "IDASVtolerances");
+    if (absolute_positions)
+      impl.check(IDAWFtolerances(impl.ida, &Impl::error_weights), "IDAWFtolerances");
+    else
+      impl.check(IDASVtolerances(impl.ida, rtol, impl.atol), "IDASVtolerances");
     impl.check(IDASetId(impl.ida, impl.ids), "IDASetId");
     impl.check(IDASetSuppressAlg(impl.ida, SUNTRUE), "IDASetSuppressAlg");
     impl.check(IDASetMaxNumSteps(impl.ida, settings_.max_steps_per_output), "IDASetMaxNumSteps");
@@ -706,7 +787,7 @@ bool IdaIntegrator::lag_within_tolerance(int e, const std::array<DaeSystem::Elem
   return true;
 }
 
-void IdaIntegrator::check_start(const double* y, const double* yp, const double* atol, double t_end) const {
+void IdaIntegrator::check_start(const double* y, const double* yp, double t_end) const {
   const std::string source = system_.non_finite_source(0.0, y, yp);
   if (!source.empty())
     throw InputError(source + " at t = 0, before the first step; check its numbers (a value too large or too small)");
@@ -715,7 +796,7 @@ void IdaIntegrator::check_start(const double* y, const double* yp, const double*
   constexpr double kLargestWeightedChange = 1e150;  // squared in a norm: below the largest double
   const int nq = system_.body_unknowns();
   for (int k = 0; k < 2 * nq; ++k) {
-    const double weighted_change = std::abs(yp[k]) * t_end / (settings_.rtol * std::abs(y[k]) + atol[k]);
+    const double weighted_change = std::abs(yp[k]) * t_end / impl_->tolerance(static_cast<std::size_t>(k), y[k]);
     if (weighted_change > kLargestWeightedChange) {
       std::ostringstream msg;
       msg << system_.unknown_name(k) << " changes at " << yp[k] << " per unit time at t = 0, " << weighted_change

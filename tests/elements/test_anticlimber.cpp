@@ -129,6 +129,7 @@ Run simulate(const LoadedModel& loaded) {
   const SimulationSettings& simulation = loaded.run_spec.simulation;
   auto integrator = make_integrator(system, simulation);
   run.outcome = integrator->run(simulation.t_end, output_interval_of(simulation), run.samples);
+  INFO(run.outcome.message);
   REQUIRE(run.outcome.ok);
   run.final_mode = system.modes().as<Anticlimber::State>(0);
   return run;

@@ -89,11 +89,18 @@ std::vector<std::string> integrator_names();
 /// The names for a message: "auto, ida or euler" (`quote`: each in it, e.g. "\"").
 std::string integrator_names_text(const std::string& quote = "");
 
+/// How IDA's error test weighs positions (simulation: position_tolerance; README "Position
+/// tolerances"). Relative: SUNDIALS' form, rtol |q| + atol (atol default 0.1 rtol L).
+/// Absolute: atol alone, with no part that grows with the distance from the model's origin
+/// (atol default rtol V / omega: the speed scale over the model's highest frequency).
+enum class PositionTolerance { Relative, Absolute };
+
 struct SimulationSettings {
   double t_end = 1.0;               // [time]
   IntegratorKind integrator = IntegratorKind::Auto;
   double rtol = 1e-6;               // ida: relative tolerance
   std::optional<double> atol;       // ida: absolute tolerance on lengths [length]; default derived from the model
+  PositionTolerance position_tolerance = PositionTolerance::Relative;  // ida: how positions are weighed
   double dt = 0.0;                  // euler: step [time]; 0 = 0.5 x stability limit
   double output_interval = 0.0;     // [time]; 0 = t_end / 500
   bool force_dt = false;            // euler: accept a step above the stability limit

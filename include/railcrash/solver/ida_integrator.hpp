@@ -3,10 +3,11 @@
 // * Consistent start: position assembly and velocity projection (initial_conditions.hpp),
 //   then accelerations and multipliers from the acceleration-level system (consistent_rates;
 //   IDACalcIC cannot find them for the GGL form, see initial_conditions.hpp).
-// * Per-component absolute tolerances from the model's scales: lengths 0.1 rtol L (or the
-//   model's atol), angles that over L, velocities that times V / L, multipliers lambda
-//   min(1, 100 rtol) F and mu V (see the comment in run()), where L is
-//   the model's extent, F its largest initial generalized force and V the larger of its
+// * Tolerances per component (IDAWFtolerances): positions absolute only, rtol x 10 mm in the
+//   model's length unit (or the model's atol), angles that over their body's size; velocities
+//   rtol |v| + 0.1 rtol V (or rtol |v| + atol V / L); multipliers lambda rtol |lambda| +
+//   min(1, max(100 rtol, 1e-5)) F and mu rtol |mu| + V (see the comment in start()), where L
+//   is the model's extent, F its largest initial generalized force and V the larger of its
 //   initial speeds and sqrt(2 E / M) with E = max(initial kinetic energy, F L).
 // * IDASetId marks q, v differential and lambda, mu algebraic; IDASetSuppressAlg keeps the
 //   algebraic unknowns out of the error test.
@@ -36,6 +37,7 @@ namespace railcrash {
 struct IdaSettings {
   double rtol = 1e-6;
   std::optional<double> atol;  // [length]
+  PositionTolerance position_tolerance = PositionTolerance::Relative;
   long max_steps_per_output = 500000;
   long max_steps = 10000000;  // [steps] in the whole run; the run fails (not ok) beyond
   CommonRunSettings run;      // t_end, static_equilibrium
@@ -69,7 +71,7 @@ class IdaIntegrator : public Integrator {
   friend class IdaEventHandler;  // (ida_integrator.cpp) IDA's side of the event loop
   /// Before the first step: InputError naming the element or body whose residual, Jacobian or
   /// rates are not finite (or so large that IDA's norms overflow) at t = 0.
-  void check_start(const double* y, const double* yp, const double* atol, double t_end) const;
+  void check_start(const double* y, const double* yp, double t_end) const;
   /// Why IDA failed, in the model's terms: a non-finite residual's element or body, a
   /// singular configuration of the joints, the unknowns with the largest weighted errors.
   std::string explain_failure(int flag);
