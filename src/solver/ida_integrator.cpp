@@ -449,7 +449,7 @@ void IdaIntegrator::start(double t_end) {
   // that size in a position stores as much energy in the stiffest element as the speed
   // tolerance rtol V carries in its mass. On a 3+3-car unit (L = 120 m, 1e9 N/m anticlimbers
   // on 800 kg end structures, V = 10 m/s) that is 6.3 mm x rtol, where the relative form allows
-  // 12-72 mm x rtol: at rtol 1e-3 IDA's order-1 steps moved the crush zones' ends by up to
+  // 12-72 m x rtol: at rtol 1e-3 IDA's order-1 steps moved the crush zones' ends by up to
   // 1.4 mm more than the motion's own, and the work of the 1.6 MN crush forces on that lost
   // 2.3 % of the energy and 2.4 % of the largest crush (bench/HISTORY.md, "Positions held to
   // an absolute tolerance").
