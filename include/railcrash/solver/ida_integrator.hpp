@@ -3,11 +3,14 @@
 // * Consistent start: position assembly and velocity projection (initial_conditions.hpp),
 //   then accelerations and multipliers from the acceleration-level system (consistent_rates;
 //   IDACalcIC cannot find them for the GGL form, see initial_conditions.hpp).
-// * Tolerances per component (IDAWFtolerances): positions absolute only, rtol x 10 mm in the
-//   model's length unit (or the model's atol), angles that over their body's size; velocities
-//   rtol |v| + 0.1 rtol V (or rtol |v| + atol V / L); multipliers lambda rtol |lambda| +
-//   min(1, max(100 rtol, 1e-5)) F and mu rtol |mu| + V (see the comment in start()), where L
-//   is the model's extent, F its largest initial generalized force and V the larger of its
+// * Tolerances per component: velocities rtol |v| + 0.1 rtol V (or rtol |v| + atol V / L);
+//   positions, by simulation: position_tolerance, relative (default; IDASVtolerances):
+//   rtol |q| + 0.1 rtol L (or rtol |q| + atol), or absolute (IDAWFtolerances): atol alone,
+//   by default rtol V / omega (omega the highest natural frequency, from Euler's stability
+//   limit), at most 0.1 rtol L; angles get the length tolerance over their body's size;
+//   multipliers lambda rtol |lambda| + min(1, max(100 rtol, 1e-5)) F and mu rtol |mu| + V (see
+//   the comment in start()), where L is the model's extent (absolute: the box around its bodies
+//   and ground points), F its largest initial generalized force and V the larger of its
 //   initial speeds and sqrt(2 E / M) with E = max(initial kinetic energy, F L).
 // * IDASetId marks q, v differential and lambda, mu algebraic; IDASetSuppressAlg keeps the
 //   algebraic unknowns out of the error test.
