@@ -81,11 +81,18 @@ void Model::finalize() {
     min_y = std::min(min_y, b.y); max_y = std::max(max_y, b.y);
   }
   extent = std::hypot(max_x - min_x, max_y - min_y);
+  double body_offset = 0.0;  // [length] the largest offset of an element's point on a body
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     Element& el = *elements_[e];
     for (const PointRef& p : el.points()) {
       RAILCRASH_DEMAND(p.body >= kGround && p.body < body_count());
       extent = std::max(extent, std::hypot(p.sx, p.sy));
+      if (p.body == kGround) {
+        min_x = std::min(min_x, p.sx); max_x = std::max(max_x, p.sx);
+        min_y = std::min(min_y, p.sy); max_y = std::max(max_y, p.sy);
+      } else {
+        body_offset = std::max(body_offset, std::hypot(p.sx, p.sy));
+      }
       if (p.body != kGround && bodies_[static_cast<std::size_t>(p.body)].inertia == 0.0 &&
           (p.sx != 0.0 || p.sy != 0.0 || el.applies_moment()) && el.constraint_count() == 0)
         throw InputError(el.where().prefix() + "element '" + el.name() + "' acts at an offset point of body '" +
@@ -114,6 +121,8 @@ void Model::finalize() {
                        "', which has zero inertia; give the body a positive inertia or apply the force at [0, 0]");
   }
   length_scale_ = extent > 0.0 ? extent : 1.0;
+  const double origin_free = std::max(std::hypot(max_x - min_x, max_y - min_y), body_offset);
+  origin_free_length_scale_ = origin_free > 0.0 ? origin_free : 1.0;
   finalized_ = true;
 }
 

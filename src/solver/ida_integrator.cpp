@@ -30,28 +30,6 @@ namespace {
 constexpr double kRestartStepFraction = 0.3;
 constexpr double kReachableMultiple = 1e4;
 
-/// The model's size for the absolute position tolerance: the diagonal of the box around its
-/// bodies and its ground points, or an element's largest offset on a body if that is more.
-/// (Model::length_scale counts a ground point's distance from the origin as an offset: 10 km
-/// along the track a model was 10 km long.)
-double origin_free_length(const Model& model) {
-  double min_x = model.bodies().front().x, max_x = min_x, min_y = model.bodies().front().y, max_y = min_y;
-  const auto include = [&](double x, double y) {
-    min_x = std::min(min_x, x), max_x = std::max(max_x, x), min_y = std::min(min_y, y), max_y = std::max(max_y, y);
-  };
-  for (const Body& b : model.bodies()) include(b.x, b.y);
-  double offset = 0.0;
-  for (const auto& element : model.elements())
-    for (const PointRef& p : element->points()) {
-      if (p.body == kGround)
-        include(p.sx, p.sy);
-      else
-        offset = std::max(offset, std::hypot(p.sx, p.sy));
-    }
-  const double length = std::max(std::hypot(max_x - min_x, max_y - min_y), offset);
-  return length > 0.0 ? length : 1.0;
-}
-
 std::string flag_name(int flag) {
   char* name = IDAGetReturnFlagName(flag);
   std::string out = name ? name : std::to_string(flag);
@@ -156,11 +134,10 @@ struct IdaIntegrator::Impl {
   static int error_weights(N_Vector y_now, N_Vector weights, void* user) noexcept {
     const auto* self = static_cast<const Impl*>(user);
     const double* values = N_VGetArrayPointer(y_now);
-    const double* absolute = N_VGetArrayPointer(self->atol);
     double* w = N_VGetArrayPointer(weights);
     const std::size_t n = self->relative.size();
     for (std::size_t i = 0; i < n; ++i) {
-      const double tol = self->relative[i] * std::abs(values[i]) + absolute[i];
+      const double tol = self->tolerance(i, values[i]);
       if (!(tol > 0.0)) return -1;  // (IDA stops with IDA_ILL_INPUT; start() makes every atol_i positive)
       w[i] = 1.0 / tol;
     }
@@ -411,7 +388,7 @@ void IdaIntegrator::start(double t_end) {
 
   // ---- scales for the tolerances ----
   const bool absolute_positions = settings_.position_tolerance == PositionTolerance::Absolute;
-  const double length = absolute_positions ? origin_free_length(model) : model.length_scale();
+  const double length = absolute_positions ? model.origin_free_length_scale() : model.length_scale();
   std::vector<double> f0(static_cast<std::size_t>(nq), 0.0);
   system_.generalized_forces(0.0, y0.data(), y0.data() + nq, f0.data());
   double force_scale = 0.0, speed = 0.0, total_mass = 0.0;

@@ -103,8 +103,14 @@ class Model {
   int mu_index(int row) const { return 6 * body_count() + constraint_rows_ + row; }
   /// Degrees of freedom (3 n - m); constraints may still be redundant, see initial_conditions.
   int degrees_of_freedom() const { return 3 * body_count() - constraint_rows_; }
-  /// Characteristic length of the model [length]: its extent, at least one unit.
+  /// Characteristic length of the model [length]: its extent, at least one unit. A ground
+  /// point counts by its distance from the origin (as an offset), so this grows when the model
+  /// is placed far from it; IDA's relative position tolerance uses it (README "Position
+  /// tolerances").
   double length_scale() const { return length_scale_; }
+  /// The same with ground points counted as positions, inside the box around the bodies: the
+  /// model's size wherever it lies (IDA's absolute position tolerance) [length].
+  double origin_free_length_scale() const { return origin_free_length_scale_; }
 
  private:
   void require_editable(const char* what) const;
@@ -117,6 +123,7 @@ class Model {
   std::vector<int> constraint_offset_;
   int constraint_rows_ = 0;
   double length_scale_ = 1.0;
+  double origin_free_length_scale_ = 1.0;
   bool finalized_ = false;
 };
 
