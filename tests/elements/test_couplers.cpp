@@ -469,6 +469,93 @@ TEST_CASE("draft_gear: the pin shears at the pin shear load, travels, goes solid
   }
 }
 
+TEST_CASE("draft_gear: its points meeting while it carries force stops the run naming it under every integrator",
+          "[elements][couplers][faults]") {
+  // 500 kg at 30 m/s into a gear 1 m long that is soft after bottoming (1e5 N/m): 225 kJ against
+  // about 60 kJ over the whole metre, so the mass reaches the gear's ground point. Closed form
+  // (Walker): stuck to H / (Kt - k), loading on k x + H to the travel, bottomed on K up to the
+  // points-meet margin, compression 0.999 m. Before this check Euler carried the mass past the
+  // ground point with the force turned around (the gear's line of action reverses with r2 - r1).
+  const Gear g{1.0e5, 0.05, 1.0e5, 1.0e4, 1.0e6};
+  const double v0 = 30.0, meet = 1.0 - DraftGear::kPointsMeetFraction;
+  const auto compression = [](double x) { return x; };
+  Walker w(kGearMass, v0);
+  w.go(0.0, g.Kt, g.H / (g.Kt - g.k), "sliding (buff)", compression);
+  w.go(g.H, g.k, g.s, "bottomed (buff)", compression);
+  w.go(g.k * g.s + g.H - g.K * g.s, g.K, meet, "points meet", compression);
+  REQUIRE(w.v > 20.0);  // still fast: the gear is driven through, not stopped short
+  for (const char* integrator : {"ida", "euler", "auto"}) {
+    INFO(integrator);
+    const bool euler = std::string(integrator) == "euler";
+    const LoadedModel loaded =
+        testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -v0, 0.0, 0.2, integrator));
+    DaeSystem system(loaded.model);
+    struct Quiet : RunObserver {
+      void sample(double, const double*, const double*, const double*, const double*) override {}
+    } observer;
+    const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.2, 0.001, observer);
+    INFO(outcome.message);
+    CHECK_FALSE(outcome.ok);
+    CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: draft_gear 'e' is compressed through the whole distance "
+                                                  "between its points at t = ") &&
+                                    Catch::Contains("(intact): its points are ") && Catch::Contains("of a free_length of 1,"));
+    const double t_message = std::stod(outcome.message.substr(outcome.message.find("at t = ") + 7));
+    CHECK(t_message == Approx(w.t).epsilon(euler ? 1e-4 : 1e-6));
+    CHECK(outcome.t_reached <= t_message);  // the run keeps its samples up to there
+    CHECK(outcome.stats.handed_over_at < 0.0);  // auto: not an IDA failure, no hand-over to Euler
+  }
+  // A step that carries the mass past the ground point (Euler at 1 ms moves it 26 mm) is caught
+  // as well, and the message says so.
+  const LoadedModel coarse =
+      testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -v0, 0.0, 0.2, "euler", 1e-3));
+  DaeSystem system(coarse.model);
+  struct Quiet : RunObserver {
+    void sample(double, const double*, const double*, const double*, const double*) override {}
+  } observer;
+  const RunOutcome outcome = make_integrator(system, coarse.run_spec.simulation)->run(0.2, 0.001, observer);
+  INFO(outcome.message);
+  CHECK_FALSE(outcome.ok);
+  CHECK_THAT(outcome.message, Catch::Contains("draft_gear 'e' is compressed through") &&
+                                  Catch::Contains("its points have passed each other (by "));
+}
+
+TEST_CASE("draft_gear: the points-meet root measures along the turned initial direction, near the points alone",
+          "[elements][couplers][faults]") {
+  // The gear from ground (body 1, axis +x) to a mass 1 m along +x: free length 1 m, margin 1 mm.
+  GearByHand h;
+  const double margin = DraftGear::kPointsMeetFraction * 1.0;
+  const auto at = [&](double x, double y) {
+    h.y[0] = x;
+    h.y[1] = y;
+    return gather_state(h.gear, h.y.data(), h.y.data() + 3, h.system.modes().of(0));
+  };
+  CHECK(h.gear.points_meet_gap(at(1.0, 0.0)) == Approx(1.0 - margin));
+  CHECK(h.gear.points_meet_gap(at(0.002, 0.0)) == Approx(0.002 - margin));  // about to meet
+  CHECK(h.gear.points_meet_gap(at(0.0005, 0.0)) < 0.0);                      // within the margin
+  CHECK(h.gear.points_meet_gap(at(-0.3, 0.0)) == Approx(-0.3 - margin));     // passed, close by
+  // Swung about body 1, far from it: a gear whose far end has gone round, not one whose points met.
+  CHECK(h.gear.points_meet_gap(at(0.0, 1.0)) == Approx(1.0 - margin));
+  CHECK(h.gear.points_meet_gap(at(-0.8, 0.0)) == Approx(0.8 - margin));
+}
+
+TEST_CASE("draft_gear: a fractured gear's points may pass each other, the run goes on (the report's final_two_car)",
+          "[elements][couplers][faults]") {
+  // Fracture at 5e4 N during the bottomed phase; after it no force acts and the mass coasts past
+  // the gear's ground point (its line of action has no direction there, and no force to direct).
+  const Gear g{1.0e5, 0.05, 1.0e5, 1.0e4, 1.0e6};
+  const double v0 = 30.0;
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const LoadedModel loaded = testing::loaded_from_text(
+        one_mass(gear_yaml(g, "    fracture_load: 5.0e4\n"), kGearMass, 1.0, 0.0, -v0, 0.0, 0.1, integrator));
+    DaeSystem system(loaded.model);
+    const Run r = run(system, loaded.run_spec.simulation);
+    CHECK(r.x < -1.0);  // well past the ground point
+    CHECK(system.modes().as<DraftGear::State>(0).stage == DraftGear::Stage::Fractured);
+    CHECK(r.outcome.events.back().what == "fracture");
+  }
+}
+
 TEST_CASE("draft_gear: in draft the pin does not shear, the gear fractures at the fracture load",
           "[elements][couplers]") {
   const double fracture = 1.0e5, v0 = 10.0;

@@ -85,6 +85,17 @@
 // fracture_load (buff or draft, before or after pin shear) the element carries no force
 // from then on ("fracture"). Event value for "pin shear" and "fracture": the force.
 // Force on P2 = +F (r2 - r1) / L, on P1 the opposite.
+// Points meeting: while the gear carries force (intact, or solid after pin shear), its points
+// coming within 1e-3 free_length of each other, or passing each other, stops the run with a
+// message naming the element: there (r2 - r1) / L has no direction, and a step that carried P2
+// past P1 turned the force around (Euler did so under 540 kN in a unit whose gears were
+// shorter than the crush zones beside them: a silent wrong answer). "Passed" is measured along
+// the initial direction P1 -> P2 turned with body 1 (as crush_spring's), and counts only while
+// the points are within half the free length: a gear that swings about body 1 (an unguided
+// coupling whose ends part vertically) is not taken for one whose points met. A sheared or
+// fractured gear carries no force, and its points may pass (the report's final_two_car: after
+// fracture car1's yoke comes within 1.5e-5 in of its housing's centre under IDA, and Euler
+// carries it past).
 // Report values (Table 5, repeated in Table 8; they read cleanly in both scans): initial
 // stiffness 24,000 lb/in, travel 1.25 in, stiffness after bottoming 320,000 lb/in,
 // hysteresis load 10,000 lb, pin shear load 150,000 lb, post-shear travel 1.375 in,
@@ -354,7 +365,15 @@ class DraftGear : public HybridElement<DraftGear> {
   }
 
   void initialize(const ElementState<double>& initial) override;
-  static constexpr int kRoots = AxialHysteresis::kRoots + 2;  // + pin shear, fracture
+  static constexpr int kRoots = AxialHysteresis::kRoots + 3;  // + pin shear, fracture, points meet
+  /// The last root, while the gear carries force: its points come within kPointsMeetFraction of
+  /// the free length of each other, or pass each other (the header comment). The run stops there
+  /// (SolverError from commit_in).
+  static constexpr int kPointsMeetRoot = AxialHysteresis::kRoots + 2;
+  static constexpr double kPointsMeetFraction = 1e-3;  // [-] of free_length
+  /// The points-meet root's value: |r2 - r1| less the margin, negative once the points have
+  /// passed each other [length].
+  double points_meet_gap(const ElementState<double>& s) const;
   int root_count() const override { return kRoots; }
   void roots_in(const State& st, const ElementState<double>& s, double* g) const;
   bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
@@ -375,8 +394,13 @@ class DraftGear : public HybridElement<DraftGear> {
   void roots_at(const State& st, const Kinematics& k, double* g) const;
   void apply(State& st, int index, const Kinematics& k, Event& event) const;
 
+  /// Whether the gear carries force in stage `stage` (its points meeting then stops the run).
+  static bool carries_force(Stage stage) { return stage == Stage::Intact || stage == Stage::Solid; }
+  [[noreturn]] void points_met(double t, const State& st, const ElementState<double>& s) const;
+
   AxialHysteresis law_;
   State initial_state_;  // the mode a run starts in (from the initial configuration)
+  Vec2<double> reference_axis_{1.0, 0.0};  // [-] initial unit direction P1 -> P2 in body 1's frame (initialize)
 };
 
 class CouplerEnd : public HybridElement<CouplerEnd> {
