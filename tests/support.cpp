@@ -66,14 +66,25 @@ RunOutcome simulate(const LoadedModel& loaded, double output_interval) {
   return simulate(system, loaded.run_spec.simulation, output_interval);
 }
 
-RunOutcome simulate(DaeSystem& system, const SimulationSettings& simulation, double output_interval) {
+namespace {
+RunOutcome run_quietly(DaeSystem& system, const SimulationSettings& simulation, double output_interval) {
   struct Quiet : RunObserver {
     void sample(double, const double*, const double*, const double*, const double*) override {}
   } observer;
-  RunOutcome outcome = make_integrator(system, simulation)->run(simulation.t_end, output_interval, observer);
+  return make_integrator(system, simulation)->run(simulation.t_end, output_interval, observer);
+}
+}  // namespace
+
+RunOutcome simulate(DaeSystem& system, const SimulationSettings& simulation, double output_interval) {
+  RunOutcome outcome = run_quietly(system, simulation, output_interval);
   INFO(outcome.message);
   REQUIRE(outcome.ok);
   return outcome;
+}
+
+RunOutcome simulate_to_stop(const LoadedModel& loaded, double output_interval) {
+  DaeSystem system(loaded.model);
+  return run_quietly(system, loaded.run_spec.simulation, output_interval);
 }
 
 BodyState split(const DaeSystem& system, const std::vector<double>& y) {

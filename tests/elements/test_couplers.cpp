@@ -487,13 +487,8 @@ TEST_CASE("draft_gear: its points meeting while it carries force stops the run n
   for (const char* integrator : {"ida", "euler", "auto"}) {
     INFO(integrator);
     const bool euler = std::string(integrator) == "euler";
-    const LoadedModel loaded =
-        testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -v0, 0.0, 0.2, integrator));
-    DaeSystem system(loaded.model);
-    struct Quiet : RunObserver {
-      void sample(double, const double*, const double*, const double*, const double*) override {}
-    } observer;
-    const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.2, 0.001, observer);
+    const RunOutcome outcome = testing::simulate_to_stop(
+        testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -v0, 0.0, 0.2, integrator)));
     INFO(outcome.message);
     CHECK_FALSE(outcome.ok);
     CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: draft_gear 'e' is compressed through the whole distance "
@@ -506,13 +501,8 @@ TEST_CASE("draft_gear: its points meeting while it carries force stops the run n
   }
   // A step that carries the mass past the ground point (Euler at 1 ms moves it 26 mm) is caught
   // as well, and the message says so.
-  const LoadedModel coarse =
-      testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -v0, 0.0, 0.2, "euler", 1e-3));
-  DaeSystem system(coarse.model);
-  struct Quiet : RunObserver {
-    void sample(double, const double*, const double*, const double*, const double*) override {}
-  } observer;
-  const RunOutcome outcome = make_integrator(system, coarse.run_spec.simulation)->run(0.2, 0.001, observer);
+  const RunOutcome outcome = testing::simulate_to_stop(
+      testing::loaded_from_text(one_mass(gear_yaml(g), kGearMass, 1.0, 0.0, -v0, 0.0, 0.2, "euler", 1e-3)));
   INFO(outcome.message);
   CHECK_FALSE(outcome.ok);
   CHECK_THAT(outcome.message, Catch::Contains("draft_gear 'e' is compressed through") &&

@@ -363,13 +363,7 @@ TEST_CASE("crush spring crushed through its free length stops the run naming it 
   const double t_meet = gap / speed + t_y + (v_y - std::sqrt(v_y * v_y - 2.0 * a * plastic)) / a;  // [s] 0.0375
   for (const char* integrator : {"ida", "euler", "auto"}) {
     INFO(integrator);
-    const LoadedModel loaded = testing::loaded_from_text(impact(speed, gap, integrator));
-    const Model& model = loaded.model;
-    DaeSystem system(model);
-    struct Quiet : RunObserver {
-      void sample(double, const double*, const double*, const double*, const double*) override {}
-    } observer;
-    const RunOutcome outcome = make_integrator(system, loaded.run_spec.simulation)->run(0.2, 0.001, observer);
+    const RunOutcome outcome = testing::simulate_to_stop(testing::loaded_from_text(impact(speed, gap, integrator)));
     INFO(outcome.message);
     CHECK_FALSE(outcome.ok);
     CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: crush_spring 'crush' is crushed through its whole length at t = "));
