@@ -419,10 +419,8 @@ DraftGear::Kinematics DraftGear::kinematics(const ElementState<double>& s) const
 
 void DraftGear::initialize(const ElementState<double>& initial) {
   require_direction(*this, initial);
-  const LineGeometry<double> line = line_geometry(*this, initial);
-  const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(point_slot(0))];
-  reference_axis_ = {(r.cos * line.d.x + r.sin * line.d.y) / line.length, (-r.sin * line.d.x + r.cos * line.d.y) / line.length};
-  if (!free_length) free_length = line.length;
+  points_meet_.initialize(*this, initial);
+  if (!free_length) free_length = line_geometry(*this, initial).length;
   const Kinematics k = kinematics(initial);
   State& st = initial_state_;
   st = State{};
@@ -464,33 +462,6 @@ void DraftGear::roots_in(const State& st, const ElementState<double>& s, double*
   if (carries_force(st.stage)) g[kPointsMeetRoot] = points_meet_gap(s);
 }
 
-double DraftGear::points_meet_gap(const ElementState<double>& s) const {
-  const LineGeometry<double> line = line_geometry(*this, s);
-  const double margin = kPointsMeetFraction * *free_length;  // [length]
-  const auto k1 = static_cast<std::size_t>(point_slot(0));
-  const Vec2<double> axis = rotate(s.rotation[k1], reference_axis_.x, reference_axis_.y);
-  // Passed: P2 behind P1 along the turned initial direction, the two close together. Only the
-  // second keeps a gear that swings about body 1 (P2 abeam of P1, far from it) running.
-  const bool passed = dot(line.d, axis) <= 0.0 && line.length < 0.5 * *free_length;
-  return passed ? -line.length - margin : line.length - margin;
-}
-
-void DraftGear::points_met(double t, const State& st, const ElementState<double>& s) const {
-  const LineGeometry<double> line = line_geometry(*this, s);
-  const bool passed = points_meet_gap(s) + kPointsMeetFraction * *free_length < 0.0;
-  char where_now[96];
-  if (passed) std::snprintf(where_now, sizeof where_now, "its points have passed each other (by %g)", line.length);
-  else std::snprintf(where_now, sizeof where_now, "its points are %g apart", line.length);
-  char text[600];
-  std::snprintf(text, sizeof text,
-                "' is compressed through the whole distance between its points at t = %.6g s (%s): %s, of a "
-                "free_length of %g, where its force has no direction left. The gear needs a stroke it does not "
-                "have: set its points farther apart (at least the compression its law must reach), or give a "
-                "stiffness_after_bottoming, pin_shear_load or fracture_load that ends the travel first",
-                t, st.stage == Stage::Solid ? "solid after pin shear" : "intact", where_now, *free_length);
-  throw SolverError(where().prefix() + "draft_gear '" + name() + text);
-}
-
 void DraftGear::apply(State& st, int index, const Kinematics& k, Event& event) const {
   const double force = gear_force(st, k.d);
   if (index == kFractureRoot) {
@@ -529,7 +500,10 @@ bool DraftGear::commit_in(State& st, int index, int direction, double t, const E
   // Checked whatever root fired: a step known at its end alone (Euler's) commits one root per
   // element, and the step that carries P2 past P1 may cross another of the gear's roots first.
   if (carries_force(st.stage) && (points_meet_gap(s) < 0.0 || (index == kPointsMeetRoot && direction < 0)))
-    points_met(t, st, s);
+    points_meet_.stop(*this, t, s, *free_length, st.stage == Stage::Solid ? "solid after pin shear" : "intact",
+                      "The gear needs a stroke it does not have: set its points farther apart (at least the compression "
+                      "its law must reach), or give a stiffness_after_bottoming, pin_shear_load or fracture_load that "
+                      "ends the travel first");
   if (index == kPointsMeetRoot) return false;
   const Kinematics k = kinematics(s);
   return commit_crossing<kRoots>(

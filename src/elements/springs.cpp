@@ -1,7 +1,10 @@
 #include "railcrash/elements/springs.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
+#include "railcrash/core/error.hpp"
 #include "railcrash/model/element_registry.hpp"
 
 namespace railcrash {
@@ -11,6 +14,42 @@ void require_direction(const Element& e, const ElementState<double>& initial) {
     throw InputError(e.where().prefix() + e.type() + " '" + e.name() +
                      "': its two points coincide in the initial configuration, so it has no direction; move them apart" +
                      (e.type() == "special_spring" ? " or give it an axis" : ""));
+}
+
+void PointsMeet::initialize(const Element& e, const ElementState<double>& initial) {
+  const LineGeometry<double> line = line_geometry(e, initial);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(e.point_slot(static_cast<int>(k)))];
+    reference_axis_[k] = {(r.cos * line.d.x + r.sin * line.d.y) / line.length,
+                          (-r.sin * line.d.x + r.cos * line.d.y) / line.length};
+  }
+}
+
+double PointsMeet::gap(const Element& e, const ElementState<double>& s, double free_length) const {
+  const LineGeometry<double> line = line_geometry(e, s);
+  const double margin = kFraction * free_length;  // [length]
+  bool passed = true;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Vec2<double> axis =
+        rotate(s.rotation[static_cast<std::size_t>(e.point_slot(static_cast<int>(k)))], reference_axis_[k].x, reference_axis_[k].y);
+    passed = passed && dot(line.d, axis) <= 0.0;
+  }
+  passed = passed && line.length < kPassedFraction * free_length;
+  return passed ? -line.length - margin : line.length - margin;
+}
+
+void PointsMeet::stop(const Element& e, double t, const ElementState<double>& s, double free_length,
+                      const std::string& state, const std::string& advice) const {
+  const double length = line_geometry(e, s).length;
+  const bool passed = gap(e, s, free_length) + kFraction * free_length < 0.0;
+  char where_now[96];
+  if (passed) std::snprintf(where_now, sizeof where_now, "its points have passed each other (by %g)", length);
+  else std::snprintf(where_now, sizeof where_now, "its points are %g apart", length);
+  char text[300];
+  std::snprintf(text, sizeof text, "' is compressed through the whole distance between its points at t = %.6g s%s: %s, "
+                "of a free_length of %g, where its force has no direction left. ",
+                t, state.empty() ? "" : (" (" + state + ")").c_str(), where_now, free_length);
+  throw SolverError(e.where().prefix() + e.type() + " '" + e.name() + text + advice);
 }
 
 LinearSpring::LinearSpring(ElementSpec& spec)
@@ -25,6 +64,20 @@ void LinearSpring::initialize(const ElementState<double>& initial) {
     throw InputError(where().prefix() + "linear_spring '" + name() +
                      "': its two points coincide in the initial configuration, so the spring has no direction; "
                      "move the points apart or set free_length: 0");
+  if (length > 0.0) points_meet_.initialize(*this, initial);
+}
+
+void LinearSpring::roots(double, const ElementState<double>& s, const double*, double* g) const {
+  g[0] = *free_length > 0.0 ? points_meet_.gap(*this, s, *free_length) : 1.0;
+}
+
+bool LinearSpring::commit(int index, int direction, double t, const ElementState<double>& s, const double*, void*,
+                          Event&) const {
+  if (*free_length > 0.0 && (points_meet_.gap(*this, s, *free_length) < 0.0 || (index == 0 && direction < 0)))
+    points_meet_.stop(*this, t, s, *free_length, "",
+                      "The spring needs a stroke it does not have: keep its points apart (a stiffer spring, its points "
+                      "farther apart, or a contact or crush element that stops the motion first)");
+  return false;
 }
 
 double LinearSpring::potential_energy(const ElementState<double>& s) const {
@@ -82,7 +135,9 @@ void TorsionalDashpot::outputs(const ElementState<double>& s, const double*, dou
 void register_spring_elements(ElementRegistry& registry) {
   const std::string two_points = "P1 on body 1, P2 on body 2: the ends";
   registry.add({"linear_spring", "1", 2, two_points,
-                "Linear spring along P1-P2: tension T = stiffness (L - free_length), L the distance between the points.",
+                "Linear spring along P1-P2: tension T = stiffness (L - free_length), L the distance between the points. "
+                "With a free length, its points meeting (within 1e-3 free_length) or passing each other stops the run, "
+                "naming it.",
                 {{"stiffness", Unit::ForcePerLength, required, Range::NonNegative, "spring rate"},
                  {"free_length", Unit::Length, optional("the initial distance P1-P2"), Range::NonNegative,
                   "length at zero force"}},

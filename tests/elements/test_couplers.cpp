@@ -477,7 +477,7 @@ TEST_CASE("draft_gear: its points meeting while it carries force stops the run n
   // points-meet margin, compression 0.999 m. Before this check Euler carried the mass past the
   // ground point with the force turned around (the gear's line of action reverses with r2 - r1).
   const Gear g{1.0e5, 0.05, 1.0e5, 1.0e4, 1.0e6};
-  const double v0 = 30.0, meet = 1.0 - DraftGear::kPointsMeetFraction;
+  const double v0 = 30.0, meet = 1.0 - PointsMeet::kFraction;
   const auto compression = [](double x) { return x; };
   Walker w(kGearMass, v0);
   w.go(0.0, g.Kt, g.H / (g.Kt - g.k), "sliding (buff)", compression);
@@ -513,7 +513,7 @@ TEST_CASE("draft_gear: the points-meet root measures along the turned initial di
           "[elements][couplers][faults]") {
   // The gear from ground (body 1, axis +x) to a mass 1 m along +x: free length 1 m, margin 1 mm.
   GearByHand h;
-  const double margin = DraftGear::kPointsMeetFraction * 1.0;
+  const double margin = PointsMeet::kFraction * 1.0;
   const auto at = [&](double x, double y) {
     h.y[0] = x;
     h.y[1] = y;
@@ -522,10 +522,16 @@ TEST_CASE("draft_gear: the points-meet root measures along the turned initial di
   CHECK(h.gear.points_meet_gap(at(1.0, 0.0)) == Approx(1.0 - margin));
   CHECK(h.gear.points_meet_gap(at(0.002, 0.0)) == Approx(0.002 - margin));  // about to meet
   CHECK(h.gear.points_meet_gap(at(0.0005, 0.0)) < 0.0);                      // within the margin
-  CHECK(h.gear.points_meet_gap(at(-0.3, 0.0)) == Approx(-0.3 - margin));     // passed, close by
-  // Swung about body 1, far from it: a gear whose far end has gone round, not one whose points met.
+  CHECK(h.gear.points_meet_gap(at(-0.03, 0.0)) == Approx(-0.03 - margin));   // passed
+  CHECK(h.gear.points_meet_gap(at(-0.3, 0.0)) == Approx(-0.3 - margin));     // passed (an explicit step's jump)
+  // Abeam of body 1, or behind it farther than half the free length: swung round, not passed.
   CHECK(h.gear.points_meet_gap(at(0.0, 1.0)) == Approx(1.0 - margin));
   CHECK(h.gear.points_meet_gap(at(-0.8, 0.0)) == Approx(0.8 - margin));
+  // Behind P1 along body 1's turned axis but not along body 2's: the mass has turned round with
+  // the gear (a half turn, as a crank would carry it): swung, not passed.
+  h.y[2] = kPi;
+  CHECK(h.gear.points_meet_gap(at(-0.3, 0.0)) == Approx(0.3 - margin));
+  h.y[2] = 0.0;
 }
 
 TEST_CASE("draft_gear: a fractured gear's points may pass each other, the run goes on (the report's final_two_car)",

@@ -475,3 +475,50 @@ TEST_CASE("linear_spring output force is positive when stretched and negative wh
   // A stretched spring pulls the body back towards the ground point.
   CHECK(forces(stretched_system, split(stretched_system, stretched_system.initial_state()))[0] == Approx(-5.0));
 }
+
+namespace {
+/// A 1 kg mass 1 m along +x from a ground point, moving towards it at `speed`, tied to it by a
+/// linear_spring of 10 N/m with free length `free_length`.
+std::string spring_impact(double speed, double free_length, const std::string& integrator, double dt = 1e-5) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "railcrash: 1\nname: spring impact\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: mass, mass: 1, inertia: 1, position: [1, 0], velocity: [" << -speed << ", 0]}\n"
+    << "elements:\n  - {name: k, type: linear_spring, stiffness: 10, free_length: " << free_length
+    << ", points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+    << "simulation: {t_end: 1, integrator: " << integrator << ", rtol: 1e-10, dt: " << dt << ", output_interval: 0.01}\n";
+  return s.str();
+}
+}  // namespace
+
+TEST_CASE("linear_spring compressed through its points stops the run naming it under every integrator",
+          "[elements][faults]") {
+  // 10 m/s against 10 N/m over 1 m: x = L0 - (v0 / w) sin(w t), w = sqrt(10), an amplitude of
+  // 3.16 m, so the mass reaches the ground point; the stop is at x = 1e-3 L0. Before it Euler
+  // carried the mass past the point with the spring's push k L0 turned around.
+  const double v0 = 10.0, w = std::sqrt(10.0);
+  const double t_meet = std::asin((1.0 - PointsMeet::kFraction) * w / v0) / w;  // [s] 0.1016
+  for (const char* integrator : {"ida", "euler", "auto"}) {
+    INFO(integrator);
+    const RunOutcome outcome = testing::simulate_to_stop(testing::loaded_from_text(spring_impact(v0, 1.0, integrator)));
+    INFO(outcome.message);
+    CHECK_FALSE(outcome.ok);
+    CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: linear_spring 'k' is compressed through the whole distance "
+                                                  "between its points at t = ") &&
+                                    Catch::Contains("s: its points are ") && Catch::Contains("of a free_length of 1,"));
+    const double t_message = std::stod(outcome.message.substr(outcome.message.find("at t = ") + 7));
+    CHECK(t_message == Approx(t_meet).epsilon(std::string(integrator) == "euler" ? 1e-3 : 1e-6));
+  }
+  // A step that carries the mass past the point (Euler at 5 ms moves it about 47 mm) says so.
+  const RunOutcome coarse = testing::simulate_to_stop(testing::loaded_from_text(spring_impact(v0, 1.0, "euler", 5e-3)));
+  CHECK_THAT(coarse.message, Catch::Contains("linear_spring 'k' is compressed through") &&
+                                 Catch::Contains("its points have passed each other (by "));
+  // A spring of zero free length pulls with k (r2 - r1), defined at every separation: the mass
+  // swings through the point and the run goes on (x = -(v0 / w) sin(w t) ... from x = 1).
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const RunOutcome through = testing::simulate(testing::loaded_from_text(spring_impact(v0, 0.0, integrator)));
+    const double x_end = std::cos(w) - v0 / w * std::sin(w);  // [m] at t = 1
+    CHECK(through.y[0] == Approx(x_end).epsilon(std::string(integrator) == "euler" ? 1e-3 : 1e-7));
+  }
+}

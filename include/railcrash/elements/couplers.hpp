@@ -87,12 +87,10 @@
 // Force on P2 = +F (r2 - r1) / L, on P1 the opposite.
 // Points meeting: while the gear carries force (intact, or solid after pin shear), its points
 // coming within 1e-3 free_length of each other, or passing each other, stops the run with a
-// message naming the element: there (r2 - r1) / L has no direction, and a step that carried P2
-// past P1 turned the force around (Euler did so under 540 kN in a unit whose gears were
-// shorter than the crush zones beside them: a silent wrong answer). "Passed" is measured along
-// the initial direction P1 -> P2 turned with body 1 (as crush_spring's), and counts only while
-// the points are within half the free length: a gear that swings about body 1 (an unguided
-// coupling whose ends part vertically) is not taken for one whose points met. A sheared or
+// message naming the element (springs.hpp, PointsMeet): there (r2 - r1) / L has no direction,
+// and a step that carried P2 past P1 turned the force around (Euler did so under 540 kN in a
+// unit whose gears were shorter than the crush zones beside them: a silent wrong answer). A
+// gear that swings about body 1 (an unguided coupling whose ends part vertically) runs on. A sheared or
 // fractured gear carries no force, and its points may pass (the report's final_two_car: after
 // fracture car1's yoke comes within 1.5e-5 in of its housing's centre under IDA, and Euler
 // carries it past).
@@ -366,14 +364,12 @@ class DraftGear : public HybridElement<DraftGear> {
 
   void initialize(const ElementState<double>& initial) override;
   static constexpr int kRoots = AxialHysteresis::kRoots + 3;  // + pin shear, fracture, points meet
-  /// The last root, while the gear carries force: its points come within kPointsMeetFraction of
+  /// The last root, while the gear carries force: its points come within PointsMeet::kFraction of
   /// the free length of each other, or pass each other (the header comment). The run stops there
   /// (SolverError from commit_in).
   static constexpr int kPointsMeetRoot = AxialHysteresis::kRoots + 2;
-  static constexpr double kPointsMeetFraction = 1e-3;  // [-] of free_length
-  /// The points-meet root's value: |r2 - r1| less the margin, negative once the points have
-  /// passed each other [length].
-  double points_meet_gap(const ElementState<double>& s) const;
+  /// The points-meet root's value (PointsMeet::gap) [length].
+  double points_meet_gap(const ElementState<double>& s) const { return points_meet_.gap(*this, s, *free_length); }
   int root_count() const override { return kRoots; }
   void roots_in(const State& st, const ElementState<double>& s, double* g) const;
   bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
@@ -396,11 +392,10 @@ class DraftGear : public HybridElement<DraftGear> {
 
   /// Whether the gear carries force in stage `stage` (its points meeting then stops the run).
   static bool carries_force(Stage stage) { return stage == Stage::Intact || stage == Stage::Solid; }
-  [[noreturn]] void points_met(double t, const State& st, const ElementState<double>& s) const;
 
   AxialHysteresis law_;
   State initial_state_;  // the mode a run starts in (from the initial configuration)
-  Vec2<double> reference_axis_{1.0, 0.0};  // [-] initial unit direction P1 -> P2 in body 1's frame (initialize)
+  PointsMeet points_meet_;
 };
 
 class CouplerEnd : public HybridElement<CouplerEnd> {
