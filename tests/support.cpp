@@ -87,6 +87,11 @@ RunOutcome simulate_to_stop(const LoadedModel& loaded, double output_interval) {
   return run_quietly(system, loaded.run_spec.simulation, output_interval);
 }
 
+double message_time(const std::string& message) {
+  const std::size_t at = message.find("at t = ");
+  return at == std::string::npos ? std::numeric_limits<double>::quiet_NaN() : std::stod(message.substr(at + 7));
+}
+
 BodyState split(const DaeSystem& system, const std::vector<double>& y) {
   const auto nq = static_cast<std::ptrdiff_t>(system.body_unknowns());
   return {{y.begin(), y.begin() + nq}, {y.begin() + nq, y.begin() + 2 * nq}};

@@ -34,6 +34,8 @@ RunOutcome simulate(const LoadedModel& loaded, double output_interval = 0.01);
 RunOutcome simulate(DaeSystem& system, const SimulationSettings& simulation, double output_interval = 0.01);
 /// The same for a run that may stop early (a test of a stop's message): the outcome, ok or not.
 RunOutcome simulate_to_stop(const LoadedModel& loaded, double output_interval = 0.001);
+/// The time a stop's message names ("... at t = T s ..."); NaN without one.
+double message_time(const std::string& message);
 
 /// The system's element modes to write by hand (an element test commits an element directly or
 /// sets its mode), through a ModeTracker of the system: their one writer. The reference is the

@@ -494,7 +494,7 @@ TEST_CASE("draft_gear: its points meeting while it carries force stops the run n
     CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: draft_gear 'e' is compressed through the whole distance "
                                                   "between its points at t = ") &&
                                     Catch::Contains("(intact): its points are ") && Catch::Contains("of a free_length of 1,"));
-    const double t_message = std::stod(outcome.message.substr(outcome.message.find("at t = ") + 7));
+    const double t_message = testing::message_time(outcome.message);
     CHECK(t_message == Approx(w.t).epsilon(euler ? 1e-4 : 1e-6));
     CHECK(outcome.t_reached <= t_message);  // the run keeps its samples up to there
     CHECK(outcome.stats.handed_over_at < 0.0);  // auto: not an IDA failure, no hand-over to Euler

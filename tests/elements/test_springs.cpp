@@ -506,7 +506,7 @@ TEST_CASE("linear_spring compressed through its points stops the run naming it u
     CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: linear_spring 'k' is compressed through the whole distance "
                                                   "between its points at t = ") &&
                                     Catch::Contains("s: its points are ") && Catch::Contains("of a free_length of 1,"));
-    const double t_message = std::stod(outcome.message.substr(outcome.message.find("at t = ") + 7));
+    const double t_message = testing::message_time(outcome.message);
     CHECK(t_message == Approx(t_meet).epsilon(std::string(integrator) == "euler" ? 1e-3 : 1e-6));
   }
   // A step that carries the mass past the point (Euler at 5 ms moves it about 47 mm) says so.
