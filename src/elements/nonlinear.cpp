@@ -106,6 +106,7 @@ template <class Derived>
 void PiecewiseLineElement<Derived>::initialize(const ElementState<double>& initial) {
   Derived& self = *static_cast<Derived*>(this);
   self.prepare(initial);
+  if (checks_points_meet_) points_meet_.initialize(*this, initial);
   const double x = self.measure(initial);
   SegmentMode& m = initial_mode_;
   m = SegmentMode{};
@@ -134,12 +135,22 @@ void PiecewiseLineElement<Derived>::roots_in(const SegmentMode& m, const Element
     g[2] = *fracture_load - f;
     if (fracture_roots() > 1) g[3] = *fracture_load + f;
   }
+  if (checks_points_meet_) g[points_meet_root()] = points_meet_gap(s);
 }
 
 template <class Derived>
-bool PiecewiseLineElement<Derived>::commit_in(SegmentMode& m, int index, int direction, double,
+double PiecewiseLineElement<Derived>::points_meet_gap(const ElementState<double>& s) const {
+  const double free_length = static_cast<const Derived*>(this)->points_meet_length();
+  return free_length > 0.0 ? points_meet_.gap(*this, s, free_length) : 1.0;
+}
+
+template <class Derived>
+bool PiecewiseLineElement<Derived>::commit_in(SegmentMode& m, int index, int direction, double t,
                                               const ElementState<double>& s, Element::Event& event) const {
   if (m.broken) return false;
+  if (checks_points_meet_ && (points_meet_gap(s) < 0.0 || (index == points_meet_root() && direction < 0)))
+    points_meet_.stop(*this, t, s, static_cast<const Derived*>(this)->points_meet_length(), "", PointsMeet::kSpringAdvice);
+  if (checks_points_meet_ && index == points_meet_root()) return false;
   const double x = measure_of(s);
   if (index >= 2) {  // fracture roots: leave when they fall through zero
     if (direction > 0) return false;
@@ -223,6 +234,7 @@ NonlinearSpring::NonlinearSpring(ElementSpec& spec)
   if (fracture_load && std::abs(preload) >= *fracture_load)
     spec.parameters->fail("preload", "'preload' must be smaller in size than 'fracture_load' (the spring would break at once)");
   set_law(PiecewiseLinearLaw::two_branch(-preload, compression, "compression", extension, "extension"));
+  set_points_meet(true);
 }
 
 int NonlinearSpring::rate_sign(const ElementState<double>& s) const { return sign_of(length_rate(s, *this)); }
@@ -282,6 +294,7 @@ SpecialSpring::SpecialSpring(ElementSpec& spec) : PiecewiseLineElement<SpecialSp
     breakpoints.push_back(b);
   }
   set_law(PiecewiseLinearLaw(breakpoints, segments));
+  set_points_meet(kind == 1 && !axis);  // along an axis the separation has a sign; in tension it pushes nothing
 }
 
 double SpecialSpring::separation(const ElementState<double>& s) const {
@@ -348,7 +361,8 @@ void register_nonlinear_elements(ElementRegistry& registry) {
       {"nonlinear_spring", "19", 2, ends,
        "Piecewise-linear spring along P1-P2: two slopes on each side of e = L - free_length: tension T = -preload + "
        "compression_stiffness_1 e (e < 0) or extension_stiffness_1 e (e > 0), continuing with the second slope beyond "
-       "the breakpoint; continuous in e, elastic; breaks when |T| reaches fracture_load.",
+       "the breakpoint; continuous in e, elastic; breaks when |T| reaches fracture_load. Its points meeting (within "
+       "1e-3 free_length) or passing each other stops the run, naming it.",
        joined(joined(branch_specs("compression_stiffness_1", "compression_stiffness_2", "compression_breakpoint",
                                   "compression branch", Unit::ForcePerLength, Unit::Length),
                      branch_specs("extension_stiffness_1", "extension_stiffness_2", "extension_breakpoint",
@@ -377,7 +391,8 @@ void register_nonlinear_elements(ElementRegistry& registry) {
        "One-sided contact spring: kind 1 acts in compression (d = free_length - L, pushes the points apart), kind 2 "
        "in tension (d = L - free_length, pulls them together). No force while d < 0; P = preload + stiffness_1 d, "
        "then stiffness_2 beyond the breakpoint. With an axis the length is measured along it and the force acts "
-       "along it. Breaks when P reaches fracture_load.",
+       "along it. Breaks when P reaches fracture_load. Kind 1 without an axis: its points meeting (within 1e-3 "
+       "free_length) or passing each other stops the run, naming it.",
        joined({{"kind", Unit::Choice, default_value(1), Range::Any, "1: acts in compression, 2: acts in tension"}},
               joined(branch_specs("stiffness_1", "stiffness_2", "breakpoint", "closed law", Unit::ForcePerLength,
                                   Unit::Length),

@@ -833,3 +833,36 @@ TEST_CASE("Euler's stability limit sees a piecewise law's steepest segment befor
   DaeSystem system(model);
   CHECK(EulerIntegrator::estimate_stability_limit(system, system.initial_state(), nullptr) == Approx(0.01).epsilon(1e-9));
 }
+
+TEST_CASE("nonlinear_spring and special_spring compressed through their points stop the run naming them",
+          "[elements][faults]") {
+  // As the linear spring's test (test_springs.cpp): a 1 kg mass 1 m from a ground point at
+  // 10 m/s into 10 N/m over a free length of 1 m reaches the point; the stop is at x = 1e-3 m,
+  // t = asin(0.999 w / v0) / w, w = sqrt(10). Along an axis a special spring's separation has a
+  // sign and its force a direction, so it has no such stop: the mass goes through.
+  const double v0 = 10.0, w = std::sqrt(10.0);
+  const double t_meet = std::asin((1.0 - PointsMeet::kFraction) * w / v0) / w;  // [s] 0.1016
+  const auto model = [](const std::string& element, const std::string& integrator) {
+    return "railcrash: 1\nname: spring impact\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+           "  - {name: mass, mass: 1, inertia: 1, position: [1, 0], velocity: [-10, 0]}\n"
+           "elements:\n  - {name: s, " + element + ", points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+           "simulation: {t_end: 1, integrator: " + integrator + ", rtol: 1e-10, dt: 1e-5, output_interval: 0.01}\n";
+  };
+  const std::string nonlinear = "type: nonlinear_spring, compression_stiffness_1: 10, extension_stiffness_1: 10, free_length: 1";
+  const std::string special = "type: special_spring, kind: 1, stiffness_1: 10, free_length: 1";
+  for (const auto& [element, type] : {std::pair{nonlinear, std::string("nonlinear_spring")}, std::pair{special, std::string("special_spring")}}) {
+    for (const char* integrator : {"ida", "euler"}) {
+      INFO(type << ", " << integrator);
+      const RunOutcome outcome = testing::simulate_to_stop(testing::loaded_from_text(model(element, integrator)));
+      INFO(outcome.message);
+      CHECK_FALSE(outcome.ok);
+      CHECK_THAT(outcome.message, Catch::StartsWith("test.yaml:8: " + type + " 's' is compressed through the whole distance") &&
+                                      Catch::Contains("of a free_length of 1,"));
+      CHECK(testing::message_time(outcome.message) == Approx(t_meet).epsilon(std::string(integrator) == "euler" ? 1e-3 : 1e-6));
+    }
+  }
+  // Along the axis the mass goes 2.16 m past the point and back: a half period pi / w in
+  // contact, then it leaves at 10 m/s, at x = 1 + v0 (1 - pi / w) at t = 1.
+  const RunOutcome along_axis = testing::simulate(testing::loaded_from_text(model(special + ", axis: [1, 0]", "ida")));
+  CHECK(along_axis.y[0] == Approx(1.0 + v0 * (1.0 - std::acos(-1.0) / w)).epsilon(1e-6));
+}

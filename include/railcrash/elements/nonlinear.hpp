@@ -56,6 +56,12 @@
 //     kind: 2 is this program's addition (the report does not say what distinguishes its
 //     types), the same law acting in tension.
 //
+// Points meeting: a nonlinear_spring, and a special_spring of kind 1 without an axis, whose
+// points come within 1e-3 free_length of each other, or pass each other, stop the run with a
+// message naming them (PointsMeet, springs.hpp): along P1-P2 the force has no direction there,
+// and a step that carried one point past the other turned it around. Along an axis the
+// separation has a sign and the force a direction: no such stop.
+//
 // Breakpoints may be zero (the report's nonlinear spring type 5 has an extension breakpoint
 // of 0 in): the first segment is then empty and the second slope acts from the start. A
 // second slope and its breakpoint go together; without them a branch has one slope.
@@ -181,11 +187,15 @@ struct SegmentMode {
 /// stays at zero; the band stays below what the restart look-ahead of DaeSystem moves),
 /// fracture roots (2: fracture_load - f,
 /// 3: fracture_load + f, as many as fracture sides) and the mode bookkeeping.
+/// A spring that pushes its points apart along P1-P2 (nonlinear_spring; special_spring of kind
+/// 1 without an axis) has one more root, the last: its points meeting or passing each other
+/// (PointsMeet, springs.hpp), where the run stops naming it.
 /// Derived provides
 ///   double measure(const ElementState<double>&) const;    x
 ///   int rate_sign(const ElementState<double>&) const;     sign of x', 0 when unknown
 ///   void prepare(const ElementState<double>& initial);     checks and defaults from the initial configuration
 ///   Element::Event segment_event(int from, int to, double x) const;
+///   double points_meet_length() const;                     the free length for PointsMeet (after prepare)
 template <class Derived>
 class PiecewiseLineElement : public HybridElement<Derived> {
  public:
@@ -195,7 +205,7 @@ class PiecewiseLineElement : public HybridElement<Derived> {
   using State = SegmentMode;
   RAILCRASH_ELEMENT_MODE(SegmentMode, initial_mode_)
 
-  int root_count() const override { return 2 + fracture_roots(); }
+  int root_count() const override { return 2 + fracture_roots() + (checks_points_meet() ? 1 : 0); }
   void roots_in(const SegmentMode& m, const ElementState<double>& s, double* g) const;
   bool commit_in(SegmentMode& m, int index, int direction, double t, const ElementState<double>& s,
                  Element::Event& event) const;
@@ -221,6 +231,13 @@ class PiecewiseLineElement : public HybridElement<Derived> {
   void set_law(PiecewiseLinearLaw law);
   /// Number of fracture roots (fixed once the constructor has read fracture_load).
   int fracture_roots() const { return fracture_load ? fracture_sides_ : 0; }
+  /// Whether the element has the points-meet root (fixed once the constructor has run).
+  bool checks_points_meet() const { return checks_points_meet_; }
+  /// Gives the element the points-meet root (a derived constructor, before the run).
+  void set_points_meet(bool checks) { checks_points_meet_ = checks; }
+  /// The points-meet root's index (the last) and value [length]; 1 with a free length of 0.
+  int points_meet_root() const { return 2 + fracture_roots(); }
+  double points_meet_gap(const ElementState<double>& s) const;
   /// Integral of f dx from x = 0 to the state's x in the current mode (0 once broken): the
   /// elastic energy of the springs.
   double law_integral(const ElementState<double>& s) const;
@@ -230,6 +247,8 @@ class PiecewiseLineElement : public HybridElement<Derived> {
   double root_band_ = 0.0;  // [unit of x] distance past a breakpoint at which a segment root fires
   SegmentMode initial_mode_;  // the mode a run starts in (from the initial configuration)
   int fracture_sides_ = 0;
+  bool checks_points_meet_ = false;  // set_points_meet
+  PointsMeet points_meet_;
 };
 
 class NonlinearSpring : public PiecewiseLineElement<NonlinearSpring> {
@@ -252,6 +271,7 @@ class NonlinearSpring : public PiecewiseLineElement<NonlinearSpring> {
   }
 
   double measure(const ElementState<double>& s) const { return line_geometry(*this, s).length - *free_length; }
+  double points_meet_length() const { return *free_length; }
   int rate_sign(const ElementState<double>& s) const;
   void prepare(const ElementState<double>& initial);
   Event segment_event(int from, int to, double x) const;
@@ -278,6 +298,7 @@ class NonlinearDashpot : public PiecewiseLineElement<NonlinearDashpot> {
   }
 
   double measure(const ElementState<double>& s) const;
+  double points_meet_length() const { return 0.0; }  // (no points-meet root)
   int rate_sign(const ElementState<double>&) const { return 0; }  // x' is an acceleration
   void prepare(const ElementState<double>& initial);
   Event segment_event(int from, int to, double x) const;
@@ -346,6 +367,7 @@ class SpecialSpring : public PiecewiseLineElement<SpecialSpring> {
   double separation(const ElementState<double>& s) const;
 
   double measure(const ElementState<double>& s) const { return direction() * (*free_length - separation(s)); }
+  double points_meet_length() const { return *free_length; }
   int rate_sign(const ElementState<double>& s) const;
   void prepare(const ElementState<double>& initial);
   Event segment_event(int from, int to, double x) const;

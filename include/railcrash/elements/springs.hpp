@@ -79,6 +79,10 @@ class PointsMeet {
  public:
   static constexpr double kFraction = 1e-3;        // [-] the margin, of the free length
   static constexpr double kPassedFraction = 0.5;   // [-] behind P1 nearer than this, of the free length: passed
+  /// What a spring's stop message asks for.
+  static constexpr const char* kSpringAdvice =
+      "The spring needs a stroke it does not have: keep its points apart (a stiffer spring, its points farther "
+      "apart, or a contact or crush element that stops the motion first)";
   /// Takes the initial direction P1 -> P2 in each body's frame (the points apart: require_direction).
   void initialize(const Element& e, const ElementState<double>& initial);
   /// The root: |r2 - r1| less the margin, or -|r2 - r1| - margin once the points have passed
