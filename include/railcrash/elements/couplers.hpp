@@ -90,10 +90,10 @@
 // message naming the element (springs.hpp, PointsMeet): there (r2 - r1) / L has no direction,
 // and a step that carried P2 past P1 turned the force around (Euler did so under 540 kN in a
 // unit whose gears were shorter than the crush zones beside them: a silent wrong answer). A
-// gear that swings about body 1 (an unguided coupling whose ends part vertically) runs on. A sheared or
-// fractured gear carries no force, and its points may pass (the report's final_two_car: after
-// fracture car1's yoke comes within 1.5e-5 in of its housing's centre under IDA, and Euler
-// carries it past).
+// gear that swings round (an unguided coupling whose car ends part vertically) runs on. A
+// sheared or fractured gear carries no force, and its points may pass (the report's
+// final_two_car: after fracture car1's yoke comes within 1.5e-5 in of its housing's centre
+// under IDA, and Euler carries it past).
 // Report values (Table 5, repeated in Table 8; they read cleanly in both scans): initial
 // stiffness 24,000 lb/in, travel 1.25 in, stiffness after bottoming 320,000 lb/in,
 // hysteresis load 10,000 lb, pin shear load 150,000 lb, post-shear travel 1.375 in,
