@@ -103,9 +103,7 @@ void CrushSpring::initialize(const ElementState<double>& initial) {
   constexpr double kRoundOffUlps = 16.0;  // a sum of positions and offsets, a difference and a square root
   const double crushed = *free_length - g.length;
   if (crushed > 0.0 && crushed <= kRoundOffUlps * std::numeric_limits<double>::epsilon() * coordinates) free_length = g.length;
-  // The initial direction P1 -> P2 in body 1's frame (the points-meet root).
-  const Rotation<double>& r = initial.rotation[static_cast<std::size_t>(point_slot(0))];
-  reference_axis_ = {(r.cos * g.d.x + r.sin * g.d.y) / g.length, (-r.sin * g.d.x + r.cos * g.d.y) / g.length};
+  points_meet_.initialize(*this, initial);
   initial_state_ = State{};
   const double crush = crush_of(initial);
   enter_mode_at(initial_state_, crush, crush_rate_of(initial));
@@ -131,14 +129,6 @@ void CrushSpring::stiffest_force_jacobian(double, const ElementState<double>& s,
   line_force_law(ad::seeded_state<D>(s), elastic, stiffest, fd);
   std::array<Pose<double>, 2> f{};
   ad::extract_forces(fd, f, df_dq, df_dv);
-}
-
-double CrushSpring::points_meet_gap(const ElementState<double>& s) const {
-  // Signed: the distance along the initial direction, turned with body 1, goes negative when
-  // the points pass each other within a step (Euler's), where the unsigned length may not dip.
-  const auto k1 = static_cast<std::size_t>(point_slot(0));
-  const Vec2<double> axis = rotate(s.rotation[k1], reference_axis_.x, reference_axis_.y);
-  return dot(line_geometry(*this, s).d, axis) - kPointsMeetFraction * *free_length;
 }
 
 void CrushSpring::roots_in(const State& st, const ElementState<double>& s, double* g) const {
@@ -178,17 +168,10 @@ bool CrushSpring::commit_in(State& st, int index, int direction, double t, const
     // No mode goes on from here: the run stops with what it has (Integrator::run keeps the
     // samples up to now and takes this as the run's message; not a step failure, so auto does
     // not hand the run to Euler either).
-    const double ahead = points_meet_gap(s) + kPointsMeetFraction * *free_length;  // P2 ahead of P1 [length]
-    char where_now[96];
-    if (ahead > 0.0) std::snprintf(where_now, sizeof where_now, "its points are %g apart", ahead);
-    else std::snprintf(where_now, sizeof where_now, "its points have passed each other (by %g)", -ahead);
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "' is crushed through its whole length at t = %.6g s: %s, of a free_length of %g, where its "
-                  "force has no direction left. The structure needs a stroke it does not have: give a free_length "
-                  "above the crush its curve must reach, a stiffer end of the curve, or less energy to absorb",
-                  t, where_now, *free_length);
-    throw SolverError(where().prefix() + "crush_spring '" + name() + text);
+    points_meet_.stop(*this, t, s, *free_length, "",
+                      "The structure needs a stroke it does not have: give a free_length above the crush its curve "
+                      "must reach, a stiffer end of the curve, or less energy to absorb",
+                      "is crushed through its whole length");
   }
   switch (st.mode) {
     case Mode::Loading:

@@ -16,9 +16,9 @@
 //   open                  P = 0, or tension_stiffness * (d - d_p) (< 0) when that is given
 //                         leaves when d > d_p (contact again: elastic, or loading if the
 //                         structure has never been crushed)
-// In every mode, L reaching 1e-3 free_length (the points meet) stops the run with a message:
-// the force has no direction there (a curve may be tabulated beyond free_length; that part is
-// never reached).
+// In every mode, L reaching 1e-3 free_length (the points meet), or the points passing each
+// other (PointsMeet, springs.hpp), stops the run with a message: the force has no direction
+// there (a curve may be tabulated beyond free_length; that part is never reached).
 // Roots are written positive inside their mode (element.hpp's convention).
 // The loader refuses an unloading_stiffness below the curve's steepest segment slope: from a
 // crush on such a segment the unloading line would rise above the loading curve (more force
@@ -77,17 +77,16 @@ class CrushSpring : public HybridElement<CrushSpring> {
   double segment_slope(int segment) const;
 
   void initialize(const ElementState<double>& initial) override;
-  /// Root 3, in every mode: P2 comes within kPointsMeetFraction of the free length of P1,
-  /// measured along the initial direction P1 -> P2 turned with body 1 (so a step that carries P2
-  /// past P1 is caught too) (crush reaches 99.9 % of free_length). The run stops there with a message
-  /// naming the element (SolverError from commit): beyond it u = (r2 - r1) / L is lost, and
-  /// Euler went on through the other side with the force reversed (a silent wrong answer).
+  /// Root 3, in every mode: P2 comes within kPointsMeetFraction of the free length of P1, or
+  /// passes it (PointsMeet, springs.hpp) (crush reaches 99.9 % of free_length). The run stops
+  /// there with a message naming the element (SolverError from commit): beyond it
+  /// u = (r2 - r1) / L is lost, and Euler went on through the other side with the force
+  /// reversed (a silent wrong answer).
   static constexpr int kPointsMeetRoot = 3;
-  static constexpr double kPointsMeetFraction = 1e-3;
-  Vec2<double> reference_axis_{1.0, 0.0};  // [-] initial unit direction P1 -> P2 in body 1's frame (initialize)
+  static constexpr double kPointsMeetFraction = PointsMeet::kFraction;
   int root_count() const override { return 4; }
-  /// Root 3's value: P2's distance from P1 along the turned initial direction, less the margin [length].
-  double points_meet_gap(const ElementState<double>& s) const;
+  /// Root 3's value (PointsMeet::gap) [length].
+  double points_meet_gap(const ElementState<double>& s) const { return points_meet_.gap(*this, s, *free_length); }
   void roots_in(const State& st, const ElementState<double>& s, double* g) const;
   bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
   void stiffest_force_jacobian(double t, const ElementState<double>& s, ForceBlock& df_dq, ForceBlock& df_dv) const override;
@@ -129,6 +128,7 @@ class CrushSpring : public HybridElement<CrushSpring> {
   double crush_rate_of(const ElementState<double>& s) const;
 
   State initial_state_;  // the mode a run starts in (from the initial configuration)
+  PointsMeet points_meet_;
 };
 
 }  // namespace railcrash

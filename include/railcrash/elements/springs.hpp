@@ -65,16 +65,16 @@ LineGeometry<T> line_geometry(const Element& e, const ElementState<T>& s) {
 /// coincide in the initial configuration.
 void require_direction(const Element& e, const ElementState<double>& initial);
 
-/// The points-meet check of a line element that pushes its points apart (linear_spring with a
-/// free length, draft_gear): its line of action u = (r2 - r1) / L has no direction at L = 0,
+/// The points-meet check of a line element that pushes its points apart (crush_spring,
+/// draft_gear, linear_spring with a free length, nonlinear_spring, special_spring): its line of action u = (r2 - r1) / L has no direction at L = 0,
 /// and a step that carries P2 past P1 turns the force around. The root is L less a margin; and
 /// negative once P2 lies behind P1 along the initial direction P1 -> P2 turned with body 1 AND
 /// along it turned with body 2, within half the free length (an explicit step may jump past P1
 /// by a good part of a short element: a 2 cm coupler spring by 3 mm). An element that swings
-/// round one of its bodies (the slider-crank's spring turns right round its crank at half its
-/// free length), or round both far from its points' meeting (a coupling's gear whose car ends
-/// part vertically, turned through 90 degrees at 0.9 of its free length), is not taken for one
-/// whose points met.
+/// round one of its bodies (the SUNDIALS slider-crank's spring, shorter than half its free
+/// length, turns past 90 degrees against its crank), or round both far from its points' meeting
+/// (a coupling's gear whose car ends part vertically, turned through 90 degrees at 0.9 of its
+/// free length), is not taken for one whose points met.
 class PointsMeet {
  public:
   static constexpr double kFraction = 1e-3;        // [-] the margin, of the free length
@@ -92,8 +92,11 @@ class PointsMeet {
   /// distance between its points at t = ... s (<state>): its points are ... apart, of a
   /// free_length of ..., where its force has no direction left. <advice>" (no parentheses
   /// without a state).
+  /// `what` replaces "is compressed through the whole distance between its points" (a crush
+  /// zone is "crushed through its whole length").
   [[noreturn]] void stop(const Element& e, double t, const ElementState<double>& s, double free_length,
-                         const std::string& state, const std::string& advice) const;
+                         const std::string& state, const std::string& advice,
+                         const char* what = "is compressed through the whole distance between its points") const;
 
  private:
   std::array<Vec2<double>, 2> reference_axis_{};  // [-] initial unit direction P1 -> P2 in body 1's and body 2's frames
