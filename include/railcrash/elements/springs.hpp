@@ -66,8 +66,9 @@ LineGeometry<T> line_geometry(const Element& e, const ElementState<T>& s) {
 void require_direction(const Element& e, const ElementState<double>& initial);
 
 /// The points-meet check of a line element that pushes its points apart (crush_spring,
-/// draft_gear, linear_spring with a free length, nonlinear_spring, special_spring): its line of action u = (r2 - r1) / L has no direction at L = 0,
-/// and a step that carries P2 past P1 turns the force around. The root is L less a margin; and
+/// draft_gear, linear_spring with a free length, nonlinear_spring, special_spring without an
+/// axis): its line of action u = (r2 - r1) / L has no direction at L = 0, and a step that
+/// carries P2 past P1 turns the force around. The root is L less a margin; and
 /// negative once P2 lies behind P1 along the initial direction P1 -> P2 turned with body 1 AND
 /// along it turned with body 2, within half the free length (an explicit step may jump past P1
 /// by a good part of a short element: a 2 cm coupler spring by 3 mm). An element that swings
