@@ -573,6 +573,7 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     << ", \"settling_steps\": " << s.settling_steps << ", \"settling_displacement\": " << json_number(s.settling_displacement)
     << ", \"unknowns\": " << system_.size() << ", \"jacobian_nonzeros\": " << system_.pattern().nonzeros();
   if (s.factor_nonzeros > 0) j << ", \"factor_nonzeros\": " << s.factor_nonzeros;
+  if (!s.factor_ordering.empty()) j << ", \"factor_ordering\": " << json_string(s.factor_ordering);
   if (s.phases_timed) {  // (--timings) exclusive wall seconds per phase, adding up to wall_seconds
     j << ", \"seconds\": {";
     for (int p = 0; p < kPhaseCount; ++p)

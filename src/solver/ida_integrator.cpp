@@ -890,6 +890,7 @@ void IdaIntegrator::finish() {
   if (impl_ && impl_->linear_solver) {
     const long entries = klu_factor_entries(impl_->linear_solver);
     if (entries > 0) stats().factor_nonzeros = entries;
+    stats().factor_ordering = klu_ordering(impl_->linear_solver);
   }
   impl_.reset();
 }

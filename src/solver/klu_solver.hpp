@@ -10,6 +10,8 @@
 // goes, phase by phase"), where bytes are time.
 //
 // The solver also does what railcrash used to patch into SUNLinSol_KLU:
+//  - the first analysis tries KLU's AMD and COLAMD orderings and keeps the one whose factors
+//    hold fewer entries (SUNDIALS' module uses COLAMD alone);
 //  - initialize keeps a symbolic analysis once made (a restart's IDAReInit would redo the
 //    ordering of a matrix whose pattern never changes);
 //  - setup refactors with the previous pivot order while KLU's reciprocal pivot growth stays
@@ -43,6 +45,10 @@ SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& colu
 /// The entries KLU stores for the last factorization (L, U and the off-diagonal blocks of its
 /// block triangular form); 0 before the first.
 long klu_factor_entries(SUNLinearSolver solver);
+
+/// The fill-reducing ordering the first analysis chose, "AMD" or "COLAMD" (the one whose first
+/// factorization held fewer entries); "" before the first.
+std::string klu_ordering(SUNLinearSolver solver);
 
 /// Why the solver's last setup or solve failed, for a failure message ("" when it did not).
 std::string klu_failure(SUNLinearSolver solver);

@@ -98,6 +98,7 @@ struct RunStatistics {
   long settling_steps = 0;           // static equilibrium: pseudo-time steps
   double settling_displacement = 0.0;  // [length] static equilibrium: largest move
   long factor_nonzeros = 0;          // ida: entries KLU stores: L, U and the off-diagonal blocks (last factorization)
+  std::string factor_ordering;       // ida: KLU's fill-reducing ordering, "AMD" or "COLAMD" (the one with fewer entries)
   double handed_over_at = -1.0;      // [time] integrator auto: when IDA handed the run to Euler (-1: it did not)
   std::string hand_over_reason;      // integrator auto: why it did, or why IDA kept the run ("" before the run ends)
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
