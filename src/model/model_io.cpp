@@ -456,7 +456,7 @@ const std::vector<std::string> kResponseKeys = {"crush_gauges", "crush", "refere
                                                 "collision_post_distance"};
 const std::vector<std::string> kCrushGaugeKeys = {"name", "points"};
 const std::vector<std::string> kVariantKeys = {"railcrash", "variant_of", "name", "description", "set"};
-const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "position_tolerance", "dt", "output_interval", "force_dt", "max_steps",
+const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "position_tolerance", "linear_ordering", "dt", "output_interval", "force_dt", "max_steps",
                                                   "static_equilibrium",
                                                   "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
                                                   "penalty_rotational_damping"};
@@ -781,6 +781,18 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
     } else if (how != "relative") {
       r.fail(node["position_tolerance"], "simulation: position_tolerance must be relative (rtol |q| + atol, the default) "
                                          "or absolute (atol alone, whatever the distance from the origin), not '" + how + "'");
+    }
+  }
+  if (node["linear_ordering"]) {
+    const std::string how = r.text(node["linear_ordering"], "simulation: linear_ordering");
+    if (how == "amd") {
+      s.linear_ordering = LinearOrdering::Amd;
+    } else if (how == "colamd") {
+      s.linear_ordering = LinearOrdering::Colamd;
+    } else if (how != "fewest_entries") {
+      r.fail(node["linear_ordering"], "simulation: linear_ordering must be fewest_entries (the default: AMD or COLAMD, "
+                                      "whichever factors the first Newton matrix with fewer entries), amd or colamd, not '" +
+                                          how + "'");
     }
   }
   if (auto v = positive("dt")) s.dt = *v;

@@ -370,6 +370,10 @@ std::map<std::string, SectionKeys> section_keys() {
                                            "ida: relative (default: rtol |q| + atol, atol 0.1 rtol x the model's size) or "
                                            "absolute (atol alone, default rtol x the speed scale over the model's highest "
                                            "frequency; README \"Position tolerances\")")}},
+      {"linear_ordering", {one_of_words({"fewest_entries", "amd", "colamd"},
+                                        "ida: the fill-reducing ordering of the sparse LU (KLU): fewest_entries (default: AMD "
+                                        "or COLAMD, whichever factors the first Newton matrix with fewer entries), amd or "
+                                        "colamd; it changes round-off only")}},
       {"dt", {number("euler: time step [s]", Range::Positive)}},
       {"output_interval", {number("time between output rows [s]", Range::Positive)}},
       {"force_dt", {flag("euler: run with dt even above the stability limit")}},

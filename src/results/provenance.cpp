@@ -78,6 +78,8 @@ std::string provenance_json(const Provenance& p) {
   if (ida) {
     j += ", \"rtol\": " + json_number(s.rtol) + ", \"atol\": " + (s.atol ? json_number(*s.atol) : "\"from the model\"");
     if (s.position_tolerance == PositionTolerance::Absolute) j += ", \"position_tolerance\": \"absolute\"";
+    if (s.linear_ordering != LinearOrdering::FewestEntries)
+      j += std::string(", \"linear_ordering\": ") + (s.linear_ordering == LinearOrdering::Amd ? "\"amd\"" : "\"colamd\"");
   }
   j += std::string(", \"static_equilibrium\": ") + (s.static_equilibrium ? "true" : "false") + "}}";
   return j;

@@ -201,6 +201,7 @@ std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationS
   ida.rtol = settings.rtol;
   ida.atol = settings.atol;
   ida.position_tolerance = settings.position_tolerance;
+  ida.linear_ordering = settings.linear_ordering;
   ida.max_steps = settings.max_steps;
   ida.run = run;
   if (settings.integrator == IntegratorKind::Auto) return std::make_unique<AutoIntegrator>(system, ida, euler);

@@ -30,6 +30,15 @@ namespace {
 constexpr double kRestartStepFraction = 0.3;
 constexpr double kReachableMultiple = 1e4;
 
+KluOrdering klu_ordering_of(LinearOrdering ordering) {
+  switch (ordering) {
+    case LinearOrdering::Amd: return KluOrdering::Amd;
+    case LinearOrdering::Colamd: return KluOrdering::Colamd;
+    case LinearOrdering::FewestEntries: break;
+  }
+  return KluOrdering::FewestEntries;
+}
+
 std::string flag_name(int flag) {
   char* name = IDAGetReturnFlagName(flag);
   std::string out = name ? name : std::to_string(flag);
@@ -523,7 +532,9 @@ void IdaIntegrator::start(double t_end) {
     impl.jacobian = impl.created(make_klu_jacobian_matrix(impl.context, pattern.column_start, pattern.row_index), "SUNSparseMatrix");
     impl.phase_clock = phase_clock();
     impl.linear_solver =
-        impl.created(make_klu_solver(impl.context, pattern.column_start, pattern.row_index, impl.phase_clock), "SUNLinSolNewEmpty");
+        impl.created(make_klu_solver(impl.context, pattern.column_start, pattern.row_index, impl.phase_clock,
+                                     klu_ordering_of(settings_.linear_ordering)),
+                     "SUNLinSolNewEmpty");
     impl.check(IDASetLinearSolver(impl.ida, impl.linear_solver, impl.jacobian), "IDASetLinearSolver");
     impl.check(IDASetJacFn(impl.ida, &Impl::jacobian_values), "IDASetJacFn");
     impl.check(IDAQuadInit(impl.ida, &Impl::quadrature, impl.quad), "IDAQuadInit");

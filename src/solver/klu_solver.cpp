@@ -19,7 +19,8 @@ struct KluContent {
   klu_symbolic* symbolic = nullptr;  // ordering and block triangular form, kept between restarts
   klu_numeric* numeric = nullptr;    // the last factorization
   bool first_factorize = true;       // the next setup analyses and factors afresh
-  int ordering = -1;                 // the fill-reducing ordering kept: 0 AMD, 1 COLAMD (-1: none yet)
+  std::vector<int> orderings;        // the fill-reducing orderings the first analysis tries: 0 AMD, 1 COLAMD
+  int ordering = -1;                 // the one kept (-1: none yet)
   int size = 0;                      // rows and columns
   std::vector<int> column_start;     // the matrix's pattern (CSC), 32-bit
   std::vector<int> row_index;
@@ -55,19 +56,19 @@ long entries_of(const klu_numeric* numeric) {
   return static_cast<long>(numeric->lnz) + numeric->unz + numeric->nzoff;
 }
 
-/// The first analysis: KLU's two fill-reducing orderings, AMD (on A + A^T) and COLAMD (on
-/// A^T A), each followed by a factorization with partial pivoting of the first matrix; the one
-/// whose factors hold fewer entries is kept (a tie keeps AMD), with its factorization. Every
+/// The first analysis: each of the solver's fill-reducing orderings (by default both of KLU's,
+/// AMD on A + A^T and COLAMD on A^T A), each followed by a factorization with partial pivoting
+/// of the first matrix; the one whose factors hold fewer entries is kept (a tie keeps the first
+/// tried, AMD), with its factorization. Every
 /// later refactorization and solve streams through those entries, and the pattern never changes,
 /// so this is decided once per run. (The Jacobians of the crash models are structurally almost
 /// symmetric, where AMD is the natural choice: 6,832 entries against COLAMD's 9,634 on
 /// mu_3plus3_si, 2,306 against 2,751 on the report's two-car crash; bench/HISTORY.md, "KLU's
 /// ordering chosen by fill".)
 int analyse_and_factor_first(KluContent& klu, double* values) {
-  constexpr int kOrderings[] = {0, 1};  // AMD, COLAMD
   int failure = SUNLS_PACKAGE_FAIL_UNREC;
   int failed_status = KLU_OK;
-  for (const int ordering : kOrderings) {
+  for (const int ordering : klu.orderings) {
     klu.common.ordering = ordering;
     klu_symbolic* symbolic = klu_analyze(klu.size, klu.column_start.data(), klu.row_index.data(), &klu.common);
     if (symbolic == nullptr) continue;
@@ -163,12 +164,17 @@ int keep_matrix(SUNMatrix) { return 0; }
 }  // namespace
 
 SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index,
-                                PhaseClock* clock) {
+                                PhaseClock* clock, KluOrdering ordering) {
   SUNLinearSolver solver = SUNLinSolNewEmpty(context);
   if (solver == nullptr) return nullptr;
   auto* klu = new KluContent;
   klu_defaults(&klu->common);
-  // The ordering (AMD or COLAMD) is chosen at the first analysis, analyse_and_factor_first.
+  // The ordering is chosen at the first analysis (analyse_and_factor_first) from these.
+  switch (ordering) {
+    case KluOrdering::FewestEntries: klu->orderings = {0, 1}; break;
+    case KluOrdering::Amd: klu->orderings = {0}; break;
+    case KluOrdering::Colamd: klu->orderings = {1}; break;
+  }
   klu->size = static_cast<int>(column_start.size()) - 1;
   klu->column_start = column_start;
   klu->row_index = row_index;

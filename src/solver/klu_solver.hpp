@@ -11,7 +11,7 @@
 //
 // The solver also does what railcrash used to patch into SUNLinSol_KLU:
 //  - the first analysis tries KLU's AMD and COLAMD orderings and keeps the one whose factors
-//    hold fewer entries (SUNDIALS' module uses COLAMD alone);
+//    hold fewer entries (SUNDIALS' module uses COLAMD alone), unless one is named;
 //  - initialize keeps a symbolic analysis once made (a restart's IDAReInit would redo the
 //    ordering of a matrix whose pattern never changes);
 //  - setup refactors with the previous pivot order while KLU's reciprocal pivot growth stays
@@ -37,10 +37,14 @@ namespace railcrash {
 
 class PhaseClock;
 
+/// Which fill-reducing ordering the first analysis keeps: AMD or COLAMD, whichever factors the
+/// first matrix with fewer entries (a tie keeps AMD), or the one named.
+enum class KluOrdering { FewestEntries, Amd, Colamd };
+
 /// A KLU solver for n x n matrices of the given CSC pattern (column_start has n + 1 entries).
 /// `clock` (may be null) times setup and solve. The caller frees it with SUNLinSolFree.
 SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index,
-                                PhaseClock* clock);
+                                PhaseClock* clock, KluOrdering ordering = KluOrdering::FewestEntries);
 
 /// The entries KLU stores for the last factorization (L, U and the off-diagonal blocks of its
 /// block triangular form); 0 before the first.

@@ -95,12 +95,20 @@ std::string integrator_names_text(const std::string& quote = "");
 /// (atol default rtol V / omega: the speed scale over the model's highest frequency).
 enum class PositionTolerance { Relative, Absolute };
 
+/// The fill-reducing ordering of IDA's sparse LU factorization (KLU) (simulation:
+/// linear_ordering). FewestEntries: AMD and COLAMD both factor the first Newton matrix and the
+/// one whose factors hold fewer entries is kept (a tie keeps AMD). Amd, Colamd: that one alone.
+/// The ordering changes only round-off, but round-off is what decides a chaotic quantity's last
+/// digits (the report's R2: bench/HISTORY.md, "KLU's ordering chosen by fill").
+enum class LinearOrdering { FewestEntries, Amd, Colamd };
+
 struct SimulationSettings {
   double t_end = 1.0;               // [time]
   IntegratorKind integrator = IntegratorKind::Auto;
   double rtol = 1e-6;               // ida: relative tolerance
   std::optional<double> atol;       // ida: absolute tolerance on lengths [length]; default derived from the model
   PositionTolerance position_tolerance = PositionTolerance::Relative;  // ida: how positions are weighed
+  LinearOrdering linear_ordering = LinearOrdering::FewestEntries;    // ida: KLU's fill-reducing ordering
   double dt = 0.0;                  // euler: step [time]; 0 = 0.5 x stability limit
   double output_interval = 0.0;     // [time]; 0 = t_end / 500
   bool force_dt = false;            // euler: accept a step above the stability limit

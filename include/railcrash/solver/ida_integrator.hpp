@@ -41,6 +41,7 @@ struct IdaSettings {
   double rtol = 1e-6;
   std::optional<double> atol;  // [length]
   PositionTolerance position_tolerance = PositionTolerance::Relative;
+  LinearOrdering linear_ordering = LinearOrdering::FewestEntries;  // KLU's fill-reducing ordering
   long max_steps_per_output = 500000;
   long max_steps = 10000000;  // [steps] in the whole run; the run fails (not ok) beyond
   CommonRunSettings run;      // t_end, static_equilibrium
