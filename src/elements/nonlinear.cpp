@@ -234,7 +234,11 @@ NonlinearSpring::NonlinearSpring(ElementSpec& spec)
   if (fracture_load && std::abs(preload) >= *fracture_load)
     spec.parameters->fail("preload", "'preload' must be smaller in size than 'fracture_load' (the spring would break at once)");
   set_law(PiecewiseLinearLaw::two_branch(-preload, compression, "compression", extension, "extension"));
-  set_points_meet(true);
+  // A tension-only tie (no preload, no compression stiffness) is slack when its points meet:
+  // its force is zero whatever the direction, so they may pass.
+  const bool pushes_in_compression =
+      preload != 0.0 || compression.slope_1 != 0.0 || (compression.slope_2 && *compression.slope_2 != 0.0);
+  set_points_meet(pushes_in_compression);
 }
 
 int NonlinearSpring::rate_sign(const ElementState<double>& s) const { return sign_of(length_rate(s, *this)); }
@@ -362,7 +366,8 @@ void register_nonlinear_elements(ElementRegistry& registry) {
        "Piecewise-linear spring along P1-P2: two slopes on each side of e = L - free_length: tension T = -preload + "
        "compression_stiffness_1 e (e < 0) or extension_stiffness_1 e (e > 0), continuing with the second slope beyond "
        "the breakpoint; continuous in e, elastic; breaks when |T| reaches fracture_load. Its points meeting (within "
-       "1e-3 free_length) or passing each other stops the run, naming it.",
+       "1e-3 free_length) or passing each other stops the run, naming it, unless it pushes nothing in compression "
+       "(no preload, no compression stiffness: a tension-only tie, slack there).",
        joined(joined(branch_specs("compression_stiffness_1", "compression_stiffness_2", "compression_breakpoint",
                                   "compression branch", Unit::ForcePerLength, Unit::Length),
                      branch_specs("extension_stiffness_1", "extension_stiffness_2", "extension_breakpoint",

@@ -866,3 +866,33 @@ TEST_CASE("nonlinear_spring and special_spring compressed through their points s
   const RunOutcome along_axis = testing::simulate(testing::loaded_from_text(model(special + ", axis: [1, 0]", "ida")));
   CHECK(along_axis.y[0] == Approx(1.0 + v0 * (1.0 - std::acos(-1.0) / w)).epsilon(1e-6));
 }
+
+TEST_CASE("A tension-only nonlinear_spring lets its points pass each other: it is slack there", "[elements][faults]") {
+  // The mass of the test above through a nonlinear_spring with no compression stiffness and no
+  // preload: slack from the start, the force is zero whichever way the points lie, so the mass
+  // coasts through the ground point at 10 m/s. At t = 0.15 s it is 0.5 m past it; the tie then
+  // stretches (extension 10 N/m once L > 1 m: at x = -1 m, t = 0.2 s) and pulls it back.
+  const std::string text =
+      "railcrash: 1\nname: slack tie\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: mass, mass: 1, inertia: 1, position: [1, 0], velocity: [-10, 0]}\n"
+      "elements:\n  - {name: s, type: nonlinear_spring, compression_stiffness_1: 0, extension_stiffness_1: 10, "
+      "free_length: 1, points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n";
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const RunOutcome outcome = testing::simulate(
+        testing::loaded_from_text(text + "simulation: {t_end: 0.15, integrator: " + integrator +
+                                  ", rtol: 1e-10, dt: 1e-5, output_interval: 0.01}\n"));
+    INFO(outcome.message);
+    REQUIRE(outcome.ok);
+    CHECK(outcome.y[0] == Approx(1.0 - 10.0 * 0.15).epsilon(1e-6));
+  }
+  // With a preload it pushes at the point (a direction it does not have there): the stop.
+  const RunOutcome preloaded = testing::simulate_to_stop(testing::loaded_from_text(
+      "railcrash: 1\nname: preloaded tie\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+      "  - {name: mass, mass: 1, inertia: 1, position: [1, 0], velocity: [-10, 0]}\n"
+      "elements:\n  - {name: s, type: nonlinear_spring, compression_stiffness_1: 0, extension_stiffness_1: 10, "
+      "preload: 1, free_length: 1, points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+      "simulation: {t_end: 0.15, integrator: ida, rtol: 1e-10, output_interval: 0.01}\n"));
+  CHECK_FALSE(preloaded.ok);
+  CHECK_THAT(preloaded.message, Catch::Contains("nonlinear_spring 's' is compressed through the whole distance"));
+}

@@ -60,7 +60,9 @@
 // points come within 1e-3 free_length of each other, or pass each other, stop the run with a
 // message naming them (PointsMeet, springs.hpp): along P1-P2 the force has no direction there,
 // and a step that carried one point past the other turned it around. Along an axis the
-// separation has a sign and the force a direction: no such stop.
+// separation has a sign and the force a direction: no such stop. Nor for a nonlinear_spring
+// that pushes nothing in compression (no preload, compression slopes 0: a tension-only tie,
+// slack when its points meet), nor for a special_spring of kind 2 (tension only).
 //
 // Breakpoints may be zero (the report's nonlinear spring type 5 has an extension breakpoint
 // of 0 in): the first segment is then empty and the second slope acts from the start. A
