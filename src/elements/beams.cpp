@@ -8,6 +8,11 @@ namespace railcrash {
 
 namespace {
 
+/// What a beam's points-meet stop asks for.
+const char* const kBeamAdvice =
+    "A beam cannot be crushed through its length: give it a plastic_modulus above 0 (it then fractures at "
+    "ultimate_stress), or model the crush with a crush_spring, or stop the motion first with a contact element";
+
 BeamMaterial read_material(ElementSpec& spec) {
   ParameterReader& p = *spec.parameters;
   BeamMaterial m{};
@@ -137,6 +142,7 @@ void BeamElement::initialize(const ElementState<double>& initial) {
     throw InputError(where().prefix() + type() + " '" + name() +
                      "': its two points coincide in the initial configuration; a beam needs a length, move them apart");
   direction_ = {d.x / length_, d.y / length_};
+  points_meet_.initialize(*this, initial);
   initial_angle_ = {initial.q[k1].theta, initial.q[k2].theta};
   for (std::size_t k = 0; k < 2; ++k) {  // u0 in each end body's frame: R(-theta_k(0)) u0
     const Vec2<double> u = rotate(-initial_angle_[k], direction_[0], direction_[1]);
@@ -194,11 +200,12 @@ double BeamElement::stress(const std::array<double, 3>& force) const {
 }
 
 void BeamElement::roots_in(const State& st, const ElementState<double>& s, double* g) const {
-  g[0] = g[1] = g[2] = g[3] = 1.0;
+  g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
   if (st.failed) return;
   std::array<double, 3> force{}, offset{}, rate{};
   evaluate(s, force, offset, &rate);
   roots_from(st, force, offset, rate, g);
+  g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_);
 }
 
 void BeamElement::roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
@@ -210,9 +217,11 @@ void BeamElement::roots_from(const State& st, const std::array<double, 3>& force
   g[3] = 1.0 - stress(force) / material.ultimate_stress;
 }
 
-bool BeamElement::commit_in(State& st, int index, int direction, double, const ElementState<double>& s,
+bool BeamElement::commit_in(State& st, int index, int direction, double t, const ElementState<double>& s,
                             Event& event) const {
   if (st.failed || direction > 0) return false;
+  if (points_meet_.gap(*this, s, length_) < 0.0 || index == kPointsMeetRoot)
+    points_meet_.stop(*this, t, s, length_, "", kBeamAdvice, "is crushed through its whole length", "an initial length");
   std::array<double, 3> force{}, offset{};
   evaluate(s, force, offset);
   if (index == 3) {
@@ -270,8 +279,11 @@ void BeamElement::roots_and_outputs(double, const ElementState<double>& s, const
   std::array<double, 3> force{}, offset{}, rate{}, x{};
   evaluate(s, force, offset, &rate, &x);
   if (g != nullptr) {
-    g[0] = g[1] = g[2] = g[3] = 1.0;
-    if (!st.failed) roots_from(st, force, offset, rate, g);
+    g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
+    if (!st.failed) {
+      roots_from(st, force, offset, rate, g);
+      g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_);
+    }
   }
   if (out != nullptr) outputs_from(st, force, offset, x, out);
 }
@@ -287,8 +299,11 @@ void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& 
   Kinematics<double> chord;
   evaluate(s, force, offset, &rate, nullptr, &chord);
   if (g != nullptr) {
-    g[0] = g[1] = g[2] = g[3] = 1.0;
-    if (!st.failed) roots_from(st, force, offset, rate, g);
+    g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
+    if (!st.failed) {
+      roots_from(st, force, offset, rate, g);
+      g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_);
+    }
   }
   if (out != nullptr) outputs_from(st, force, offset, chord.strain, out);
   // The dual pass's kinematics values are the double pass's, operation for operation. Its
@@ -330,7 +345,8 @@ const char* const kBeamLaw =
     "co-rotational planar beam rigidly attached to both bodies, axial force N = k_a (e - e_p), end moments "
     "[M1; M2] = K_b (phi - phi_p); axial yield at yield_stress times the area, end hinges at yield_stress times "
     "the plastic section modulus, kinematic hardening with plastic_modulus, elastic unloading; fracture when "
-    "|N| / A or |M| / Z reaches ultimate_stress.";
+    "|N| / A or |M| / Z reaches ultimate_stress. Its ends meeting (within 1e-3 of its initial length) or passing "
+    "each other stops the run, naming it.";
 const char* const kBeamMaterialExample =
     "elastic_modulus: 2.0e11\nplastic_modulus: 2.0e9\nyield_stress: 2.5e8\nultimate_stress: 4.0e8\n";
 

@@ -39,15 +39,16 @@ double PointsMeet::gap(const Element& e, const ElementState<double>& s, double f
 }
 
 void PointsMeet::stop(const Element& e, double t, const ElementState<double>& s, double free_length,
-                      const std::string& state, const std::string& advice, const char* what) const {
+                      const std::string& state, const std::string& advice, const char* what,
+                      const char* length_name) const {
   const double length = line_geometry(e, s).length;
   const bool passed = gap(e, s, free_length) + kFraction * free_length < 0.0;
   char where_now[96];
   if (passed) std::snprintf(where_now, sizeof where_now, "its points have passed each other (by %g)", length);
   else std::snprintf(where_now, sizeof where_now, "its points are %g apart", length);
   char text[400];
-  std::snprintf(text, sizeof text, "' %s at t = %.6g s%s: %s, of a free_length of %g, where its force has no direction left. ",
-                what, t, state.empty() ? "" : (" (" + state + ")").c_str(), where_now, free_length);
+  std::snprintf(text, sizeof text, "' %s at t = %.6g s%s: %s, of %s of %g, where its force has no direction left. ",
+                what, t, state.empty() ? "" : (" (" + state + ")").c_str(), where_now, length_name, free_length);
   throw SolverError(e.where().prefix() + e.type() + " '" + e.name() + text + advice);
 }
 

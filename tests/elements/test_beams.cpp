@@ -932,3 +932,35 @@ TEST_CASE("beam outputs are named and the failed beam reports zero resultants", 
   CHECK(beam->potential_energy(beam.at(s.q.data(), s.v.data())) == 0.0);
   for (double x : forces(system, s)) CHECK(x == 0.0);
 }
+
+TEST_CASE("a perfectly plastic beam crushed through its length stops the run naming it; a hardening one fractures first",
+          "[elements][beams][faults]") {
+  // A very heavy body at constant speed v0 towards the ground end of a 1 m beam: the chord
+  // shortens as L = L0 - v0 t. With plastic_modulus 0 the beam crushes at its yield force
+  // without end: the stop comes at L = 1e-3 L0 (PointsMeet), t = 0.999 L0 / v0. With the
+  // steel's plastic_modulus the axial stress reaches ultimate_stress first (at 7.5 % of the
+  // length) and the beam fractures; the body then passes the ground end with nothing to stop.
+  const double v0 = 10.0, length = 1.0;
+  const std::string body = "mass: 1.0e15, inertia: 1.0e15, position: [1.0, 0.0], velocity: [" + num(-v0) + ", 0]";
+  Steel perfectly_plastic;
+  perfectly_plastic.et = 0.0;
+  for (const bool use_ida : {true, false}) {
+    const double dt = 1e-5, t_end = 0.15;
+    INFO((use_ida ? "ida" : "euler"));
+    const std::string simulation = use_ida ? ida(t_end, kHeavyRtol) : euler(t_end, dt);
+    const RunOutcome stopped =
+        testing::simulate_to_stop(testing::loaded_from_text(cantilever_model(body, perfectly_plastic.parameters(), simulation)));
+    INFO(stopped.message);
+    CHECK_FALSE(stopped.ok);
+    CHECK_THAT(stopped.message, Catch::StartsWith("test.yaml:8: elastic_plastic_beam 'e' is crushed through its whole length") &&
+                                    Catch::Contains("of an initial length of 1,") && Catch::Contains("plastic_modulus above 0"));
+    CHECK(std::abs(testing::message_time(stopped.message) - (1.0 - PointsMeet::kFraction) * length / v0) <
+          (use_ida ? 1e-7 : 2.0 * dt));
+    const Run fractured = simulate(cantilever_model(body, Steel().parameters(), simulation));
+    INFO(fractured.outcome.message);
+    CHECK(fractured.outcome.ok);
+    REQUIRE(fractured.outcome.events.size() == 2);
+    CHECK(event_at(fractured.outcome, 1).what == "fracture");
+    CHECK(event_at(fractured.outcome, 1).t < 0.1 * length / v0);
+  }
+}

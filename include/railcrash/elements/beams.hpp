@@ -51,13 +51,21 @@
 // reaches ultimate_stress. A failed beam carries nothing; the elastic energy it held at
 // fracture is released (it shows up as dissipated energy).
 //
-// Modes and events (4 root functions; an inactive one returns 1):
+// Points meeting: a beam crushed axially until its ends come within 1e-3 L0 of each other, or
+// pass each other, stops the run with a message naming it (PointsMeet, springs.hpp): the chord
+// has no direction there, and a step that carried one end past the other would turn its axial
+// force and end moments around. (With plastic_modulus > 0 the axial stress reaches
+// ultimate_stress and the beam fractures first; a perfectly plastic beam, plastic_modulus 0,
+// crushes at its yield force without end.)
+//
+// Modes and events (5 root functions; an inactive one returns 1):
 //   g_k, k = 0 axial, 1 hinge 1, 2 hinge 2:
 //     elastic   1 + 1e-9 - |F_k - c_k p_k| / Y_k  goes negative: yield (event "axial yield in
 //               tension|compression" with N, "plastic hinge at end i" with M_i)
 //     plastic   s_k dp_k/dt (the plastic flow rate) goes negative: unloading (event
 //               "axial unloading" / "hinge at end i unloading"), p_k is stored
 //   g_3         1 - max(|N| / (sigma_u A_min), |M_i| / (sigma_u Z_i)) goes negative: "fracture"
+//   g_4         the ends' distance less 1e-3 L0 (PointsMeet::gap): the run stops
 // The potential energy is the elastic energy U above (what unloading would give back); the
 // rest of the work done on the beam is dissipated by plastic flow (and fracture).
 //
@@ -221,7 +229,8 @@ class BeamElement : public HybridElement<BeamElement> {
 
   void initialize(const ElementState<double>& initial) override;
   bool applies_moment() const override { return true; }
-  int root_count() const override { return 4; }
+  int root_count() const override { return 5; }
+  static constexpr int kPointsMeetRoot = 4;
   void roots_in(const State& st, const ElementState<double>& s, double* g) const;
   bool commit_in(State& st, int index, int direction, double t, const ElementState<double>& s, Event& event) const;
   bool failed(const void* mode) const override { return static_cast<const State*>(mode)->failed; }
@@ -257,6 +266,7 @@ class BeamElement : public HybridElement<BeamElement> {
   /// Largest of |N| / A_min, |M_i| / Z_i [force/length^2].
   double stress(const std::array<double, 3>& force) const;
 
+  PointsMeet points_meet_;                    // the ends meeting (root kPointsMeetRoot)
   double length_ = 0.0;                       // [length] L0
   std::array<double, 2> direction_{1.0, 0.0}; // u0, initial chord direction
   std::array<double, 2> initial_angle_{};     // [rad] theta of the body of P1, P2 at t = 0

@@ -94,10 +94,12 @@ class PointsMeet {
   /// free_length of ..., where its force has no direction left. <advice>" (no parentheses
   /// without a state).
   /// `what` replaces "is compressed through the whole distance between its points" (a crush
-  /// zone is "crushed through its whole length").
+  /// zone is "crushed through its whole length"), `length_name` the "free_length" (a beam's
+  /// "initial length").
   [[noreturn]] void stop(const Element& e, double t, const ElementState<double>& s, double free_length,
                          const std::string& state, const std::string& advice,
-                         const char* what = "is compressed through the whole distance between its points") const;
+                         const char* what = "is compressed through the whole distance between its points",
+                         const char* length_name = "a free_length") const;
 
  private:
   std::array<Vec2<double>, 2> reference_axis_{};  // [-] initial unit direction P1 -> P2 in body 1's and body 2's frames
