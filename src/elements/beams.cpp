@@ -203,9 +203,10 @@ void BeamElement::roots_in(const State& st, const ElementState<double>& s, doubl
   g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
   if (st.failed) return;
   std::array<double, 3> force{}, offset{}, rate{};
-  evaluate(s, force, offset, &rate);
+  Kinematics<double> chord;
+  evaluate(s, force, offset, &rate, nullptr, &chord);
   roots_from(st, force, offset, rate, g);
-  g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_);
+  g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_, chord.d, chord.length);
 }
 
 void BeamElement::roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
@@ -276,16 +277,17 @@ void BeamElement::outputs(const ElementState<double>& s, const double*, double* 
 
 void BeamElement::roots_and_outputs(double, const ElementState<double>& s, const double*, double* g, double* out) const {
   const State& st = mode_as<State>(s);
-  std::array<double, 3> force{}, offset{}, rate{}, x{};
-  evaluate(s, force, offset, &rate, &x);
+  std::array<double, 3> force{}, offset{}, rate{};
+  Kinematics<double> chord;
+  evaluate(s, force, offset, &rate, nullptr, &chord);
   if (g != nullptr) {
     g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
     if (!st.failed) {
       roots_from(st, force, offset, rate, g);
-      g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_);
+      g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_, chord.d, chord.length);
     }
   }
-  if (out != nullptr) outputs_from(st, force, offset, x, out);
+  if (out != nullptr) outputs_from(st, force, offset, chord.strain, out);
 }
 
 void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& s, const double*,
@@ -302,7 +304,7 @@ void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& 
     g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
     if (!st.failed) {
       roots_from(st, force, offset, rate, g);
-      g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_);
+      g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_, chord.d, chord.length);
     }
   }
   if (out != nullptr) outputs_from(st, force, offset, chord.strain, out);

@@ -27,15 +27,20 @@ void PointsMeet::initialize(const Element& e, const ElementState<double>& initia
 
 double PointsMeet::gap(const Element& e, const ElementState<double>& s, double free_length) const {
   const LineGeometry<double> line = line_geometry(e, s);
+  return gap(e, s, free_length, line.d, line.length);
+}
+
+double PointsMeet::gap(const Element& e, const ElementState<double>& s, double free_length, const Vec2<double>& d,
+                       double length) const {
   const double margin = kFraction * free_length;  // [length]
   bool passed = true;
   for (std::size_t k = 0; k < 2; ++k) {
     const Vec2<double> axis =
         rotate(s.rotation[static_cast<std::size_t>(e.point_slot(static_cast<int>(k)))], reference_axis_[k].x, reference_axis_[k].y);
-    passed = passed && dot(line.d, axis) <= 0.0;
+    passed = passed && dot(d, axis) <= 0.0;
   }
-  passed = passed && line.length < kPassedFraction * free_length;
-  return passed ? -line.length - margin : line.length - margin;
+  passed = passed && length < kPassedFraction * free_length;
+  return passed ? -length - margin : length - margin;
 }
 
 void PointsMeet::stop(const Element& e, double t, const ElementState<double>& s, double free_length,

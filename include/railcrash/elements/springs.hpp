@@ -89,6 +89,9 @@ class PointsMeet {
   /// The root: |r2 - r1| less the margin, or -|r2 - r1| - margin once the points have passed
   /// each other [length].
   double gap(const Element& e, const ElementState<double>& s, double free_length) const;
+  /// The same from the line r2 - r1 = d of length `length` at state s, already at hand.
+  double gap(const Element& e, const ElementState<double>& s, double free_length, const Vec2<double>& d,
+             double length) const;
   /// Stops the run (SolverError): "<file:line: ><type> '<name>' is compressed through the whole
   /// distance between its points at t = ... s (<state>): its points are ... apart, of a
   /// free_length of ..., where its force has no direction left. <advice>" (no parentheses
