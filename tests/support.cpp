@@ -7,12 +7,18 @@
 #include <limits>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/run.hpp"
 
 namespace railcrash::testing {
+
+std::filesystem::path temp_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "_" + name);
+}
 
 Model model_from_text(const std::string& yaml) { return load_model_text(yaml, "test.yaml").model; }
 

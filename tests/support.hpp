@@ -1,6 +1,7 @@
 // Helpers shared by the unit tests.
 #pragma once
 
+#include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
@@ -12,6 +13,11 @@
 #include "railcrash/solver/integrator.hpp"
 
 namespace railcrash::testing {
+
+/// A path in the system's temporary folder for a test's scratch file or folder, its name
+/// prefixed with this process's id: two test processes (ctest -j, or two checkouts tested on
+/// one machine) never share one.
+std::filesystem::path temp_path(const std::string& name);
 
 /// Loads a model from YAML text (file name "test.yaml" in messages): the physical model alone.
 Model model_from_text(const std::string& yaml);

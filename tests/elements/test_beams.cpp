@@ -933,7 +933,7 @@ TEST_CASE("beam outputs are named and the failed beam reports zero resultants", 
   for (double x : forces(system, s)) CHECK(x == 0.0);
 }
 
-TEST_CASE("a perfectly plastic beam crushed through its length stops the run naming it; a hardening one fractures first",
+TEST_CASE("a perfectly plastic beam crushed through its length stops the run naming it, a hardening one fractures first",
           "[elements][beams][faults]") {
   // A very heavy body at constant speed v0 towards the ground end of a 1 m beam: the chord
   // shortens as L = L0 - v0 t. With plastic_modulus 0 the beam crushes at its yield force

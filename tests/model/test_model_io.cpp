@@ -356,7 +356,7 @@ TEST_CASE("overrides given with --set change the model before it is checked", "[
 }
 
 TEST_CASE("the run command's options go through --set's path, after it, and are named in messages", "[model_io]") {
-  const auto path = std::filesystem::temp_directory_path() / "railcrash_test_options.yaml";
+  const auto path = testing::temp_path("railcrash_test_options.yaml");
   std::ofstream(path) << kBase;
   RunOverrides options;
   options.t_end = 0.25;
@@ -441,7 +441,7 @@ namespace {
 
 /// Writes `text` to a file in a fresh temporary folder; returns its path.
 std::string write_file(const std::string& folder, const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / ("railcrash_test_variants_" + folder);
+  const auto dir = testing::temp_path("railcrash_test_variants_" + folder);
   std::filesystem::create_directories(dir);
   std::ofstream(dir / name) << text;
   return (dir / name).string();

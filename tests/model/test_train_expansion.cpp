@@ -71,7 +71,7 @@ const Element& element(const Model& model, const std::string& name) {
 }
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  const std::string path = (testing::temp_path(name)).string();
   std::ofstream(path) << text;
   return path;
 }

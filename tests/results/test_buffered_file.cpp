@@ -16,6 +16,7 @@
 
 #include "railcrash/results/buffered_file.hpp"
 #include "railcrash/results/results.hpp"
+#include "support.hpp"
 
 using railcrash::BufferedFile;
 
@@ -58,7 +59,7 @@ TEST_CASE("numbers are written as printf's %.12g, byte for byte", "[results]") {
     std::memcpy(&value, &pattern, sizeof value);
     values.push_back(k % 2 ? value : -value);
   }
-  const std::string path = (std::filesystem::temp_directory_path() / "railcrash_test_buffered_file.csv").string();
+  const std::string path = (railcrash::testing::temp_path("railcrash_test_buffered_file.csv")).string();
   std::string expected;
   int json_differs = 0;  // summary.json's numbers (json_number) are the same text, null where not finite
   {

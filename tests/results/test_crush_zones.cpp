@@ -127,7 +127,7 @@ TEST_CASE("a crush zone between two cars counts half for each and the cars add u
 }
 
 TEST_CASE("energy_zones.csv and summary.json give the energy per crush zone and per car of one run", "[results][crush_zones]") {
-  const auto dir = (std::filesystem::temp_directory_path() / "railcrash_test_energy_zones").string();
+  const auto dir = (testing::temp_path("railcrash_test_energy_zones")).string();
   std::filesystem::remove_all(dir);
   const LoadedModel loaded = testing::loaded_from_text(kPushedCrushSpring);
   const Model& model = loaded.model;

@@ -16,6 +16,7 @@
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/results/hdf5_file.hpp"
 #include "railcrash/results/run.hpp"
+#include "support.hpp"
 
 #ifdef RAILCRASH_HDF5
 #include <hdf5.h>
@@ -26,7 +27,7 @@ using namespace railcrash;
 namespace {
 
 std::string temporary_folder(const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / ("railcrash_test_hdf5_" + name);
+  const auto path = testing::temp_path("railcrash_test_hdf5_" + name);
   std::filesystem::remove_all(path);
   return path.string();
 }

@@ -8,13 +8,14 @@
 #include <sstream>
 
 #include "railcrash/results/plot.hpp"
+#include "support.hpp"
 
 using namespace railcrash;
 
 namespace {
 
 std::string write_and_read(const plot::Figure& figure, const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / name;
+  const auto path = testing::temp_path(name);
   plot::write_svg(figure, path);
   std::ifstream file(path);
   std::stringstream text;

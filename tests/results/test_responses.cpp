@@ -108,7 +108,7 @@ TEST_CASE("R1 from the anticlimber's crush: a car end into a fixed anticlimber, 
 namespace {
 
 std::string temporary_folder(const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / ("railcrash_test_" + name);
+  const auto path = testing::temp_path("railcrash_test_" + name);
   std::filesystem::remove_all(path);
   return path.string();
 }

@@ -23,7 +23,7 @@ using namespace railcrash;
 namespace {
 
 std::string temporary_folder(const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / ("railcrash_test_" + name);
+  const auto path = testing::temp_path("railcrash_test_" + name);
   std::filesystem::remove_all(path);
   return path.string();
 }

@@ -79,7 +79,7 @@ TEST_CASE("consist: couplings start with the faces touching and carry no force",
 }
 
 TEST_CASE("consist: a template without the car1_/car2_ naming is refused with the reason", "[consist]") {
-  const auto path = std::filesystem::temp_directory_path() / "railcrash_consist_bad.yaml";
+  const auto path = testing::temp_path("railcrash_consist_bad.yaml");
   {
     std::ofstream file(path);
     file << "railcrash: 1\nname: x\nunits: SI\nbodies:\n  - {name: a, mass: 1, inertia: 1, position: [0, 0]}\n"

@@ -16,6 +16,7 @@
 #include "railcrash/scenarios/en15227.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "requests.hpp"
+#include "support.hpp"
 
 using namespace railcrash;
 
@@ -344,7 +345,7 @@ TEST_CASE("scenario: a train model without what the scenario needs is refused na
   q.train_path = std::string(RAILCRASH_SOURCE_DIR) + "/models/examples/coupled_cars.yaml";
   CHECK_THAT(error_of(q), Catch::Contains("coupled_cars.yaml:") && Catch::Contains("no front end: the scenario needs a crush element"));
   // No car declared at all.
-  const std::string path = (std::filesystem::temp_directory_path() / "railcrash_scenario_no_car.yaml").string();
+  const std::string path = (testing::temp_path("railcrash_scenario_no_car.yaml")).string();
   std::ofstream(path) << "railcrash: 1\nname: one body\nunits: SI\nbodies:\n  - {name: a, mass: 1000, inertia: 100, position: [0, 1]}\n"
                          "elements: []\nsimulation: {t_end: 0.1}\n";
   q.train_path = path;

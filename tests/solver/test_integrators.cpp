@@ -280,7 +280,7 @@ TEST_CASE("the dashpot's dissipated energy equals the energy the oscillator lost
 }
 
 TEST_CASE("run_model writes timeseries, events and summary, also for a failed run", "[integrators]") {
-  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_test_results").string();
+  const std::string dir = (testing::temp_path("railcrash_test_results")).string();
   std::filesystem::remove_all(dir);
   LoadedModel loaded = testing::loaded_from_text(oscillator(200.0, 0.0, 200.0, ", integrator: euler, dt: 0.3, force_dt: true, output_interval: 1"));
   Model& model = loaded.model;
@@ -350,7 +350,7 @@ TEST_CASE("IDA at rtol 1e-9 runs the barrier crash through and agrees with rtol 
 TEST_CASE("a timed run's phases add up to its wall time, each where its work is", "[integrators]") {
   // The barrier crash has every phase: IDA's Newton iterations, Jacobians, KLU, steps with
   // roots, located mode changes and restarts (the wall contact, the dampers).
-  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_test_phases").string();
+  const std::string dir = (testing::temp_path("railcrash_test_phases")).string();
   std::filesystem::remove_all(dir);
   const LoadedModel loaded = load_model(std::string(RAILCRASH_SOURCE_DIR) + "/models/barrier/two_car_barrier.yaml",
                                  {"simulation.t_end=0.2"});

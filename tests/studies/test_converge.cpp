@@ -12,6 +12,7 @@
 #include "railcrash/results/cfc_filter.hpp"
 #include "railcrash/results/run.hpp"
 #include "railcrash/studies/converge.hpp"
+#include "support.hpp"
 
 using namespace railcrash;
 
@@ -257,7 +258,7 @@ TEST_CASE("convergence study: log-log slope and the files written", "[converge]"
   options.t_end = 0.5;
   options.jobs = 2;
   const ConvergeResult result = run_convergence(plan_convergence(case_path("damped_spring_mass"), options));
-  const std::string dir = (std::filesystem::temp_directory_path() / "railcrash_converge_test").string();
+  const std::string dir = (testing::temp_path("railcrash_converge_test")).string();
   std::filesystem::remove_all(dir);
   const std::string md = write_convergence(result, dir);
   CHECK_THAT(md, Catch::Contains("Observed orders"));

@@ -18,7 +18,7 @@ using Catch::Matchers::StartsWith;
 namespace {
 
 std::string temporary_file(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("railcrash_test_readings_" + name);
+  const auto path = testing::temp_path("railcrash_test_readings_" + name);
   std::ofstream(path) << text;
   return path.string();
 }
@@ -203,7 +203,7 @@ TEST_CASE("a reading study ranks first the reading that reproduces the published
   CHECK(printed.responses[0].spearman == Approx(1.0));  // P1 and P2 lower the crush, P3 changes nothing
   CHECK(printed.responses[0].sign_agreements == printed.responses[0].significant_runs);
   CHECK(results[0].agreement.responses[0].value == Approx(0.02 / 0.02).epsilon(1e-4));  // crush 0.02 m / reference 0.02 m
-  const std::string out = (std::filesystem::temp_directory_path() / "railcrash_test_readings_out").string();
+  const std::string out = (testing::temp_path("railcrash_test_readings_out")).string();
   std::filesystem::remove_all(out);
   const std::string md = write_readings(results, plan, design, out);
   CHECK_THAT(md, Contains("| 1 | 1 | printed |"));  // ranked first: combination 1
