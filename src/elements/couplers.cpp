@@ -413,7 +413,10 @@ DraftGear::DraftGear(ElementSpec& spec) : HybridElement(spec.name, spec.type, sp
 }
 
 DraftGear::Kinematics DraftGear::kinematics(const ElementState<double>& s) const {
-  const LineGeometry<double> g = line_geometry(*this, s);
+  return kinematics_of(line_geometry(*this, s));
+}
+
+DraftGear::Kinematics DraftGear::kinematics_of(const LineGeometry<double>& g) const {
   return {*free_length - g.length, -dot(g.d, g.d_rate) / g.length};
 }
 
@@ -458,8 +461,9 @@ void DraftGear::roots_at(const State& st, const Kinematics& k, double* g) const 
 }
 
 void DraftGear::roots_in(const State& st, const ElementState<double>& s, double* g) const {
-  roots_at(st, kinematics(s), g);
-  if (carries_force(st.stage)) g[kPointsMeetRoot] = points_meet_gap(s);
+  const LineGeometry<double> line = line_geometry(*this, s);  // once for the law's roots and the points-meet root
+  roots_at(st, kinematics_of(line), g);
+  if (carries_force(st.stage)) g[kPointsMeetRoot] = points_meet_.gap(*this, s, *free_length, line.d, line.length);
 }
 
 void DraftGear::apply(State& st, int index, const Kinematics& k, Event& event) const {

@@ -685,8 +685,9 @@ TEST_CASE("hinge unloading keeps its rotation offset and reverses at M - 2 M_p",
   const double k22 = beam->bending_stiffness()[2], c2 = beam->hardening()[2], mp = beam->yield_levels()[2];
   CHECK(k22 == Approx(4.0 * steel.e * steel.second_moment()).epsilon(1e-12));
   CHECK(mp == Approx(steel.yield * steel.z()).epsilon(1e-12));
+  REQUIRE(beam->root_count() == 5);  // the array below
   const auto roots_at = [&](const BodyState& state) {
-    std::array<double, 4> g{};
+    std::array<double, 5> g{};
     beam->roots(0.0, beam.at(state.q.data(), state.v.data()), nullptr, g.data());
     return g;
   };

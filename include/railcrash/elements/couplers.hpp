@@ -387,6 +387,8 @@ class DraftGear : public HybridElement<DraftGear> {
     double d, rate;  // compression and its rate
   };
   Kinematics kinematics(const ElementState<double>& s) const;
+  /// The same from the line geometry at hand.
+  Kinematics kinematics_of(const LineGeometry<double>& line) const;
   void roots_at(const State& st, const Kinematics& k, double* g) const;
   void apply(State& st, int index, const Kinematics& k, Event& event) const;
 
