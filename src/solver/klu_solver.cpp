@@ -59,9 +59,8 @@ long entries_of(const klu_numeric* numeric) {
 /// The first analysis: each of the solver's fill-reducing orderings (by default both of KLU's,
 /// AMD on A + A^T and COLAMD on A^T A), each followed by a factorization with partial pivoting
 /// of the first matrix; the one whose factors hold fewer entries is kept (a tie keeps the first
-/// tried, AMD), with its factorization. Every
-/// later refactorization and solve streams through those entries, and the pattern never changes,
-/// so this is decided once per run. (The Jacobians of the crash models are structurally almost
+/// tried, AMD), with its factorization. Every later refactorization and solve streams through
+/// those entries, and the pattern never changes, so this is decided once per run. (The Jacobians of the crash models are structurally almost
 /// symmetric, where AMD is the natural choice: 6,832 entries against COLAMD's 9,634 on
 /// mu_3plus3_si, 2,306 against 2,751 on the report's two-car crash; bench/HISTORY.md, "KLU's
 /// ordering chosen by fill".)
