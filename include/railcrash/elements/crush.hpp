@@ -77,13 +77,12 @@ class CrushSpring : public HybridElement<CrushSpring> {
   double segment_slope(int segment) const;
 
   void initialize(const ElementState<double>& initial) override;
-  /// Root 3, in every mode: P2 comes within kPointsMeetFraction of the free length of P1, or
+  /// Root 3, in every mode: P2 comes within PointsMeet::kFraction of the free length of P1, or
   /// passes it (PointsMeet, springs.hpp) (crush reaches 99.9 % of free_length). The run stops
   /// there with a message naming the element (SolverError from commit): beyond it
   /// u = (r2 - r1) / L is lost, and Euler went on through the other side with the force
   /// reversed (a silent wrong answer).
   static constexpr int kPointsMeetRoot = 3;
-  static constexpr double kPointsMeetFraction = PointsMeet::kFraction;
   int root_count() const override { return 4; }
   /// Root 3's value (PointsMeet::gap) [length].
   double points_meet_gap(const ElementState<double>& s) const { return points_meet_.gap(*this, s, *free_length); }
