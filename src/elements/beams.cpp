@@ -221,8 +221,9 @@ void BeamElement::roots_from(const State& st, const std::array<double, 3>& force
 bool BeamElement::commit_in(State& st, int index, int direction, double t, const ElementState<double>& s,
                             Event& event) const {
   if (st.failed || direction > 0) return false;
-  if (points_meet_.gap(*this, s, length_) < 0.0 || index == kPointsMeetRoot)
+  if (points_meet_.met(*this, s, length_, index, kPointsMeetRoot, direction))
     points_meet_.stop(*this, t, s, length_, "", kBeamAdvice, "is crushed through its whole length", "an initial length");
+  if (index == kPointsMeetRoot) return false;
   std::array<double, 3> force{}, offset{};
   evaluate(s, force, offset);
   if (index == 3) {

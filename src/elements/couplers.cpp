@@ -503,7 +503,7 @@ bool DraftGear::commit_in(State& st, int index, int direction, double t, const E
                           Event& event) const {
   // Checked whatever root fired: a step known at its end alone (Euler's) commits one root per
   // element, and the step that carries P2 past P1 may cross another of the gear's roots first.
-  if (carries_force(st.stage) && (points_meet_gap(s) < 0.0 || (index == kPointsMeetRoot && direction < 0)))
+  if (carries_force(st.stage) && points_meet_.met(*this, s, *free_length, index, kPointsMeetRoot, direction))
     points_meet_.stop(*this, t, s, *free_length, st.stage == Stage::Solid ? "solid after pin shear" : "intact",
                       "The gear needs a stroke it does not have: set its points farther apart (at least the compression "
                       "its law must reach), or give a stiffness_after_bottoming, pin_shear_load or fracture_load that "

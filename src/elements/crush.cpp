@@ -164,7 +164,7 @@ bool CrushSpring::commit_in(State& st, int index, int direction, double t, const
   const double crush = crush_of(s);
   // Checked whatever root fired: a step known at its end alone (Euler's) commits one root per
   // element, and the step that carries P2 past P1 may also reverse the crush rate (root 0, first).
-  if (points_meet_gap(s) < 0.0 || (index == kPointsMeetRoot && direction < 0)) {
+  if (points_meet_.met(*this, s, *free_length, index, kPointsMeetRoot, direction)) {
     // No mode goes on from here: the run stops with what it has (Integrator::run keeps the
     // samples up to now and takes this as the run's message; not a step failure, so auto does
     // not hand the run to Euler either).

@@ -148,7 +148,8 @@ template <class Derived>
 bool PiecewiseLineElement<Derived>::commit_in(SegmentMode& m, int index, int direction, double t,
                                               const ElementState<double>& s, Element::Event& event) const {
   if (m.broken) return false;
-  if (checks_points_meet_ && (points_meet_gap(s) < 0.0 || (index == points_meet_root() && direction < 0)))
+  if (checks_points_meet_ &&
+      points_meet_.met(*this, s, static_cast<const Derived*>(this)->points_meet_length(), index, points_meet_root(), direction))
     points_meet_.stop(*this, t, s, static_cast<const Derived*>(this)->points_meet_length(), "", PointsMeet::kSpringAdvice);
   if (checks_points_meet_ && index == points_meet_root()) return false;
   const double x = measure_of(s);

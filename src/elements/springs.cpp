@@ -78,7 +78,7 @@ void LinearSpring::roots(double, const ElementState<double>& s, const double*, d
 
 bool LinearSpring::commit(int index, int direction, double t, const ElementState<double>& s, const double*, void*,
                           Event&) const {
-  if (*free_length > 0.0 && (points_meet_.gap(*this, s, *free_length) < 0.0 || (index == 0 && direction < 0)))
+  if (*free_length > 0.0 && points_meet_.met(*this, s, *free_length, index, 0, direction))
     points_meet_.stop(*this, t, s, *free_length, "", PointsMeet::kSpringAdvice);
   return false;
 }
