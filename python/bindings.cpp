@@ -49,7 +49,7 @@ py::dict sensitivity_run_dict(const railcrash::SensitivityRun& run) {
   row["wall_seconds"] = run.wall_seconds;
   row["outcomes"] = run.ok ? run.outcomes.text() : std::string();  // the discrete outcome (issue 40)
   row["branch"] = run.ok ? run.outcomes.order() : std::string();    // order only: equal texts, one branch
-  row["integrator_used"] = run.integrator.method;     // "ida", "euler", "ida+euler" ("" : the run did not start)
+  row["integrator_used"] = run.integrator.method;     // "ida", "euler", "ida+euler", "ida+euler+ida" ("" : the run did not start)
   row["euler_from_t"] = run.integrator.euler_from_t;  // ida+euler: when IDA handed the run to Euler (else NaN)
   return row;
 }

@@ -185,8 +185,8 @@ def sensitivity(model_path, design="report", jobs=0, only=None, second_order=Tru
     design: a design file, or "report" for sensitivity_design.yaml beside the model.
     Returns a dict: "runs" (one row per run: parameter, variation, factor, ok, R1-R3, and its
     discrete outcome: "outcomes" with times, "branch" order only, and the method it used:
-    "integrator_used" "ida", "euler" or "ida+euler", "euler_from_t" the time integrator auto
-    handed the run to Euler, NaN when it did not), "first_order" (A_i per
+    "integrator_used" "ida", "euler", "ida+euler" or "ida+euler+ida" (IDA took it back),
+    "euler_from_t" the time integrator auto handed the run to Euler, NaN when it did not), "first_order" (A_i per
     parameter), "constant" (A0 for R1-R3), "branch_changes" (each first-order run whose branch
     differs from run 0's, its step bisected `bisect` times: the values of P on and off run 0's
     branch, A_i, the effect within the branch and the jump) and, with a second-order design,
@@ -217,8 +217,8 @@ def sweep(model_path, plan, jobs=0, out=None, resume=False, run_limit=0.0):
     summary.md (default: a temporary folder, removed afterwards). Returns a
     pandas.DataFrame when pandas is installed, else a dict of columns (numpy arrays for
     numbers, lists of text): run, hash, one column per factor, status, one per response,
-    wall_seconds, message, outcomes, branch, integrator_used ("ida", "euler" or "ida+euler"),
-    euler_from_t (when integrator auto handed the run to Euler; NaN when it did not). Runs not
+    wall_seconds, message, outcomes, branch, integrator_used ("ida", "euler", "ida+euler" or
+    "ida+euler+ida": IDA took the run back), euler_from_t (when integrator auto handed the run to Euler; NaN when it did not). Runs not
     done (interrupted) are left out.
     """
     import tempfile

@@ -419,7 +419,8 @@ class SweepTest(unittest.TestCase):
     def test_the_method_each_run_used(self):
         """integrator_used and euler_from_t: a ball bouncing on a floor (ten bounces in 2 s) run
         with ida, euler and auto, which hands it to Euler (Euler's step 1 ms) after five mode
-        changes, at the time the same run made alone reports in summary.json."""
+        changes, at the time the same run made alone reports in summary.json, and takes it back
+        when Euler's energy drift passes half the accuracy warnings' limit (euler_until_t)."""
         ball = ("railcrash: 1\nname: ball\nunits: SI\ngravity: [0, -9.81]\nbodies:\n"
                 "  - {name: ball, mass: 1.0, inertia: 0.01, position: [0, 0.05]}\nelements:\n"
                 "  - {name: floor, type: contact, stiffness: 1.0e5, damping: 20, friction: 0, line_point: [0, 0], "
@@ -433,10 +434,11 @@ class SweepTest(unittest.TestCase):
                     "responses": ["t_reached"]}
             table = railcrash.sweep(model, plan, jobs=2)
             alone = railcrash.run(model)
-        self.assertEqual(list(table["integrator_used"]), ["ida", "euler", "ida+euler"])
+        self.assertEqual(list(table["integrator_used"]), ["ida", "euler", "ida+euler+ida"])
         euler_from_t = numpy.asarray(table["euler_from_t"], dtype=float)
         self.assertTrue(numpy.isnan(euler_from_t[0]) and numpy.isnan(euler_from_t[1]))
-        self.assertEqual(alone.summary["integrator_used"]["method"], "ida+euler")
+        self.assertEqual(alone.summary["integrator_used"]["method"], "ida+euler+ida")
+        self.assertGreater(alone.summary["integrator_used"]["euler_until_t"], alone.summary["integrator_used"]["euler_from_t"])
         # (summary.json writes 12 significant digits, runs.csv the exact double)
         self.assertAlmostEqual(euler_from_t[2], alone.summary["integrator_used"]["euler_from_t"], delta=1e-11)
 

@@ -54,7 +54,7 @@ int run_and_print(const std::string& path, const std::vector<std::string>& setti
     }
     std::printf("\n");
   }
-  if (o.stats.stability_limit > 0.0)
+  if (o.stats.stability_limit > 0.0 && o.stats.handed_back_at < 0.0)  // (Euler ended the run)
     std::printf("euler step %.4g, stability limit %.4g\n", o.stats.last_step, o.stats.stability_limit);
   std::printf("energy: kinetic %.6g, elastic %.6g, gravity %.6g, dissipated %.6g, external work %.6g; integration drift "
               "%.3g of the initial %.6g (energy the integration lost, no element's)\n",

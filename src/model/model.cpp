@@ -9,6 +9,8 @@ double standard_gravity(UnitSystem units) {
   return units == UnitSystem::SI ? 9.80665 : 386.088;  // [m/s^2] | [in/s^2] (9.80665 / 0.0254)
 }
 
+double metres_per_length_unit(UnitSystem units) { return units == UnitSystem::SI ? 1.0 : 0.0254; }  // [m]
+
 const char* unit_system_name(UnitSystem units) { return units == UnitSystem::SI ? "SI" : "in-lbf-s"; }
 
 std::array<double, 2> TimeTable::at(double t) const {

@@ -11,9 +11,7 @@
 namespace railcrash {
 
 double relative_balance_error(const EnergyBalance& energy) {
-  const double turned_over = std::max(std::abs(energy.initial_total),
-                                      std::abs(energy.kinetic) + std::abs(energy.elastic) + std::abs(energy.gravity) +
-                                          std::abs(energy.dissipated) + std::abs(energy.external_work));
+  const double turned_over = energy.turned_over();
   return turned_over > 0.0 ? energy.error() / turned_over : 0.0;
 }
 
@@ -22,7 +20,9 @@ AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integ
   facts.relative_balance_error = relative_balance_error(EnergyBalance::between(outcome.initial_energy, outcome.final_energy));
   facts.max_constraint_residual = outcome.max_constraint_residual;
   facts.units = units;
-  facts.euler_ran = integrator == integrator_name(IntegratorKind::Euler) || outcome.stats.handed_over_at >= 0.0;
+  // Auto's Euler counts when it ended the run; IDA taking the run back held Euler's share within half the limits.
+  facts.euler_ran = integrator == integrator_name(IntegratorKind::Euler) ||
+                    (outcome.stats.handed_over_at >= 0.0 && outcome.stats.handed_back_at < 0.0);
   facts.euler_step = outcome.stats.last_step;
   return facts;
 }
@@ -56,7 +56,7 @@ std::vector<std::string> accuracy_warnings(const AccuracyFacts& facts) {
     warnings.push_back(text + remedy(facts));
   }
   const bool si = facts.units == UnitSystem::SI;
-  const double limit = si ? kConstraintResidualLimit : kConstraintResidualLimit / 0.0254;  // [m] or [in]
+  const double limit = kConstraintResidualLimit / metres_per_length_unit(facts.units);  // [m] or [in]
   if (facts.max_constraint_residual > limit) {
     char text[200];
     std::snprintf(text, sizeof text, "joints open by up to %.3g %s at the output samples (more than %.3g %s): ",

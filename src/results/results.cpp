@@ -555,8 +555,12 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"t_reached\": " << json_number(outcome.t_reached) << ",\n";
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
   if (!s.hand_over_reason.empty())  // integrator auto: which method ran when, and why
-    j << "  \"integrator_used\": {\"method\": " << json_string(s.handed_over_at >= 0.0 ? "ida+euler" : "ida")
+    j << "  \"integrator_used\": {\"method\": "
+      << json_string(s.handed_back_at >= 0.0   ? kIdaEulerIdaMethod
+                     : s.handed_over_at >= 0.0 ? kIdaThenEulerMethod
+                                               : integrator_name(IntegratorKind::Ida))
       << ", \"euler_from_t\": " << (s.handed_over_at >= 0.0 ? json_number(s.handed_over_at) : "null")
+      << ", \"euler_until_t\": " << (s.handed_back_at >= 0.0 ? json_number(s.handed_back_at) : "null")
       << ", \"reason\": " << json_string(s.hand_over_reason) << "},\n";
   for (const std::unique_ptr<OutputSink>& sink : sinks_) j << sink->summary_entry();  // (none for the CSV files)
   j << "  \"units\": {\"system\": " << json_string(unit_system_name(model.units)) << ", \"length\": "

@@ -1,14 +1,67 @@
 #include "railcrash/solver/auto_integrator.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace railcrash {
+
+namespace {
+
+/// Euler after IDA's hand-over, on trial (auto_integrator.hpp): at each new output sample, its
+/// energy drift since the hand-over and its joints' opening against the rule's limits.
+class EulerOnTrial final : public EulerIntegrator {
+ public:
+  EulerOnTrial(DaeSystem& system, const EulerSettings& settings, Step step, double t0, const std::vector<double>& y,
+               const std::vector<double>& quadratures, const AutoSettings& rule, double drift_at_hand_over)
+      : EulerIntegrator(system, settings, std::move(step), t0, y, quadratures),
+        energy_share_(rule.euler_energy_share),
+        joint_opening_(rule.euler_joint_opening / metres_per_length_unit(system.model().units)),
+        drift_at_hand_over_(drift_at_hand_over),
+        checked_at_(t0) {}
+
+  bool returns_run(double t, const double* /*y*/) override {
+    if (!(last_sample_time() > checked_at_)) return false;  // a new sample only
+    checked_at_ = last_sample_time();
+    const EnergyBalance balance =
+        EnergyBalance::between(run_initial_energy(), energy(last_sample_state().data(), last_sample_quadratures().data()));
+    const double drift = balance.integration_drift() - drift_at_hand_over_;  // [energy] Euler's own
+    const double turned_over = balance.turned_over();
+    const double share = turned_over > 0.0 ? std::abs(drift) / turned_over : 0.0;
+    const double opening = last_sample_residual();
+    char why[300];
+    if (share > energy_share_)
+      std::snprintf(why, sizeof why, "its integration had %s %.4g %% of the energy turned over since (more than %.4g %%)",
+                    drift < 0.0 ? "created" : "lost", 100.0 * share, 100.0 * energy_share_);
+    else if (opening > joint_opening_)
+      std::snprintf(why, sizeof why, "its penalty joints opened by %.3g length units (more than %.3g)", opening,
+                    joint_opening_);
+    else
+      return false;
+    char reason[420];
+    std::snprintf(reason, sizeof reason, "; IDA took the run back at t = %.6g, where Euler was less accurate than "
+                  "the accuracy warnings allow: %s", t, why);
+    stats().hand_over_reason += reason;
+    stats().handed_back_at = t;
+    return true;
+  }
+
+ private:
+  double energy_share_;        // [-]
+  double joint_opening_;       // [length]
+  double drift_at_hand_over_;  // [energy] the run's integration drift when Euler took it
+  double checked_at_;          // [time] the last sample checked
+};
+
+}  // namespace
 
 AutoIntegrator::AutoIntegrator(DaeSystem& system, IdaSettings ida, EulerSettings euler, AutoSettings rule)
     : IdaIntegrator(system, ida), rule_(rule), euler_settings_(euler) {}
 
 void AutoIntegrator::start(double t_end) {
   IdaIntegrator::start(t_end);
+  t_end_ = t_end;
+  euler_taking_over_ = false;
+  ida_last_step_ = 0.0;
   steps_ = 0;
   window_t_ = 0.0;
   window_restarts_ = 0;
@@ -45,8 +98,10 @@ std::unique_ptr<Integrator> AutoIntegrator::hand_over(double t, const double* /*
     return nullptr;
   std::vector<double> state, quadratures;
   state_for_successor(t, state, quadratures);
-  auto euler = std::make_unique<EulerIntegrator>(system_, euler_settings_, std::move(*euler_step_), t, state, quadratures);
+  const double drift = EnergyBalance::between(run_initial_energy(), energy(state.data(), quadratures.data())).integration_drift();
+  auto euler = std::make_unique<EulerOnTrial>(system_, euler_settings_, std::move(*euler_step_), t, state, quadratures, rule_, drift);
   euler_step_.reset();
+  euler_taking_over_ = true;
   char reason[400];
   std::snprintf(reason, sizeof reason,
                 "IDA handed the run to Euler at t = %.6g: from t = %.6g its steps (mean %.4g) and restarts cost about "
@@ -79,7 +134,17 @@ std::unique_ptr<Integrator> AutoIntegrator::rescue(const std::string& failure, d
   return euler;
 }
 
+void AutoIntegrator::resume(double t, std::vector<double> y, const std::vector<double>& quadratures) {
+  resume_at(t, std::move(y), quadratures, ida_last_step_, t_end_);
+}
+
 void AutoIntegrator::finish() {
+  if (euler_taking_over_) {  // Euler takes the run on trial: IDA's objects are kept for the way back
+    euler_taking_over_ = false;
+    suspend();
+    ida_last_step_ = stats().last_step;
+    return;
+  }
   IdaIntegrator::finish();
   if (stats().handed_over_at >= 0.0) return;  // the reason of the hand-over stands
   if (!euler_refusal_.empty()) {

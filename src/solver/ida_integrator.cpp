@@ -257,8 +257,8 @@ struct IdaIntegrator::Impl {
 
   /// Restarts IDA at t from the state now in y, yp and quad (its counters are added to stats
   /// first: IDAReInit clears them, and the stop time with them).
-  void reinitialize(double t, double t_end, RunStatistics& stats) {
-    accumulate(stats);
+  void reinitialize(double t, double t_end, RunStatistics& stats, bool add_counters = true) {
+    if (add_counters) accumulate(stats);
     check(IDAReInit(ida, t, y, yp), "IDAReInit");
     check(IDAQuadReInit(ida, quad), "IDAQuadReInit");
     check(IDASetStopTime(ida, t_end), "IDASetStopTime");
@@ -309,11 +309,12 @@ struct IdaIntegrator::Impl {
   };
   /// The one way IDA restarts: from the state `from` holds (t, y, y', quadratures), in the
   /// present modes; IDA's counters go to stats first (reinitialize).
-  void restart(const RestartRetry& from, FirstStep rule, double t_end, RunStatistics& stats) {
+  /// add_counters false: they are in stats already (IdaIntegrator::suspend).
+  void restart(const RestartRetry& from, FirstStep rule, double t_end, RunStatistics& stats, bool add_counters = true) {
     std::copy(from.y.begin(), from.y.end(), N_VGetArrayPointer(y));
     std::copy(from.yp.begin(), from.yp.end(), N_VGetArrayPointer(yp));
     std::copy(from.quad.begin(), from.quad.end(), N_VGetArrayPointer(quad));
-    reinitialize(from.t, t_end, stats);
+    reinitialize(from.t, t_end, stats, add_counters);
     double first_step = 0.0;  // IDA's own
     if (from.step_before > 0.0)
       first_step = rule == FirstStep::Retry ? 0.1 * from.step_before : restart_first_step(from.step_before, from.t, t_end);
@@ -892,6 +893,11 @@ std::string IdaIntegrator::step_limit_advice(double t_end) const {
 }
 
 void IdaIntegrator::finish() {
+  suspend();
+  impl_.reset();
+}
+
+void IdaIntegrator::suspend() {
   if (impl_ && impl_->ida) {
     try {
       impl_->accumulate(stats());
@@ -903,7 +909,39 @@ void IdaIntegrator::finish() {
     if (entries > 0) stats().factor_nonzeros = entries;
     stats().factor_ordering = klu_ordering(impl_->linear_solver);
   }
-  impl_.reset();
+}
+
+void IdaIntegrator::resume_at(double t, std::vector<double> y, const std::vector<double>& quadratures, double step_before,
+                              double t_end) {
+  RAILCRASH_DEMAND(impl_ && impl_->ida);
+  Impl& impl = *impl_;
+  const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
+  outputs_current_ = false;
+  // Euler's penalty joints leave them open by a little: the positions and velocities nearest
+  // to its state that satisfy them (the start's assembly), then consistent rates and
+  // multipliers in the present modes (and boundary commits there), as at any restart.
+  try {
+    assemble_initial_state(system_, y);
+  } catch (const InputError& e) {
+    throw StepFailure(std::string("IDA could not take the run back at t = ") + std::to_string(t) +
+                      ": the state's joints could not be closed (" + e.what() + ")");
+  }
+  std::vector<double> yp;
+  std::vector<EventRecord> events;
+  std::vector<char> changed_now;
+  restart_state(mode_tracker(), t, y, yp, events, changed_now, impl.rates_cache);
+  report_events(events, y.data());
+  Impl::RestartRetry& retry = impl.retry;
+  retry.t = t;
+  retry.step_before = step_before;
+  retry.available = step_before > 0.0;
+  retry.y = std::move(y);
+  retry.yp = std::move(yp);
+  retry.quad = quadratures;
+  impl.restart(retry, Impl::FirstStep::AfterEvent, t_end, stats(), /*add_counters=*/false);
+  mode_tracker().arm(t, N_VGetArrayPointer(impl.y));
+  impl.t_reached = t;
+  impl.at_start = false;
 }
 
 }  // namespace railcrash

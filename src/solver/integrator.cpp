@@ -149,8 +149,8 @@ void Integrator::deliver_sample(double t) {
     if (last_sample_y_.empty()) msg << " before its first sample";
     throw StepFailure(msg.str());
   }
-  outcome_.max_constraint_residual =
-      std::max(outcome_.max_constraint_residual, system_.constraint_residual(sample_y_.data(), constraint_scratch_));
+  last_sample_residual_ = system_.constraint_residual(sample_y_.data(), constraint_scratch_);
+  outcome_.max_constraint_residual = std::max(outcome_.max_constraint_residual, last_sample_residual_);
   t_sampled_ = t;
   last_sample_y_ = sample_y_;
   last_sample_quadratures_ = sample_quadratures_;
@@ -176,6 +176,7 @@ void Integrator::take_run_from(Integrator& previous) {
   output_interval_ = previous.output_interval_;
   output_index_ = previous.output_index_;
   t_sampled_ = previous.t_sampled_;
+  last_sample_residual_ = previous.last_sample_residual_;
   sample_y_ = std::move(previous.sample_y_);
   sample_quadratures_ = std::move(previous.sample_quadratures_);
   sample_outputs_ = std::move(previous.sample_outputs_);
@@ -224,6 +225,17 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
     successor = std::move(next);  // (the previous successor, if any, is done with)
     active = successor.get();
     dense = active->dense_output();
+  };
+  // The successor gives the run back (returns_run): this integrator goes on from its state.
+  const auto take_run_back = [&](double t) {
+    std::vector<double> y, quadratures;
+    active->state_for_successor(t, y, quadratures);
+    active->finish();
+    take_run_from(*active);
+    active = this;
+    dense = dense_output();
+    resume(t, std::move(y), quadratures);
+    successor.reset();
   };
   try {
     {
@@ -275,7 +287,10 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
           ++active->output_index_;
       }
       if (t_reached < t_end) {
-        if (std::unique_ptr<Integrator> next = active->hand_over(t_reached, active->current_state())) pass_run_to(std::move(next));
+        if (std::unique_ptr<Integrator> next = active->hand_over(t_reached, active->current_state()))
+          pass_run_to(std::move(next));
+        else if (active != this && active->returns_run(t_reached, active->current_state()))
+          take_run_back(t_reached);
       }
     }
   } catch (const InputError&) {

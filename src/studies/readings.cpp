@@ -597,8 +597,8 @@ std::vector<ReadingsCombinationResult> run_readings(const std::string& model_pat
 namespace {
 
 /// A combination's runs' methods for readings.csv: the methods its runs used ("ida", "euler",
-/// "ida+euler" in that order, joined by spaces), the earliest hand-over to Euler and how many
-/// runs were handed over.
+/// "ida+euler", "ida+euler+ida" in that order, joined by spaces), the earliest hand-over to
+/// Euler and how many runs were handed over (whether or not IDA took them back).
 struct CombinationIntegrators {
   std::string methods;
   IntegratorUsed earliest;
@@ -607,21 +607,21 @@ struct CombinationIntegrators {
 
 CombinationIntegrators combination_integrators(const SensitivityResult& study) {
   CombinationIntegrators used;
-  bool seen[3] = {false, false, false};
+  constexpr int kMethods = 4;
+  const char* names[kMethods] = {integrator_name(IntegratorKind::Ida), integrator_name(IntegratorKind::Euler),
+                                 kIdaThenEulerMethod, kIdaEulerIdaMethod};
+  bool seen[kMethods] = {false, false, false, false};
   const auto add = [&](const SensitivityRun& run) {
     const std::string& method = run.integrator.method;
-    const char* names[3] = {integrator_name(IntegratorKind::Ida), integrator_name(IntegratorKind::Euler), kIdaThenEulerMethod};
-    for (int k = 0; k < 3; ++k) seen[k] = seen[k] || method == names[k];
-    if (method != kIdaThenEulerMethod) return;
-    seen[2] = true;
+    for (int k = 0; k < kMethods; ++k) seen[k] = seen[k] || method == names[k];
+    if (method != kIdaThenEulerMethod && method != kIdaEulerIdaMethod) return;
     ++used.handed_over_runs;
     if (std::isnan(used.earliest.euler_from_t) || run.integrator.euler_from_t < used.earliest.euler_from_t) used.earliest = run.integrator;
   };
   add(study.base);
   for (const SensitivityRun& run : study.runs) add(run);
   for (const SensitivityRun& run : study.second_order_runs) add(run);
-  const char* names[3] = {integrator_name(IntegratorKind::Ida), integrator_name(IntegratorKind::Euler), kIdaThenEulerMethod};
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; k < kMethods; ++k)
     if (seen[k]) used.methods += (used.methods.empty() ? "" : " ") + std::string(names[k]);
   return used;
 }

@@ -25,6 +25,8 @@ enum class UnitSystem { SI, InLbfS };
 
 /// Standard gravity in the unit system's length unit per s^2.
 double standard_gravity(UnitSystem units);
+/// The system's length unit in metres: 1 (SI) or 0.0254 (in-lbf-s).
+double metres_per_length_unit(UnitSystem units);
 const char* unit_system_name(UnitSystem units);
 
 struct Body {

@@ -75,6 +75,8 @@ inline constexpr IntegratorName kIntegratorNames[] = {
 /// The method a run of integrator auto reports when it handed the run from IDA to Euler
 /// (summary.json's integrator_used, the studies' tables).
 inline constexpr const char* kIdaThenEulerMethod = "ida+euler";
+/// ... when IDA then took the run back from Euler and finished it (Euler's trial failed).
+inline constexpr const char* kIdaEulerIdaMethod = "ida+euler+ida";
 
 /// The integrator's name ("ida", "euler", "auto").
 constexpr const char* integrator_name(IntegratorKind kind) {

@@ -23,7 +23,9 @@
 // ModeTracker, a friend): its commits, its reset to the start modes and its snapshot restore.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -87,6 +89,13 @@ struct EnergyBalance {
   double integration_drift() const { return initial_total + external_work - (kinetic + elastic + gravity + dissipated); }
   /// The same with the opposite sign (energy gained), as summary.json's balance_error.
   double error() const { return -integration_drift(); }
+  /// The energy turned over, the scale the drift is judged against (the accuracy warnings,
+  /// integrator auto): max(|initial total|, |kinetic| + |elastic| + |gravity| + |dissipated|
+  /// + |external work|) [force*length].
+  double turned_over() const {
+    return std::max(std::abs(initial_total),
+                    std::abs(kinetic) + std::abs(elastic) + std::abs(gravity) + std::abs(dissipated) + std::abs(external_work));
+  }
   static EnergyBalance between(const EnergyState& start, const EnergyState& now);
 };
 

@@ -63,6 +63,10 @@ class EulerIntegrator : public Integrator {
   static double estimate_stability_limit(const DaeSystem& system, const std::vector<double>& y,
                                          const PenaltyRows* penalty);
 
+ protected:
+  /// The system's energy figures with the penalty springs' stored energy and work.
+  EnergyState energy(const double* y, const double* quadratures) const override;
+
  private:
   friend class EulerEventHandler;  // (euler_integrator.cpp) Euler's side of the event loop
   /// Euler's step for the event layer: known at its end alone (not dense), the state there.
@@ -101,7 +105,6 @@ class EulerIntegrator : public Integrator {
   /// of the next step, the root functions into g_after_, the element outputs.
   void sweep();
   void final_state(std::vector<double>& y, std::vector<double>& quadratures) override { state_at(t_, y, quadratures); }
-  EnergyState energy(const double* y, const double* quadratures) const override;
   std::string step_limit_advice(double t_end) const override;
   std::string divergence_phrase() const override { return "explicit Euler diverged"; }
   std::string divergence_advice(const std::vector<double>& last_good, double t_last_good) const override;

@@ -70,6 +70,15 @@ class IdaIntegrator : public Integrator {
   void finish() override;
   /// IDA's current time: after a failed step, the time of its last good state (state_at there).
   double current_time() const;
+  /// At a hand-over that may come back (integrator auto): IDA's counters and KLU's figures
+  /// into stats(), as finish() puts them, with SUNDIALS' objects kept for resume_at.
+  void suspend();
+  /// Goes on at t from a successor's state y (positions and velocities; its multipliers are
+  /// replaced) and quadratures, with the tolerances, Jacobian pattern and KLU analysis of the
+  /// run so far (suspend()): the joints closed by the start's assembly, consistent rates in the
+  /// present modes, and the one restart, its first step a fraction of step_before. Throws
+  /// StepFailure when the joints cannot be closed.
+  void resume_at(double t, std::vector<double> y, const std::vector<double>& quadratures, double step_before, double t_end);
 
  private:
   friend class IdaEventHandler;  // (ida_integrator.cpp) IDA's side of the event loop

@@ -100,6 +100,7 @@ struct RunStatistics {
   long factor_nonzeros = 0;          // ida: entries KLU stores: L, U and the off-diagonal blocks (last factorization)
   std::string factor_ordering;       // ida: KLU's fill-reducing ordering, "AMD" or "COLAMD" (the one with fewer entries)
   double handed_over_at = -1.0;      // [time] integrator auto: when IDA handed the run to Euler (-1: it did not)
+  double handed_back_at = -1.0;      // [time] integrator auto: when IDA took the run back from Euler (-1: it did not)
   std::string hand_over_reason;      // integrator auto: why it did, or why IDA kept the run ("" before the run ends)
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
@@ -272,6 +273,17 @@ class Integrator {
   virtual std::unique_ptr<Integrator> hand_over(double /*t*/, const double* /*y*/) { return nullptr; }
   /// Called on the successor once it holds the run (its statistics among it).
   virtual void continue_from_hand_over() {}
+  /// Asked of a successor after every accepted step (t: its end, y: current_state()): whether
+  /// the integrator that began the run takes it back from this state (integrator auto: Euler
+  /// whose run has turned out less accurate than the accuracy warnings allow). The run loop
+  /// then calls this one's finish() and the first integrator's resume().
+  virtual bool returns_run(double /*t*/, const double* /*y*/) { return false; }
+  /// On the integrator that began the run, once it holds the run again (returns_run): goes on
+  /// from the successor's state y and quadratures at t; must be ready to advance() from t.
+  /// Throws StepFailure when it cannot.
+  virtual void resume(double /*t*/, std::vector<double> /*y*/, const std::vector<double>& /*quadratures*/) {
+    throw StepFailure("this integrator cannot take a run back");
+  }
   /// Asked when advance() failed with a StepFailure (failure: its message) by the run loop: the
   /// integrator that takes the rest of the run from this one's last good state (integrator:
   /// auto hands IDA's failed run to Euler), or null to end the run failed. *t: the time of
@@ -306,6 +318,14 @@ class Integrator {
   /// !step_outputs_wanted()). An integrator that hands over current_outputs() need compute
   /// only these elements' outputs per step (DaeSystem::SweepExtras::output_elements).
   const char* step_output_elements() const { return observe_steps_ && !step_elements_.empty() ? step_elements_.data() : nullptr; }
+  /// The run's energy figures at t = 0, and its last output sample so far: its time, state,
+  /// quadratures and largest constraint residual |Phi| [length] (a successor's own check of
+  /// its accuracy, returns_run).
+  const EnergyState& run_initial_energy() const { return outcome_.initial_energy; }
+  double last_sample_time() const { return t_sampled_; }
+  const std::vector<double>& last_sample_state() const { return last_sample_y_; }
+  const std::vector<double>& last_sample_quadratures() const { return last_sample_quadratures_; }
+  double last_sample_residual() const { return last_sample_residual_; }
   /// The state and quadratures at t for a successor (hand_over): as state_at gives them.
   void state_for_successor(double t, std::vector<double>& y, std::vector<double>& quadratures) { state_at(t, y, quadratures); }
 
@@ -339,6 +359,7 @@ class Integrator {
   std::vector<double> sample_forces_;       // generalized forces at the sample, when the observer wants them
   bool observe_sample_forces_ = false;      // the observer wants_sample_forces()
   std::vector<double> constraint_scratch_;  // work space of the per-sample constraint residual
+  double last_sample_residual_ = 0.0;       // [length] |Phi| at the last sample
   std::vector<double> last_sample_y_, last_sample_quadratures_;
   bool observe_steps_ = false;       // the observer wants step()
   bool time_phases_ = false;         // time_phases()

@@ -23,7 +23,8 @@ struct RunReport;
 /// The method a study's run used, for the studies' columns integrator_used and euler_from_t:
 /// "ida" or "euler" (the one the model names; integrator auto whose IDA kept the run: "ida"), or
 /// "ida+euler" (integrator auto: IDA handed the run to Euler at euler_from_t [the model's time
-/// unit], as summary.json's integrator_used says). "" and NaN for a run that did not start.
+/// unit], as summary.json's integrator_used says), or "ida+euler+ida" (and IDA took it back
+/// later, summary.json's euler_until_t). "" and NaN for a run that did not start.
 struct IntegratorUsed {
   std::string method;
   double euler_from_t = std::numeric_limits<double>::quiet_NaN();
