@@ -20,10 +20,10 @@ AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integ
   facts.relative_balance_error = relative_balance_error(EnergyBalance::between(outcome.initial_energy, outcome.final_energy));
   facts.max_constraint_residual = outcome.max_constraint_residual;
   facts.units = units;
-  // Auto's Euler counts when it ended the run; IDA taking the run back held Euler's share within half the limits.
-  facts.euler_ran = integrator == integrator_name(IntegratorKind::Euler) ||
-                    (outcome.stats.handed_over_at >= 0.0 && outcome.stats.handed_back_at < 0.0);
-  facts.euler_step = outcome.stats.last_step;
+  facts.euler_ran = integrator == integrator_name(IntegratorKind::Euler) || outcome.stats.handed_over_at >= 0.0;
+  facts.euler_step = outcome.stats.euler_step > 0.0 ? outcome.stats.euler_step : outcome.stats.last_step;
+  facts.euler_from = outcome.stats.handed_over_at;
+  facts.ida_took_back_at = outcome.stats.handed_back_at;
   return facts;
 }
 
@@ -37,6 +37,14 @@ std::string format(const char* pattern, double a, double b) {
 
 /// What to change, for the method that integrated the run.
 std::string remedy(const AccuracyFacts& facts) {
+  if (facts.euler_ran && facts.ida_took_back_at >= 0.0) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "integrator auto ran Euler (steps of %.3g s) from t = %.6g to %.6g, where IDA took the run back; "
+                  "run with --integrator ida to leave Euler out, and compare",
+                  facts.euler_step, facts.euler_from, facts.ida_took_back_at);
+    return text;
+  }
   if (facts.euler_ran)
     return format("Euler's step was %.3g s: halve it (--dt %.3g) and compare, or run with --integrator ida; "
                   "`railcrash converge` shows how the results move with the step",

@@ -15,7 +15,7 @@ class EulerOnTrial final : public EulerIntegrator {
                const std::vector<double>& quadratures, const AutoSettings& rule, double drift_at_hand_over)
       : EulerIntegrator(system, settings, std::move(step), t0, y, quadratures),
         energy_share_(rule.euler_energy_share),
-        joint_opening_(rule.euler_joint_opening / metres_per_length_unit(system.model().units)),
+        joint_opening_(AutoIntegrator::joint_opening_limit(system, rule)),
         drift_at_hand_over_(drift_at_hand_over),
         checked_at_(t0) {}
 
@@ -66,6 +66,7 @@ void AutoIntegrator::start(double t_end) {
   window_t_ = 0.0;
   window_restarts_ = 0;
   ida_cost_ = euler_cost_ = ida_mean_step_ = 0.0;
+  joints_would_open_ = 0.0;
   euler_step_.reset();
   euler_refusal_.clear();
   // Euler's step from the state IDA starts from (assembled and settled), as a plain Euler run
@@ -80,7 +81,23 @@ void AutoIntegrator::start(double t_end) {
   }
 }
 
-std::unique_ptr<Integrator> AutoIntegrator::hand_over(double t, const double* /*y*/) {
+double AutoIntegrator::penalty_opening(const double* y) const {
+  // Euler's penalty force on row r is k_r Phi_r + c_r Phi_r', IDA's the multiplier lambda_r:
+  // carrying the same load at rest, the joint stands open by |lambda_r| / k_r (an angle row
+  // counted times the model's length, as the constraint residual counts it).
+  const int nq = system_.body_unknowns();
+  const std::vector<double>& stiffness = euler_step_->penalty.stiffness;
+  double widest = 0.0;  // [length]
+  for (int row = 0; row < system_.constraint_rows(); ++row) {
+    const double k = stiffness[static_cast<std::size_t>(row)];
+    if (!(k > 0.0)) continue;
+    const double scale = system_.constraint_row_is_rotational(row) ? system_.model().length_scale() : 1.0;
+    widest = std::max(widest, std::abs(y[2 * nq + row]) / k * scale);
+  }
+  return widest;
+}
+
+std::unique_ptr<Integrator> AutoIntegrator::hand_over(double t, const double* y) {
   if (!euler_step_) return nullptr;
   if (++steps_ <= rule_.startup_steps) {
     window_t_ = t;
@@ -96,6 +113,13 @@ std::unique_ptr<Integrator> AutoIntegrator::hand_over(double t, const double* /*
   if (t - window_t_ < rule_.min_span_steps * dt || stats().events < rule_.min_events ||
       ida_cost_ <= rule_.margin * euler_cost_ || (rule_.require_resolution && ida_mean_step_ < dt))
     return nullptr;
+  // (3) Euler's penalty joints would stand open within the trial's limit under the loads the
+  // joints carry now (past it, the trial would give the run back at its first sample, with
+  // that sample's joints open).
+  if (rule_.require_closed_joints) {
+    joints_would_open_ = penalty_opening(y);
+    if (joints_would_open_ > joint_opening_limit()) return nullptr;
+  }
   std::vector<double> state, quadratures;
   state_for_successor(t, state, quadratures);
   const double drift = EnergyBalance::between(run_initial_energy(), energy(state.data(), quadratures.data())).integration_drift();
@@ -156,11 +180,16 @@ void AutoIntegrator::finish() {
     return;
   }
   const double dt = euler_step_ ? euler_step_->dt : 0.0;
+  char joints[200];
+  std::snprintf(joints, sizeof joints,
+                "dearer, but Euler's penalty joints would stand open by %.3g length units under the joints' loads "
+                "(more than %.3g)", joints_would_open_, joint_opening_limit());
   const char* why = ida_cost_ <= rule_.margin * euler_cost_ ? "cheaper or not clearly dearer"
                     : rule_.require_resolution && ida_mean_step_ < dt
                         ? "dearer, but its steps are shorter than Euler's: Euler would resolve the motion less finely"
-                        : "dearer, but with too few mode changes for a crash run";
-  char reason[480];
+                    : joints_would_open_ > joint_opening_limit() ? joints
+                                                                 : "dearer, but with too few mode changes for a crash run";
+  char reason[600];
   std::snprintf(reason, sizeof reason,
                 "IDA kept the run: from t = %.6g its steps (mean %.4g) and restarts cost about %.0f force sweeps, Euler's "
                 "steps of %.4g about %.0f: IDA %s",

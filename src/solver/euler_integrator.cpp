@@ -186,6 +186,7 @@ EulerIntegrator::EulerIntegrator(DaeSystem& system, EulerSettings settings, Step
 void EulerIntegrator::continue_from_hand_over() {
   stats().stability_limit = stability_limit_;
   stats().last_step = dt_;
+  stats().euler_step = dt_;
 }
 
 void EulerIntegrator::start(double /*t_end*/) {
@@ -194,6 +195,7 @@ void EulerIntegrator::start(double /*t_end*/) {
   stats().settling_steps = settling_steps_;
   stats().settling_displacement = settling_displacement_;
   stats().last_step = dt_;
+  stats().euler_step = dt_;
   y_ = y0_;
   quadratures_.assign(static_cast<std::size_t>(system_.quadrature_count()), 0.0);
   // Modes as prepared (and settled) in the constructor; a second run starts from them too.

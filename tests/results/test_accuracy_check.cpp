@@ -68,6 +68,16 @@ TEST_CASE("accuracy warnings fire past the stated limits and name what to change
   REQUIRE(w.size() == 1);
   CHECK(contains(w[0], "0.04 in"));
 
+  // auto that ran Euler for a while and took the run back: the remedy names that part and leaves Euler out
+  facts.euler_from = 0.0147;
+  facts.ida_took_back_at = 0.0261;
+  w = accuracy_warnings(facts);
+  REQUIRE(w.size() == 1);
+  CHECK(contains(w[0], "integrator auto ran Euler (steps of 0.0004 s) from t = 0.0147 to 0.0261, where IDA took the run back"));
+  CHECK(contains(w[0], "--integrator ida"));
+  CHECK_FALSE(contains(w[0], "--dt"));
+  facts.ida_took_back_at = -1.0;
+
   // IDA: the remedy is its tolerance, not a step
   facts.euler_ran = false;
   w = accuracy_warnings(facts);

@@ -262,6 +262,7 @@ TEST_CASE("IDA takes a run back from Euler's open penalty joints, closes them an
   rule.min_span_steps = 0.0;
   rule.margin = 0.0;
   rule.require_resolution = false;
+  rule.require_closed_joints = false;
   rule.euler_joint_opening = 1e-12;  // [m]
   AutoIntegrator integrator(system, ida, euler_settings(loaded.run_spec.simulation), rule);
   SampleTimes samples;
@@ -286,4 +287,35 @@ TEST_CASE("IDA takes a run back from Euler's open penalty joints, closes them an
   // The energy the pendulum holds: Euler's few steps and the joint's closing changed it little.
   const EnergyBalance b = EnergyBalance::between(outcome.initial_energy, outcome.final_energy);
   CHECK(std::abs(b.integration_drift()) < 1e-3 * std::abs(b.turned_over()));
+}
+
+TEST_CASE("auto keeps IDA where Euler's penalty joints would stand open under the joints' loads", "[integrators][auto]") {
+  // The pendulum's pin carries its bob's weight and swing (IDA's multipliers, up to 3 m g): with
+  // Euler's penalty stiffness k the pin would stand open by |lambda| / k, more than a limit of
+  // 1e-12 m as soon as it carries anything. The same rule with the check off hands over.
+  const double t_end = 0.2;  // [s]
+  const LoadedModel loaded = testing::loaded_from_text(pendulum(t_end));
+  AutoSettings rule;
+  rule.startup_steps = 5;
+  rule.min_events = 0;
+  rule.min_span_steps = 0.0;
+  rule.margin = 0.0;
+  rule.require_resolution = false;
+  rule.euler_joint_opening = 1e-12;  // [m]
+  for (const bool check : {true, false}) {
+    INFO("require_closed_joints " << check);
+    rule.require_closed_joints = check;
+    DaeSystem system(loaded.model);
+    AutoIntegrator integrator(system, ida_settings(loaded.run_spec.simulation), euler_settings(loaded.run_spec.simulation), rule);
+    SampleTimes samples;
+    const RunOutcome outcome = integrator.run(t_end, 0.01, samples);
+    INFO(outcome.stats.hand_over_reason);
+    REQUIRE(outcome.ok);
+    if (check) {
+      CHECK(outcome.stats.handed_over_at < 0.0);
+      CHECK_THAT(outcome.stats.hand_over_reason, Catch::Contains("Euler's penalty joints would stand open by"));
+    } else {
+      CHECK(outcome.stats.handed_over_at > 0.0);
+    }
+  }
 }

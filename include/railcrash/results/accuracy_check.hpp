@@ -36,8 +36,10 @@ struct AccuracyFacts {
   double relative_balance_error = 0.0;    // [-] as summary.json
   double max_constraint_residual = 0.0;   // [length of the model's unit system]
   UnitSystem units = UnitSystem::SI;
-  bool euler_ran = false;                 // Euler integrated all of the run or its rest (auto's hand-over)
+  bool euler_ran = false;                 // Euler integrated all of the run or a part (auto's hand-over)
   double euler_step = 0.0;                // [s] its step, when euler_ran
+  double ida_took_back_at = -1.0;         // [s] auto: IDA took the run back from Euler then (-1: it did not)
+  double euler_from = -1.0;               // [s] auto: Euler's part began then (-1: Euler ran all the run)
 };
 
 /// The facts of a finished run; `integrator` is the method the run was set to ("ida", "euler"

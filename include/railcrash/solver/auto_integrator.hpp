@@ -17,13 +17,17 @@
 //   pace), IDA's cost since then is compared after every step with Euler's over the same
 //   span, 1.1 (t - t_w) / dt_E. IDA hands the run over when, over a span of at least
 //   min_span_steps Euler steps and after at least min_events mode changes,
-//     (1) its cost exceeds Euler's by the margin (1.5), and
+//     (1) its cost exceeds Euler's by the margin (1.5),
 //     (2) its mean step over the span is at least dt_E: Euler, first order, is not to take
 //         coarser steps than IDA's error control needs. On the SI multiple-unit examples
 //         IDA's mean step is a third to a seventh of Euler's stable step, and Euler there is
 //         up to 16 % off in a trailing car's crush and 7-16 % in the energy the crush zones
 //         absorb (bench/HISTORY.md, "integrator: auto"): cheaper, but not at the same
-//         accuracy, so IDA keeps those runs.
+//         accuracy, so IDA keeps those runs; and
+//     (3) Euler's penalty joints, carrying the loads IDA's multipliers say the joints carry,
+//         would stand open by less than the trial's limit below (|lambda| / k per row): on
+//         EN 15227's scenario 2 built from emu3_wall the first Euler step opened a joint by
+//         9 mm, sampled before the trial could give the run back.
 // * Euler goes on from IDA's state at the end of that step, in the element modes reached.
 // * Euler is on trial: at each output sample it measures what the accuracy warnings measure
 //   (results/accuracy_check.hpp), its own energy drift since the hand-over as a share of the
@@ -54,6 +58,7 @@ struct AutoSettings {
   double ida_restart_cost = 10.0; // [force sweeps] per IDA restart
   double euler_step_cost = 1.1;   // [force sweeps] per Euler step
   bool require_resolution = true; // condition (2): IDA's mean step at least Euler's
+  bool require_closed_joints = true;  // condition (3): Euler's joints within the trial's limit under their loads
   // Euler on trial: IDA takes the run back past either (half the accuracy warnings' limits,
   // kEnergyShareLimit and kConstraintResidualLimit in results/accuracy_check.hpp).
   double euler_energy_share = 0.005;   // [-] Euler's drift since the hand-over over the energy turned over
@@ -76,6 +81,18 @@ class AutoIntegrator : public IdaIntegrator {
   /// Euler gave the run back (its trial failed): IDA goes on from its state.
   void resume(double t, std::vector<double> y, const std::vector<double>& quadratures) override;
 
+ public:
+  /// The trial's limit on Euler's joints, rule.euler_joint_opening in the model's length unit.
+  static double joint_opening_limit(const DaeSystem& system, const AutoSettings& rule) {
+    return rule.euler_joint_opening / metres_per_length_unit(system.model().units);
+  }
+
+ private:
+  double joint_opening_limit() const { return joint_opening_limit(system_, rule_); }
+  /// How far Euler's penalty joints would stand open [length] carrying the multipliers of IDA's
+  /// state y (|lambda| / k, the largest over the rows).
+  double penalty_opening(const double* y) const;
+
  private:
   AutoSettings rule_;
   EulerSettings euler_settings_;
@@ -87,6 +104,7 @@ class AutoIntegrator : public IdaIntegrator {
   double ida_cost_ = 0.0, euler_cost_ = 0.0;  // [force sweeps] over the span so far
   double ida_mean_step_ = 0.0;                // [time] over the span so far
   double t_end_ = 0.0;                        // [time] the run's
+  double joints_would_open_ = 0.0;            // [length] penalty_opening at the last hand-over that passed (1) and (2)
   bool euler_taking_over_ = false;  // hand_over returned Euler: finish() keeps IDA's objects (suspend)
   double ida_last_step_ = 0.0;      // [time] IDA's last step before the hand-over (the first after a resume)
 };

@@ -101,6 +101,7 @@ struct RunStatistics {
   std::string factor_ordering;       // ida: KLU's fill-reducing ordering, "AMD" or "COLAMD" (the one with fewer entries)
   double handed_over_at = -1.0;      // [time] integrator auto: when IDA handed the run to Euler (-1: it did not)
   double handed_back_at = -1.0;      // [time] integrator auto: when IDA took the run back from Euler (-1: it did not)
+  double euler_step = 0.0;           // [time] euler, or auto's Euler part: its step (0: Euler took none)
   std::string hand_over_reason;      // integrator auto: why it did, or why IDA kept the run ("" before the run ends)
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
