@@ -43,6 +43,15 @@ double PointsMeet::gap(const Element& e, const ElementState<double>& s, double f
   return passed ? -length - margin : length - margin;
 }
 
+bool PointsMeet::met(const Element& e, const ElementState<double>& s, double free_length, int index, int root,
+                     int direction) const {
+  const LineGeometry<double> line = line_geometry(e, s);
+  const double g = gap(e, s, free_length, line.d, line.length);
+  const bool passed = g + kFraction * free_length < 0.0;
+  if (!passed && dot(line.d, line.d_rate) > 0.0) return false;  // within the margin, moving apart
+  return g < 0.0 || (index == root && direction < 0);
+}
+
 void PointsMeet::stop(const Element& e, double t, const ElementState<double>& s, double free_length,
                       const std::string& state, const std::string& advice, const char* what,
                       const char* length_name) const {

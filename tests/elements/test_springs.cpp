@@ -522,3 +522,37 @@ TEST_CASE("linear_spring compressed through its points stops the run naming it u
     CHECK(through.y[0] == Approx(x_end).epsilon(std::string(integrator) == "euler" ? 1e-3 : 1e-7));
   }
 }
+
+namespace {
+/// spring_impact's mass and spring (10 N/m, free length 1 m), the mass starting 0.5 mm from the
+/// ground point, within the points-meet margin of 1e-3 L0, at `speed` along +x (away).
+std::string spring_start_near(double speed, const std::string& integrator) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "railcrash: 1\nname: spring near\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+    << "  - {name: mass, mass: 1, inertia: 1, position: [0.0005, 0], velocity: [" << speed << ", 0]}\n"
+    << "elements:\n  - {name: k, type: linear_spring, stiffness: 10, free_length: 1, "
+    << "points: [{body: ground, at: [0, 0]}, {body: mass, at: [0, 0]}]}\n"
+    << "simulation: {t_end: 0.2, integrator: " << integrator << ", rtol: 1e-10, dt: 1e-5, output_interval: 0.01}\n";
+  return s.str();
+}
+}  // namespace
+
+TEST_CASE("linear_spring starting within the points-meet margin runs on while its points move apart", "[elements][faults]") {
+  // x = 1 - (1 - x0) cos(w t) + (v0 / w) sin(w t), w = sqrt(10): moving away at 1 m/s the mass
+  // leaves the margin at once; the start's commit of the negative root stopped the run at t = 0
+  // before. Moving towards the point it stops there, at t = 0.
+  const double w = std::sqrt(10.0), x0 = 0.0005, v0 = 1.0, t_end = 0.2;
+  for (const char* integrator : {"ida", "euler"}) {
+    INFO(integrator);
+    const RunOutcome away = testing::simulate(testing::loaded_from_text(spring_start_near(v0, integrator)));
+    INFO(away.message);
+    REQUIRE(away.ok);
+    const double x_end = 1.0 - (1.0 - x0) * std::cos(w * t_end) + v0 / w * std::sin(w * t_end);  // [m]
+    CHECK(away.y[0] == Approx(x_end).epsilon(std::string(integrator) == "euler" ? 1e-4 : 1e-7));
+    const RunOutcome towards = testing::simulate_to_stop(testing::loaded_from_text(spring_start_near(-v0, integrator)));
+    CHECK_FALSE(towards.ok);
+    CHECK_THAT(towards.message, Catch::Contains("linear_spring 'k' is compressed through the whole distance between its "
+                                                "points at t = 0 s: its points are 0.0005 apart"));
+  }
+}

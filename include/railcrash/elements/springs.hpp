@@ -95,10 +95,11 @@ class PointsMeet {
   /// Whether a commit of root `index` (crossing in `direction`) finds the points met: the
   /// points-meet root `root` crossing downwards, or the gap already negative whatever root
   /// fired (a step known at its end alone, Euler's, commits one root per element, and the step
-  /// that carries P2 past P1 may cross another of the element's roots first).
-  bool met(const Element& e, const ElementState<double>& s, double free_length, int index, int root, int direction) const {
-    return gap(e, s, free_length) < 0.0 || (index == root && direction < 0);
-  }
+  /// that carries P2 past P1 may cross another of the element's roots first). Never while the
+  /// points, within the margin but not past each other, move apart (a spring that starts
+  /// there: the start commits every negative root); its root, carried on its boundary, fires
+  /// when they close again.
+  bool met(const Element& e, const ElementState<double>& s, double free_length, int index, int root, int direction) const;
   /// Stops the run (SolverError): "<file:line: ><type> '<name>' is compressed through the whole
   /// distance between its points at t = ... s (<state>): its points are ... apart, of a
   /// free_length of ..., where its force has no direction left. <advice>" (no parentheses
