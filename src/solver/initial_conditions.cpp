@@ -61,14 +61,31 @@ std::string describe_rows(const DaeSystem& system, const std::vector<int>& rows,
 
 }  // namespace
 
-std::vector<int> dependent_constraint_rows(const DaeSystem& system, const double* q, double pivot_threshold, int& rank) {
+std::vector<int> dependent_constraint_rows(const DaeSystem& system, const double* q, double pivot_threshold, int& rank,
+                                           RowScaling scaling) {
   const int m = system.constraint_rows();
   rank = m;
   if (m == 0) return {};
   Eigen::VectorXd phi;
   const SparseMatrix g = constraint_gradient(system, q, phi);
-  const Eigen::VectorXd root_w = assembly_weights(system).cwiseSqrt();
-  SparseMatrix scaled_transpose = (g * root_w.asDiagonal()).transpose();
+  SparseMatrix scaled_transpose;
+  if (scaling == RowScaling::AssemblyWeights) {
+    const Eigen::VectorXd root_w = assembly_weights(system).cwiseSqrt();
+    scaled_transpose = (g * root_w.asDiagonal()).transpose();
+  } else {
+    // Angles as arcs at each body's own size (a row's angle entries, lever arms, over it), and
+    // each row then of unit length: the threshold is the share of a row outside the others'
+    // span, in any unit system.
+    Eigen::VectorXd column_scale = Eigen::VectorXd::Ones(system.body_unknowns());
+    const std::vector<double> size = system.body_angle_lengths();
+    for (int i = 0; i < system.model().body_count(); ++i) column_scale[3 * i + 2] = 1.0 / size[static_cast<std::size_t>(i)];
+    SparseMatrix scaled = g * column_scale.asDiagonal();
+    Eigen::VectorXd row_scale = Eigen::VectorXd::Zero(m);
+    for (int k = 0; k < scaled.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(scaled, k); it; ++it) row_scale[it.row()] += it.value() * it.value();
+    for (int r = 0; r < m; ++r) row_scale[r] = row_scale[r] > 0.0 ? 1.0 / std::sqrt(row_scale[r]) : 1.0;
+    scaled_transpose = (row_scale.asDiagonal() * scaled).transpose();
+  }
   scaled_transpose.makeCompressed();
   Eigen::SparseQR<SparseMatrix, Eigen::COLAMDOrdering<int>> qr;
   qr.setPivotThreshold(pivot_threshold);
@@ -105,10 +122,9 @@ std::string singular_configuration(const DaeSystem& system, const double* q, dou
   // Near a singular configuration G is nearly, not exactly, rank deficient at the last good
   // state: IDA's Newton iteration fails while the links are still a few degrees from it (the
   // IFToMM N-four-bar, N = 40, at rtol 1e-8: 0.02 rad from flat, found at 1e-2, not at 1e-3).
-  constexpr double kNearlyDependent = 1e-2;  // pivot threshold on G^T W^1/2, times the length scale
+  constexpr double kNearlyDependent = 1e-2;  // pivot threshold on G^T, its rows of unit length (RowScaling::UnitRows)
   int rank = m;
-  const std::vector<int> rows =
-      dependent_constraint_rows(system, q, kNearlyDependent * system.model().length_scale(), rank);
+  const std::vector<int> rows = dependent_constraint_rows(system, q, kNearlyDependent, rank, RowScaling::UnitRows);
   if (rows.empty()) return "";
   std::ostringstream msg;
   msg << "singular configuration: joints " << describe_rows(system, rows, 6) << " lose rank at t = " << t << " ("

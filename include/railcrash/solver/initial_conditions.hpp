@@ -114,7 +114,13 @@ void check_constraint_rank(const DaeSystem& system, const double* q);
 
 /// Constraint rows in a linearly dependent set at q (a column-pivoted sparse QR of G^T with the
 /// given pivot threshold); rank receives G's rank. Empty when G has full rank.
-std::vector<int> dependent_constraint_rows(const DaeSystem& system, const double* q, double pivot_threshold, int& rank);
+/// How the rows of G are scaled before the rank-revealing QR: AssemblyWeights, G W^1/2 (the
+/// assembly's metric, for exact redundancy at a threshold near round-off); UnitRows, angles as
+/// arcs at each body's size (DaeSystem::body_angle_lengths) and every row of unit length, so
+/// that the threshold is the share of a row outside the others' span (near-singularity).
+enum class RowScaling { AssemblyWeights, UnitRows };
+std::vector<int> dependent_constraint_rows(const DaeSystem& system, const double* q, double pivot_threshold, int& rank,
+                                           RowScaling scaling = RowScaling::AssemblyWeights);
 
 /// After a solver failure: "singular configuration: joints 'a' (pin_joint, line 9), ... lose
 /// rank at t = ..." when G at q is nearly rank deficient; a note when the model is too large
