@@ -29,8 +29,9 @@
 //         EN 15227's scenario 2 built from emu3_wall the first Euler step opened a joint by
 //         9 mm, sampled before the trial could give the run back.
 // * Euler goes on from IDA's state at the end of that step, in the element modes reached.
-// * Euler is on trial: at each output sample it measures what the accuracy warnings measure
-//   (results/accuracy_check.hpp), its own energy drift since the hand-over as a share of the
+// * Euler is on trial: at each output sample, and every 50 of its steps between samples far
+//   apart, it measures what the accuracy warnings measure (results/accuracy_check.hpp), its
+//   own energy drift since the hand-over as a share of the
 //   energy turned over, and how far its penalty joints open. Past half of either warning's
 //   limit (0.5 % of the energy, 0.5 mm), IDA takes the run back from Euler's state (the joints
 //   closed, consistent rates, a restart with IDA's objects of before) and keeps it. A rule
@@ -63,6 +64,7 @@ struct AutoSettings {
   // kEnergyShareLimit and kConstraintResidualLimit in results/accuracy_check.hpp).
   double euler_energy_share = 0.005;   // [-] Euler's drift since the hand-over over the energy turned over
   double euler_joint_opening = 0.5e-3; // [m] |Phi| at an output sample
+  long euler_check_steps = 50;         // [steps] Euler's checks come at every output sample and at least this often
 };
 
 class AutoIntegrator : public IdaIntegrator {
