@@ -7,8 +7,9 @@ namespace railcrash {
 
 namespace {
 
-/// Euler after IDA's hand-over, on trial (auto_integrator.hpp): at each new output sample, its
-/// energy drift since the hand-over and its joints' opening against the rule's limits.
+/// Euler after IDA's hand-over, on trial (auto_integrator.hpp): at each new output sample and
+/// every rule.euler_check_steps steps, its energy drift since the hand-over and its joints'
+/// opening against the rule's limits; past either it gives the run back (returns_run).
 class EulerOnTrial final : public EulerIntegrator {
  public:
   EulerOnTrial(DaeSystem& system, const EulerSettings& settings, Step step, double t0, const std::vector<double>& y,
