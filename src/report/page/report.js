@@ -601,6 +601,13 @@
       var s = summary.stats || {};
       row("status", summary.status + (summary.message ? ": " + summary.message : ""), summary.status === "ok" ? "status-ok" : "status-failed");
       row("integrator", summary.integrator);
+      var used = summary.integrator_used;  // integrator auto: which method ran when, and why
+      if (used) {
+        var span = used.euler_from_t === null || used.euler_from_t === undefined ? ""
+          : ", Euler from t = " + fmt(used.euler_from_t) + " s" +
+            (used.euler_until_t === null || used.euler_until_t === undefined ? " to the end" : " to " + fmt(used.euler_until_t) + " s");
+        row("method used", used.method + span + ": " + used.reason);
+      }
       row("t reached", fmt(summary.t_reached) + " s");
       row("wall time, steps, events", fmt(s.wall_seconds, 3) + " s, " + s.steps + " steps, " + s.events + " events");
       var e = summary.energy || {};
