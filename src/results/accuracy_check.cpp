@@ -38,10 +38,11 @@ std::string format(const char* pattern, double a, double b) {
 /// What to change, for the method that integrated the run.
 std::string remedy(const AccuracyFacts& facts) {
   if (facts.euler_ran && facts.ida_took_back_at >= 0.0) {
-    char text[300];
+    char text[400];
     std::snprintf(text, sizeof text,
-                  "integrator auto ran Euler (steps of %.3g s) from t = %.6g to %.6g, where IDA took the run back; "
-                  "run with --integrator ida to leave Euler out, and compare",
+                  "integrator auto ran Euler (steps of %.3g s) from t = %.6g to %.6g, where IDA took the run back: "
+                  "run with --integrator ida to leave Euler out, or tighten IDA's tolerance (--rtol, --atol), and compare; "
+                  "`railcrash converge` shows how the results move with it",
                   facts.euler_step, facts.euler_from, facts.ida_took_back_at);
     return text;
   }
