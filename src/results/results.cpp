@@ -556,9 +556,7 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   j << "  \"integrator\": " << json_string(integrator) << ",\n";
   if (!s.hand_over_reason.empty())  // integrator auto: which method ran when, and why
     j << "  \"integrator_used\": {\"method\": "
-      << json_string(s.handed_back_at >= 0.0   ? kIdaEulerIdaMethod
-                     : s.handed_over_at >= 0.0 ? kIdaThenEulerMethod
-                                               : integrator_name(IntegratorKind::Ida))
+      << json_string(ida_or_auto_method(s))
       << ", \"euler_from_t\": " << (s.handed_over_at >= 0.0 ? json_number(s.handed_over_at) : "null")
       << ", \"euler_until_t\": " << (s.handed_back_at >= 0.0 ? json_number(s.handed_back_at) : "null")
       << ", \"reason\": " << json_string(s.hand_over_reason) << "},\n";

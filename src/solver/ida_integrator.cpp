@@ -711,22 +711,31 @@ void IdaIntegrator::restart_at_event(const Crossing& c, const double* y_at_event
   const PhaseClock::Scope restart_timed(phase_clock(), Phase::Restarts);
   // Restart at the event: consistent rates for the new law (and roots that sit on their
   // boundary there), quadratures interpolated to it.
-  std::vector<double> y_restart(y_at_event, y_at_event + n), yp_restart;
-  std::vector<char> changed_now = mode_tracker().changed_at(c.t);  // the elements that changed at c.t
-  restart_state(mode_tracker(), c.t, y_restart, yp_restart, events, changed_now, impl.rates_cache);
-  report_events(events, y_restart.data());
   impl.check(IDAGetQuadDky(impl.ida, c.t, 0, impl.quad_out), "IDAGetQuadDky");
+  double step_before = 0.0;
+  impl.check(IDAGetLastStep(impl.ida, &step_before), "IDAGetLastStep");
+  restart_from(c.t, std::vector<double>(y_at_event, y_at_event + n), mode_tracker().changed_at(c.t),
+               std::vector<double>(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad),
+               step_before, events, t_end, /*add_counters=*/true);
+}
+
+void IdaIntegrator::restart_from(double t, std::vector<double> y, std::vector<char> changed, std::vector<double> quadratures,
+                                 double step_before, std::vector<EventRecord>& events, double t_end, bool add_counters) {
+  Impl& impl = *impl_;
+  std::vector<double> yp;
+  restart_state(mode_tracker(), t, y, yp, events, changed, impl.rates_cache);
+  report_events(events, y.data());
   // Kept until IDA's first step after it succeeds, for one retry (take_step).
   Impl::RestartRetry& retry = impl.retry;
-  retry.t = c.t;
-  impl.check(IDAGetLastStep(impl.ida, &retry.step_before), "IDAGetLastStep");
-  retry.available = retry.step_before > 0.0;
-  retry.y = std::move(y_restart);
-  retry.yp = std::move(yp_restart);
-  retry.quad.assign(N_VGetArrayPointer(impl.quad_out), N_VGetArrayPointer(impl.quad_out) + nquad);
-  impl.restart(retry, Impl::FirstStep::AfterEvent, t_end, stats());
-  mode_tracker().arm(c.t, N_VGetArrayPointer(impl.y));
-  impl.t_reached = c.t;
+  retry.t = t;
+  retry.step_before = step_before;
+  retry.available = step_before > 0.0;
+  retry.y = std::move(y);
+  retry.yp = std::move(yp);
+  retry.quad = std::move(quadratures);
+  impl.restart(retry, Impl::FirstStep::AfterEvent, t_end, stats(), add_counters);
+  mode_tracker().arm(t, N_VGetArrayPointer(impl.y));
+  impl.t_reached = t;
 }
 
 bool IdaIntegrator::lag_within_tolerance(int e, const std::array<DaeSystem::ElementLoad, 2>& before, double t_event,
@@ -926,21 +935,9 @@ void IdaIntegrator::resume_at(double t, std::vector<double> y, const std::vector
     throw StepFailure(std::string("IDA could not take the run back at t = ") + std::to_string(t) +
                       ": the state's joints could not be closed (" + e.what() + ")");
   }
-  std::vector<double> yp;
   std::vector<EventRecord> events;
-  std::vector<char> changed_now;
-  restart_state(mode_tracker(), t, y, yp, events, changed_now, impl.rates_cache);
-  report_events(events, y.data());
-  Impl::RestartRetry& retry = impl.retry;
-  retry.t = t;
-  retry.step_before = step_before;
-  retry.available = step_before > 0.0;
-  retry.y = std::move(y);
-  retry.yp = std::move(yp);
-  retry.quad = quadratures;
-  impl.restart(retry, Impl::FirstStep::AfterEvent, t_end, stats(), /*add_counters=*/false);
-  mode_tracker().arm(t, N_VGetArrayPointer(impl.y));
-  impl.t_reached = t;
+  // IDA's counters went to the statistics at the hand-over (suspend): none to add.
+  restart_from(t, std::move(y), {}, quadratures, step_before, events, t_end, /*add_counters=*/false);
   impl.at_start = false;
 }
 

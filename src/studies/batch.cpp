@@ -264,7 +264,7 @@ IntegratorUsed integrator_used(const RunReport& report) {
   IntegratorUsed used;
   if (report.integrator.empty()) return used;
   if (report.outcome.stats.handed_over_at >= 0.0) {
-    used.method = report.outcome.stats.handed_back_at >= 0.0 ? kIdaEulerIdaMethod : kIdaThenEulerMethod;
+    used.method = ida_or_auto_method(report.outcome.stats);
     used.euler_from_t = report.outcome.stats.handed_over_at;
   } else {
     used.method = integrator_name(report.integrator == integrator_name(IntegratorKind::Euler) ? IntegratorKind::Euler : IntegratorKind::Ida);

@@ -851,10 +851,7 @@ std::string write_convergence(const ConvergeResult& r, const std::string& direct
         << (!run.ok || !r.reference.ok ? "" : &run == &r.reference ? "reference" : same_branch(outcomes, reference_outcomes) ? "same" : "changed");
     // The method that ran (the study names ida or euler for each run; an IDA run is never handed over).
     IntegratorUsed used;
-    used.method = run.method == kEulerMethod           ? kEulerMethod
-                  : run.stats.handed_back_at >= 0.0 ? kIdaEulerIdaMethod
-                  : run.stats.handed_over_at >= 0.0 ? kIdaThenEulerMethod
-                                                    : kIdaMethod;
+    used.method = run.method == kEulerMethod ? kEulerMethod : ida_or_auto_method(run.stats);
     if (run.stats.handed_over_at >= 0.0) used.euler_from_t = run.stats.handed_over_at;
     csv << "," << used.method << "," << used.euler_from_t_text() << "\n";
   };

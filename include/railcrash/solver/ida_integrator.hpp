@@ -99,6 +99,13 @@ class IdaIntegrator : public Integrator {
   /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
   /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
   void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);
+  /// The one restart, from an event or a take-back: consistent rates for y in the present
+  /// modes at t and the boundary commits there (changed: the elements that already changed
+  /// at t; the commits are appended to events and reported), then Impl::restart with its first
+  /// step from step_before (kept for one retry), the roots armed. add_counters: IDA's counters
+  /// go to the statistics first (false after suspend, which put them there).
+  void restart_from(double t, std::vector<double> y, std::vector<char> changed, std::vector<double> quadratures,
+                    double step_before, std::vector<EventRecord>& events, double t_end, bool add_counters);
   /// Whether element e's mode change at t_event (its load in the old modes `before`: at the
   /// event and at t_n) leaves IDA's step to t_n within the local tolerances without a restart
   /// (the lag test; see advance()). quadratures: at t_n.

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "railcrash/model/run_spec.hpp"  // the methods' names
 #include "railcrash/solver/chatter_guard.hpp"
 #include "railcrash/solver/dae_system.hpp"
 #include "railcrash/solver/events.hpp"
@@ -106,6 +107,14 @@ struct RunStatistics {
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
 };
+
+/// The method a run of integrator ida or auto used, from its statistics: "ida", "ida+euler"
+/// (IDA handed the run to Euler) or "ida+euler+ida" (and took it back).
+inline const char* ida_or_auto_method(const RunStatistics& s) {
+  return s.handed_back_at >= 0.0   ? kIdaEulerIdaMethod
+         : s.handed_over_at >= 0.0 ? kIdaThenEulerMethod
+                                   : integrator_name(IntegratorKind::Ida);
+}
 
 /// Which element outputs a RunObserver::step() call holds values of at its state: those of the
 /// elements the observer's step columns belong to (RunObserver::mark_step_columns: all of them
@@ -319,13 +328,11 @@ class Integrator {
   /// !step_outputs_wanted()). An integrator that hands over current_outputs() need compute
   /// only these elements' outputs per step (DaeSystem::SweepExtras::output_elements).
   const char* step_output_elements() const { return observe_steps_ && !step_elements_.empty() ? step_elements_.data() : nullptr; }
-  /// The run's energy figures at t = 0, and its last output sample so far: its time, state,
-  /// quadratures and largest constraint residual |Phi| [length] (a successor's own check of
-  /// its accuracy, returns_run).
+  /// The run's energy figures at t = 0, and its last output sample so far: its time and
+  /// largest constraint residual |Phi| [length] (a successor's own check of its accuracy,
+  /// returns_run).
   const EnergyState& run_initial_energy() const { return outcome_.initial_energy; }
   double last_sample_time() const { return t_sampled_; }
-  const std::vector<double>& last_sample_state() const { return last_sample_y_; }
-  const std::vector<double>& last_sample_quadratures() const { return last_sample_quadratures_; }
   double last_sample_residual() const { return last_sample_residual_; }
   /// The state and quadratures at t for a successor (hand_over): as state_at gives them.
   void state_for_successor(double t, std::vector<double>& y, std::vector<double>& quadratures) { state_at(t, y, quadratures); }
