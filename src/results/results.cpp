@@ -576,6 +576,8 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     << ", \"unknowns\": " << system_.size() << ", \"jacobian_nonzeros\": " << system_.pattern().nonzeros();
   if (s.factor_nonzeros > 0) j << ", \"factor_nonzeros\": " << s.factor_nonzeros;
   if (!s.factor_ordering.empty()) j << ", \"factor_ordering\": " << json_string(s.factor_ordering);
+  if (s.newton_iterations_raised_at >= 0.0)
+    j << ", \"newton_iterations_raised_at\": " << json_number(s.newton_iterations_raised_at);
   if (s.phases_timed) {  // (--timings) exclusive wall seconds per phase, adding up to wall_seconds
     j << ", \"seconds\": {";
     for (int p = 0; p < kPhaseCount; ++p)

@@ -654,9 +654,30 @@ double IdaIntegrator::take_step(double t_end) {
     impl.rethrow_callback_error();
   }
   impl.retry.available = false;  // (a step was taken, or the run fails now)
+  if (flag == IDA_CONV_FAIL && stats().newton_iterations_raised_at < 0.0) {
+    // IDA's Newton iteration failed at every step size down to ~1e-10. Where a joint's
+    // friction reads its normal force as the size of its multipliers, N = sqrt(R^2 + (2M/l)^2),
+    // and a multiplier crosses zero within the step, IDA's predictor lands on the other side of
+    // that kink from the solution: the Newton matrix, exact there, has the friction's slope with
+    // the wrong sign, and its modified Newton iteration converges only linearly (a residual
+    // halving per iteration on models/report/preliminary_car.yaml at rtol 3e-3; smaller steps
+    // do not help, the multipliers do not shrink with h). SUNDIALS' default of 4 iterations
+    // cannot reach the tolerance that way. From here on IDA may take kPatientNewtonIterations;
+    // it goes on from its last good state, at the step it cut to (bench/HISTORY.md, "Newton
+    // iterations after a convergence failure").
+    stats().newton_iterations_raised_at = t_n;
+    impl.check(IDASetMaxNonlinIters(impl.ida, kPatientNewtonIterations), "IDASetMaxNonlinIters");
+    impl.last_sundials_message.clear();
+    impl.non_finite_y.clear();
+    flag = IDASolve(impl.ida, t_end, &t_n, impl.y, impl.yp, IDA_ONE_STEP);
+    impl.rethrow_callback_error();
+  }
   if (flag < 0) {
     std::ostringstream msg;
     msg << "IDA failed at t = " << t_n << " with " << flag_name(flag);
+    if (flag == IDA_CONV_FAIL && stats().newton_iterations_raised_at >= 0.0)
+      msg << " (allowing " << kPatientNewtonIterations << " Newton iterations per step since t = "
+          << stats().newton_iterations_raised_at << ")";
     if (!impl.last_sundials_message.empty()) msg << " (" << impl.last_sundials_message << ")";
     msg << explain_failure(flag);
     throw StepFailure(msg.str());

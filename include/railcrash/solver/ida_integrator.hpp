@@ -52,6 +52,9 @@ class IdaIntegrator : public Integrator {
   IdaIntegrator(DaeSystem& system, IdaSettings settings);
   ~IdaIntegrator() override;
   const char* name() const override { return integrator_name(IntegratorKind::Ida); }
+  // Newton iterations IDA may take per step once its iteration has failed to converge in a
+  // run (SUNDIALS' default, 4, until then; take_step says why).
+  static constexpr int kPatientNewtonIterations = 20;
 
   struct Impl;
 
