@@ -162,7 +162,7 @@ void BeamElement::initialize(const ElementState<double>& initial) {
 
 void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
                            std::array<double, 3>* offset_rate, std::array<double, 3>* strain,
-                           Kinematics<double>* chord) const {
+                           Kinematics<double>* chord, std::array<double, 3>* force_rate) const {
   // One pass with a single directional derivative along the velocities gives the rates.
   using D = Dual<double, 1>;
   ElementState<D> sd;
@@ -185,6 +185,7 @@ void BeamElement::evaluate(const ElementState<double>& s, std::array<double, 3>&
     force[k] = r[k].value;
     offset[k] = p[k].value;
     if (offset_rate) (*offset_rate)[k] = p[k].grad[0];
+    if (force_rate) (*force_rate)[k] = r[k].grad[0];
     if (strain) (*strain)[k] = x[k].value;
   }
   if (chord) {
@@ -202,18 +203,24 @@ double BeamElement::stress(const std::array<double, 3>& force) const {
 void BeamElement::roots_in(const State& st, const ElementState<double>& s, double* g) const {
   g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
   if (st.failed) return;
-  std::array<double, 3> force{}, offset{}, rate{};
+  std::array<double, 3> force{}, offset{}, rate{}, force_rate{};
   Kinematics<double> chord;
-  evaluate(s, force, offset, &rate, nullptr, &chord);
-  roots_from(st, force, offset, rate, g);
+  evaluate(s, force, offset, &rate, nullptr, &chord, &force_rate);
+  roots_from(st, force, offset, rate, force_rate, g);
   g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_, chord.d, chord.length);
 }
 
 void BeamElement::roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
-                             const std::array<double, 3>& rate, double* g) const {
+                             const std::array<double, 3>& rate, const std::array<double, 3>& force_rate, double* g) const {
   for (std::size_t k = 0; k < 3; ++k) {
     const int sign = st.sign[k];
-    g[k] = sign == 0 ? 1.0 + kYieldMargin - std::abs(force[k] - hardening_[k] * offset[k]) / yield_[k] : sign * rate[k];
+    if (sign != 0) {
+      g[k] = sign * rate[k];  // the plastic flow rate
+      continue;
+    }
+    const double excess = force[k] - hardening_[k] * offset[k];  // [force] F_k - c_k p_k
+    const double growth = (excess < 0.0 ? -force_rate[k] : force_rate[k]) / yield_[k];  // [1/time] d|F_k - c_k p_k|/dt / Y_k
+    g[k] = position_root_moving_on(1.0 + kYieldMargin - std::abs(excess) / yield_[k], growth);
   }
   g[3] = 1.0 - stress(force) / material.ultimate_stress;
 }
@@ -278,13 +285,13 @@ void BeamElement::outputs(const ElementState<double>& s, const double*, double* 
 
 void BeamElement::roots_and_outputs(double, const ElementState<double>& s, const double*, double* g, double* out) const {
   const State& st = mode_as<State>(s);
-  std::array<double, 3> force{}, offset{}, rate{};
+  std::array<double, 3> force{}, offset{}, rate{}, force_rate{};
   Kinematics<double> chord;
-  evaluate(s, force, offset, &rate, nullptr, &chord);
+  evaluate(s, force, offset, &rate, nullptr, &chord, &force_rate);
   if (g != nullptr) {
     g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
     if (!st.failed) {
-      roots_from(st, force, offset, rate, g);
+      roots_from(st, force, offset, rate, force_rate, g);
       g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_, chord.d, chord.length);
     }
   }
@@ -298,13 +305,13 @@ void BeamElement::force_roots_and_outputs(double t, const ElementState<double>& 
     return;
   }
   const State& st = mode_as<State>(s);
-  std::array<double, 3> force{}, offset{}, rate{};
+  std::array<double, 3> force{}, offset{}, rate{}, force_rate{};
   Kinematics<double> chord;
-  evaluate(s, force, offset, &rate, nullptr, &chord);
+  evaluate(s, force, offset, &rate, nullptr, &chord, &force_rate);
   if (g != nullptr) {
     g[0] = g[1] = g[2] = g[3] = g[kPointsMeetRoot] = 1.0;
     if (!st.failed) {
-      roots_from(st, force, offset, rate, g);
+      roots_from(st, force, offset, rate, force_rate, g);
       g[kPointsMeetRoot] = points_meet_.gap(*this, s, length_, chord.d, chord.length);
     }
   }

@@ -60,8 +60,13 @@
 //
 // Modes and events (5 root functions; an inactive one returns 1):
 //   g_k, k = 0 axial, 1 hinge 1, 2 hinge 2:
-//     elastic   1 + 1e-9 - |F_k - c_k p_k| / Y_k  goes negative: yield (event "axial yield in
-//               tension|compression" with N, "plastic hinge at end i" with M_i)
+//     elastic   1 + 1e-9 - |F_k - c_k p_k| / Y_k  goes negative while |F_k - c_k p_k| grows
+//               along the velocities (position_root_moving_on, hybrid.hpp): yield (event "axial
+//               yield in tension|compression" with N, "plastic hinge at end i" with M_i).
+//               Moving back it stays positive: the constraints' position correction (GGL) can
+//               carry a section past its yield surface while its velocities unload it, and the
+//               plastic mode's own root then unloaded it at once (10,000 alternating mode
+//               changes at one instant on scenario1_report_car's draw bar at rtol 2e-3)
 //     plastic   s_k dp_k/dt (the plastic flow rate) goes negative: unloading (event
 //               "axial unloading" / "hinge at end i unloading"), p_k is stored
 //   g_3         1 - max(|N| / (sigma_u A_min), |M_i| / (sigma_u Z_i)) goes negative: "fracture"
@@ -253,13 +258,14 @@ class BeamElement : public HybridElement<BeamElement> {
 
  private:
   /// Resultants F and offsets p at state s, and (when given) dp/dt along s.v, the
-  /// deformations x (stretch, end rotations) and the chord (d, L; as kinematics() gives them).
+  /// deformations x (stretch, end rotations), the chord (d, L; as kinematics() gives them) and
+  /// dF/dt along s.v.
   void evaluate(const ElementState<double>& s, std::array<double, 3>& force, std::array<double, 3>& offset,
                 std::array<double, 3>* offset_rate = nullptr, std::array<double, 3>* strain = nullptr,
-                Kinematics<double>* chord = nullptr) const;
+                Kinematics<double>* chord = nullptr, std::array<double, 3>* force_rate = nullptr) const;
   /// The roots in mode st (not failed) from an evaluation at the state.
   void roots_from(const State& st, const std::array<double, 3>& force, const std::array<double, 3>& offset,
-                  const std::array<double, 3>& offset_rate, double* g) const;
+                  const std::array<double, 3>& offset_rate, const std::array<double, 3>& force_rate, double* g) const;
   /// The outputs in mode st from an evaluation at the state.
   void outputs_from(const State& st, std::array<double, 3> force, const std::array<double, 3>& offset,
                     const std::array<double, 3>& strain, double* out) const;
