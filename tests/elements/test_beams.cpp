@@ -675,7 +675,7 @@ TEST_CASE("a hinge unloads when the tip turns back and yields again in reverse a
   }
 }
 
-TEST_CASE("hinge unloading keeps its rotation offset and reverses at M - 2 M_p; past M_p a hinge yields only while M grows",
+TEST_CASE("hinge unloading keeps its rotation offset and reverses at M - 2 M_p, and past M_p a hinge yields only while M grows",
           "[elements][beams]") {
   // Drive the element's modes by hand at prescribed states (commit as the integrator would).
   const Steel steel;
