@@ -20,9 +20,9 @@ ElasticPlasticLaw::State ElasticPlasticLaw::fresh() const {
 void ElasticPlasticLaw::roots(const State& st, double d, double rate, double* g) const {
   g[0] = g[1] = g[2] = 1.0;
   switch (st.mode) {
-    case Mode::Elastic:
-      g[0] = st.upper - d;
-      g[1] = d - st.lower;
+    case Mode::Elastic:  // yield or reload at either end of the elastic range, moving on to it
+      g[0] = position_root_moving_on(st.upper - d, rate);
+      g[1] = position_root_moving_on(d - st.lower, -rate);
       break;
     case Mode::PlasticUp:
       g[0] = rate;

@@ -609,17 +609,18 @@ DeadBand::Mode CouplerEnd::lossy_band(const State& st, const Kinematics& k) cons
 
 void CouplerEnd::lossy_roots(const State& st, const Kinematics& k, double* g) const {
   const double touch = faces_.lo - permanent_set(st), tol = faces_.tolerance;
+  // The position roots are crossed only moving on (position_root_moving_on, hybrid.hpp).
   if (st.blocked) {
-    g[0] = touch - k.h + tol;  // clear once apart beyond the set
+    g[0] = position_root_moving_on(touch - k.h + tol, k.h_rate);  // clear once apart beyond the set
     return;
   }
   if (st.band == DeadBand::Mode::Inside) {
-    g[0] = k.h - touch + tol;  // contact
+    g[0] = position_root_moving_on(k.h - touch + tol, -k.h_rate);  // contact
   } else if (!st.unloading) {
     g[0] = -k.h_rate;  // loading while the penetration grows
   } else {
-    g[0] = touch - k.h + tol;                           // separation at the set
-    g[1] = k.h - (faces_.lo - st.peak) + tol;       // back on the loading line at delta_max
+    g[0] = position_root_moving_on(touch - k.h + tol, k.h_rate);                        // separation at the set
+    g[1] = position_root_moving_on(k.h - (faces_.lo - st.peak) + tol, -k.h_rate);  // back on the loading line at delta_max
   }
 }
 

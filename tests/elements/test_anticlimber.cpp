@@ -456,6 +456,33 @@ TEST_CASE("anticlimber elastic-plastic law: bilinear loading, kinematic hardenin
     CHECK(in + out == Approx(in - peak * peak / (2.0 * ke)).epsilon(1e-12));  // the elastic energy comes back
     CHECK(law.force(st, d) == Approx(0.0).margin(1e-9));
   }
+  SECTION("past an end of the elastic range but moving back is no crossing; at rest the position decides") {
+    // The constraints' position correction moves a deflection without its rate (hybrid.hpp,
+    // position_root_moving_on): yield, reloading and release are crossed only moving on.
+    const ElasticPlasticLaw::State st = law.fresh();
+    const double past = 1e-6 * dy;
+    double g[3];
+    law.roots(st, dy + past, -1e-9, g);  // past the upper yield point, moving down
+    CHECK(g[0] > 0.0);
+    law.roots(st, dy + past, 1e-3, g);   // moving up
+    CHECK(g[0] == Approx(-past).margin(1e-15));
+    law.roots(st, dy + past, 0.0, g);    // at rest
+    CHECK(g[0] == Approx(-past).margin(1e-15));
+    law.roots(st, -dy - past, 1e-9, g);  // past the lower yield point, moving up
+    CHECK(g[1] > 0.0);
+    law.roots(st, -dy - past, -1e-3, g);
+    CHECK(g[1] == Approx(-past).margin(1e-15));
+    // One-sided: the release at the permanent deformation, only while the faces open.
+    law.one_sided = true;
+    ElasticPlasticLaw::State one = law.fresh();
+    one.offset = one.lower = 0.01;
+    one.upper = 0.05;
+    law.roots(one, 0.01 - past, 1e-9, g);
+    CHECK(g[1] > 0.0);
+    law.roots(one, 0.01 - past, -1e-3, g);
+    CHECK(g[1] < 0.0);
+    law.one_sided = false;
+  }
   SECTION("rupture at the rupture deflection, in either direction") {
     for (const double sign : {1.0, -1.0}) {
       law.rupture_deflection = 0.05;

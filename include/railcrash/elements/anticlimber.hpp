@@ -125,7 +125,9 @@
 //                      (torsional). Failures are permanent damage: they outlast a separation.
 // Root functions (11, positive inside the mode): 0-2 horizontal law, 3-5 vertical law, 6-8
 // torsional law (each: upper bound / unloading rate, lower bound / unloading rate, rupture),
-// 9 contact (open: p_h - d_h), 10 override (engaged: face_height - |v|). A commit re-checks
+// 9 contact (open: p_h - d_h), 10 override (engaged: face_height - |v|). An elastic law's bound
+// (yield, reloading, the horizontal release) is crossed only while its deformation moves on to
+// it (position_root_moving_on, hybrid.hpp; at rest the position alone). A commit re-checks
 // the root in the current mode (an earlier commit of the same step may have changed it) and
 // then applies every transition whose root is already negative (explicit Euler sees roots
 // only at the end of a step, possibly past several boundaries), listing them all in one event.

@@ -134,6 +134,9 @@
 //       loading     P = k delta                     delta' = 0: "unloading" (delta_max = delta)
 //       unloading   P = k_u (delta - p)             delta = p: "separation"; delta = delta_max:
 //                                                   "reloading" (back on the loading line)
+//     The position roots ("contact", "separation", "reloading", and "faces clear" after
+//     overlap regained past the set) are crossed only while delta moves on to them
+//     (position_root_moving_on, hybrid.hpp; at rest the position alone decides).
 //     delta_max (and so p) changes only at these events (and at "vertical overlap lost"
 //     while loading). Energy in contact: P^2 / (2 k_u), what unloading would give back; the
 //     rest of the work done on the faces is dissipated. With e = 1 there is no unloading
