@@ -53,6 +53,7 @@ class SurfaceContact : public HybridElement<SurfaceContact> {
   double damping;                 // [force*time/length] c
   double friction;                // [-] mu
   double friction_velocity;       // [length/time] v_f
+  double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
 
   enum class Mode { Open, Contact, Released };
   struct State {

@@ -413,6 +413,7 @@ class CouplerEnd : public HybridElement<CouplerEnd> {
   double total_horizontal_slack = 0.0;         // [length] knuckle free play (coupled only)
   double friction = 0.0;                       // [-] mu between the faces
   double friction_velocity = 0.01;             // [length/time] v_f
+  double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
   bool coupled = false;                        // knuckles carry draft
   double restitution = 1.0;                    // [-] e of the buff contact, 0 < e <= 1
   std::optional<double> shear_load;            // [force] buff face force at which the faces shear off; none: never
@@ -506,6 +507,7 @@ class Coupling : public HybridElement<Coupling> {
   double misalignment = 0.0;          // [length] vertical offset of head L above head K with the points level
   double friction = 0.0;              // [-] mu between the heads
   double friction_velocity = 0.01;    // [length/time] v_f
+  double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
   std::optional<double> free_length;  // [length] spacing at the centre of the slack; default: initial
 
   struct State {

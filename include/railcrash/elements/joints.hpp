@@ -65,6 +65,8 @@ class PinJoint : public ConstraintElement<PinJoint> {
   explicit PinJoint(ElementSpec& spec);
   double friction_radius = 0.0;    // [length] muR
   double friction_velocity = 0.01; // [rad/time] w_f
+  double friction_slip_velocity() const override { return friction_radius > 0.0 ? friction_velocity : 0.0; }
+  bool friction_slip_is_angular() const override { return true; }
   template <class T>
   void constraint_law(const std::array<Pose<T>, 2>& q, T* phi) const {
     const Vec2<T> d = Joint::separation(*this, q);
@@ -104,6 +106,7 @@ class SliderJoint : public ConstraintElement<SliderJoint>, public AngleLockingJo
   double friction = 0.0;            // [-] mu
   double slider_length = 1.0;       // [length] l
   double friction_velocity = 0.01;  // [length/time] v_f
+  double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
   template <class T>
   void constraint_law(const std::array<Pose<T>, 2>& q, T* phi) const {
     phi[0] = Joint::normal_offset(*this, q, axis_x, axis_y);

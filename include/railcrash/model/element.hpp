@@ -173,6 +173,13 @@ class Element {
                                         std::array<Pose<double>, 2>& /*f*/, ForceBlock& /*df_dq*/, ForceBlock& /*df_dv*/,
                                         double /*df_dlambda*/[6][kMaxConstraintRows]) const {}
 
+  /// Regularized Coulomb friction, F = -mu N tanh(v / v_f): its v_f when the element has
+  /// friction (a slip speed [length/time], or a relative turning rate [rad/time] when
+  /// friction_slip_is_angular), else 0. IDA holds the velocities of the element's bodies to a
+  /// tenth of it (IdaIntegrator::start), so that its steps resolve which way the friction acts.
+  virtual double friction_slip_velocity() const { return 0.0; }
+  virtual bool friction_slip_is_angular() const { return false; }
+
   // ---- force elements ----
   /// Generalized forces on slot 0 and 1 (force x, force y, moment), added to f.
   virtual void add_force(double /*t*/, const ElementState<double>& /*s*/, std::array<Pose<double>, 2>& /*f*/) const {}
