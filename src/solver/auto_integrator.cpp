@@ -18,22 +18,19 @@ class EulerOnTrial final : public EulerIntegrator {
         energy_share_(rule.euler_energy_share),
         joint_opening_(AutoIntegrator::joint_opening_limit(system, rule)),
         drift_at_hand_over_(drift_at_hand_over),
-        checked_at_(t0),
         check_steps_(rule.euler_check_steps) {}
 
-  bool returns_run(double t, const double* /*y*/) override {
-    // At each new sample (taken at this step's end: Euler samples there), and every
-    // check_steps steps between samples far apart.
-    const bool sampled = last_sample_time() > checked_at_;
-    if (!sampled && ++steps_since_check_ < check_steps_) return false;
+  bool returns_run(double t, const double* /*y*/, bool sample_here) override {
+    // Before each sample (taken at this step's end: Euler samples there), so that a state past
+    // the limits is never written, and every check_steps steps between samples far apart.
+    if (!sample_here && ++steps_since_check_ < check_steps_) return false;
     steps_since_check_ = 0;
-    checked_at_ = t;
     state_for_successor(t, state_, quadratures_);
     const EnergyBalance balance = EnergyBalance::between(run_initial_energy(), energy(state_.data(), quadratures_.data()));
     const double drift = balance.integration_drift() - drift_at_hand_over_;  // [energy] Euler's own
     const double turned_over = balance.turned_over();
     const double share = turned_over > 0.0 ? std::abs(drift) / turned_over : 0.0;
-    const double opening = sampled ? last_sample_residual() : system_.constraint_residual(state_.data(), phi_);
+    const double opening = system_.constraint_residual(state_.data(), phi_);
     char why[300];
     if (share > energy_share_)
       std::snprintf(why, sizeof why, "its integration had %s %.4g %% of the energy turned over since (more than %.4g %%)",
@@ -55,7 +52,6 @@ class EulerOnTrial final : public EulerIntegrator {
   double energy_share_;        // [-]
   double joint_opening_;       // [length]
   double drift_at_hand_over_;  // [energy] the run's integration drift when Euler took it
-  double checked_at_;          // [time] the last check
   long check_steps_;           // [steps] the most between two checks
   long steps_since_check_ = 0;
   std::vector<double> state_, quadratures_, phi_;  // at the check

@@ -984,7 +984,7 @@ void IdaIntegrator::resume_at(double t, std::vector<double> y, const std::vector
   std::vector<EventRecord> events;
   // IDA's counters went to the statistics at the hand-over (suspend): none to add.
   restart_from(t, std::move(y), {}, quadratures, step_before, events, t_end, /*add_counters=*/false);
-  impl.at_start = false;
+  impl.at_start = true;  // until its next step, the state at t is the one restarted from (state_at)
 }
 
 }  // namespace railcrash

@@ -277,21 +277,25 @@ RunOutcome Integrator::run(double t_end, double output_interval, RunObserver& ob
             << active->divergence_advice(active->last_sample_y_, active->t_sampled_);
         throw StepFailure(msg.str());
       }
+      // The end of a step that passes an output time is the sample of an integrator without
+      // dense output.
+      const auto sample_here = [&] { return !dense && t_reached >= active->next_output_time() * (1.0 - 1e-12); };
+      // A successor's step judged less accurate than the run allows is neither delivered nor
+      // sampled: the first integrator takes the run back from its end (its joints closed) and
+      // the step's end is delivered from there.
+      if (active != this && active->returns_run(t_reached, active->current_state(), sample_here()))
+        take_run_back(t_reached);
       active->deliver_step(t_reached, active->current_state());
       if (dense) {
         active->sample_up_to(t_reached);
-      } else if (t_reached >= active->next_output_time() * (1.0 - 1e-12)) {
-        // The end of the step that passes an output time is the sample.
+      } else if (sample_here()) {
         active->deliver_sample(t_reached);
         while (static_cast<double>(active->output_index_) * active->output_interval_ <= t_reached * (1.0 + 1e-12))
           ++active->output_index_;
       }
-      if (t_reached < t_end) {
+      if (t_reached < t_end)
         if (std::unique_ptr<Integrator> next = active->hand_over(t_reached, active->current_state()))
           pass_run_to(std::move(next));
-        else if (active != this && active->returns_run(t_reached, active->current_state()))
-          take_run_back(t_reached);
-      }
     }
   } catch (const InputError&) {
     active->finish();

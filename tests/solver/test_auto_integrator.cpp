@@ -43,18 +43,25 @@ EulerSettings euler_settings(const SimulationSettings& s) {
   return {s.dt, s.force_dt, s.penalty, s.max_steps, {s.t_end, s.static_equilibrium}};
 }
 
+/// auto's rule set to hand the run to Euler at the first chance: after IDA's sixth step, with
+/// no events, span or margin asked for and the resolution check off.
+AutoSettings hand_over_at_first_chance() {
+  AutoSettings rule;
+  rule.startup_steps = 5;
+  rule.min_events = 0;
+  rule.min_span_steps = 0.0;
+  rule.margin = 0.0;
+  rule.require_resolution = false;
+  return rule;
+}
+
 }  // namespace
 
 TEST_CASE("IDA hands a run to Euler that goes on from its state with the run's samples and counters", "[integrators][auto]") {
   const double dt = 1e-4, t_end = 2.0, interval = 0.01;  // [s]
   const LoadedModel loaded = testing::loaded_from_text(oscillator(t_end, ", dt: 1e-4"));
   DaeSystem system(loaded.model);
-  AutoSettings rule;  // a hand-over at the first chance: after IDA's sixth step
-  rule.startup_steps = 5;
-  rule.min_events = 0;
-  rule.min_span_steps = 0.0;
-  rule.margin = 0.0;
-  rule.require_resolution = false;
+  const AutoSettings rule = hand_over_at_first_chance();
   AutoIntegrator integrator(system, ida_settings(loaded.run_spec.simulation), euler_settings(loaded.run_spec.simulation), rule);
   SampleTimes observer;
   const RunOutcome outcome = integrator.run(t_end, interval, observer);
@@ -254,6 +261,30 @@ TEST_CASE("IDA takes the run back from an Euler whose energy drifts past half th
   CHECK(dissipated(one_row) == Approx(dissipated(by_ida)).epsilon(0.01));
 }
 
+namespace {
+
+/// The pendulum under auto handed to Euler at the first chance and taken back once its penalty
+/// joint opens at all (1e-12 m; the energy limit set aside: early on the swing turns over little
+/// energy), checked every check_steps Euler steps and at each sample.
+RunOutcome pendulum_taken_back(DaeSystem& system, const LoadedModel& loaded, const IdaSettings& ida, double t_end,
+                               long check_steps, SampleTimes& samples) {
+  AutoSettings rule = hand_over_at_first_chance();
+  rule.require_closed_joints = false;
+  rule.euler_joint_opening = 1e-12;  // [m]
+  rule.euler_energy_share = 1.0;
+  rule.euler_check_steps = check_steps;
+  AutoIntegrator integrator(system, ida, euler_settings(loaded.run_spec.simulation), rule);
+  const RunOutcome outcome = integrator.run(t_end, 0.01, samples);
+  INFO(outcome.message);
+  INFO(outcome.stats.hand_over_reason);
+  REQUIRE(outcome.ok);
+  REQUIRE(outcome.stats.handed_over_at > 0.0);
+  CHECK_THAT(outcome.stats.hand_over_reason, Catch::Contains("its penalty joints opened by"));
+  return outcome;
+}
+
+}  // namespace
+
 TEST_CASE("IDA takes a run back from Euler's open penalty joints, closes them and goes on with the motion", "[integrators][auto]") {
   const double t_end = 1.0;  // [s]
   const LoadedModel loaded = testing::loaded_from_text(pendulum(t_end));
@@ -264,26 +295,11 @@ TEST_CASE("IDA takes a run back from Euler's open penalty joints, closes them an
   REQUIRE(by_ida.ok);
 
   DaeSystem system(loaded.model);
-  AutoSettings rule;  // a hand-over at the first chance, and a joint opening no Euler step stays within
-  rule.startup_steps = 5;
-  rule.min_events = 0;
-  rule.min_span_steps = 0.0;
-  rule.margin = 0.0;
-  rule.require_resolution = false;
-  rule.require_closed_joints = false;
-  rule.euler_joint_opening = 1e-12;  // [m]
-  rule.euler_energy_share = 1.0;     // (the joints alone: early on the swing turns over little energy)
-  AutoIntegrator integrator(system, ida, euler_settings(loaded.run_spec.simulation), rule);
   SampleTimes samples;
-  const RunOutcome outcome = integrator.run(t_end, 0.01, samples);
-  INFO(outcome.message);
-  INFO(outcome.stats.hand_over_reason);
-  REQUIRE(outcome.ok);
-  REQUIRE(outcome.stats.handed_over_at > 0.0);
+  const RunOutcome outcome = pendulum_taken_back(system, loaded, ida, t_end, 50, samples);
   // Taken back at Euler's first check: its 50th step (before the first sample, at 0.01 s).
   CHECK(outcome.stats.handed_back_at > outcome.stats.handed_over_at);
   CHECK(outcome.stats.handed_back_at == Approx(outcome.stats.handed_over_at + 50 * 1e-4).epsilon(1e-9));
-  CHECK_THAT(outcome.stats.hand_over_reason, Catch::Contains("its penalty joints opened by"));
   REQUIRE(samples.times.size() == 101);
   // IDA closed the joint and went on: the bob 1 m from the pin, and where IDA alone has it,
   // within what a few Euler steps of 1e-4 s (omega dt ~ 3e-4) can move it.
@@ -298,18 +314,31 @@ TEST_CASE("IDA takes a run back from Euler's open penalty joints, closes them an
   CHECK(std::abs(b.integration_drift()) < 1e-3 * std::abs(b.turned_over()));
 }
 
+TEST_CASE("a sample where Euler's joints stand open is not written: IDA takes the run back before it", "[integrators][auto]") {
+  // The trial checks before the step's end is sampled: the open state is never an output row
+  // (emu_two_car_crush_zones at rtol 1e-3 wrote a 2.02 mm opening at one sample, with a
+  // warning, before IDA took that run back).
+  const double t_end = 0.1;  // [s]
+  const LoadedModel loaded = testing::loaded_from_text(pendulum(t_end));
+  DaeSystem system(loaded.model);
+  SampleTimes samples;  // checks at the samples alone
+  const RunOutcome outcome =
+      pendulum_taken_back(system, loaded, ida_settings(loaded.run_spec.simulation), t_end, 1000000, samples);
+  // Taken back at the first sample after the hand-over: the end of Euler's step past 0.01 s.
+  CHECK(outcome.stats.handed_back_at == Approx(0.01).margin(1e-4));
+  REQUIRE(samples.times.size() == 11);
+  // Every sample has the joint closed to IDA's tolerance: the one at 0.01 s is IDA's, from the
+  // state it closed. Euler's stood open by 6.1e-7 m there (hand_over_reason), and was written.
+  CHECK(outcome.max_constraint_residual < 1e-8);
+}
+
 TEST_CASE("auto keeps IDA where Euler's penalty joints would stand open under the joints' loads", "[integrators][auto]") {
   // The pendulum's pin carries its bob's weight and swing (IDA's multipliers, up to 3 m g): with
   // Euler's penalty stiffness k the pin would stand open by |lambda| / k, more than a limit of
   // 1e-12 m as soon as it carries anything. The same rule with the check off hands over.
   const double t_end = 0.2;  // [s]
   const LoadedModel loaded = testing::loaded_from_text(pendulum(t_end));
-  AutoSettings rule;
-  rule.startup_steps = 5;
-  rule.min_events = 0;
-  rule.min_span_steps = 0.0;
-  rule.margin = 0.0;
-  rule.require_resolution = false;
+  AutoSettings rule = hand_over_at_first_chance();
   rule.euler_joint_opening = 1e-12;  // [m]
   for (const bool check : {true, false}) {
     INFO("require_closed_joints " << check);

@@ -284,11 +284,13 @@ class Integrator {
   virtual std::unique_ptr<Integrator> hand_over(double /*t*/, const double* /*y*/) { return nullptr; }
   /// Called on the successor once it holds the run (its statistics among it).
   virtual void continue_from_hand_over() {}
-  /// Asked of a successor after every accepted step (t: its end, y: current_state()): whether
-  /// the integrator that began the run takes it back from this state (integrator auto: Euler
-  /// whose run has turned out less accurate than the accuracy warnings allow). The run loop
-  /// then calls this one's finish() and the first integrator's resume().
-  virtual bool returns_run(double /*t*/, const double* /*y*/) { return false; }
+  /// Asked of a successor after every accepted step (t: its end, y: current_state()), before
+  /// the step is delivered to the observers or sampled (sample_here: the step's end will be an
+  /// output sample): whether the integrator that began the run takes it back from this state
+  /// (integrator auto: Euler whose run has turned out less accurate than the accuracy warnings
+  /// allow). The run loop then calls this one's finish() and the first integrator's resume(),
+  /// and the step's end is delivered and sampled from the state resume() left.
+  virtual bool returns_run(double /*t*/, const double* /*y*/, bool /*sample_here*/) { return false; }
   /// On the integrator that began the run, once it holds the run again (returns_run): goes on
   /// from the successor's state y and quadratures at t; must be ready to advance() from t.
   /// Throws StepFailure when it cannot.
@@ -329,12 +331,8 @@ class Integrator {
   /// !step_outputs_wanted()). An integrator that hands over current_outputs() need compute
   /// only these elements' outputs per step (DaeSystem::SweepExtras::output_elements).
   const char* step_output_elements() const { return observe_steps_ && !step_elements_.empty() ? step_elements_.data() : nullptr; }
-  /// The run's energy figures at t = 0, and its last output sample so far: its time and
-  /// largest constraint residual |Phi| [length] (a successor's own check of its accuracy,
-  /// returns_run).
+  /// The run's energy figures at t = 0 (a successor's own check of its accuracy, returns_run).
   const EnergyState& run_initial_energy() const { return outcome_.initial_energy; }
-  double last_sample_time() const { return t_sampled_; }
-  double last_sample_residual() const { return last_sample_residual_; }
   /// The state and quadratures at t for a successor (hand_over): as state_at gives them.
   void state_for_successor(double t, std::vector<double>& y, std::vector<double>& quadratures) { state_at(t, y, quadratures); }
 
