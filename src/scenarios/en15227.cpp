@@ -23,11 +23,12 @@
 namespace railcrash {
 namespace {
 
-constexpr double kInch = 0.0254;              // [m]
 constexpr double kPoundForce = 4.4482216152605;  // [N]
 constexpr double kPoundMass = 0.45359237;     // [kg]
-constexpr double kStandardGravitySI = 9.80665;  // [m/s^2]
-constexpr double kStandardGravityInch = 386.088;  // [in/s^2] the value results.hpp's g in in-lbf-s models uses
+// The unit systems' own constants (model.hpp): the inch in metres, standard gravity.
+const double kInch = metres_per_length_unit(UnitSystem::InLbfS);               // [m]
+const double kStandardGravitySI = standard_gravity(UnitSystem::SI);            // [m/s^2]
+const double kStandardGravityInch = standard_gravity(UnitSystem::InLbfS);      // [in/s^2]
 
 /// Conversions from the command's units (km/h, mm, kN, t) to the model's.
 struct Units {
