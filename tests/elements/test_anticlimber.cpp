@@ -456,7 +456,7 @@ TEST_CASE("anticlimber elastic-plastic law: bilinear loading, kinematic hardenin
     CHECK(in + out == Approx(in - peak * peak / (2.0 * ke)).epsilon(1e-12));  // the elastic energy comes back
     CHECK(law.force(st, d) == Approx(0.0).margin(1e-9));
   }
-  SECTION("past an end of the elastic range but moving back is no crossing; at rest the position decides") {
+  SECTION("past an end of the elastic range but moving back is no crossing, at rest the position decides") {
     // The constraints' position correction moves a deflection without its rate (hybrid.hpp,
     // position_root_moving_on): yield, reloading and release are crossed only moving on.
     const ElasticPlasticLaw::State st = law.fresh();
