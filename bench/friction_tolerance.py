@@ -31,9 +31,12 @@ def guide_friction_variant(path):
 
 
 def run(executable, model, out, rtol):
+    summary = os.path.join(out, "summary.json")
+    if os.path.exists(summary):
+        os.remove(summary)  # (a run that writes none must not be read as the last one)
     subprocess.run([executable, "run", model, "--integrator", "ida", "--quiet", "--out", out, "--rtol", rtol],
                    cwd=ROOT, capture_output=True, text=True)
-    with open(os.path.join(out, "summary.json")) as f:
+    with open(summary) as f:
         return json.load(f)
 
 

@@ -26,9 +26,12 @@ RTOLS = ["1e-2", "5e-3", "3e-3", "2e-3", "1e-3", "7e-4", "5e-4", "3e-4", "2e-4",
 
 
 def run(executable, model, out, options):
+    summary = os.path.join(out, "summary.json")
+    if os.path.exists(summary):
+        os.remove(summary)  # (a run that writes none must not be read as the last one)
     subprocess.run([executable, "run", model, "--integrator", "ida", "--quiet", "--out", out] + options,
                    cwd=ROOT, capture_output=True, text=True)
-    with open(os.path.join(out, "summary.json")) as f:
+    with open(summary) as f:
         return json.load(f)
 
 

@@ -513,7 +513,7 @@ void IdaIntegrator::start(double t_end) {
     // faces' v_f is 0.01 in/s) IDA's steps did not resolve which way the friction acted, and it
     // created energy: 59 times the initial at rtol 3e-3, 12 % at 1e-3 (bench/HISTORY.md,
     // "Velocities held to the friction's slip speed"). At the shipped models' own tolerances
-    // no weight changes.
+    // only scenario2_report_car's draft slider bodies are held tighter (1.4e-3 -> 1e-3 in/s).
     constexpr double kFrictionResolution = 0.1;  // [-] velocity tolerance / v_f
     for (const auto& element : model.elements()) {
       const double slip = element->friction_slip_velocity();  // [length/time] or [rad/time]
@@ -685,8 +685,9 @@ double IdaIntegrator::take_step(double t_end) {
     // and a multiplier crosses zero within the step, IDA's predictor lands on the other side of
     // that kink from the solution: the Newton matrix, exact there, has the friction's slope with
     // the wrong sign, and its modified Newton iteration converges only linearly (a residual
-    // halving per iteration on models/report/preliminary_car.yaml at rtol 3e-3; smaller steps
-    // do not help, the multipliers do not shrink with h). SUNDIALS' default of 4 iterations
+    // halving per iteration on models/report/preliminary_car.yaml at rtol 3e-3, traced before
+    // the friction's velocity tolerance; at rtol 1e-3 it still fails so at 0.0174 s; smaller
+    // steps do not help, the multipliers do not shrink with h). SUNDIALS' default of 4 iterations
     // cannot reach the tolerance that way. From here on IDA may take kPatientNewtonIterations;
     // it goes on from its last good state, at the step it cut to (bench/HISTORY.md, "Newton
     // iterations after a convergence failure").

@@ -37,10 +37,16 @@ def main():
                 for ordering in ORDERINGS:
                     runs += 1
                     what = f"{os.path.relpath(model, source)} --rtol {rtol} ({ordering})"
-                    subprocess.run([railcrash, "run", model, "--integrator", "ida", "--rtol", rtol, "--quiet",
-                                    "--set", "simulation.linear_ordering=" + ordering, "--out", tmp],
-                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
-                    with open(os.path.join(tmp, "summary.json")) as f:
+                    summary_path = os.path.join(tmp, "summary.json")
+                    if os.path.exists(summary_path):
+                        os.remove(summary_path)  # (a run that writes none must not be judged by the last one's)
+                    done = subprocess.run([railcrash, "run", model, "--integrator", "ida", "--rtol", rtol, "--quiet",
+                                           "--set", "simulation.linear_ordering=" + ordering, "--out", tmp],
+                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
+                    if not os.path.exists(summary_path):
+                        failures.append(f"{what}: no summary.json (exit status {done.returncode})")
+                        continue
+                    with open(summary_path) as f:
                         summary = json.load(f)
                     energy = summary["energy"]
                     created = -energy["integration_drift"] / energy["initial_total"] if energy["initial_total"] else 0.0
