@@ -89,15 +89,14 @@ void AutoIntegrator::start(double t_end) {
 double AutoIntegrator::penalty_opening(const double* y) const {
   // Euler's penalty force on row r is k_r Phi_r + c_r Phi_r', IDA's the multiplier lambda_r:
   // carrying the same load at rest, the joint stands open by |lambda_r| / k_r (an angle row
-  // counted times the model's length, as the constraint residual counts it).
+  // counted at its bodies' size, DaeSystem::constraint_row_length, as the constraint residual counts it).
   const int nq = system_.body_unknowns();
   const std::vector<double>& stiffness = euler_step_->penalty.stiffness;
   double widest = 0.0;  // [length]
   for (int row = 0; row < system_.constraint_rows(); ++row) {
     const double k = stiffness[static_cast<std::size_t>(row)];
     if (!(k > 0.0)) continue;
-    const double scale = system_.constraint_row_is_rotational(row) ? system_.model().length_scale() : 1.0;
-    widest = std::max(widest, std::abs(y[2 * nq + row]) / k * scale);
+    widest = std::max(widest, std::abs(y[2 * nq + row]) / k * system_.constraint_row_length(row));
   }
   return widest;
 }

@@ -97,6 +97,27 @@ EnergyBalance EnergyBalance::between(const EnergyState& start, const EnergyState
   return b;
 }
 
+namespace {
+
+/// Each body's size [length]: the larger of its radius of gyration and its farthest connection
+/// point; 0 for a point mass without offset connections.
+std::vector<double> body_sizes(const Model& model) {
+  std::vector<double> size(static_cast<std::size_t>(model.body_count()), 0.0);
+  for (int i = 0; i < model.body_count(); ++i) {
+    const Body& b = model.bodies()[static_cast<std::size_t>(i)];
+    if (b.mass > 0.0 && b.inertia > 0.0) size[static_cast<std::size_t>(i)] = std::sqrt(b.inertia / b.mass);
+  }
+  for (const auto& element : model.elements())
+    for (const PointRef& p : element->points())
+      if (p.body != kGround) {
+        double& r = size[static_cast<std::size_t>(p.body)];
+        r = std::max(r, std::hypot(p.sx, p.sy));
+      }
+  return size;
+}
+
+}  // namespace
+
 DaeSystem::DaeSystem(const Model& model) : model_(model), modes_(model) {
   RAILCRASH_DEMAND(model.finalized());
   const int n = model.body_count();
@@ -134,6 +155,18 @@ DaeSystem::DaeSystem(const Model& model) : model_(model), modes_(model) {
     }
     for (int r = 0; r < el.constraint_count(); ++r) unknowns.push_back(6 * model.body_count() + model.constraint_offset(e) + r);
     element_unknowns_.push_back(std::move(unknowns));
+  }
+
+  const std::vector<double> sizes = body_sizes(model);
+  row_length_.assign(static_cast<std::size_t>(model.constraint_rows()), 1.0);
+  for (std::size_t e = 0; e < model.elements().size(); ++e) {
+    const Element& el = *model.elements()[e];
+    double arm = 0.0;  // [length]
+    for (int slot = 0; slot < 2; ++slot)
+      if (el.slot_body(slot) != kGround) arm = std::max(arm, sizes[static_cast<std::size_t>(el.slot_body(slot))]);
+    if (!(arm > 0.0)) arm = model.origin_free_length_scale();
+    for (int r = 0; r < el.constraint_count(); ++r)
+      if (el.constraint_row_is_rotational(r)) row_length_[static_cast<std::size_t>(model.constraint_offset(e) + r)] = arm;
   }
 
   // Dry run: learn the pattern from the same assembly code, then give every addition its slot.
@@ -615,8 +648,7 @@ double DaeSystem::constraint_residual(const double* q, std::vector<double>& phi)
   }
   double worst = 0.0;
   for (int row = 0; row < constraint_rows(); ++row) {
-    const double scale = constraint_row_is_rotational(row) ? model_.length_scale() : 1.0;
-    worst = std::max(worst, std::abs(phi[static_cast<std::size_t>(row)]) * scale);
+    worst = std::max(worst, std::abs(phi[static_cast<std::size_t>(row)]) * constraint_row_length(row));
   }
   return worst;
 }
@@ -637,17 +669,7 @@ bool DaeSystem::constraint_element_failed(int e) const {
 
 std::vector<double> DaeSystem::body_angle_lengths() const {
   const double length = model_.length_scale();
-  std::vector<double> size(static_cast<std::size_t>(model_.body_count()), 0.0);
-  for (int i = 0; i < model_.body_count(); ++i) {
-    const Body& b = model_.bodies()[static_cast<std::size_t>(i)];
-    if (b.mass > 0.0 && b.inertia > 0.0) size[static_cast<std::size_t>(i)] = std::sqrt(b.inertia / b.mass);
-  }
-  for (const auto& element : model_.elements())
-    for (const PointRef& p : element->points())
-      if (p.body != kGround) {
-        double& r = size[static_cast<std::size_t>(p.body)];
-        r = std::max(r, std::hypot(p.sx, p.sy));
-      }
+  std::vector<double> size = body_sizes(model_);
   for (double& r : size) r = r > 0.0 ? std::min(std::max(r, 1e-3 * length), length) : length;
   return size;
 }

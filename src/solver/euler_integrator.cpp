@@ -357,12 +357,11 @@ std::string EulerIntegrator::divergence_advice(const std::vector<double>& last_g
   if (m == 0 || last_good.empty()) return text.str();
   std::vector<double> phi(static_cast<std::size_t>(m));
   system_.constraints(last_good.data(), phi.data(), nullptr);
-  const double length = system_.model().length_scale();
   int worst = -1;
   double worst_violation = 0.0;  // [length]
   for (int r = 0; r < m; ++r) {
     if (!system_.constraint_row_active(r)) continue;
-    const double violation = std::abs(phi[static_cast<std::size_t>(r)]) * (system_.constraint_row_is_rotational(r) ? length : 1.0);
+    const double violation = std::abs(phi[static_cast<std::size_t>(r)]) * system_.constraint_row_length(r);
     if (violation > worst_violation) worst_violation = violation, worst = r;
   }
   if (worst < 0) return text.str();

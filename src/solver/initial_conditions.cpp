@@ -39,7 +39,8 @@ Eigen::VectorXd assembly_weights(const DaeSystem& system) {
   return w;
 }
 
-/// Row scale so rotational rows are measured in length units.
+/// Row scale so rotational rows are measured in length units: an angle times the model's length
+/// scale, for convergence tests against the round-off of its coordinates (1e-12 of it).
 double row_scale(const DaeSystem& system, int row) {
   return system.constraint_row_is_rotational(row) ? system.model().length_scale() : 1.0;
 }
@@ -141,7 +142,7 @@ void check_constraint_rank(const DaeSystem& system, const double* q) {
   Eigen::VectorXd phi;
   constraint_gradient(system, q, phi);
   double worst = 0.0;
-  for (int row : involved) worst = std::max(worst, std::abs(phi[row]) * row_scale(system, row));
+  for (int row : involved) worst = std::max(worst, std::abs(phi[row]) * system.constraint_row_length(row));
   const std::string file_prefix = SourceLocation{system.model().file, 0}.prefix();
   std::ostringstream msg;
   msg << file_prefix << "the joints are redundant: " << (m - rank) << " of the " << m

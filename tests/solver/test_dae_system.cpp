@@ -224,3 +224,34 @@ TEST_CASE("a damped spring-mass dissipates the integral of c v^2 in its dashpot,
     CHECK(std::abs(column(columns, row, "integration_drift")) < (ida ? 1e-7 : 1e-4) * 0.5 * k * x0 * x0);
   }
 }
+
+TEST_CASE("an angle misfit counts as an opening at its bodies' size, wherever the model sits", "[dae][residual]") {
+  // Two bodies on one point, joined rigidly (at the angle they start at), the second then
+  // turned by 1 mrad about that point: the joint's angle
+  // row misses by 1e-3 rad, its distance rows by nothing. The second body's radius of gyration,
+  // sqrt(9 / 1) = 3 m, is the larger size: the misfit moves its points by up to 3 mm. Before,
+  // the angle counted times the model's length scale, which grows with the distance from the
+  // origin (10 km away it read 10 m).
+  const auto model_at = [](double x) {
+    char text[600];
+    std::snprintf(text, sizeof text,
+                  "railcrash: 1\nname: r\nunits: SI\ngravity: [0, 0]\nbodies:\n"
+                  "  - {name: a, mass: 1.0, inertia: 1.0, position: [%.17g, 0]}\n"
+                  "  - {name: b, mass: 1.0, inertia: 9.0, position: [%.17g, 0]}\n"
+                  "elements:\n  - {name: weld, type: rigid_joint, points: [{body: a, at: [0, 0]}, {body: b, at: [0, 0]}]}\n"
+                  "simulation: {t_end: 1}\n",
+                  x, x);
+    return testing::model_from_text(text);
+  };
+  for (const double x : {0.0, 1.0e4}) {
+    INFO("model at x = " << x << " m");
+    const Model model = model_at(x);
+    const DaeSystem system(model);
+    std::vector<double> y = system.initial_state();
+    REQUIRE(system.constraint_residual(y.data()) == 0.0);
+    y[5] += 1.0e-3;  // body b's angle [rad]
+    CHECK(system.constraint_row_length(2) == Approx(3.0).epsilon(1e-15));
+    CHECK(system.constraint_row_length(0) == 1.0);
+    CHECK(system.constraint_residual(y.data()) == Approx(3.0e-3).epsilon(1e-9));
+  }
+}

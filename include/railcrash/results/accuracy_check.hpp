@@ -7,13 +7,14 @@
 //       share = |integration_drift| / max(|initial total|, |kinetic| + |elastic| + |gravity|
 //                                                          + |dissipated| + |external work|)
 //     (summary.json's relative_balance_error);
-//   - the largest constraint residual |Phi| at the output samples, a length: with Euler it is
-//     how far its penalty springs let the joints open.
+//   - the largest constraint residual |Phi| at the output samples, a length (an angle row
+//     counts at its bodies' size, DaeSystem::constraint_row_length): with Euler it is how far
+//     its penalty springs let the joints open.
 // A run is warned about when the share exceeds kEnergyShareLimit or the residual exceeds
 // kConstraintResidualLimit. The limits are stated, not tuned to pass: on the report's models
 // (in-lbf-s) Euler at the printed step turns 0.015-0.087 % and opens joints by at most
-// 0.29 mm; on the SI example models its default step creates 2.9-9.9 % and opens joints by
-// 6 mm to 0.46 m (bench/accuracy_warnings.py prints these figures; README "Accuracy warnings").
+// 0.015 mm; on the SI example models its default step creates 2.9-9.9 % and opens joints by
+// 6 to 68 mm (bench/accuracy_warnings.py prints these figures; README "Accuracy warnings").
 #include <string>
 #include <vector>
 

@@ -180,6 +180,15 @@ class DaeSystem {
   /// gyration and its farthest connection point, kept within [1e-3, 1] x the model's length
   /// scale; a point mass without connections gets the length scale. One entry per body.
   std::vector<double> body_angle_lengths() const;
+  /// What constraint row `row`'s residual counts as in length units [length per residual
+  /// unit]: 1 for a distance row; for an angle row the larger of its two bodies' sizes (radius
+  /// of gyration or farthest connection point, as body_angle_lengths without its bounds), the
+  /// distance by which an angle misfit moves the farther points. Where the model sits and how
+  /// long the train is do not enter (an angle row used to count times the model's length
+  /// scale, which grows with the distance from the origin: bench/HISTORY.md, "Joint openings
+  /// at the bodies' own size"). A row between bodies without size gets the model's
+  /// origin-free length.
+  double constraint_row_length(int row) const { return row_length_[static_cast<std::size_t>(row)]; }
   /// Per constraint row, an upper bound of 1 / (its effective mass) over all orientations of
   /// its bodies: a translational row moves body b's point at distance a_b from its centre, so
   /// 1 / m_eff <= sum 1/m_b + a_b^2/J_b; an angle row gives sum 1/J_b [1/mass] or [1/inertia].
@@ -347,6 +356,7 @@ class DaeSystem {
   std::vector<int> output_offset_;  // first output of each element in output_names_
   std::vector<int> constraint_row_owner_;  // element index of each constraint row
   std::vector<bool> row_is_rotational_;
+  std::vector<double> row_length_;  // constraint_row_length, per row [length per residual unit]
   std::vector<int> root_offset_;  // first root of each element
   std::vector<int> root_owner_;   // element of each root
   std::vector<std::vector<int>> element_unknowns_;  // y indices each element reads
