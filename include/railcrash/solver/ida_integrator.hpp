@@ -55,6 +55,14 @@ class IdaIntegrator : public Integrator {
   // Newton iterations IDA may take per step once its iteration has failed to converge in a
   // run (SUNDIALS' default, 4, until then; take_step says why).
   static constexpr int kPatientNewtonIterations = 20;
+  // BDF orders 3 to 5 are not A-stable: a lightly damped oscillation that a loose tolerance
+  // resolves coarsely can grow under them, and the integration creates energy. Once it has
+  // created kCreatedEnergyShare of the energy turned over (work_balance, after every step of
+  // order 3 or more), IDA restarts there with its order held to kHeldOrder (BDF2, A-stable)
+  // for the rest of the run (hold_order_if_energy_created; bench/HISTORY.md, "BDF order held
+  // where the integration creates energy").
+  static constexpr double kCreatedEnergyShare = 5e-2;  // [-] of the energy turned over: 5x the accuracy warning's
+  static constexpr int kHeldOrder = 2;
 
   struct Impl;
 
@@ -99,6 +107,18 @@ class IdaIntegrator : public Integrator {
   /// IdaEventHandler's); kinks within tolerance go on, a jump restarts at its event (then
   /// true: the step's end is discarded).
   bool handle_events(double t_step_start, double t_n, double t_end);
+  /// After a step to t_n that did not restart: when the integration has created more than
+  /// kCreatedEnergyShare of the energy turned over since IDA started (or took the run back),
+  /// holds IDA's BDF order to kHeldOrder from t_n, with a restart there (IDA keeps no history
+  /// of a higher order then); stats().bdf_order_held_at says where. Once per run.
+  void hold_order_if_energy_created(double t_n, double t_end);
+  /// The energy the integration has lost by state (y, quadratures), every element's energy
+  /// taken as the work done on it, and the energy turned over [energy] (work_balance).
+  struct WorkBalance {
+    double lost = 0.0;
+    double turned_over = 0.0;
+  };
+  WorkBalance work_balance(const double* y, const double* quadratures) const;
   /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
   /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
   void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);

@@ -104,6 +104,7 @@ struct RunStatistics {
   double handed_back_at = -1.0;      // [time] integrator auto: when IDA took the run back from Euler (-1: it did not)
   double euler_step = 0.0;           // [time] euler, or auto's Euler part: its step (0: Euler took none)
   double newton_iterations_raised_at = -1.0;  // [time] ida: where a Newton failure raised IDA's iterations per step from 4 (-1: never)
+  double bdf_order_held_at = -1.0;  // [time] ida: where the energy the integration created held IDA's BDF order to 2 (-1: never)
   std::string hand_over_reason;      // integrator auto: why it did, or why IDA kept the run ("" before the run ends)
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
