@@ -160,7 +160,13 @@ struct IdaIntegrator::Impl {
 
   explicit Impl(const DaeSystem& s) : system(s) {}
   ~Impl() {
-    if (ida) IDAFree(&ida);
+    if (ida) {
+      // IDAS frees its quadrature history up to the maximum order set last, not the one it
+      // allocated for (5, SUNDIALS' default): after hold_order_if_energy_created lowered it,
+      // three of those vectors leaked (LeakSanitizer). The allocation's order back first.
+      if (order_held) IDASetMaxOrd(ida, kAllocatedOrder);
+      IDAFree(&ida);
+    }
     if (linear_solver) SUNLinSolFree(linear_solver);
     if (jacobian) SUNMatDestroy(jacobian);
     for (N_Vector* v : {&y, &yp, &ids, &atol, &quad, &quad_atol, &local_errors, &derivative, &rates_out, &y_out, &quad_out})

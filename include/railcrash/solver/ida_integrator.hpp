@@ -63,6 +63,7 @@ class IdaIntegrator : public Integrator {
   // where the integration creates energy").
   static constexpr double kCreatedEnergyShare = 5e-2;  // [-] of the energy turned over: 5x the accuracy warning's
   static constexpr int kHeldOrder = 2;
+  static constexpr int kAllocatedOrder = 5;  // SUNDIALS' default maximum order, which IDAInit allocates for
 
   struct Impl;
 
