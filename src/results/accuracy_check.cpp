@@ -10,14 +10,15 @@
 
 namespace railcrash {
 
-double relative_balance_error(const EnergyBalance& energy) {
-  const double turned_over = energy.turned_over();
+double relative_balance_error(const EnergyBalance& energy, double most_turned_over) {
+  const double turned_over = std::max(energy.turned_over(), most_turned_over);
   return turned_over > 0.0 ? energy.error() / turned_over : 0.0;
 }
 
 AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integrator, UnitSystem units) {
   AccuracyFacts facts;
-  facts.relative_balance_error = relative_balance_error(EnergyBalance::between(outcome.initial_energy, outcome.final_energy));
+  facts.relative_balance_error = relative_balance_error(EnergyBalance::between(outcome.initial_energy, outcome.final_energy),
+                                                        outcome.most_energy_turned_over);
   facts.max_constraint_residual = outcome.max_constraint_residual;
   facts.units = units;
   facts.euler_ran = integrator == integrator_name(IntegratorKind::Euler) || outcome.stats.handed_over_at >= 0.0;

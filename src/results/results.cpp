@@ -593,7 +593,7 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     << ", \"external_work\": " << json_number(energy.external_work) << ", \"initial_total\": "
     << json_number(energy.initial_total) << ", \"integration_drift\": " << json_number(energy.integration_drift())
     << ", \"balance_error\": " << json_number(energy.error())
-    << ", \"relative_balance_error\": " << json_number(relative_balance_error(energy)) << "},\n";
+    << ", \"relative_balance_error\": " << json_number(relative_balance_error(energy, outcome.most_energy_turned_over)) << "},\n";
   j << "  \"accuracy_warnings\": [";  // (results/accuracy_check.hpp: the limits and why)
   const std::vector<std::string> warnings = accuracy_warnings(accuracy_facts(outcome, integrator, model.units));
   for (std::size_t k = 0; k < warnings.size(); ++k) j << (k ? ", " : "") << json_string(warnings[k]);

@@ -680,7 +680,7 @@ IdaIntegrator::WorkBalance IdaIntegrator::work_balance(const double* y, const do
   for (int k = 0; k < 1 + system_.element_count(); ++k) work += work_done[k];
   WorkBalance b;
   b.lost = start.kinetic + loads - (kinetic + gravity + work);
-  b.turned_over = std::max(std::abs(start.kinetic + start.elastic), kinetic + std::abs(gravity) + std::abs(work) + std::abs(loads));
+  b.turned_over = system_.energy_turned_over(start, y, quadratures);
   return b;
 }
 

@@ -29,8 +29,11 @@ constexpr double kEnergyShareLimit = 0.01;          // [-] of the energy turned 
 constexpr double kConstraintResidualLimit = 1.0e-3;  // [m] (converted to the model's length unit)
 
 /// summary.json's relative_balance_error: the energy the integration gained (error()) over the
-/// energy turned over; 0 for a model that turns none over.
-double relative_balance_error(const EnergyBalance& energy);
+/// energy turned over, at the end or the most at any output sample (most_turned_over,
+/// RunOutcome::most_energy_turned_over), whichever is larger; 0 for a model that turns none over.
+/// With the end alone, a pendulum from rest that ended at its turning point read "created
+/// 100 %" for a drift of 7e-7 J.
+double relative_balance_error(const EnergyBalance& energy, double most_turned_over);
 
 /// What the run said about its own accuracy, as what an engineer would act on.
 struct AccuracyFacts {

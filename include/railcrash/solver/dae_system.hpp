@@ -234,6 +234,13 @@ class DaeSystem {
   /// Potential of gravity, -sum m g . r [force*length].
   double gravity_potential(const double* q) const;
   EnergyState energy(const double* y, const double* quadratures, const PenaltyRows* penalty = nullptr) const;
+  /// The energy turned over since `start` by state (y, quadratures), from the work quadratures
+  /// alone (no element evaluated): max(|initial kinetic + elastic|, kinetic + |change of
+  /// gravity| + |work done on the elements and penalties| + |work of the loads|) [force*length].
+  /// Its largest value over a run is the scale of the run's energy error (RunOutcome::
+  /// most_energy_turned_over): at one instant every energy can be near zero (a pendulum from
+  /// rest back at its turning point).
+  double energy_turned_over(const EnergyState& start, const double* y, const double* quadratures) const;
   /// Element e's stored elastic energy at the state y [force*length], its bodies' rotations from
   /// the same cache as every sweep (an output row has computed them already).
   double element_potential_energy(std::size_t e, const double* y) const;
