@@ -872,13 +872,16 @@ EnergyState DaeSystem::energy(const double* y, const double* quadratures, const 
   return s;
 }
 
-double DaeSystem::energy_turned_over(const EnergyState& start, const double* y, const double* quadratures) const {
+DaeSystem::WorkBalance DaeSystem::work_balance(const EnergyState& start, const double* y, const double* quadratures) const {
   const double kinetic = kinetic_energy(y + body_unknowns());
   const double gravity = gravity_potential(y) - start.gravity;
   const double loads = quadratures[kLoadWork] - start.load_work;
   double work = -start.element_work;  // penalties', then each element's
   for (int k = kPenaltyWork; k < kFirstElementWork + element_count(); ++k) work += quadratures[k];
-  return std::max(std::abs(start.kinetic + start.elastic), kinetic + std::abs(gravity) + std::abs(work) + std::abs(loads));
+  WorkBalance b;
+  b.lost = start.kinetic + loads - (kinetic + gravity + work);
+  b.turned_over = std::max(std::abs(start.kinetic + start.elastic), kinetic + std::abs(gravity) + std::abs(work) + std::abs(loads));
+  return b;
 }
 
 double DaeSystem::element_potential_energy(std::size_t e, const double* y) const {

@@ -665,25 +665,6 @@ double IdaIntegrator::advance(double t_end) {
   return impl.t_reached;
 }
 
-IdaIntegrator::WorkBalance IdaIntegrator::work_balance(const double* y, const double* quadratures) const {
-  // The run's energy theorem with every element's stored and dissipated energy taken as the
-  // work done on it (its quadrature): K + V_gravity + sum W_e - W_loads keeps its start value
-  // on the exact solution. O(bodies + elements) and no element evaluated, so cheap enough for
-  // every step (EnergyBalance evaluates every element's stored energy).
-  const EnergyState& start = run_initial_energy();
-  const int nq = system_.body_unknowns();
-  const double kinetic = system_.kinetic_energy(y + nq);
-  const double gravity = system_.gravity_potential(y) - start.gravity;
-  const double loads = quadratures[DaeSystem::kLoadWork] - start.load_work;
-  const double* work_done = quadratures + DaeSystem::kPenaltyWork;  // penalties', then each element's
-  double work = -start.element_work;
-  for (int k = 0; k < 1 + system_.element_count(); ++k) work += work_done[k];
-  WorkBalance b;
-  b.lost = start.kinetic + loads - (kinetic + gravity + work);
-  b.turned_over = system_.energy_turned_over(start, y, quadratures);
-  return b;
-}
-
 void IdaIntegrator::hold_order_if_energy_created(double t_n, double t_end) {
   Impl& impl = *impl_;
   if (impl.order_held) return;
@@ -696,7 +677,7 @@ void IdaIntegrator::hold_order_if_energy_created(double t_n, double t_end) {
   impl.check(IDAGetQuad(impl.ida, &t_quad, impl.quad), "IDAGetQuad");
   const double* y = N_VGetArrayPointer(impl.y);
   const double* quadratures = N_VGetArrayPointer(impl.quad);
-  const WorkBalance balance = work_balance(y, quadratures);
+  const DaeSystem::WorkBalance balance = system_.work_balance(run_initial_energy(), y, quadratures);
   const double created = impl.lost_at_start - balance.lost;  // [energy] since IDA started
   // Against the most energy turned over at any check, and at least the energy scale of the
   // tolerances (start()): a model from rest turns over none at first (a dropped mass at
@@ -1064,7 +1045,7 @@ void IdaIntegrator::resume_at(double t, std::vector<double> y, const std::vector
   restart_from(t, std::move(y), {}, quadratures, step_before, events, t_end, /*add_counters=*/false);
   impl.at_start = true;  // until its next step, the state at t is the one restarted from (state_at)
   // The energy Euler created or lost is its own (its trial judges it): IDA's guard counts from here.
-  impl.lost_at_start = work_balance(N_VGetArrayPointer(impl.y), quadratures.data()).lost;
+  impl.lost_at_start = system_.work_balance(run_initial_energy(), N_VGetArrayPointer(impl.y), quadratures.data()).lost;
 }
 
 }  // namespace railcrash

@@ -128,7 +128,7 @@ void Integrator::deliver_sample(double t) {
   }
   outcome_.most_energy_turned_over =
       std::max(outcome_.most_energy_turned_over,
-               system_.energy_turned_over(outcome_.initial_energy, sample_y_.data(), sample_quadratures_.data()));
+               system_.work_balance(outcome_.initial_energy, sample_y_.data(), sample_quadratures_.data()).turned_over);
   const int nq = system_.body_unknowns();
   const double* lambda = sample_y_.data() + 2 * nq;
   if (observe_sample_forces_) {  // the outputs and the forces from one sweep over the elements

@@ -234,13 +234,19 @@ class DaeSystem {
   /// Potential of gravity, -sum m g . r [force*length].
   double gravity_potential(const double* q) const;
   EnergyState energy(const double* y, const double* quadratures, const PenaltyRows* penalty = nullptr) const;
-  /// The energy turned over since `start` by state (y, quadratures), from the work quadratures
-  /// alone (no element evaluated): max(|initial kinetic + elastic|, kinetic + |change of
-  /// gravity| + |work done on the elements and penalties| + |work of the loads|) [force*length].
-  /// Its largest value over a run is the scale of the run's energy error (RunOutcome::
-  /// most_energy_turned_over): at one instant every energy can be near zero (a pendulum from
-  /// rest back at its turning point).
-  double energy_turned_over(const EnergyState& start, const double* y, const double* quadratures) const;
+  /// The run's energy theorem since `start` with every element's stored and dissipated energy
+  /// taken as the work done on it (its quadrature), at state (y, quadratures): K + V_gravity +
+  /// sum W - W_loads keeps its start value on the exact solution. From the quadratures alone
+  /// (no element evaluated), so cheap enough for every step or sample. [force*length]
+  struct WorkBalance {
+    double lost = 0.0;         // the energy the integration lost (< 0: created)
+    double turned_over = 0.0;  // max(|initial kinetic + elastic|, kinetic + |change of gravity|
+                               //     + |work done on the elements and penalties| + |work of the loads|)
+  };
+  /// Its turned_over's largest value over a run is the scale of the run's energy error
+  /// (RunOutcome::most_energy_turned_over): at one instant every energy can be near zero (a
+  /// pendulum from rest back at its turning point).
+  WorkBalance work_balance(const EnergyState& start, const double* y, const double* quadratures) const;
   /// Element e's stored elastic energy at the state y [force*length], its bodies' rotations from
   /// the same cache as every sweep (an output row has computed them already).
   double element_potential_energy(std::size_t e, const double* y) const;

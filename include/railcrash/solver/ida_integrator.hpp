@@ -57,7 +57,7 @@ class IdaIntegrator : public Integrator {
   static constexpr int kPatientNewtonIterations = 20;
   // BDF orders 3 to 5 are not A-stable: a lightly damped oscillation that a loose tolerance
   // resolves coarsely can grow under them, and the integration creates energy. Once it has
-  // created kCreatedEnergyShare of the energy turned over (work_balance, after every step of
+  // created kCreatedEnergyShare of the energy turned over (DaeSystem::work_balance, after every step of
   // order 3 or more), IDA restarts there with its order held to kHeldOrder (BDF2, A-stable)
   // for the rest of the run (hold_order_if_energy_created; bench/HISTORY.md, "BDF order held
   // where the integration creates energy").
@@ -113,13 +113,6 @@ class IdaIntegrator : public Integrator {
   /// holds IDA's BDF order to kHeldOrder from t_n, with a restart there (IDA keeps no history
   /// of a higher order then); stats().bdf_order_held_at says where. Once per run.
   void hold_order_if_energy_created(double t_n, double t_end);
-  /// The energy the integration has lost by state (y, quadratures), every element's energy
-  /// taken as the work done on it, and the energy turned over [energy] (work_balance).
-  struct WorkBalance {
-    double lost = 0.0;
-    double turned_over = 0.0;
-  };
-  WorkBalance work_balance(const double* y, const double* quadratures) const;
   /// Restarts IDA at crossing c's event (state y_at_event): consistent rates in the new modes
   /// (and boundary commits there), quadratures interpolated, the one restart (Impl::restart).
   void restart_at_event(const Crossing& c, const double* y_at_event, double t_end);

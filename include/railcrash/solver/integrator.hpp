@@ -198,7 +198,7 @@ struct RunOutcome {
   EnergyState initial_energy;
   EnergyState final_energy;
   double max_constraint_residual = 0.0;  // largest |Phi| over the output samples [length]
-  double most_energy_turned_over = 0.0;  // largest DaeSystem::energy_turned_over over the output samples [energy]
+  double most_energy_turned_over = 0.0;  // largest DaeSystem::work_balance turned_over at the output samples [energy]
   std::vector<EventRecord> events;       // every committed mode change, in order
 };
 
