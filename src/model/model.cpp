@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace railcrash {
 
@@ -146,6 +147,11 @@ void ElementStates::reset() {
   const auto& elements = model_->elements();
   for (std::size_t e = 0; e < elements.size(); ++e)
     if (bytes_[e] > 0) elements[e]->write_start_mode(block_.data() + offset_[e]);
+}
+
+bool ElementStates::same_as(const Snapshot& snapshot) const {
+  return snapshot.block.size() == block_.size() &&
+         std::memcmp(snapshot.block.data(), block_.data(), block_.size() * sizeof(std::max_align_t)) == 0;
 }
 
 void ElementStates::restore(const Snapshot& snapshot) {

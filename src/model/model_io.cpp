@@ -456,7 +456,7 @@ const std::vector<std::string> kResponseKeys = {"crush_gauges", "crush", "refere
                                                 "collision_post_distance"};
 const std::vector<std::string> kCrushGaugeKeys = {"name", "points"};
 const std::vector<std::string> kVariantKeys = {"railcrash", "variant_of", "name", "description", "set"};
-const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "position_tolerance", "linear_ordering", "dt", "output_interval", "force_dt", "max_steps",
+const std::vector<std::string> kSimulationKeys = {"t_end", "integrator", "rtol", "atol", "position_tolerance", "linear_ordering", "jacobian_kept_steps", "dt", "output_interval", "force_dt", "max_steps",
                                                   "static_equilibrium",
                                                   "penalty_stiffness", "penalty_damping", "penalty_rotational_stiffness",
                                                   "penalty_rotational_damping"};
@@ -767,6 +767,17 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
     s.integrator = *kind;
   }
   const auto positive = [&](const char* key) { return r.positive_key(node, key, "simulation"); };
+  // A count of steps: a whole number of at least `least`; `what` says what it counts.
+  const auto whole_steps = [&](const char* key, double least, const char* what) {
+    const std::string name = std::string("simulation: ") + key;
+    const double steps = r.number(node[key], name);
+    if (!(steps >= least) || steps != std::floor(steps) || steps > 9.0e18) {
+      std::ostringstream least_text;
+      least_text << least;
+      r.fail(node[key], name + " must be a whole number of at least " + least_text.str() + " (" + what + ")");
+    }
+    return static_cast<long>(steps);
+  };
   if (node["rtol"]) {
     s.rtol = r.number(node["rtol"], "simulation: rtol");
     if (const std::string problem = rtol_problem(s.rtol, "simulation: rtol"); !problem.empty()) r.fail(node["rtol"], problem);
@@ -795,6 +806,9 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
                                           how + "'");
     }
   }
+  if (node["jacobian_kept_steps"])
+    s.jacobian_kept_steps = whole_steps("jacobian_kept_steps", 0.0, "the steps a Jacobian serves IDA's later setups; 0: one "
+                                                                    "evaluated at every setup");
   if (auto v = positive("dt")) s.dt = *v;
   if (auto v = positive("output_interval")) s.output_interval = *v;
   const std::string rows_problem = output_rows_problem(s);
@@ -803,13 +817,7 @@ void read_simulation(const Reader& r, const YAML::Node& node, SimulationSettings
     r.fail(interval && (r.overridden(interval) || !r.overridden(t_end)) ? interval : t_end, "simulation: " + rows_problem);
   }
   if (node["force_dt"]) s.force_dt = r.boolean(node["force_dt"], "simulation: force_dt");
-  if (node["max_steps"]) {
-    const double steps = r.number(node["max_steps"], "simulation: max_steps");
-    if (!(steps >= 1.0) || steps != std::floor(steps) || steps > 9.0e18)
-      r.fail(node["max_steps"], "simulation: max_steps must be a whole number of at least 1 (the steps either integrator "
-                                "may take)");
-    s.max_steps = static_cast<long>(steps);
-  }
+  if (node["max_steps"]) s.max_steps = whole_steps("max_steps", 1.0, "the steps either integrator may take");
   if (node["static_equilibrium"])
     s.static_equilibrium = r.boolean(node["static_equilibrium"], "simulation: static_equilibrium");
   const auto scaled = [](std::optional<double> value, double factor) { return value ? std::optional<double>(*value * factor) : value; };

@@ -374,6 +374,10 @@ std::map<std::string, SectionKeys> section_keys() {
                                         "ida: the fill-reducing ordering of the sparse LU (KLU): fewest_entries (default: AMD "
                                         "or COLAMD, whichever factors the first Newton matrix with fewer entries), amd or "
                                         "colamd; it changes round-off only")}},
+      {"jacobian_kept_steps", {typed("integer", "ida: steps a Jacobian serves IDA's later setups, its rates' part updated "
+                                                "(default 20; 0: one evaluated at every setup, as before it was kept); it "
+                                                "changes IDA's Newton iterates only, within its tolerance")
+                                              .set("minimum", Json::number(0))}},
       {"dt", {number("euler: time step [s]", Range::Positive)}},
       {"output_interval", {number("time between output rows [s]", Range::Positive)}},
       {"force_dt", {flag("euler: run with dt even above the stability limit")}},

@@ -80,6 +80,8 @@ std::string provenance_json(const Provenance& p) {
     if (s.position_tolerance == PositionTolerance::Absolute) j += ", \"position_tolerance\": \"absolute\"";
     if (s.linear_ordering != LinearOrdering::FewestEntries)
       j += std::string(", \"linear_ordering\": ") + (s.linear_ordering == LinearOrdering::Amd ? "\"amd\"" : "\"colamd\"");
+    if (s.jacobian_kept_steps != SimulationSettings{}.jacobian_kept_steps)
+      j += ", \"jacobian_kept_steps\": " + std::to_string(s.jacobian_kept_steps);
   }
   j += std::string(", \"static_equilibrium\": ") + (s.static_equilibrium ? "true" : "false") + "}}";
   return j;

@@ -566,7 +566,8 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
     << ", \"mass\": " << json_string(si ? "kg" : "lbf*s^2/in") << ", \"angle\": \"rad\", \"energy\": "
     << json_string(si ? "J" : "in*lbf") << "},\n";
   j << "  \"stats\": {\"steps\": " << s.steps << ", \"residual_evaluations\": " << s.residual_evaluations
-    << ", \"jacobian_evaluations\": " << s.jacobian_evaluations << ", \"nonlinear_iterations\": " << s.nonlinear_iterations
+    << ", \"jacobian_evaluations\": " << s.jacobian_evaluations << ", \"linear_setups\": " << s.linear_setups
+    << ", \"nonlinear_iterations\": " << s.nonlinear_iterations
     << ", \"error_test_failures\": " << s.error_test_failures
     << ", \"nonlinear_convergence_failures\": " << s.nonlinear_convergence_failures << ", \"events\": " << s.events
     << ", \"located_mode_changes\": " << s.root_returns << ", \"reinitializations\": " << s.reinitializations << ", \"wall_seconds\": " << json_number(s.wall_seconds)

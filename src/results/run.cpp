@@ -202,6 +202,7 @@ std::unique_ptr<Integrator> make_integrator(DaeSystem& system, const SimulationS
   ida.atol = settings.atol;
   ida.position_tolerance = settings.position_tolerance;
   ida.linear_ordering = settings.linear_ordering;
+  ida.jacobian_kept_steps = settings.jacobian_kept_steps;
   ida.max_steps = settings.max_steps;
   ida.run = run;
   if (settings.integrator == IntegratorKind::Auto) return std::make_unique<AutoIntegrator>(system, ida, euler);

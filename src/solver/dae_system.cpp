@@ -539,6 +539,15 @@ void DaeSystem::jacobian(double t, double cj, const double* y, const double* yp,
   RAILCRASH_DEMAND(writer.slot == slots_.data() + slots_.size());
 }
 
+void DaeSystem::add_rate_jacobian(double factor, double* values) const {
+  // assemble_jacobian's first 3 nq additions: (k, k) cj, (k, nq + k) -1, (nq + k, nq + k) cj M_k.
+  const int nq = body_unknowns();
+  for (int k = 0; k < nq; ++k) {
+    values[slots_[static_cast<std::size_t>(3 * k)]] += factor;
+    values[slots_[static_cast<std::size_t>(3 * k + 2)]] += factor * mass_[static_cast<std::size_t>(k)];
+  }
+}
+
 void DaeSystem::force_jacobian(double t, const double* q, const double* v, const PenaltyRows* penalty,
                                std::vector<Triplet>& df_dq, std::vector<Triplet>& df_dv, bool stiffest) const {
   df_dq.clear();

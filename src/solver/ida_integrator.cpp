@@ -106,6 +106,7 @@ struct IdaIntegrator::Impl {
 
   // The run in progress (IdaIntegrator::start sets them up, advance takes one step).
   double rtol = 0.0;
+  long jacobian_kept_steps = 0;  // IdaSettings::jacobian_kept_steps
   double t_reached = 0.0;                   // IDA's last step (or restart) time
   IdaStepInterpolant interpolant{*this};  // IDA's polynomial over its last step, for the event layer
   std::vector<EventRecord> events;
@@ -132,6 +133,16 @@ struct IdaIntegrator::Impl {
     double t = 0.0;
     std::vector<double> y, g, outputs;
   } sweep;
+  // The Jacobian's values kept for IDA's next setups, which change cj, not y (as CVODE's linear
+  // solver interface keeps its Jacobian; IDA's evaluates one at every setup).
+  struct KeptJacobian {
+    bool valid = false;             // values hold one; cleared at every IDAReInit
+    double cj = 0.0;                // [1/time] the cj the values are for
+    long step = 0;                  // IDA's step count at the evaluation
+    long convergence_failures = 0;  // IDA's Newton failures then
+    mutable long reuses = 0;        // setups that kept it, since IDA's counters were last read
+    ElementStates::Snapshot modes;  // the element modes it was evaluated in
+  } kept;
   // The first trial state whose residual was not finite (cleared before every step).
   double non_finite_t = 0.0;
   std::vector<double> non_finite_y, non_finite_yp;
@@ -215,8 +226,35 @@ struct IdaIntegrator::Impl {
     const PhaseClock::Scope timed(self->phase_clock, Phase::Jacobian);
     try {
       // The matrix's pattern was written when it was made, and IDA's zeroing leaves it
-      // (make_klu_jacobian_matrix); the values are all written here.
-      self->system.jacobian(t, cj, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), SUNSparseMatrix_Data(matrix));
+      // (make_klu_jacobian_matrix); the values are all written here, or kept (below).
+      // IDA calls for a setup when cj = alpha / h has moved by more than a quarter from the
+      // matrix's, after a failed step, and at every start. Only cj's part is new in the first
+      // case: the elements' part (dr/dy) of the matrix already there is kept while it is
+      // recent, no element has changed mode since (a contact's 1e9 N/m appearing is not
+      // recent), and IDA's Newton iteration has not failed since (a failure on a kept matrix
+      // makes IDA cut its step and set up again: that setup evaluates). Modified Newton
+      // converges to the same solution with a kept dr/dy; it costs iterations only if the
+      // matrix is far off. Per setup this saves the elements' Jacobians (automatic
+      // differentiation), not KLU's refactorization: 9-19 % of the CPU of the shipped crash
+      // models (bench/HISTORY.md, "The Jacobian kept between setups").
+      double* values = SUNSparseMatrix_Data(matrix);
+      KeptJacobian& kept = self->kept;
+      long steps = 0, failures = 0;
+      self->check(IDAGetNumSteps(self->ida, &steps), "IDAGetNumSteps");
+      self->check(IDAGetNumNonlinSolvConvFails(self->ida, &failures), "IDAGetNumNonlinSolvConvFails");
+      if (kept.valid && steps - kept.step < self->jacobian_kept_steps && failures == kept.convergence_failures &&
+          self->system.modes().same_as(kept.modes)) {
+        self->system.add_rate_jacobian(cj - kept.cj, values);
+        kept.cj = cj;
+        ++kept.reuses;
+        return 0;
+      }
+      self->system.jacobian(t, cj, N_VGetArrayPointer(yy), N_VGetArrayPointer(ypv), values);
+      kept.valid = true;
+      kept.cj = cj;
+      kept.step = steps;
+      kept.convergence_failures = failures;
+      self->system.modes().snapshot_into(kept.modes);
       return 0;
     } catch (...) {
       self->callback_error = std::current_exception();
@@ -254,7 +292,10 @@ struct IdaIntegrator::Impl {
     check(IDAGetNumResEvals(ida, &value), "IDAGetNumResEvals");
     stats.residual_evaluations += value;
     check(IDAGetNumJacEvals(ida, &value), "IDAGetNumJacEvals");
-    stats.jacobian_evaluations += value;
+    stats.jacobian_evaluations += value - kept.reuses;  // (IDA counts every setup's call)
+    kept.reuses = 0;
+    check(IDAGetNumLinSolvSetups(ida, &value), "IDAGetNumLinSolvSetups");
+    stats.linear_setups += value;
     check(IDAGetNumNonlinSolvIters(ida, &value), "IDAGetNumNonlinSolvIters");
     stats.nonlinear_iterations += value;
     check(IDAGetNumErrTestFails(ida, &value), "IDAGetNumErrTestFails");
@@ -271,6 +312,7 @@ struct IdaIntegrator::Impl {
   void reinitialize(double t, double t_end, RunStatistics& stats, bool add_counters = true) {
     if (add_counters) accumulate(stats);
     check(IDAReInit(ida, t, y, yp), "IDAReInit");
+    kept.valid = false;
     check(IDAQuadReInit(ida, quad), "IDAQuadReInit");
     check(IDASetStopTime(ida, t_end), "IDASetStopTime");
     ++stats.reinitializations;
@@ -578,6 +620,7 @@ void IdaIntegrator::start(double t_end) {
     impl.check(IDAQuadSVtolerances(impl.ida, rtol, impl.quad_atol), "IDAQuadSVtolerances");
     impl.check(IDASetQuadErrCon(impl.ida, SUNTRUE), "IDASetQuadErrCon");
     impl.rtol = rtol;
+    impl.jacobian_kept_steps = settings_.jacobian_kept_steps;
     impl.most_turned_over = energy_scale;  // (the tolerances' energy scale: a run from rest turns over none at first)
     impl.local_errors = impl.created(N_VClone(impl.y), "N_VClone");
     impl.derivative = impl.created(N_VClone(impl.y), "N_VClone");

@@ -55,8 +55,13 @@ TEST_CASE("ida: an oscillation growing under BDF orders 3 to 5 is stopped by hol
   REQUIRE(loose.ok);
   CHECK(loose.held_at > 0.035);
   CHECK(loose.held_at < 0.045);
-  CHECK(loose.created_share > IdaIntegrator::kCreatedEnergyShare);  // measured 5.3 %: the growth is stopped there,
-  CHECK(loose.created_share < 0.1);                                 // not undone
+  // The growth is stopped there, not undone. Measured 5.3 %; 11.0 % since IDA keeps its
+  // Jacobian between setups (IdaSettings::jacobian_kept_steps): on that path the energy comes in
+  // one burst between t = 0.040 and 0.044 s, before the check after the next step of order 3
+  // or more, and none is created after the hold (energy.csv's integration_drift stays at
+  // -1.95e6 to -1.91e6 in-lbf from 0.044 s on). Without the hold the run created 98.8 %.
+  CHECK(loose.created_share > IdaIntegrator::kCreatedEnergyShare);
+  CHECK(loose.created_share < 0.2);
   // The crush is the tight run's: an independent run at rtol 1e-6, which never holds.
   const BarrierCarsRun tight = barrier_cars("1e-6", "absolute");
   INFO(tight.message);

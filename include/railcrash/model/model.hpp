@@ -162,6 +162,10 @@ class ElementStates {
     std::vector<std::max_align_t> block;
   };
   Snapshot snapshot() const { return {block_}; }
+  /// snapshot() into one already made (its storage reused).
+  void snapshot_into(Snapshot& snapshot) const { snapshot.block.assign(block_.begin(), block_.end()); }
+  /// Every element's mode and history as the snapshot holds them.
+  bool same_as(const Snapshot& snapshot) const;
   void restore(const Snapshot& snapshot);
 
  private:

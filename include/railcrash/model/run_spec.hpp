@@ -104,6 +104,10 @@ enum class PositionTolerance { Relative, Absolute };
 /// digits (the report's R2: bench/HISTORY.md, "KLU's ordering chosen by fill").
 enum class LinearOrdering { FewestEntries, Amd, Colamd };
 
+/// IDA: the steps a Jacobian serves later setups by default (simulation: jacobian_kept_steps;
+/// IdaSettings::jacobian_kept_steps; README "Jacobians kept").
+inline constexpr long kDefaultJacobianKeptSteps = 20;  // [steps]
+
 struct SimulationSettings {
   double t_end = 1.0;               // [time]
   IntegratorKind integrator = IntegratorKind::Auto;
@@ -111,6 +115,7 @@ struct SimulationSettings {
   std::optional<double> atol;       // ida: absolute tolerance on lengths [length]; default derived from the model
   PositionTolerance position_tolerance = PositionTolerance::Relative;  // ida: how positions are weighed
   LinearOrdering linear_ordering = LinearOrdering::FewestEntries;    // ida: KLU's fill-reducing ordering
+  long jacobian_kept_steps = kDefaultJacobianKeptSteps;  // [steps] ida: how long a Jacobian serves later setups (IdaSettings::jacobian_kept_steps; 0: every setup evaluates)
   double dt = 0.0;                  // euler: step [time]; 0 = 0.5 x stability limit
   double output_interval = 0.0;     // [time]; 0 = t_end / 500
   bool force_dt = false;            // euler: accept a step above the stability limit

@@ -117,6 +117,10 @@ class DaeSystem {
   const SparsePattern& pattern() const { return pattern_; }
   /// Writes the Jacobian values in pattern order (values has pattern().nonzeros() entries).
   void jacobian(double t, double cj, const double* y, const double* yp, double* values) const;
+  /// values += factor dr/dy' in pattern order: the rates' part of the Jacobian, the identity on
+  /// the position rows and the mass matrix on the velocity rows (nothing else reads y'). With
+  /// factor = cj_new - cj_old it turns jacobian(t, cj_old, ...) into jacobian(t, cj_new, ...).
+  void add_rate_jacobian(double factor, double* values) const;
 
   /// Generalized forces f(t, q, v) from gravity, loads and force elements; when penalty is
   /// given, constraints add -G^T (k Phi + c G v) and penalty_lambda receives k Phi + c G v.

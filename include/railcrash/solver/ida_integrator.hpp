@@ -43,6 +43,13 @@ struct IdaSettings {
   PositionTolerance position_tolerance = PositionTolerance::Relative;
   LinearOrdering linear_ordering = LinearOrdering::FewestEntries;  // KLU's fill-reducing ordering
   long max_steps_per_output = 500000;
+  // A Jacobian evaluated at a setup serves IDA's later setups for up to this many steps, its
+  // rates' part changed to the new cj (DaeSystem::add_rate_jacobian), while no element has
+  // changed mode and IDA's Newton iteration has not failed since (as CVODE's linear solver
+  // interface keeps its Jacobian; IDA's own evaluates one at every setup). 0: a Jacobian at
+  // every setup (simulation: jacobian_kept_steps; README "Jacobians kept"; bench/HISTORY.md,
+  // "The Jacobian kept between setups").
+  long jacobian_kept_steps = kDefaultJacobianKeptSteps;  // [steps]
   long max_steps = 10000000;  // [steps] in the whole run; the run fails (not ok) beyond
   CommonRunSettings run;      // t_end, static_equilibrium
 };

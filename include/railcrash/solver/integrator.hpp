@@ -85,7 +85,8 @@ class PhaseClock {
 struct RunStatistics {
   long steps = 0;
   long residual_evaluations = 0;   // ida: residual calls; euler: force evaluations
-  long jacobian_evaluations = 0;
+  long jacobian_evaluations = 0;   // ida: the elements' Jacobians evaluated
+  long linear_setups = 0;          // ida: Newton matrices factored (a Jacobian evaluated or kept: IdaSettings::jacobian_kept_steps)
   long nonlinear_iterations = 0;
   long error_test_failures = 0;
   long nonlinear_convergence_failures = 0;
