@@ -150,8 +150,9 @@ void ElementStates::reset() {
 }
 
 bool ElementStates::same_as(const Snapshot& snapshot) const {
-  return snapshot.block.size() == block_.size() &&
-         std::memcmp(snapshot.block.data(), block_.data(), block_.size() * sizeof(std::max_align_t)) == 0;
+  if (snapshot.block.size() != block_.size()) return false;
+  // (No element with modes: both empty, and memcmp may not be given their null data.)
+  return block_.empty() || std::memcmp(snapshot.block.data(), block_.data(), block_.size() * sizeof(std::max_align_t)) == 0;
 }
 
 void ElementStates::restore(const Snapshot& snapshot) {
