@@ -232,11 +232,14 @@ struct IdaIntegrator::Impl {
       // case: the elements' part (dr/dy) of the matrix already there is kept while it is
       // recent, no element has changed mode since (a contact's 1e9 N/m appearing is not
       // recent), and IDA's Newton iteration has not failed since (a failure on a kept matrix
-      // makes IDA cut its step and set up again: that setup evaluates). Modified Newton
-      // converges to the same solution with a kept dr/dy; it costs iterations only if the
-      // matrix is far off. Per setup this saves the elements' Jacobians (automatic
-      // differentiation), not KLU's refactorization: 9-19 % of the CPU of the shipped crash
-      // models (bench/HISTORY.md, "The Jacobian kept between setups").
+      // makes IDA cut its step and set up again: that setup evaluates). A retry that SUNDIALS'
+      // Newton solver makes within a step on an older factorization (jbad) is not told apart
+      // here and may keep it; evaluating there moved IDA's path for no gain outside the
+      // friction models (bench/HISTORY.md). Modified Newton converges to the same solution
+      // with a kept dr/dy; it costs iterations only if the matrix is far off. Per setup this
+      // saves the elements' Jacobians (automatic differentiation), not KLU's refactorization:
+      // 14-20 % of IDA's CPU on the SI multiple units, 2-13 % on the others, nothing where
+      // joints carry friction (bench/HISTORY.md, "The Jacobian kept between setups").
       double* values = SUNSparseMatrix_Data(matrix);
       KeptJacobian& kept = self->kept;
       long steps = 0, failures = 0;
