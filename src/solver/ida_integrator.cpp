@@ -227,8 +227,8 @@ struct IdaIntegrator::Impl {
     try {
       // The matrix's pattern was written when it was made, and IDA's zeroing leaves it
       // (make_klu_jacobian_matrix); the values are all written here, or kept (below).
-      // IDA calls for a setup when cj = alpha / h has moved by more than a quarter from the
-      // matrix's, after a failed step, and at every start. Only cj's part is new in the first
+      // IDA calls for a setup when cj = alpha / h has left 0.6 to 1.67 times the matrix's,
+      // after a failed step, and at every start. Only cj's part is new in the first
       // case: the elements' part (dr/dy) of the matrix already there is kept while it is
       // recent, no element has changed mode since (a contact's 1e9 N/m appearing is not
       // recent), and IDA's Newton iteration has not failed since (a failure on a kept matrix
