@@ -17,28 +17,14 @@ using namespace railcrash;
 
 namespace {
 
-struct NoSamples : RunObserver {
-  void sample(double, const double*, const double*, const double*, const double*) override {}
-};
-
-IdaSettings settings_of(const SimulationSettings& s, long kept_steps) {
-  IdaSettings ida;
-  ida.rtol = s.rtol;
-  ida.atol = s.atol;
-  ida.position_tolerance = s.position_tolerance;
-  ida.run = {s.t_end, s.static_equilibrium};
-  ida.jacobian_kept_steps = kept_steps;
-  return ida;
-}
-
+/// A run of the loaded model under IDA, as `run` makes it (make_integrator), with its Jacobian
+/// kept for kept_steps steps (simulation: jacobian_kept_steps).
 RunOutcome run_ida(const LoadedModel& loaded, long kept_steps) {
+  SimulationSettings simulation = loaded.run_spec.simulation;
+  simulation.integrator = IntegratorKind::Ida;
+  simulation.jacobian_kept_steps = kept_steps;
   DaeSystem system(loaded.model);
-  NoSamples none;
-  const SimulationSettings& s = loaded.run_spec.simulation;
-  RunOutcome outcome = IdaIntegrator(system, settings_of(s, kept_steps)).run(s.t_end, output_interval_of(s), none);
-  INFO(outcome.message);
-  REQUIRE(outcome.ok);
-  return outcome;
+  return testing::simulate(system, simulation, output_interval_of(simulation));  // (REQUIREs ok)
 }
 
 }  // namespace
