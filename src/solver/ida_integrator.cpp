@@ -107,6 +107,7 @@ struct IdaIntegrator::Impl {
   // The run in progress (IdaIntegrator::start sets them up, advance takes one step).
   double rtol = 0.0;
   long jacobian_kept_steps = 0;  // IdaSettings::jacobian_kept_steps
+  long failures_at_last_setup = 0;  // IDA's Newton failures at its last setup (since IDAReInit)
   double t_reached = 0.0;                   // IDA's last step (or restart) time
   IdaStepInterpolant interpolant{*this};  // IDA's polynomial over its last step, for the event layer
   std::vector<EventRecord> events;
@@ -245,6 +246,10 @@ struct IdaIntegrator::Impl {
       long steps = 0, failures = 0;
       self->check(IDAGetNumSteps(self->ida, &steps), "IDAGetNumSteps");
       self->check(IDAGetNumNonlinSolvConvFails(self->ida, &failures), "IDAGetNumNonlinSolvConvFails");
+      // The setup after a failed Newton iteration checks that the kept pivot order still
+      // factors this matrix soundly (klu_solver.hpp).
+      if (failures != self->failures_at_last_setup) klu_check_pivot_growth_at_next_setup(self->linear_solver);
+      self->failures_at_last_setup = failures;
       if (kept.valid && steps - kept.step < self->jacobian_kept_steps && failures == kept.convergence_failures &&
           self->system.modes().same_as(kept.modes)) {
         self->system.add_rate_jacobian(cj - kept.cj, values);
@@ -316,6 +321,7 @@ struct IdaIntegrator::Impl {
     if (add_counters) accumulate(stats);
     check(IDAReInit(ida, t, y, yp), "IDAReInit");
     kept.valid = false;
+    failures_at_last_setup = 0;  // (IDAReInit restarts IDA's counters)
     check(IDAQuadReInit(ida, quad), "IDAQuadReInit");
     check(IDASetStopTime(ida, t_end), "IDASetStopTime");
     ++stats.reinitializations;

@@ -19,6 +19,7 @@ struct KluContent {
   klu_symbolic* symbolic = nullptr;  // ordering and block triangular form, kept between restarts
   klu_numeric* numeric = nullptr;    // the last factorization
   bool first_factorize = true;       // the next setup analyses and factors afresh
+  bool check_growth = false;         // the next refactorization's pivot growth is checked
   std::vector<int> orderings;        // the fill-reducing orderings the first analysis tries: 0 AMD, 1 COLAMD
   int ordering = -1;                 // the one kept (-1: none yet)
   int size = 0;                      // rows and columns
@@ -107,13 +108,15 @@ int analyse_and_factor(KluContent& klu, double* values) {
   return klu.numeric == nullptr ? failure_flag(klu) : SUNLS_SUCCESS;
 }
 
-/// Refactors with the previous pivot order while it stays sound, judged by KLU's reciprocal
-/// pivot growth (one pass over the matrix); factors afresh when the growth exceeds 1e8 or the
-/// refactorization fails.
+/// Refactors with the previous pivot order; factors afresh when the refactorization fails
+/// (a zero pivot) or, when asked for (klu_check_pivot_growth_at_next_setup), when KLU's
+/// reciprocal pivot growth (one pass over the matrix and U) has fallen below 1e-8.
 int klu_setup(SUNLinearSolver solver, SUNMatrix matrix) {
   KluContent& klu = content_of(solver);
   const PhaseClock::Scope timed(klu.clock, Phase::LinearSetup);
   double* values = SUNSparseMatrix_Data(matrix);
+  const bool check_growth = klu.check_growth;
+  klu.check_growth = false;
   if (klu.first_factorize || klu.numeric == nullptr) {
     klu.last_flag = analyse_and_factor(klu, values);
     klu.first_factorize = klu.last_flag != SUNLS_SUCCESS;
@@ -121,8 +124,9 @@ int klu_setup(SUNLinearSolver solver, SUNMatrix matrix) {
   }
   constexpr double kSmallestReciprocalGrowth = 1e-8;
   if (klu_refactor(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
-      klu_rgrowth(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
-      klu.common.rgrowth > kSmallestReciprocalGrowth) {
+      (!check_growth ||
+       (klu_rgrowth(klu.column_start.data(), klu.row_index.data(), values, klu.symbolic, klu.numeric, &klu.common) &&
+        klu.common.rgrowth > kSmallestReciprocalGrowth))) {
     klu.last_flag = SUNLS_SUCCESS;
     return klu.last_flag;
   }
@@ -188,6 +192,8 @@ SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& colu
   solver->ops->free = &klu_free;
   return solver;
 }
+
+void klu_check_pivot_growth_at_next_setup(SUNLinearSolver solver) { content_of(solver).check_growth = true; }
 
 long klu_factor_entries(SUNLinearSolver solver) {
   const klu_numeric* numeric = content_of(solver).numeric;

@@ -14,11 +14,15 @@
 //    hold fewer entries (SUNDIALS' module uses COLAMD alone), unless one is named;
 //  - initialize keeps a symbolic analysis once made (a restart's IDAReInit would redo the
 //    ordering of a matrix whose pattern never changes);
-//  - setup refactors with the previous pivot order while KLU's reciprocal pivot growth stays
-//    above 1e-8, and factors afresh (partial pivoting) when it does not or the refactorization
-//    fails (SUNDIALS' module judges by condition estimates, which the GGL Jacobian of a crash
-//    model, mixing masses, inertias and multiplier rows over many decades, always fails: every
-//    setup paid for three factorizations);
+//  - setup refactors with the previous pivot order, and factors afresh (partial pivoting) when
+//    the refactorization fails or, at a setup the caller marks
+//    (klu_check_pivot_growth_at_next_setup: IDA's after a failed Newton iteration), when KLU's
+//    reciprocal pivot growth has fallen below 1e-8. SUNDIALS' module judges every setup by
+//    condition estimates, which the GGL Jacobian of a crash model, mixing masses, inertias and
+//    multiplier rows over many decades, always fails: every setup paid for three
+//    factorizations. The growth check at every setup, as before, never once factored afresh
+//    on any shipped model at its own settings, and cost 7 % of IDA's CPU on mu_3plus3_si
+//    (bench/HISTORY.md, "Pivot growth checked after Newton failures");
 //  - setup and solve are timed as Phase::LinearSetup and Phase::LinearSolve when the run is.
 //
 // The matrix handed to setup and solve is IDA's SUNSparseMatrix (CSC): its values are read in
@@ -45,6 +49,11 @@ enum class KluOrdering { FewestEntries, Amd, Colamd };
 /// `clock` (may be null) times setup and solve. The caller frees it with SUNLinSolFree.
 SUNLinearSolver make_klu_solver(SUNContext context, const std::vector<int>& column_start, const std::vector<int>& row_index,
                                 PhaseClock* clock, KluOrdering ordering = KluOrdering::FewestEntries);
+
+/// Asks the next setup to check the kept pivot order's growth (klu_setup) before using it.
+/// A refactorization whose pivots have grown makes an inaccurate Newton matrix, which shows as
+/// a Newton iteration that fails: the setup after one is where the check pays.
+void klu_check_pivot_growth_at_next_setup(SUNLinearSolver solver);
 
 /// The entries KLU stores for the last factorization (L, U and the off-diagonal blocks of its
 /// block triangular form); 0 before the first.

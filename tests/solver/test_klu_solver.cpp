@@ -75,7 +75,7 @@ struct Sundials {
 
 }  // namespace
 
-TEST_CASE("KLU with 32-bit indices solves, refactors, falls back to pivoting and reports singular matrices", "[klu]") {
+TEST_CASE("KLU with 32-bit indices solves, refactors, falls back to pivoting when asked to check growth and reports singular matrices", "[klu]") {
   Sundials s;
   CHECK(SUNLinSolGetType(s.solver) == SUNLINEARSOLVER_DIRECT);
   CHECK(klu_factor_entries(s.solver) == 0);  // nothing factored yet
@@ -96,10 +96,18 @@ TEST_CASE("KLU with 32-bit indices solves, refactors, falls back to pivoting and
   CHECK(s.error_of_solve(nearby, flag) < 1e-14);
 
   // A restart's initialize keeps the analysis; the pivots chosen for the first values are now
-  // tiny (pivot growth 1e12): the setup factors afresh and the solution stays accurate.
+  // tiny (pivot growth 1e12). A setup that is not asked to check the growth refactors with
+  // them, and the solution is far off; one that is asked factors afresh, and it is accurate.
   REQUIRE(SUNLinSolInitialize(s.solver) == SUNLS_SUCCESS);
   const std::array<double, 8> repivot{1e-12, 1, 1e-12, 1, 1, 1e-12, 1, 1e-12};
   s.set(repivot);
+  REQUIRE(SUNLinSolSetup(s.solver, s.matrix) == SUNLS_SUCCESS);
+  const double stale_error = s.error_of_solve(repivot, flag);
+  CHECK(stale_error > 1e-6);
+  klu_check_pivot_growth_at_next_setup(s.solver);
+  REQUIRE(SUNLinSolSetup(s.solver, s.matrix) == SUNLS_SUCCESS);
+  CHECK(s.error_of_solve(repivot, flag) < 1e-9);
+  // The request holds for one setup; the pivots it chose then serve the next refactorization.
   REQUIRE(SUNLinSolSetup(s.solver, s.matrix) == SUNLS_SUCCESS);
   CHECK(s.error_of_solve(repivot, flag) < 1e-9);
 

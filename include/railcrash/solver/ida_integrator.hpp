@@ -25,7 +25,8 @@
 //   with the old one over the rest of the step within the local tolerances (kinks), and
 //   restarts from consistent values at the event otherwise (jumps, joint failures).
 // * KLU: the symbolic analysis is kept across restarts, the pivot order across Jacobian
-//   updates while the pivot growth stays small (see ida_integrator.cpp).
+//   updates; its growth is checked at the setup after a failed Newton iteration, where a
+//   stale order would show (klu_solver.hpp).
 // * Every SUNDIALS return code is checked; failures become SolverError with the flag's name.
 //   Callbacks never let an exception into SUNDIALS: they store it and return -1.
 #pragma once
