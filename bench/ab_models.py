@@ -2,6 +2,7 @@
 """This tree's railcrash against another build on whole runs of given models, interleaved.
 
     bench/run.sh ab BASE_EXECUTABLE [--models M1,M2,...] [--repeats 9] [--options "..."]
+                                    [--new EXECUTABLE] [--new-env NAME=VALUE ...]
 
 Each model runs with BASE_EXECUTABLE and with build/railcrash in turn (base, new, base, new,
 ...), REPEATS times each, with the model's own settings (plus OPTIONS). The figure is the
@@ -70,11 +71,21 @@ def main():
     parser.add_argument("--models", default=",".join(DEFAULT_MODELS))
     parser.add_argument("--repeats", type=int, default=9)
     parser.add_argument("--options", default="", help="extra `railcrash run` options, e.g. \"--rtol 1e-4\"")
+    parser.add_argument("--new", default=os.path.join(ROOT, "build", "railcrash"),
+                        help="the new executable (default: this tree's build/railcrash)")
+    parser.add_argument("--new-env", action="append", default=[],
+                        help="NAME=VALUE set in the new runs' environment only (a scratch build's switch; "
+                             "with --new the same as the base, the switch alone is compared)")
     args = parser.parse_args()
-    new = os.path.join(ROOT, "build", "railcrash")
+    new = args.new
+    new_env = dict(os.environ)
+    for assignment in args.new_env:
+        name, _, value = assignment.partition("=")
+        new_env[name] = value
     extra = args.options.split()
     scratch = tempfile.mkdtemp(prefix="railcrash-ab-")
-    print(f"new {new} against base {args.base}; {args.repeats} interleaved pairs per model; "
+    print(f"new {new}{' with ' + ' '.join(args.new_env) if args.new_env else ''} against base {args.base}; "
+          f"{args.repeats} interleaved pairs per model; "
           f"load average before: {os.getloadavg()[0]:.2f}")
     print("| model | base CPU s (median) | new CPU s (median) | new / base | per-pair range | outputs |")
     print("|---|---|---|---|---|---|")
@@ -84,7 +95,8 @@ def main():
         outs = {which: os.path.join(scratch, which) for which in times}
         for _ in range(args.repeats):
             for which, executable in (("base", args.base), ("new", new)):
-                cpu, _ = run_timed([executable, "run", path, "--out", outs[which], "--quiet"] + extra)
+                cpu, _ = run_timed([executable, "run", path, "--out", outs[which], "--quiet"] + extra,
+                                   env=new_env if which == "new" else None)
                 times[which].append(cpu)
         ratios = sorted(n / b for b, n in zip(times["base"], times["new"]))
         base, new_median = statistics.median(times["base"]), statistics.median(times["new"])

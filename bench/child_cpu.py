@@ -3,13 +3,13 @@ import resource
 import subprocess
 
 
-def run_timed(command):
-    """Runs command (a list); returns (CPU seconds, user + system, of that process; its CompletedProcess).
+def run_timed(command, env=None):
+    """Runs command (a list; env: its environment, None for this one's); returns (CPU seconds, user + system, of that process; its CompletedProcess).
 
     The kernel's accounting of the child: other work on the machine does not inflate it the
     way it inflates wall time. Raises RuntimeError naming the command when it fails."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    finished = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    finished = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if finished.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} failed ({finished.returncode}): {finished.stderr.strip()}")
