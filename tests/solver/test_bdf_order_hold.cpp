@@ -55,13 +55,12 @@ TEST_CASE("ida: an oscillation growing under BDF orders 3 to 5 is stopped by hol
   REQUIRE(loose.ok);
   CHECK(loose.held_at > 0.035);
   CHECK(loose.held_at < 0.045);
-  // The growth is stopped there, not undone. Measured 5.3 %; 11.0 % since IDA keeps its
-  // Jacobian between setups (IdaSettings::jacobian_kept_steps): on that path the energy comes in
-  // one burst between t = 0.040 and 0.044 s, before the check after the next step of order 3
-  // or more, and none is created after the hold (energy.csv's integration_drift stays at
-  // -1.95e6 to -1.91e6 in-lbf from 0.044 s on). Without the hold the run created 98.8 %.
+  // The growth is stopped at the first check past the threshold, not undone; a burst between
+  // two checks overshoots it: measured 3.85 % against the 2 % threshold. With the threshold at
+  // 5 %, as first set, the run created 11.0 %, in one burst between t = 0.040 and 0.044 s.
+  // Without the hold it created 98.8 %.
   CHECK(loose.created_share > IdaIntegrator::kCreatedEnergyShare);
-  CHECK(loose.created_share < 0.2);
+  CHECK(loose.created_share < 2.5 * IdaIntegrator::kCreatedEnergyShare);
   // The crush is the tight run's: an independent run at rtol 1e-6, which never holds.
   const BarrierCarsRun tight = barrier_cars("1e-6", "absolute");
   INFO(tight.message);
