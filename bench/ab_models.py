@@ -80,7 +80,9 @@ def main():
     new = args.new
     new_env = dict(os.environ)
     for assignment in args.new_env:
-        name, _, value = assignment.partition("=")
+        name, equals, value = assignment.partition("=")
+        if not name or not equals:
+            parser.error(f"--new-env {assignment!r}: give NAME=VALUE")
         new_env[name] = value
     extra = args.options.split()
     scratch = tempfile.mkdtemp(prefix="railcrash-ab-")
