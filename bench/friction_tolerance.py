@@ -24,7 +24,7 @@ RTOLS = ["1e-2", "3e-3", "1e-3", "1e-4"]
 def guide_friction_variant(path):
     with open(os.path.join(ROOT, "models/examples/emu3_wall.yaml")) as f:
         text = f.read()
-    text, count = re.subn(r"(name: (?:front|rear)_guide, type: slider_joint,)", r"\1 friction: 0.2, slider_length: 0.6,", text)
+    text, count = re.subn(r"(name: (?:front|rear)_guide, type: slider_joint,)", r"\1 friction: 0.2, friction_velocity: 0.01, slider_length: 0.6,", text)
     assert count == 4, count
     with open(path, "w") as f:
         f.write(text)

@@ -168,7 +168,7 @@ std::vector<ParameterSpec> contact_law_specs(std::vector<ParameterSpec> surface)
       {"damping", Unit::ForceTimePerLength, default_value(0.0), Range::NonNegative,
        "normal damping c (the force never pulls)"},
       {"friction", Unit::Dimensionless, default_value(0.0), Range::NonNegative, "friction coefficient mu"},
-      {"friction_velocity", Unit::Velocity, default_value(0.01), Range::Positive,
+      {"friction_velocity", Unit::Velocity, default_velocity(0.01), Range::Positive,
        "slip speed over which the friction builds up (tanh(v_t / friction_velocity))"}};
   all.insert(all.end(), surface.begin(), surface.end());
   return all;

@@ -896,7 +896,7 @@ void Coupling::outputs(const ElementState<double>& s, const double*, double* out
 namespace {
 
 ParameterSpec friction_velocity_spec() {
-  return {"friction_velocity", Unit::Velocity, default_value(0.01), Range::Positive,
+  return {"friction_velocity", Unit::Velocity, default_velocity(0.01), Range::Positive,
           "vertical sliding speed over which the friction builds up (tanh(v / friction_velocity))"};
 }
 

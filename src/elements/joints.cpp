@@ -127,7 +127,9 @@ ParameterSpec axis_spec() {
 }
 
 ParameterSpec friction_velocity_spec(Unit unit) {
-  return {"friction_velocity", unit, default_value(0.01), Range::Positive,
+  // A slip speed is the same in both unit systems (0.01 in/s = 2.54e-4 m/s); an angular one, in
+  // rad/s, is already.
+  return {"friction_velocity", unit, unit == Unit::Velocity ? default_velocity(0.01) : default_value(0.01), Range::Positive,
           "relative speed over which the friction builds up (tanh(v / friction_velocity))"};
 }
 

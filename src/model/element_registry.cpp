@@ -67,19 +67,27 @@ const char* range_text(Range range) {
   return "";
 }
 
-const Presence required{Presence::Required, 0.0, ""};
+const Presence required{Presence::Required, 0.0, "", std::nullopt};
 
-Presence optional(std::string when_absent) { return {Presence::Optional, 0.0, std::move(when_absent)}; }
+Presence optional(std::string when_absent) { return {Presence::Optional, 0.0, std::move(when_absent), std::nullopt}; }
 
 Presence default_value(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", value);
-  return {Presence::Default, value, text};
+  return {Presence::Default, value, text, std::nullopt};
 }
 
-Presence default_flag(bool value) { return {Presence::Default, value ? 1.0 : 0.0, value ? "true" : "false"}; }
+Presence default_velocity(double inches_per_second) {
+  const double metres_per_second = inches_per_second * metres_per_length_unit(UnitSystem::InLbfS);
+  char text[128];
+  std::snprintf(text, sizeof text, "%g in/s (in-lbf-s), %g m/s (SI), %g mm/s (mm-t-s-N): one speed", inches_per_second,
+                metres_per_second, 1e3 * metres_per_second);
+  return {Presence::Default, inches_per_second, text, metres_per_second};
+}
 
-Presence default_word(std::string word) { return {Presence::Default, 0.0, std::move(word)}; }
+Presence default_flag(bool value) { return {Presence::Default, value ? 1.0 : 0.0, value ? "true" : "false", std::nullopt}; }
+
+Presence default_word(std::string word) { return {Presence::Default, 0.0, std::move(word), std::nullopt}; }
 
 const ParameterSpec* ElementType::find(const std::string& key) const {
   for (const ParameterSpec& spec : parameters)
@@ -149,7 +157,7 @@ void ParameterReader::check_range(const ParameterSpec& spec, double value) const
 std::optional<double> ParameterReader::number(const std::string& key) {
   const ParameterSpec& spec = declared(key, Shape::Number);
   const std::optional<double> given = given_number(key);
-  if (!given) return spec.presence.kind == Presence::Default ? std::optional<double>(spec.presence.value) : std::nullopt;
+  if (!given) return spec.presence.kind == Presence::Default ? std::optional<double>(spec.presence.value_in(units_)) : std::nullopt;
   check_range(spec, *given);
   return given;
 }

@@ -228,7 +228,9 @@ Json parameter_schema(const ParameterSpec& spec) {
       } else {
         j = number(description, spec.range);
       }
-      if (spec.presence.kind == Presence::Default) j.set("default", Json::number(spec.presence.value));
+      // (A default that depends on the unit system is given in the description alone.)
+      if (spec.presence.kind == Presence::Default && !spec.presence.si_value)
+        j.set("default", Json::number(spec.presence.value));
       break;
     case Shape::Pair: j = pair(description, spec.range); break;
     case Shape::Table: j = table(description, spec.range); break;

@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -79,8 +80,8 @@ std::string location_of(const std::string& text, const std::string& key) {
 /// Serves an element's parameters from a YAML map and records every key the factory asks for.
 class RecordingReader : public ParameterReader {
  public:
-  RecordingReader(const ElementType& type, YAML::Node parameters)
-      : ParameterReader(type, UnitSystem::SI), parameters_(parameters) {}
+  RecordingReader(const ElementType& type, YAML::Node parameters, UnitSystem units = UnitSystem::SI)
+      : ParameterReader(type, units), parameters_(parameters) {}
   std::set<std::string> asked;
 
   [[noreturn]] void fail(const std::string& key, const std::string& what_to_change) const override {
@@ -274,4 +275,53 @@ TEST_CASE("the reader refuses undeclared keys and wrong shapes, and hands out de
   CHECK(empty_anticlimber.word("interlock_while_unloading") == std::string("hold"));
   RecordingReader given_pin(pin, YAML::Load("{friction_velocity: 0.5}"));
   CHECK(given_pin.value("friction_velocity") == 0.5);
+}
+
+TEST_CASE("a dimensional default is one physical value in every unit system", "[registry][units]") {
+  // friction_velocity's 0.01 once applied in the model's own units: 0.01 in/s in an in-lbf-s
+  // model, 0.01 m/s (39 times faster) in SI, so the same model regularized its friction
+  // differently when written in SI. Every default with a unit is now zero, an angle (rad in
+  // both) or given per unit system.
+  int per_unit_system = 0;
+  for (const std::string& name : ElementRegistry::instance().types()) {
+    const ElementType& type = *ElementRegistry::instance().find(name);
+    for (const ParameterSpec& spec : type.parameters) {
+      INFO(name << "." << spec.name);
+      if (spec.presence.kind != Presence::Default || spec.shape != Shape::Number) continue;
+      const bool same_in_both = spec.unit == Unit::Dimensionless || spec.unit == Unit::Angle ||
+                                spec.unit == Unit::AngularVelocity || spec.unit == Unit::Choice;
+      if (same_in_both || spec.presence.value == 0.0) {
+        CHECK(!spec.presence.si_value);
+        continue;
+      }
+      REQUIRE(spec.presence.si_value);
+      REQUIRE(spec.unit == Unit::Velocity);  // the only kind with a per-unit default so far
+      CHECK(*spec.presence.si_value == Approx(spec.presence.value * metres_per_length_unit(UnitSystem::InLbfS)).epsilon(1e-15));
+      RecordingReader in_inches(type, YAML::Load("{}"), UnitSystem::InLbfS), in_si(type, YAML::Load("{}"), UnitSystem::SI);
+      CHECK(in_inches.value(spec.name) == 0.01);  // the in-lbf-s models' value, the report's reading
+      CHECK(in_si.value(spec.name) == Approx(2.54e-4).epsilon(1e-15));
+      ++per_unit_system;
+    }
+  }
+  CHECK(per_unit_system == 5);  // friction_velocity of contact, wheel_rail, coupler_end, coupling, slider_joint
+}
+
+TEST_CASE("a friction element left at its default slip speed regularizes alike in SI, mm-t-s-N and in-lbf-s", "[registry][units]") {
+  // The same block on the same slider, written three ways: the element's slip speed, in m/s,
+  // must not depend on the units the file was written in.
+  const auto slip_speed_in_metres_per_second = [](const std::string& units, double length) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "railcrash: 1\nname: slide\nunits: " << units << "\ngravity: [0, 0]\nbodies:\n"
+      << "  - {name: block, mass: 1, inertia: 1, position: [0, 0]}\n"
+      << "elements:\n  - {name: guide, type: slider_joint, axis: [1, 0], friction: 0.3, slider_length: " << 0.5 * length
+      << ", points: [{body: ground, at: [0, 0]}, {body: block, at: [0, 0]}]}\n"
+      << "simulation: {t_end: 0.1}\n";
+    const Model model = testing::model_from_text(s.str());
+    return model.elements()[0]->friction_slip_velocity() * metres_per_length_unit(model.units);
+  };
+  const double si = slip_speed_in_metres_per_second("SI", 1.0);
+  CHECK(si == Approx(2.54e-4).epsilon(1e-12));
+  CHECK(slip_speed_in_metres_per_second("mm-t-s-N", 1e3) == Approx(si).epsilon(1e-12));
+  CHECK(slip_speed_in_metres_per_second("in-lbf-s", 1.0 / 0.0254) == Approx(si).epsilon(1e-12));
 }

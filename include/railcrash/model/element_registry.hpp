@@ -56,14 +56,22 @@ enum class Shape { Number, Pair /* [a, b] */, Table /* [[a, b], ...] */, Flag, W
 /// Whether a parameter must be given, and what applies when it is not.
 struct Presence {
   enum Kind { Required, Optional, Default } kind = Required;
-  double value = 0.0;       // Default: the value applied (a number; a flag as 0 / 1)
+  double value = 0.0;       // Default: the value applied (a number; a flag as 0 / 1); in-lbf-s where si_value is set
   std::string text;         // Optional: what its absence means; Default: the value as written
+  std::optional<double> si_value;  // Default: the value applied in an SI (or mm-t-s-N) model, where it differs
+  /// The default in a model of unit system `units`.
+  double value_in(UnitSystem units) const { return units == UnitSystem::SI && si_value ? *si_value : value; }
 };
 extern const Presence required;
 /// Absent means `when_absent` (e.g. "the initial length", "no fracture"); the factory decides.
 Presence optional(std::string when_absent);
 /// Absent means `value` (the reader hands it out).
 Presence default_value(double value);
+/// A velocity's default: `inches_per_second` in an in-lbf-s model, the same speed in m/s in an
+/// SI model (and so in an mm-t-s-N one, read into SI). A plain default_value of a dimensional
+/// quantity would mean a speed 39 times larger in SI than in inches: the same physical model
+/// would behave differently with its units.
+Presence default_velocity(double inches_per_second);
 Presence default_flag(bool value);
 Presence default_word(std::string word);
 
