@@ -6,11 +6,13 @@ Runs every model of models/examples, models/scenarios, the report's cars, the ba
 robustness model IDA fails on, under the model's own integrator and under Euler, with both
 executables, and compares every file of the two folders byte for byte, apart from:
   - the provenance comment line of the CSV files ("# railcrash provenance ...");
-  - summary.json's provenance, run_id and stats.wall_seconds (and any stats entry named *seconds*);
+  - summary.json's provenance, run_id and stats.wall_seconds (and any stats entry named *seconds*),
+    and the stats entries named by --ignore-stat (a statistic the new build adds);
   - model.json's provenance, if any.
 Exit codes and the first line of stderr must agree too (a failed run must fail the same way).
 
     bench/same_outputs.py OLD_BINARY NEW_BINARY [--jobs 2] [--extra "--format hdf5"] [--only PATTERN]
+                          [--ignore-stat NAME ...]
 
 Prints one line per run and a final count; exits 1 if any run differs.
 """
@@ -26,6 +28,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+IGNORED_STATS = []  # --ignore-stat
 
 
 def models():
@@ -49,7 +52,7 @@ def normalized(path):
                 data.pop(key, None)
             stats = data.get("stats")
             if isinstance(stats, dict):
-                for key in [k for k in stats if "seconds" in k]:
+                for key in [k for k in stats if "seconds" in k or k in IGNORED_STATS]:
                     stats.pop(key)
         return json.dumps(data, sort_keys=True).encode()
     with open(path, "rb") as f:
@@ -119,7 +122,9 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--extra", default="", help="more arguments for every run, e.g. \"--format hdf5\"")
     ap.add_argument("--only", default="", help="only models whose path contains this")
+    ap.add_argument("--ignore-stat", action="append", default=[], help="a summary.json stats entry left out of the comparison")
     args = ap.parse_args()
+    IGNORED_STATS.extend(args.ignore_stat)
     old, new = os.path.abspath(args.old), os.path.abspath(args.new)
     extra = shlex.split(args.extra)
     cases = [(m, i) for m in models() if args.only in m for i in ("", "euler")]

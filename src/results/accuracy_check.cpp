@@ -25,6 +25,7 @@ AccuracyFacts accuracy_facts(const RunOutcome& outcome, const std::string& integ
   facts.euler_step = outcome.stats.euler_step > 0.0 ? outcome.stats.euler_step : outcome.stats.last_step;
   facts.euler_from = outcome.stats.handed_over_at;
   facts.ida_took_back_at = outcome.stats.handed_back_at;
+  facts.origin_distance_in_sizes = outcome.stats.origin_distance_in_sizes;
   return facts;
 }
 
@@ -72,6 +73,16 @@ std::vector<std::string> accuracy_warnings(const AccuracyFacts& facts) {
     std::snprintf(text, sizeof text, "joints open by up to %.3g %s at the output samples (more than %.3g %s): ",
                   facts.max_constraint_residual, si ? "m" : "in", limit, si ? "m" : "in");
     warnings.push_back(text + remedy(facts));
+  }
+  if (facts.origin_distance_in_sizes > kOriginDistanceLimit) {
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "the model sits %.3g times its own size from its origin (more than %.3g): IDA's relative position "
+                  "tolerance, rtol |q| + atol, grows with that distance and holds its positions that much more loosely "
+                  "than at the origin: set simulation.position_tolerance: absolute (--set "
+                  "simulation.position_tolerance=absolute), or move the model to its origin",
+                  facts.origin_distance_in_sizes, kOriginDistanceLimit);
+    warnings.push_back(text);
   }
   return warnings;
 }

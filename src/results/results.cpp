@@ -580,6 +580,7 @@ std::string ResultWriter::summary_text(const RunOutcome& outcome, const std::str
   if (s.newton_iterations_raised_at >= 0.0)
     j << ", \"newton_iterations_raised_at\": " << json_number(s.newton_iterations_raised_at);
   if (s.bdf_order_held_at >= 0.0) j << ", \"bdf_order_held_at\": " << json_number(s.bdf_order_held_at);
+  if (s.origin_distance_in_sizes > 0.0) j << ", \"origin_distance_in_sizes\": " << json_number(s.origin_distance_in_sizes);
   if (s.phases_timed) {  // (--timings) exclusive wall seconds per phase, adding up to wall_seconds
     j << ", \"seconds\": {";
     for (int p = 0; p < kPhaseCount; ++p)

@@ -504,6 +504,12 @@ void IdaIntegrator::start(double t_end) {
   // 2.3 % of the energy and 2.4 % of the largest crush (bench/HISTORY.md, "Positions held to
   // an absolute tolerance").
   const double position_rtol = absolute_positions ? 0.0 : rtol;
+  if (!absolute_positions) {  // (for the run's accuracy warnings: accuracy_check.hpp)
+    double farthest = model.length_scale();  // [length]
+    for (int i = 0; i < model.body_count(); ++i)
+      farthest = std::max({farthest, std::abs(y0[static_cast<std::size_t>(3 * i)]), std::abs(y0[static_cast<std::size_t>(3 * i + 1)])});
+    stats().origin_distance_in_sizes = farthest / model.origin_free_length_scale();
+  }
   double atol_length = 0.1 * rtol * length;
   if (settings_.atol) {
     atol_length = *settings_.atol;

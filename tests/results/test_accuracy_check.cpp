@@ -107,6 +107,16 @@ TEST_CASE("accuracy warnings fire past the stated limits and name what to change
   REQUIRE(w.size() == 1);
   CHECK(contains(w[0], "--rtol"));
   CHECK_FALSE(contains(w[0], "--dt"));
+
+  // IDA's relative position tolerance on a model far from its origin: at 10 of its sizes not yet
+  facts.max_constraint_residual = 0.0;
+  facts.origin_distance_in_sizes = 10.0;
+  CHECK(accuracy_warnings(facts).empty());
+  facts.origin_distance_in_sizes = 84.2;
+  w = accuracy_warnings(facts);
+  REQUIRE(w.size() == 1);
+  CHECK(contains(w[0], "sits 84.2 times its own size from its origin (more than 10)"));
+  CHECK(contains(w[0], "--set simulation.position_tolerance=absolute"));
 }
 
 TEST_CASE("a user's SI unit run by Euler's default step is warned about and the same run by IDA is not",

@@ -8,8 +8,10 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "railcrash/model/model_io.hpp"
+#include "railcrash/results/accuracy_check.hpp"
 #include "railcrash/results/run.hpp"
 #include "support.hpp"
 
@@ -34,12 +36,15 @@ std::string oscillator(double offset, const char* position_tolerance) {
 struct Oscillation {
   long steps = 0;
   double error = 0.0;  // [m] |x(t_end) - exact|
+  double origin_distance_in_sizes = 0.0;  // RunStatistics'
+  std::vector<std::string> warnings;      // the run's accuracy warnings
 };
 
 Oscillation oscillate(double offset, const char* position_tolerance) {
   const LoadedModel loaded = testing::loaded_from_text(oscillator(offset, position_tolerance));
   const RunOutcome outcome = testing::simulate(loaded, 0.5);
-  return {outcome.stats.steps, std::abs(outcome.y[0] - (offset + 1.0 + 0.01 * std::cos(100.0 * 0.5)))};
+  return {outcome.stats.steps, std::abs(outcome.y[0] - (offset + 1.0 + 0.01 * std::cos(100.0 * 0.5))),
+          outcome.stats.origin_distance_in_sizes, accuracy_warnings(accuracy_facts(outcome, "ida", UnitSystem::SI))};
 }
 
 double largest_crush(const LoadedModel& loaded) {
@@ -68,6 +73,18 @@ TEST_CASE("position_tolerance: absolute holds positions alike wherever the model
   CHECK(near_absolute.error < 1e-6);
   CHECK(far_relative.steps < near_relative.steps / 2);
   CHECK(far_relative.error > 10.0 * far_absolute.error);
+  // The relative run 10 km out says so (the spring and its mass span 1.01 m: 9,900 sizes from
+  // the origin); the runs at the origin and the absolute one say nothing.
+  CHECK(near_relative.origin_distance_in_sizes == Approx(1.0));
+  CHECK(far_relative.origin_distance_in_sizes == Approx((1.0e4 + 1.01) / 1.01).epsilon(1e-9));
+  CHECK(far_absolute.origin_distance_in_sizes == 0.0);
+  CHECK(near_relative.warnings.empty());
+  CHECK(near_absolute.warnings.empty());
+  CHECK(far_absolute.warnings.empty());
+  // (It also lost 2.5 % of its energy: that warning comes first.)
+  REQUIRE(!far_relative.warnings.empty());
+  CHECK_THAT(far_relative.warnings.back(), Catch::Contains("sits 9.9e+03 times its own size from its origin") &&
+                                               Catch::Contains("position_tolerance: absolute"));
 }
 
 TEST_CASE("position_tolerance: absolute gets a 3+3-car unit's largest crush to 0.5 % at rtol 1e-3", "[solver][ida]") {

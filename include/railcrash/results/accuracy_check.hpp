@@ -11,7 +11,8 @@
 //     counts at its bodies' size, DaeSystem::constraint_row_length): with Euler it is how far
 //     its penalty springs let the joints open.
 // A run is warned about when the share exceeds kEnergyShareLimit or the residual exceeds
-// kConstraintResidualLimit. The limits are stated, not tuned to pass: on the report's models
+// kConstraintResidualLimit, and (a setting, not a measure) when IDA held its positions to the
+// relative tolerance on a model farther from its origin than kOriginDistanceLimit times its size. The limits are stated, not tuned to pass: on the report's models
 // (in-lbf-s) Euler at the printed step turns 0.015-0.087 % and opens joints by at most
 // 0.015 mm; on the SI example models its default step creates 2.9-9.9 % and opens joints by
 // 6 to 68 mm (bench/accuracy_warnings.py prints these figures; README "Accuracy warnings").
@@ -27,6 +28,13 @@ struct RunOutcome;
 
 constexpr double kEnergyShareLimit = 0.01;          // [-] of the energy turned over
 constexpr double kConstraintResidualLimit = 1.0e-3;  // [m] (converted to the model's length unit)
+// IDA's relative position tolerance, rtol |q| + atol (atol 0.1 rtol L), grows with the
+// distance of the model from its origin: past this many times its own size, the run says so.
+// mu_3plus3_si (120 m) at its own rtol 1e-5 moved 10 km along x (84 sizes) ends its largest
+// crush 9.1e-4 short of the rtol 1e-9 run, 100 km along (838 sizes) 1.3e-3, at the origin
+// 3.7e-4 and 1 km along (8.9 sizes) 4.3e-4; the absolute form 0.9-1.1e-4 at every distance
+// (bench/position_origin.py).
+constexpr double kOriginDistanceLimit = 10.0;  // [model sizes]
 
 /// summary.json's relative_balance_error: the energy the integration gained (error()) over the
 /// energy turned over, at the end or the most at any output sample (most_turned_over,
@@ -44,6 +52,7 @@ struct AccuracyFacts {
   double euler_step = 0.0;                // [s] its step, when euler_ran
   double ida_took_back_at = -1.0;         // [s] auto: IDA took the run back from Euler then (-1: it did not)
   double euler_from = -1.0;               // [s] auto: Euler's part began then (-1: Euler ran all the run)
+  double origin_distance_in_sizes = 0.0;  // [-] IDA's relative position tolerance: RunStatistics' figure
 };
 
 /// The facts of a finished run; `integrator` is the method the run was set to ("ida", "euler"

@@ -106,6 +106,10 @@ struct RunStatistics {
   double euler_step = 0.0;           // [time] euler, or auto's Euler part: its step (0: Euler took none)
   double newton_iterations_raised_at = -1.0;  // [time] ida: where a Newton failure raised IDA's iterations per step from 4 (-1: never)
   double bdf_order_held_at = -1.0;  // [time] ida: where the energy the integration created held IDA's BDF order to 2 (-1: never)
+  // ida, relative position tolerance: how far the model sits from its origin, in its own size
+  // (the relative form's length scale, or its farthest body coordinate at t = 0, over the box
+  // around its bodies and ground points); 0 under the absolute form (README "Position tolerances").
+  double origin_distance_in_sizes = 0.0;
   std::string hand_over_reason;      // integrator auto: why it did, or why IDA kept the run ("" before the run ends)
   bool phases_timed = false;         // the run was timed by phase (Integrator::time_phases)
   std::array<double, kPhaseCount> phase_seconds{};  // [s] wall time per Phase, when timed
