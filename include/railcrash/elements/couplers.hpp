@@ -412,7 +412,7 @@ class CouplerEnd : public HybridElement<CouplerEnd> {
   std::array<double, 2> coupler_height;        // [length] face height, end K, end L
   double total_horizontal_slack = 0.0;         // [length] knuckle free play (coupled only)
   double friction = 0.0;                       // [-] mu between the faces
-  double friction_velocity = 0.01;             // [length/time] v_f
+  double friction_velocity = 0.01;             // [length/time] v_f (as read: 0.01 in/s or 2.54e-4 m/s by default)
   double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
   bool coupled = false;                        // knuckles carry draft
   double restitution = 1.0;                    // [-] e of the buff contact, 0 < e <= 1
@@ -506,7 +506,7 @@ class Coupling : public HybridElement<Coupling> {
   double vertical_stiffness = 0.0;    // [force/length] once the vertical slack is taken up
   double misalignment = 0.0;          // [length] vertical offset of head L above head K with the points level
   double friction = 0.0;              // [-] mu between the heads
-  double friction_velocity = 0.01;    // [length/time] v_f
+  double friction_velocity = 0.01;    // [length/time] v_f (as read: 0.01 in/s or 2.54e-4 m/s by default)
   double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
   std::optional<double> free_length;  // [length] spacing at the centre of the slack; default: initial
 

@@ -26,7 +26,8 @@
 //                 N = sqrt(Rn^2 + (2 M / l)^2) combines the normal reaction Rn and the
 //                 moment M of the angle lock carried by the slider's two ends l apart
 //                 (`friction` mu, `slider_length` l [length], `friction_velocity` v_f
-//                 [length/time], default 0.01), v_rel the slip of P2 along a relative to body 1.
+//                 [length/time], default 0.01 in/s = 2.54e-4 m/s), v_rel the slip of P2 along a
+//                 relative to body 1.
 // |R| and N are evaluated as sqrt(x^2 + 1e-30) so their derivative exists at zero load.
 #pragma once
 
@@ -105,7 +106,7 @@ class SliderJoint : public ConstraintElement<SliderJoint>, public AngleLockingJo
   double axis_x, axis_y;            // unit sliding direction in body 1's frame
   double friction = 0.0;            // [-] mu
   double slider_length = 1.0;       // [length] l
-  double friction_velocity = 0.01;  // [length/time] v_f
+  double friction_velocity = 0.01;  // [length/time] v_f (as read: default_velocity(0.01), one speed in every unit system)
   double friction_slip_velocity() const override { return friction > 0.0 ? friction_velocity : 0.0; }
   template <class T>
   void constraint_law(const std::array<Pose<T>, 2>& q, T* phi) const {
