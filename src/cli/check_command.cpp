@@ -8,7 +8,7 @@
 #include "common.hpp"
 #include "railcrash/model/model_io.hpp"
 #include "railcrash/solver/dae_system.hpp"
-#include "railcrash/solver/euler_integrator.hpp"
+#include "railcrash/solver/stability_limit.hpp"
 #include "railcrash/solver/initial_conditions.hpp"
 
 namespace railcrash::cli {
@@ -84,7 +84,7 @@ int check_model(const std::string& path, const std::vector<std::string>& setting
   bool all_inertia = true;
   for (const Body& b : model.bodies()) all_inertia = all_inertia && b.inertia > 0.0;
   if (all_inertia) {
-    const double limit = EulerIntegrator::estimate_stability_limit(system, y, nullptr);
+    const double limit = explicit_stability_limit(system, y, nullptr);
     std::printf("euler      stability limit of the elements alone: dt < %.4g (joints add penalty springs)\n", limit);
   }
   const SimulationSettings& simulation = loaded.run_spec.simulation;

@@ -1,7 +1,5 @@
 #include "railcrash/solver/euler_integrator.hpp"
 
-#include <Eigen/Dense>
-#include <Eigen/SparseCore>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +7,7 @@
 
 #include "railcrash/solver/event_loop.hpp"
 #include "railcrash/solver/initial_conditions.hpp"
+#include "railcrash/solver/stability_limit.hpp"
 
 namespace railcrash {
 
@@ -16,53 +15,7 @@ namespace {
 
 constexpr double kPenaltyStepAngle = 0.4;  // penalty circular frequency times dt
 
-/// Largest eigenvalue of the symmetric part of M^-1/2 A M^-1/2 (exact for small systems,
-/// a Gershgorin upper bound otherwise).
-double largest_scaled_eigenvalue(const std::vector<DaeSystem::Triplet>& a, const Eigen::VectorXd& inv_root_mass) {
-  const int n = static_cast<int>(inv_root_mass.size());
-  if (n <= 600) {
-    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
-    for (const auto& t : a) dense(t.row, t.col) += t.value;
-    dense = 0.5 * (dense + dense.transpose()).eval();
-    dense = inv_root_mass.asDiagonal() * dense * inv_root_mass.asDiagonal();
-    if (n == 0) return 0.0;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(dense, Eigen::EigenvaluesOnly);
-    return std::max(0.0, eigen.eigenvalues().maxCoeff());
-  }
-  Eigen::SparseMatrix<double> sparse(n, n);
-  std::vector<Eigen::Triplet<double>> entries;
-  for (const auto& t : a) {
-    const double v = 0.5 * t.value * inv_root_mass[t.row] * inv_root_mass[t.col];
-    entries.emplace_back(t.row, t.col, v);
-    entries.emplace_back(t.col, t.row, v);
-  }
-  sparse.setFromTriplets(entries.begin(), entries.end());
-  double bound = 0.0;
-  for (int k = 0; k < sparse.outerSize(); ++k) {
-    double row_sum = 0.0;
-    for (Eigen::SparseMatrix<double>::InnerIterator it(sparse, k); it; ++it) row_sum += std::abs(it.value());
-    bound = std::max(bound, row_sum);
-  }
-  return bound;
-}
-
 }  // namespace
-
-double EulerIntegrator::estimate_stability_limit(const DaeSystem& system, const std::vector<double>& y,
-                                                 const PenaltyRows* penalty) {
-  const int nq = system.body_unknowns();
-  Eigen::VectorXd inv_root_mass(nq);
-  for (int k = 0; k < nq; ++k) inv_root_mass[k] = 1.0 / std::sqrt(system.mass_diagonal(k));
-  std::vector<DaeSystem::Triplet> df_dq, df_dv;
-  system.force_jacobian(0.0, y.data(), y.data() + nq, penalty, df_dq, df_dv, /*stiffest=*/true);
-  for (auto& t : df_dq) t.value = -t.value;  // K = -df/dq
-  for (auto& t : df_dv) t.value = -t.value;  // C = -df/dv
-  const double omega_squared = largest_scaled_eigenvalue(df_dq, inv_root_mass);
-  const double damping_rate = largest_scaled_eigenvalue(df_dv, inv_root_mass);
-  const double omega = std::sqrt(omega_squared);
-  const double denominator = std::sqrt(omega * omega + 0.25 * damping_rate * damping_rate) + 0.5 * damping_rate;
-  return denominator > 0.0 ? 2.0 / denominator : std::numeric_limits<double>::infinity();
-}
 
 PenaltyRows EulerIntegrator::make_penalty(const DaeSystem& system, const Element::PenaltyOverrides& global, double dt) {
   const int m = system.constraint_rows();
@@ -127,16 +80,16 @@ EulerIntegrator::Step EulerIntegrator::choose_step(const DaeSystem& system, cons
     // Before penalties sized for a dt that cannot run.
     throw_if(step_count_problem(system.model(), settings.run.t_end, step.dt, settings.max_steps, 0.0));
     step.penalty = make_penalty(system, settings.penalty, step.dt);
-    step.stability_limit = estimate_stability_limit(system, y, &step.penalty);
+    step.stability_limit = explicit_stability_limit(system, y, &step.penalty);
     return step;
   }
   // Automatic: half the limit of the elements alone, then penalties for that step; shrink
   // once more if the penalties lowered the limit.
-  const double physical_limit = estimate_stability_limit(system, y, nullptr);
+  const double physical_limit = explicit_stability_limit(system, y, nullptr);
   step.dt = std::isfinite(physical_limit) ? 0.5 * physical_limit : 1e-3 * settings.run.t_end;
   for (int pass = 0; pass < 20; ++pass) {
     step.penalty = make_penalty(system, settings.penalty, step.dt);
-    step.stability_limit = estimate_stability_limit(system, y, &step.penalty);
+    step.stability_limit = explicit_stability_limit(system, y, &step.penalty);
     if (step.dt <= 0.8 * step.stability_limit) break;
     step.dt = 0.5 * step.stability_limit;
   }

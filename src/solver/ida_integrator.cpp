@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "klu_solver.hpp"
-#include "railcrash/solver/euler_integrator.hpp"  // (its stability limit: the model's highest frequency)
+#include "railcrash/solver/stability_limit.hpp"  // (the model's highest frequency: the absolute position tolerance)
 #include "railcrash/solver/event_loop.hpp"
 #include "railcrash/solver/events.hpp"
 #include "railcrash/solver/initial_conditions.hpp"
@@ -514,7 +514,7 @@ void IdaIntegrator::start(double t_end) {
   if (settings_.atol) {
     atol_length = *settings_.atol;
   } else if (absolute_positions) {
-    const double stable_step = EulerIntegrator::estimate_stability_limit(system_, y0, nullptr);  // 2 / omega [time]
+    const double stable_step = explicit_stability_limit(system_, y0, nullptr);  // 2 / omega [time]
     if (std::isfinite(stable_step) && stable_step > 0.0) atol_length = std::min(atol_length, rtol * speed * 0.5 * stable_step);
     // Never below 1000 times the round-off of the largest coordinate: a model at rest has a
     // speed scale of round-off, and IDA stopped at once with IDA_TOO_MUCH_ACC.

@@ -18,6 +18,7 @@
 #include "railcrash/results/results.hpp"
 #include "railcrash/results/run.hpp"
 #include "railcrash/solver/euler_integrator.hpp"
+#include "railcrash/solver/stability_limit.hpp"
 #include "railcrash/solver/initial_conditions.hpp"
 #include "railcrash/studies/batch.hpp"
 
@@ -630,7 +631,7 @@ ConvergePlan plan_convergence(const std::string& model_path, const ConvergeOptio
     std::vector<double> y0 = system.initial_state();
     std::vector<EventRecord> start_events;
     prepare_start(system, y0, start_events, simulation.static_equilibrium);
-    plan.element_stability_limit = EulerIntegrator::estimate_stability_limit(system, y0, nullptr);
+    plan.element_stability_limit = explicit_stability_limit(system, y0, nullptr);
     if (!std::isfinite(plan.element_stability_limit))
       throw InputError("the model's elements give Euler no stability limit (no stiffness); give a first step with --euler-dt");
     dt0 = commensurate(options.euler_safety * plan.element_stability_limit);

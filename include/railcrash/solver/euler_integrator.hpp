@@ -10,11 +10,8 @@
 // Joint keys / simulation keys penalty_stiffness, penalty_damping (translational rows) and
 // penalty_rotational_stiffness, penalty_rotational_damping (angle rows) override them.
 //
-// Stability: for a mode with circular frequency w and damping rate c (= 2 zeta w) the
-// scheme is stable for dt < 2 / (sqrt(w^2 + (c/2)^2) + c/2). The largest w and c come from
-// the eigenvalues of M^-1/2 K M^-1/2 and M^-1/2 C M^-1/2 (K = -df/dq, C = -df/dv at the
-// start, penalties included): exactly for models up to 600 unknowns, otherwise bounded
-// above by Gershgorin's theorem (a safe, possibly pessimistic limit).
+// Stability: the scheme is stable below explicit_stability_limit (stability_limit.hpp: from
+// the model's stiffest and most damped modes at the start, penalties included).
 #pragma once
 
 #include "railcrash/model/run_spec.hpp"  // the integrators' names (IntegratorKind)
@@ -58,10 +55,6 @@ class EulerIntegrator : public Integrator {
   double step() const { return dt_; }
   double stability_limit() const { return stability_limit_; }
   const PenaltyRows& penalty() const { return penalty_; }
-
-  /// Largest stable step for the given penalty rows at state y (see header comment).
-  static double estimate_stability_limit(const DaeSystem& system, const std::vector<double>& y,
-                                         const PenaltyRows* penalty);
 
  protected:
   /// The system's energy figures with the penalty springs' stored energy and work.

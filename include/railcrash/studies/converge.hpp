@@ -5,7 +5,7 @@
 //      retried ten times looser, as long as it stays ten times tighter than every IDA run).
 //   2. Explicit Euler at steps dt_k = dt_0 / 2^k, k = 0 .. N-1, where dt_0 is a safety factor
 //      (default 0.8) times the stability limit of the model's elements at the start
-//      (EulerIntegrator::estimate_stability_limit, as `railcrash check` prints it), rounded
+//      (explicit_stability_limit, as `railcrash check` prints it), rounded
 //      down to a whole fraction of the output interval so that every run samples at the same
 //      times, and lowered further if the penalty joints at that step make it unstable.
 //   3. IDA at each requested relative tolerance (a model that sets atol has it scaled with rtol).
