@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -459,27 +460,36 @@ std::string sweep_dry_run_text(const SweepPlan& plan, const SweepRunGenerator& g
 
 namespace {
 
+/// A number read as summary.json's scalars read: true 1, false 0, a number itself, a string
+/// that is wholly a number that number (railcrash writes none), anything else NaN.
+double scalar_value(const nlohmann::json& node) {
+  if (node.is_boolean()) return node.get<bool>() ? 1.0 : 0.0;
+  if (node.is_number()) return node.get<double>();
+  if (!node.is_string()) return kNaN;  // null (a time that never came), an object, a list
+  const std::string& text = node.get_ref<const std::string&>();
+  if (text == "true") return 1.0;
+  if (text == "false") return 0.0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size() ? value : kNaN;
+}
+
 /// A value in summary.json by its dotted path; keys may hold dots themselves
 /// ("anticlimber.force"), so the longest key that matches is taken at each level.
-double summary_value(const YAML::Node& node, const std::string& path) {
-  if (path.empty()) {
-    if (!node.IsScalar()) return kNaN;
-    if (node.Scalar() == "true") return 1.0;
-    if (node.Scalar() == "false") return 0.0;
-    try {
-      return node.as<double>();
-    } catch (const YAML::Exception&) {
-      return kNaN;
+double summary_value(const nlohmann::json& node, const std::string& path) {
+  if (path.empty()) return scalar_value(node);
+  if (!node.is_object()) return kNaN;
+  const nlohmann::json* best = nullptr;
+  std::size_t best_size = 0;
+  for (const auto& entry : node.items()) {
+    const std::string& key = entry.key();
+    if ((path == key || path.rfind(key + ".", 0) == 0) && (best == nullptr || key.size() > best_size)) {
+      best = &entry.value();
+      best_size = key.size();
     }
   }
-  if (!node.IsMap()) return kNaN;
-  std::string best;
-  for (const auto& entry : node) {
-    const std::string key = entry.first.as<std::string>();
-    if ((path == key || path.rfind(key + ".", 0) == 0) && key.size() > best.size()) best = key;
-  }
-  if (best.empty()) return kNaN;
-  return summary_value(node[best], path.size() == best.size() ? "" : path.substr(best.size() + 1));
+  if (best == nullptr) return kNaN;
+  return summary_value(*best, path.size() == best_size ? "" : path.substr(best_size + 1));
 }
 
 /// COLUMN@TIME: the column interpolated linearly at TIME (NaN outside the samples).
@@ -513,9 +523,10 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     row.integrator = integrator_used(report);
     if (!report.outcome.ok && control.timed_out()) row.message = run_limit_message(control.run_time_limit(), report.outcome.t_reached);
     if (!report.outcome.ok && control.interrupted()) row.message = "interrupted";
-    // railcrash's own summary, just written: YAML::Load without the structure check that
-    // guards user files (that check was 45 % of reading it back, 1.2 % of a two-car sweep run).
-    const YAML::Node summary = YAML::Load(report.summary_json);
+    // railcrash's own summary, just written (JSON), read with nlohmann's parser: with yaml-cpp's
+    // a sweep run of mu_3plus3_si under Euler cost 1.11 times as much CPU (bench/HISTORY.md,
+    // "A sweep run's summary read back").
+    const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
     for (std::size_t k = 0; k < plan.responses.size(); ++k) {
       const std::string& name = plan.responses[k];
       if (const auto at = name.rfind('@'); at != std::string::npos) {

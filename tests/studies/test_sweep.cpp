@@ -586,3 +586,22 @@ TEST_CASE("sweep: a run its run time limit stops says so in the words of every s
   CHECK_THAT(line, Catch::Contains("stopped at the run time limit of 0.2 s (--run-limit), at t = "));
   CHECK(run_limit_message(0.25, 0.0123456789) == "stopped at the run time limit of 0.25 s (--run-limit), at t = 0.0123457");
 }
+
+TEST_CASE("sweep: a response reads summary.json's true as 1, false as 0, and a null, a text or a missing key as no value", "[sweep]") {
+  // The R1 model's car is stopped by the anticlimber without override (responses.override:
+  // false, its time null); its CFC 60 filter is adequately sampled (true); units.system is "SI".
+  Files files;
+  files.write_plan("sweep: 1\ndesign: full_factorial\nfactors:\n  - {key: elements.ac.horizontal_yield_deflection, scale: true, levels: [1.0]}\n"
+                   "responses: [responses.override, peak_accelerations.filter.adequately_sampled, responses.override_time, units.system, "
+                   "responses.no_such_key, R1]\n");
+  run_sweep(files.model, load_sweep_plan(files.plan, files.model), files.dir + "/out", SweepOptions{});
+  const std::vector<std::map<std::string, std::string>> rows = csv_rows(files.dir + "/out/runs.csv");
+  REQUIRE(rows.size() == 1);
+  CHECK(rows[0].at("status") == "ok");
+  CHECK(rows[0].at("responses.override") == "0");
+  CHECK(rows[0].at("peak_accelerations.filter.adequately_sampled") == "1");
+  CHECK(rows[0].at("responses.override_time").empty());
+  CHECK(rows[0].at("units.system").empty());
+  CHECK(rows[0].at("responses.no_such_key").empty());
+  CHECK(number_in(rows[0], "R1") == Approx(crush_for(0.01) / 0.02).epsilon(1e-5));  // (2 m/s, the model's d_y)
+}
