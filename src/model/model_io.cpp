@@ -309,6 +309,22 @@ void put_value(const YAML::Node& root, const std::vector<DocumentStep>& path, co
   }
 }
 
+/// The names of the items of the document's lists `sections` (bodies, elements).
+std::vector<std::string> names_in(const YAML::Node& document, std::initializer_list<const char*> sections) {
+  std::vector<std::string> names;
+  for (const char* section : sections) {
+    const YAML::Node list = document[section];
+    if (!list || !list.IsSequence()) continue;
+    for (const YAML::Node& item : list)
+      if (item.IsMap() && item["name"] && item["name"].IsScalar()) names.push_back(item["name"].Scalar());
+  }
+  return names;
+}
+
+bool has_dotted_name(const std::vector<std::string>& names) {
+  return std::any_of(names.begin(), names.end(), [](const std::string& name) { return name.find('.') != std::string::npos; });
+}
+
 /// The path a setting's KEY names (simulation.t_end, bodies.<name>.<key>, elements.<name>.<key>,
 /// a top-level key, each optionally followed by [INDEX] for an entry of a list: gravity[1],
 /// bodies.cart.velocity[0]). The lists and maps on the way must exist; the last key may be new
@@ -352,15 +368,29 @@ std::vector<DocumentStep> setting_path(YAML::Node& root, const std::string& key,
       root[parts[0]] = YAML::Node(YAML::NodeType::Map);
     }
     path = {{parts[0], {}}, {parts[1], {}}};
-  } else if (parts.size() == 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
+  } else if (parts.size() >= 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
+    // bodies.<name>.<key>: the name is everything between the section and the last key, so a
+    // name with dots is found too (a train's car's body: bodies.unitA.car2.body.mass).
+    std::string item_name = parts[1];
+    for (std::size_t k = 2; k + 1 < parts.size(); ++k) item_name += "." + parts[k];
     const YAML::Node list = document[parts[0]];
     if (list && list.IsSequence())
       for (std::size_t i = 0; i < list.size() && path.empty(); ++i)
-        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == parts[1])
-          path = {{parts[0], {}}, {"", i}, {parts[2], {}}};
+        if (list[i].IsMap() && list[i]["name"] && list[i]["name"].IsScalar() && list[i]["name"].Scalar() == item_name)
+          path = {{parts[0], {}}, {"", i}, {parts.back(), {}}};
     if (path.empty())
       throw InputError(where + (for_scaling ? no_number : "the model has no " + std::string(parts[0] == "bodies" ? "body" : "element") +
-                                                              " named '" + parts[1] + "'"));
+                                                              " named '" + item_name + "'" +
+                                                              suggestion(item_name, names_in(document, {parts[0] == "bodies" ? "bodies" : "elements"}))));
+  } else if (parts.size() >= 3 && !document[parts[0]] && has_dotted_name(names_in(document, {"bodies", "elements"}))) {
+    // <name>.<key> with a generated name (unitA.car2.body.mass) that no body or element has
+    // (apply_instance_setting took those that one has), in a model with generated names.
+    std::string item_name = parts[0];
+    for (std::size_t k = 1; k + 1 < parts.size(); ++k) item_name += "." + parts[k];
+    throw InputError(where + "the model has no body or element named '" + item_name + "'" +
+                     suggestion(item_name, names_in(document, {"bodies", "elements"})) +
+                     "; a train's car's body or element is set as <train>.<car>.<name>.<key> (e.g. unitA.car2.body.mass=33000) "
+                     "or bodies.<name>.<key>, elements.<name>.<key>");
   } else {
     throw InputError(where + (for_scaling ? no_number : "KEY must be a top-level key, section.key (e.g. simulation.rtol), "
                                                         "bodies.<name>.<key> or elements.<name>.<key>"));

@@ -286,6 +286,24 @@ TEST_CASE("settings address a car type (every instance) or one instance, the typ
   CHECK(load_model_text(kTrainModel, path, {"simulation.t_end=0.2"}).run_spec.simulation.t_end == 0.2);
 }
 
+TEST_CASE("a generated body or element is also set as bodies.<name>.<key>, and a misspelt name is named with its nearest", "[trains]") {
+  const std::string path = "trains.yaml";
+  // bodies.<name>.<key> with the name's dots: the same as the instance's own key.
+  CHECK(body(load_model_text(kTrainModel, path, {"bodies.unitA.mid.body.mass=3000"}).model, "unitA.mid.body").mass == 3000.0);
+  CHECK(body(load_model_text(kTrainModel, path, {"bodies.unitA.mid.body.mass*=2"}).model, "unitA.mid.body").mass == 2000.0);
+  CHECK(body(load_model_text(kTrainModel, path, {"bodies.unitA.mid.body.mass=3000"}).model, "unitA.car1.body").mass == 1000.0);
+  CHECK(body(load_model_text(kTrainModel, path, {"bodies.unitA.mid.body.velocity[0]=7"}).model, "unitA.mid.body").vx == 7.0);
+  // A misspelt generated name, in either form.
+  CHECK_THROWS_WITH(load_model_text(kTrainModel, path, {"bodies.unitA.mid.bodyy.mass=3000"}),
+                    Contains("trains.yaml: --set 'bodies.unitA.mid.bodyy.mass=3000': the model has no body named 'unitA.mid.bodyy' "
+                             "(did you mean 'unitA.mid.body'?)"));
+  CHECK_THROWS_WITH(load_model_text(kTrainModel, path, {"unitA.mid.bodyy.mass=3000"}),
+                    Contains("trains.yaml: --set 'unitA.mid.bodyy.mass=3000': the model has no body or element named 'unitA.mid.bodyy' "
+                             "(did you mean 'unitA.mid.body'?); a train's car's body or element is set as <train>.<car>.<name>.<key>"));
+  CHECK_THROWS_WITH(load_model_text(kTrainModel, path, {"unitA.mid.bodyy.mass*=2"}),
+                    Contains("the model has no body or element named 'unitA.mid.bodyy' (did you mean 'unitA.mid.body'?)"));
+}
+
 TEST_CASE("mm-t-s-N models equal the same model in SI", "[trains][units]") {
   // The two coaches of the flat-model test in mm, t, s, N.
   const std::string si = replaced(replaced(kTrainModel, "      - {type: coach, reversed: true}\n", ""), "gravity: [0, 0]", "");
