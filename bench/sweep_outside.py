@@ -99,9 +99,9 @@ def main():
     if args.all_responses:
         compare_all(args, builds)
         return
-    cpu = {b: [] for b in builds}
-    share = {b: [] for b in builds}
-    responses = {}
+    cpu = [[], []]  # per build, by position (OLD and NEW may be the same executable: a noise check)
+    share = [[], []]
+    responses = [None, None]
     with tempfile.TemporaryDirectory(prefix="railcrash_sweep_outside_") as scratch:
         plan = os.path.join(scratch, "plan.yaml")
         with open(plan, "w") as f:
@@ -112,18 +112,19 @@ def main():
                 failed = [r for r in rows if r["status"] != "ok"]
                 if failed:
                     raise SystemExit(f"{build}: run {failed[0]['run']} failed: {failed[0]['message']}")
-                cpu[build].append(seconds / len(rows))
-                share[build] += [float(r["stats.wall_seconds"]) / float(r["wall_seconds"]) for r in rows]
-                responses.setdefault(build, [(r["crush_zones.total_absorbed"], r["stats.steps"]) for r in rows])
-    if responses[builds[0]] != responses[builds[1]]:
+                cpu[k].append(seconds / len(rows))
+                share[k] += [float(r["stats.wall_seconds"]) / float(r["wall_seconds"]) for r in rows]
+                if responses[k] is None:
+                    responses[k] = [(r["crush_zones.total_absorbed"], r["stats.steps"]) for r in rows]
+    if responses[0] != responses[1]:
         print("the two builds' responses differ")
     print(f"{os.path.relpath(args.model, ROOT)} under {args.integrator}: a sweep of {args.runs} runs ({args.factor} x 0.9 ... 1.1), "
           f"1 job, {args.repeats} repeats interleaved")
     print("| build | CPU per run [s], median | integration's share of a run's wall time, median |")
     print("|---|---|---|")
-    for build in builds:
-        print(f"| {build} | {statistics.median(cpu[build]):.4f} | {100 * statistics.median(share[build]):.1f} % |")
-    print(f"NEW / OLD in CPU per run: {statistics.median(cpu[builds[1]]) / statistics.median(cpu[builds[0]]):.3f}")
+    for k, build in enumerate(builds):
+        print(f"| {('OLD', 'NEW')[k]} {build} | {statistics.median(cpu[k]):.4f} | {100 * statistics.median(share[k]):.1f} % |")
+    print(f"NEW / OLD in CPU per run: {statistics.median(cpu[1]) / statistics.median(cpu[0]):.3f}")
 
 
 if __name__ == "__main__":
