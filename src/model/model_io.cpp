@@ -325,6 +325,14 @@ bool has_dotted_name(const std::vector<std::string>& names) {
   return std::any_of(names.begin(), names.end(), [](const std::string& name) { return name.find('.') != std::string::npos; });
 }
 
+/// A KEY's parts from `first` up to the last one (its key) joined by dots: the name of a body
+/// or element, which may hold dots itself (unitA.car2.body).
+std::string name_before_key(const std::vector<std::string>& parts, std::size_t first) {
+  std::string name = parts[first];
+  for (std::size_t k = first + 1; k + 1 < parts.size(); ++k) name += "." + parts[k];
+  return name;
+}
+
 /// The path a setting's KEY names (simulation.t_end, bodies.<name>.<key>, elements.<name>.<key>,
 /// a top-level key, each optionally followed by [INDEX] for an entry of a list: gravity[1],
 /// bodies.cart.velocity[0]). The lists and maps on the way must exist; the last key may be new
@@ -371,8 +379,7 @@ std::vector<DocumentStep> setting_path(YAML::Node& root, const std::string& key,
   } else if (parts.size() >= 3 && (parts[0] == "bodies" || parts[0] == "elements")) {
     // bodies.<name>.<key>: the name is everything between the section and the last key, so a
     // name with dots is found too (a train's car's body: bodies.unitA.car2.body.mass).
-    std::string item_name = parts[1];
-    for (std::size_t k = 2; k + 1 < parts.size(); ++k) item_name += "." + parts[k];
+    const std::string item_name = name_before_key(parts, 1);
     const YAML::Node list = document[parts[0]];
     if (list && list.IsSequence())
       for (std::size_t i = 0; i < list.size() && path.empty(); ++i)
@@ -382,13 +389,12 @@ std::vector<DocumentStep> setting_path(YAML::Node& root, const std::string& key,
       throw InputError(where + (for_scaling ? no_number : "the model has no " + std::string(parts[0] == "bodies" ? "body" : "element") +
                                                               " named '" + item_name + "'" +
                                                               suggestion(item_name, names_in(document, {parts[0] == "bodies" ? "bodies" : "elements"}))));
-  } else if (parts.size() >= 3 && !document[parts[0]] && has_dotted_name(names_in(document, {"bodies", "elements"}))) {
+  } else if (const std::vector<std::string> names = names_in(document, {"bodies", "elements"});
+             parts.size() >= 3 && !document[parts[0]] && has_dotted_name(names)) {
     // <name>.<key> with a generated name (unitA.car2.body.mass) that no body or element has
     // (apply_instance_setting took those that one has), in a model with generated names.
-    std::string item_name = parts[0];
-    for (std::size_t k = 1; k + 1 < parts.size(); ++k) item_name += "." + parts[k];
-    throw InputError(where + "the model has no body or element named '" + item_name + "'" +
-                     suggestion(item_name, names_in(document, {"bodies", "elements"})) +
+    const std::string item_name = name_before_key(parts, 0);
+    throw InputError(where + "the model has no body or element named '" + item_name + "'" + suggestion(item_name, names) +
                      "; a train's car's body or element is set as <train>.<car>.<name>.<key> (e.g. unitA.car2.body.mass=33000) "
                      "or bodies.<name>.<key>, elements.<name>.<key>");
   } else {

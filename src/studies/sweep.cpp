@@ -460,18 +460,11 @@ std::string sweep_dry_run_text(const SweepPlan& plan, const SweepRunGenerator& g
 
 namespace {
 
-/// A number read as summary.json's scalars read: true 1, false 0, a number itself, a string
-/// that is wholly a number that number (railcrash writes none), anything else NaN.
+/// A summary.json value as a response: true 1, false 0, a number itself; a null (a time that
+/// never came), a text, an object or a list: no value (NaN).
 double scalar_value(const nlohmann::json& node) {
   if (node.is_boolean()) return node.get<bool>() ? 1.0 : 0.0;
-  if (node.is_number()) return node.get<double>();
-  if (!node.is_string()) return kNaN;  // null (a time that never came), an object, a list
-  const std::string& text = node.get_ref<const std::string&>();
-  if (text == "true") return 1.0;
-  if (text == "false") return 0.0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size() ? value : kNaN;
+  return node.is_number() ? node.get<double>() : kNaN;
 }
 
 /// A value in summary.json by its dotted path; keys may hold dots themselves
@@ -526,7 +519,9 @@ SweepRow run_sweep_spec(const SweepPlan& plan, const std::string& model_path, co
     // railcrash's own summary, just written (JSON), read with nlohmann's parser: with yaml-cpp's
     // a sweep run of mu_3plus3_si under Euler cost 1.11 times as much CPU (bench/HISTORY.md,
     // "A sweep run's summary read back").
-    const nlohmann::json summary = nlohmann::json::parse(report.summary_json);
+    // Without exceptions: a text that is not JSON (none is written) gives no values, as yaml-cpp
+    // gave for an empty one, and the run keeps its own status and message.
+    const nlohmann::json summary = nlohmann::json::parse(report.summary_json, nullptr, /*allow_exceptions=*/false);
     for (std::size_t k = 0; k < plan.responses.size(); ++k) {
       const std::string& name = plan.responses[k];
       if (const auto at = name.rfind('@'); at != std::string::npos) {
